@@ -1,0 +1,15 @@
+"""heritage_bayes: Bayesian calibration of RC models of the indoor climate of monuments.
+
+The forward models follow Kramer, van Schijndel & Schellen, "Inverse modeling of climate
+responses of monumental buildings" (thermal model 4a, hygric model 3).
+"""
+
+from heritage_bayes._version import __version__
+from heritage_bayes.errors import ConfigError, DataError, InputError
+
+__all__ = [
+    "ConfigError",
+    "DataError",
+    "InputError",
+    "__version__",
+]

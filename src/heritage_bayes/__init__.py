@@ -6,10 +6,17 @@ responses of monumental buildings" (thermal model 4a, hygric model 3).
 
 from heritage_bayes._version import __version__
 from heritage_bayes.errors import ConfigError, DataError, InputError
+from heritage_bayes.rc import Network, RCModel, available_models, discretize, model, simulate
 
 __all__ = [
     "ConfigError",
     "DataError",
     "InputError",
+    "Network",
+    "RCModel",
     "__version__",
+    "available_models",
+    "discretize",
+    "model",
+    "simulate",
 ]

@@ -1,0 +1,27 @@
+"""Layer 1: RC networks, exact discretization and the fast simulator (pure numpy/scipy).
+
+See :mod:`heritage_bayes.rc.catalog` for the paper's models.
+"""
+
+from heritage_bayes.rc.catalog import CATALOG, available_models, model
+from heritage_bayes.rc.discretize import ModalForm, discretize, modal_form
+from heritage_bayes.rc.model import RCModel
+from heritage_bayes.rc.network import Link, Network, Node, ParameterInfo, Source
+from heritage_bayes.rc.simulate import iter_simulate, simulate
+
+__all__ = [
+    "CATALOG",
+    "Link",
+    "ModalForm",
+    "Network",
+    "Node",
+    "ParameterInfo",
+    "RCModel",
+    "Source",
+    "available_models",
+    "discretize",
+    "iter_simulate",
+    "modal_form",
+    "model",
+    "simulate",
+]

@@ -1,0 +1,233 @@
+"""The paper's models and the ladder of model orders around them.
+
+Thermal models (domain ``thermal``: [°C], [J/K], [W/K], apertures [m²], irradiance
+[W/m²]); inputs ``Te`` (outdoor air temperature [°C]), one irradiance per solar surface
+``I_<surface>`` (default the four vertical facades N, E, S, W, the paper's order) and
+``Tf`` (fixed/ground temperature [°C]).
+
+- ``thermal_4a``: the paper's Figure 1, nodes ``Tw`` (envelope, ``Cw``), ``Ti`` (indoor
+  air, ``Ci``), ``Tint`` (interior mass, ``Cint``); conductances ``Gw`` (wall to outdoor),
+  ``Gi`` (wall to indoor air), ``Gint`` (air to interior mass), ``Gfast`` (ventilation
+  and other fast paths to outdoor air), ``Gf`` (air to the fixed/ground temperature).
+  **Solar parameterization**: one effective aperture per surface ``fI_<surface>`` [m²]
+  (window area × transmittance × shading, the paper's vector fI) and one split fraction
+  ``fsol`` [-]: the share of the solar gain absorbed by the interior mass ``Cint``; the
+  rest, ``1 - fsol``, heats the air node ``Ci`` (the paper's text: "connected to Cint
+  and Ci"). With ``fsol = 0`` the B matrix is exactly the paper's printed matrix.
+- ``thermal_4a_nosolar``: the same network without solar input (the paper's
+  "no solar input" row).
+- ``thermal_2c``: ``thermal_4a`` without the interior-mass node.
+- ``thermal_1c``: one air node with total conductance ``Ge`` to outdoor air, ``Gf`` to
+  ``Tf`` and solar apertures.
+
+Hygric models (domain ``hygric``: [Pa], [kg/Pa], [kg/(s·Pa)]), input ``Pe`` (outdoor
+vapour pressure [Pa]), output ``Pi``:
+
+- ``hygric_2c``: the paper's "model 3", nodes ``Pw`` (``Cw``, buffering surfaces) and
+  ``Pi`` (``Ci``, indoor air), conductances ``Gw``, ``Gi``, ``Gfast``.
+- ``hygric_2c_fixed``: adds ``Gf`` to a fixed vapour-pressure node whose pressure ``Pf``
+  [Pa] is an estimable constant (the paper's "additional fixed vapour pressure node",
+  e.g. a wall in contact with a canal).
+- ``hygric_1c``: one air node ``Pi`` with ``Gfast`` to ``Pe`` (ladder bottom).
+
+Options (keywords of :func:`model`): ``surfaces`` (sequence of surface names for the
+thermal models with solar), ``ground`` (bool, default True: include ``Gf``/``Tf``),
+``heating`` (bool, default False: an input ``Ph`` [W] of known gain 1 into the air node,
+e.g. measured heating power in a test cell; it makes the absolute scale of C and G
+identifiable).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+
+from heritage_bayes.rc.model import RCModel
+from heritage_bayes.rc.network import Link, Network, Node, Source
+
+__all__ = ["CATALOG", "available_models", "model"]
+
+DEFAULT_SURFACES = ("N", "E", "S", "W")
+
+_DESCRIPTIONS = {
+    "Cw": "capacity of the envelope (walls)",
+    "Ci": "capacity of the indoor air node (incl. fast-responding contents)",
+    "Cint": "capacity of the interior constructions and contents",
+    "Gw": "conductance envelope - outdoor",
+    "Gi": "conductance envelope - indoor air",
+    "Gint": "conductance indoor air - interior mass",
+    "Gfast": "fast conductance indoor air - outdoor (ventilation, glazing)",
+    "Gf": "conductance indoor air - fixed node (ground / fixed potential)",
+    "Ge": "total conductance indoor air - outdoor",
+    "fsol": "share of solar gain absorbed by the interior mass (rest heats the air)",
+    "Pf": "vapour pressure of the fixed node",
+    "Te": "outdoor air temperature",
+    "Tf": "fixed (ground) temperature",
+    "Pe": "outdoor vapour pressure",
+    "Ph": "heating power into the air node (known gain 1)",
+}
+
+
+def _thermal(
+    name: str, *, nodes: str, surfaces: Sequence[str] | None, ground: bool, heating: bool
+) -> Network:
+    surfaces = tuple(surfaces) if surfaces else ()
+    desc = dict(_DESCRIPTIONS)
+    node_list = {
+        "1c": [Node("Ti", "Ci")],
+        "2c": [Node("Tw", "Cw"), Node("Ti", "Ci")],
+        "3c": [Node("Tw", "Cw"), Node("Ti", "Ci"), Node("Tint", "Cint")],
+    }[nodes]
+    if nodes == "1c":
+        links = [Link("Ti", "Te", "Ge")]
+    else:
+        links = [Link("Tw", "Te", "Gw"), Link("Tw", "Ti", "Gi")]
+        if nodes == "3c":
+            links.append(Link("Ti", "Tint", "Gint"))
+        links.append(Link("Ti", "Te", "Gfast"))
+    if ground:
+        links.append(Link("Ti", "Tf", "Gf"))
+    inputs = ["Te"] + [f"I_{s}" for s in surfaces] + (["Tf"] if ground else [])
+    sources = []
+    for s in surfaces:
+        desc[f"fI_{s}"] = f"effective solar aperture of surface {s}"
+        desc[f"I_{s}"] = f"solar irradiance on surface {s}"
+        if nodes == "3c":
+            sources.append(Source(f"I_{s}", "Ti", f"fI_{s}", "1-fsol"))
+            sources.append(Source(f"I_{s}", "Tint", f"fI_{s}", "fsol"))
+        else:
+            sources.append(Source(f"I_{s}", "Ti", f"fI_{s}"))
+    units = {}
+    if heating:
+        inputs.append("Ph")
+        sources.append(Source("Ph", "Ti", 1.0))
+        units["Ph"] = "W"
+    return Network(
+        name=name,
+        domain="thermal",
+        nodes=tuple(node_list),
+        links=tuple(links),
+        inputs=tuple(inputs),
+        outputs=("Ti",),
+        sources=tuple(sources),
+        descriptions=desc,
+        input_units=units,
+    )
+
+
+def _hygric(name: str, *, nodes: str, fixed: bool) -> Network:
+    if nodes == "1c":
+        node_list = [Node("Pi", "Ci")]
+        links = [Link("Pi", "Pe", "Gfast")]
+    else:
+        node_list = [Node("Pw", "Cw"), Node("Pi", "Ci")]
+        links = [Link("Pw", "Pe", "Gw"), Link("Pw", "Pi", "Gi"), Link("Pi", "Pe", "Gfast")]
+    constants = ()
+    if fixed:
+        links.append(Link("Pi", "Pf", "Gf"))
+        constants = ("Pf",)
+    desc = dict(_DESCRIPTIONS)
+    desc.update(
+        Cw="hygric capacity of buffering surfaces (walls, contents)",
+        Ci="hygric capacity of the indoor air node",
+        Gw="vapour conductance buffer - outdoor",
+        Gi="vapour conductance buffer - indoor air",
+        Gfast="vapour conductance indoor air - outdoor (ventilation)",
+        Gf="vapour conductance indoor air - fixed vapour-pressure node",
+    )
+    return Network(
+        name=name,
+        domain="hygric",
+        nodes=tuple(node_list),
+        links=tuple(links),
+        inputs=("Pe",),
+        outputs=("Pi",),
+        constants=constants,
+        descriptions=desc,
+    )
+
+
+def _thermal_factory(nodes: str, solar: bool, name: str) -> Callable[..., Network]:
+    def build(
+        surfaces: Sequence[str] | None = None, ground: bool = True, heating: bool = False
+    ) -> Network:
+        if not solar and surfaces:
+            raise ValueError(f"model {name!r} has no solar input; do not pass surfaces")
+        surf = (surfaces if surfaces is not None else DEFAULT_SURFACES) if solar else ()
+        return _thermal(name, nodes=nodes, surfaces=surf, ground=ground, heating=heating)
+
+    return build
+
+
+def _hygric_factory(nodes: str, fixed: bool, name: str) -> Callable[..., Network]:
+    def build() -> Network:
+        return _hygric(name, nodes=nodes, fixed=fixed)
+
+    return build
+
+
+#: Catalogue: name -> (factory of the Network, one-line description).
+CATALOG: dict[str, tuple[Callable[..., Network], str]] = {
+    "thermal_1c": (
+        _thermal_factory("1c", True, "thermal_1c"),
+        "thermal, 1 capacity (air + contents), solar, ground",
+    ),
+    "thermal_2c": (
+        _thermal_factory("2c", True, "thermal_2c"),
+        "thermal, 2 capacities (envelope, air), solar, ground",
+    ),
+    "thermal_4a": (
+        _thermal_factory("3c", True, "thermal_4a"),
+        "thermal model 4a of Kramer et al.: envelope, air, interior mass, solar on facades, ground",
+    ),
+    "thermal_4a_nosolar": (
+        _thermal_factory("3c", False, "thermal_4a_nosolar"),
+        "thermal model 4a without solar input",
+    ),
+    "hygric_1c": (
+        _hygric_factory("1c", False, "hygric_1c"),
+        "hygric, 1 capacity (air + fast buffer)",
+    ),
+    "hygric_2c": (
+        _hygric_factory("2c", False, "hygric_2c"),
+        "hygric model 3 of Kramer et al.: buffer, air",
+    ),
+    "hygric_2c_fixed": (
+        _hygric_factory("2c", True, "hygric_2c_fixed"),
+        "hygric model 3 with a fixed vapour-pressure node (Gf, Pf)",
+    ),
+}
+
+
+def available_models() -> dict[str, str]:
+    """Catalogue names and descriptions."""
+    return {k: v[1] for k, v in CATALOG.items()}
+
+
+def model(name: str, **options) -> RCModel:
+    """A catalogue model by name, compiled.
+
+    Parameters
+    ----------
+    name : str
+        One of :func:`available_models` (``"thermal_4a"``, ``"hygric_2c"``, ...).
+    **options
+        ``surfaces``, ``ground``, ``heating`` for thermal models (see module docstring).
+
+    Raises
+    ------
+    ValueError
+        Unknown name (the message lists the catalogue) or unknown option.
+    """
+    if name not in CATALOG:
+        raise ValueError(f"unknown model {name!r}; available: {sorted(CATALOG)}")
+    factory = CATALOG[name][0]
+    try:
+        net = factory(**options)
+    except TypeError as exc:
+        import inspect
+
+        allowed = list(inspect.signature(factory).parameters)
+        raise ValueError(
+            f"model {name!r}: unknown option(s) in {sorted(options)}; allowed: {allowed}"
+        ) from exc
+    return RCModel(net)

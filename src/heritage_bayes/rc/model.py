@@ -1,0 +1,235 @@
+"""A compiled RC network: names, units and batched state-space assembly."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+
+from heritage_bayes.rc.network import Network, ParameterInfo, as_index_arrays
+
+__all__ = ["RCModel"]
+
+
+class RCModel:
+    """Continuous-time state space of an RC network.
+
+    :math:`\\dot x = A x + B u + e`, :math:`y = C x + D u`, with
+    :math:`A = -C_{cap}^{-1}\\mathbf{G}` (see :mod:`heritage_bayes.rc.network`). The
+    affine term :math:`e` is non-zero only for networks with constant boundaries (the
+    fixed vapour-pressure node of hygric model 3); :meth:`offset` returns it.
+
+    Use :func:`heritage_bayes.model` to get catalogue models by name.
+    """
+
+    def __init__(self, network: Network):
+        self.network = network
+        self._ix = as_index_arrays(network)
+
+    # ------------------------------------------------------------------ names
+    @property
+    def name(self) -> str:
+        return self.network.name
+
+    @property
+    def domain(self) -> str:
+        return self.network.domain
+
+    @property
+    def parameter_names(self) -> tuple[str, ...]:
+        return self.network.parameter_names
+
+    @property
+    def input_names(self) -> tuple[str, ...]:
+        return self.network.inputs
+
+    @property
+    def state_names(self) -> tuple[str, ...]:
+        return self.network.state_names
+
+    @property
+    def output_names(self) -> tuple[str, ...]:
+        return self.network.outputs
+
+    @property
+    def parameters(self) -> tuple[ParameterInfo, ...]:
+        return self.network.parameters
+
+    @property
+    def n_states(self) -> int:
+        return len(self.network.nodes)
+
+    @property
+    def n_inputs(self) -> int:
+        return len(self.network.inputs)
+
+    @property
+    def n_outputs(self) -> int:
+        return len(self.network.outputs)
+
+    def __repr__(self) -> str:
+        return (
+            f"RCModel({self.name!r}, states={self.state_names}, "
+            f"inputs={self.input_names}, outputs={self.output_names})"
+        )
+
+    # ------------------------------------------------------------------ params
+    def param_array(self, params: Mapping[str, object]) -> tuple[np.ndarray, bool]:
+        """Parameter mapping -> (K, P) array in :attr:`parameter_names` order.
+
+        Values may be scalars or 1-D arrays of a common length K (a batch); scalars are
+        broadcast. Returns the array and whether the input was a batch.
+
+        Raises
+        ------
+        ValueError
+            Missing or unknown names, arrays of different lengths, non-finite values.
+        """
+        if not isinstance(params, Mapping):
+            raise ValueError(
+                f"params must be a mapping name -> value for model "
+                f"{self.name!r} (got {type(params).__name__})"
+            )
+        names = self.parameter_names
+        missing = [p for p in names if p not in params]
+        unknown = [p for p in params if p not in names]
+        if missing or unknown:
+            parts = []
+            if missing:
+                parts.append(f"missing {missing}")
+            if unknown:
+                parts.append(f"unknown {unknown}")
+            raise ValueError(
+                f"parameters for model {self.name!r}: {'; '.join(parts)}; "
+                f"expected exactly {list(names)}"
+            )
+        vals = [np.asarray(params[p], dtype=float) for p in names]
+        batch = any(v.ndim > 0 for v in vals)
+        sizes = {v.shape for v in vals if v.ndim > 0}
+        if any(v.ndim > 1 for v in vals) or len(sizes) > 1:
+            shapes = {p: v.shape for p, v in zip(names, vals, strict=True) if v.ndim}
+            raise ValueError(
+                f"batched parameters must be 1-D arrays of one common length (got shapes {shapes})"
+            )
+        K = next(iter(sizes))[0] if sizes else 1
+        P = np.empty((K, len(names)))
+        for j, v in enumerate(vals):
+            P[:, j] = v
+        bad = ~np.isfinite(P)
+        if bad.any():
+            j = int(np.argwhere(bad)[0, 1])
+            raise ValueError(
+                f"parameter {names[j]} must be finite (got {P[bad.any(axis=1)][0, j]})"
+            )
+        return P, batch
+
+    def check_values(self, P: np.ndarray) -> None:
+        """Raise ValueError naming the first physically invalid parameter value."""
+        for j, info in enumerate(self.parameters):
+            col = P[:, j]
+            if info.kind == "capacity" and np.any(col <= 0):
+                bad = col[col <= 0][0]
+                raise ValueError(f"capacity {info.name} must be > 0 [{info.unit}] (got {bad:g})")
+            if info.kind == "conductance" and np.any(col < 0):
+                bad = col[col < 0][0]
+                raise ValueError(
+                    f"conductance {info.name} must be >= 0 [{info.unit}] (got {bad:g})"
+                )
+            if info.kind == "fraction" and np.any((col < 0) | (col > 1)):
+                bad = col[(col < 0) | (col > 1)][0]
+                raise ValueError(f"fraction {info.name} must be within [0, 1] (got {bad:g})")
+
+    def valid_mask(self, P: np.ndarray) -> np.ndarray:
+        """(K,) bool: parameter sets that are physically admissible."""
+        ok = np.all(np.isfinite(P), axis=1)
+        for j, info in enumerate(self.parameters):
+            if info.kind == "capacity":
+                ok &= P[:, j] > 0
+            elif info.kind == "conductance":
+                ok &= P[:, j] >= 0
+            elif info.kind == "fraction":
+                ok &= (P[:, j] >= 0) & (P[:, j] <= 1)
+        return ok
+
+    # ------------------------------------------------------------------ matrices
+    def network_matrices(self, P: np.ndarray):
+        """Capacities, conductance matrix, boundary coupling and constant forcing.
+
+        Parameters
+        ----------
+        P : (K, n_params) array
+
+        Returns
+        -------
+        cap : (K, n) array
+            Node capacities [J/K] or [kg/Pa].
+        G : (K, n, n) array
+            Symmetric conductance matrix [W/K] or [kg/(s·Pa)]: node-node links as
+            Laplacian, node-boundary links on the diagonal.
+        Gu : (K, n, m) array
+            Flow into each node per unit of each input.
+        q : (K, n) array
+            Constant flow from constant boundaries (``G * P_const``).
+        """
+        ix = self._ix
+        K = P.shape[0]
+        n, m = self.n_states, self.n_inputs
+        cap = P[:, ix["cap"]]
+        G = np.zeros((K, n, n))
+        Gu = np.zeros((K, n, m))
+        q = np.zeros((K, n))
+        for a, b, g in ix["nn"]:
+            G[:, a, a] += P[:, g]
+            G[:, b, b] += P[:, g]
+            G[:, a, b] -= P[:, g]
+            G[:, b, a] -= P[:, g]
+        for a, u, g in ix["nu"]:
+            G[:, a, a] += P[:, g]
+            Gu[:, a, u] += P[:, g]
+        for a, c, g in ix["nc"]:
+            G[:, a, a] += P[:, g]
+            q[:, a] += P[:, g] * P[:, c]
+        for node, u, gi, gv, fi, comp in ix["src"]:
+            gain = P[:, gi] if gi >= 0 else gv
+            if fi >= 0:
+                gain = gain * ((1.0 - P[:, fi]) if comp else P[:, fi])
+            Gu[:, node, u] += gain
+        return cap, G, Gu, q
+
+    def output_matrix(self) -> np.ndarray:
+        """C: (n_out, n) selection of the observed nodes."""
+        Cm = np.zeros((self.n_outputs, self.n_states))
+        Cm[np.arange(self.n_outputs), self._ix["out"]] = 1.0
+        return Cm
+
+    def state_space(self, params: Mapping[str, object]):
+        """Continuous (A, B, C, D) for one parameter set or a batch.
+
+        Parameters
+        ----------
+        params : mapping name -> float (or (K,) arrays for a batch), SI units.
+
+        Returns
+        -------
+        A : (n, n) [1/s];  B : (n, m);  C : (n_out, n);  D : (n_out, m)
+            With a batch, A and B gain a leading axis K.
+        """
+        P, batch = self.param_array(params)
+        self.check_values(P)
+        cap, G, Gu, _ = self.network_matrices(P)
+        A = -G / cap[:, :, None]
+        B = Gu / cap[:, :, None]
+        Cm = self.output_matrix()
+        D = np.zeros((self.n_outputs, self.n_inputs))
+        if not batch:
+            A, B = A[0], B[0]
+        return A, B, Cm, D
+
+    def offset(self, params: Mapping[str, object]) -> np.ndarray:
+        """Affine term e [potential/s] of :math:`\\dot x = Ax + Bu + e` (zero unless
+        the network has constant boundaries)."""
+        P, batch = self.param_array(params)
+        self.check_values(P)
+        cap, _, _, q = self.network_matrices(P)
+        e = q / cap
+        return e if batch else e[0]

@@ -1,0 +1,1 @@
+"""Layer 2: priors, noise models, the vectorised log-posterior, MAP and emcee."""

@@ -1,0 +1,436 @@
+"""Parameters, bounded priors and the transform to an unconstrained sampling space.
+
+Every estimated quantity (each C, G, solar aperture, split fraction, constant boundary,
+and the noise parameters) is a :class:`Parameter` with a name, unit, kind and a bounded
+:class:`Prior`. Sampling and optimisation happen in an unconstrained space ``x``:
+
+- *log-scale* priors (``loguniform``, ``lognormal``): :math:`\\theta = \\exp(a + (b-a)\\,
+  \\sigma(x))` with :math:`a,b` the log bounds and :math:`\\sigma` the logistic function;
+- *linear* priors (``uniform``, ``normal``): :math:`\\theta = l + (u-l)\\,\\sigma(x)`.
+
+The log-prior in ``x`` includes the log-Jacobian :math:`\\log|d\\theta/dx|`, so the
+posterior is the same distribution whatever the transform (lmfit's bounded-parameter
+idea, made Bayesian).
+
+Default priors per kind are weakly informative and physically plausible (see
+:func:`default_prior`); knowledge users actually have enters as a log-normal prior, e.g.
+the room volume on the air-node capacity (:func:`air_capacity_prior`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.special import expit, logit
+
+from heritage_bayes.errors import ConfigError
+
+__all__ = [
+    "RHO_CP_AIR",
+    "Parameter",
+    "ParameterSet",
+    "Prior",
+    "air_capacity_prior",
+    "default_prior",
+    "parameters_for",
+]
+
+#: Volumetric heat capacity of air at room conditions [J/(m³·K)] (1.2 kg/m³ × 1005 J/(kg·K)).
+RHO_CP_AIR = 1.2 * 1005.0
+#: Hygric capacity of air per volume [kg/(Pa·m³)] at 15 °C: 1 / (R_v T).
+HYG_CAP_AIR = 1.0 / (461.52 * 288.15)
+
+_DISTS = ("uniform", "loguniform", "normal", "lognormal")
+
+
+@dataclass(frozen=True)
+class Prior:
+    """A bounded prior.
+
+    Parameters
+    ----------
+    dist : {"uniform", "loguniform", "normal", "lognormal"}
+    lower, upper : float
+        Bounds (the support; ``normal``/``lognormal`` are truncated to them).
+    mu, sigma : float, optional
+        ``normal``: mean and standard deviation (parameter units);
+        ``lognormal``: median and the standard deviation of the natural log
+        (``mu`` is the *median* in parameter units).
+    """
+
+    dist: str
+    lower: float
+    upper: float
+    mu: float | None = None
+    sigma: float | None = None
+
+    def __post_init__(self):
+        where = "prior"
+        if self.dist not in _DISTS:
+            raise ConfigError(f"{where}.dist: must be one of {list(_DISTS)} "
+                              f"(got {self.dist!r})")
+        lo, up = float(self.lower), float(self.upper)
+        if not (math.isfinite(lo) and math.isfinite(up)):
+            raise ConfigError(f"{where}: bounds must be finite (got [{lo}, {up}])")
+        if not lo < up:
+            raise ConfigError(f"{where}.lower: must be < upper (got {lo:g} >= {up:g})")
+        if self.log_scale and lo <= 0:
+            raise ConfigError(f"{where}.lower: a {self.dist} prior needs lower > 0 "
+                              f"(got {lo:g})")
+        if self.dist in ("normal", "lognormal"):
+            if self.mu is None or self.sigma is None or not self.sigma > 0:
+                raise ConfigError(f"{where}: a {self.dist} prior needs mu (the "
+                                  f"{'median' if self.dist == 'lognormal' else 'mean'}) "
+                                  f"and sigma > 0 (got mu={self.mu}, sigma={self.sigma})")
+            if self.dist == "lognormal" and not self.mu > 0:
+                raise ConfigError(f"{where}.mu: the median of a lognormal prior must be "
+                                  f"> 0 (got {self.mu:g})")
+
+    @property
+    def log_scale(self) -> bool:
+        return self.dist in ("loguniform", "lognormal")
+
+    @classmethod
+    def from_spec(cls, spec: Mapping, *, where: str = "prior",
+                  default: Prior | None = None) -> Prior:
+        """Build from a config mapping, naming ``where`` (the key path) in errors.
+
+        Keys: ``dist``, ``lower``, ``upper``, ``median`` (lognormal) or ``mean``
+        (normal), ``sigma``. Missing bounds are taken from ``default``; for a lognormal
+        without bounds: median × exp(±5 sigma); for a normal: mean ± 6 sigma.
+        """
+        allowed = {"dist", "lower", "upper", "median", "mean", "sigma"}
+        unknown = sorted(set(spec) - allowed)
+        if unknown:
+            raise ConfigError(f"{where}: unknown key(s) {unknown}; allowed: "
+                              f"{sorted(allowed)} (or 'fixed: value')")
+        dist = spec.get("dist", default.dist if default else None)
+        if dist is None:
+            raise ConfigError(f"{where}.dist: required, one of {list(_DISTS)}")
+        mu = spec.get("median") if dist == "lognormal" else spec.get("mean")
+        sigma = spec.get("sigma")
+        lo, up = spec.get("lower"), spec.get("upper")
+        if dist == "lognormal" and mu is not None and sigma is not None:
+            lo = lo if lo is not None else float(mu) * math.exp(-5 * float(sigma))
+            up = up if up is not None else float(mu) * math.exp(5 * float(sigma))
+        if dist == "normal" and mu is not None and sigma is not None:
+            lo = lo if lo is not None else float(mu) - 6 * float(sigma)
+            up = up if up is not None else float(mu) + 6 * float(sigma)
+        if default is not None:
+            lo = default.lower if lo is None else lo
+            up = default.upper if up is None else up
+        if lo is None or up is None:
+            raise ConfigError(f"{where}: lower and upper bounds are required for a "
+                              f"{dist} prior")
+        try:
+            return cls(dist, float(lo), float(up),
+                       None if mu is None else float(mu),
+                       None if sigma is None else float(sigma))
+        except ConfigError as exc:
+            raise ConfigError(str(exc).replace("prior", where, 1)) from None
+        except (TypeError, ValueError):
+            raise ConfigError(f"{where}: bounds, median/mean and sigma must be numbers "
+                              f"(got {dict(spec)})") from None
+
+    def to_dict(self) -> dict:
+        d = {"dist": self.dist, "lower": self.lower, "upper": self.upper}
+        if self.dist == "lognormal":
+            d.update(median=self.mu, sigma=self.sigma)
+        elif self.dist == "normal":
+            d.update(mean=self.mu, sigma=self.sigma)
+        return d
+
+    def describe(self) -> str:
+        """Short human-readable form, e.g. ``loguniform[1e+04, 1e+12]``."""
+        b = f"[{self.lower:.3g}, {self.upper:.3g}]"
+        if self.dist == "lognormal":
+            return f"lognormal(median {self.mu:.3g}, σ_log {self.sigma:.3g}) on {b}"
+        if self.dist == "normal":
+            return f"normal({self.mu:.3g}, {self.sigma:.3g}) on {b}"
+        return f"{self.dist}{b}"
+
+    # -- numerics on arrays ------------------------------------------------------
+    def logpdf(self, theta: np.ndarray) -> np.ndarray:
+        """Unnormalised log density in parameter units (bounds not checked)."""
+        if self.dist == "uniform":
+            return np.zeros_like(theta)
+        if self.dist == "loguniform":
+            return -np.log(theta)
+        if self.dist == "normal":
+            return -0.5 * ((theta - self.mu) / self.sigma) ** 2
+        lt = np.log(theta)
+        return -lt - 0.5 * ((lt - math.log(self.mu)) / self.sigma) ** 2
+
+    def _ab(self) -> tuple[float, float]:
+        if self.log_scale:
+            return math.log(self.lower), math.log(self.upper)
+        return self.lower, self.upper
+
+    def from_unconstrained(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """θ(x) and log|dθ/dx|."""
+        a, b = self._ab()
+        s = expit(x)
+        y = a + (b - a) * s
+        # log σ(x) + log(1 - σ(x)) = -softplus(-x) - softplus(x), stable for large |x|
+        logj = math.log(b - a) - np.logaddexp(0.0, -x) - np.logaddexp(0.0, x)
+        if self.log_scale:
+            return np.exp(y), logj + y
+        return y, logj
+
+    def to_unconstrained(self, theta: np.ndarray) -> np.ndarray:
+        a, b = self._ab()
+        y = np.log(theta) if self.log_scale else np.asarray(theta, dtype=float)
+        s = np.clip((y - a) / (b - a), 1e-12, 1 - 1e-12)
+        return logit(s)
+
+    def sample(self, rng: np.random.Generator, size: int) -> np.ndarray:
+        """Draws from the (truncated) prior."""
+        a, b = self._ab()
+        if self.dist in ("uniform", "loguniform"):
+            y = rng.uniform(a, b, size)
+        else:
+            from scipy.stats import truncnorm
+
+            m = math.log(self.mu) if self.dist == "lognormal" else self.mu
+            lo, hi = (a - m) / self.sigma, (b - m) / self.sigma
+            y = truncnorm.rvs(lo, hi, loc=m, scale=self.sigma, size=size,
+                              random_state=rng)
+        return np.exp(y) if self.log_scale else y
+
+
+#: Default prior bounds per (domain, kind). Documented in the user guide.
+_DEFAULTS: dict[tuple[str, str], Prior] = {
+    # thermal capacities: from a few m³ of air (1e4 J/K) to a cathedral's masonry (1e12)
+    ("thermal", "capacity"): Prior("loguniform", 1e4, 1e12),
+    # thermal conductances: a cupboard's leak (0.01 W/K) to a hall with open doors (1e5)
+    ("thermal", "conductance"): Prior("loguniform", 1e-2, 1e5),
+    # effective solar apertures (window area × transmittance) [m²]
+    ("thermal", "gain"): Prior("loguniform", 1e-3, 200.0),
+    ("thermal", "fraction"): Prior("uniform", 0.0, 1.0),
+    ("thermal", "constant"): Prior("uniform", -20.0, 40.0),
+    # hygric capacities [kg/Pa]: air of 1 m³ is 7.5e-6 kg/Pa; buffering contents far more
+    ("hygric", "capacity"): Prior("loguniform", 1e-6, 1e3),
+    # hygric conductances [kg/(s·Pa)]: 0.1 ACH in 10 m³ ~ 2e-9; 5 ACH in 1e4 m³ ~ 1e-4
+    ("hygric", "conductance"): Prior("loguniform", 1e-12, 1e-3),
+    ("hygric", "gain"): Prior("loguniform", 1e-6, 1e3),
+    ("hygric", "fraction"): Prior("uniform", 0.0, 1.0),
+    # fixed vapour pressure [Pa]: 0 to saturation at ~33 °C
+    ("hygric", "constant"): Prior("uniform", 0.0, 5000.0),
+    # noise: σ [K] or [Pa], AR(1) coefficient φ [-]
+    ("thermal", "sigma"): Prior("loguniform", 1e-3, 10.0),
+    ("hygric", "sigma"): Prior("loguniform", 1e-1, 1e3),
+    ("thermal", "phi"): Prior("uniform", 0.0, 0.999),
+    ("hygric", "phi"): Prior("uniform", 0.0, 0.999),
+}
+
+
+def default_prior(domain: str, kind: str) -> Prior:
+    """The default prior of a parameter kind in a domain (``thermal``/``hygric``)."""
+    try:
+        return _DEFAULTS[(domain, kind)]
+    except KeyError:
+        raise ValueError(f"no default prior for a {kind!r} parameter in domain "
+                         f"{domain!r}") from None
+
+
+def air_capacity_prior(domain: str, volume: float, *, factor: float | None = None,
+                       sigma: float | None = None) -> Prior:
+    """Log-normal prior on the air-node capacity ``Ci`` from the room volume [m³].
+
+    Thermal: median ``factor × ρc_air × V`` with ρc_air = 1206 J/(m³·K), default
+    factor 5 (air plus the fast-responding surface layers and light contents lumped in
+    the air node), σ_log = 1.0 (2σ range 0.7–37 × the air alone).
+    Hygric: median ``factor × V/(R_v T)`` (7.5e-6 kg/(Pa·m³)), default factor 10, σ_log
+    1.5, since fast hygroscopic surfaces buffer far more than the air.
+
+    This pins the otherwise unidentifiable overall scale of all C and G (see
+    :mod:`heritage_bayes.rc.identify`).
+    """
+    if not volume > 0:
+        raise ConfigError(f"room volume must be > 0 m³ (got {volume})")
+    if domain == "thermal":
+        base, factor, sigma = RHO_CP_AIR * volume, factor or 5.0, sigma or 1.0
+    else:
+        base, factor, sigma = HYG_CAP_AIR * volume, factor or 10.0, sigma or 1.5
+    median = base * factor
+    lo = max(base * 0.5, median * math.exp(-5 * sigma))
+    return Prior("lognormal", lo, median * math.exp(5 * sigma), median, sigma)
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """A named model or noise parameter (lmfit's Parameter, with a prior).
+
+    Attributes
+    ----------
+    name, unit, kind, description : str
+    prior : Prior
+    fixed : float or None
+        When set, the parameter is held at this value (not sampled).
+    """
+
+    name: str
+    unit: str
+    kind: str
+    prior: Prior
+    fixed: float | None = None
+    description: str = ""
+
+    @property
+    def free(self) -> bool:
+        return self.fixed is None
+
+
+@dataclass
+class ParameterSet:
+    """An ordered collection of parameters: the model's, then the noise model's.
+
+    Maps an unconstrained (K, d) array of the free parameters to (K, P) parameter values
+    in the order of ``names`` (fixed ones filled in) and computes the log-prior including
+    the Jacobian.
+    """
+
+    parameters: Sequence[Parameter]
+    _free_idx: np.ndarray = field(init=False, repr=False)
+
+    def __post_init__(self):
+        self.parameters = tuple(self.parameters)
+        self._free_idx = np.array([i for i, p in enumerate(self.parameters) if p.free],
+                                  dtype=int)
+        if self._free_idx.size == 0:
+            raise ConfigError("every parameter is fixed: nothing to calibrate")
+        # vectorised transform tables over the free parameters
+        priors = [self.parameters[j].prior for j in self._free_idx]
+        ab = np.array([p._ab() for p in priors])
+        self._a, self._w = ab[:, 0], ab[:, 1] - ab[:, 0]
+        self._log = np.array([p.log_scale for p in priors])
+        self._code = np.array([_DISTS.index(p.dist) for p in priors])
+        self._mu = np.array([(math.log(p.mu) if p.dist == "lognormal" else p.mu)
+                             if p.mu is not None else 0.0 for p in priors])
+        self._sig = np.array([p.sigma or 1.0 for p in priors])
+        self._fixed = np.array([p.fixed if p.fixed is not None else np.nan
+                                for p in self.parameters])
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        return tuple(p.name for p in self.parameters)
+
+    @property
+    def free_names(self) -> tuple[str, ...]:
+        return tuple(self.parameters[i].name for i in self._free_idx)
+
+    @property
+    def ndim(self) -> int:
+        return int(self._free_idx.size)
+
+    def __getitem__(self, name: str) -> Parameter:
+        for p in self.parameters:
+            if p.name == name:
+                return p
+        raise KeyError(name)
+
+    def transform(self, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Unconstrained (K, d) -> values (K, P) and log-prior + log-Jacobian (K,)."""
+        X = np.atleast_2d(X)
+        theta = np.tile(self._fixed, (X.shape[0], 1))
+        y = self._a + self._w * expit(X)
+        # log|dy/dx| = log w + log σ(x) + log(1 - σ(x)), stable for large |x|
+        logj = np.log(self._w) - np.logaddexp(0.0, -X) - np.logaddexp(0.0, X)
+        th = np.where(self._log, np.exp(np.where(self._log, y, 0.0)), y)
+        # y is log θ for log-scale priors: the Jacobian gains dθ/dy = θ, and
+        # loguniform (∝ 1/θ) cancels it; lognormal keeps the normal term in y
+        z = (y - self._mu) / self._sig
+        logp = logj - np.where((self._code == 2) | (self._code == 3), 0.5 * z * z, 0.0)
+        theta[:, self._free_idx] = th
+        return theta, logp.sum(axis=1)
+
+    def values(self, X: np.ndarray) -> np.ndarray:
+        """Unconstrained (K, d) -> values (K, P)."""
+        return self.transform(X)[0]
+
+    def to_unconstrained(self, theta: np.ndarray) -> np.ndarray:
+        """Values (K, P) (all parameters) -> unconstrained free coordinates (K, d)."""
+        theta = np.atleast_2d(theta)
+        return np.column_stack([
+            self.parameters[j].prior.to_unconstrained(theta[:, j]) for j in self._free_idx
+        ])
+
+    def sample_prior(self, rng: np.random.Generator, size: int) -> np.ndarray:
+        """Prior draws of all parameters (K, P) (fixed ones repeated)."""
+        theta = np.empty((size, len(self.parameters)))
+        for j, p in enumerate(self.parameters):
+            theta[:, j] = p.fixed if p.fixed is not None else p.prior.sample(rng, size)
+        return theta
+
+    def to_dict(self) -> dict:
+        return {p.name: ({"fixed": p.fixed} if p.fixed is not None else
+                         p.prior.to_dict()) | {"unit": p.unit, "kind": p.kind}
+                for p in self.parameters}
+
+
+def parameters_for(model, noise, priors: Mapping[str, Mapping] | None = None, *,
+                   room_volume: float | None = None,
+                   where: str = "priors") -> ParameterSet:
+    """The :class:`ParameterSet` of a model and its noise model.
+
+    Parameters
+    ----------
+    model : RCModel
+    noise : NoiseModel
+    priors : mapping name -> spec, optional
+        Overrides per parameter: ``{"fixed": value}``, or a prior spec
+        (``dist``, ``lower``, ``upper``, ``median``/``mean``, ``sigma``); keys missing from
+        a spec keep the default's. Unknown names are rejected.
+    room_volume : float, optional
+        Room air volume [m³]: sets a log-normal prior on ``Ci`` (see
+        :func:`air_capacity_prior`) unless ``priors`` sets ``Ci``.
+    where : str
+        Key path used in error messages.
+    """
+    priors = dict(priors or {})
+    domain = model.domain
+    specs: list[Parameter] = []
+    noise_specs = noise.parameter_specs(model.output_names)
+    known = set(model.parameter_names) | {n for n, _, _ in noise_specs}
+    unknown = sorted(set(priors) - known)
+    if unknown:
+        raise ConfigError(f"{where}: unknown parameter(s) {unknown} for model "
+                          f"{model.name!r} with noise {noise.name!r}; parameters are "
+                          f"{sorted(known)}")
+    out_units = {o: model.network.input_unit(o) if o in model.input_names else
+                 ("K" if domain == "thermal" else "Pa") for o in model.output_names}
+    entries = [(i.name, i.kind, i.unit, i.description) for i in model.parameters]
+    entries += [(n, k, out_units[o] if k == "sigma" else "-",
+                 f"{'marginal sd' if k == 'sigma' else 'AR(1) coefficient'} of the "
+                 f"residuals of {o}") for n, k, o in noise_specs]
+    for name, kind, unit, desc in entries:
+        prior = default_prior(domain, kind)
+        if name == "Ci" and room_volume is not None and kind == "capacity":
+            prior = air_capacity_prior(domain, room_volume)
+        spec = priors.get(name)
+        fixed = None
+        if spec is not None:
+            if not isinstance(spec, Mapping):
+                raise ConfigError(f"{where}.{name}: expected a mapping such as "
+                                  f"{{dist: loguniform, lower: 1, upper: 100}} or "
+                                  f"{{fixed: 50}} (got {spec!r})")
+            if "fixed" in spec:
+                if len(spec) > 1:
+                    raise ConfigError(f"{where}.{name}: 'fixed' cannot be combined with "
+                                      f"{sorted(set(spec) - {'fixed'})}")
+                try:
+                    fixed = float(spec["fixed"])
+                except (TypeError, ValueError):
+                    raise ConfigError(f"{where}.{name}.fixed: expected a number "
+                                      f"(got {spec['fixed']!r})") from None
+                if not math.isfinite(fixed):
+                    raise ConfigError(f"{where}.{name}.fixed: must be finite "
+                                      f"(got {fixed})")
+            else:
+                base = prior if spec.get("dist", prior.dist) == prior.dist else None
+                prior = Prior.from_spec(spec, where=f"{where}.{name}", default=base)
+        specs.append(Parameter(name, unit, kind, prior, fixed, desc))
+    return ParameterSet(specs)

@@ -157,8 +157,7 @@ class NoiseModel:
     def _split(self, noise: np.ndarray, o: int):
         q = len(self.kinds)
         sigma = np.ascontiguousarray(noise[:, q * o])
-        phi = (np.ascontiguousarray(noise[:, q * o + 1]) if q > 1
-               else np.zeros(noise.shape[0]))
+        phi = np.ascontiguousarray(noise[:, q * o + 1]) if q > 1 else np.zeros(noise.shape[0])
         return sigma, phi
 
     def loglik(self, Ysim, Yobs, noise, context=None) -> np.ndarray:
@@ -167,8 +166,9 @@ class NoiseModel:
         dummy = np.empty((1, 1))
         for o in range(n_out):
             sigma, phi = self._split(noise, o)
-            total += _ar1_kernel(Ysim[:, :, o], np.ascontiguousarray(Yobs[:, o]),
-                                 sigma, phi, dummy, False)
+            total += _ar1_kernel(
+                Ysim[:, :, o], np.ascontiguousarray(Yobs[:, o]), sigma, phi, dummy, False
+            )
         return total
 
     def loglik_modal(self, mf, U, z0, Yobs, noise, max_block: int = 2**20) -> np.ndarray:
@@ -182,8 +182,7 @@ class NoiseModel:
         q = len(self.kinds)
         # mode-major (j, p) layouts for the compiled pass
         sigma = np.ascontiguousarray(noise[:, 0::q][:, :n_out].T)
-        phi = (np.ascontiguousarray(noise[:, 1::q][:, :n_out].T) if q > 1
-               else np.zeros((n_out, K)))
+        phi = np.ascontiguousarray(noise[:, 1::q][:, :n_out].T) if q > 1 else np.zeros((n_out, K))
         Bcat = np.swapaxes(mf.Bdz, 0, 1).reshape(n * K, -1).T  # (m, n*K)
         ecat = mf.edz.T.reshape(n * K)
         ad = np.ascontiguousarray(mf.ad.T.reshape(n * K))
@@ -195,7 +194,7 @@ class NoiseModel:
         tot = np.zeros((n_out, K))
         rows = max(256, max_block // max(K * n, 1))
         for k0 in range(0, U.shape[0], rows):
-            W = U[k0:k0 + rows] @ Bcat
+            W = U[k0 : k0 + rows] @ Bcat
             if ecat.any():
                 W += ecat
             _fused_ar1(ad, W, z, Cz, Yobs, k0, sigma, phi, prev, last, tot)
@@ -207,13 +206,11 @@ class NoiseModel:
         for o in range(n_out):
             sigma, phi = self._split(noise, o)
             point = np.empty((K, N))
-            _ar1_kernel(Ysim[:, :, o], np.ascontiguousarray(Yobs[:, o]), sigma, phi,
-                        point, True)
+            _ar1_kernel(Ysim[:, :, o], np.ascontiguousarray(Yobs[:, o]), sigma, phi, point, True)
             out[:, :, o] = point
         return out
 
-    def sample(self, rng: np.random.Generator, noise: np.ndarray, N: int,
-               n_out: int) -> np.ndarray:
+    def sample(self, rng: np.random.Generator, noise: np.ndarray, N: int, n_out: int) -> np.ndarray:
         K = noise.shape[0]
         out = np.empty((K, N, n_out))
         for o in range(n_out):
@@ -259,5 +256,6 @@ def get_noise_model(name: str) -> NoiseModel:
     try:
         return NOISE_MODELS[name]()
     except KeyError:
-        raise ValueError(f"unknown noise model {name!r}; available: "
-                         f"{sorted(NOISE_MODELS)}") from None
+        raise ValueError(
+            f"unknown noise model {name!r}; available: {sorted(NOISE_MODELS)}"
+        ) from None

@@ -70,32 +70,34 @@ class Prior:
     def __post_init__(self):
         where = "prior"
         if self.dist not in _DISTS:
-            raise ConfigError(f"{where}.dist: must be one of {list(_DISTS)} "
-                              f"(got {self.dist!r})")
+            raise ConfigError(f"{where}.dist: must be one of {list(_DISTS)} (got {self.dist!r})")
         lo, up = float(self.lower), float(self.upper)
         if not (math.isfinite(lo) and math.isfinite(up)):
             raise ConfigError(f"{where}: bounds must be finite (got [{lo}, {up}])")
         if not lo < up:
             raise ConfigError(f"{where}.lower: must be < upper (got {lo:g} >= {up:g})")
         if self.log_scale and lo <= 0:
-            raise ConfigError(f"{where}.lower: a {self.dist} prior needs lower > 0 "
-                              f"(got {lo:g})")
+            raise ConfigError(f"{where}.lower: a {self.dist} prior needs lower > 0 (got {lo:g})")
         if self.dist in ("normal", "lognormal"):
             if self.mu is None or self.sigma is None or not self.sigma > 0:
-                raise ConfigError(f"{where}: a {self.dist} prior needs mu (the "
-                                  f"{'median' if self.dist == 'lognormal' else 'mean'}) "
-                                  f"and sigma > 0 (got mu={self.mu}, sigma={self.sigma})")
+                raise ConfigError(
+                    f"{where}: a {self.dist} prior needs mu (the "
+                    f"{'median' if self.dist == 'lognormal' else 'mean'}) "
+                    f"and sigma > 0 (got mu={self.mu}, sigma={self.sigma})"
+                )
             if self.dist == "lognormal" and not self.mu > 0:
-                raise ConfigError(f"{where}.mu: the median of a lognormal prior must be "
-                                  f"> 0 (got {self.mu:g})")
+                raise ConfigError(
+                    f"{where}.mu: the median of a lognormal prior must be > 0 (got {self.mu:g})"
+                )
 
     @property
     def log_scale(self) -> bool:
         return self.dist in ("loguniform", "lognormal")
 
     @classmethod
-    def from_spec(cls, spec: Mapping, *, where: str = "prior",
-                  default: Prior | None = None) -> Prior:
+    def from_spec(
+        cls, spec: Mapping, *, where: str = "prior", default: Prior | None = None
+    ) -> Prior:
         """Build from a config mapping, naming ``where`` (the key path) in errors.
 
         Keys: ``dist``, ``lower``, ``upper``, ``median`` (lognormal) or ``mean``
@@ -105,8 +107,9 @@ class Prior:
         allowed = {"dist", "lower", "upper", "median", "mean", "sigma"}
         unknown = sorted(set(spec) - allowed)
         if unknown:
-            raise ConfigError(f"{where}: unknown key(s) {unknown}; allowed: "
-                              f"{sorted(allowed)} (or 'fixed: value')")
+            raise ConfigError(
+                f"{where}: unknown key(s) {unknown}; allowed: {sorted(allowed)} (or 'fixed: value')"
+            )
         dist = spec.get("dist", default.dist if default else None)
         if dist is None:
             raise ConfigError(f"{where}.dist: required, one of {list(_DISTS)}")
@@ -123,17 +126,21 @@ class Prior:
             lo = default.lower if lo is None else lo
             up = default.upper if up is None else up
         if lo is None or up is None:
-            raise ConfigError(f"{where}: lower and upper bounds are required for a "
-                              f"{dist} prior")
+            raise ConfigError(f"{where}: lower and upper bounds are required for a {dist} prior")
         try:
-            return cls(dist, float(lo), float(up),
-                       None if mu is None else float(mu),
-                       None if sigma is None else float(sigma))
+            return cls(
+                dist,
+                float(lo),
+                float(up),
+                None if mu is None else float(mu),
+                None if sigma is None else float(sigma),
+            )
         except ConfigError as exc:
             raise ConfigError(str(exc).replace("prior", where, 1)) from None
         except (TypeError, ValueError):
-            raise ConfigError(f"{where}: bounds, median/mean and sigma must be numbers "
-                              f"(got {dict(spec)})") from None
+            raise ConfigError(
+                f"{where}: bounds, median/mean and sigma must be numbers (got {dict(spec)})"
+            ) from None
 
     def to_dict(self) -> dict:
         d = {"dist": self.dist, "lower": self.lower, "upper": self.upper}
@@ -196,8 +203,7 @@ class Prior:
 
             m = math.log(self.mu) if self.dist == "lognormal" else self.mu
             lo, hi = (a - m) / self.sigma, (b - m) / self.sigma
-            y = truncnorm.rvs(lo, hi, loc=m, scale=self.sigma, size=size,
-                              random_state=rng)
+            y = truncnorm.rvs(lo, hi, loc=m, scale=self.sigma, size=size, random_state=rng)
         return np.exp(y) if self.log_scale else y
 
 
@@ -232,12 +238,14 @@ def default_prior(domain: str, kind: str) -> Prior:
     try:
         return _DEFAULTS[(domain, kind)]
     except KeyError:
-        raise ValueError(f"no default prior for a {kind!r} parameter in domain "
-                         f"{domain!r}") from None
+        raise ValueError(
+            f"no default prior for a {kind!r} parameter in domain {domain!r}"
+        ) from None
 
 
-def air_capacity_prior(domain: str, volume: float, *, factor: float | None = None,
-                       sigma: float | None = None) -> Prior:
+def air_capacity_prior(
+    domain: str, volume: float, *, factor: float | None = None, sigma: float | None = None
+) -> Prior:
     """Log-normal prior on the air-node capacity ``Ci`` from the room volume [m³].
 
     Thermal: median ``factor × ρc_air × V`` with ρc_air = 1206 J/(m³·K), default
@@ -298,8 +306,7 @@ class ParameterSet:
 
     def __post_init__(self):
         self.parameters = tuple(self.parameters)
-        self._free_idx = np.array([i for i, p in enumerate(self.parameters) if p.free],
-                                  dtype=int)
+        self._free_idx = np.array([i for i, p in enumerate(self.parameters) if p.free], dtype=int)
         if self._free_idx.size == 0:
             raise ConfigError("every parameter is fixed: nothing to calibrate")
         # vectorised transform tables over the free parameters
@@ -308,11 +315,16 @@ class ParameterSet:
         self._a, self._w = ab[:, 0], ab[:, 1] - ab[:, 0]
         self._log = np.array([p.log_scale for p in priors])
         self._code = np.array([_DISTS.index(p.dist) for p in priors])
-        self._mu = np.array([(math.log(p.mu) if p.dist == "lognormal" else p.mu)
-                             if p.mu is not None else 0.0 for p in priors])
+        self._mu = np.array(
+            [
+                (math.log(p.mu) if p.dist == "lognormal" else p.mu) if p.mu is not None else 0.0
+                for p in priors
+            ]
+        )
         self._sig = np.array([p.sigma or 1.0 for p in priors])
-        self._fixed = np.array([p.fixed if p.fixed is not None else np.nan
-                                for p in self.parameters])
+        self._fixed = np.array(
+            [p.fixed if p.fixed is not None else np.nan for p in self.parameters]
+        )
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -354,9 +366,9 @@ class ParameterSet:
     def to_unconstrained(self, theta: np.ndarray) -> np.ndarray:
         """Values (K, P) (all parameters) -> unconstrained free coordinates (K, d)."""
         theta = np.atleast_2d(theta)
-        return np.column_stack([
-            self.parameters[j].prior.to_unconstrained(theta[:, j]) for j in self._free_idx
-        ])
+        return np.column_stack(
+            [self.parameters[j].prior.to_unconstrained(theta[:, j]) for j in self._free_idx]
+        )
 
     def sample_prior(self, rng: np.random.Generator, size: int) -> np.ndarray:
         """Prior draws of all parameters (K, P) (fixed ones repeated)."""
@@ -366,14 +378,21 @@ class ParameterSet:
         return theta
 
     def to_dict(self) -> dict:
-        return {p.name: ({"fixed": p.fixed} if p.fixed is not None else
-                         p.prior.to_dict()) | {"unit": p.unit, "kind": p.kind}
-                for p in self.parameters}
+        return {
+            p.name: ({"fixed": p.fixed} if p.fixed is not None else p.prior.to_dict())
+            | {"unit": p.unit, "kind": p.kind}
+            for p in self.parameters
+        }
 
 
-def parameters_for(model, noise, priors: Mapping[str, Mapping] | None = None, *,
-                   room_volume: float | None = None,
-                   where: str = "priors") -> ParameterSet:
+def parameters_for(
+    model,
+    noise,
+    priors: Mapping[str, Mapping] | None = None,
+    *,
+    room_volume: float | None = None,
+    where: str = "priors",
+) -> ParameterSet:
     """The :class:`ParameterSet` of a model and its noise model.
 
     Parameters
@@ -397,15 +416,27 @@ def parameters_for(model, noise, priors: Mapping[str, Mapping] | None = None, *,
     known = set(model.parameter_names) | {n for n, _, _ in noise_specs}
     unknown = sorted(set(priors) - known)
     if unknown:
-        raise ConfigError(f"{where}: unknown parameter(s) {unknown} for model "
-                          f"{model.name!r} with noise {noise.name!r}; parameters are "
-                          f"{sorted(known)}")
-    out_units = {o: model.network.input_unit(o) if o in model.input_names else
-                 ("K" if domain == "thermal" else "Pa") for o in model.output_names}
+        raise ConfigError(
+            f"{where}: unknown parameter(s) {unknown} for model "
+            f"{model.name!r} with noise {noise.name!r}; parameters are "
+            f"{sorted(known)}"
+        )
+    out_units = {
+        o: model.network.input_unit(o)
+        if o in model.input_names
+        else ("K" if domain == "thermal" else "Pa")
+        for o in model.output_names
+    }
     entries = [(i.name, i.kind, i.unit, i.description) for i in model.parameters]
-    entries += [(n, k, out_units[o] if k == "sigma" else "-",
-                 f"{'marginal sd' if k == 'sigma' else 'AR(1) coefficient'} of the "
-                 f"residuals of {o}") for n, k, o in noise_specs]
+    entries += [
+        (
+            n,
+            k,
+            out_units[o] if k == "sigma" else "-",
+            f"{'marginal sd' if k == 'sigma' else 'AR(1) coefficient'} of the residuals of {o}",
+        )
+        for n, k, o in noise_specs
+    ]
     for name, kind, unit, desc in entries:
         prior = default_prior(domain, kind)
         if name == "Ci" and room_volume is not None and kind == "capacity":
@@ -414,21 +445,25 @@ def parameters_for(model, noise, priors: Mapping[str, Mapping] | None = None, *,
         fixed = None
         if spec is not None:
             if not isinstance(spec, Mapping):
-                raise ConfigError(f"{where}.{name}: expected a mapping such as "
-                                  f"{{dist: loguniform, lower: 1, upper: 100}} or "
-                                  f"{{fixed: 50}} (got {spec!r})")
+                raise ConfigError(
+                    f"{where}.{name}: expected a mapping such as "
+                    f"{{dist: loguniform, lower: 1, upper: 100}} or "
+                    f"{{fixed: 50}} (got {spec!r})"
+                )
             if "fixed" in spec:
                 if len(spec) > 1:
-                    raise ConfigError(f"{where}.{name}: 'fixed' cannot be combined with "
-                                      f"{sorted(set(spec) - {'fixed'})}")
+                    raise ConfigError(
+                        f"{where}.{name}: 'fixed' cannot be combined with "
+                        f"{sorted(set(spec) - {'fixed'})}"
+                    )
                 try:
                     fixed = float(spec["fixed"])
                 except (TypeError, ValueError):
-                    raise ConfigError(f"{where}.{name}.fixed: expected a number "
-                                      f"(got {spec['fixed']!r})") from None
+                    raise ConfigError(
+                        f"{where}.{name}.fixed: expected a number (got {spec['fixed']!r})"
+                    ) from None
                 if not math.isfinite(fixed):
-                    raise ConfigError(f"{where}.{name}.fixed: must be finite "
-                                      f"(got {fixed})")
+                    raise ConfigError(f"{where}.{name}.fixed: must be finite (got {fixed})")
             else:
                 base = prior if spec.get("dist", prior.dist) == prior.dist else None
                 prior = Prior.from_spec(spec, where=f"{where}.{name}", default=base)

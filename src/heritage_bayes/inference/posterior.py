@@ -79,10 +79,14 @@ class LogPosterior:
 
     def split(self, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """All values (K, P) -> model parameters (K, P_model), noise (K, q)."""
-        return theta[:, : self.n_model], theta[:, self.n_model:]
+        return theta[:, : self.n_model], theta[:, self.n_model :]
 
-    def simulate(self, theta_model: np.ndarray, inputs: np.ndarray | None = None,
-                 u_init: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    def simulate(
+        self,
+        theta_model: np.ndarray,
+        inputs: np.ndarray | None = None,
+        u_init: np.ndarray | None = None,
+    ) -> tuple[np.ndarray, np.ndarray]:
         """Noise-free outputs (K, N, n_out) and validity (K,) for model parameters."""
         U = self.inputs if inputs is None else inputs
         mf = modal_form(self.model, theta_model, self.dt)

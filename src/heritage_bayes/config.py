@@ -161,7 +161,7 @@ class Data(_Strict):
         try:
             td = pd.Timedelta(v)
         except (ValueError, TypeError):
-            raise ValueError(f"expected a duration such as '1h' or '30min' (got {v!r})")
+            raise ValueError(f"expected a duration such as '1h' or '30min' (got {v!r})") from None
         if td < pd.Timedelta(0):
             raise ValueError(f"must not be negative (got {v!r})")
         return v
@@ -176,7 +176,7 @@ class Period(_Strict):
         try:
             s, e = pd.Timestamp(self.start), pd.Timestamp(self.end)
         except (ValueError, TypeError) as exc:
-            raise ValueError(f"start/end must be dates such as 2019-01-01 ({exc})")
+            raise ValueError(f"start/end must be dates such as 2019-01-01 ({exc})") from None
         if not s < e:
             raise ValueError(f"start must be before end (got {self.start} >= {self.end})")
         return self

@@ -4,9 +4,18 @@ The forward models follow Kramer, van Schijndel & Schellen, "Inverse modeling of
 responses of monumental buildings" (thermal model 4a, hygric model 3).
 """
 
+from heritage_bayes import climate, io
 from heritage_bayes._version import __version__
 from heritage_bayes.errors import ConfigError, DataError, InputError
-from heritage_bayes.rc import Network, RCModel, available_models, discretize, model, simulate
+from heritage_bayes.rc import (
+    Network,
+    RCModel,
+    available_models,
+    discretize,
+    model,
+    simulate,
+    structural_identifiability,
+)
 
 __all__ = [
     "ConfigError",
@@ -16,7 +25,10 @@ __all__ = [
     "RCModel",
     "__version__",
     "available_models",
+    "climate",
     "discretize",
+    "io",
     "model",
     "simulate",
+    "structural_identifiability",
 ]

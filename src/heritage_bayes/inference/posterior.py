@@ -95,6 +95,18 @@ class LogPosterior:
         Y = modal_simulate(mf, U, z0)
         return Y, mf.valid
 
+    def _loglik(self, theta: np.ndarray) -> np.ndarray:
+        """(K,) log-likelihood for valid-shaped values (K, P); -inf where invalid."""
+        tm, tn = self.split(theta)
+        with np.errstate(all="ignore"):
+            mf = modal_form(self.model, tm, self.dt)
+            z0 = mf.steady_state_modal(self.u_init)
+            z0 = np.where(np.isfinite(z0), z0, 0.0)
+            ll = self.noise.loglik_modal(mf, self.inputs, z0, self.observed, tn)
+        ll[~mf.valid] = -np.inf
+        ll[~np.isfinite(ll)] = -np.inf
+        return ll
+
     def __call__(self, X: np.ndarray) -> np.ndarray:
         X = np.asarray(X, dtype=float)
         single = X.ndim == 1
@@ -103,23 +115,17 @@ class LogPosterior:
         ok = np.all(np.isfinite(X), axis=1)
         if ok.any():
             theta, lp = self.params.transform(X[ok])
-            tm, tn = self.split(theta)
-            with np.errstate(all="ignore"):
-                mf = modal_form(self.model, tm, self.dt)
-                z0 = mf.steady_state_modal(self.u_init)
-                z0 = np.where(np.isfinite(z0), z0, 0.0)
-                ll = self.noise.loglik_modal(mf, self.inputs, z0, self.observed, tn)
-                valid = mf.valid
-            val = lp + ll
-            val[~valid] = -np.inf
+            val = lp + self._loglik(theta)
             val[~np.isfinite(val)] = -np.inf
             out[ok] = val
         return out[0] if single else out
 
     def log_likelihood(self, theta: np.ndarray) -> np.ndarray:
-        """(K,) log-likelihood for parameter values (K, P)."""
+        """(K,) log-likelihood for parameter values (K, P) (model then noise)."""
+        return self._loglik(np.atleast_2d(np.asarray(theta, dtype=float)))
+
+    def pointwise_log_likelihood(self, theta: np.ndarray) -> np.ndarray:
+        """(K, N, n_out) log-likelihood terms (NaN where excluded), for LOO."""
         tm, tn = self.split(np.atleast_2d(theta))
-        Y, valid = self.simulate(tm)
-        ll = self.noise.loglik(Y, self.observed, tn)
-        ll[~valid] = -np.inf
-        return ll
+        Y, _ = self.simulate(tm)
+        return self.noise.pointwise(Y, self.observed, tn)

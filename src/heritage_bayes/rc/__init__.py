@@ -5,23 +5,41 @@ See :mod:`heritage_bayes.rc.catalog` for the paper's models.
 
 from heritage_bayes.rc.catalog import CATALOG, available_models, model
 from heritage_bayes.rc.discretize import ModalForm, discretize, modal_form
+from heritage_bayes.rc.identify import (
+    IdentifiabilityResult,
+    NullDirection,
+    constant_contributions,
+    derived_quantities,
+    derived_units,
+    static_gains,
+    structural_identifiability,
+    time_constants,
+)
 from heritage_bayes.rc.model import RCModel
 from heritage_bayes.rc.network import Link, Network, Node, ParameterInfo, Source
 from heritage_bayes.rc.simulate import iter_simulate, simulate
 
 __all__ = [
     "CATALOG",
+    "IdentifiabilityResult",
     "Link",
     "ModalForm",
     "Network",
     "Node",
+    "NullDirection",
     "ParameterInfo",
     "RCModel",
     "Source",
     "available_models",
+    "constant_contributions",
+    "derived_quantities",
+    "derived_units",
     "discretize",
     "iter_simulate",
     "modal_form",
     "model",
     "simulate",
+    "static_gains",
+    "structural_identifiability",
+    "time_constants",
 ]

@@ -1,0 +1,337 @@
+"""Shared machinery of the readers: standard columns, time zones, validation, finalising.
+
+Private module: the public API is re-exported by :mod:`heritage_bayes.io`.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import re
+import zoneinfo
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from heritage_bayes.errors import DataError, InputError
+
+__all__ = [
+    "AVERAGED_BY_DEFAULT",
+    "IRRADIANCE_NOISE",
+    "STANDARD_COLUMNS",
+    "format_timedelta",
+    "parse_timezone",
+]
+
+#: Standard column names: name -> (unit, description, (lower, upper) physical range).
+STANDARD_COLUMNS: dict[str, tuple[str, str, tuple[float, float]]] = {
+    "Te": ("°C", "outdoor air temperature", (-60.0, 70.0)),
+    "RHe": ("%", "outdoor relative humidity (over water)", (0.0, 100.0)),
+    "ghi": ("W/m²", "global horizontal irradiance", (0.0, 1500.0)),
+    "dni": ("W/m²", "direct normal irradiance", (0.0, 1500.0)),
+    "dhi": ("W/m²", "diffuse horizontal irradiance", (0.0, 1500.0)),
+    "Ti": ("°C", "indoor air temperature", (-60.0, 70.0)),
+    "RHi": ("%", "indoor relative humidity (over water)", (0.0, 100.0)),
+    "Pe": ("Pa", "outdoor vapour pressure", (0.0, 35000.0)),
+    "Pi": ("Pa", "indoor vapour pressure", (0.0, 35000.0)),
+    "Tdew": ("°C", "outdoor dew-point temperature", (-80.0, 70.0)),
+}
+
+#: Columns that are interval averages (stamped at the interval end) unless told otherwise.
+AVERAGED_BY_DEFAULT = ("ghi", "dni", "dhi")
+IRRADIANCE = ("ghi", "dni", "dhi")
+#: Negative irradiance down to this value [W/m²] is sensor noise (thermopile night
+#: offset) and is set to 0; below it the value is invalid.
+IRRADIANCE_NOISE = 10.0
+
+_FIXED_OFFSET = re.compile(r"^(?:UTC|GMT)?\s*([+-])\s*(\d{1,2})(?::?(\d{2}))?$")
+
+
+def parse_timezone(timezone) -> _dt.tzinfo:
+    """Turn ``'UTC'``, ``'UTC+2'``, ``'UTC-03:30'``, ``'+02:00'`` or an IANA name into a tzinfo.
+
+    Fixed offsets have no daylight-saving time; IANA names (``'Europe/Copenhagen'``)
+    follow the local clock, with its DST changes.
+    """
+    if isinstance(timezone, _dt.tzinfo):
+        return timezone
+    if not isinstance(timezone, str) or not timezone.strip():
+        raise InputError(
+            f"timezone must be a string such as 'UTC', 'UTC+2' or 'Europe/Copenhagen' "
+            f"(got {timezone!r})"
+        )
+    text = timezone.strip()
+    if text.upper() in ("UTC", "Z", "GMT"):
+        return _dt.UTC
+    match = _FIXED_OFFSET.match(text.upper())
+    if match:
+        sign, hours, minutes = match.groups()
+        delta = _dt.timedelta(hours=int(hours), minutes=int(minutes or 0))
+        if delta > _dt.timedelta(hours=14):
+            raise InputError(f"timezone {timezone!r}: offset beyond ±14 h")
+        return _dt.timezone(-delta if sign == "-" else delta)
+    try:
+        return zoneinfo.ZoneInfo(text)
+    except (zoneinfo.ZoneInfoNotFoundError, ValueError) as exc:
+        raise InputError(
+            f"unknown timezone {timezone!r}; use 'UTC', a fixed offset such as 'UTC+2' or "
+            f"'UTC-03:30', or an IANA name such as 'Europe/Copenhagen'"
+        ) from exc
+
+
+def format_timedelta(td) -> str:
+    """Compact string of a duration, e.g. ``'1h'``, ``'10min'``, ``'1h30min'``, ``'2D'``."""
+    td = pd.Timedelta(td)
+    total = int(td.total_seconds())
+    if td.total_seconds() != total:
+        return str(td)
+    if total == 0:
+        return "0s"
+    sign = "-" if total < 0 else ""
+    total = abs(total)
+    days, rest = divmod(total, 86400)
+    hours, rest = divmod(rest, 3600)
+    minutes, seconds = divmod(rest, 60)
+    parts = [f"{days}D" if days else "", f"{hours}h" if hours else ""]
+    parts += [f"{minutes}min" if minutes else "", f"{seconds}s" if seconds else ""]
+    return sign + "".join(parts)
+
+
+def modal_step(index: pd.DatetimeIndex) -> pd.Timedelta | None:
+    """Most frequent positive spacing of a sorted index (None with fewer than 2 stamps)."""
+    if len(index) < 2:
+        return None
+    diffs = np.diff(index.asi8)
+    diffs = diffs[diffs > 0]
+    if diffs.size == 0:
+        return None
+    values, counts = np.unique(diffs, return_counts=True)
+    return pd.Timedelta(int(values[np.argmax(counts)]), unit=index.unit)
+
+
+def source_name(path) -> str:
+    return Path(path).name
+
+
+def check_file(path) -> Path:
+    path = Path(path)
+    if not path.exists():
+        raise DataError(f"{path}: file not found")
+    if path.is_dir():
+        raise DataError(f"{path}: is a directory, expected a data file")
+    return path
+
+
+# ---------------------------------------------------------------------------------------
+# Localisation of wall-clock timestamps (DST policy)
+# ---------------------------------------------------------------------------------------
+
+
+@dataclass
+class Localized:
+    """UTC stamps for the rows that survived, and what was dropped."""
+
+    utc: pd.DatetimeIndex
+    keep: np.ndarray  # boolean mask over the input rows
+    ambiguous_dropped: int
+    nonexistent_dropped: int
+
+
+def localize(naive: pd.DatetimeIndex, tz: _dt.tzinfo) -> Localized:
+    """Attach time zone ``tz`` to wall-clock stamps ``naive`` (in file order) and go to UTC.
+
+    Fixed offsets are exact. For a local clock with daylight-saving time:
+
+    * a stamp in the repeated autumn hour is resolved by file order: within a run of
+      consecutive rows inside the repeated hour, a stamp that does not increase on its
+      predecessor starts the second pass (standard time); rows of the first pass are
+      daylight time. A run with only one pass cannot be resolved and is dropped;
+    * a stamp in the skipped spring hour does not exist on that clock and is dropped.
+    """
+    n = len(naive)
+    if isinstance(tz, _dt.timezone):
+        return Localized(naive.tz_localize(tz).tz_convert("UTC"), np.ones(n, bool), 0, 0)
+    first = naive.tz_localize(tz, ambiguous="NaT", nonexistent="NaT")
+    as_dst = naive.tz_localize(tz, ambiguous=np.ones(n, dtype=bool), nonexistent="NaT")
+    nonexistent = np.asarray(as_dst.isna())
+    ambiguous = np.asarray(first.isna()) & ~nonexistent
+    keep = ~nonexistent
+    dst_flags = np.ones(n, dtype=bool)
+    amb_dropped = 0
+    if ambiguous.any():
+        pos = np.flatnonzero(ambiguous)
+        values = naive.asi8
+        # runs of consecutive ambiguous rows (in file order)
+        breaks = np.flatnonzero(np.diff(pos) != 1) + 1
+        for run in np.split(pos, breaks):
+            passes = np.zeros(run.size, dtype=int)
+            passes[1:] = np.cumsum(values[run[1:]] <= values[run[:-1]])
+            if passes.max() == 0:
+                keep[run] = False
+                amb_dropped += run.size
+                continue
+            dst_flags[run] = passes == 0
+            extra = run[passes >= 2]
+            keep[extra] = False
+            amb_dropped += extra.size
+    kept = naive[keep]
+    local = kept.tz_localize(tz, ambiguous=dst_flags[keep], nonexistent="raise")
+    return Localized(local.tz_convert("UTC"), keep, amb_dropped, int(nonexistent.sum()))
+
+
+# ---------------------------------------------------------------------------------------
+# Value validation
+# ---------------------------------------------------------------------------------------
+
+
+def validate_ranges(
+    frame: pd.DataFrame,
+    lines: np.ndarray,
+    name: str,
+    source_columns: Mapping[str, str],
+    invalid: str,
+    counts: dict,
+) -> dict[str, int]:
+    """Check physical ranges in place; returns the number of clipped noise values per column.
+
+    Irradiance in [-IRRADIANCE_NOISE, 0) is set to 0 (counted). Anything else outside the
+    range of :data:`STANDARD_COLUMNS` raises (``invalid='raise'``) or becomes NaN.
+    """
+    clipped: dict[str, int] = {}
+    for col in frame.columns:
+        if col not in STANDARD_COLUMNS:
+            continue
+        unit, _, (lo, hi) = STANDARD_COLUMNS[col]
+        values = frame[col].to_numpy(dtype=float, copy=True)
+        if col in IRRADIANCE:
+            noise = (values < 0) & (values >= -IRRADIANCE_NOISE)
+            if noise.any():
+                values[noise] = 0.0
+                clipped[col] = int(noise.sum())
+        with np.errstate(invalid="ignore"):
+            bad = (values < lo) | (values > hi)
+        if bad.any():
+            first = int(np.flatnonzero(bad)[0])
+            src = source_columns.get(col, col)
+            lo_txt = -IRRADIANCE_NOISE if col in IRRADIANCE else lo
+            if invalid == "raise":
+                raise DataError(
+                    f"{name}: column {src!r} ({col}) line {int(lines[first])}: value "
+                    f"{values[first]:g} {unit} is outside the physical range "
+                    f"[{lo_txt:g}, {hi:g}] {unit} ({int(bad.sum())} such values); fix the "
+                    f"file, declare sentinels with na_values=, or pass invalid='nan'"
+                )
+            values[bad] = np.nan
+            counts["out_of_range"] = counts.get("out_of_range", 0) + int(bad.sum())
+        frame[col] = values
+    return clipped
+
+
+# ---------------------------------------------------------------------------------------
+# Ordering and duplicates
+# ---------------------------------------------------------------------------------------
+
+DUPLICATE_POLICIES = ("raise", "first", "last", "mean")
+INVALID_POLICIES = ("raise", "nan")
+
+
+def check_choice(value, allowed: Iterable[str], what: str) -> str:
+    allowed = tuple(allowed)
+    if value not in allowed:
+        raise InputError(f"{what} must be one of {', '.join(map(repr, allowed))} (got {value!r})")
+    return value
+
+
+def order_and_deduplicate(
+    frame: pd.DataFrame,
+    name: str,
+    *,
+    duplicates: str,
+    sort: bool,
+    counts: dict,
+    describe=None,
+) -> pd.DataFrame:
+    """Check the UTC index is increasing and unique, applying the duplicate policy.
+
+    ``frame`` carries the file line of each row in a column ``"__line"`` (kept);
+    ``describe(line)`` adds a description of that line's timestamp to messages. Rows that
+    repeat a timestamp with identical values are dropped (counted in
+    ``counts['identical_duplicates']``); conflicting duplicates follow ``duplicates``.
+    """
+
+    def where(i: int) -> str:
+        line = int(frame["__line"].iloc[i])
+        extra = describe(line) if describe else f"{frame.index[i]:%Y-%m-%d %H:%M:%S} UTC"
+        return f"line {line} ({extra})"
+
+    idx = frame.index.asi8
+    if idx.size > 1:
+        back = np.flatnonzero(np.diff(idx) < 0)
+        if back.size:
+            if not sort:
+                i = int(back[0]) + 1
+                raise DataError(
+                    f"{name}: timestamps are not in increasing order: {where(i)} comes "
+                    f"after {where(i - 1)}; {back.size} such step(s) back. Fix the file or "
+                    f"pass sort=True to sort the rows by time"
+                )
+            frame = frame.iloc[np.argsort(idx, kind="stable")]
+            counts["sorted"] = int(back.size)
+    if frame.index.has_duplicates:
+        values = frame.drop(columns="__line").reset_index()
+        identical = values.duplicated(keep="first").to_numpy()
+        if identical.any():
+            counts["identical_duplicates"] = int(identical.sum())
+            frame = frame[~identical]
+        conflicting = frame.index.duplicated(keep="first")
+        if conflicting.any():
+            n = int(conflicting.sum())
+            if duplicates == "raise":
+                i = int(np.flatnonzero(conflicting)[0])
+                j = int(np.flatnonzero(frame.index == frame.index[i])[0])
+                raise DataError(
+                    f"{name}: {n} duplicate timestamp(s) with different values; first on "
+                    f"{where(i)}, the same UTC time as {where(j)}. Pass duplicates='first', "
+                    f"'last' or 'mean' to resolve them, or fix the file"
+                )
+            counts["duplicates"] = n
+            if duplicates == "mean":
+                frame = frame.groupby(level=0, sort=True).mean()
+            else:
+                frame = frame[~frame.index.duplicated(keep=duplicates)]
+    return frame
+
+
+def finalize(
+    frame: pd.DataFrame,
+    *,
+    source: str,
+    fmt: str,
+    averaged: Iterable[str],
+    interval,
+    counts: dict,
+    clipped: dict,
+    extra: Mapping | None = None,
+) -> pd.DataFrame:
+    """Set the index name/unit and the documented ``attrs``."""
+    frame = frame.astype(float)
+    frame.index = pd.DatetimeIndex(frame.index).tz_convert("UTC").as_unit("ns")
+    frame.index.name = "time"
+    attrs = {
+        "source": source,
+        "format": fmt,
+        "units": {c: STANDARD_COLUMNS[c][0] for c in frame.columns if c in STANDARD_COLUMNS},
+        "averaged": tuple(c for c in averaged if c in frame.columns),
+        "interval": format_timedelta(interval) if interval is not None else None,
+        "label": "interval averages stamped at the interval end; others at the reading",
+        "dropped": {k: int(v) for k, v in counts.items() if v},
+        "clipped": {k: int(v) for k, v in clipped.items() if v},
+    }
+    if any(c in frame.columns for c in IRRADIANCE):
+        attrs["irradiance_source"] = "measured"
+    if extra:
+        attrs.update(extra)
+    frame.attrs = attrs
+    return frame

@@ -1,0 +1,754 @@
+"""Readers: weather and logger files to tidy UTC DataFrames with standard column names.
+
+Every reader returns a :class:`pandas.DataFrame` with a tz-aware UTC
+:class:`~pandas.DatetimeIndex` named ``time`` (sorted, unique, nanosecond unit) and
+float columns named from :data:`heritage_bayes.io.STANDARD_COLUMNS`. Instantaneous
+quantities are stamped at the reading; interval averages (irradiance) at the **end** of
+their averaging interval. ``df.attrs`` documents what was read and done (see
+:mod:`heritage_bayes.io`).
+"""
+
+from __future__ import annotations
+
+import gzip
+from collections.abc import Iterable, Mapping, Sequence
+from os import PathLike
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from heritage_bayes.errors import DataError, InputError
+from heritage_bayes.io._common import (
+    AVERAGED_BY_DEFAULT,
+    DUPLICATE_POLICIES,
+    INVALID_POLICIES,
+    STANDARD_COLUMNS,
+    check_choice,
+    check_file,
+    finalize,
+    localize,
+    modal_step,
+    order_and_deduplicate,
+    parse_timezone,
+    source_name,
+    validate_ranges,
+)
+
+__all__ = ["read_csv", "read_epw", "read_knmi_hourly", "read_tmy3"]
+
+#: Year that typical-year files (TMY3, EPW typical years) are coerced to by default.
+TYPICAL_YEAR = 2019
+
+_LABELS = ("end", "start")
+
+
+def _quote_list(names: Iterable[str]) -> str:
+    return ", ".join(repr(n) for n in names)
+
+
+# ---------------------------------------------------------------------------------------
+# Generic CSV
+# ---------------------------------------------------------------------------------------
+
+
+def read_csv(
+    path: str | PathLike,
+    *,
+    time_column: str | Sequence[str],
+    columns: Mapping[str, str] | None = None,
+    time_format: str | None = None,
+    timezone=None,
+    sep: str = ",",
+    decimal: str = ".",
+    averaged: Iterable[str] | None = None,
+    interval=None,
+    label: str = "end",
+    duplicates: str = "raise",
+    sort: bool = False,
+    invalid: str = "raise",
+    na_values: Iterable | None = None,
+    skiprows: int = 0,
+    encoding: str = "utf-8",
+) -> pd.DataFrame:
+    """Read a delimited text table (logger export, weather service) into standard columns.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file. Header names are compared after stripping surrounding whitespace
+        (logger exports often pad them); CRLF line ends are fine.
+    time_column : str or sequence of str
+        Column holding the timestamp, or several columns whose values are joined with a
+        single space before parsing (e.g. ``("Year", "Month", "Day", "Hour (UTC)")`` with
+        ``time_format="%Y %m %d %H"``).
+    columns : mapping of str to str, optional
+        ``{standard_name: source_column}``, e.g. ``{"Ti": "TEMP C", "RHi": "%RH"}``.
+        Standard names and units: ``Te`` [°C], ``RHe`` [%], ``ghi``, ``dni``, ``dhi``
+        [W/m²], ``Ti`` [°C], ``RHi`` [%], ``Pe``, ``Pi`` [Pa], ``Tdew`` [°C]. Default: the
+        file's columns that already carry a standard name.
+    time_format : str, optional
+        :func:`~datetime.datetime.strptime` format, e.g. ``"%d-%m-%Y %H:%M"``. Default:
+        inferred from the first timestamp (and every row must then match it).
+    timezone : str or tzinfo, optional
+        Clock of the naive timestamps: ``"UTC"``, a fixed offset (``"UTC+2"``,
+        ``"UTC-03:30"``; no DST) or an IANA zone with DST (``"Europe/Copenhagen"``).
+        Required unless every timestamp carries its own UTC offset (ISO 8601 ``+02:00``
+        or ``Z``), in which case it must be omitted.
+    sep, decimal : str
+        Field separator and decimal mark (``sep=";", decimal=","`` for many European
+        exports).
+    averaged : iterable of str, optional
+        Standard names of the columns that are interval averages (or sums expressed as
+        mean rates). Default: the irradiance columns present (``ghi``, ``dni``, ``dhi``).
+        Pass ``()`` when the file holds instantaneous (or centred) irradiance values.
+    interval : str or Timedelta, optional
+        Length of the averaging interval [e.g. ``"1h"``]. Default: the most frequent
+        spacing of the timestamps.
+    label : {"end", "start"}, default "end"
+        Where the file stamps its interval averages. With ``"start"`` the averaged
+        columns are moved to the interval end (``+interval``), the returned convention.
+    duplicates : {"raise", "first", "last", "mean"}, default "raise"
+        What to do with rows that share a UTC timestamp but have different values
+        (rows that repeat a timestamp with identical values are always dropped and
+        counted). Daylight-saving repeats are handled before this step (see Notes).
+    sort : bool, default False
+        Sort rows whose UTC timestamps go backwards; by default that is an error.
+    invalid : {"raise", "nan"}, default "raise"
+        Unparseable timestamps, unparseable numbers and values outside physical ranges
+        (T outside −60..70 °C, RH outside 0..100 %, irradiance below −10 W/m² or above
+        1500 W/m²): raise a :class:`~heritage_bayes.errors.DataError` naming the file,
+        column and line, or drop the row (bad timestamp) / set the value to NaN, counted
+        in ``attrs["dropped"]``.
+    na_values : iterable, optional
+        Extra markers of missing values, e.g. ``[-9999, "ERR"]`` (empty cells, ``NA``,
+        ``NaN`` and ``null`` are always missing).
+    skiprows : int, default 0
+        Lines to skip before the header line.
+    encoding : str, default "utf-8"
+
+    Returns
+    -------
+    pandas.DataFrame
+        UTC index ``time``; one float column per entry of ``columns`` (in that order).
+        ``attrs``: ``source``, ``format``, ``timezone``, ``units``, ``averaged``,
+        ``interval``, ``dropped`` (counts of rows or values removed and why), ``clipped``
+        (irradiance noise set to 0) and ``irradiance_source``.
+
+    Raises
+    ------
+    heritage_bayes.errors.DataError
+        Missing file, missing column (the message lists the columns that exist), bad
+        timestamps or values (file, column, line), timestamps going backwards, duplicate
+        timestamps with conflicting values.
+
+    Notes
+    -----
+    Daylight-saving policy for a local clock (IANA ``timezone``):
+
+    * **repeated autumn hour**: resolved by file order. Inside a run of consecutive rows
+      stamped in the repeated hour, the first pass is daylight time and a stamp that does
+      not increase on its predecessor starts the second pass (standard time). When the
+      file holds only one pass (the logger skipped or overwrote the repeat), the pass
+      cannot be placed and its rows are dropped, counted as ``ambiguous_dst``;
+    * **skipped spring hour**: stamps inside it do not exist on that clock; such rows
+      (a logger that did not switch in time) are dropped, counted as ``nonexistent_dst``.
+      Otherwise the spring hour is simply absent, a one-hour gap.
+
+    Nothing is ever duplicated: after conversion to UTC the index is checked for order
+    and uniqueness.
+
+    Examples
+    --------
+    >>> df = read_csv("oerholm.csv", sep=";", time_column="DATE AND TIME",
+    ...               time_format="%d-%m-%Y %H:%M", timezone="Europe/Copenhagen",
+    ...               columns={"Ti": "TEMP C", "RHi": "%RH"},
+    ...               duplicates="first")  # doctest: +SKIP
+    """
+    path = check_file(path)
+    name = source_name(path)
+    check_choice(duplicates, DUPLICATE_POLICIES, "duplicates")
+    check_choice(invalid, INVALID_POLICIES, "invalid")
+    check_choice(label, _LABELS, "label")
+    if not isinstance(sort, bool):
+        raise InputError(f"sort must be True or False (got {sort!r})")
+    time_cols = [time_column] if isinstance(time_column, str) else list(time_column)
+    if not time_cols or not all(isinstance(c, str) for c in time_cols):
+        raise InputError(f"time_column must be a column name or a list of names ({time_column!r})")
+    if isinstance(skiprows, bool) or not isinstance(skiprows, int) or skiprows < 0:
+        raise InputError(f"skiprows must be a non-negative integer (got {skiprows!r})")
+    tz = parse_timezone(timezone) if timezone is not None else None
+    na_list = list(na_values) if na_values is not None else []
+    na_numeric = [float(v) for v in na_list if isinstance(v, int | float)]
+    read_kw = {"sep": sep, "skiprows": skiprows, "encoding": encoding}
+
+    # -- header --------------------------------------------------------------------------
+    try:
+        header = pd.read_csv(path, nrows=0, **read_kw)
+    except pd.errors.EmptyDataError as exc:
+        raise DataError(f"{name}: file is empty, expected a header line") from exc
+    except (pd.errors.ParserError, UnicodeDecodeError) as exc:
+        raise DataError(f"{name}: cannot read the header: {exc}") from exc
+    stripped = [str(c).strip() for c in header.columns]
+
+    if columns is None:
+        columns = {c: c for c in stripped if c in STANDARD_COLUMNS}
+        if not columns:
+            raise DataError(
+                f"{name}: no column has a standard name and no columns= mapping was given; "
+                f"columns are: {_quote_list(stripped)}; pass e.g. "
+                f"columns={{'Ti': {stripped[-1]!r}}}"
+            )
+    if not isinstance(columns, Mapping) or not columns:
+        raise InputError("columns must be a non-empty mapping {standard_name: source_column}")
+    unknown = [k for k in columns if k not in STANDARD_COLUMNS]
+    if unknown:
+        raise InputError(
+            f"columns: unknown standard name(s) {_quote_list(unknown)}; standard names are "
+            f"{_quote_list(STANDARD_COLUMNS)}"
+        )
+    wanted = {std: str(src).strip() for std, src in columns.items()}
+
+    def position(col: str) -> int:
+        hits = [i for i, c in enumerate(stripped) if c == col]
+        if not hits:
+            raise DataError(
+                f"{name}: column {col!r} not found; columns are: {_quote_list(stripped)}"
+            )
+        if len(hits) > 1:
+            raise DataError(f"{name}: column name {col!r} appears {len(hits)} times in the header")
+        return hits[0]
+
+    time_pos = [position(c) for c in time_cols]
+    value_pos = {std: position(src) for std, src in wanted.items()}
+    usecols = sorted(set(time_pos) | set(value_pos.values()))
+
+    # -- body ------------------------------------------------------------------------------
+    try:
+        raw = pd.read_csv(
+            path,
+            header=0,
+            index_col=False,
+            dtype=str,
+            na_values=[str(v) for v in na_list] or None,
+            skip_blank_lines=False,
+            **read_kw,
+        )
+    except pd.errors.ParserError as exc:
+        raise DataError(f"{name}: malformed table: {exc}") from exc
+    except UnicodeDecodeError as exc:
+        raise DataError(f"{name}: not {encoding}-encoded text ({exc}); pass encoding=") from exc
+    if raw.shape[1] != len(stripped):
+        raise DataError(f"{name}: malformed table: rows have more fields than the header")
+    raw = raw.iloc[:, usecols]
+    raw.columns = [stripped[i] for i in usecols]
+    lines = np.arange(len(raw)) + skiprows + 2  # 1-based line numbers, header on skiprows+1
+    counts: dict[str, int] = {}
+
+    blank = raw.isna().all(axis=1).to_numpy()
+    if blank.any():
+        counts["blank_rows"] = int(blank.sum())
+        raw = raw[~blank]
+        lines = lines[~blank]
+
+    # -- timestamps ------------------------------------------------------------------------
+    parts = [raw[c].str.strip() for c in time_cols]
+    text = parts[0]
+    for part in parts[1:]:
+        text = text + " " + part
+    try:
+        stamps = pd.to_datetime(text, format=time_format, errors="coerce")
+    except ValueError:  # mixed UTC offsets
+        stamps = pd.to_datetime(text, format=time_format, errors="coerce", utc=True)
+    bad = stamps.isna().to_numpy()
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        if invalid == "raise":
+            expected = f"format {time_format!r}" if time_format else "the format of line 2"
+            shown = text.iloc[i] if isinstance(text.iloc[i], str) else ""
+            raise DataError(
+                f"{name}: cannot parse timestamp {shown!r} in column(s) "
+                f"{_quote_list(time_cols)} on line {int(lines[i])} (expected {expected}); "
+                f"{int(bad.sum())} bad timestamp(s). Fix the file or pass invalid='nan' to "
+                f"drop such rows"
+            )
+        counts["bad_timestamps"] = int(bad.sum())
+        raw, text, stamps, lines = raw[~bad], text[~bad], stamps[~bad], lines[~bad]
+
+    # -- values ----------------------------------------------------------------------------
+    data = {}
+    for std, src in wanted.items():
+        cell = raw[src].str.strip()
+        if decimal != ".":
+            cell = cell.str.replace(decimal, ".", regex=False)
+        num = pd.to_numeric(cell, errors="coerce").astype(float)
+        unparsed = (num.isna() & cell.notna() & (cell != "")).to_numpy()
+        if unparsed.any():
+            i = int(np.flatnonzero(unparsed)[0])
+            if invalid == "raise":
+                raise DataError(
+                    f"{name}: column {src!r} line {int(lines[i])}: cannot parse "
+                    f"{raw[src].iloc[i]!r} as a number (decimal mark {decimal!r}); "
+                    f"{int(unparsed.sum())} such value(s). Declare missing-value markers "
+                    f"with na_values= or pass invalid='nan'"
+                )
+            counts["unparseable_values"] = counts.get("unparseable_values", 0) + int(unparsed.sum())
+        values = num.to_numpy(copy=True)
+        if na_numeric:
+            values[np.isin(values, na_numeric)] = np.nan
+        data[std] = values
+
+    # -- time zone -------------------------------------------------------------------------
+    stamp_index = pd.DatetimeIndex(stamps)
+    line_text = dict(zip(lines.tolist(), text.tolist(), strict=True))
+    if stamp_index.tz is not None:
+        if tz is not None:
+            raise DataError(
+                f"{name}: timestamps carry their own UTC offset (line {int(lines[0])}: "
+                f"{text.iloc[0]!r}); omit timezone= (got {timezone!r})"
+            )
+        utc = stamp_index.tz_convert("UTC")
+        keep = np.ones(len(utc), dtype=bool)
+        tz_label = "from the timestamps"
+    else:
+        if tz is None:
+            raise DataError(
+                f"{name}: timestamps have no UTC offset (line {int(lines[0])}: "
+                f"{text.iloc[0]!r}); pass timezone=, e.g. 'UTC', 'UTC+2' or "
+                f"'Europe/Copenhagen'"
+            )
+        loc = localize(stamp_index, tz)
+        utc, keep = loc.utc, loc.keep
+        counts["ambiguous_dst"] = loc.ambiguous_dropped
+        counts["nonexistent_dst"] = loc.nonexistent_dropped
+        tz_label = str(timezone)
+    frame = pd.DataFrame({k: v[keep] for k, v in data.items()}, index=utc)
+    lines = lines[keep]
+
+    clipped = validate_ranges(frame, lines, name, wanted, invalid, counts)
+    frame["__line"] = lines
+    frame = order_and_deduplicate(
+        frame,
+        name,
+        duplicates=duplicates,
+        sort=sort,
+        counts=counts,
+        describe=lambda line: f"{line_text[int(line)]!r}",
+    )
+    frame = frame.drop(columns="__line")
+
+    # -- interval averages -----------------------------------------------------------------
+    if averaged is None:
+        averaged_cols = tuple(c for c in AVERAGED_BY_DEFAULT if c in frame.columns)
+    else:
+        averaged_cols = (averaged,) if isinstance(averaged, str) else tuple(averaged)
+        missing = [c for c in averaged_cols if c not in frame.columns]
+        if missing:
+            raise InputError(
+                f"averaged: {_quote_list(missing)} not among the columns read "
+                f"({_quote_list(frame.columns)})"
+            )
+    step = _as_timedelta(interval, "interval") if interval is not None else modal_step(frame.index)
+    if averaged_cols and step is None:
+        raise DataError(f"{name}: cannot infer the averaging interval from one row; pass interval=")
+    if label == "start" and averaged_cols:
+        frame = _shift_columns(frame, averaged_cols, step)
+
+    return finalize(
+        frame,
+        source=str(path),
+        fmt="csv",
+        averaged=averaged_cols,
+        interval=step,
+        counts=counts,
+        clipped=clipped,
+        extra={"timezone": tz_label, "source_columns": dict(wanted)},
+    )
+
+
+def _as_timedelta(value, what: str) -> pd.Timedelta:
+    try:
+        td = pd.Timedelta(value)
+    except (ValueError, TypeError) as exc:
+        raise InputError(
+            f"{what} must be a duration such as '1h' or '10min' (got {value!r})"
+        ) from exc
+    if td <= pd.Timedelta(0):
+        raise InputError(f"{what} must be positive (got {value!r})")
+    return td
+
+
+def _shift_columns(frame: pd.DataFrame, cols: Sequence[str], by: pd.Timedelta) -> pd.DataFrame:
+    """Move ``cols`` forward in time by ``by`` (start-stamped averages to end stamps)."""
+    others = [c for c in frame.columns if c not in cols]
+    moved = frame[list(cols)].copy()
+    moved.index = moved.index + by
+    if not others:
+        return moved
+    out = frame[others].join(moved, how="outer")
+    return out[list(frame.columns)]
+
+
+# ---------------------------------------------------------------------------------------
+# KNMI hourly station data
+# ---------------------------------------------------------------------------------------
+
+_KNMI_REQUIRED = ("YYYYMMDD", "HH", "T", "U", "Q")
+
+
+def _open_text(path: Path):
+    if path.suffix == ".gz":
+        return gzip.open(path, "rt", encoding="latin-1")
+    return open(path, encoding="latin-1")
+
+
+def read_knmi_hourly(
+    path: str | PathLike | Sequence[str | PathLike], *, invalid: str = "raise"
+) -> pd.DataFrame:
+    """Read KNMI hourly station data (``uurgeg_<STN>_<period>.txt``, also ``.gz``).
+
+    Parameters
+    ----------
+    path : str, path-like, or sequence of them
+        One file, or several consecutive files of the same station (they are
+        concatenated; overlapping identical hours are dropped once).
+    invalid : {"raise", "nan"}, default "raise"
+        Values outside physical ranges: raise, or set to NaN (counted).
+
+    Returns
+    -------
+    pandas.DataFrame
+        UTC index; columns ``Te`` [°C] (``T``, at the observation), ``Tdew`` [°C]
+        (``TD``, when present), ``RHe`` [%] (``U``, at the observation) and ``ghi``
+        [W/m²] (``Q``, the mean of the hour ending at the stamp).
+        ``attrs["averaged"] == ("ghi",)``, ``attrs["interval"] == "1h"``,
+        ``attrs["station"]`` the station number.
+
+    Notes
+    -----
+    ``HH`` is the hour **ending** at HH UT (1..24; ``HH = 24`` is midnight of the next
+    day), so the stamp is ``YYYYMMDD + HH h`` in UTC: exactly the interval-end convention
+    of this package. Units in the file: ``T``, ``TD`` in 0.1 °C; ``U`` in %; ``Q`` in
+    J/cm² per hour, hence
+    :math:`G_h\\,[\\mathrm{W/m^2}] = Q \\cdot 10^4 / 3600`.
+    Empty fields are missing values (NaN).
+
+    References
+    ----------
+    .. [1] KNMI, "Hourly data of the weather in the Netherlands",
+       https://www.knmi.nl/nederland-nu/klimatologie/uurgegevens
+    """
+    check_choice(invalid, INVALID_POLICIES, "invalid")
+    paths = [path] if isinstance(path, str | PathLike) else list(path)
+    if not paths:
+        raise InputError("path: no file given")
+    parts = [_read_knmi_one(check_file(p), invalid) for p in paths]
+    parts.sort(key=lambda part: part[0].index[0])  # files given in any order
+    frame = pd.concat([p[0] for p in parts])
+    counts: dict[str, int] = {}
+    for _, c, _ in parts:
+        for k, v in c.items():
+            counts[k] = counts.get(k, 0) + v
+    stations = sorted({p[2] for p in parts})
+    names = ", ".join(source_name(p) for p in paths)
+    if len(stations) > 1:
+        raise DataError(f"{names}: files of different stations {stations}; read them separately")
+    frame = order_and_deduplicate(frame, names, duplicates="raise", sort=False, counts=counts)
+    frame = frame.drop(columns="__line")
+    return finalize(
+        frame,
+        source=str(paths[0]) if len(paths) == 1 else [str(p) for p in paths],
+        fmt="knmi-hourly",
+        averaged=("ghi",),
+        interval=pd.Timedelta("1h"),
+        counts=counts,
+        clipped={},
+        extra={"timezone": "UTC", "station": stations[0]},
+    )
+
+
+def _read_knmi_one(path: Path, invalid: str):
+    name = source_name(path)
+    header_line = None
+    try:
+        with _open_text(path) as fh:
+            for number, line in enumerate(fh):
+                if line.lstrip().startswith("# STN"):
+                    header_line = number, line
+                    break
+                if number > 500:
+                    break
+    except (OSError, EOFError) as exc:
+        raise DataError(f"{name}: cannot read the file: {exc}") from exc
+    if header_line is None:
+        raise DataError(
+            f"{name}: not a KNMI hourly file: no header line starting with "
+            f"'# STN,YYYYMMDD,HH,...' in the first 500 lines"
+        )
+    number, line = header_line
+    names = [c.strip() for c in line.strip().lstrip("#").split(",")]
+    missing = [c for c in _KNMI_REQUIRED if c not in names]
+    if missing:
+        raise DataError(
+            f"{name}: KNMI column(s) {_quote_list(missing)} not found; columns are: "
+            f"{_quote_list(names)}"
+        )
+    use = [c for c in ("STN", *_KNMI_REQUIRED, "TD") if c in names]
+    try:
+        raw = pd.read_csv(
+            path,
+            skiprows=number + 1,
+            header=None,
+            names=names,
+            usecols=use,
+            skipinitialspace=True,
+            skip_blank_lines=True,
+            dtype=float,
+            encoding="latin-1",
+        )
+    except (ValueError, pd.errors.ParserError) as exc:
+        raise DataError(f"{name}: malformed KNMI data: {exc}") from exc
+    if raw.empty:
+        raise DataError(f"{name}: no data rows after the header line {number + 1}")
+    if raw[["YYYYMMDD", "HH"]].isna().any().any():
+        i = int(np.flatnonzero(raw[["YYYYMMDD", "HH"]].isna().any(axis=1).to_numpy())[0])
+        raise DataError(f"{name}: data row {i + 1}: empty YYYYMMDD or HH")
+    hh = raw["HH"].to_numpy()
+    bad_hh = (hh < 1) | (hh > 24) | (hh != np.round(hh))
+    if bad_hh.any():
+        i = int(np.flatnonzero(bad_hh)[0])
+        raise DataError(
+            f"{name}: column 'HH' data row {i + 1} (YYYYMMDD={int(raw['YYYYMMDD'].iloc[i])}): "
+            f"expected an hour 1..24, found {hh[i]:g}"
+        )
+    dates = pd.to_datetime(
+        raw["YYYYMMDD"].astype("int64").astype(str), format="%Y%m%d", errors="coerce"
+    )
+    if dates.isna().any():
+        i = int(np.flatnonzero(dates.isna().to_numpy())[0])
+        raise DataError(
+            f"{name}: column 'YYYYMMDD' data row {i + 1}: cannot parse "
+            f"{raw['YYYYMMDD'].iloc[i]:.0f} as a date"
+        )
+    index = pd.DatetimeIndex(dates + pd.to_timedelta(hh, unit="h")).tz_localize("UTC")
+    stations = raw["STN"].dropna().unique() if "STN" in raw else np.array([np.nan])
+    if len(stations) > 1:
+        raise DataError(f"{name}: holds several stations {sorted(stations.astype(int))}")
+    frame = pd.DataFrame(
+        {
+            "Te": raw["T"].to_numpy() / 10.0,
+            **({"Tdew": raw["TD"].to_numpy() / 10.0} if "TD" in raw else {}),
+            "RHe": raw["U"].to_numpy(),
+            "ghi": raw["Q"].to_numpy() * 1.0e4 / 3600.0,
+        },
+        index=index,
+    )
+    lines = np.arange(len(frame)) + number + 3  # header, blank line, then data
+    counts: dict[str, int] = {}
+    source_cols = {"Te": "T", "Tdew": "TD", "RHe": "U", "ghi": "Q"}
+    validate_ranges(frame, lines, name, source_cols, invalid, counts)
+    frame["__line"] = lines
+    station = int(stations[0]) if np.isfinite(stations[0]) else None
+    return frame, counts, station
+
+
+# ---------------------------------------------------------------------------------------
+# EnergyPlus weather (EPW) and TMY3
+# ---------------------------------------------------------------------------------------
+
+# EPW missing-value markers (EnergyPlus Auxiliary Programs, "Weather file data fields").
+_EPW_MISSING = {"temp_air": 99.9, "temp_dew": 99.9, "relative_humidity": 999.0}
+_EPW_IRR_MISSING = 9999.0
+_WEATHER_MAP = {
+    "temp_air": "Te",
+    "relative_humidity": "RHe",
+    "ghi": "ghi",
+    "dni": "dni",
+    "dhi": "dhi",
+    "temp_dew": "Tdew",
+}
+
+
+def _site_from_meta(meta: Mapping) -> dict:
+    return {
+        "latitude": float(meta["latitude"]),
+        "longitude": float(meta["longitude"]),
+        "altitude": float(meta["altitude"]),
+    }
+
+
+def read_epw(path: str | PathLike, *, year: int | None = None, invalid: str = "raise"):
+    """Read an EnergyPlus weather file (``.epw``) with :func:`pvlib.iotools.read_epw`.
+
+    Parameters
+    ----------
+    path : str or path-like
+    year : int, optional
+        Put every row in this year (typical-year files mix months of different years).
+        Default: keep the file's years when the rows form one contiguous hourly series
+        (an actual-year file), else coerce to 2019 (a non-leap year, as EPW typical years
+        have 8760 rows).
+    invalid : {"raise", "nan"}, default "raise"
+        Values outside physical ranges: raise, or set to NaN (counted).
+
+    Returns
+    -------
+    pandas.DataFrame
+        UTC index; ``Te`` [°C], ``Tdew`` [°C], ``RHe`` [%] at the stamp; ``ghi``,
+        ``dni``, ``dhi`` [W/m²] mean of the hour ending at the stamp.
+        ``attrs["site"]`` holds ``latitude``, ``longitude``, ``altitude`` from the
+        header, ``attrs["coerced_year"]`` the year used (or None).
+
+    Notes
+    -----
+    EPW rows are in local **standard** time (``TZ`` of the LOCATION line, no DST). Hour
+    ``h`` (1..24) is the interval from ``h-1`` to ``h``; radiation fields are energy over
+    that hour [Wh/m²], i.e. its mean irradiance [W/m²], stamped here at ``h`` (pvlib
+    stamps the interval start). EPW missing-value markers (99.9 °C, 999 %, 9999 W/m²)
+    become NaN.
+
+    References
+    ----------
+    .. [1] U.S. DOE, "EnergyPlus Auxiliary Programs", chapter "Weather Converter
+       Program", section "EnergyPlus Weather File (EPW) Data Dictionary".
+    """
+    import pvlib
+
+    path = check_file(path)
+    name = source_name(path)
+    check_choice(invalid, INVALID_POLICIES, "invalid")
+    try:
+        data, meta = pvlib.iotools.read_epw(str(path))
+    except Exception as exc:  # pvlib raises assorted errors on malformed files
+        raise DataError(f"{name}: cannot read as EPW: {exc}") from exc
+    years = data["year"].to_numpy()
+    month, day, hour = (data[c].to_numpy() for c in ("month", "day", "hour"))
+    if year is None:
+        naive = _epw_naive(years, month, day, hour)
+        steps = None if naive is None else np.unique(np.diff(naive.asi8))
+        contiguous = steps is not None and steps.size == 1 and steps[0] > 0
+        year_used = None if contiguous else TYPICAL_YEAR
+    else:
+        year_used = _check_year(year)
+    if year_used is not None:
+        naive = _epw_naive(np.full_like(years, year_used), month, day, hour)
+        if naive is None:
+            raise DataError(f"{name}: contains 29 February; pass a leap year, e.g. year=2020")
+    tz = pd.Timedelta(hours=float(meta["TZ"]))
+    index = (naive - tz).tz_localize("UTC")
+    frame = pd.DataFrame(
+        {std: data[src].to_numpy(dtype=float) for src, std in _WEATHER_MAP.items()},
+        index=index,
+    )
+    for src, marker in _EPW_MISSING.items():
+        col = _WEATHER_MAP[src]
+        frame.loc[frame[col] >= marker, col] = np.nan
+    for col in ("ghi", "dni", "dhi"):
+        frame.loc[frame[col] >= _EPW_IRR_MISSING, col] = np.nan
+    lines = np.arange(len(frame)) + 9  # 8 header lines
+    counts: dict[str, int] = {}
+    clipped = validate_ranges(frame, lines, name, {}, invalid, counts)
+    frame["__line"] = lines
+    frame = order_and_deduplicate(frame, name, duplicates="raise", sort=False, counts=counts)
+    frame = frame.drop(columns="__line")
+    return finalize(
+        frame,
+        source=str(path),
+        fmt="epw",
+        averaged=("ghi", "dni", "dhi"),
+        interval=pd.Timedelta("1h"),
+        counts=counts,
+        clipped=clipped,
+        extra={
+            "timezone": f"UTC{float(meta['TZ']):+g} (local standard time)",
+            "site": _site_from_meta(meta),
+            "coerced_year": year_used,
+            "station": str(meta.get("city", "")),
+        },
+    )
+
+
+def _check_year(year) -> int:
+    if isinstance(year, bool) or not isinstance(year, int | np.integer) or not 1 <= year <= 9998:
+        raise InputError(f"year must be an integer year such as 2019 (got {year!r})")
+    return int(year)
+
+
+def _epw_naive(years, month, day, hour) -> pd.DatetimeIndex | None:
+    """Naive local stamps at the end of each EPW hour; None if a date does not exist."""
+    dates = pd.to_datetime(
+        pd.DataFrame({"year": years, "month": month, "day": day}), errors="coerce"
+    )
+    if dates.isna().any():
+        return None
+    return pd.DatetimeIndex(dates + pd.to_timedelta(hour, unit="h"))
+
+
+def read_tmy3(path: str | PathLike, *, year: int | None = None, invalid: str = "raise"):
+    """Read a TMY3 file with :func:`pvlib.iotools.read_tmy3`.
+
+    Parameters
+    ----------
+    path : str or path-like
+        E.g. the file shipped with pvlib, ``pvlib/data/723170TYA.CSV`` (Greensboro, NC).
+    year : int, optional
+        Year every row is put in. TMY3 months come from different years; default 2019,
+        a non-leap year (TMY3 has no 29 February), so the index increases monotonically.
+        The last row (24:00 on 31 December) lands at midnight of ``year + 1``.
+    invalid : {"raise", "nan"}, default "raise"
+
+    Returns
+    -------
+    pandas.DataFrame
+        UTC index; ``Te`` [°C], ``Tdew`` [°C], ``RHe`` [%] at the stamp; ``ghi``, ``dni``,
+        ``dhi`` [W/m²], mean of the hour ending at the stamp. ``attrs["site"]`` from the
+        header (latitude, longitude, altitude).
+
+    Notes
+    -----
+    TMY3 stamps are local standard time (header ``TZ``, no DST) at the end of the hour
+    the radiation is integrated over [1]_.
+
+    References
+    ----------
+    .. [1] S. Wilcox and W. Marion, "Users manual for TMY3 data sets", NREL/TP-581-43156
+       (2008). doi:10.2172/928611
+    """
+    import pvlib
+
+    path = check_file(path)
+    name = source_name(path)
+    check_choice(invalid, INVALID_POLICIES, "invalid")
+    year_used = TYPICAL_YEAR if year is None else _check_year(year)
+    try:
+        data, meta = pvlib.iotools.read_tmy3(str(path), coerce_year=year_used, map_variables=True)
+    except Exception as exc:  # pvlib raises assorted errors on malformed files
+        raise DataError(f"{name}: cannot read as TMY3: {exc}") from exc
+    missing = [c for c in _WEATHER_MAP if c not in data.columns]
+    if missing:
+        raise DataError(f"{name}: TMY3 column(s) {_quote_list(missing)} not found")
+    frame = pd.DataFrame(
+        {std: data[src].to_numpy(dtype=float) for src, std in _WEATHER_MAP.items()},
+        index=data.index.tz_convert("UTC"),
+    )
+    lines = np.arange(len(frame)) + 3  # metadata line, header line
+    counts: dict[str, int] = {}
+    clipped = validate_ranges(frame, lines, name, {}, invalid, counts)
+    frame["__line"] = lines
+    frame = order_and_deduplicate(frame, name, duplicates="raise", sort=False, counts=counts)
+    frame = frame.drop(columns="__line")
+    return finalize(
+        frame,
+        source=str(path),
+        fmt="tmy3",
+        averaged=("ghi", "dni", "dhi"),
+        interval=pd.Timedelta("1h"),
+        counts=counts,
+        clipped=clipped,
+        extra={
+            "timezone": f"UTC{float(meta['TZ']):+g} (local standard time)",
+            "site": _site_from_meta(meta),
+            "coerced_year": year_used,
+            "station": str(meta.get("Name", "")).strip('"'),
+        },
+    )

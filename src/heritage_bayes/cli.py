@@ -21,8 +21,72 @@ def _build_parser() -> argparse.ArgumentParser:
         description="Bayesian calibration of RC models of the indoor climate of monuments.",
     )
     parser.add_argument("--version", action="version", version=f"hbayes {__version__}")
-    parser.add_subparsers(dest="command", metavar="COMMAND")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+
+    cal = sub.add_parser(
+        "calibrate",
+        help="calibrate the models of a YAML config",
+        description="Calibrate the thermal and/or hygric RC models of a "
+        "config; write posterior.nc, summary.json, config.yaml "
+        "and report.html to the run directory.",
+    )
+    cal.add_argument("config", help="YAML configuration file (e.g. configs/demo.yaml)")
+    cal.add_argument("--out", metavar="DIR", help="run directory (default: reports/<config name>/)")
+    cal.add_argument("--seed", type=int, help="random seed (overrides the config's)")
+    cal.add_argument(
+        "--resume", action="store_true", help="continue the chains saved in the run directory"
+    )
+    cal.add_argument("--quiet", action="store_true", help="no progress output")
+    cal.add_argument("--no-report", action="store_true", help="skip report.html")
+    cal.set_defaults(func=_cmd_calibrate)
+
+    rep = sub.add_parser(
+        "report",
+        help="(re)write RUN_DIR/report.html",
+        description="Write the self-contained HTML report of a run.",
+    )
+    rep.add_argument("run_dir", help="a run directory written by `hbayes calibrate`")
+    rep.add_argument("--quiet", action="store_true")
+    rep.set_defaults(func=_cmd_report)
+
+    mod = sub.add_parser("models", help="list the catalogue of RC models")
+    mod.set_defaults(func=_cmd_models)
     return parser
+
+
+def _cmd_calibrate(args) -> int:
+    from heritage_bayes.calibrate import run_calibration
+    from heritage_bayes.config import load_config
+
+    cfg = load_config(args.config)
+    out = run_calibration(
+        cfg,
+        args.out,
+        seed=args.seed,
+        resume=args.resume,
+        quiet=args.quiet,
+        report=False if args.no_report else None,
+    )
+    if not args.quiet:
+        print(out)
+    return 0
+
+
+def _cmd_report(args) -> int:
+    from heritage_bayes.report import write_report
+
+    path = write_report(args.run_dir)
+    if not args.quiet:
+        print(path)
+    return 0
+
+
+def _cmd_models(args) -> int:
+    from heritage_bayes.rc.catalog import available_models
+
+    for name, desc in available_models().items():
+        print(f"{name:<20s} {desc}")
+    return 0
 
 
 def main(argv: list[str] | None = None) -> int:

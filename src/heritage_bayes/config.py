@@ -2,7 +2,8 @@
 
 Unknown keys are rejected; every error names the key path, the expected form and the
 value found, e.g. ``priors.Gw.lower: must be < upper (got 500 > 200)``. Relative paths
-in ``data`` are relative to the config file.
+in ``data`` are relative to the config file. How ``data`` and ``periods`` become model
+inputs and outputs: :mod:`heritage_bayes.prepare`.
 
 Layout (see ``configs/demo.yaml`` for a complete, commented example)::
 
@@ -14,20 +15,21 @@ Layout (see ``configs/demo.yaml`` for a complete, commented example)::
     site: {latitude: 52.1, longitude: 5.18, altitude: 2}
     room_volume: 800               # [m³], optional: log-normal prior on each model's Ci
     data:
-      demo: {...}                  # the built-in virtual monument, or:
+      demo: {seed: 7, gap: [2019-03-10, 2019-03-17]}   # the built-in virtual monument
+                                   # (heritage_bayes.demo), or real files:
       weather: {format: knmi, path: ../shared/data/knmi-debilt/uurgeg_260_2011-2020.txt.gz}
       measurements: {format: csv, path: logger.csv, time_column: ..., timezone: ...,
-                     columns: {Ti: "TEMP C", RHi: "%RH"}}
+                     columns: {Ti: "TEMP C", RHi: "%RH"}}   # or a list of such tables
       irradiance: measured         # measured | clear_sky (explicit proxy) | none
-      surfaces: {N: [90, 0], E: [90, 90], S: [90, 180], W: [90, 270]}
+      surfaces: {N: [90, 0], E: [90, 90], S: [90, 180], W: [90, 270]}  # (tilt, azimuth)
       ground_temperature: {mode: annual_mean}   # or {mode: constant, value: 10},
-                                                #    {mode: column, column: Tg}
+                        # {mode: column, column: T, source: {format: csv, path: ...}}
       step: 1h
       max_gap: 6h
-    periods:
-      calibration: {start: 2019-01-01, end: 2019-07-01}
+    periods:                       # dates: UTC unless they carry an offset
+      calibration: {start: 2019-01-01, end: 2019-07-01}   # [start, end)
       validation: {start: 2019-07-01, end: 2020-01-01}
-      warmup: 14d
+      warmup: 14d                  # durations: 1h, 30min, 14d (see parse_duration)
     thermal: {model: thermal_4a, noise: ar1, priors: {Gf: {fixed: 0}}}
     hygric: {model: hygric_2c_fixed, noise: ar1}
     sampler: {max_steps: 20000}
@@ -36,22 +38,91 @@ Layout (see ``configs/demo.yaml`` for a complete, commented example)::
 
 from __future__ import annotations
 
+import datetime as _dt
 import hashlib
 import json
+import re
 from pathlib import Path
-from typing import Any, Literal
+from typing import Annotated, Any, Literal
 
 import pandas as pd
 import yaml
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+from pydantic import (
+    BaseModel,
+    BeforeValidator,
+    ConfigDict,
+    Field,
+    ValidationError,
+    field_validator,
+    model_validator,
+)
 
 from heritage_bayes.errors import ConfigError
 
-__all__ = ["CalibrationConfig", "config_hash", "load_config", "parse_config"]
+__all__ = ["CalibrationConfig", "config_hash", "load_config", "parse_config", "parse_duration"]
 
 
 class _Strict(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=False)
+
+
+def _date_text(v):
+    """YAML turns ``2019-01-01`` into a date: accept it as the ISO text it was."""
+    if isinstance(v, _dt.datetime | _dt.date):
+        return v.isoformat()
+    return v
+
+
+#: A date or date-time: YAML dates and strings such as ``2019-01-01`` or
+#: ``2019-01-01T06:00``; naive values are UTC, an explicit offset (``+01:00``) is honoured.
+DateText = Annotated[str, BeforeValidator(_date_text)]
+
+
+_DAY_UNIT = re.compile(r"(?<=\d)\s*[dD](?![A-Za-z])")
+_HOUR_UNIT = re.compile(r"(?<=\d)\s*H(?![A-Za-z])")
+
+
+def parse_duration(text) -> pd.Timedelta:
+    """A config duration (``'14d'``, ``'1h'``, ``'30min'``, ``'1d12h'``) as a Timedelta.
+
+    ``d``/``D`` are days and ``h``/``H`` hours (pandas 3 deprecates the aliases ``d``
+    and ``H``; they are normalised first).
+    """
+    return pd.Timedelta(_normalise_duration(text))
+
+
+def _check_duration(v: str, *, positive: bool = False) -> str:
+    try:
+        td = parse_duration(v)
+    except (ValueError, TypeError):
+        raise ValueError(
+            f"expected a duration such as '1h', '14d' or '30min' (got {v!r})"
+        ) from None
+    if td < pd.Timedelta(0) or (positive and td == pd.Timedelta(0)):
+        raise ValueError(f"must be {'positive' if positive else 'non-negative'} (got {v!r})")
+    return _normalise_duration(v)
+
+
+def _normalise_duration(v):
+    return _HOUR_UNIT.sub("h", _DAY_UNIT.sub("D", v.strip())) if isinstance(v, str) else v
+
+
+def _utc(text: str) -> pd.Timestamp:
+    """A config date as a UTC timestamp (naive values are UTC)."""
+    ts = pd.Timestamp(text)
+    return ts.tz_localize("UTC") if ts.tzinfo is None else ts.tz_convert("UTC")
+
+
+def _check_dates(start: str, end: str) -> tuple[pd.Timestamp, pd.Timestamp]:
+    try:
+        s, e = _utc(start), _utc(end)
+    except (ValueError, TypeError) as exc:
+        raise ValueError(
+            f"start/end must be dates such as 2019-01-01 or 2019-01-01T06:00 ({exc})"
+        ) from None
+    if not s < e:
+        raise ValueError(f"start must be before end (got {start} >= {end})")
+    return s, e
 
 
 class Site(_Strict):
@@ -61,20 +132,57 @@ class Site(_Strict):
 
 
 class DemoData(_Strict):
-    """The built-in virtual monument (see :mod:`heritage_bayes.demo`)."""
+    """The built-in virtual monument (see :mod:`heritage_bayes.demo`).
+
+    ``truth`` overrides documented true parameter values, e.g.
+    ``{thermal: {fI_S: 0}, hygric: {Cw: 1.0}}`` (SI units).
+    """
 
     seed: int = 7
     weather: Literal["greensboro_tmy3"] = "greensboro_tmy3"
     sensor_noise_T: float = Field(default=0.1, ge=0, description="[K] sd of white noise")
-    sensor_noise_RH: float = Field(default=1.0, ge=0, description="[%RH] sd")
-    gap: tuple[str, str] | None = ("2019-03-10", "2019-03-17")
+    sensor_noise_RH: float = Field(default=1.0, ge=0, description="[%RH] sd of white noise")
+    model_error_T: float = Field(default=0.2, ge=0, description="[K] sd of the AR(1) error")
+    model_error_P: float = Field(default=25.0, ge=0, description="[Pa] sd of the AR(1) error")
+    model_error_phi: float = Field(default=0.9, ge=0, lt=1, description="[-] hourly AR(1)")
+    gap: tuple[DateText, DateText] | None = ("2019-03-10", "2019-03-17")
+    truth: dict[Literal["thermal", "hygric"], dict[str, float]] = Field(default_factory=dict)
+
+    @field_validator("gap")
+    @classmethod
+    def _gap(cls, v):
+        if v is not None:
+            _check_dates(*v)
+        return v
+
+
+_CSV_ONLY = (
+    "time_column",
+    "time_format",
+    "timezone",
+    "columns",
+    "sep",
+    "decimal",
+    "averaged",
+    "interval",
+    "label",
+    "duplicates",
+    "na_values",
+)
 
 
 class Source(_Strict):
-    """A table to read: ``format`` selects the reader; the rest are its options."""
+    """A table to read: ``format`` selects the reader; the rest are its options.
+
+    ``csv``: :func:`heritage_bayes.io.read_csv` (``time_column``, ``timezone`` and the
+    ``columns`` mapping ``{standard name: column in the file}``); ``epw``/``tmy3``:
+    :func:`~heritage_bayes.io.read_epw`/:func:`~heritage_bayes.io.read_tmy3` (``year``
+    for typical years); ``knmi``: :func:`~heritage_bayes.io.read_knmi_hourly` (``path``
+    may list consecutive files).
+    """
 
     format: Literal["csv", "epw", "knmi", "tmy3"]
-    path: str
+    path: str | list[str]
     time_column: str | list[str] | None = None
     time_format: str | None = None
     timezone: str | None = None
@@ -85,49 +193,92 @@ class Source(_Strict):
     interval: str | None = None
     label: Literal["end", "start"] = "end"
     duplicates: Literal["raise", "first", "last", "mean"] = "raise"
+    na_values: list[str | float] | None = None
+    invalid: Literal["raise", "nan"] = "raise"
     year: int | None = None
 
     @model_validator(mode="after")
-    def _csv_needs_time(self):
+    def _options_fit_format(self):
         if self.format == "csv" and self.time_column is None:
             raise ValueError("time_column: required for format 'csv'")
+        fields = type(self).model_fields
+        given = {k for k in fields if getattr(self, k) != fields[k].default}
         if self.format != "csv":
-            extra = [
-                k
-                for k in ("time_column", "time_format", "timezone", "columns")
-                if getattr(self, k) is not None
-            ]
+            extra = [k for k in _CSV_ONLY if k in given]
             if extra:
-                raise ValueError(f"{extra}: only for format 'csv' (format is {self.format!r})")
+                also = f"; also {', '.join(extra[1:])}" if len(extra) > 1 else ""
+                raise ValueError(
+                    f"{extra[0]}: only for format 'csv' (format is {self.format!r}){also}"
+                )
+        if self.year is not None and self.format not in ("epw", "tmy3"):
+            raise ValueError(f"year: only for formats 'epw' and 'tmy3' (format is {self.format!r})")
+        if isinstance(self.path, list) and self.format != "knmi":
+            raise ValueError(
+                f"path: a list of files is only for format 'knmi' (format is {self.format!r})"
+            )
+        if isinstance(self.path, list) and not self.path:
+            raise ValueError("path: the list of files is empty")
+        if self.interval is not None:
+            _check_duration(self.interval, positive=True)
         return self
 
 
 class GroundTemperature(_Strict):
+    """The fixed (ground) temperature input ``Tf`` of the thermal models.
+
+    ``annual_mean``: the outdoor temperature averaged over a year, see
+    :func:`heritage_bayes.prepare.annual_mean_temperature`; ``constant``: ``value``
+    [°C]; ``column``: a measured series, the column ``column`` (name in the file) of the
+    CSV table ``source`` or, without ``source``, of the weather or measurement CSV files.
+    """
+
     mode: Literal["annual_mean", "constant", "column"] = "annual_mean"
-    value: float | None = Field(default=None, description="[°C] for mode constant")
+    value: float | None = Field(default=None, ge=-60, le=70, description="[°C] mode constant")
     column: str | None = None
+    source: Source | None = None
 
     @model_validator(mode="after")
     def _check(self):
         if self.mode == "constant" and self.value is None:
             raise ValueError("value: required for mode 'constant' (a temperature in °C)")
         if self.mode == "column" and not self.column:
-            raise ValueError("column: required for mode 'column'")
+            raise ValueError("column: required for mode 'column' (a column name in a CSV file)")
+        if self.mode != "constant" and self.value is not None:
+            raise ValueError(f"value: only for mode 'constant' (mode is {self.mode!r})")
+        if self.mode != "column" and (self.column is not None or self.source is not None):
+            raise ValueError(f"column/source: only for mode 'column' (mode is {self.mode!r})")
+        if self.source is not None:
+            if self.source.format != "csv":
+                raise ValueError("source: must be a CSV table (format: csv)")
+            if self.source.columns is not None:
+                raise ValueError("source.columns: not used here; name the column with 'column'")
         return self
+
+
+#: The four vertical facades (the paper's N, E, S, W): name -> (tilt, azimuth) [°].
+_DEFAULT_SURFACES = {
+    "N": (90.0, 0.0),
+    "E": (90.0, 90.0),
+    "S": (90.0, 180.0),
+    "W": (90.0, 270.0),
+}
+
+
+def _as_list(v):
+    return [v] if isinstance(v, dict) else v
+
+
+_SURFACE_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 
 
 class Data(_Strict):
     demo: DemoData | None = None
     weather: Source | None = None
-    measurements: Source | list[Source] | None = None
+    #: One table or several (e.g. separate T and RH loggers); kept as a list.
+    measurements: Annotated[list[Source] | None, BeforeValidator(_as_list)] = None
     irradiance: Literal["measured", "clear_sky", "none"] = "measured"
     surfaces: dict[str, tuple[float, float]] = Field(
-        default_factory=lambda: {
-            "N": (90.0, 0.0),
-            "E": (90.0, 90.0),
-            "S": (90.0, 180.0),
-            "W": (90.0, 270.0),
-        },
+        default_factory=lambda: dict(_DEFAULT_SURFACES),
         description="name -> (tilt [°], azimuth [°, 0 = N, 90 = E])",
     )
     ground_temperature: GroundTemperature = Field(default_factory=GroundTemperature)
@@ -143,50 +294,95 @@ class Data(_Strict):
                 "'demo' generates its own data: remove 'weather' and "
                 "'measurements' or remove 'demo'"
             )
+        if self.irradiance == "none" and self.surfaces != _DEFAULT_SURFACES:
+            raise ValueError(
+                "surfaces: given, but irradiance is 'none' (no solar input); remove "
+                "'surfaces' or set irradiance to 'measured' or 'clear_sky'"
+            )
         return self
 
     @field_validator("surfaces")
     @classmethod
     def _surfaces(cls, v):
+        if not v:
+            raise ValueError(
+                "at least one surface is needed for solar input; for none set irradiance: none"
+            )
         for name, (tilt, az) in v.items():
+            if not _SURFACE_NAME.match(name):
+                raise ValueError(
+                    f"{name!r}: surface names must be letters, digits and '_' starting with "
+                    f"a letter (they become input names I_<name>)"
+                )
             if not 0 <= tilt <= 180:
                 raise ValueError(f"{name}: tilt must be within 0..180° (got {tilt})")
             if not 0 <= az <= 360:
                 raise ValueError(f"{name}: azimuth must be within 0..360° (got {az})")
         return v
 
-    @field_validator("step", "max_gap")
+    @field_validator("step")
     @classmethod
-    def _duration(cls, v):
-        try:
-            td = pd.Timedelta(v)
-        except (ValueError, TypeError):
-            raise ValueError(f"expected a duration such as '1h' or '30min' (got {v!r})") from None
-        if td < pd.Timedelta(0):
-            raise ValueError(f"must not be negative (got {v!r})")
-        return v
+    def _step(cls, v):
+        return _check_duration(v, positive=True)
+
+    @field_validator("max_gap")
+    @classmethod
+    def _max_gap(cls, v):
+        return _check_duration(v)
 
 
 class Period(_Strict):
-    start: str
-    end: str
+    """``[start, end)``; naive dates and times are UTC."""
+
+    start: DateText
+    end: DateText
 
     @model_validator(mode="after")
     def _order(self):
-        try:
-            s, e = pd.Timestamp(self.start), pd.Timestamp(self.end)
-        except (ValueError, TypeError) as exc:
-            raise ValueError(f"start/end must be dates such as 2019-01-01 ({exc})") from None
-        if not s < e:
-            raise ValueError(f"start must be before end (got {self.start} >= {self.end})")
+        _check_dates(self.start, self.end)
         return self
 
 
 class Periods(_Strict):
+    """Calibration and validation periods, warm-up and initial-state window.
+
+    Default (no periods): the common period of all data, its first 2/3 for calibration
+    and the rest for validation. ``warmup``: the first part of the calibration period
+    simulated but excluded from the likelihood (absorbs the initial state);
+    ``init_window``: the window used to estimate initial states.
+    """
+
     calibration: Period | None = None
     validation: Period | None = None
-    warmup: str = "14d"
-    init_window: str = "7d"
+    warmup: str = "14D"
+    init_window: str = "7D"
+
+    @field_validator("warmup", "init_window")
+    @classmethod
+    def _duration(cls, v):
+        return _check_duration(v)
+
+    @model_validator(mode="after")
+    def _check(self):
+        if self.validation is not None and self.calibration is None:
+            raise ValueError("calibration: required when 'validation' is given")
+        if self.calibration is not None and self.validation is not None:
+            cs, ce = _utc(self.calibration.start), _utc(self.calibration.end)
+            vs, ve = _utc(self.validation.start), _utc(self.validation.end)
+            if vs < ce and cs < ve:
+                raise ValueError(
+                    f"validation: overlaps the calibration period (calibration "
+                    f"{self.calibration.start} to {self.calibration.end}, validation "
+                    f"{self.validation.start} to {self.validation.end})"
+                )
+        if self.calibration is not None:
+            length = _utc(self.calibration.end) - _utc(self.calibration.start)
+            if parse_duration(self.warmup) >= length:
+                raise ValueError(
+                    f"warmup: {self.warmup} is not shorter than the calibration period "
+                    f"({self.calibration.start} to {self.calibration.end})"
+                )
+        return self
 
 
 class ModelSection(_Strict):
@@ -239,8 +435,16 @@ class CalibrationConfig(_Strict):
     def _needs_models(self):
         if self.thermal is None and self.hygric is None:
             raise ValueError("give at least one of 'thermal' and 'hygric'")
+        if self.data.demo is not None and self.site is not None:
+            raise ValueError(
+                "site: the demo uses the site of its weather file (Greensboro, NC); remove 'site'"
+            )
+        site_in_file = self.data.weather is not None and self.data.weather.format in (
+            "epw",
+            "tmy3",
+        )
         needs_sun = self.data.irradiance != "none" and self.data.demo is None
-        if needs_sun and self.site is None:
+        if needs_sun and self.site is None and not site_in_file:
             raise ValueError(
                 "site: required (latitude, longitude) to compute solar "
                 "irradiance on the surfaces; or set data.irradiance: none"
@@ -281,8 +485,33 @@ def _allowed_keys(loc) -> list[str]:
     return []
 
 
+def _key_path(loc, raw: Any) -> str:
+    """``data.measurements[1].columns`` from a pydantic error location.
+
+    Drops pydantic's validator/union tags (``function-after[...]``, ``list[...]``) and the
+    index ``0`` that a single mapping gets when accepted as a list of one.
+    """
+    text = ""
+    node = raw
+    for x in loc:
+        if isinstance(x, str) and "[" in x:
+            continue
+        if isinstance(x, int):
+            if isinstance(node, dict):  # a single mapping given where a list is allowed
+                continue
+            text += f"[{x}]"
+            node = node[x] if isinstance(node, list) and -len(node) <= x < len(node) else None
+            continue
+        text += f".{x}" if text else str(x)
+        node = node.get(x) if isinstance(node, dict) else None
+    return text
+
+
+_KEY_PREFIX = re.compile(r"^([A-Za-z_]\w*(?:\.[A-Za-z_]\w*)*): ")
+
+
 def _format_error(err: dict, raw: Any) -> str:
-    loc = ".".join(str(x) for x in err["loc"] if not str(x).startswith("function-"))
+    loc = _key_path(err["loc"], raw)
     msg = err["msg"]
     if msg.startswith("Value error, "):
         msg = msg[len("Value error, ") :]
@@ -295,6 +524,12 @@ def _format_error(err: dict, raw: Any) -> str:
     if typ == "missing":
         return f"{loc}: required"
     if isinstance(found, dict):  # a section-level check: its message says what was found
+        # "warmup: ..." raised by the section 'periods' reads as "periods.warmup: ..."
+        m = _KEY_PREFIX.match(msg)
+        if m and loc:
+            return f"{loc}.{m.group(1)}: {msg[m.end() :]}"
+        return f"{loc or '(top level)'}: {msg}"
+    if "(got " in msg:  # the check already says what it found
         return f"{loc or '(top level)'}: {msg}"
     return f"{loc or '(top level)'}: {msg} (got {found!r})"
 

@@ -1,0 +1,433 @@
+"""Orchestration of a calibration run and loading it back.
+
+``run_calibration(cfg, out_dir)`` does what ``hbayes calibrate`` does: prepare the data
+(:mod:`heritage_bayes.prepare`), then for each configured model (thermal, hygric,
+calibrated independently as in the paper): parameters and priors, the vectorised
+log-posterior, the MAP warm start, the structural identifiability check at the MAP, and
+emcee until converged; then the run directory (see :mod:`heritage_bayes.inference.results`).
+
+``load_run(DIR)`` returns a :class:`Run`: the models, the resolved config, the
+InferenceData and a method to simulate posterior draws on new inputs (the entry point
+for climate-change projections).
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from heritage_bayes._version import __version__
+from heritage_bayes.climate.psychro import saturation_vapour_pressure
+from heritage_bayes.config import CalibrationConfig, config_hash, parse_config
+from heritage_bayes.errors import ConfigError, InputError
+from heritage_bayes.inference.likelihoods import get_noise_model
+from heritage_bayes.inference.optimize import find_map
+from heritage_bayes.inference.parameters import parameters_for
+from heritage_bayes.inference.posterior import LogPosterior
+from heritage_bayes.inference.results import atomic_write, atomic_write_text, dump_json
+from heritage_bayes.inference.sampler import run_sampler
+from heritage_bayes.rc.catalog import CATALOG
+from heritage_bayes.rc.catalog import model as catalog_model
+from heritage_bayes.rc.identify import structural_identifiability
+from heritage_bayes.rc.model import RCModel
+from heritage_bayes.rc.network import Network
+from heritage_bayes.rc.simulate import check_inputs
+
+__all__ = ["SECTIONS", "Run", "build_model", "load_run", "run_calibration"]
+
+SECTIONS = ("thermal", "hygric")
+_SOLAR = {"thermal_1c", "thermal_2c", "thermal_4a"}
+
+
+def build_model(cfg: CalibrationConfig, section: str) -> RCModel:
+    """The RC model of config section ``thermal`` or ``hygric``.
+
+    Catalogue models get their solar surfaces from ``data.surfaces`` (none when
+    ``data.irradiance: none``); a mapping under ``model:`` is a custom network
+    (:meth:`heritage_bayes.rc.Network.from_dict`).
+    """
+    sec = getattr(cfg, section)
+    where = f"{section}.model"
+    try:
+        if isinstance(sec.model, Mapping):
+            m = Network.from_dict(sec.model, where=where).compile()
+        else:
+            if sec.model not in CATALOG:
+                raise ConfigError(
+                    f"{where}: unknown model {sec.model!r}; available: {sorted(CATALOG)}"
+                )
+            options = dict(sec.options)
+            if sec.model in _SOLAR and "surfaces" not in options:
+                options["surfaces"] = (
+                    tuple(cfg.data.surfaces) if cfg.data.irradiance != "none" else ()
+                )
+            m = catalog_model(sec.model, **options)
+    except ConfigError:
+        raise
+    except ValueError as exc:
+        raise ConfigError(f"{where}: {exc}") from None
+    if m.domain != section:
+        raise ConfigError(f"{where}: a {m.domain} model cannot be used in the {section!r} section")
+    return m
+
+
+@dataclass
+class _Section:
+    name: str
+    model: RCModel
+    logpost: LogPosterior
+    map: object = None
+    identifiability: object = None
+    chain: object = None
+    X: np.ndarray | None = None  # (walkers, draws, d) unconstrained
+    theta: np.ndarray | None = None  # (walkers, draws, P)
+    lp: np.ndarray | None = None
+    timings: dict = field(default_factory=dict)
+
+
+class _Progress:
+    def __init__(self, quiet: bool):
+        self.quiet = quiet
+        self.bar = None
+
+    def say(self, msg: str) -> None:
+        if not self.quiet:
+            print(msg, file=sys.stderr, flush=True)
+
+    def sampler(self, label: str, max_steps: int):
+        if self.quiet:
+            return None
+        from tqdm.auto import tqdm
+
+        bar = tqdm(
+            total=max_steps,
+            desc=f"[{label}] emcee",
+            unit="step",
+            file=sys.stderr,
+            leave=True,
+            dynamic_ncols=True,
+        )
+
+        def update(done, total, info):
+            bar.n = done
+            bar.set_postfix_str(
+                f"τmax {info['tau_max']:.0f}, need {info['needed']:.0f} "
+                f"steps, acc {info['acceptance']:.2f}"
+            )
+            bar.refresh()
+
+        self.bar = bar
+        return update
+
+    def close(self):
+        if self.bar is not None:
+            self.bar.close()
+            self.bar = None
+
+
+def run_calibration(
+    cfg: CalibrationConfig,
+    out_dir: str | Path | None = None,
+    *,
+    seed: int | None = None,
+    resume: bool = False,
+    quiet: bool = False,
+    report: bool | None = None,
+) -> Path:
+    """Calibrate the configured models and write the run directory; return its path.
+
+    Parameters
+    ----------
+    cfg : CalibrationConfig
+    out_dir : path, optional
+        Default ``reports/<config name>/`` relative to the current folder.
+    seed : int, optional
+        Overrides ``cfg.seed``. The same seed gives the same posterior.
+    resume : bool
+        Continue the chains saved in ``out_dir`` (``chain_<model>.h5``).
+    quiet : bool
+        No progress output.
+    report : bool, optional
+        Write ``report.html`` (default ``cfg.report``).
+    """
+    t_start = time.perf_counter()
+    if seed is not None:
+        cfg = cfg.model_copy(update={"seed": int(seed)})
+    out = Path(out_dir) if out_dir is not None else Path("reports") / (cfg.name or "run")
+    out.mkdir(parents=True, exist_ok=True)
+    chash = config_hash(cfg)
+    say = _Progress(quiet)
+    from heritage_bayes.prepare import prepare
+
+    say.say(f"hbayes {__version__}: calibrating {cfg.name!r} -> {out}")
+    t0 = time.perf_counter()
+    prep = prepare(cfg)
+    t_prep = time.perf_counter() - t0
+    say.say(
+        f"data: {prep.n_rows} steps of {prep.dt / 3600:g} h from "
+        f"{prep.frame.index[0]} to {prep.frame.index[-1]} "
+        f"(irradiance: {prep.irradiance_source})"
+    )
+    atomic_write_text(
+        out / "config.yaml", yaml.safe_dump(cfg.resolved(), sort_keys=False, allow_unicode=True)
+    )
+    sections: list[_Section] = []
+    for name in SECTIONS:
+        sec_cfg = getattr(cfg, name)
+        if sec_cfg is None:
+            continue
+        model = build_model(cfg, name)
+        noise = get_noise_model(sec_cfg.noise)
+        params = parameters_for(
+            model,
+            noise,
+            sec_cfg.priors,
+            room_volume=sec_cfg.room_volume or cfg.room_volume,
+            where=f"{name}.priors",
+        )
+        U = prep.model_inputs(name, model)
+        Y = prep.observed(name, model)
+        cal = prep.calibration
+        try:
+            lp = LogPosterior(
+                model,
+                params,
+                noise,
+                U[cal],
+                Y[cal],
+                dt=prep.dt,
+                warmup=prep.warmup_steps,
+                init_window=prep.init_steps,
+            )
+        except ValueError as exc:
+            raise InputError(f"{name}: {exc}") from None
+        sections.append(_Section(name, model, lp))
+    ndims = [s.logpost.ndim for s in sections]
+    nwalkers = cfg.sampler.walkers or max(32, 2 * max(ndims) + 2)
+    for i, s in enumerate(sections):
+        t0 = time.perf_counter()
+        say.say(
+            f"[{s.name}] {s.model.name}: {s.logpost.ndim} free parameters, MAP search "
+            f"({cfg.optimizer.method})"
+        )
+        s.map = find_map(
+            s.logpost,
+            seed=cfg.seed + 101 * i,
+            method=cfg.optimizer.method,
+            popsize=cfg.optimizer.popsize,
+            maxiter=cfg.optimizer.maxiter,
+            starts=cfg.optimizer.starts,
+        )
+        s.timings["map_seconds"] = time.perf_counter() - t0
+        say.say(
+            f"[{s.name}] MAP log-posterior {s.map.log_post:.1f}; "
+            f"{s.map.n_agreed}/{s.map.n_starts} starts agreed"
+        )
+        t0 = time.perf_counter()
+        tm = s.map.theta[: s.logpost.n_model]
+        fixed = tuple(
+            p.name for p in s.logpost.params.parameters[: s.logpost.n_model] if not p.free
+        )
+        s.identifiability = structural_identifiability(
+            s.model, dict(zip(s.model.parameter_names, tm, strict=True)), dt=prep.dt, fixed=fixed
+        )
+        s.timings["identifiability_seconds"] = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        update = say.sampler(s.name, cfg.sampler.max_steps)
+        try:
+            s.chain = run_sampler(
+                s.logpost,
+                s.map.x,
+                seed=cfg.seed + 101 * i,
+                nwalkers=nwalkers,
+                moves=cfg.sampler.moves,
+                max_steps=cfg.sampler.max_steps,
+                check_every=cfg.sampler.check_every,
+                tau_factor=cfg.sampler.tau_factor,
+                tau_rtol=cfg.sampler.tau_rtol,
+                init_ball=cfg.sampler.init_ball,
+                checkpoint=out / f"chain_{s.name}.h5",
+                tag=f"{chash}:{s.name}",
+                resume=resume,
+                progress=update,
+            )
+        finally:
+            say.close()
+        s.timings["sampling_seconds"] = time.perf_counter() - t0
+        verdict = "converged" if s.chain.converged else "NOT converged"
+        say.say(f"[{s.name}] {s.chain.steps} steps, τmax {np.nanmax(s.chain.tau):.0f}: {verdict}")
+    # common number of retained draws per walker across models
+    per = max(1, cfg.sampler.max_draws // nwalkers)
+    draws = []
+    for s in sections:
+        X, lpv = s.chain.draws(cfg.sampler.max_draws)
+        draws.append(X.shape[1])
+        s.X, s.lp = X, lpv
+    n_draw = min([per, *draws])
+    for s in sections:
+        s.X, s.lp = s.X[:, -n_draw:], s.lp[:, -n_draw:]
+        s.theta = s.logpost.params.values(s.X.reshape(-1, s.X.shape[-1])).reshape(
+            s.X.shape[0], n_draw, -1
+        )
+    t0 = time.perf_counter()
+    from heritage_bayes.inference.idata import build_run_outputs
+
+    idata, summary = build_run_outputs(cfg, prep, sections, chash=chash, seed=cfg.seed)
+    t_out = time.perf_counter() - t0
+    summary["timings"] = {
+        "prepare_seconds": t_prep,
+        **{f"{s.name}_{k}": v for s in sections for k, v in s.timings.items()},
+        "outputs_seconds": t_out,
+    }
+    summary["wall_seconds"] = time.perf_counter() - t_start
+    atomic_write(out / "posterior.nc", lambda p: idata.to_netcdf(str(p), engine="h5netcdf"))
+    dump_json(out / "summary.json", summary)
+    say.say(
+        f"summary: converged={summary['converged']}, max R-hat "
+        f"{summary['max_rhat']:.3f}, min bulk ESS {summary['min_ess_bulk']:.0f}, "
+        f"{summary['wall_seconds']:.0f} s"
+    )
+    if cfg.report if report is None else report:
+        from heritage_bayes.report import write_report
+
+        path = write_report(out)
+        say.say(f"report: {path}")
+    return out
+
+
+# ----------------------------------------------------------------------------- loading
+@dataclass
+class Run:
+    """A calibration run loaded from its directory.
+
+    Attributes
+    ----------
+    path : Path
+    config : CalibrationConfig
+        The resolved config.
+    idata : arviz.InferenceData
+    summary : dict
+        ``summary.json``.
+    models : dict
+        Section name (``thermal``/``hygric``) -> RCModel.
+    """
+
+    path: Path
+    config: CalibrationConfig
+    idata: object
+    summary: dict
+    models: dict
+
+    @property
+    def sections(self) -> tuple[str, ...]:
+        return tuple(self.models)
+
+    def draws(self, section: str, n: int | None = None, seed: int = 0) -> dict[str, np.ndarray]:
+        """Posterior draws of the model parameters: name -> (K,) arrays [SI units].
+
+        ``n`` draws chosen at random without replacement (default all).
+        """
+        model = self._model(section)
+        post = self.idata.posterior
+        cols = [post[f"{section}.{p}"].values.reshape(-1) for p in model.parameter_names]
+        K = cols[0].size
+        idx = np.arange(K)
+        if n is not None and n < K:
+            idx = np.sort(np.random.default_rng(seed).choice(K, size=n, replace=False))
+        return {p: c[idx] for p, c in zip(model.parameter_names, cols, strict=True)}
+
+    def _model(self, section: str) -> RCModel:
+        if section not in self.models:
+            raise InputError(
+                f"run {self.path} has no {section!r} model; it has {list(self.models)}"
+            )
+        return self.models[section]
+
+    def simulate(
+        self,
+        inputs,
+        section: str = "thermal",
+        n_draws: int | None = 200,
+        seed: int = 0,
+        dt: float | None = None,
+        x0=None,
+        init_window: int | None = None,
+    ) -> np.ndarray:
+        """Simulate posterior draws on new inputs (e.g. future weather).
+
+        Parameters
+        ----------
+        inputs : DataFrame or (N, m) array
+            Model inputs (``model.input_names``), e.g. a morphed weather file prepared
+            like the calibration data.
+        section : {"thermal", "hygric"}
+        n_draws : int or None
+            Number of posterior draws (random, seeded); None for all.
+        dt : float, optional
+            Time step [s]; default the calibration's.
+        init_window : int, optional
+            Steps of inputs averaged for the steady-state initial state (default the
+            calibration's ``periods.init_window``); or give ``x0``.
+
+        Returns
+        -------
+        (K, N, n_out) array of noise-free outputs ([°C] or [Pa]).
+        """
+        from heritage_bayes.rc.discretize import modal_form
+        from heritage_bayes.rc.simulate import modal_simulate
+
+        model = self._model(section)
+        U = check_inputs(model, inputs)
+        dt = float(dt or self.summary.get("dt", 3600.0))
+        draws = self.draws(section, n_draws, seed)
+        P, _ = model.param_array(draws)
+        mf = modal_form(model, P, dt)
+        if x0 is not None:
+            z0 = mf.to_modal(np.asarray(x0, dtype=float))
+        else:
+            w = init_window or int(self.summary.get("init_steps", 168))
+            z0 = mf.steady_state_modal(U[: max(1, w)].mean(axis=0))
+        return modal_simulate(mf, U, np.ascontiguousarray(np.broadcast_to(z0, mf.lam.shape)))
+
+    def simulate_rh(
+        self, thermal_inputs, hygric_inputs, n_draws: int | None = 200, seed: int = 0, **kw
+    ) -> np.ndarray:
+        """Indoor RH [%] from paired thermal and hygric draws: RH = Pi / Psat(Ti)."""
+        Ti = self.simulate(thermal_inputs, "thermal", n_draws, seed, **kw)[..., 0]
+        Pi = self.simulate(hygric_inputs, "hygric", n_draws, seed, **kw)[..., 0]
+        return 100.0 * Pi / saturation_vapour_pressure(Ti)
+
+
+def load_run(path: str | Path) -> Run:
+    """Load a run directory written by ``hbayes calibrate``.
+
+    Raises
+    ------
+    InputError
+        The folder or one of ``posterior.nc``, ``summary.json``, ``config.yaml`` is
+        missing.
+    """
+    import json
+
+    import arviz as az
+
+    p = Path(path)
+    for name in ("posterior.nc", "summary.json", "config.yaml"):
+        if not (p / name).is_file():
+            raise InputError(
+                f"{p}: not a complete run directory ({name} is missing); "
+                "run `hbayes calibrate` first"
+            )
+    raw = yaml.safe_load((p / "config.yaml").read_text(encoding="utf-8"))
+    cfg_path = raw.pop("name", None)
+    cfg = parse_config({**raw, "name": cfg_path}, source=str(p / "config.yaml"))
+    summary = json.loads((p / "summary.json").read_text(encoding="utf-8"))
+    idata = az.from_netcdf(str(p / "posterior.nc"), engine="h5netcdf")
+    models = {s: build_model(cfg, s) for s in SECTIONS if getattr(cfg, s) is not None}
+    return Run(path=p, config=cfg, idata=idata, summary=summary, models=models)

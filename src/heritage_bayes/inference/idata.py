@@ -1,0 +1,365 @@
+"""Build the run's InferenceData and ``summary.json`` from sampled sections.
+
+See :mod:`heritage_bayes.inference.results` for the layout. Thermal and hygric models are
+sampled independently; their retained draws share the (chain, draw) grid so that draw
+*i* of one pairs with draw *i* of the other, which is how the combined indoor RH
+(:math:`RH = P_i / P_{sat}(T_i)`) is predicted.
+"""
+
+from __future__ import annotations
+
+import math
+from datetime import UTC, datetime
+
+import arviz as az
+import numpy as np
+import pandas as pd
+import xarray as xr
+
+from heritage_bayes._version import __version__
+from heritage_bayes.climate.psychro import saturation_vapour_pressure
+from heritage_bayes.inference.results import coverage, fit_metrics
+from heritage_bayes.rc.discretize import modal_form
+from heritage_bayes.rc.identify import derived_quantities, derived_units
+from heritage_bayes.rc.simulate import modal_simulate
+
+__all__ = ["CONVERGENCE", "build_run_outputs"]
+
+#: Convergence criteria (also in summary.json).
+CONVERGENCE = {"max_rhat": 1.01, "min_ess_bulk": 400.0}
+
+_OUT_UNITS = {"Ti": "°C", "Pi": "Pa", "RHi": "%"}
+
+
+def _times(prep) -> np.ndarray:
+    idx = pd.DatetimeIndex(prep.frame.index)
+    return idx.tz_convert("UTC").tz_localize(None).values
+
+
+def _period_codes(prep) -> np.ndarray:
+    code = np.full(prep.n_rows, -1, dtype=np.int8)
+    cal = prep.calibration
+    code[cal] = 1
+    if prep.validation is not None:
+        code[prep.validation] = 2
+    code[cal.start : cal.start + prep.warmup_steps] = 0
+    return code
+
+
+def _predictive_index(n_chain: int, n_draw: int, n_total: int) -> np.ndarray:
+    m = max(1, min(n_draw, math.ceil(n_total / n_chain)))
+    return np.unique(np.linspace(0, n_draw - 1, m).round().astype(int))
+
+
+def _prior_variance(prior, rng) -> float:
+    y = prior.sample(rng, 20000)
+    y = np.log(y) if prior.log_scale else y
+    return float(np.var(y))
+
+
+def _summ(x: np.ndarray) -> dict:
+    q05, q50, q95 = np.quantile(x, [0.05, 0.5, 0.95])
+    return {
+        "median": float(q50),
+        "q05": float(q05),
+        "q95": float(q95),
+        "mean": float(np.mean(x)),
+        "sd": float(np.std(x)),
+    }
+
+
+def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
+    """(InferenceData, summary dict) for sampled sections (see module docstring)."""
+    rng = np.random.default_rng(seed + 7)
+    times = _times(prep)
+    codes = _period_codes(prep)
+    W, D = sections[0].X.shape[:2]
+    sel = _predictive_index(W, D, cfg.sampler.n_predictive)
+    post: dict[str, xr.DataArray] = {}
+    stats: dict[str, xr.DataArray] = {}
+    loglik: dict[str, xr.DataArray] = {}
+    pp: dict[str, xr.DataArray] = {}
+    summary_params: dict[str, dict] = {}
+    summary_derived: dict[str, dict] = {}
+    metrics: dict[str, dict] = {}
+    sec_info: dict[str, dict] = {}
+    correlations: dict[str, dict] = {}
+    pp_outputs: dict[str, np.ndarray] = {}
+    truth_all = prep.truth or {}
+    cdims = ("chain", "draw")
+    coords = {"chain": np.arange(W), "draw": np.arange(D)}
+    for s in sections:
+        ps = s.logpost.params
+        names = ps.names
+        tm = s.theta[..., : s.logpost.n_model]
+        for j, p in enumerate(ps.parameters):
+            post[f"{s.name}.{p.name}"] = xr.DataArray(
+                s.theta[..., j],
+                dims=cdims,
+                attrs={"unit": p.unit, "kind": p.kind, "description": p.description},
+            )
+        dq = derived_quantities(s.model, tm.reshape(-1, tm.shape[-1]))
+        units = derived_units(s.model)
+        for k, v in dq.items():
+            arr = np.broadcast_to(np.asarray(v, dtype=float), (W * D,)).reshape(W, D)
+            post[f"{s.name}.{k}"] = xr.DataArray(arr, dims=cdims, attrs={"unit": units.get(k, "")})
+        stats[f"{s.name}.lp"] = xr.DataArray(s.lp, dims=cdims)
+        stats[f"{s.name}.acceptance_rate"] = xr.DataArray(
+            np.broadcast_to(s.chain.acceptance[:, None], (W, D)).copy(), dims=cdims
+        )
+        # predictive over the whole frame for the selected draws
+        th_sel = s.theta[:, sel].reshape(-1, s.theta.shape[-1])
+        tm_sel, tn_sel = th_sel[:, : s.logpost.n_model], th_sel[:, s.logpost.n_model :]
+        U = prep.model_inputs(s.name, s.model)
+        mf = modal_form(s.model, tm_sel, prep.dt)
+        z0 = mf.steady_state_modal(U[: max(1, prep.init_steps)].mean(axis=0))
+        Ysim = modal_simulate(mf, U, np.ascontiguousarray(z0))
+        noise = s.logpost.noise.sample(rng, tn_sel, U.shape[0], s.model.n_outputs)
+        Ypp = Ysim + noise
+        shape = (W, len(sel), U.shape[0])
+        pcoords = {"chain": np.arange(W), "draw": sel, "time": times}
+        for o, out in enumerate(s.model.output_names):
+            attrs = {"unit": _OUT_UNITS.get(out, "")}
+            pp[f"{s.name}.{out}"] = xr.DataArray(
+                Ypp[..., o].reshape(shape).astype(np.float32),
+                dims=("chain", "draw", "time"),
+                coords=pcoords,
+                attrs=attrs,
+            )
+            pp[f"{s.name}.{out}_sim"] = xr.DataArray(
+                Ysim[..., o].reshape(shape).astype(np.float32),
+                dims=("chain", "draw", "time"),
+                coords=pcoords,
+                attrs=attrs,
+            )
+            pp_outputs[out] = (Ypp[..., o], Ysim[..., o])
+        pw = s.logpost.pointwise_log_likelihood(th_sel)
+        cal = prep.calibration
+        for o, out in enumerate(s.model.output_names):
+            loglik[f"{s.name}.{out}"] = xr.DataArray(
+                pw[..., o].reshape(W, len(sel), -1),
+                dims=("chain", "draw", "time_cal"),
+                coords={"chain": np.arange(W), "draw": sel, "time_cal": times[cal]},
+            )
+        # parameter summaries
+        ds = xr.Dataset(
+            {k: v for k, v in post.items() if k.startswith(f"{s.name}.")}, coords=coords
+        )
+        free_vars = [f"{s.name}.{p.name}" for p in ps.parameters if p.free]
+        rhat = az.rhat(ds[free_vars])
+        ess_b = az.ess(ds[free_vars], method="bulk")
+        ess_t = az.ess(ds[free_vars], method="tail")
+        tau = dict(zip(ps.free_names, s.chain.tau, strict=True))
+        truth = truth_all.get(s.name, {}) or {}
+        mapv = dict(zip(names, s.map.theta, strict=True))
+        prng = np.random.default_rng(seed + 11)
+        for j, p in enumerate(ps.parameters):
+            key = f"{s.name}.{p.name}"
+            x = s.theta[..., j].reshape(-1)
+            entry = {
+                "unit": p.unit,
+                "kind": p.kind,
+                "description": p.description,
+                "fixed": p.fixed,
+                "prior": None if p.fixed is not None else p.prior.describe(),
+                "map": mapv[p.name],
+                **_summ(x),
+                "truth": truth.get(p.name),
+            }
+            if p.free:
+                y = np.log(x) if p.prior.log_scale else x
+                a, b = (
+                    (math.log(p.prior.lower), math.log(p.prior.upper))
+                    if p.prior.log_scale
+                    else (p.prior.lower, p.prior.upper)
+                )
+                pos = (np.quantile(y, [0.05, 0.95]) - a) / (b - a)
+                entry.update(
+                    r_hat=float(rhat[key]),
+                    ess_bulk=float(ess_b[key]),
+                    ess_tail=float(ess_t[key]),
+                    tau=float(tau[p.name]),
+                    contraction=float(1 - np.var(y) / _prior_variance(p.prior, prng)),
+                    at_bound=("lower" if pos[0] < 0.01 else "upper" if pos[1] > 0.99 else None),
+                )
+            summary_params[key] = entry
+        for k in dq:
+            key = f"{s.name}.{k}"
+            x = post[key].values.reshape(-1)
+            summary_derived[key] = {"unit": units.get(k, ""), **_summ(x)}
+            if np.all(np.isfinite(x)) and np.ptp(x) > 0:
+                summary_derived[key]["r_hat"] = float(az.rhat(post[key].values))
+                summary_derived[key]["ess_bulk"] = float(az.ess(post[key].values, method="bulk"))
+        # posterior correlations of the free parameters (log scale where the prior is)
+        Y = []
+        for j, p in enumerate(ps.parameters):
+            if p.free:
+                x = s.theta[..., j].reshape(-1)
+                Y.append(np.log(x) if p.prior.log_scale else x)
+        corr = np.corrcoef(np.array(Y)) if len(Y) > 1 else np.ones((1, 1))
+        correlations[s.name] = {"names": list(ps.free_names), "matrix": corr.tolist()}
+        # fit metrics per output and period
+        metrics[s.name] = _metrics_for(prep, codes, s.model.output_names, pp_outputs)
+        sec_info[s.name] = {
+            "model": s.model.name,
+            "domain": s.model.domain,
+            "state_names": list(s.model.state_names),
+            "input_names": list(s.model.input_names),
+            "output_names": list(s.model.output_names),
+            "noise": s.logpost.noise.name,
+            "map": s.map.to_dict(names),
+            "identifiability": s.identifiability.to_dict(),
+            "chain": {
+                "walkers": int(W),
+                "steps": int(s.chain.steps),
+                "burn": int(s.chain.burn),
+                "thin": int(s.chain.thin),
+                "draws_per_walker": int(D),
+                "converged_tau": bool(s.chain.converged),
+                "tau_max": float(np.nanmax(s.chain.tau)),
+                "tau_history": [list(map(float, r)) for r in s.chain.tau_history],
+                "acceptance_mean": float(np.mean(s.chain.acceptance)),
+                "resumed_from": int(s.chain.resumed_from),
+            },
+        }
+    # combined RH from paired thermal and hygric draws
+    if "Ti" in pp_outputs and "Pi" in pp_outputs:
+        ti_pp, ti_sim = pp_outputs["Ti"]
+        pi_pp, pi_sim = pp_outputs["Pi"]
+        rh_pp = 100.0 * pi_pp / saturation_vapour_pressure(ti_pp)
+        rh_sim = 100.0 * pi_sim / saturation_vapour_pressure(ti_sim)
+        shape = (W, len(sel), prep.n_rows)
+        pcoords = {"chain": np.arange(W), "draw": sel, "time": times}
+        pp["RHi"] = xr.DataArray(
+            rh_pp.reshape(shape).astype(np.float32),
+            dims=("chain", "draw", "time"),
+            coords=pcoords,
+            attrs={"unit": "%"},
+        )
+        pp["RHi_sim"] = xr.DataArray(
+            rh_sim.reshape(shape).astype(np.float32),
+            dims=("chain", "draw", "time"),
+            coords=pcoords,
+            attrs={"unit": "%"},
+        )
+        if "RHi" in prep.frame:
+            metrics["combined"] = _metrics_for(prep, codes, ("RHi",), {"RHi": (rh_pp, rh_sim)})
+    observed = {
+        c: xr.DataArray(
+            prep.frame[c].to_numpy(dtype=float),
+            dims=("time",),
+            coords={"time": times},
+            attrs={"unit": _OUT_UNITS.get(c, "")},
+        )
+        for c in ("Ti", "Pi", "RHi")
+        if c in prep.frame
+    }
+    inputs = sorted({c for s in sections for c in s.model.input_names})
+    const = {
+        c: xr.DataArray(prep.frame[c].to_numpy(dtype=float), dims=("time",), coords={"time": times})
+        for c in inputs
+    }
+    const["period"] = xr.DataArray(
+        codes,
+        dims=("time",),
+        coords={"time": times},
+        attrs={"codes": "-1 outside, 0 warm-up, 1 calibration, 2 validation"},
+    )
+    for c in inputs:
+        if c in prep.flags:
+            const[f"interpolated.{c}"] = xr.DataArray(
+                prep.flags[c].to_numpy(dtype=np.int8), dims=("time",), coords={"time": times}
+            )
+    attrs = {
+        "heritage_bayes_version": __version__,
+        "seed": int(seed),
+        "config_hash": chash,
+        "created_at": datetime.now(UTC).isoformat(timespec="seconds"),
+        "run_name": cfg.name or "",
+        "dt_seconds": float(prep.dt),
+    }
+    groups = {
+        "posterior": xr.Dataset(post, coords=coords, attrs=attrs),
+        "sample_stats": xr.Dataset(stats, coords=coords, attrs=attrs),
+        "log_likelihood": xr.Dataset(loglik, attrs=attrs),
+        "posterior_predictive": xr.Dataset(pp, attrs=attrs),
+        "observed_data": xr.Dataset(observed, attrs=attrs),
+        "constant_data": xr.Dataset(const, attrs=attrs),
+    }
+    idata = az.InferenceData(**groups)
+    free_rhat = [v["r_hat"] for v in summary_params.values() if "r_hat" in v]
+    free_ess = [v["ess_bulk"] for v in summary_params.values() if "ess_bulk" in v]
+    max_rhat = float(np.max(free_rhat))
+    min_ess = float(np.min(free_ess))
+    tau_ok = all(s.chain.converged for s in sections)
+    converged = bool(
+        tau_ok and max_rhat <= CONVERGENCE["max_rhat"] and min_ess >= CONVERGENCE["min_ess_bulk"]
+    )
+    summary = {
+        "name": cfg.name,
+        "building": cfg.building,
+        "room": cfg.room,
+        "notes": cfg.notes,
+        "heritage_bayes_version": __version__,
+        "seed": int(seed),
+        "config_hash": chash,
+        "created_at": attrs["created_at"],
+        "converged": converged,
+        "converged_tau": tau_ok,
+        "max_rhat": max_rhat,
+        "min_ess_bulk": min_ess,
+        "criteria": {
+            **CONVERGENCE,
+            "tau_factor": cfg.sampler.tau_factor,
+            "tau_rtol": cfg.sampler.tau_rtol,
+        },
+        "dt": float(prep.dt),
+        "warmup_steps": int(prep.warmup_steps),
+        "init_steps": int(prep.init_steps),
+        "periods": _periods(prep),
+        "irradiance_source": prep.irradiance_source,
+        "parameters": summary_params,
+        "derived": summary_derived,
+        "metrics": metrics,
+        "models": sec_info,
+        "correlations": correlations,
+        "alignment": prep.alignment,
+        "sources": prep.sources,
+        "truth": truth_all or None,
+    }
+    return idata, summary
+
+
+def _periods(prep) -> dict:
+    idx = prep.frame.index
+    out = {}
+    for name in ("calibration", "validation"):
+        sl = getattr(prep, name)
+        if sl is None:
+            continue
+        out[name] = {
+            "start": idx[sl.start].isoformat(),
+            "end": (idx[sl.stop - 1] + (idx[1] - idx[0])).isoformat(),
+            "steps": int(sl.stop - sl.start),
+        }
+    return out
+
+
+def _metrics_for(prep, codes, outputs, pp_outputs) -> dict:
+    res: dict[str, dict] = {}
+    for out in outputs:
+        if out not in prep.frame:
+            continue
+        meas = prep.frame[out].to_numpy(dtype=float)
+        ypp, ysim = pp_outputs[out]
+        med = np.median(ysim, axis=0)
+        res[out] = {}
+        for pname, code in (("calibration", 1), ("validation", 2)):
+            rows = codes == code
+            if not rows.any():
+                continue
+            m = fit_metrics(meas[rows], med[rows])
+            m["coverage50"] = coverage(meas[rows], ypp[:, rows], 0.5)
+            m["coverage90"] = coverage(meas[rows], ypp[:, rows], 0.9)
+            res[out][pname] = m
+    return res

@@ -1,0 +1,134 @@
+"""The one result format: arviz InferenceData on disk, fit metrics, atomic writes.
+
+Run directory (``hbayes calibrate``):
+
+- ``posterior.nc``: arviz InferenceData (NetCDF4/HDF5). Variables are qualified by the
+  calibrated model: ``thermal.Cw``, ``hygric.Ci``, ``thermal.tau_1_h``, ...
+
+  - ``posterior``: parameters (fixed ones included as constants) and derived
+    identifiable quantities (time constants [h], static gains) per walker (``chain``) and
+    retained draw;
+  - ``sample_stats``: ``<model>.lp`` (log-posterior), ``<model>.acceptance_rate``;
+  - ``log_likelihood``: pointwise terms over the calibration period for a subset of
+    draws (for LOO; NaN where excluded);
+  - ``observed_data``: ``Ti``, ``Pi``, ``RHi`` on the ``time`` axis;
+  - ``constant_data``: the model inputs and a ``period`` code (0 warm-up, 1 calibration,
+    2 validation, -1 outside);
+  - ``posterior_predictive``: ``<model>.<output>`` with noise and
+    ``<model>.<output>_sim`` without, over calibration and validation periods, for a
+    subset of draws (and ``RHi`` combining thermal and hygric draws);
+  - attributes: package version, seed, config hash, creation time.
+
+- ``summary.json``: per parameter median, 5 %, 95 %, r_hat, ess_bulk, ess_tail, τ; fit
+  metrics; convergence verdict; MAP; identifiability.
+- ``config.yaml``: the resolved config.
+
+All files are written to a temporary name in the same folder and renamed into place.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["atomic_write", "atomic_write_text", "coverage", "fit_metrics"]
+
+
+def atomic_write(path: str | Path, write: Callable[[Path], None]) -> Path:
+    """Call ``write(tmp_path)``, then rename ``tmp_path`` to ``path`` (same folder).
+
+    An interrupted write leaves at most a ``.tmp`` file, never a half-written ``path``.
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    os.close(fd)
+    tmp_path = Path(tmp)
+    try:
+        write(tmp_path)
+        os.replace(tmp_path, path)
+    except BaseException:
+        tmp_path.unlink(missing_ok=True)
+        raise
+    return path
+
+
+def atomic_write_text(path: str | Path, text: str) -> Path:
+    """Write text atomically (UTF-8)."""
+    return atomic_write(path, lambda p: p.write_text(text, encoding="utf-8"))
+
+
+def fit_metrics(measured: np.ndarray, simulated: np.ndarray) -> dict[str, float]:
+    """The paper's fit criteria over the finite measurement pairs.
+
+    Parameters
+    ----------
+    measured : (N,) array
+        Measured signal :math:`y'` (NaN = missing).
+    simulated : (N,) array
+        Simulated signal :math:`y`.
+
+    Returns
+    -------
+    dict
+        ``MSE`` = :math:`\\frac1N\\sum(y'-y)^2` [unit²], ``MAE`` = :math:`\\frac1N\\sum|y'-y|`
+        [unit], ``FIT`` = :math:`100\\,(1 - \\|y'-y\\| / \\|y'-\\bar{y}'\\|)` [%]
+        (Kramer, van Schijndel & Schellen; Ljung's goodness of fit), and ``n``.
+    """
+    m = np.asarray(measured, dtype=float)
+    s = np.asarray(simulated, dtype=float)
+    ok = np.isfinite(m) & np.isfinite(s)
+    if ok.sum() < 2:
+        return {"MSE": float("nan"), "MAE": float("nan"), "FIT": float("nan"), "n": int(ok.sum())}
+    e = m[ok] - s[ok]
+    denom = np.linalg.norm(m[ok] - m[ok].mean())
+    fit = 100.0 * (1.0 - np.linalg.norm(e) / denom) if denom > 0 else float("nan")
+    return {
+        "MSE": float(np.mean(e**2)),
+        "MAE": float(np.mean(np.abs(e))),
+        "FIT": float(fit),
+        "n": int(ok.sum()),
+    }
+
+
+def coverage(measured: np.ndarray, draws: np.ndarray, level: float) -> float:
+    """Share of measurements inside the central ``level`` predictive band.
+
+    ``draws`` is (K, N) posterior-predictive samples; ``level`` e.g. 0.9.
+    """
+    m = np.asarray(measured, dtype=float)
+    lo, hi = np.quantile(draws, [(1 - level) / 2, (1 + level) / 2], axis=0)
+    ok = np.isfinite(m)
+    if not ok.any():
+        return float("nan")
+    return float(np.mean((m[ok] >= lo[ok]) & (m[ok] <= hi[ok])))
+
+
+def to_jsonable(obj):
+    """Recursively convert numpy scalars/arrays and non-finite floats for JSON."""
+    if isinstance(obj, dict):
+        return {str(k): to_jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [to_jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return to_jsonable(obj.tolist())
+    if isinstance(obj, (np.floating, float)):
+        v = float(obj)
+        return v if np.isfinite(v) else None
+    if isinstance(obj, (np.integer,)):
+        return int(obj)
+    if isinstance(obj, (np.bool_,)):
+        return bool(obj)
+    return obj
+
+
+def dump_json(path: str | Path, data: dict) -> Path:
+    """Atomically write ``data`` as indented JSON (NaN/inf -> null)."""
+    return atomic_write_text(
+        path, json.dumps(to_jsonable(data), indent=2, ensure_ascii=False) + "\n"
+    )

@@ -1,0 +1,972 @@
+"""From a validated configuration to model-ready arrays: read, derive, add sun, align.
+
+:func:`prepare` is the bridge between :mod:`heritage_bayes.config` and the calibration
+engine. It reads the weather and measurement files with the readers of
+:mod:`heritage_bayes.io` (or generates the built-in :mod:`~heritage_bayes.demo`), derives
+vapour pressures, computes the irradiance on the solar surfaces
+(:func:`heritage_bayes.climate.surface_irradiance`), builds the fixed (ground)
+temperature input ``Tf``, and puts everything on one regular UTC grid with
+:func:`heritage_bayes.io.align`. The demo goes through exactly the same path as real data.
+
+Conventions (those of :func:`~heritage_bayes.io.align`)
+-------------------------------------------------------
+* Row ``k`` of :attr:`Prepared.frame` is the instant ``t_k`` (UTC). Input columns hold
+  the mean over ``[t_k, t_k + dt)`` (zero-order hold of the simulator), output columns
+  the measured value at ``t_k`` (NaN where missing: the likelihood masks it).
+* Input columns: ``Te`` [°C], ``I_<surface>`` [W/m²] (one per key of ``data.surfaces``),
+  ``Tf`` [°C] for the thermal models; ``Pe`` [Pa] for the hygric models. Output columns:
+  ``Ti`` [°C], ``Pi`` [Pa], and ``RHi`` [%] when measured (for the combined RH check).
+* Vapour pressures come from temperature and relative humidity (over water, IAPWS,
+  :mod:`heritage_bayes.climate.psychro`) row by row at the native resolution, before any
+  averaging.
+
+Periods
+-------
+Dates in the config are UTC unless they carry an offset. The frame spans the earliest
+start to the latest end of the calibration and validation periods; the simulation runs
+continuously over the whole frame. Without ``periods``, the frame is the common period of
+all inputs and measurements, its first 2/3 (rounded to whole rows) the calibration period
+and the rest the validation period. Period boundaries that do not fall on the grid are
+rounded up to the next row. ``warmup_steps`` (from ``periods.warmup``) are the first rows
+of the calibration period, simulated but excluded from the likelihood by the caller.
+
+Ground temperature ``Tf``
+-------------------------
+``annual_mean`` (default), see :func:`annual_mean_temperature`: the mean outdoor
+temperature of a year around each instant, from the **whole** weather record (not only
+the frame): constant when the record is shorter than 365 days (a typical-year file),
+otherwise a 365-day centred running mean. ``constant``: a given value. ``column``: a
+measured series (e.g. the heated room below an attic, a crypt), aligned like the other
+inputs.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from heritage_bayes.config import parse_duration
+from heritage_bayes.errors import ConfigError, DataError, InputError
+
+__all__ = [
+    "INPUT_COLUMNS",
+    "OUTPUT_COLUMNS",
+    "Prepared",
+    "annual_mean_temperature",
+    "prepare",
+    "solar_inputs",
+]
+
+#: Standard columns that weather files may provide (model inputs and what they derive from).
+INPUT_COLUMNS = ("Te", "RHe", "Pe", "ghi", "dni", "dhi", "Tdew")
+#: Standard columns that measurement files may provide (model outputs).
+OUTPUT_COLUMNS = ("Ti", "RHi", "Pi")
+
+_SECTIONS = ("thermal", "hygric")
+_IRRADIANCE = ("ghi", "dni", "dhi")
+_YEAR = pd.Timedelta(days=365)
+#: A 365-day window of daily means counts as complete with this many valid days.
+_MIN_DAYS = 350
+#: Transposition model and ground albedo used for the surfaces.
+_TRANSPOSITION = "perez"
+_ALBEDO = 0.2
+
+
+# ---------------------------------------------------------------------------------------
+# The result
+# ---------------------------------------------------------------------------------------
+
+
+@dataclass
+class Prepared:
+    """Model-ready data of a calibration run (see :func:`prepare`).
+
+    Attributes
+    ----------
+    frame : pandas.DataFrame
+        Regular UTC grid (tz-aware index ``time``): the model inputs (``Te``,
+        ``I_<surface>``, ``Tf`` [°C, W/m², °C]; ``Pe`` [Pa]) then the outputs (``Ti``
+        [°C], ``Pi`` [Pa], ``RHi`` [%]); NaN = missing output.
+    flags : pandas.DataFrame
+        Boolean, same index and columns: True where an input value depends on an
+        interpolated (gap-filled) sample.
+    alignment : dict
+        :meth:`heritage_bayes.io.AlignmentReport.to_dict` (JSON-serialisable).
+    dt : float
+        Grid step [s].
+    calibration : slice
+        Row positions ``[start, stop)`` of the calibration period in ``frame``.
+    validation : slice or None
+        Row positions of the validation period.
+    warmup_steps, init_steps : int
+        Rows of ``periods.warmup`` and ``periods.init_window``.
+    irradiance_source : str
+        ``"measured"``, ``"clear-sky proxy (pvlib Ineichen)"``, ``"none"``, or the
+        demo's description.
+    truth : dict or None
+        Demo only: ``{"thermal": {name: value}, "hygric": {...}}``, the true parameters
+        and the **nominal** noise parameters (``sigma_Ti``, ``phi_Ti``, ``sigma_Pi``,
+        ``phi_Pi``) of the realised noise in the calibration period (see
+        :func:`heritage_bayes.demo.nominal_noise`).
+    sources : dict
+        Provenance: files, formats, site, irradiance, ground temperature, demo settings
+        (JSON-serialisable).
+    """
+
+    frame: pd.DataFrame
+    flags: pd.DataFrame
+    alignment: dict
+    dt: float
+    calibration: slice
+    validation: slice | None
+    warmup_steps: int
+    init_steps: int
+    irradiance_source: str
+    truth: dict | None = None
+    sources: dict = field(default_factory=dict)
+
+    @property
+    def n_rows(self) -> int:
+        return len(self.frame)
+
+    def model_inputs(self, section: str, model) -> np.ndarray:
+        """The (N, m) float array of ``model.input_names`` columns of :attr:`frame`.
+
+        Raises
+        ------
+        ConfigError
+            The model needs an input the data do not provide (named, with the config
+            key that would provide it).
+        """
+        _check_section(section)
+        names = tuple(model.input_names)
+        missing = [c for c in names if c not in self.frame.columns]
+        if missing:
+            raise ConfigError(
+                f"{section}.model: model {model.name!r} needs input(s) {missing} that the "
+                f"prepared data do not provide ({_input_hint(missing, self)}); inputs "
+                f"available: {[c for c in self.frame.columns if c not in OUTPUT_COLUMNS]}"
+            )
+        U = self.frame.loc[:, list(names)].to_numpy(dtype=float)
+        if not np.isfinite(U).all():  # align fills or rejects input gaps: internal error
+            col = names[int(np.argwhere(~np.isfinite(U))[0, 1])]
+            raise RuntimeError(f"prepared input {col!r} has non-finite values")
+        return np.ascontiguousarray(U)
+
+    def observed(self, section: str, model) -> np.ndarray:
+        """The (N, n_out) float array of ``model.output_names`` columns (NaN = missing).
+
+        Raises
+        ------
+        ConfigError
+            An output the measurements do not provide.
+        """
+        _check_section(section)
+        names = tuple(model.output_names)
+        missing = [c for c in names if c not in self.frame.columns]
+        if missing:
+            raise ConfigError(
+                f"{section}.model: model {model.name!r} predicts {missing}, which the "
+                f"measurements do not provide ({_output_hint(missing)}); measured: "
+                f"{[c for c in self.frame.columns if c in OUTPUT_COLUMNS]}"
+            )
+        return np.ascontiguousarray(self.frame.loc[:, list(names)].to_numpy(dtype=float))
+
+    def period_index(self, which: str) -> pd.DatetimeIndex:
+        """Timestamps of the ``"calibration"`` or ``"validation"`` rows."""
+        sl = {"calibration": self.calibration, "validation": self.validation}[which]
+        return self.frame.index[sl] if sl is not None else self.frame.index[:0]
+
+
+def _check_section(section: str) -> None:
+    if section not in _SECTIONS:
+        raise ValueError(f"section must be 'thermal' or 'hygric' (got {section!r})")
+
+
+def _input_hint(missing: Sequence[str], prep: Prepared) -> str:
+    hints = []
+    solar = [c for c in missing if c.startswith("I_")]
+    if solar:
+        if prep.irradiance_source == "none":
+            hints.append(
+                "data.irradiance is 'none': build the thermal model without solar surfaces, "
+                "or set data.irradiance to 'measured' or 'clear_sky'"
+            )
+        else:
+            hints.append(
+                f"solar surfaces come from data.surfaces, which has "
+                f"{sorted(c[2:] for c in prep.frame.columns if c.startswith('I_'))}"
+            )
+    if "Pe" in missing:
+        hints.append("Pe is prepared for a 'hygric' section from the weather's Te and RHe")
+    if "Tf" in missing or "Te" in missing:
+        hints.append("Te and Tf are prepared for a 'thermal' section")
+    other = [c for c in missing if not c.startswith("I_") and c not in ("Pe", "Tf", "Te")]
+    if other:
+        hints.append(f"{other}: not an input the data layer provides")
+    return "; ".join(hints)
+
+
+def _output_hint(missing: Sequence[str]) -> str:
+    hints = []
+    if "Ti" in missing:
+        hints.append("map the indoor temperature in data.measurements.columns.Ti")
+    if "Pi" in missing:
+        hints.append(
+            "Pi is derived from Ti and RHi: map data.measurements.columns.Ti and "
+            "data.measurements.columns.RHi"
+        )
+    return "; ".join(hints) or "unknown output"
+
+
+# ---------------------------------------------------------------------------------------
+# Building blocks (also used by heritage_bayes.demo)
+# ---------------------------------------------------------------------------------------
+
+
+def annual_mean_temperature(te: pd.Series, times: pd.DatetimeIndex) -> tuple[np.ndarray, dict]:
+    """Fixed (ground) temperature ``Tf`` from outdoor temperature: the mean of a year.
+
+    Parameters
+    ----------
+    te : pandas.Series
+        Outdoor air temperature [°C] with a tz-aware index: the **whole** weather record
+        (NaN allowed), not only the period to simulate.
+    times : pandas.DatetimeIndex
+        Tz-aware instants at which ``Tf`` is wanted (e.g. the middle of each grid row).
+
+    Returns
+    -------
+    values : numpy.ndarray
+        ``Tf`` [°C] at ``times``.
+    info : dict
+        ``method`` (plain words), ``min``, ``max`` [°C], ``record_days``.
+
+    Notes
+    -----
+    * Record shorter than 365 days (typical-year files such as TMY3/EPW: 8760 hourly
+      values span 364 d 23 h): the mean of all values, a constant.
+    * Otherwise: daily means (UTC days with at least half of the typical number of
+      readings), their 365-day centred running mean where the window holds at least 350
+      valid days, linearly interpolated to ``times`` and held constant before the first
+      and after the last complete window. The result follows slow year-to-year changes
+      but not the seasons.
+    * No complete window (a long record full of gaps): the mean of all values, and
+      ``info["method"]`` says so.
+
+    The ground under a building and thick masonry follow the annual mean outdoor
+    temperature with a seasonal swing that decays with depth; the constant (or slowly
+    varying) annual mean is the usual choice for the fixed node of RC models.
+    """
+    s = pd.Series(np.asarray(te, dtype=float), index=te.index).dropna()
+    if s.empty:
+        raise DataError("outdoor temperature Te has no values: cannot form an annual mean")
+    span = s.index[-1] - s.index[0]
+    days = span / pd.Timedelta(days=1)
+    info = {"record_days": round(float(days), 2)}
+    if span >= _YEAR:
+        daily = s.resample("1D").agg(["mean", "count"])
+        typical = float(daily["count"].median())
+        means = daily["mean"].where(daily["count"] >= 0.5 * typical)
+        roll = means.rolling(365, center=True, min_periods=_MIN_DAYS).mean().dropna()
+        if not roll.empty:
+            centres = (roll.index + pd.Timedelta(hours=12)).asi8.astype(float)
+            t = np.clip(times.asi8.astype(float), centres[0], centres[-1])
+            values = np.interp(t, centres, roll.to_numpy())
+            info["method"] = (
+                "365-day centred running mean of the daily mean Te over the whole weather "
+                "record, held constant beyond the first/last complete window"
+            )
+            info.update(min=float(values.min()), max=float(values.max()))
+            return values, info
+        method = (
+            f"mean of Te over the whole weather record ({days:.0f} days): no 365-day "
+            f"window holds {_MIN_DAYS} valid days"
+        )
+    else:
+        method = f"mean of Te over the whole weather record ({days:.2f} days, less than a year)"
+    value = float(s.mean())
+    info.update(method=method, min=value, max=value)
+    return np.full(len(times), value), info
+
+
+def solar_inputs(
+    weather: pd.DataFrame,
+    site: Mapping,
+    surfaces: Mapping[str, Sequence[float]],
+    mode: str,
+    *,
+    where: str = "data.weather",
+) -> tuple[pd.DataFrame, str, str]:
+    """Irradiance on each solar surface as model inputs ``I_<surface>`` [W/m²].
+
+    Parameters
+    ----------
+    weather : pandas.DataFrame
+        A reader's output (``ghi`` and optionally ``dni``, ``dhi``, with ``attrs``).
+    site : mapping
+        ``latitude``, ``longitude`` [°], ``altitude`` [m].
+    surfaces : mapping
+        ``{name: (tilt, azimuth)}`` [°].
+    mode : {"measured", "clear_sky"}
+        Measured irradiance, or the explicit clear-sky proxy (measured columns, if any,
+        are then dropped and the proxy is labelled).
+
+    Returns
+    -------
+    table : pandas.DataFrame
+        ``I_<name>`` columns, interval averages stamped at the interval end (``attrs``).
+    label : str
+        Short label: ``"measured"`` or ``"clear-sky proxy (pvlib Ineichen)"``.
+    detail : str
+        The full provenance label of :func:`heritage_bayes.climate.surface_irradiance`.
+    """
+    from heritage_bayes.climate.solar import surface_irradiance
+
+    present = [c for c in _IRRADIANCE if c in weather.columns]
+    attrs = dict(weather.attrs)
+    if mode == "measured":
+        if "ghi" not in present:
+            raise DataError(
+                f"{where}: data.irradiance is 'measured' but the weather has no global "
+                f"horizontal irradiance 'ghi' (columns: {list(weather.columns)}); map it in "
+                f"{where}.columns.ghi, or set data.irradiance to 'clear_sky' (a labelled "
+                f"clear-sky proxy) or 'none'"
+            )
+        table = weather[present].copy()
+        table.attrs = attrs
+        kwargs = {}
+        label = "measured"
+    elif mode == "clear_sky":
+        table = weather.drop(columns=present)
+        table.attrs = attrs
+        kwargs = {"clear_sky": True}
+        label = "clear-sky proxy (pvlib Ineichen)"
+    else:
+        raise ValueError(f"mode must be 'measured' or 'clear_sky' (got {mode!r})")
+    try:
+        irr = surface_irradiance(
+            table,
+            dict(site),
+            {k: tuple(v) for k, v in surfaces.items()},
+            model=_TRANSPOSITION,
+            albedo=_ALBEDO,
+            **kwargs,
+        )
+    except DataError as exc:
+        raise DataError(f"{where}: {exc}") from None
+    except InputError as exc:
+        raise ConfigError(f"{where}: {exc}") from None
+    detail = irr.attrs.get("irradiance_source", label)
+    if mode == "clear_sky" and present:
+        detail += f"; measured {present} ignored (data.irradiance: clear_sky)"
+    out = irr.rename(columns={k: f"I_{k}" for k in surfaces})
+    out.attrs = dict(irr.attrs)
+    out.attrs["averaged"] = tuple(f"I_{k}" for k in irr.attrs.get("averaged", ()))
+    out.attrs["units"] = {f"I_{k}": "W/m²" for k in surfaces}
+    out.attrs["irradiance_source"] = detail
+    out.attrs["source"] = f"{attrs.get('source', 'weather')} (irradiance on surfaces)"
+    return out, label, detail
+
+
+def _with_vapour_pressure(df: pd.DataFrame, target: str, where: str) -> pd.DataFrame:
+    """Add ``Pe`` (from Te, RHe) or ``Pi`` (from Ti, RHi) unless already present."""
+    from heritage_bayes.io import add_vapour_pressure
+
+    t, rh = {"Pe": ("Te", "RHe"), "Pi": ("Ti", "RHi")}[target]
+    if target in df.columns or not (t in df.columns and rh in df.columns):
+        return df
+    sub = df[[t, rh]].copy()
+    sub.attrs = dict(df.attrs)
+    try:
+        out = add_vapour_pressure(sub, over="water")
+    except DataError as exc:
+        raise DataError(f"{where}: {exc}") from None
+    res = df.copy()
+    res[target] = out[target]
+    res.attrs = dict(df.attrs)
+    res.attrs["units"] = {**df.attrs.get("units", {}), target: "Pa"}
+    res.attrs["derived"] = {**df.attrs.get("derived", {}), **out.attrs.get("derived", {})}
+    return res
+
+
+def _table(df: pd.DataFrame, columns: Sequence[str]) -> pd.DataFrame:
+    """Columns of a reader's table, keeping (and trimming) its attrs."""
+    out = df[list(columns)].copy()
+    attrs = dict(df.attrs)
+    attrs["averaged"] = tuple(c for c in df.attrs.get("averaged", ()) if c in columns)
+    attrs["units"] = {c: u for c, u in df.attrs.get("units", {}).items() if c in columns}
+    out.attrs = attrs
+    return out
+
+
+def weather_inputs(
+    weather: pd.DataFrame,
+    *,
+    thermal: bool,
+    hygric: bool,
+    irradiance: str,
+    site: Mapping | None,
+    surfaces: Mapping[str, Sequence[float]],
+    where: str = "data.weather",
+) -> tuple[list[pd.DataFrame], dict]:
+    """The input tables to align: ``Te`` (thermal), ``Pe`` (hygric), ``I_<surface>``.
+
+    Returns the tables and a dict ``{"irradiance_source": short, "irradiance": {...}}``.
+    """
+    need = []
+    if thermal:
+        need.append("Te")
+    if hygric:
+        weather = _with_vapour_pressure(weather, "Pe", where)
+        need.append("Pe")
+    missing = [c for c in need if c not in weather.columns]
+    if missing:
+        why = {
+            "Te": "outdoor temperature Te (thermal section)",
+            "Pe": "outdoor vapour pressure Pe, or Te and RHe to derive it (hygric section)",
+        }
+        raise DataError(
+            f"{where}: no {' and no '.join(why[c] for c in missing)}; the weather has "
+            f"{list(weather.columns)}"
+            + (f"; map them in {where}.columns" if weather.attrs.get("format") == "csv" else "")
+        )
+    tables = [_table(weather, need)] if need else []
+    note: dict = {"irradiance_source": "none", "irradiance": {"mode": "none"}}
+    if thermal and irradiance != "none":
+        if site is None:
+            raise ConfigError(
+                "site: required (latitude, longitude) to compute solar irradiance on the "
+                "surfaces; or set data.irradiance: none"
+            )
+        irr, label, detail = solar_inputs(weather, site, surfaces, irradiance, where=where)
+        tables.append(irr)
+        note = {
+            "irradiance_source": label,
+            "irradiance": {
+                "mode": irradiance,
+                "label": detail,
+                "surfaces": {k: {"tilt": v[0], "azimuth": v[1]} for k, v in surfaces.items()},
+                "transposition": f"{_TRANSPOSITION}, albedo {_ALBEDO:g}",
+                "site": dict(site),
+            },
+        }
+    return tables, note
+
+
+# ---------------------------------------------------------------------------------------
+# Reading configured sources
+# ---------------------------------------------------------------------------------------
+
+
+def _quote(names) -> str:
+    return ", ".join(repr(n) for n in names)
+
+
+def _csv_header(path: Path, src, where: str) -> list[str]:
+    try:
+        header = pd.read_csv(path, nrows=0, sep=src.sep, encoding="utf-8")
+    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
+        raise DataError(f"{where}: {path.name}: cannot read the header line: {exc}") from None
+    return [str(c).strip() for c in header.columns]
+
+
+def _check_csv_columns(path: Path, src, where: str, allowed: Sequence[str]) -> None:
+    """Check the config's column names against the file header (precise key paths)."""
+    from heritage_bayes.io import STANDARD_COLUMNS
+
+    header = _csv_header(path, src, where)
+    tcols = [src.time_column] if isinstance(src.time_column, str) else list(src.time_column)
+    for c in tcols:
+        if c.strip() not in header:
+            raise DataError(
+                f"{where}.time_column: column {c!r} not found in {path.name}; columns are: "
+                f"{_quote(header)}"
+            )
+    for std, col in (src.columns or {}).items():
+        if std not in STANDARD_COLUMNS:
+            raise ConfigError(
+                f"{where}.columns.{std}: not a standard column name; use one of {_quote(allowed)}"
+            )
+        if std not in allowed:
+            role = "weather (model inputs)" if "Te" in allowed else "measurements (outputs)"
+            raise ConfigError(
+                f"{where}.columns.{std}: not a column of the {role}; allowed here: "
+                f"{_quote(allowed)}"
+            )
+        if str(col).strip() not in header:
+            raise DataError(
+                f"{where}.columns.{std}: column {col!r} not found in {path.name}; columns "
+                f"are: {_quote(header)}"
+            )
+
+
+def _csv_kwargs(src) -> dict:
+    kw = {
+        "time_column": src.time_column,
+        "time_format": src.time_format,
+        "timezone": src.timezone,
+        "sep": src.sep,
+        "decimal": src.decimal,
+        "averaged": src.averaged,
+        "interval": src.interval,
+        "label": src.label,
+        "duplicates": src.duplicates,
+        "invalid": src.invalid,
+    }
+    if src.na_values is not None:
+        kw["na_values"] = src.na_values
+    return kw
+
+
+def _resolve_paths(cfg, src, where: str) -> Path | list[Path]:
+    paths = [
+        cfg.path(p).resolve() for p in (src.path if isinstance(src.path, list) else [src.path])
+    ]
+    for p in paths:
+        if not p.is_file():
+            what = "is a directory, expected a data file" if p.is_dir() else "file not found"
+            raise DataError(f"{where}.path: {p}: {what}")
+    return paths if isinstance(src.path, list) else paths[0]
+
+
+def read_source(cfg, src, where: str, allowed: Sequence[str]) -> pd.DataFrame:
+    """Read one configured :class:`~heritage_bayes.config.Source`; errors name ``where``."""
+    from heritage_bayes.io import read_csv, read_epw, read_knmi_hourly, read_tmy3
+
+    path = _resolve_paths(cfg, src, where)
+    try:
+        if src.format == "csv":
+            _check_csv_columns(path, src, where, allowed)
+            df = read_csv(path, columns=src.columns, **_csv_kwargs(src))
+        elif src.format == "epw":
+            df = read_epw(path, year=src.year, invalid=src.invalid)
+        elif src.format == "tmy3":
+            df = read_tmy3(path, year=src.year, invalid=src.invalid)
+        else:
+            df = read_knmi_hourly(path, invalid=src.invalid)
+    except ConfigError:
+        raise
+    except DataError as exc:
+        raise DataError(f"{where}: {exc}") from None
+    except InputError as exc:
+        raise ConfigError(f"{where}: {exc}") from None
+    # columns of the other role picked up by name (no 'columns' mapping) are not used
+    extra = [c for c in df.columns if c not in allowed]
+    out = df.drop(columns=extra)
+    out.attrs = dict(df.attrs)
+    if not len(out.columns):
+        raise DataError(
+            f"{where}: {Path(str(df.attrs.get('source', ''))).name} has none of the columns "
+            f"{_quote(allowed)} (found {_quote(df.columns)})"
+        )
+    return out
+
+
+def _ground_column(cfg, gt, where: str) -> tuple[pd.DataFrame, dict]:
+    """Read the measured ``Tf`` series of ground_temperature mode 'column'."""
+    from heritage_bayes.io import read_csv
+
+    candidates = []
+    if gt.source is not None:
+        candidates.append((gt.source, f"{where}.source"))
+    else:
+        if cfg.data.weather is not None and cfg.data.weather.format == "csv":
+            candidates.append((cfg.data.weather, "data.weather"))
+        for i, m in enumerate(cfg.data.measurements or []):
+            if m.format == "csv":
+                key = "data.measurements" + (f"[{i}]" if len(cfg.data.measurements) > 1 else "")
+                candidates.append((m, key))
+    if not candidates:
+        raise ConfigError(
+            f"{where}.column: mode 'column' needs a CSV table holding {gt.column!r}: give "
+            f"{where}.source, or use CSV weather or measurement files"
+        )
+    seen = []
+    for src, key in candidates:
+        path = _resolve_paths(cfg, src, key)
+        header = _csv_header(path, src, key)
+        if gt.column.strip() not in header:
+            seen.append(f"{path.name}: {_quote(header)}")
+            continue
+        kw = _csv_kwargs(src)
+        kw["averaged"] = None
+        try:
+            df = read_csv(path, columns={"Te": gt.column}, **kw)
+        except DataError as exc:
+            raise DataError(f"{where} (column {gt.column!r} of {key}): {exc}") from None
+        except InputError as exc:
+            raise ConfigError(f"{where} (column {gt.column!r} of {key}): {exc}") from None
+        df = df.rename(columns={"Te": "Tf"})
+        df.attrs["units"] = {"Tf": "°C"}
+        df.attrs["averaged"] = ()
+        return df, {"mode": "column", "column": gt.column, "file": str(path), "key": key}
+    raise DataError(
+        f"{where}.column: column {gt.column!r} not found; columns are: " + "; ".join(seen)
+    )
+
+
+# ---------------------------------------------------------------------------------------
+# Periods
+# ---------------------------------------------------------------------------------------
+
+
+def _utc(text: str) -> pd.Timestamp:
+    ts = pd.Timestamp(text)
+    return ts.tz_localize("UTC") if ts.tzinfo is None else ts.tz_convert("UTC")
+
+
+def _rows(t: pd.Timestamp, start: pd.Timestamp, step: pd.Timedelta) -> int:
+    """Grid row of instant ``t`` (rounded up to the next row)."""
+    return math.ceil((t - start) / step - 1e-9)
+
+
+def _iso(ts: pd.Timestamp) -> str:
+    return ts.tz_convert("UTC").strftime("%Y-%m-%dT%H:%M:%SZ")
+
+
+# ---------------------------------------------------------------------------------------
+# prepare
+# ---------------------------------------------------------------------------------------
+
+
+def _check_models_vs_irradiance(cfg) -> None:
+    sec = cfg.thermal
+    if sec is None or cfg.data.irradiance != "none":
+        return
+    surf = sec.options.get("surfaces") if isinstance(sec.options, Mapping) else None
+    if surf:
+        raise ConfigError(
+            f"thermal.options.surfaces: {list(surf)} are solar surfaces, but data.irradiance "
+            f"is 'none' (no solar input): remove thermal.options.surfaces (the thermal model "
+            f"is then built without solar apertures) or set data.irradiance to 'measured' or "
+            f"'clear_sky'"
+        )
+
+
+def prepare(cfg) -> Prepared:
+    """Read, derive, align: the model-ready data of a validated configuration.
+
+    Parameters
+    ----------
+    cfg : heritage_bayes.config.CalibrationConfig
+
+    Returns
+    -------
+    Prepared
+
+    Raises
+    ------
+    heritage_bayes.errors.ConfigError
+        A setting that does not fit the data or the models (names the key path).
+    heritage_bayes.errors.DataError
+        A data problem: missing file or column, bad values, input gaps longer than
+        ``data.max_gap`` inside the frame, a period not covered by the inputs, no
+        observations in a period (names the key path and the file, column or row).
+    """
+    from heritage_bayes.io import align
+
+    thermal, hygric = cfg.thermal is not None, cfg.hygric is not None
+    if not (thermal or hygric):
+        raise ConfigError("give at least one of 'thermal' and 'hygric'")
+    _check_models_vs_irradiance(cfg)
+    data = cfg.data
+    step = parse_duration(data.step)
+    surfaces = {k: tuple(v) for k, v in data.surfaces.items()}
+    sources: dict = {}
+    truth = None
+    monument = None
+
+    # -- read ------------------------------------------------------------------------------
+    if data.demo is not None:
+        monument = _demo(data.demo)
+        weather = monument.weather
+        meas_tables = [monument.measurements]
+        site = dict(monument.info["site"])
+        sources["demo"] = monument.info["settings"] | {
+            "description": monument.info["description"],
+            "weather_file": monument.info["weather_file"],
+            "station": monument.info["station"],
+            "true_Tf": monument.info["Tf"],
+        }
+        sources["weather"] = {
+            "path": monument.info["weather_file"],
+            "format": "tmy3",
+            "note": "shipped with pvlib",
+        }
+        sources["measurements"] = [{"generated": monument.measurements.attrs["source"]}]
+        sources["site"] = site | {"from": "weather file (TMY3 metadata)"}
+    else:
+        weather = read_source(cfg, data.weather, "data.weather", INPUT_COLUMNS)
+        many = len(data.measurements) > 1
+        meas_tables = []
+        for i, src in enumerate(data.measurements):
+            key = "data.measurements" + (f"[{i}]" if many else "")
+            meas_tables.append(read_source(cfg, src, key, OUTPUT_COLUMNS))
+        if cfg.site is not None:
+            site = cfg.site.model_dump()
+            sources["site"] = site | {"from": "config"}
+        else:
+            site = weather.attrs.get("site")
+            if site is not None:
+                sources["site"] = dict(site) | {"from": "weather file"}
+        sources["weather"] = _source_note(weather, data.weather.format)
+        sources["measurements"] = [
+            _source_note(m, s.format) for m, s in zip(meas_tables, data.measurements, strict=True)
+        ]
+
+    # -- inputs ----------------------------------------------------------------------------
+    tables, note = weather_inputs(
+        weather,
+        thermal=thermal,
+        hygric=hygric,
+        irradiance=data.irradiance,
+        site=site,
+        surfaces=surfaces,
+        where="data.weather",
+    )
+    sources["irradiance"] = note["irradiance"]
+    irradiance_source = note["irradiance_source"]
+    if monument is not None and irradiance_source == "measured":
+        irradiance_source = monument.info["irradiance_label"]
+    gt = data.ground_temperature
+    if thermal and gt.mode == "column":
+        tf_table, sources["ground_temperature"] = _ground_column(cfg, gt, "data.ground_temperature")
+        tables.append(tf_table)
+
+    # -- outputs ---------------------------------------------------------------------------
+    key = "data.measurements"
+    meas_tables = [_with_vapour_pressure(m, "Pi", key) for m in meas_tables]
+    measured = {c for m in meas_tables for c in m.columns}
+    if thermal and "Ti" not in measured:
+        raise ConfigError(
+            f"{key}.columns.Ti: the thermal section needs the indoor temperature Ti; the "
+            f"measurements provide {sorted(measured)}"
+        )
+    if hygric and "Pi" not in measured and not {"Ti", "RHi"} <= measured:
+        raise ConfigError(
+            f"{key}.columns.RHi: the hygric section needs the indoor vapour pressure Pi, "
+            f"or Ti and RHi to derive it; the measurements provide {sorted(measured)}"
+        )
+
+    # -- periods and alignment -------------------------------------------------------------
+    per = cfg.periods
+    start = end = None
+    if per.calibration is not None:
+        bounds = [per.calibration] + ([per.validation] if per.validation is not None else [])
+        start = min(_utc(p.start) for p in bounds)
+        end = max(_utc(p.end) for p in bounds)
+    try:
+        aligned = align(
+            tables,
+            meas_tables,
+            step=step,
+            max_gap=parse_duration(data.max_gap),
+            start=start,
+            end=end,
+        )
+    except DataError as exc:
+        what = (
+            f"the periods ({_iso(start)} to {_iso(end)})"
+            if start is not None
+            else "the common period of all data (no periods given)"
+        )
+        raise DataError(
+            f"data.weather/data.measurements: aligning on {what} with data.step="
+            f"{data.step}, data.max_gap={data.max_gap}: {exc}"
+        ) from None
+    except InputError as exc:
+        raise ConfigError(f"data: {exc}") from None
+
+    frame = aligned.frame.copy()
+    flags = aligned.flags.copy()
+    n = len(frame)
+    s0 = frame.index[0]
+
+    # Tf (annual mean or constant); column mode came through align
+    if thermal and gt.mode != "column":
+        if gt.mode == "constant":
+            tf = np.full(n, float(gt.value))
+            sources["ground_temperature"] = {"mode": "constant", "value": float(gt.value)}
+        else:
+            mids = frame.index + step / 2
+            tf, info = annual_mean_temperature(weather["Te"], mids)
+            sources["ground_temperature"] = {"mode": "annual_mean"} | info
+        frame["Tf"] = tf
+        flags["Tf"] = False
+    if "Pi" not in frame.columns and {"Ti", "RHi"} <= set(frame.columns):
+        from heritage_bayes.climate.psychro import vapour_pressure
+
+        frame["Pi"] = vapour_pressure(frame["Ti"].to_numpy(), frame["RHi"].to_numpy())
+        flags["Pi"] = False
+
+    order = [c for c in ("Te", *[f"I_{k}" for k in surfaces], "Tf", "Pe") if c in frame]
+    order += [c for c in frame.columns if c not in order and c not in OUTPUT_COLUMNS]
+    order += [c for c in ("Ti", "Pi", "RHi") if c in frame]
+    frame = frame[order]
+    flags = flags[order]
+    frame.attrs = dict(aligned.frame.attrs)
+    frame.attrs["inputs"] = tuple(c for c in order if c not in OUTPUT_COLUMNS)
+    frame.attrs["outputs"] = tuple(c for c in order if c in OUTPUT_COLUMNS)
+    frame.attrs["units"] = {
+        **frame.attrs.get("units", {}),
+        **{c: "W/m²" for c in order if c.startswith("I_")},
+        **({"Tf": "°C"} if "Tf" in order else {}),
+        **({"Pi": "Pa"} if "Pi" in order else {}),
+    }
+
+    # -- period rows -----------------------------------------------------------------------
+    if per.calibration is not None:
+        cal = slice(
+            _rows(_utc(per.calibration.start), s0, step),
+            min(n, _rows(_utc(per.calibration.end), s0, step)),
+        )
+        val = None
+        if per.validation is not None:
+            val = slice(
+                _rows(_utc(per.validation.start), s0, step),
+                min(n, _rows(_utc(per.validation.end), s0, step)),
+            )
+        period_note = "config"
+    else:
+        k = round(2 * n / 3)
+        if k < 1 or k >= n:
+            raise DataError(
+                f"periods: the common period of all data has only {n} rows of "
+                f"{data.step}; too short to split into calibration and validation"
+            )
+        cal, val = slice(0, k), slice(k, n)
+        period_note = "default: first 2/3 of the common period of all data, then the rest"
+    dt = float(step.total_seconds())
+    warmup_steps = math.ceil(parse_duration(per.warmup) / step - 1e-9)
+    init_steps = math.ceil(parse_duration(per.init_window) / step - 1e-9)
+    cal_rows = cal.stop - cal.start
+    if warmup_steps >= cal_rows:
+        raise ConfigError(
+            f"periods.warmup: {per.warmup} ({warmup_steps} rows) is not shorter than the "
+            f"calibration period ({cal_rows} rows, {_iso(frame.index[cal.start])} to "
+            f"{_iso(frame.index[cal.stop - 1] + step)})"
+        )
+    _check_observations(frame, cal, val, warmup_steps, thermal, hygric, step)
+
+    def _span(sl):
+        if sl is None:
+            return None
+        return {
+            "start": _iso(frame.index[sl.start]),
+            "end": _iso(frame.index[sl.stop - 1] + step),
+            "rows": [sl.start, sl.stop],
+        }
+
+    sources["periods"] = {
+        "from": period_note,
+        "calibration": _span(cal),
+        "validation": _span(val),
+        "warmup": per.warmup,
+        "warmup_steps": warmup_steps,
+        "init_window": per.init_window,
+        "init_steps": init_steps,
+    }
+
+    if monument is not None:
+        from heritage_bayes.demo import nominal_noise
+
+        truth = {sec: dict(vals) for sec, vals in monument.truth.items()}
+        rows = frame.index[cal.start + warmup_steps : cal.stop]
+        truth["thermal"].update(nominal_noise(monument, "Ti", rows))
+        truth["hygric"].update(nominal_noise(monument, "Pi", rows))
+
+    return Prepared(
+        frame=frame,
+        flags=flags,
+        alignment=aligned.report.to_dict(),
+        dt=dt,
+        calibration=cal,
+        validation=val,
+        warmup_steps=warmup_steps,
+        init_steps=init_steps,
+        irradiance_source=irradiance_source,
+        truth=truth,
+        sources=_jsonable(sources),
+    )
+
+
+def _check_observations(frame, cal, val, warmup_steps, thermal, hygric, step) -> None:
+    needed = (["Ti"] if thermal else []) + (["Pi"] if hygric else [])
+    periods = [("calibration (after the warm-up)", slice(cal.start + warmup_steps, cal.stop))]
+    if val is not None:
+        if val.stop <= val.start:
+            raise ConfigError("periods.validation: has no rows on the grid")
+        periods.append(("validation", val))
+    for what, sl in periods:
+        for col in needed:
+            if not np.isfinite(frame[col].to_numpy()[sl]).any():
+                a = frame.index[sl.start] if sl.start < len(frame) else frame.index[-1]
+                b = frame.index[max(sl.stop - 1, 0)] + step
+                raise DataError(
+                    f"data.measurements: no {col} observation in the {what} period "
+                    f"{_iso(a)} to {_iso(b)}; check periods and the measurement file's "
+                    f"time zone"
+                )
+
+
+def _source_note(df: pd.DataFrame, fmt: str) -> dict:
+    attrs = df.attrs
+    note = {
+        "path": attrs.get("source"),
+        "format": fmt,
+        "columns": list(df.columns),
+        "rows": len(df),
+        "first": _iso(df.index[0]) if len(df) else None,
+        "last": _iso(df.index[-1]) if len(df) else None,
+    }
+    for key in ("timezone", "dropped", "clipped", "station", "source_columns", "coerced_year"):
+        if attrs.get(key) not in (None, {}, ()):
+            note[key] = attrs[key]
+    return note
+
+
+def _demo(settings):
+    from heritage_bayes.demo import virtual_monument
+
+    truth = settings.truth or {}
+    try:
+        return virtual_monument(
+            seed=settings.seed,
+            weather=settings.weather,
+            sensor_noise_T=settings.sensor_noise_T,
+            sensor_noise_RH=settings.sensor_noise_RH,
+            model_error_T=settings.model_error_T,
+            model_error_P=settings.model_error_P,
+            model_error_phi=settings.model_error_phi,
+            gap=settings.gap,
+            thermal=truth.get("thermal"),
+            hygric=truth.get("hygric"),
+        )
+    except InputError as exc:  # its messages start with the setting's name
+        raise ConfigError(f"data.demo.{exc}") from None
+
+
+def _jsonable(obj):
+    if isinstance(obj, Mapping):
+        return {str(k): _jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return [_jsonable(v) for v in obj]
+    if isinstance(obj, np.integer):
+        return int(obj)
+    if isinstance(obj, np.floating):
+        return float(obj)
+    if isinstance(obj, np.bool_):
+        return bool(obj)
+    if isinstance(obj, pd.Timestamp):
+        return _iso(obj)
+    if isinstance(obj, pd.Timedelta | Path):
+        return str(obj)
+    if obj is None or isinstance(obj, str | int | float | bool):
+        return obj
+    return str(obj)

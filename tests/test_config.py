@@ -1,0 +1,319 @@
+"""The YAML schema: the example configs load, and bad configs give key-path messages."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+import yaml
+
+from heritage_bayes.config import Periods, config_hash, load_config, parse_config
+from heritage_bayes.errors import ConfigError, InputError
+
+CONFIGS = Path(__file__).resolve().parents[1] / "configs"
+
+DEMO = {"data": {"demo": {}}, "thermal": {"model": "thermal_4a"}}
+
+
+def _error(raw) -> str:
+    with pytest.raises(ConfigError) as exc:
+        parse_config(raw)
+    return str(exc.value)
+
+
+def _with(**sections) -> dict:
+    raw = json.loads(json.dumps(DEMO))
+    raw.update(sections)
+    return raw
+
+
+def _csv_data(**extra) -> dict:
+    data = {
+        "weather": {"format": "csv", "path": "w.csv", "time_column": "t", "timezone": "UTC"},
+        "measurements": {"format": "csv", "path": "m.csv", "time_column": "t", "timezone": "UTC"},
+        "irradiance": "none",
+    }
+    data.update(extra)
+    return data
+
+
+# ---------------------------------------------------------------------------------------
+# valid configs
+# ---------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("name", ["demo", "orholm", "trh1_attic"])
+def test_example_configs_load(name):
+    cfg = load_config(CONFIGS / f"{name}.yaml")
+    assert cfg.name == name
+    assert cfg.thermal is not None and cfg.hygric is not None
+    assert cfg.periods.calibration is not None and cfg.periods.validation is not None
+    resolved = cfg.resolved()
+    json.dumps(resolved)  # serialisable
+    assert "base_dir" not in resolved
+    # the resolved config is itself a valid config, with the same hash
+    again = parse_config(resolved, base_dir=cfg.base_dir)
+    assert config_hash(again) == config_hash(cfg)
+
+
+def test_example_config_paths_resolve_beside_the_repo():
+    cfg = load_config(CONFIGS / "orholm.yaml")
+    weather = cfg.path(cfg.data.weather.path).resolve()
+    assert weather.parts[-4:] == (
+        "shared",
+        "data",
+        "orholm",
+        "DMI_outdoor-climate-data_2009-2021.csv",
+    )
+    assert weather.parents[3] == CONFIGS.parents[1]
+
+
+def test_demo_config_values():
+    cfg = load_config(CONFIGS / "demo.yaml")
+    assert cfg.data.demo is not None and cfg.site is None
+    assert cfg.data.demo.gap == ("2019-03-10", "2019-03-17")
+    assert cfg.periods.calibration.start == "2019-01-02"  # a YAML date kept as text
+    assert cfg.room_volume == 400
+    assert cfg.thermal.model == "thermal_4a" and cfg.thermal.noise == "ar1"
+    assert cfg.hygric.model == "hygric_2c" and cfg.hygric.noise == "ar1"
+
+
+def test_yaml_dates_and_offsets_are_accepted():
+    raw = yaml.safe_load(
+        """
+        data: {demo: {gap: [2019-02-01, 2019-02-03T12:00:00]}}
+        thermal: {model: thermal_4a}
+        periods:
+          calibration: {start: 2019-01-02, end: "2019-04-01T00:00+01:00"}
+        """
+    )
+    cfg = parse_config(raw)
+    assert cfg.periods.calibration.end == "2019-04-01T00:00+01:00"
+    assert cfg.data.demo.gap[1].startswith("2019-02-03T12:00")
+
+
+def test_single_measurement_table_becomes_a_list():
+    cfg = parse_config({"data": _csv_data(), "thermal": {"model": "thermal_4a"}})
+    assert isinstance(cfg.data.measurements, list) and len(cfg.data.measurements) == 1
+
+
+def test_site_from_epw_or_tmy3_file_is_enough():
+    data = _csv_data(irradiance="measured")
+    data["weather"] = {"format": "epw", "path": "uccle.epw"}
+    parse_config({"data": data, "thermal": {"model": "thermal_4a"}})
+
+
+# ---------------------------------------------------------------------------------------
+# error messages
+# ---------------------------------------------------------------------------------------
+
+
+def test_unknown_top_level_key_lists_allowed_keys():
+    msg = _error(_with(modle="x"))
+    assert "modle: unknown key; allowed keys: name, building, room" in msg
+    assert "base_dir" not in msg
+
+
+def test_unknown_nested_key_names_its_path():
+    raw = {"data": _csv_data(), "thermal": {"model": "thermal_4a"}}
+    raw["data"]["weather"]["colums"] = {"Te": "T"}
+    msg = _error(raw)
+    assert "data.weather.colums: unknown key; allowed keys: format, path, time_column" in msg
+
+
+def test_unknown_key_in_second_measurement_table_has_index():
+    data = _csv_data()
+    data["measurements"] = [data["measurements"], dict(data["measurements"], bogus=1)]
+    msg = _error({"data": data, "thermal": {"model": "thermal_4a"}})
+    assert "data.measurements[1].bogus: unknown key" in msg
+
+
+def test_wrong_type_says_what_was_found():
+    msg = _error(_with(seed="abc"))
+    assert "seed: Input should be a valid integer" in msg and "(got 'abc')" in msg
+    msg = _error(_with(site={"latitude": 100, "longitude": 5}))
+    assert "site.latitude" in msg and "(got 100)" in msg
+    msg = _error(_with(data={"demo": {"sensor_noise_T": -1}}))
+    assert "data.demo.sensor_noise_T" in msg and "(got -1)" in msg
+
+
+def test_durations_are_normalised_for_pandas():
+    cfg = parse_config(_with(periods={"warmup": "3d", "init_window": "36H"}))
+    assert (cfg.periods.warmup, cfg.periods.init_window) == ("3D", "36h")
+    assert cfg.periods.warmup == Periods().warmup.replace("14", "3")
+
+
+def test_bad_duration():
+    msg = _error(_with(periods={"warmup": "two weeks"}))
+    assert "periods.warmup: expected a duration such as '1h'" in msg
+    assert msg.count("(got ") == 1
+    msg = _error(_with(data={"demo": {}, "step": "0h"}))
+    assert "data.step: must be positive (got '0h')" in msg
+
+
+def test_priors_key_path():
+    """``thermal.priors.Gw.lower``: checked where the model is known (the inference layer)."""
+    import heritage_bayes as hb
+    from heritage_bayes.inference.likelihoods import get_noise_model
+    from heritage_bayes.inference.parameters import parameters_for
+
+    raw = _with(thermal={"model": "thermal_4a", "priors": {"Gw": {"lower": 500, "upper": 200}}})
+    try:
+        cfg = parse_config(raw)
+    except ConfigError as exc:  # if the schema checks priors itself
+        msg = str(exc)
+    else:
+        with pytest.raises(ConfigError) as exc:
+            parameters_for(
+                hb.model(cfg.thermal.model),
+                get_noise_model(cfg.thermal.noise),
+                cfg.thermal.priors,
+                where="thermal.priors",
+            )
+        msg = str(exc.value)
+    assert "thermal.priors.Gw.lower: must be < upper" in msg
+    assert "500" in msg and "200" in msg
+
+
+def test_priors_must_be_mappings():
+    msg = _error(_with(thermal={"model": "thermal_4a", "priors": {"Gw": 5}}))
+    assert "thermal.priors.Gw: Input should be a valid dictionary" in msg
+
+
+@pytest.mark.parametrize(
+    ("start", "end"),
+    [("2019-04-01", "2019-01-01"), ("2019-01-01", "2019-01-01")],
+)
+def test_start_not_before_end(start, end):
+    msg = _error(_with(periods={"calibration": {"start": start, "end": end}}))
+    assert f"periods.calibration: start must be before end (got {start} >= {end})" in msg
+
+
+def test_bad_date():
+    msg = _error(_with(periods={"calibration": {"start": "yesterday", "end": "2019-01-01"}}))
+    assert "periods.calibration: start/end must be dates such as 2019-01-01" in msg
+
+
+def test_period_rules():
+    cal = {"start": "2019-01-01", "end": "2019-04-01"}
+    msg = _error(_with(periods={"validation": cal}))
+    assert "periods.calibration: required when 'validation' is given" in msg
+    msg = _error(
+        _with(
+            periods={"calibration": cal, "validation": {"start": "2019-03-01", "end": "2019-05-01"}}
+        )
+    )
+    assert "periods.validation: overlaps the calibration period" in msg
+    msg = _error(_with(periods={"calibration": cal, "warmup": "100d"}))
+    assert "periods.warmup: 100D is not shorter than the calibration period" in msg
+
+
+def test_missing_required_keys():
+    msg = _error({"thermal": {"model": "thermal_4a"}})
+    assert "data: required" in msg
+    msg = _error(_with(thermal={"noise": "ar1"}))
+    assert "thermal.model: required" in msg
+    data = _csv_data()
+    del data["weather"]["format"]
+    msg = _error({"data": data, "thermal": {"model": "thermal_4a"}})
+    assert "data.weather.format: required" in msg
+    data = _csv_data()
+    del data["measurements"]["time_column"]
+    msg = _error({"data": data, "thermal": {"model": "thermal_4a"}})
+    assert "data.measurements.time_column: required for format 'csv'" in msg
+
+
+def test_needs_a_model_and_data():
+    assert "give at least one of 'thermal' and 'hygric'" in _error({"data": {"demo": {}}})
+    msg = _error({"data": {"weather": _csv_data()["weather"]}, "thermal": {"model": "x"}})
+    assert "give either 'demo' or both 'weather' and 'measurements'" in msg
+    msg = _error({"data": dict(_csv_data(), demo={}), "thermal": {"model": "x"}})
+    assert "'demo' generates its own data" in msg
+
+
+def test_options_must_fit_the_format():
+    data = _csv_data()
+    data["weather"] = {"format": "knmi", "path": "a.txt", "sep": ";", "timezone": "UTC"}
+    msg = _error({"data": data, "thermal": {"model": "thermal_4a"}})
+    assert "data.weather.timezone: only for format 'csv' (format is 'knmi'); also sep" in msg
+    data = _csv_data()
+    data["weather"]["year"] = 2019
+    msg = _error({"data": data, "thermal": {"model": "thermal_4a"}})
+    assert "data.weather.year: only for formats 'epw' and 'tmy3'" in msg
+    data = _csv_data()
+    data["weather"]["path"] = ["a.csv", "b.csv"]
+    msg = _error({"data": data, "thermal": {"model": "thermal_4a"}})
+    assert "data.weather.path: a list of files is only for format 'knmi'" in msg
+
+
+def test_ground_temperature_rules():
+    def gt(spec):
+        return _error(_with(data={"demo": {}, "ground_temperature": spec}))
+
+    assert "data.ground_temperature.value: required for mode 'constant'" in gt({"mode": "constant"})
+    assert "data.ground_temperature.value: only for mode 'constant'" in gt({"value": 10})
+    assert "data.ground_temperature.column: required for mode 'column'" in gt({"mode": "column"})
+    msg = gt(
+        {
+            "mode": "column",
+            "column": "T",
+            "source": {"format": "csv", "path": "x.csv", "time_column": "t", "columns": {}},
+        }
+    )
+    assert "data.ground_temperature.source.columns: not used here" in msg
+
+
+def test_surfaces_rules():
+    msg = _error(_with(data={"demo": {}, "irradiance": "none", "surfaces": {"S": [90, 180]}}))
+    assert "data.surfaces: given, but irradiance is 'none'" in msg
+    msg = _error(_with(data={"demo": {}, "surfaces": {"S": [90, 400]}}))
+    assert "data.surfaces.S: azimuth must be within 0..360° (got 400.0)" in msg
+    msg = _error(_with(data={"demo": {}, "surfaces": {"roof-E": [30, 90]}}))
+    assert "data.surfaces: 'roof-E': surface names must be letters" in msg
+
+
+def test_site_rules():
+    assert "site: the demo uses the site of its weather file" in _error(
+        _with(site={"latitude": 52, "longitude": 5})
+    )
+    msg = _error({"data": _csv_data(irradiance="measured"), "thermal": {"model": "thermal_4a"}})
+    assert "site: required (latitude, longitude)" in msg
+
+
+def test_demo_truth_sections():
+    msg = _error(_with(data={"demo": {"truth": {"thermic": {"Gw": 1}}}}))
+    assert "data.demo.truth.thermic" in msg
+
+
+def test_not_a_mapping():
+    with pytest.raises(ConfigError, match="expected a YAML mapping at the top level"):
+        parse_config([1, 2])
+
+
+def test_yaml_syntax_error_has_line_and_column(tmp_path):
+    path = tmp_path / "bad.yaml"
+    path.write_text("name: x\ndata:\n  demo: {seed: 1\nthermal: {model: thermal_4a}\n")
+    with pytest.raises(ConfigError) as exc:
+        load_config(path)
+    msg = str(exc.value)
+    assert str(path) in msg and "not valid YAML at line 4, column" in msg
+
+
+def test_missing_file(tmp_path):
+    with pytest.raises(ConfigError, match="config file not found"):
+        load_config(tmp_path / "nope.yaml")
+
+
+def test_errors_are_input_errors_without_chained_tracebacks():
+    with pytest.raises(InputError) as exc:
+        parse_config(_with(bogus=1))
+    assert exc.value.__cause__ is None and exc.value.__suppress_context__
+
+
+def test_name_defaults_to_file_stem(tmp_path):
+    path = tmp_path / "my_room.yaml"
+    path.write_text(yaml.safe_dump(DEMO))
+    cfg = load_config(path)
+    assert cfg.name == "my_room"
+    assert cfg.path("data.csv") == tmp_path.resolve() / "data.csv"

@@ -1,0 +1,253 @@
+"""Priors and transforms, noise models, the vectorised log-posterior, MAP and sampler."""
+
+import math
+
+import numpy as np
+import pytest
+from scipy import integrate, stats
+
+import heritage_bayes as hb
+from heritage_bayes.errors import ConfigError, InputError
+from heritage_bayes.inference.likelihoods import AR1Noise, IIDNoise, _ar1_sample, get_noise_model
+from heritage_bayes.inference.optimize import find_map
+from heritage_bayes.inference.parameters import (
+    Parameter,
+    ParameterSet,
+    Prior,
+    air_capacity_prior,
+    parameters_for,
+)
+from heritage_bayes.inference.posterior import LogPosterior
+from heritage_bayes.inference.sampler import run_sampler
+from heritage_bayes.rc.discretize import modal_form
+
+PRIORS = [
+    Prior("uniform", -2.0, 5.0),
+    Prior("loguniform", 1e-2, 1e5),
+    Prior("normal", 0.0, 10.0, mu=3.0, sigma=2.0),
+    Prior("lognormal", 1e3, 1e8, mu=2e5, sigma=1.5),
+]
+
+
+@pytest.mark.parametrize("prior", PRIORS, ids=lambda p: p.dist)
+def test_transform_density_integrates_to_the_prior_mass(prior):
+    """exp(logpdf(θ(x)) + log|dθ/dx|) over x equals ∫ exp(logpdf(θ)) dθ over the bounds."""
+    ps = ParameterSet([Parameter("p", "-", "x", prior)])
+
+    def dens_x(x):
+        return math.exp(ps.transform(np.array([[x]]))[1][0])
+
+    mass_x = integrate.quad(dens_x, -60, 60, limit=400)[0]
+    mass_theta = integrate.quad(
+        lambda t: math.exp(prior.logpdf(np.array(t))),
+        prior.lower,
+        prior.upper,
+        limit=400,
+        points=[prior.mu or prior.lower],
+    )[0]
+    assert mass_x == pytest.approx(mass_theta, rel=1e-6)
+    # round trip and bounds
+    theta = prior.sample(np.random.default_rng(0), 200)
+    assert np.all((theta >= prior.lower) & (theta <= prior.upper))
+    back = ps.values(prior.to_unconstrained(theta)[:, None])[:, 0]
+    np.testing.assert_allclose(back, theta, rtol=1e-9)
+
+
+def test_vectorised_transform_matches_per_prior_path():
+    ps = ParameterSet(
+        [Parameter(f"p{i}", "-", "x", p) for i, p in enumerate(PRIORS)]
+        + [Parameter("fixed", "-", "x", PRIORS[0], fixed=1.5)]
+    )
+    X = np.random.default_rng(1).normal(0, 3, (50, 4))
+    theta, lp = ps.transform(X)
+    ref = np.zeros(50)
+    for j, p in enumerate(PRIORS):
+        th, lj = p.from_unconstrained(X[:, j])
+        np.testing.assert_allclose(theta[:, j], th, rtol=1e-13)
+        ref += p.logpdf(th) + lj
+    np.testing.assert_allclose(lp, ref, rtol=1e-12)
+    assert np.all(theta[:, 4] == 1.5)
+
+
+def test_prior_specs_and_errors_name_the_key():
+    p = Prior.from_spec({"dist": "lognormal", "median": 100.0, "sigma": 0.5}, where="x")
+    assert p.lower == pytest.approx(100 * math.exp(-2.5))
+    with pytest.raises(ConfigError, match=r"priors\.Gw\.lower: must be < upper \(got 500 >= 200\)"):
+        Prior.from_spec({"dist": "loguniform", "lower": 500, "upper": 200}, where="priors.Gw")
+    with pytest.raises(ConfigError, match=r"priors\.Gw: unknown key\(s\) \['low'\]"):
+        Prior.from_spec({"dist": "loguniform", "low": 1}, where="priors.Gw")
+    m = hb.model("thermal_1c")
+    with pytest.raises(ConfigError, match=r"thermal\.priors: unknown parameter\(s\) \['Gx'\]"):
+        parameters_for(m, AR1Noise(), {"Gx": {"fixed": 1}}, where="thermal.priors")
+    with pytest.raises(ConfigError, match=r"priors\.Ge\.fixed: expected a number"):
+        parameters_for(m, AR1Noise(), {"Ge": {"fixed": "abc"}})
+    ps = parameters_for(m, AR1Noise(), {"Ge": {"fixed": 50}, "Gf": {"upper": 10}}, room_volume=400)
+    assert ps["Ge"].fixed == 50 and "Ge" not in ps.free_names
+    assert ps["Gf"].prior.upper == 10 and ps["Gf"].prior.dist == "loguniform"
+    # the room volume sets a log-normal prior on the air capacity around 5 x rho c V
+    assert ps["Ci"].prior.dist == "lognormal"
+    assert ps["Ci"].prior.mu == pytest.approx(5 * 1206 * 400)
+    assert air_capacity_prior("hygric", 400).mu == pytest.approx(10 * 400 / (461.52 * 288.15))
+
+
+def _ar1_cov(sigma, phi, idx):
+    d = np.abs(idx[:, None] - idx[None, :])
+    return sigma**2 * phi**d
+
+
+@pytest.mark.parametrize("phi", [0.0, 0.5, 0.95])
+def test_ar1_likelihood_with_gaps_equals_multivariate_normal(phi):
+    rng = np.random.default_rng(3)
+    N = 60
+    ysim = rng.normal(size=(2, N))
+    yobs = rng.normal(size=N)
+    yobs[[5, 6, 7, 30, 41]] = np.nan
+    noise = np.array([[0.7, phi], [1.3, phi]])
+    ll = AR1Noise().loglik(ysim[:, :, None], yobs[:, None], noise)
+    idx = np.flatnonzero(np.isfinite(yobs))
+    for k in range(2):
+        ref = stats.multivariate_normal(np.zeros(idx.size), _ar1_cov(noise[k, 0], phi, idx)).logpdf(
+            yobs[idx] - ysim[k, idx]
+        )
+        assert ll[k] == pytest.approx(ref, rel=1e-10)
+    pw = AR1Noise().pointwise(ysim[:, :, None], yobs[:, None], noise)
+    np.testing.assert_allclose(np.nansum(pw, axis=(1, 2)), ll, rtol=1e-12)
+    assert np.isnan(pw[0, 5, 0])
+
+
+def test_iid_likelihood_is_the_normal_density():
+    rng = np.random.default_rng(4)
+    ysim = rng.normal(size=(3, 40, 1))
+    yobs = rng.normal(size=(40, 1))
+    yobs[10] = np.nan
+    sig = np.array([[0.5], [1.0], [2.0]])
+    ll = IIDNoise().loglik(ysim, yobs, sig)
+    ok = np.isfinite(yobs[:, 0])
+    for k in range(3):
+        ref = stats.norm(ysim[k, ok, 0], sig[k, 0]).logpdf(yobs[ok, 0]).sum()
+        assert ll[k] == pytest.approx(ref, rel=1e-12)
+
+
+def test_ar1_noise_sampler_has_the_right_moments():
+    rng = np.random.default_rng(5)
+    z = rng.standard_normal((4, 200_000))
+    out = np.empty_like(z)
+    _ar1_sample(z, np.full(4, 0.8), np.full(4, 2.0), out)
+    x = out.reshape(-1)
+    # sd 2 and lag-1 correlation 0.8, to within a few standard errors
+    assert np.std(x) == pytest.approx(2.0, rel=0.02)
+    r1 = np.mean([np.corrcoef(o[:-1], o[1:])[0, 1] for o in out])
+    assert r1 == pytest.approx(0.8, abs=0.01)
+
+
+def _problem(name="thermal_1c", N=24 * 30, seed=0, noise=("ar1", 0.15, 0.8), **kw):
+    rng = np.random.default_rng(seed)
+    m = hb.model(name, **({"surfaces": ("S",)} if name.startswith("thermal") else {}))
+    t = np.arange(N)
+    cols = []
+    for nm in m.input_names:
+        if nm == "Te":
+            cols.append(
+                5 + 4 * np.sin(2 * np.pi * (t - 14) / 24) + np.cumsum(rng.normal(0, 0.3, N))
+            )
+        elif nm.startswith("I_"):
+            cols.append(
+                np.clip(400 * np.sin(2 * np.pi * (t - 6) / 24), 0, None) * rng.uniform(0.2, 1.0, N)
+            )
+        elif nm == "Tf":
+            cols.append(np.full(N, 10.0))
+        elif nm == "Pe":
+            cols.append(900 + np.cumsum(rng.normal(0, 15, N)))
+    U = np.column_stack(cols)
+    truth = {
+        "thermal_1c": dict(Ci=5e6, Ge=200.0, Gf=30.0, fI_S=3.0),
+        "hygric_2c": dict(Cw=0.5, Ci=0.03, Gw=2e-8, Gi=1e-6, Gfast=4e-7),
+    }[name]
+    y = hb.simulate(m, truth, U)[:, 0]
+    kind, sd, phi = noise
+    e = np.empty((1, N))
+    _ar1_sample(
+        rng.standard_normal((1, N)), np.array([phi if kind == "ar1" else 0.0]), np.array([sd]), e
+    )
+    nm = get_noise_model(kind)
+    ps = parameters_for(m, nm, **kw)
+    lp = LogPosterior(m, ps, nm, U, (y + e[0])[:, None], warmup=48, init_window=24)
+    return lp, truth
+
+
+def test_log_posterior_is_vectorised_and_never_raises():
+    lp, truth = _problem()
+    X = np.random.default_rng(0).normal(size=(9, lp.ndim))
+    batch = lp(X)
+    single = np.array([lp(x) for x in X])
+    np.testing.assert_allclose(batch, single, rtol=1e-12)
+    X[2, 0] = np.nan
+    X[3, 1] = np.inf
+    out = lp(X)
+    assert out[2] == -np.inf and out[3] == -np.inf and np.isfinite(out[0])
+    # non-physical parameter sets in the likelihood give -inf, not an exception
+    theta = np.tile(lp.params.values(np.zeros((1, lp.ndim))), (2, 1))
+    theta[1, 0] = -1.0  # negative capacity
+    ll = lp.log_likelihood(theta)
+    assert np.isfinite(ll[0]) and ll[1] == -np.inf
+
+
+def test_fused_likelihood_equals_simulate_then_likelihood():
+    lp, _ = _problem("hygric_2c", noise=("ar1", 20.0, 0.7))
+    lp.observed[100:130] = np.nan
+    X = np.random.default_rng(2).normal(size=(7, lp.ndim))
+    theta, _ = lp.params.transform(X)
+    tm, tn = lp.split(theta)
+    Y, _ = lp.simulate(tm)
+    ref = lp.noise.loglik(Y, lp.observed, tn)
+    mf = modal_form(lp.model, tm, lp.dt)
+    z0 = mf.steady_state_modal(lp.u_init)
+    fused = lp.noise.loglik_modal(mf, lp.inputs, z0, lp.observed, tn, max_block=500)
+    np.testing.assert_allclose(fused, ref, rtol=1e-11)
+
+
+def test_map_is_reproducible_and_finds_the_identifiable_quantities():
+    lp, truth = _problem(room_volume=None)
+    a = find_map(lp, seed=3, maxiter=60, starts=3)
+    b = find_map(lp, seed=3, maxiter=60, starts=3)
+    np.testing.assert_array_equal(a.theta, b.theta)
+    assert a.n_starts == 3 and 1 <= a.n_agreed <= 3
+    names = lp.params.names
+    th = dict(zip(names, a.theta, strict=True))
+    # time constant Ci/(Ge+Gf) and the gains are identifiable (the scale is not)
+    tau_true = truth["Ci"] / (truth["Ge"] + truth["Gf"])
+    assert th["Ci"] / (th["Ge"] + th["Gf"]) == pytest.approx(tau_true, rel=0.15)
+    assert th["Ge"] / (th["Ge"] + th["Gf"]) == pytest.approx(200 / 230, rel=0.05)
+    assert th["sigma_Ti"] == pytest.approx(0.15, rel=0.2)
+
+
+def test_sampler_same_seed_same_chain_and_resume_continues_it(tmp_path):
+    lp, _ = _problem(N=24 * 15)
+    x0 = find_map(lp, seed=1, maxiter=30, starts=1).x
+    kw = dict(seed=5, max_steps=300, check_every=100, tau_factor=1000)
+    a = run_sampler(lp, x0, checkpoint=tmp_path / "a.h5", tag="t", **kw)
+    b = run_sampler(lp, x0, checkpoint=tmp_path / "b.h5", tag="t", **kw)
+    np.testing.assert_array_equal(a.chain, b.chain)
+    assert a.chain.shape == (300, 32, lp.ndim)
+
+    class Interrupting:
+        """The log-posterior, interrupted (Ctrl-C) in the middle of the second chunk."""
+
+        def __init__(self, lp, after):
+            self.lp, self.n, self.after = lp, 0, after
+
+        def __call__(self, X):
+            self.n += 1
+            if self.n == self.after:
+                raise KeyboardInterrupt
+            return self.lp(X)
+
+    with pytest.raises(KeyboardInterrupt):
+        run_sampler(
+            Interrupting(lp, after=2 * 150 + 1), x0, checkpoint=tmp_path / "c.h5", tag="t", **kw
+        )
+    c = run_sampler(lp, x0, checkpoint=tmp_path / "c.h5", tag="t", resume=True, **kw)
+    assert 0 < c.resumed_from < 300
+    np.testing.assert_array_equal(c.chain, a.chain)
+    with pytest.raises(InputError, match="different configuration"):
+        run_sampler(lp, x0, checkpoint=tmp_path / "c.h5", tag="other", resume=True, **kw)

@@ -74,8 +74,9 @@ def test_demo_config_values():
     assert cfg.data.demo is not None and cfg.site is None
     assert cfg.data.demo.gap == ("2019-03-10", "2019-03-17")
     assert cfg.periods.calibration.start == "2019-01-02"  # a YAML date kept as text
-    assert cfg.room_volume == 400
-    assert cfg.thermal.model == "thermal_4a" and cfg.thermal.noise == "ar1"
+    assert cfg.room_volume == 400 and cfg.air_change_rate == 0.5
+    assert cfg.thermal.model == "thermal_2c" and cfg.thermal.noise == "ar1"
+    assert cfg.hygric.priors["Gw"]["dist"] == "lognormal"
     assert cfg.hygric.model == "hygric_2c" and cfg.hygric.noise == "ar1"
 
 

@@ -32,6 +32,12 @@ def monument() -> VirtualMonument:
 
 
 @pytest.fixture(scope="module")
+def demo_room() -> VirtualMonument:
+    """The room of configs/demo.yaml (``thermal_model: thermal_2c``)."""
+    return virtual_monument(seed=7, thermal_model="thermal_2c")
+
+
+@pytest.fixture(scope="module")
 def prepared():
     return prepare(load_config(CONFIGS / "demo.yaml"))
 
@@ -96,7 +102,8 @@ def test_generated_by_the_projects_forward_model(monument, prepared):
         np.testing.assert_allclose(y0[late], ref[late], atol=0.05 if out == "Ti" else 15.0)
 
 
-def test_observation_model(monument, prepared):
+def test_observation_model(demo_room, prepared):
+    monument = demo_room
     meas = monument.measurements
     # logger resolution 0.1
     for col in ("Ti", "RHi"):
@@ -170,3 +177,11 @@ def test_override_errors():
         virtual_monument(model_error_phi=1.0)
     with pytest.raises(ConfigError, match="unknown demo weather"):
         virtual_monument(weather="paris")
+
+
+def test_the_two_capacity_room_and_the_model_choice():
+    simple = virtual_monument(seed=7, thermal_model="thermal_2c", gap=None)
+    assert not {"Cint", "Gint", "fsol"} & set(simple.truth["thermal"])
+    assert simple.truth["thermal"]["Cw"] == 2.0e8
+    with pytest.raises(ConfigError, match="thermal_model"):
+        virtual_monument(seed=7, thermal_model="thermal_9z")

@@ -29,15 +29,18 @@ PRIORS = [
 ]
 
 
+@pytest.mark.parametrize("kind", ["capacity", "fraction"])
 @pytest.mark.parametrize("prior", PRIORS, ids=lambda p: p.dist)
-def test_transform_density_integrates_to_the_prior_mass(prior):
+def test_transform_density_integrates_to_the_prior_mass(prior, kind):
     """exp(logpdf(θ(x)) + log|dθ/dx|) over x equals ∫ exp(logpdf(θ)) dθ over the bounds."""
-    ps = ParameterSet([Parameter("p", "-", "x", prior)])
+    ps = ParameterSet([Parameter("p", "-", kind, prior)])
 
     def dens_x(x):
         return math.exp(ps.transform(np.array([[x]]))[1][0])
 
-    mass_x = integrate.quad(dens_x, -60, 60, limit=400)[0]
+    a, b = prior._ab()
+    lo, hi = (-60, 60) if kind == "fraction" else (a, b)
+    mass_x = integrate.quad(dens_x, lo, hi, limit=400)[0]
     mass_theta = integrate.quad(
         lambda t: math.exp(prior.logpdf(np.array(t))),
         prior.lower,
@@ -49,7 +52,7 @@ def test_transform_density_integrates_to_the_prior_mass(prior):
     # round trip and bounds
     theta = prior.sample(np.random.default_rng(0), 200)
     assert np.all((theta >= prior.lower) & (theta <= prior.upper))
-    back = ps.values(prior.to_unconstrained(theta)[:, None])[:, 0]
+    back = ps.values(ps.to_unconstrained(theta[:, None]))[:, 0]
     np.testing.assert_allclose(back, theta, rtol=1e-9)
 
 
@@ -67,6 +70,9 @@ def test_vectorised_transform_matches_per_prior_path():
         ref += p.logpdf(th) + lj
     np.testing.assert_allclose(lp, ref, rtol=1e-12)
     assert np.all(theta[:, 4] == 1.5)
+    # outside the bounds of a direct (log) coordinate: zero prior density
+    out = ps.transform(np.array([[0.0, math.log(1e6), 0.0, 12.0]]))[1]
+    assert out[0] == -np.inf
 
 
 def test_prior_specs_and_errors_name_the_key():
@@ -177,7 +183,7 @@ def _problem(name="thermal_1c", N=24 * 30, seed=0, noise=("ar1", 0.15, 0.8), **k
 
 def test_log_posterior_is_vectorised_and_never_raises():
     lp, truth = _problem()
-    X = np.random.default_rng(0).normal(size=(9, lp.ndim))
+    X = lp.params.to_unconstrained(lp.params.sample_prior(np.random.default_rng(0), 9))
     batch = lp(X)
     single = np.array([lp(x) for x in X])
     np.testing.assert_allclose(batch, single, rtol=1e-12)
@@ -186,7 +192,7 @@ def test_log_posterior_is_vectorised_and_never_raises():
     out = lp(X)
     assert out[2] == -np.inf and out[3] == -np.inf and np.isfinite(out[0])
     # non-physical parameter sets in the likelihood give -inf, not an exception
-    theta = np.tile(lp.params.values(np.zeros((1, lp.ndim))), (2, 1))
+    theta = np.tile(lp.params.values(X[:1]), (2, 1))
     theta[1, 0] = -1.0  # negative capacity
     ll = lp.log_likelihood(theta)
     assert np.isfinite(ll[0]) and ll[1] == -np.inf
@@ -195,7 +201,7 @@ def test_log_posterior_is_vectorised_and_never_raises():
 def test_fused_likelihood_equals_simulate_then_likelihood():
     lp, _ = _problem("hygric_2c", noise=("ar1", 20.0, 0.7))
     lp.observed[100:130] = np.nan
-    X = np.random.default_rng(2).normal(size=(7, lp.ndim))
+    X = lp.params.to_unconstrained(lp.params.sample_prior(np.random.default_rng(2), 7))
     theta, _ = lp.params.transform(X)
     tm, tn = lp.split(theta)
     Y, _ = lp.simulate(tm)

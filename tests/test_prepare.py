@@ -69,7 +69,7 @@ def test_demo_frame_columns_grid_and_periods(demo):
     assert demo.dt == 3600.0
     assert demo.calibration == slice(0, 2136)  # 2019-01-02 .. 2019-04-01
     assert demo.validation == slice(2136, 3192)  # .. 2019-05-15
-    assert demo.warmup_steps == 14 * 24 and demo.init_steps == 7 * 24
+    assert demo.warmup_steps == 14 * 24 and demo.init_steps == 30 * 24
     assert f.index[demo.validation.start] == pd.Timestamp("2019-04-01", tz="UTC")
     assert list(demo.flags.columns) == list(f.columns)
     assert not demo.flags.to_numpy().any()
@@ -95,7 +95,11 @@ def test_demo_gap_left_as_nan(demo):
 
 def test_demo_truth_and_labels(demo):
     assert set(demo.truth) == {"thermal", "hygric"}
-    assert set(THERMAL_4A) <= set(demo.truth["thermal"])
+    # configs/demo.yaml generates the room with thermal_2c
+    assert set(demo.truth["thermal"]) - {"sigma_Ti", "phi_Ti"} == set(
+        hb.model("thermal_2c").parameter_names
+    )
+    assert demo.sources["demo"]["models"]["thermal"] == "thermal_2c"
     assert {"Cw", "Ci", "Gw", "Gi", "Gfast"} <= set(demo.truth["hygric"])
     assert 0.15 < demo.truth["thermal"]["sigma_Ti"] < 0.35
     assert 0.5 < demo.truth["thermal"]["phi_Ti"] < 0.9

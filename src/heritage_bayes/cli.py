@@ -105,8 +105,18 @@ def main(argv: list[str] | None = None) -> int:
         print(f"hbayes: error: {exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
-        print("hbayes: interrupted", file=sys.stderr)
+        hint = " (continue with --resume)" if args.command == "calibrate" else ""
+        print(f"hbayes: interrupted{hint}", file=sys.stderr)
         return 130
+    except Exception:  # an internal error: a bug, so show where it happened
+        import traceback
+
+        traceback.print_exc()
+        print(
+            "hbayes: internal error (exit code 1); please report it with the traceback above",
+            file=sys.stderr,
+        )
+        return 1
 
 
 if __name__ == "__main__":  # pragma: no cover

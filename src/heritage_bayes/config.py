@@ -59,7 +59,14 @@ from pydantic import (
 
 from heritage_bayes.errors import ConfigError
 
-__all__ = ["CalibrationConfig", "config_hash", "load_config", "parse_config", "parse_duration"]
+__all__ = [
+    "CalibrationConfig",
+    "chain_tag",
+    "config_hash",
+    "load_config",
+    "parse_config",
+    "parse_duration",
+]
 
 
 class _Strict(BaseModel):
@@ -140,6 +147,7 @@ class DemoData(_Strict):
 
     seed: int = 7
     weather: Literal["greensboro_tmy3"] = "greensboro_tmy3"
+    thermal_model: Literal["thermal_4a", "thermal_2c"] = "thermal_4a"
     sensor_noise_T: float = Field(default=0.1, ge=0, description="[K] sd of white noise")
     sensor_noise_RH: float = Field(default=1.0, ge=0, description="[%RH] sd of white noise")
     model_error_T: float = Field(default=0.2, ge=0, description="[K] sd of the AR(1) error")
@@ -349,13 +357,15 @@ class Periods(_Strict):
     Default (no periods): the common period of all data, its first 2/3 for calibration
     and the rest for validation. ``warmup``: the first part of the calibration period
     simulated but excluded from the likelihood (absorbs the initial state);
-    ``init_window``: the window used to estimate initial states.
+    ``init_window``: the initial state is the steady state of the mean inputs over the
+    first ``init_window`` of the simulation (default 30 days: slow modes with time
+    constants of weeks start near their level; the fast ones settle within the warm-up).
     """
 
     calibration: Period | None = None
     validation: Period | None = None
     warmup: str = "14D"
-    init_window: str = "7D"
+    init_window: str = "30D"
 
     @field_validator("warmup", "init_window")
     @classmethod
@@ -422,6 +432,12 @@ class CalibrationConfig(_Strict):
     seed: int = 1
     site: Site | None = None
     room_volume: float | None = Field(default=None, gt=0, description="[m³]")
+    air_change_rate: float | None = Field(
+        default=None, gt=0, description="[1/h]: log-normal prior on Gfast of both models"
+    )
+    air_change_sigma: float = Field(
+        default=1.0, gt=0, le=5, description="[-] sd of log(air change rate)"
+    )
     data: Data
     periods: Periods = Field(default_factory=Periods)
     thermal: ModelSection | None = None
@@ -429,6 +445,11 @@ class CalibrationConfig(_Strict):
     sampler: SamplerSettings = Field(default_factory=SamplerSettings)
     optimizer: OptimizerSettings = Field(default_factory=OptimizerSettings)
     report: bool = True
+    ladder: bool = Field(
+        default=True,
+        description="MAP fits of the neighbouring model "
+        "orders for the accuracy-vs-identifiability comparison",
+    )
     base_dir: str | None = Field(default=None, description="set by load_config")
 
     @model_validator(mode="after")
@@ -572,6 +593,19 @@ def load_config(path) -> CalibrationConfig:
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
         raise ConfigError(f"{p}: not valid YAML{where}: {getattr(exc, 'problem', exc)}") from None
     return parse_config(raw, source=str(p), base_dir=str(p.parent.resolve()), name=p.stem)
+
+
+def chain_tag(cfg: CalibrationConfig) -> str:
+    """Hash of what determines the Markov chains (data, models, priors, seed, walkers,
+    moves, optimiser), leaving out run-length settings (``max_steps``, ``check_every``,
+    ``tau_factor``, ...) and outputs, so that ``--resume`` may extend a run."""
+    d = cfg.resolved()
+    keep = {k: d["sampler"][k] for k in ("walkers", "moves", "init_ball")}
+    d = {**d, "sampler": keep}
+    for k in ("report", "ladder", "name", "building", "room", "notes"):
+        d.pop(k, None)
+    blob = json.dumps(d, sort_keys=True, default=str).encode()
+    return hashlib.sha256(blob).hexdigest()[:16]
 
 
 def config_hash(cfg: CalibrationConfig) -> str:

@@ -947,6 +947,7 @@ def _demo(settings):
             gap=settings.gap,
             thermal=truth.get("thermal"),
             hygric=truth.get("hygric"),
+            thermal_model=settings.thermal_model,
         )
     except InputError as exc:  # its messages start with the setting's name
         raise ConfigError(f"data.demo.{exc}") from None

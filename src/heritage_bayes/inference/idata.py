@@ -150,7 +150,7 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
         ess_b = az.ess(ds[free_vars], method="bulk")
         ess_t = az.ess(ds[free_vars], method="tail")
         tau = dict(zip(ps.free_names, s.chain.tau, strict=True))
-        truth = truth_all.get(s.name, {}) or {}
+        truth, truth_dq = _truth_for(cfg, prep, s)
         mapv = dict(zip(names, s.map.theta, strict=True))
         prng = np.random.default_rng(seed + 11)
         for j, p in enumerate(ps.parameters):
@@ -162,6 +162,8 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
                 "description": p.description,
                 "fixed": p.fixed,
                 "prior": None if p.fixed is not None else p.prior.describe(),
+                "prior_spec": None if p.fixed is not None else p.prior.to_dict(),
+                "transform": None if p.fixed is not None else ps.modes[ps.free_names.index(p.name)],
                 "map": mapv[p.name],
                 **_summ(x),
                 "truth": truth.get(p.name),
@@ -186,7 +188,7 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
         for k in dq:
             key = f"{s.name}.{k}"
             x = post[key].values.reshape(-1)
-            summary_derived[key] = {"unit": units.get(k, ""), **_summ(x)}
+            summary_derived[key] = {"unit": units.get(k, ""), **_summ(x), "truth": truth_dq.get(k)}
             if np.all(np.isfinite(x)) and np.ptp(x) > 0:
                 summary_derived[key]["r_hat"] = float(az.rhat(post[key].values))
                 summary_derived[key]["ess_bulk"] = float(az.ess(post[key].values, method="bulk"))
@@ -328,6 +330,72 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
         "truth": truth_all or None,
     }
     return idata, summary
+
+
+def _truth_for(cfg, prep, section) -> tuple[dict, dict]:
+    """True parameter values and derived quantities to show beside the posterior.
+
+    Only for generated data (the demo). Parameters are compared when the calibrated
+    model is the generating one; otherwise only the model-independent properties of the
+    room are: the static gains, constant-boundary offsets and the slowest time constant.
+    """
+    truth = (prep.truth or {}).get(section.name) or {}
+    gen = (((prep.sources or {}).get("demo") or {}).get("models") or {}).get(section.name)
+    if not truth or gen is None:
+        return {}, {}
+    from heritage_bayes.rc.catalog import model as catalog_model
+
+    if gen == section.model.name:
+        gen_model = section.model
+        params_truth = truth
+    else:
+        try:
+            opts = {}
+            if section.model.domain == "thermal" and gen != "thermal_4a_nosolar":
+                opts["surfaces"] = tuple(cfg.data.surfaces)
+            gen_model = catalog_model(gen, **opts)
+        except ValueError:
+            return {}, {}
+        params_truth = {}
+    p = {k: v for k, v in truth.items() if k in gen_model.parameter_names}
+    if len(p) != len(gen_model.parameter_names):
+        return params_truth, {}
+    dq = {
+        k: float(np.asarray(v).reshape(-1)[0]) for k, v in derived_quantities(gen_model, p).items()
+    }
+    if gen != section.model.name:
+        dq = {k: v for k, v in dq.items() if not k.startswith("tau_") or k == "tau_1_h"}
+    return params_truth, dq
+
+
+def _versions() -> dict:
+    """Versions of the key libraries that produced the run."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    out = {}
+    for name in (
+        "heritage_bayes",
+        "numpy",
+        "scipy",
+        "pandas",
+        "numba",
+        "emcee",
+        "arviz",
+        "xarray",
+        "matplotlib",
+        "corner",
+        "pvlib",
+        "h5py",
+        "pydantic",
+    ):
+        try:
+            out[name] = version(name)
+        except PackageNotFoundError:
+            out[name] = None
+    import platform
+
+    out["python"] = platform.python_version()
+    return out
 
 
 def _periods(prep) -> dict:

@@ -26,7 +26,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.optimize import differential_evolution, minimize
-from scipy.special import logit
 
 __all__ = ["MAPResult", "find_map"]
 
@@ -116,7 +115,30 @@ class _Objective:
         return float(f[0]), g
 
 
-def find_map(
+def find_map(logpost, **kwargs) -> MAPResult:
+    """Global-then-local maximisation of the posterior (see module docstring).
+
+    Parameters
+    ----------
+    logpost : LogPosterior
+    seed : int
+        Seeds the global search and the random starts: same seed, same result.
+    method : {"differential_evolution", "multistart"}
+    popsize, maxiter : int
+        Differential-evolution settings (population = popsize × d).
+    starts : int
+        Candidates polished with L-BFGS-B (the best distinct DE members, or random
+        starts for ``multistart``).
+
+    BLAS runs single-threaded meanwhile (many small products: threads only spin).
+    """
+    from threadpoolctl import threadpool_limits
+
+    with threadpool_limits(limits=1, user_api="blas"):
+        return _find_map(logpost, **kwargs)
+
+
+def _find_map(
     logpost,
     *,
     seed: int = 1,
@@ -187,7 +209,7 @@ def find_map(
     best_f, best_s = finals[0]
     agreed = sum(1 for f, _ in finals if f - best_f <= 1.0)
     theta, _ = obj.values(best_s[None])
-    x = logit(np.clip(best_s, 1e-7, 1 - 1e-7))
+    x = logpost.params.to_unconstrained(theta)[0]
     return MAPResult(
         x=x,
         theta=theta[0],

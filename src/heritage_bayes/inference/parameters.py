@@ -2,11 +2,17 @@
 
 Every estimated quantity (each C, G, solar aperture, split fraction, constant boundary,
 and the noise parameters) is a :class:`Parameter` with a name, unit, kind and a bounded
-:class:`Prior`. Sampling and optimisation happen in an unconstrained space ``x``:
+:class:`Prior`. Sampling happens in a transformed space ``x``:
 
-- *log-scale* priors (``loguniform``, ``lognormal``): :math:`\\theta = \\exp(a + (b-a)\\,
-  \\sigma(x))` with :math:`a,b` the log bounds and :math:`\\sigma` the logistic function;
-- *linear* priors (``uniform``, ``normal``): :math:`\\theta = l + (u-l)\\,\\sigma(x)`.
+- positive parameters with *log-scale* priors (``loguniform``, ``lognormal``):
+  :math:`x = \\log\\theta` (unbounded for positivity), the prior bounds as hard walls;
+- *linear* priors (``uniform``, ``normal``): :math:`x = \\theta`, the bounds as walls;
+- fractions and the AR(1) coefficient: :math:`\\theta = l + (u-l)\\,\\sigma(x)` (logit).
+
+Log rather than logit for C, G and apertures matters: RC posteriors have ridges that are
+exactly straight in log space (scaling all C and G together leaves the output unchanged),
+and a logit of each parameter's own range would bend them into thin curved bananas,
+which ensemble samplers explore badly (measured: τ ≈ 1750 vs a few hundred steps).
 
 The log-prior in ``x`` includes the log-Jacobian :math:`\\log|d\\theta/dx|`, so the
 posterior is the same distribution whatever the transform (lmfit's bounded-parameter
@@ -36,6 +42,7 @@ __all__ = [
     "air_capacity_prior",
     "default_prior",
     "parameters_for",
+    "ventilation_prior",
 ]
 
 #: Volumetric heat capacity of air at room conditions [J/(m³·K)] (1.2 kg/m³ × 1005 J/(kg·K)).
@@ -44,6 +51,8 @@ RHO_CP_AIR = 1.2 * 1005.0
 HYG_CAP_AIR = 1.0 / (461.52 * 288.15)
 
 _DISTS = ("uniform", "loguniform", "normal", "lognormal")
+#: Parameter kinds sampled through a logit (bounded on both sides by nature).
+_LOGIT_KINDS = ("fraction", "phi")
 
 
 @dataclass(frozen=True)
@@ -176,9 +185,19 @@ class Prior:
             return math.log(self.lower), math.log(self.upper)
         return self.lower, self.upper
 
-    def from_unconstrained(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """θ(x) and log|dθ/dx|."""
+    def from_unconstrained(self, x: np.ndarray, mode: str = "direct"):
+        """θ(x) and log|dθ/dx| (``-inf`` outside the bounds in ``direct`` mode).
+
+        ``direct``: x = log θ (log-scale priors) or θ, the bounds hard walls;
+        ``logit``: x = logit of the position between the bounds.
+        """
         a, b = self._ab()
+        if mode == "direct":
+            x = np.asarray(x, dtype=float)
+            logj = np.where((x >= a) & (x <= b), 0.0, -np.inf)
+            if self.log_scale:
+                return np.exp(np.clip(x, -700, 700)), logj + x
+            return x, logj
         s = expit(x)
         y = a + (b - a) * s
         # log σ(x) + log(1 - σ(x)) = -softplus(-x) - softplus(x), stable for large |x|
@@ -187,9 +206,11 @@ class Prior:
             return np.exp(y), logj + y
         return y, logj
 
-    def to_unconstrained(self, theta: np.ndarray) -> np.ndarray:
+    def to_unconstrained(self, theta: np.ndarray, mode: str = "direct") -> np.ndarray:
         a, b = self._ab()
         y = np.log(theta) if self.log_scale else np.asarray(theta, dtype=float)
+        if mode == "direct":
+            return y
         s = np.clip((y - a) / (b - a), 1e-12, 1 - 1e-12)
         return logit(s)
 
@@ -268,6 +289,30 @@ def air_capacity_prior(
     return Prior("lognormal", lo, median * math.exp(5 * sigma), median, sigma)
 
 
+def ventilation_prior(
+    domain: str, volume: float, air_change_rate: float, *, sigma: float = 1.0
+) -> Prior:
+    """Log-normal prior on the fast conductance ``Gfast`` from an air change rate.
+
+    Thermal: median ``ρc_air × V × n / 3600`` [W/K]; in model 4a ``Gfast`` also carries
+    other fast paths (glazing), which the default width σ_log = 1.0 (a factor 2.7)
+    admits. Hygric: median ``V × n / (3600 R_v T)`` [kg/(s·Pa)] (ventilation only).
+    ``air_change_rate`` n in [1/h], ``volume`` V in [m³]. Sharing n between the thermal
+    and hygric models is the physical link between them, and it pins the overall scale
+    of C and G that hourly temperatures alone leave free (the air node's own capacity
+    ``Ci`` cannot, since its time constant is usually shorter than the time step).
+    """
+    if not volume > 0:
+        raise ConfigError(f"room_volume must be > 0 m³ (got {volume})")
+    if not air_change_rate > 0:
+        raise ConfigError(f"air_change_rate must be > 0 per hour (got {air_change_rate})")
+    flow = volume * air_change_rate / 3600.0  # [m³/s]
+    median = flow * (RHO_CP_AIR if domain == "thermal" else HYG_CAP_AIR)
+    return Prior(
+        "lognormal", median * math.exp(-5 * sigma), median * math.exp(5 * sigma), median, sigma
+    )
+
+
 @dataclass(frozen=True)
 class Parameter:
     """A named model or noise parameter (lmfit's Parameter, with a prior).
@@ -322,6 +367,12 @@ class ParameterSet:
             ]
         )
         self._sig = np.array([p.sigma or 1.0 for p in priors])
+        # logit for quantities bounded on both sides by nature (fractions, AR(1) phi);
+        # log θ (or θ) with the bounds as hard walls for the rest, so that the exactly
+        # linear log-space ridges of RC models (the overall scale) stay straight lines,
+        # which affine-invariant ensemble moves follow at no cost
+        self._logit = np.array([self.parameters[j].kind in _LOGIT_KINDS for j in self._free_idx])
+        self.modes = tuple("logit" if m else "direct" for m in self._logit)
         self._fixed = np.array(
             [p.fixed if p.fixed is not None else np.nan for p in self.parameters]
         )
@@ -348,10 +399,16 @@ class ParameterSet:
         """Unconstrained (K, d) -> values (K, P) and log-prior + log-Jacobian (K,)."""
         X = np.atleast_2d(X)
         theta = np.tile(self._fixed, (X.shape[0], 1))
-        y = self._a + self._w * expit(X)
-        # log|dy/dx| = log w + log σ(x) + log(1 - σ(x)), stable for large |x|
-        logj = np.log(self._w) - np.logaddexp(0.0, -X) - np.logaddexp(0.0, X)
-        th = np.where(self._log, np.exp(np.where(self._log, y, 0.0)), y)
+        # logit coordinates: y = a + w σ(x), log|dy/dx| = log w + log σ(x)(1 - σ(x))
+        y = np.where(self._logit, self._a + self._w * expit(X), X)
+        with np.errstate(invalid="ignore"):
+            inside = (y >= self._a) & (y <= self._a + self._w)
+        logj = np.where(
+            self._logit,
+            np.log(self._w) - np.logaddexp(0.0, -X) - np.logaddexp(0.0, X),
+            np.where(inside, 0.0, -np.inf),
+        )
+        th = np.where(self._log, np.exp(np.clip(np.where(self._log, y, 0.0), -700, 700)), y)
         # y is log θ for log-scale priors: the Jacobian gains dθ/dy = θ, and
         # loguniform (∝ 1/θ) cancels it; lognormal keeps the normal term in y
         z = (y - self._mu) / self._sig
@@ -367,7 +424,10 @@ class ParameterSet:
         """Values (K, P) (all parameters) -> unconstrained free coordinates (K, d)."""
         theta = np.atleast_2d(theta)
         return np.column_stack(
-            [self.parameters[j].prior.to_unconstrained(theta[:, j]) for j in self._free_idx]
+            [
+                self.parameters[j].prior.to_unconstrained(theta[:, j], mode)
+                for j, mode in zip(self._free_idx, self.modes, strict=True)
+            ]
         )
 
     def sample_prior(self, rng: np.random.Generator, size: int) -> np.ndarray:
@@ -391,6 +451,8 @@ def parameters_for(
     priors: Mapping[str, Mapping] | None = None,
     *,
     room_volume: float | None = None,
+    air_change_rate: float | None = None,
+    air_change_sigma: float = 1.0,
     where: str = "priors",
 ) -> ParameterSet:
     """The :class:`ParameterSet` of a model and its noise model.
@@ -406,6 +468,9 @@ def parameters_for(
     room_volume : float, optional
         Room air volume [m³]: sets a log-normal prior on ``Ci`` (see
         :func:`air_capacity_prior`) unless ``priors`` sets ``Ci``.
+    air_change_rate : float, optional
+        Air changes per hour [1/h] (needs ``room_volume``): a log-normal prior of width
+        ``air_change_sigma`` on ``Gfast`` (see :func:`ventilation_prior`).
     where : str
         Key path used in error messages.
     """
@@ -441,6 +506,13 @@ def parameters_for(
         prior = default_prior(domain, kind)
         if name == "Ci" and room_volume is not None and kind == "capacity":
             prior = air_capacity_prior(domain, room_volume)
+        if name == "Gfast" and air_change_rate is not None and kind == "conductance":
+            if room_volume is None:
+                raise ConfigError(
+                    "air_change_rate: needs room_volume (the ventilation "
+                    "conductance is volume × air change rate)"
+                )
+            prior = ventilation_prior(domain, room_volume, air_change_rate, sigma=air_change_sigma)
         spec = priors.get(name)
         fixed = None
         if spec is not None:

@@ -8,7 +8,7 @@ and the compiled noise-model likelihood. Non-physical or non-finite parameter se
 ``-inf``, never an exception.
 
 Initial state: the steady state of the mean input over the first ``init_window`` steps
-(default one week), followed by a warm-up period (``warmup`` steps, default two weeks)
+(30 days by default in configs), followed by a warm-up period (``warmup`` steps, default two weeks)
 whose observations are excluded from the likelihood. This absorbs the start-up
 transient of all but the slowest modes without adding the initial states as parameters;
 for envelopes with time constants of months, lengthen the warm-up.
@@ -59,7 +59,7 @@ class LogPosterior:
     observed: np.ndarray
     dt: float = 3600.0
     warmup: int = 336
-    init_window: int = 168
+    init_window: int = 720
 
     def __post_init__(self):
         self.inputs = np.ascontiguousarray(self.inputs, dtype=float)
@@ -115,7 +115,10 @@ class LogPosterior:
         ok = np.all(np.isfinite(X), axis=1)
         if ok.any():
             theta, lp = self.params.transform(X[ok])
-            val = lp + self._loglik(theta)
+            inside = np.isfinite(lp)  # outside the prior support: no simulation
+            val = np.full(lp.shape, -np.inf)
+            if inside.any():
+                val[inside] = lp[inside] + self._loglik(theta[inside])
             val[~np.isfinite(val)] = -np.inf
             out[ok] = val
         return out[0] if single else out

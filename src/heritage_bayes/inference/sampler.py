@@ -114,6 +114,33 @@ class ChainResult:
         return np.swapaxes(x, 0, 1), lp.T
 
 
+def _burn_thin(tau: np.ndarray, steps: int) -> tuple[int, int]:
+    tmax = float(np.nanmax(tau)) if np.isfinite(tau).any() else float(steps)
+    burn = min(int(np.ceil(2 * tmax)), steps // 2)
+    thin = max(1, int(0.5 * np.nanmin(tau))) if np.isfinite(tau).any() else 1
+    return burn, thin
+
+
+def _mixing_ok(chain, tau, max_rhat, min_ess, max_draws) -> bool:
+    """R-hat and bulk ESS of the retained draws (walkers as chains) meet the targets."""
+    import arviz as az
+
+    burn, thin = _burn_thin(tau, chain.shape[0])
+    res = ChainResult(
+        chain=chain,
+        log_prob=np.zeros(chain.shape[:2]),
+        accepted=np.zeros(chain.shape[1]),
+        tau=tau,
+        burn=burn,
+        thin=thin,
+    )
+    X, _ = res.draws(max_draws)
+    ds = az.convert_to_dataset({"x": X})
+    if max_rhat is not None and float(az.rhat(ds)["x"].max()) > max_rhat:
+        return False
+    return min_ess is None or float(az.ess(ds, method="bulk")["x"].min()) >= min_ess
+
+
 def _tau(chain: np.ndarray) -> np.ndarray:
     return emcee.autocorr.integrated_time(chain, c=5, tol=0, quiet=True)
 
@@ -212,7 +239,16 @@ class _Interrupt:
         return False
 
 
-def run_sampler(
+def run_sampler(logpost, x_map, **kwargs) -> ChainResult:
+    """Sample the posterior with emcee until converged: see :func:`_run_sampler` for
+    the parameters. BLAS runs single-threaded meanwhile (many small products)."""
+    from threadpoolctl import threadpool_limits
+
+    with threadpool_limits(limits=1, user_api="blas"):
+        return _run_sampler(logpost, x_map, **kwargs)
+
+
+def _run_sampler(
     logpost,
     x_map: np.ndarray,
     *,
@@ -228,6 +264,9 @@ def run_sampler(
     tag: str = "",
     resume: bool = False,
     progress=None,
+    max_rhat: float | None = 1.01,
+    min_ess: float | None = 400.0,
+    max_draws: int = 4000,
 ) -> ChainResult:
     """Sample the posterior with emcee until converged (see module docstring).
 
@@ -246,6 +285,12 @@ def run_sampler(
         (its ``tag`` must match).
     progress : callable, optional
         Called after every chunk as ``progress(steps_done, max_steps, info_dict)``.
+    max_rhat, min_ess : float or None
+        Once the chain is long enough for τ, it also runs until the rank-normalised
+        R-hat (walkers as chains) is at most ``max_rhat`` and the bulk ESS at least
+        ``min_ess`` for every parameter, on the draws kept after burn-in and thinning
+        (at most ``max_draws``); None skips that check. Both statistics are invariant
+        under the monotone transforms of the sampling space.
     """
     d = int(np.size(x_map))
     if nwalkers is None:
@@ -299,8 +344,15 @@ def run_sampler(
     t0 = time.perf_counter()
     converged = False
     tau = np.full(d, np.nan)
+    if done > 0:  # resumed: the saved chain may already be long enough
+        tau = _tau(np.concatenate(chunks_x))
+        tmax = float(np.max(tau))
+        stable = bool(tau_hist) and abs(tmax - tau_hist[-1][1]) / tmax < tau_rtol
+        converged = bool(done >= tau_factor * tmax and stable and np.all(np.isfinite(tau)))
+        if converged and (max_rhat is not None or min_ess is not None):
+            converged = _mixing_ok(np.concatenate(chunks_x), tau, max_rhat, min_ess, max_draws)
     with _Interrupt():
-        while done < max_steps:
+        while done < max_steps and not converged:
             # chunk boundaries on absolute multiples of check_every (resume-invariant)
             n = min(check_every - done % check_every, max_steps - done)
             sampler.reset()
@@ -329,6 +381,8 @@ def run_sampler(
             if ck is not None:
                 ck.append(x, lp, accepted, state.random_state, tau_hist)
             converged = done >= tau_factor * tmax and stable and np.all(np.isfinite(tau))
+            if converged and (max_rhat is not None or min_ess is not None):
+                converged = _mixing_ok(np.concatenate(chunks_x), tau, max_rhat, min_ess, max_draws)
             if progress is not None:
                 progress(
                     done,
@@ -343,9 +397,7 @@ def run_sampler(
                 break
     chain = np.concatenate(chunks_x)
     log_prob = np.concatenate(chunks_lp)
-    tmax = float(np.nanmax(tau)) if np.isfinite(tau).any() else float(chain.shape[0])
-    burn = min(int(np.ceil(2 * tmax)), chain.shape[0] // 2)
-    thin = max(1, int(0.5 * np.nanmin(tau))) if np.isfinite(tau).any() else 1
+    burn, thin = _burn_thin(tau, chain.shape[0])
     return ChainResult(
         chain=chain,
         log_prob=log_prob,

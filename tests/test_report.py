@@ -1,0 +1,469 @@
+"""The HTML calibration report (issue 5): content, safety, errors, and a real browser.
+
+A module-scoped fixture runs a tiny real calibration of the virtual monument
+(thermal_1c + hygric_1c, 10 days + 5 days, 600 sampler steps: a few seconds, not
+converged — so the report must say so in red) and writes its report once.
+"""
+
+from __future__ import annotations
+
+import base64
+import io
+import json
+import math
+import re
+import shutil
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from _report_browser import find_chromium, open_page
+from heritage_bayes.calibrate import run_calibration
+from heritage_bayes.cli import main
+from heritage_bayes.config import parse_config
+from heritage_bayes.errors import InputError
+from heritage_bayes.report import write_report
+from heritage_bayes.report._diag import acf, cumulative_periodogram, innovations
+from heritage_bayes.report.build import (
+    SECTIONS,
+    convergence_verdict,
+    fmt,
+    ladder_metrics,
+    prior_text,
+)
+
+ROOM = "<script>alert(1)</script>"
+BUILDING = 'Château "Ter <b>Horst</b>" & Co'
+NOTES = "line one\n</pre><img src=x onerror=alert(2)> & {{ 7*7 }}"
+EXPECTED_FIGURES = [
+    "fig-data",
+    "fig-fit-thermal-Ti",
+    "fig-fit-hygric-Pi",
+    "fig-fit-combined-RHi",
+    "fig-corr-thermal",
+    "fig-corner-thermal",
+    "fig-corr-hygric",
+    "fig-corner-hygric",
+    "fig-ladder",
+    "fig-tau",
+    "fig-trace-thermal",
+    "fig-trace-hygric",
+    "fig-resid-thermal-Ti",
+    "fig-resid-hygric-Pi",
+]
+TINY = {
+    "name": "tiny",
+    "building": BUILDING,
+    "room": ROOM,
+    "notes": NOTES,
+    "seed": 3,
+    "data": {"demo": {"seed": 7, "gap": ["2019-02-05", "2019-02-06"]}},
+    "periods": {
+        "calibration": {"start": "2019-02-01", "end": "2019-02-11"},
+        "validation": {"start": "2019-02-11", "end": "2019-02-16"},
+        "warmup": "2d",
+        "init_window": "2d",
+    },
+    "thermal": {"model": "thermal_1c"},
+    "hygric": {"model": "hygric_1c"},
+    "sampler": {"max_steps": 600, "check_every": 200},
+    "optimizer": {"maxiter": 20, "starts": 2, "popsize": 4},
+}
+
+
+@pytest.fixture(scope="module")
+def run_dir(tmp_path_factory) -> Path:
+    out = tmp_path_factory.mktemp("report") / "run"
+    run_calibration(parse_config(TINY), out_dir=out, report=False, quiet=True)
+    return out
+
+
+@pytest.fixture(scope="module")
+def report(run_dir) -> tuple[Path, str]:
+    path = write_report(run_dir)
+    return path, path.read_text(encoding="utf-8")
+
+
+def _figures(html: str) -> dict[str, bytes]:
+    """figure id -> PNG bytes of its image."""
+    out = {}
+    for m in re.finditer(r'<figure id="([^"]+)">\s*<img src="data:image/png;base64,([^"]+)"', html):
+        out[m.group(1)] = base64.b64decode(m.group(2), validate=True)
+    return out
+
+
+def _copy_run(run_dir: Path, dest: Path) -> Path:
+    shutil.copytree(run_dir, dest)
+    (dest / "report.html").unlink(missing_ok=True)
+    return dest
+
+
+# ---------------------------------------------------------------------- the file
+def test_report_written_atomically(report, run_dir):
+    path, html = report
+    assert path == run_dir / "report.html"
+    assert html.startswith("<!DOCTYPE html>") and html.rstrip().endswith("</html>")
+    assert not list(run_dir.glob(".report.html.*")), "temporary file left behind"
+    assert path.stat().st_mode & 0o444 == 0o444 or path.stat().st_mode & 0o044, (
+        "report must be readable like an ordinary file, not 0600"
+    )
+
+
+def test_sections_in_order(report):
+    _, html = report
+    ids = re.findall(r'<section id="([^"]+)">', html)
+    assert ids == [sid for sid, _ in SECTIONS]
+    assert [sid for sid, _ in SECTIONS] == [
+        "summary",
+        "data",
+        "fit",
+        "metrics",
+        "parameters",
+        "identifiability",
+        "diagnostics",
+        "reproducibility",
+    ]
+
+
+def test_every_figure_is_an_embedded_png(report):
+    _, html = report
+    figs = _figures(html)
+    assert list(figs) == EXPECTED_FIGURES
+    import matplotlib.image as mpimg
+
+    for fid, png in figs.items():
+        assert png[:8] == b"\x89PNG\r\n\x1a\n", fid
+        img = mpimg.imread(io.BytesIO(png), format="png")
+        assert img.shape[0] > 200 and img.shape[1] > 400, fid
+        assert float(np.std(img[..., :3])) > 0.02, f"{fid} looks blank"
+
+
+def test_self_contained_no_external_reference(report):
+    _, html = report
+    assert "<script" not in html.lower()
+    assert "<link" not in html.lower() and "@import" not in html
+    assert "url(" not in html
+    text = re.sub(r"data:image/png;base64,[A-Za-z0-9+/=]+", "", html)
+    text = text.split('<pre class="config">')[0].replace("http-equiv", "")
+    assert not re.search(r"(?i)(https?:|ftp:|file:|//[a-z0-9])", text), "external URL in the report"
+    for attr, val in re.findall(r'\b(src|href|action|srcset|poster)\s*=\s*"([^"]*)"', html):
+        if attr == "src":
+            assert val.startswith("data:image/png;base64,"), val[:60]
+        else:
+            assert attr == "href" and val.startswith("#"), (attr, val)
+    csp = re.search(r'http-equiv="Content-Security-Policy" content="([^"]+)"', html)
+    assert csp and "default-src 'none'" in csp.group(1) and "script-src" not in csp.group(1)
+
+
+def test_untrusted_text_is_escaped(report):
+    _, html = report
+    assert ROOM not in html
+    assert "&lt;script&gt;alert(1)&lt;/script&gt;" in html
+    assert "<img src=x" not in html and "&lt;img src=x onerror=alert(2)&gt;" in html
+    assert "<b>Horst</b>" not in html and "&lt;b&gt;Horst&lt;/b&gt;" in html
+    assert "{{ 7*7 }}" in html  # shown as text, never evaluated as a template
+    assert (
+        "<title>Calibration report — Château &#34;Ter &lt;b&gt;Horst&lt;/b&gt;&#34; &amp;" in html
+    )
+
+
+# ------------------------------------------------------------------------ content
+def test_header_verdict_red_and_first(report, run_dir):
+    _, html = report
+    summary = json.loads((run_dir / "summary.json").read_text())
+    assert summary["converged"] is False  # 600 steps cannot converge
+    head = html[: html.index('<section id="data">')]
+    assert 'class="verdict red"' in head and "NOT CONVERGED" in head
+    assert html.index('id="verdict"') < html.index("<h2>1. Summary</h2>")
+    for text in (
+        "thermal_1c",
+        "hygric_1c",
+        "2019-02-01 00:00 UTC",
+        "2019-02-11 00:00 UTC",
+        "2019-02-16 00:00 UTC",
+        summary["config_hash"],
+        "heritage_bayes 0.1.0",
+    ):
+        assert text in head, text
+
+
+def test_metrics_table_in_table2_form(report, run_dir):
+    _, html = report
+    summary = json.loads((run_dir / "summary.json").read_text())
+    table = html[html.index('id="table-metrics"') :]
+    table = table[: table.index("</table>")]
+    for unit in ("MSE [°C²]", "MAE [°C]", "MSE [Pa²]", "MAE [Pa]", "MSE [%²]", "FIT [%]"):
+        assert unit in table, unit
+    for m, o in (("thermal", "Ti"), ("hygric", "Pi"), ("combined", "RHi")):
+        for period in ("calibration", "validation"):
+            v = summary["metrics"][m][o][period]
+            assert fmt(v["MSE"]) in table and fmt(v["MAE"]) in table
+            assert f"{v['FIT']:.1f}".replace("-", "−") in table
+    cov = html[html.index('id="table-coverage"') :]
+    cov = cov[: cov.index("</table>")]
+    v = summary["metrics"]["thermal"]["Ti"]["validation"]
+    assert f"{100 * v['coverage90']:.0f} %" in cov
+
+
+def test_parameter_tables(report, run_dir):
+    _, html = report
+    summary = json.loads((run_dir / "summary.json").read_text())
+    for m in ("thermal", "hygric"):
+        table = html[html.index(f'id="table-params-{m}"') :]
+        table = table[: table.index("</table>")]
+        params = {
+            k.split(".", 1)[1]: v for k, v in summary["parameters"].items() if k.startswith(m + ".")
+        }
+        assert params
+        for name, v in params.items():
+            assert f"<strong>{name}</strong>" in table
+            assert fmt(v["median"]) in table and fmt(v["map"]) in table
+            assert f"{v['r_hat']:.3f}" in table
+            assert prior_text(v["prior"]) in table
+        # thermal_1c/hygric_1c are not the demo's generating models: no parameter truth
+        assert '<th class="num">truth</th>' not in table
+    # ... but the model-independent quantities have one (gains, slowest time constant)
+    gains = html[html.index('id="table-gains-thermal"') :]
+    gains = gains[: gains.index("</table>")]
+    truth = summary["derived"]["thermal.gain_Ti_Te"]["truth"]
+    assert truth is not None and f"{fmt(truth)}" in gains
+    assert "the calibrated model is not the generating one" in html
+
+
+def test_identifiability_and_derived(report, run_dir):
+    _, html = report
+    summary = json.loads((run_dir / "summary.json").read_text())
+    sec = html[
+        html.index('<section id="identifiability">') : html.index('<section id="diagnostics">')
+    ]
+    for m in ("thermal", "hygric"):
+        idf = summary["models"][m]["identifiability"]
+        assert f"rank {idf['rank']} of {idf['n_params']}" in sec
+        for d in idf["null_directions"]:
+            assert d["description"].split(":")[0] in sec
+        assert f'id="table-tau-{m}"' in sec and f'id="table-gains-{m}"' in sec
+    assert "[d]" in sec and "[h]" in sec
+    # the model-order ladder (MAP fits of thermal 1c/2c/4a, hygric 1c/2c/2c_fixed)
+    assert sec.count('<table class="table-ladder">') == 2
+    for m in ("thermal", "hygric"):
+        rows = summary["ladder"][m]
+        for r in rows:
+            assert f"<td>{r['model']}</td>" in sec
+        sampled = [r["model"] for r in rows if r["sampled"]]
+        assert sampled == [summary["models"][m]["model"]]
+        assert f'<tr class="sampled"><td>{sampled[0]}</td>' in sec
+        fit = rows[0]["fit"]["validation"]
+        ((out, v),) = fit.items()
+        assert f"{v['FIT']:.1f}".replace("-", "−") in sec
+    assert "Not computed for this run." not in sec
+
+
+def test_diagnostics_and_reproducibility(report, run_dir):
+    _, html = report
+    diag = html[
+        html.index('<section id="diagnostics">') : html.index('<section id="reproducibility">')
+    ]
+    assert "AR(1) noise model expects" in diag and "φ =" in diag
+    assert "not met" in diag  # τ criterion of a 600-step run
+    repro = html[html.index('<section id="reproducibility">') :]
+    for lib in (
+        "numpy",
+        "scipy",
+        "pandas",
+        "emcee",
+        "arviz",
+        "matplotlib",
+        "pvlib",
+        "heritage_bayes",
+    ):
+        assert f"<td>{lib}</td>" in repro, lib
+    assert "max_steps: 600" in repro  # the resolved config, verbatim
+    assert "thermal map" in repro and "this report" in repro
+
+
+def test_ladder_metrics_formats():
+    keyed = {"validation": {"Ti": {"FIT": 80.0}}}
+    flat = {"validation": {"FIT": 80.0, "MSE": 0.1}}
+    assert ladder_metrics(keyed, "validation") == {"Ti": {"FIT": 80.0}}
+    assert ladder_metrics(flat, "validation") == {"": {"FIT": 80.0, "MSE": 0.1}}
+    assert ladder_metrics(None, "calibration") == {}
+    from heritage_bayes.report.figures import fig_ladder
+
+    fig = fig_ladder(
+        {
+            "thermal": [
+                {
+                    "model": "a",
+                    "n_params": 3,
+                    "fit": flat,
+                    "n_null": 1,
+                    "condition_number_identifiable": None,
+                },
+                {
+                    "model": "b",
+                    "n_params": 5,
+                    "n_model_params": 4,
+                    "fit": keyed,
+                    "n_null": 0,
+                    "sampled": True,
+                    "condition_number_identifiable": 10.0,
+                },
+            ]
+        }
+    )
+    assert len(fig.axes) == 2
+
+
+@pytest.mark.parametrize("missing", ["posterior.nc", "summary.json", "config.yaml"])
+def test_incomplete_run_dir_is_an_input_error(run_dir, tmp_path, missing, capsys):
+    d = _copy_run(run_dir, tmp_path / "incomplete")
+    (d / missing).unlink()
+    with pytest.raises(InputError, match=re.escape(missing)):
+        write_report(d)
+    assert not (d / "report.html").exists()
+    assert main(["report", str(d)]) == 2
+    assert missing in capsys.readouterr().err
+
+
+def test_not_a_directory_and_damaged_summary(tmp_path, run_dir):
+    with pytest.raises(InputError, match="not found"):
+        write_report(tmp_path / "nope")
+    d = _copy_run(run_dir, tmp_path / "damaged")
+    (d / "summary.json").write_text("{not json")
+    with pytest.raises(InputError, match=r"summary\.json"):
+        write_report(d)
+
+
+def test_cli_on_a_run_without_ladder_and_chain_file(run_dir, tmp_path, capsys):
+    """``hbayes report`` on an older/partial run: no ladder, a chain file deleted."""
+    import matplotlib
+
+    backend = matplotlib.get_backend()
+    d = _copy_run(run_dir, tmp_path / "partial")
+    (d / "chain_hygric.h5").unlink()
+    s = json.loads((d / "summary.json").read_text())
+    s.pop("ladder", None)
+    (d / "summary.json").write_text(json.dumps(s))
+    assert main(["report", str(d)]) == 0
+    assert capsys.readouterr().out.strip() == str(d / "report.html")
+    html = (d / "report.html").read_text(encoding="utf-8")
+    figs = _figures(html)
+    assert "fig-ladder" not in figs and "fig-trace-hygric" not in figs
+    assert "fig-trace-thermal" in figs
+    assert "Not computed for this run." in html
+    assert "chain_hygric.h5" in html and "Chain files missing" in html
+    assert matplotlib.get_backend() == backend  # Agg canvases only, no backend switch
+    if "matplotlib.pyplot" in sys.modules:  # corner imports pyplot: no figure kept open
+        assert sys.modules["matplotlib.pyplot"].get_fignums() == []
+
+
+# --------------------------------------------------------------- pure functions
+def _summary(rhat, ess, tau_ok=True, converged=None):
+    conv = tau_ok and rhat <= 1.01 and ess >= 400 if converged is None else converged
+    return {
+        "converged": conv,
+        "converged_tau": tau_ok,
+        "max_rhat": rhat,
+        "min_ess_bulk": ess,
+        "criteria": {"max_rhat": 1.01, "min_ess_bulk": 400.0, "tau_factor": 50.0},
+        "parameters": {"thermal.Ci": {"r_hat": rhat, "ess_bulk": ess}},
+        "models": {
+            "thermal": {
+                "model": "thermal_1c",
+                "identifiability": {"n_null": 1},
+                "chain": {"steps": 5000, "tau_max": 150.0, "converged_tau": tau_ok},
+            }
+        },
+    }
+
+
+def test_convergence_verdict_levels():
+    v = convergence_verdict(_summary(1.004, 1200))
+    assert v["level"] == "green" and v["models"] == ["thermal (thermal_1c): all criteria met."]
+    v = convergence_verdict(_summary(1.03, 250, tau_ok=False))
+    assert v["level"] == "amber"
+    assert "need at least 50 × τ = 7 500 steps" in v["models"][0]
+    assert "R-hat up to 1.030 for Ci" in v["models"][0]
+    assert "bulk ESS down to 250" in v["models"][0]
+    v = convergence_verdict(_summary(1.2, 40, tau_ok=False))
+    assert v["level"] == "red" and "NOT CONVERGED" in v["title"]
+    assert "room_volume" in v["advice"]  # a null direction slows mixing
+    # R-hat fine but the summary says not converged (τ): never green
+    assert convergence_verdict(_summary(1.001, 5000, tau_ok=False))["level"] == "amber"
+    # NaN R-hat is red, not silently green
+    assert convergence_verdict(_summary(float("nan"), 5000))["level"] == "red"
+
+
+def test_formatting():
+    assert fmt(None) == "—" and fmt(float("nan")) == "—"
+    assert fmt(2.41e6) == "2.41×10⁶" and fmt(-1.2e-4) == "−1.2×10⁻⁴"
+    assert fmt(0.0512) == "0.0512" and fmt(95.73) == "95.7" and fmt(0) == "0"
+    assert prior_text("loguniform[1e+04, 1e+12]") == "loguniform[10000, 10¹²]"
+    assert (
+        prior_text("lognormal(median 2.41e+06, σ_log 1) on [2.41e+05, 3.58e+08]")
+        == "lognormal(median 2.41×10⁶, σ_log 1) on [2.41×10⁵, 3.58×10⁸]"
+    )
+
+
+def test_residual_diagnostics():
+    rng = np.random.default_rng(0)
+    n = 4000
+    white = rng.standard_normal(n)
+    lags, rho, m = acf(white, 48)
+    assert m == n and rho[0] == pytest.approx(1.0)
+    assert np.mean(np.abs(rho[1:]) > 1.96 / math.sqrt(n)) < 0.15
+    f, c, band = cumulative_periodogram(white)
+    assert np.max(np.abs(c - 2 * f)) < band
+    phi = 0.8
+    ar = np.empty(n)
+    ar[0] = white[0]
+    for t in range(1, n):
+        ar[t] = phi * ar[t - 1] + white[t]
+    ar[1000:1100] = np.nan  # a gap
+    _, rho, m = acf(ar, 5)
+    assert m == n - 100 and rho[1] == pytest.approx(phi, abs=0.05)
+    w = innovations(ar, phi)
+    assert np.isnan(w[0]) and np.isnan(w[1000]) and np.isnan(w[1100])
+    _, rho_w, _ = acf(w, 24)
+    assert np.all(np.abs(rho_w[1:]) < 4 / math.sqrt(n))
+    f, c, band = cumulative_periodogram(ar)
+    assert np.max(np.abs(c - 2 * f)) > band  # AR(1) is red noise, not white
+
+
+# ------------------------------------------------------------------------ browser
+@pytest.mark.browser
+def test_report_in_headless_chromium(report):
+    chromium = find_chromium()
+    if chromium is None:
+        pytest.skip(
+            "chromium not installed (Debian package 'chromium'; .ci/run installs "
+            "it): the report was not opened in a real browser"
+        )
+    path, _ = report
+    res = open_page(path, chromium=chromium, width=1280, height=1600)
+    assert res.errors == [], res.errors
+    assert res.requests, "no request recorded: the DevTools network log is not working"
+    assert res.requests[0] == path.resolve().as_uri()
+    external = [u for u in res.requests[1:] if not u.startswith("data:")]
+    assert external == [], external
+    dom = res.dom
+    assert dom["sections"] == [sid for sid, _ in SECTIONS]
+    assert dom["figures"] == EXPECTED_FIGURES
+    assert dom["scripts"] == 0
+    assert len(dom["images"]) == len(EXPECTED_FIGURES)
+    assert all(i["complete"] and i["w"] > 400 and i["h"] > 200 for i in dom["images"])
+    assert ROOM in dom["title"]  # shown as text, not run
+    v = dom["verdict"]
+    assert "red" in v["cls"] and "NOT CONVERGED" in v["text"]
+    assert 0 <= v["top"] < 400, "the verdict must be on the first screen"
+    import matplotlib.image as mpimg
+
+    img = mpimg.imread(io.BytesIO(res.screenshot), format="png")
+    assert img.shape[:2] == (1600, 1280)
+    rgb = img[..., :3]
+    assert float(rgb.std()) > 0.05
+    assert float(np.mean(rgb.mean(axis=2) < 0.9)) > 0.03, "screenshot is (almost) blank"
+    red = (rgb[..., 0] > 0.55) & (rgb[..., 1] < 0.3) & (rgb[..., 2] < 0.3)
+    assert red.sum() > 500, "the red verdict banner is not visible"

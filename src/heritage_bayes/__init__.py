@@ -17,6 +17,16 @@ from heritage_bayes.rc import (
     structural_identifiability,
 )
 
+
+def __getattr__(name):
+    # heavier entry points, imported on first use (no side effects at import)
+    if name in ("load_run", "run_calibration"):
+        from heritage_bayes import calibrate
+
+        return getattr(calibrate, name)
+    raise AttributeError(f"module 'heritage_bayes' has no attribute {name!r}")
+
+
 __all__ = [
     "ConfigError",
     "DataError",
@@ -28,7 +38,9 @@ __all__ = [
     "climate",
     "discretize",
     "io",
+    "load_run",
     "model",
+    "run_calibration",
     "simulate",
     "structural_identifiability",
 ]

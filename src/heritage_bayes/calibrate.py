@@ -186,22 +186,7 @@ def _run_calibration(
     quiet: bool = False,
     report: bool | None = None,
 ) -> Path:
-    """Calibrate the configured models and write the run directory; return its path.
-
-    Parameters
-    ----------
-    cfg : CalibrationConfig
-    out_dir : path, optional
-        Default ``reports/<config name>/`` relative to the current folder.
-    seed : int, optional
-        Overrides ``cfg.seed``. The same seed gives the same posterior.
-    resume : bool
-        Continue the chains saved in ``out_dir`` (``chain_<model>.h5``).
-    quiet : bool
-        No progress output.
-    report : bool, optional
-        Write ``report.html`` (default ``cfg.report``).
-    """
+    """Implementation of :func:`run_calibration` (same parameters)."""
     t_start = time.perf_counter()
     if seed is not None:
         cfg = cfg.model_copy(update={"seed": int(seed)})
@@ -590,7 +575,7 @@ def load_run(path: str | Path) -> Run:
     """
     import json
 
-    import arviz as az
+    from heritage_bayes._arviz import az
 
     p = Path(path)
     for name in ("posterior.nc", "summary.json", "config.yaml"):

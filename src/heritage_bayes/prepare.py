@@ -52,6 +52,7 @@ import pandas as pd
 
 from heritage_bayes.config import parse_duration
 from heritage_bayes.errors import ConfigError, DataError, InputError
+from heritage_bayes.io._common import to_jsonable
 
 __all__ = [
     "INPUT_COLUMNS",
@@ -892,7 +893,7 @@ def prepare(cfg) -> Prepared:
         init_steps=init_steps,
         irradiance_source=irradiance_source,
         truth=truth,
-        sources=_jsonable(sources),
+        sources=to_jsonable(sources),
     )
 
 
@@ -951,23 +952,3 @@ def _demo(settings):
         )
     except InputError as exc:  # its messages start with the setting's name
         raise ConfigError(f"data.demo.{exc}") from None
-
-
-def _jsonable(obj):
-    if isinstance(obj, Mapping):
-        return {str(k): _jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, list | tuple):
-        return [_jsonable(v) for v in obj]
-    if isinstance(obj, np.integer):
-        return int(obj)
-    if isinstance(obj, np.floating):
-        return float(obj)
-    if isinstance(obj, np.bool_):
-        return bool(obj)
-    if isinstance(obj, pd.Timestamp):
-        return _iso(obj)
-    if isinstance(obj, pd.Timedelta | Path):
-        return str(obj)
-    if obj is None or isinstance(obj, str | int | float | bool):
-        return obj
-    return str(obj)

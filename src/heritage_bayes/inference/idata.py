@@ -11,11 +11,11 @@ from __future__ import annotations
 import math
 from datetime import UTC, datetime
 
-import arviz as az
 import numpy as np
 import pandas as pd
 import xarray as xr
 
+from heritage_bayes._arviz import az
 from heritage_bayes._version import __version__
 from heritage_bayes.climate.psychro import saturation_vapour_pressure
 from heritage_bayes.inference.results import coverage, fit_metrics

@@ -147,20 +147,7 @@ def _find_map(
     maxiter: int = 300,
     starts: int = 4,
 ) -> MAPResult:
-    """Global-then-local maximisation of the posterior (see module docstring).
-
-    Parameters
-    ----------
-    logpost : LogPosterior
-    seed : int
-        Seeds the global search and the random starts: same seed, same result.
-    method : {"differential_evolution", "multistart"}
-    popsize, maxiter : int
-        Differential-evolution settings (population = popsize × d).
-    starts : int
-        Candidates polished with L-BFGS-B (the best distinct DE members, or random
-        starts for ``multistart``).
-    """
+    """Implementation of :func:`find_map` (same parameters)."""
     obj = _Objective(logpost)
     d = logpost.params.ndim
     rng = np.random.default_rng(seed)

@@ -36,6 +36,8 @@ from pathlib import Path
 
 import numpy as np
 
+from heritage_bayes.io._common import to_jsonable
+
 __all__ = ["atomic_write", "atomic_write_text", "coverage", "fit_metrics"]
 
 
@@ -111,24 +113,6 @@ def coverage(measured: np.ndarray, draws: np.ndarray, level: float) -> float:
     if not ok.any():
         return float("nan")
     return float(np.mean((m[ok] >= lo[ok]) & (m[ok] <= hi[ok])))
-
-
-def to_jsonable(obj):
-    """Recursively convert numpy scalars/arrays and non-finite floats for JSON."""
-    if isinstance(obj, dict):
-        return {str(k): to_jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [to_jsonable(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return to_jsonable(obj.tolist())
-    if isinstance(obj, (np.floating, float)):
-        v = float(obj)
-        return v if np.isfinite(v) else None
-    if isinstance(obj, (np.integer,)):
-        return int(obj)
-    if isinstance(obj, (np.bool_,)):
-        return bool(obj)
-    return obj
 
 
 def dump_json(path: str | Path, data: dict) -> Path:

@@ -123,7 +123,7 @@ def _burn_thin(tau: np.ndarray, steps: int) -> tuple[int, int]:
 
 def _mixing_ok(chain, tau, max_rhat, min_ess, max_draws) -> bool:
     """R-hat and bulk ESS of the retained draws (walkers as chains) meet the targets."""
-    import arviz as az
+    from heritage_bayes._arviz import az
 
     burn, thin = _burn_thin(tau, chain.shape[0])
     res = ChainResult(

@@ -335,3 +335,33 @@ def finalize(
         attrs.update(extra)
     frame.attrs = attrs
     return frame
+
+
+def to_jsonable(obj):
+    """Recursively convert to strict-JSON types: numpy scalars and arrays to Python,
+    non-finite floats to None, timestamps to ISO 8601, durations as ``format_timedelta``,
+    paths and anything else to text."""
+    from collections.abc import Mapping
+    from pathlib import PurePath
+
+    if isinstance(obj, Mapping):
+        return {str(k): to_jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return [to_jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return to_jsonable(obj.tolist())
+    if isinstance(obj, bool | np.bool_):
+        return bool(obj)
+    if isinstance(obj, int | np.integer):
+        return int(obj)
+    if isinstance(obj, float | np.floating):
+        return float(obj) if np.isfinite(obj) else None
+    if isinstance(obj, pd.Timestamp):
+        return obj.isoformat()
+    if isinstance(obj, pd.Timedelta):
+        return format_timedelta(obj)
+    if obj is None or isinstance(obj, str):
+        return obj
+    if isinstance(obj, PurePath):
+        return str(obj)
+    return str(obj)

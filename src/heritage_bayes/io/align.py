@@ -34,7 +34,12 @@ import numpy as np
 import pandas as pd
 
 from heritage_bayes.errors import DataError, InputError
-from heritage_bayes.io._common import AVERAGED_BY_DEFAULT, format_timedelta, modal_step
+from heritage_bayes.io._common import (
+    AVERAGED_BY_DEFAULT,
+    format_timedelta,
+    modal_step,
+    to_jsonable,
+)
 
 __all__ = ["Aligned", "AlignmentReport", "Gap", "align"]
 
@@ -159,26 +164,8 @@ class AlignmentReport:
             "input_gaps": [g.to_dict() for g in self.input_gaps],
             "measurement_gaps": [g.to_dict() for g in self.measurement_gaps],
             "measurement_missing": {k: int(v) for k, v in self.measurement_missing.items()},
-            "sources": [_jsonable(s) for s in self.sources],
+            "sources": [to_jsonable(s) for s in self.sources],
         }
-
-
-def _jsonable(obj):
-    if isinstance(obj, dict):
-        return {str(k): _jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, list | tuple):
-        return [_jsonable(v) for v in obj]
-    if isinstance(obj, np.integer):
-        return int(obj)
-    if isinstance(obj, np.floating):
-        return float(obj)
-    if isinstance(obj, pd.Timestamp):
-        return _iso(obj)
-    if isinstance(obj, pd.Timedelta):
-        return format_timedelta(obj)
-    if obj is None or isinstance(obj, str | int | float | bool):
-        return obj
-    return str(obj)
 
 
 @dataclass(frozen=True)

@@ -64,7 +64,8 @@ __all__ = [
 ]
 
 #: Standard columns that weather files may provide (model inputs and what they derive from).
-INPUT_COLUMNS = ("Te", "RHe", "Pe", "ghi", "dni", "dhi", "Tdew")
+#: ("Ph": a known heat input [W], e.g. measured heating power of a test cell.)
+INPUT_COLUMNS = ("Te", "RHe", "Pe", "ghi", "dni", "dhi", "Tdew", "Ph")
 #: Standard columns that measurement files may provide (model outputs).
 OUTPUT_COLUMNS = ("Ti", "RHi", "Pi")
 
@@ -406,6 +407,21 @@ def _table(df: pd.DataFrame, columns: Sequence[str]) -> pd.DataFrame:
     return out
 
 
+def _extra_inputs(cfg) -> list[str]:
+    """Model inputs beyond those built here (Te, Pe, Tf, I_<surface>), in model order."""
+    from heritage_bayes.calibrate import build_model  # the models decide their inputs
+
+    built = {"Te", "Pe", "Tf"} | {f"I_{s}" for s in cfg.data.surfaces}
+    extra: list[str] = []
+    for section in ("thermal", "hygric"):
+        if getattr(cfg, section) is None:
+            continue
+        for name in build_model(cfg, section).input_names:
+            if name not in built and name not in extra:
+                extra.append(name)
+    return extra
+
+
 def weather_inputs(
     weather: pd.DataFrame,
     *,
@@ -415,12 +431,17 @@ def weather_inputs(
     site: Mapping | None,
     surfaces: Mapping[str, Sequence[float]],
     where: str = "data.weather",
+    extra: Sequence[str] = (),
 ) -> tuple[list[pd.DataFrame], dict]:
     """The input tables to align: ``Te`` (thermal), ``Pe`` (hygric), ``I_<surface>``.
 
+    ``extra``: further input columns the models need and the weather table carries
+    as they are (e.g. a measured heating power ``Ph`` [W] for a heated test cell, or the
+    inputs of a custom network); a missing one is reported when the model asks for it.
+
     Returns the tables and a dict ``{"irradiance_source": short, "irradiance": {...}}``.
     """
-    need = []
+    need = [c for c in extra if c in weather.columns]
     if thermal:
         need.append("Te")
     if hygric:
@@ -730,6 +751,7 @@ def prepare(cfg) -> Prepared:
         site=site,
         surfaces=surfaces,
         where="data.weather",
+        extra=_extra_inputs(cfg),
     )
     sources["irradiance"] = note["irradiance"]
     irradiance_source = note["irradiance_source"]

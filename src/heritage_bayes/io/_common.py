@@ -37,10 +37,12 @@ STANDARD_COLUMNS: dict[str, tuple[str, str, tuple[float, float]]] = {
     "Pe": ("Pa", "outdoor vapour pressure", (0.0, 35000.0)),
     "Pi": ("Pa", "indoor vapour pressure", (0.0, 35000.0)),
     "Tdew": ("°C", "outdoor dew-point temperature", (-80.0, 70.0)),
+    "Tf": ("°C", "fixed (ground, neighbouring room) temperature", (-60.0, 70.0)),
+    "Ph": ("W", "known heat input into the air node (heating power)", (-1e7, 1e7)),
 }
 
 #: Columns that are interval averages (stamped at the interval end) unless told otherwise.
-AVERAGED_BY_DEFAULT = ("ghi", "dni", "dhi")
+AVERAGED_BY_DEFAULT = ("ghi", "dni", "dhi", "Ph")
 IRRADIANCE = ("ghi", "dni", "dhi")
 #: Negative irradiance down to this value [W/m²] is sensor noise (thermopile night
 #: offset) and is set to 0; below it the value is invalid.

@@ -51,8 +51,9 @@ class ModalForm:
         ZOH gain factor :math:`(1-e^{-\\lambda\\Delta t})/\\lambda` [s].
     Cz : (K, n_out, n) array
         Output matrix in modal coordinates :math:`C\\,C_{cap}^{-1/2}V`.
-    T, Tinv : (K, n, n) arrays
-        State transformation :math:`x = Tz`, :math:`z = T^{-1}x`.
+    s, V : (K, n), (K, n, n) arrays
+        :math:`C_{cap}^{-1/2}` and the eigenvectors: the state transformation
+        :attr:`T` (:math:`x = Tz`) and :attr:`Tinv` are built from them on demand.
     valid : (K,) bool
         Parameter sets that are admissible and gave finite, positive decay rates.
     dt : float
@@ -65,10 +66,20 @@ class ModalForm:
     ez: np.ndarray
     phi: np.ndarray
     Cz: np.ndarray
-    T: np.ndarray
-    Tinv: np.ndarray
+    s: np.ndarray
+    V: np.ndarray
     valid: np.ndarray
     dt: float
+
+    @property
+    def T(self) -> np.ndarray:
+        """(K, n, n) state transformation :math:`x = Tz`, :math:`T = C^{-1/2}V`."""
+        return self.s[:, :, None] * self.V
+
+    @property
+    def Tinv(self) -> np.ndarray:
+        """(K, n, n) inverse transformation :math:`T^{-1} = V^T C^{1/2}`."""
+        return np.swapaxes(self.V, 1, 2) / self.s[:, None, :]
 
     @property
     def Bdz(self) -> np.ndarray:
@@ -123,10 +134,10 @@ def modal_form(model, P: np.ndarray, dt: float) -> ModalForm:
     lam, V = np.linalg.eigh(S)
     Vt = np.swapaxes(V, 1, 2)
     Bz = Vt @ (s[:, :, None] * Gu)
-    ez = np.einsum("kij,kj->ki", Vt, s * q)
-    T = s[:, :, None] * V
-    Tinv = Vt / s[:, None, :]
-    Cz = model.output_matrix()[None] @ T
+    ez = np.einsum("kij,kj->ki", Vt, s * q) if q.any() else np.zeros_like(lam)
+    # outputs are node potentials: rows of T = C^-1/2 V for the observed nodes
+    out = model._ix["out"]
+    Cz = s[:, out, None] * V[:, out, :]
     x = lam * dt
     # poles below 1e-200 (modes faster than dt/460) are flushed to exactly zero: the
     # same result to machine precision, without subnormal arithmetic in the recursion
@@ -136,9 +147,7 @@ def modal_form(model, P: np.ndarray, dt: float) -> ModalForm:
         phi = np.where(x > 1e-300, -np.expm1(-x) / np.where(lam > 0, lam, 1.0), dt)
     ok = valid & np.all(np.isfinite(lam), axis=1) & np.all(lam > 0, axis=1)
     ok &= np.all(np.isfinite(Bz), axis=(1, 2))
-    return ModalForm(
-        lam=lam, ad=ad, Bz=Bz, ez=ez, phi=phi, Cz=Cz, T=T, Tinv=Tinv, valid=ok, dt=float(dt)
-    )
+    return ModalForm(lam=lam, ad=ad, Bz=Bz, ez=ez, phi=phi, Cz=Cz, s=s, V=V, valid=ok, dt=float(dt))
 
 
 def discretize(model, params, dt: float = 3600.0):

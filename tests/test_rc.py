@@ -356,3 +356,18 @@ def test_invalid_parameter_sets_are_flagged_not_raised_in_modal_form():
     mf = modal_form(m, P, 3600.0)
     np.testing.assert_array_equal(mf.valid, [True, False, False])
     assert np.all(np.isfinite(mf.ad))
+
+
+def test_estimated_fixed_temperature_node():
+    """ground="estimate": Tf is a constant parameter [°C] (thermal counterpart of Pf)."""
+    m = hb.model("thermal_2c", surfaces=(), ground="estimate")
+    assert m.input_names == ("Te",)
+    assert m.parameter_names[-1] == "Tf" and m.parameters[-1].unit == "°C"
+    p = dict(Cw=2e8, Ci=2e6, Gw=400.0, Gi=1600.0, Gfast=130.0, Gf=100.0, Tf=15.0)
+    y = hb.simulate(m, p, np.full((10, 1), 3.0))
+    A, B, _, _ = m.state_space(p)
+    x_ss = np.linalg.solve(-A, B @ [3.0] + m.offset(p))
+    np.testing.assert_allclose(y[:, 0], x_ss[1], rtol=1e-12)
+    assert 3.0 < y[-1, 0] < 15.0
+    with pytest.raises(ValueError, match="option ground must be"):
+        hb.model("thermal_2c", ground="maybe")

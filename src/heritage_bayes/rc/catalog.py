@@ -31,7 +31,10 @@ vapour pressure [Pa]), output ``Pi``:
 - ``hygric_1c``: one air node ``Pi`` with ``Gfast`` to ``Pe`` (ladder bottom).
 
 Options (keywords of :func:`model`): ``surfaces`` (sequence of surface names for the
-thermal models with solar), ``ground`` (bool, default True: include ``Gf``/``Tf``),
+thermal models with solar), ``ground`` (default True: ``Gf`` to the input column ``Tf``;
+False: no fixed node; ``"estimate"``: ``Tf`` [°C] is a constant to estimate, like the
+fixed vapour pressure ``Pf`` of hygric model 3: a ground or neighbouring space of
+unknown but steady temperature, or the net effect of minimal heating),
 ``heating`` (bool, default False: an input ``Ph`` [W] of known gain 1 into the air node,
 e.g. measured heating power in a test cell; it makes the absolute scale of C and G
 identifiable).
@@ -84,9 +87,16 @@ def _thermal(
         if nodes == "3c":
             links.append(Link("Ti", "Tint", "Gint"))
         links.append(Link("Ti", "Te", "Gfast"))
+    if ground not in (True, False, "estimate"):
+        raise ValueError(
+            f"model {name!r}: option ground must be true, false or 'estimate' (got {ground!r})"
+        )
     if ground:
         links.append(Link("Ti", "Tf", "Gf"))
-    inputs = ["Te"] + [f"I_{s}" for s in surfaces] + (["Tf"] if ground else [])
+    # ground="estimate": Tf is a constant potential to estimate [°C] (the thermal
+    # counterpart of hygric model 3's fixed vapour-pressure node), not an input column
+    constants = ("Tf",) if ground == "estimate" else ()
+    inputs = ["Te"] + [f"I_{s}" for s in surfaces] + (["Tf"] if ground is True else [])
     sources = []
     for s in surfaces:
         desc[f"fI_{s}"] = f"effective solar aperture of surface {s}"
@@ -109,6 +119,7 @@ def _thermal(
         inputs=tuple(inputs),
         outputs=("Ti",),
         sources=tuple(sources),
+        constants=constants,
         descriptions=desc,
         input_units=units,
     )

@@ -577,6 +577,31 @@ def _site_from_meta(meta: Mapping) -> dict:
     }
 
 
+def _typical_year(frame, path, name, fmt, meta, year_used, invalid, *, first_line, station):
+    """Shared tail of the EPW and TMY3 readers: ranges, order, provenance attrs."""
+    lines = np.arange(len(frame)) + first_line
+    counts: dict[str, int] = {}
+    clipped = validate_ranges(frame, lines, name, {}, invalid, counts)
+    frame["__line"] = lines
+    frame = order_and_deduplicate(frame, name, duplicates="raise", sort=False, counts=counts)
+    frame = frame.drop(columns="__line")
+    return finalize(
+        frame,
+        source=str(path),
+        fmt=fmt,
+        averaged=("ghi", "dni", "dhi"),
+        interval=pd.Timedelta("1h"),
+        counts=counts,
+        clipped=clipped,
+        extra={
+            "timezone": f"UTC{float(meta['TZ']):+g} (local standard time)",
+            "site": _site_from_meta(meta),
+            "coerced_year": year_used,
+            "station": station,
+        },
+    )
+
+
 def read_epw(path: str | PathLike, *, year: int | None = None, invalid: str = "raise"):
     """Read an EnergyPlus weather file (``.epw``) with :func:`pvlib.iotools.read_epw`.
 
@@ -645,26 +670,16 @@ def read_epw(path: str | PathLike, *, year: int | None = None, invalid: str = "r
         frame.loc[frame[col] >= marker, col] = np.nan
     for col in ("ghi", "dni", "dhi"):
         frame.loc[frame[col] >= _EPW_IRR_MISSING, col] = np.nan
-    lines = np.arange(len(frame)) + 9  # 8 header lines
-    counts: dict[str, int] = {}
-    clipped = validate_ranges(frame, lines, name, {}, invalid, counts)
-    frame["__line"] = lines
-    frame = order_and_deduplicate(frame, name, duplicates="raise", sort=False, counts=counts)
-    frame = frame.drop(columns="__line")
-    return finalize(
+    return _typical_year(
         frame,
-        source=str(path),
-        fmt="epw",
-        averaged=("ghi", "dni", "dhi"),
-        interval=pd.Timedelta("1h"),
-        counts=counts,
-        clipped=clipped,
-        extra={
-            "timezone": f"UTC{float(meta['TZ']):+g} (local standard time)",
-            "site": _site_from_meta(meta),
-            "coerced_year": year_used,
-            "station": str(meta.get("city", "")),
-        },
+        path,
+        name,
+        "epw",
+        meta,
+        year_used,
+        invalid,
+        first_line=9,  # 8 header lines
+        station=str(meta.get("city", "")),
     )
 
 
@@ -731,24 +746,14 @@ def read_tmy3(path: str | PathLike, *, year: int | None = None, invalid: str = "
         {std: data[src].to_numpy(dtype=float) for src, std in _WEATHER_MAP.items()},
         index=data.index.tz_convert("UTC"),
     )
-    lines = np.arange(len(frame)) + 3  # metadata line, header line
-    counts: dict[str, int] = {}
-    clipped = validate_ranges(frame, lines, name, {}, invalid, counts)
-    frame["__line"] = lines
-    frame = order_and_deduplicate(frame, name, duplicates="raise", sort=False, counts=counts)
-    frame = frame.drop(columns="__line")
-    return finalize(
+    return _typical_year(
         frame,
-        source=str(path),
-        fmt="tmy3",
-        averaged=("ghi", "dni", "dhi"),
-        interval=pd.Timedelta("1h"),
-        counts=counts,
-        clipped=clipped,
-        extra={
-            "timezone": f"UTC{float(meta['TZ']):+g} (local standard time)",
-            "site": _site_from_meta(meta),
-            "coerced_year": year_used,
-            "station": str(meta.get("Name", "")).strip('"'),
-        },
+        path,
+        name,
+        "tmy3",
+        meta,
+        year_used,
+        invalid,
+        first_line=3,  # metadata line, header line
+        station=str(meta.get("Name", "")).strip('"'),
     )

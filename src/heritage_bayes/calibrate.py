@@ -71,12 +71,7 @@ def build_model(cfg: CalibrationConfig, section: str) -> RCModel:
                 raise ConfigError(
                     f"{where}: unknown model {sec.model!r}; available: {sorted(CATALOG)}"
                 )
-            options = dict(sec.options)
-            if sec.model in _SOLAR and "surfaces" not in options:
-                options["surfaces"] = (
-                    tuple(cfg.data.surfaces) if cfg.data.irradiance != "none" else ()
-                )
-            m = catalog_model(sec.model, **options)
+            m = catalog_model(sec.model, **_catalog_options(cfg, section, sec.model))
     except ConfigError:
         raise
     except ValueError as exc:
@@ -84,6 +79,42 @@ def build_model(cfg: CalibrationConfig, section: str) -> RCModel:
     if m.domain != section:
         raise ConfigError(f"{where}: a {m.domain} model cannot be used in the {section!r} section")
     return m
+
+
+def _catalog_options(cfg: CalibrationConfig, section: str, name: str) -> dict:
+    """Options of catalogue model ``name`` in a section: the configured ones, plus the
+    solar surfaces from ``data.surfaces`` (none when ``data.irradiance: none``)."""
+    options = dict(getattr(cfg, section).options)
+    if name in _SOLAR and "surfaces" not in options:
+        options["surfaces"] = tuple(cfg.data.surfaces) if cfg.data.irradiance != "none" else ()
+    return options
+
+
+def _log_posterior(cfg, prep, section: str, model: RCModel, priors: Mapping) -> LogPosterior:
+    """The log-posterior of ``model`` on the calibration period of a config section."""
+    sec_cfg = getattr(cfg, section)
+    noise = get_noise_model(sec_cfg.noise)
+    params = parameters_for(
+        model,
+        noise,
+        priors,
+        room_volume=sec_cfg.room_volume or cfg.room_volume,
+        where=f"{section}.priors",
+    )
+    cal = prep.calibration
+    try:
+        return LogPosterior(
+            model,
+            params,
+            noise,
+            prep.model_inputs(section, model)[cal],
+            prep.observed(section, model)[cal],
+            dt=prep.dt,
+            warmup=prep.warmup_steps,
+            init_window=prep.init_steps,
+        )
+    except ValueError as exc:
+        raise InputError(f"{section}: {exc}") from None
 
 
 @dataclass
@@ -214,30 +245,7 @@ def _run_calibration(
         if sec_cfg is None:
             continue
         model = build_model(cfg, name)
-        noise = get_noise_model(sec_cfg.noise)
-        params = parameters_for(
-            model,
-            noise,
-            sec_cfg.priors,
-            room_volume=sec_cfg.room_volume or cfg.room_volume,
-            where=f"{name}.priors",
-        )
-        U = prep.model_inputs(name, model)
-        Y = prep.observed(name, model)
-        cal = prep.calibration
-        try:
-            lp = LogPosterior(
-                model,
-                params,
-                noise,
-                U[cal],
-                Y[cal],
-                dt=prep.dt,
-                warmup=prep.warmup_steps,
-                init_window=prep.init_steps,
-            )
-        except ValueError as exc:
-            raise InputError(f"{name}: {exc}") from None
+        lp = _log_posterior(cfg, prep, name, model, sec_cfg.priors)
         sections.append(_Section(name, model, lp))
     ndims = [s.logpost.ndim for s in sections]
     nwalkers = cfg.sampler.walkers or max(32, 2 * max(ndims) + 2)
@@ -374,42 +382,18 @@ def model_ladder(cfg: CalibrationConfig, prep, section: _Section, *, seed: int) 
             model, lp, mp = section.model, section.logpost, section.map
         else:
             try:
-                options = dict(sec_cfg.options)
-                if name in _SOLAR and "surfaces" not in options:
-                    options["surfaces"] = (
-                        tuple(cfg.data.surfaces) if cfg.data.irradiance != "none" else ()
-                    )
-                model = catalog_model(name, **options)
+                model = catalog_model(name, **_catalog_options(cfg, section.name, name))
             except ValueError:
                 continue
             if model.output_names != out:
                 continue
-            noise = section.logpost.noise
+            # the configured priors whose parameters exist in this model order
             priors = {
                 k: v
                 for k, v in sec_cfg.priors.items()
                 if k in model.parameter_names or k.split("_")[0] in ("sigma", "phi")
             }
-            params = parameters_for(
-                model,
-                noise,
-                priors,
-                room_volume=sec_cfg.room_volume or cfg.room_volume,
-                air_change_rate=cfg.air_change_rate,
-                air_change_sigma=cfg.air_change_sigma,
-                where=f"{section.name}.priors",
-            )
-            cal = prep.calibration
-            lp = LogPosterior(
-                model,
-                params,
-                noise,
-                prep.model_inputs(section.name, model)[cal],
-                prep.observed(section.name, model)[cal],
-                dt=prep.dt,
-                warmup=prep.warmup_steps,
-                init_window=prep.init_steps,
-            )
+            lp = _log_posterior(cfg, prep, section.name, model, priors)
             mp = find_map(
                 lp,
                 seed=seed,
@@ -585,8 +569,7 @@ def load_run(path: str | Path) -> Run:
                 "run `hbayes calibrate` first"
             )
     raw = yaml.safe_load((p / "config.yaml").read_text(encoding="utf-8"))
-    cfg_path = raw.pop("name", None)
-    cfg = parse_config({**raw, "name": cfg_path}, source=str(p / "config.yaml"))
+    cfg = parse_config(raw, source=str(p / "config.yaml"))
     summary = json.loads((p / "summary.json").read_text(encoding="utf-8"))
     idata = az.from_netcdf(str(p / "posterior.nc"), engine="h5netcdf")
     models = {s: build_model(cfg, s) for s in SECTIONS if getattr(cfg, s) is not None}

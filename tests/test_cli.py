@@ -205,3 +205,17 @@ def test_resume_may_extend_a_run(tiny_run, tmp_path):
     chain = s["models"]["thermal"]["chain"]
     assert chain["resumed_from"] == 400
     assert chain["steps"] == 600 or chain["converged_tau"]
+
+
+def test_air_change_rate_sets_the_ventilation_prior_of_both_models(tiny_run, tmp_path):
+    cfg = json.loads(json.dumps(TINY))
+    cfg["air_change_rate"] = 0.5
+    cfg["sampler"]["max_steps"] = 200
+    path = _write(tmp_path / "ach.yaml", cfg)
+    assert main(["calibrate", str(path), "--out", str(tmp_path / "run"), "--quiet"]) == 0
+    s = json.loads((tmp_path / "run" / "summary.json").read_text())
+    # hygric_1c's single conductance is Gfast; thermal_1c has none (Ge is total)
+    assert s["parameters"]["hygric.Gfast"]["prior"].startswith("lognormal")
+    assert s["parameters"]["hygric.Gfast"]["prior_spec"]["median"] == pytest.approx(
+        400 * 0.5 / 3600 / (461.52 * 288.15)
+    )

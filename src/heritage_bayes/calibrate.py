@@ -99,6 +99,8 @@ def _log_posterior(cfg, prep, section: str, model: RCModel, priors: Mapping) -> 
         noise,
         priors,
         room_volume=sec_cfg.room_volume or cfg.room_volume,
+        air_change_rate=cfg.air_change_rate,
+        air_change_sigma=cfg.air_change_sigma,
         where=f"{section}.priors",
     )
     cal = prep.calibration
@@ -126,7 +128,9 @@ class _Section:
     identifiability: object = None
     chain: object = None
     X: np.ndarray | None = None  # (walkers, draws, d) unconstrained
-    theta: np.ndarray | None = None  # (walkers, draws, P)
+    theta: np.ndarray | None = None  # (walkers, draws, P), common across models
+    theta_kept: np.ndarray | None = None  # (walkers, draws, P), all retained draws
+    X_kept: np.ndarray | None = None  # the same in sampler coordinates
     lp: np.ndarray | None = None
     timings: dict = field(default_factory=dict)
 
@@ -304,19 +308,19 @@ def _run_calibration(
         s.timings["sampling_seconds"] = time.perf_counter() - t0
         verdict = "converged" if s.chain.converged else "NOT converged"
         say.say(f"[{s.name}] {s.chain.steps} steps, τmax {np.nanmax(s.chain.tau):.0f}: {verdict}")
-    # common number of retained draws per walker across models
-    per = max(1, cfg.sampler.max_draws // nwalkers)
-    draws = []
+    # the draws each sampler checked (R-hat, ESS) give the summaries; the posterior
+    # group holds a common number per walker, so draw i of one model pairs with draw i
+    # of the other (combined RH)
     for s in sections:
-        X, lpv = s.chain.draws(cfg.sampler.max_draws)
-        draws.append(X.shape[1])
-        s.X, s.lp = X, lpv
-    n_draw = min([per, *draws])
+        s.X, s.lp = s.chain.draws(cfg.sampler.max_draws)
+        s.X_kept = s.X
+        s.theta_kept = s.logpost.params.values(s.X.reshape(-1, s.X.shape[-1])).reshape(
+            *s.X.shape[:2], -1
+        )
+    n_draw = min(s.X.shape[1] for s in sections)
     for s in sections:
         s.X, s.lp = s.X[:, -n_draw:], s.lp[:, -n_draw:]
-        s.theta = s.logpost.params.values(s.X.reshape(-1, s.X.shape[-1])).reshape(
-            s.X.shape[0], n_draw, -1
-        )
+        s.theta = s.theta_kept[:, -n_draw:]
     ladder = {}
     if cfg.ladder:
         for i, s in enumerate(sections):

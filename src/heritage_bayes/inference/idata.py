@@ -142,10 +142,12 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
                 coords={"chain": np.arange(W), "draw": sel, "time_cal": times[cal]},
             )
         # parameter summaries
-        ds = xr.Dataset(
-            {k: v for k, v in post.items() if k.startswith(f"{s.name}.")}, coords=coords
-        )
-        free_vars = [f"{s.name}.{p.name}" for p in ps.parameters if p.free]
+        # statistics on all draws the sampler checked; R-hat and ESS in the sampler's
+        # coordinates, exactly as its stopping rule computed them (folded R-hat is not
+        # invariant under the log/logit transforms)
+        kept = s.theta_kept
+        free_vars = [f"{s.name}.{n}" for n in ps.free_names]
+        ds = xr.Dataset({v: (cdims, s.X_kept[..., i]) for i, v in enumerate(free_vars)})
         rhat = az.rhat(ds[free_vars])
         ess_b = az.ess(ds[free_vars], method="bulk")
         ess_t = az.ess(ds[free_vars], method="tail")
@@ -155,7 +157,7 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
         prng = np.random.default_rng(seed + 11)
         for j, p in enumerate(ps.parameters):
             key = f"{s.name}.{p.name}"
-            x = s.theta[..., j].reshape(-1)
+            x = kept[..., j].reshape(-1)
             entry = {
                 "unit": p.unit,
                 "kind": p.kind,
@@ -196,7 +198,7 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
         Y = []
         for j, p in enumerate(ps.parameters):
             if p.free:
-                x = s.theta[..., j].reshape(-1)
+                x = kept[..., j].reshape(-1)
                 Y.append(np.log(x) if p.prior.log_scale else x)
         corr = np.corrcoef(np.array(Y)) if len(Y) > 1 else np.ones((1, 1))
         correlations[s.name] = {"names": list(ps.free_names), "matrix": corr.tolist()}

@@ -51,6 +51,25 @@ def _build_parser() -> argparse.ArgumentParser:
 
     mod = sub.add_parser("models", help="list the catalogue of RC models")
     mod.set_defaults(func=_cmd_models)
+
+    bat = sub.add_parser(
+        "batch",
+        help="calibrate every room of a portfolio on Dask",
+        description="Calibrate every room of a portfolio file as a task on dask.distributed "
+        "(a local cluster by default, or --scheduler); write one run directory per room, "
+        "portfolio.csv, portfolio.json and index.html.",
+    )
+    bat.add_argument("portfolio", help="portfolio YAML file (e.g. configs/portfolio_demo.yaml)")
+    bat.add_argument("--out", metavar="DIR", help="output folder (default: reports/<name>/)")
+    bat.add_argument(
+        "--scheduler", metavar="ADDRESS", help="a running Dask scheduler, e.g. tcp://host:8786"
+    )
+    bat.add_argument("--workers", type=int, metavar="N", help="local workers (default: cores)")
+    bat.add_argument(
+        "--resume", action="store_true", help="skip finished rooms, continue interrupted chains"
+    )
+    bat.add_argument("--quiet", action="store_true", help="no progress output")
+    bat.set_defaults(func=_cmd_batch)
     return parser
 
 
@@ -87,6 +106,24 @@ def _cmd_models(args) -> int:
     for name, desc in available_models().items():
         print(f"{name:<20s} {desc}")
     return 0
+
+
+def _cmd_batch(args) -> int:
+    from heritage_bayes.portfolio import load_portfolio, run
+
+    pf = load_portfolio(args.portfolio)  # every room validated before any work starts
+    df = run(
+        pf,
+        args.out,
+        scheduler=args.scheduler,
+        workers=args.workers,
+        resume=args.resume,
+        quiet=args.quiet,
+    )
+    bad = df[~df["status"].isin(["done", "skipped"])]
+    for _, r in bad.iterrows():
+        print(f"hbayes: room {r['room']!r} {r['status']}: {r['message']}", file=sys.stderr)
+    return 0 if bad.empty else 1 if (bad["status"] == "error").any() else 2
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -1,0 +1,197 @@
+"""One room as a Dask task, and its row of the portfolio table."""
+
+from __future__ import annotations
+
+import json
+import time
+import traceback
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from heritage_bayes.errors import InputError
+from heritage_bayes.portfolio.spec import RoomSpec
+
+__all__ = ["measured_risk", "room_row"]
+
+
+def _is_done(run_dir: Path, chash: str) -> bool:
+    """A finished run of the same config: summary.json exists with the same config hash."""
+    try:
+        s = json.loads((run_dir / "summary.json").read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return False
+    return s.get("config_hash") == chash
+
+
+def _room_task(spec: RoomSpec, out_dir: str, resume: bool) -> dict:
+    """Calibrate one room in a worker; never raises (the row carries the failure)."""
+    from heritage_bayes.config import config_hash, parse_config
+
+    t0 = time.perf_counter()
+    run_dir = Path(out_dir) / spec.name
+    row: dict[str, Any] = {"room": spec.name, "config": str(spec.config_path)}
+    try:
+        cfg = parse_config(spec.raw, source=str(spec.config_path), base_dir=spec.base_dir)
+        if resume and _is_done(run_dir, config_hash(cfg)):
+            row["status"] = "skipped"
+            row["message"] = "done in an earlier run (--resume)"
+        else:
+            from heritage_bayes.calibrate import run_calibration
+
+            has_chain = any(run_dir.glob("chain_*.h5"))
+            run_calibration(cfg, run_dir, resume=resume and has_chain, quiet=True)
+            row["status"] = "done"
+            row["message"] = "resumed the saved chains" if resume and has_chain else ""
+        row.update(room_row(run_dir))
+        if spec.projection is not None:
+            row.update(_project_room(run_dir, spec.projection, resume))
+    except InputError as exc:
+        row["status"] = "failed"
+        row["message"] = str(exc)
+    except KeyboardInterrupt:
+        raise
+    except Exception as exc:  # an internal error in one room must not stop the others
+        row["status"] = "error"
+        row["message"] = f"internal error: {type(exc).__name__}: {exc}\n" + "".join(
+            traceback.format_exception(exc)[-6:]
+        )
+    row["task_seconds"] = time.perf_counter() - t0
+    row["worker_peak_rss_mb"] = _peak_rss_mb()
+    return row
+
+
+def _peak_rss_mb() -> float:
+    try:
+        import resource
+
+        return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+    except (ImportError, OSError):  # pragma: no cover - not on POSIX
+        return float("nan")
+
+
+def _project_room(run_dir: Path, projection: Path, resume: bool) -> dict:
+    """Run the room's projection (when the projection layer is installed) and keep a few
+    headline numbers for the table."""
+    try:
+        from heritage_bayes import projection as proj_mod
+    except ImportError:  # pragma: no cover - the projection layer ships with the package
+        raise InputError(
+            f"{projection}: this installation has no projection layer (heritage_bayes."
+            "projection); remove 'projection' from the portfolio entry"
+        ) from None
+    return proj_mod.portfolio_columns(run_dir, projection, resume=resume)
+
+
+def _get(d: Mapping, *keys, default=float("nan")):
+    for k in keys:
+        if not isinstance(d, Mapping) or k not in d:
+            return default
+        d = d[k]
+    return d
+
+
+def room_row(run_dir: str | Path) -> dict:
+    """The portfolio table's row of one finished run directory.
+
+    Columns: convergence (``converged``, ``max_rhat``, ``min_ess_bulk``,
+    ``wall_seconds``), per measured output ``<section>.<output>.FIT_cal`` /
+    ``FIT_val`` [%] and ``coverage90_val`` [-], the slowest time constant and the
+    outdoor-temperature gain of each section, and conservation-risk indicators of the
+    *measured* indoor climate over the data period (:func:`measured_risk`).
+    """
+    run_dir = Path(run_dir)
+    s = json.loads((run_dir / "summary.json").read_text(encoding="utf-8"))
+    row: dict[str, Any] = {
+        "run_dir": str(run_dir),
+        "report": str(run_dir / "report.html") if (run_dir / "report.html").is_file() else "",
+        "building": s.get("building", ""),
+        "room_description": s.get("room", ""),
+        "converged": bool(s.get("converged", False)),
+        "max_rhat": s.get("max_rhat", float("nan")),
+        "min_ess_bulk": s.get("min_ess_bulk", float("nan")),
+        "wall_seconds": s.get("wall_seconds", float("nan")),
+    }
+    for section, outputs in (s.get("metrics") or {}).items():
+        if section == "combined" or not isinstance(outputs, Mapping):
+            continue
+        for out, per in outputs.items():
+            key = f"{section}.{out}"
+            row[f"{key}.FIT_cal"] = _get(per, "calibration", "FIT")
+            row[f"{key}.FIT_val"] = _get(per, "validation", "FIT")
+            row[f"{key}.coverage90_val"] = _get(per, "validation", "coverage90")
+    derived = s.get("derived") or {}
+    for section in ("thermal", "hygric"):
+        for q, col in ((f"{section}.tau_1_h", "tau_1_h"), (f"{section}.gain_Ti_Te", "gain_Te")):
+            if q in derived:
+                row[f"{section}.{col}"] = derived[q].get("median", float("nan"))
+                row[f"{section}.{col}_q05"] = derived[q].get("q05", float("nan"))
+                row[f"{section}.{col}_q95"] = derived[q].get("q95", float("nan"))
+    row.update(measured_risk(run_dir))
+    return row
+
+
+def measured_risk(run_dir: str | Path) -> dict:
+    """Conservation-risk indicators of the measured indoor climate of a run.
+
+    Uses the logged ``Ti`` [°C] and ``RHi`` [%] of the run's data period (calibration
+    and validation, gaps omitted) with :func:`heritage_bayes.climate.risk.assess`. The
+    chemical (TWPI [years]) and mechanical (EMC range [% MC]) indicators need no minimum
+    length; the mould index (VTT), ASHRAE classes and the EN 15757 band need a year of
+    data and are left out (NaN) for shorter logs. ``risk_flags`` counts the indicators
+    rated "risk" by their published thresholds (see ``assess``); the overview sorts by
+    it. Both temperature and RH must have been logged; otherwise the columns are absent.
+    """
+    from heritage_bayes._arviz import az
+    from heritage_bayes.climate import risk
+
+    path = Path(run_dir) / "posterior.nc"
+    try:
+        obs = az.from_netcdf(str(path)).observed_data
+    except (OSError, ValueError, AttributeError):
+        return {}
+    if "Ti" not in obs or "RHi" not in obs:
+        return {}
+    T = np.asarray(obs["Ti"].values, dtype=float)
+    RH = np.asarray(obs["RHi"].values, dtype=float)
+    ok = np.isfinite(T) & np.isfinite(RH)
+    if ok.sum() < 24:
+        return {}
+    T, RH = T[ok], np.clip(RH[ok], 0.0, 100.0)
+    groups = ["chemical", "mechanical"]
+    if ok.sum() >= 8760:
+        groups += ["mould", "ashrae", "en15757"]
+    table = risk.assess(T, RH, indicators=groups, nan_policy="omit")
+    by = table.set_index("indicator")
+    out: dict[str, Any] = {"risk_hours": int(ok.sum())}
+    for ind, col in (
+        ("twpi", "twpi_years"),
+        ("emc_range", "emc_range_pct"),
+        ("vtt_mould_index_max", "mould_index_max"),
+        ("en15757_outside", "en15757_outside_pct"),
+    ):
+        out[col] = float(by.loc[ind, "value"]) if ind in by.index else float("nan")
+    if "ashrae_best_class" in by.index:
+        out["ashrae_best_class"] = str(by.loc["ashrae_best_class", "rating"])
+    ratings = table["rating"].astype(str).str.lower()
+    out["risk_flags"] = int((ratings == "risk").sum())
+    out["risk_flagged"] = ", ".join(table.loc[ratings == "risk", "indicator"].astype(str))
+    return out
+
+
+def _attention_order(df: pd.DataFrame) -> pd.DataFrame:
+    """Rooms that need attention first: failed or unconverged calibrations (their
+    figures cannot be trusted), then the most indicators rated "risk", then the
+    shortest preservation index (TWPI)."""
+    status_rank = df["status"].map({"failed": 0, "error": 0}).fillna(1)
+    conv = df.get("converged", pd.Series(True, index=df.index)).fillna(False).astype(bool)
+    flags = df.get("risk_flags", pd.Series(0, index=df.index)).fillna(0)
+    twpi = df.get("twpi_years", pd.Series(np.inf, index=df.index)).fillna(np.inf)
+    key = pd.DataFrame({"s": status_rank, "c": conv.astype(int), "f": -flags, "t": twpi})
+    order = key.sort_values(["s", "c", "f", "t"], kind="stable").index
+    out = df.loc[order].reset_index(drop=True)
+    out.insert(0, "attention_rank", np.arange(1, len(out) + 1))
+    return out

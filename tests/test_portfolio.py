@@ -1,0 +1,166 @@
+"""Portfolios on dask.distributed: validation up front, a failed room does not stop the
+others, the overview table and page, --resume."""
+
+import json
+
+import pandas as pd
+import pytest
+import yaml
+
+from heritage_bayes.cli import main
+from heritage_bayes.errors import ConfigError
+from heritage_bayes.portfolio import load_portfolio, run
+
+pytest.importorskip("distributed")
+
+TINY = {
+    "name": "tiny",
+    "seed": 3,
+    "data": {"demo": {}},
+    "room_volume": 400,
+    "periods": {
+        "calibration": {"start": "2019-01-02", "end": "2019-01-16"},
+        "validation": {"start": "2019-01-16", "end": "2019-01-21"},
+        "warmup": "2D",
+        "init_window": "2D",
+    },
+    "thermal": {"model": "thermal_1c", "noise": "ar1"},
+    "hygric": {"model": "hygric_1c", "noise": "ar1"},
+    "sampler": {"max_steps": 200, "check_every": 100},
+    "optimizer": {"maxiter": 10, "starts": 1},
+    "ladder": False,
+    "report": True,
+}
+
+
+def _write(path, obj):
+    path.write_text(yaml.safe_dump(obj, sort_keys=False), encoding="utf-8")
+    return path
+
+
+@pytest.fixture(scope="module")
+def portfolio_dir(tmp_path_factory):
+    d = tmp_path_factory.mktemp("portfolio")
+    _write(d / "room.yaml", TINY)
+    pf = {
+        "name": "three",
+        "defaults": {"report": True},
+        "rooms": [
+            {"name": "a", "config": "room.yaml"},
+            {"name": "b", "config": "room.yaml", "overrides": {"data": {"demo": {"seed": 11}}}},
+            # valid config, but its periods lie outside the demo's weather year: fails
+            # while it runs (data), and must not stop the others
+            {
+                "name": "bad",
+                "config": "room.yaml",
+                "overrides": {
+                    "periods": {
+                        "calibration": {"start": "2021-01-02", "end": "2021-01-16"},
+                        "validation": {"start": "2021-01-16", "end": "2021-01-21"},
+                    }
+                },
+            },
+        ],
+    }
+    return d, _write(d / "portfolio.yaml", pf)
+
+
+@pytest.fixture(scope="module")
+def finished(portfolio_dir):
+    d, pf = portfolio_dir
+    code = main(["batch", str(pf), "--out", str(d / "out"), "--workers", "2", "--quiet"])
+    return d, pf, code
+
+
+def test_three_rooms_two_workers_one_bad(finished):
+    d, _, code = finished
+    assert code == 2  # a room failed on its data: a user error, reported by name
+    out = d / "out"
+    df = pd.read_csv(out / "portfolio.csv")
+    assert set(df["room"]) == {"a", "b", "bad"}
+    by = df.set_index("room")
+    assert by.loc["a", "status"] == "done" and by.loc["b", "status"] == "done"
+    assert by.loc["bad", "status"] == "failed"
+    assert "not covered by every input" in by.loc["bad", "message"]
+    # failed rooms come first in attention order; every room has a rank
+    assert list(df["attention_rank"]) == [1, 2, 3] and df.iloc[0]["room"] == "bad"
+    for room in ("a", "b"):
+        summary = json.loads((out / room / "summary.json").read_text())
+        assert by.loc[room, "thermal.Ti.FIT_cal"] == pytest.approx(
+            summary["metrics"]["thermal"]["Ti"]["calibration"]["FIT"]
+        )
+        assert by.loc[room, "converged"] == summary["converged"]
+        assert (out / room / "report.html").is_file()
+        assert by.loc[room, "twpi_years"] > 0  # risk of the measured climate
+    # the two good rooms differ (different logger seeds)
+    assert by.loc["a", "thermal.Ti.FIT_cal"] != by.loc["b", "thermal.Ti.FIT_cal"]
+    meta = json.loads((out / "portfolio.json").read_text())
+    assert meta["rooms_total"] == 3 and len(meta["rows"]) == 3
+    page = (out / "index.html").read_text()
+    assert "href='a/report.html'" in page and "href='b/report.html'" in page
+    assert "not covered by every input" in page
+    assert "script-src 'sha256-" in page  # the sort script is the only one allowed
+    assert not list(out.rglob("*.tmp"))
+
+
+def test_resume_skips_finished_rooms(finished):
+    d, pf, _ = finished
+    out = d / "out"
+    before = (out / "a" / "posterior.nc").stat().st_mtime_ns
+    df = run(pf, out, workers=2, resume=True, quiet=True)
+    by = df.set_index("room")
+    assert by.loc["a", "status"] == "skipped" and by.loc["b", "status"] == "skipped"
+    assert by.loc["bad", "status"] == "failed"
+    assert (out / "a" / "posterior.nc").stat().st_mtime_ns == before
+    assert by.loc["a", "thermal.Ti.FIT_cal"] == pytest.approx(
+        pd.read_csv(out / "portfolio.csv").set_index("room").loc["a", "thermal.Ti.FIT_cal"]
+    )
+
+
+def test_every_bad_entry_reported_before_any_work(tmp_path, capsys):
+    _write(tmp_path / "room.yaml", TINY)
+    bad_model = dict(TINY, thermal={"model": "thermal_9z"})
+    _write(tmp_path / "bad_model.yaml", bad_model)
+    pf = _write(
+        tmp_path / "p.yaml",
+        {
+            "rooms": [
+                {"name": "ok", "config": "room.yaml"},
+                {"name": "missing", "config": "nope.yaml"},
+                {"name": "typo", "config": "room.yaml", "overrides": {"sampler": {"max_stepz": 5}}},
+                {"name": "ok", "config": "room.yaml"},
+                {"name": "model", "config": "bad_model.yaml"},
+            ]
+        },
+    )
+    with pytest.raises(ConfigError) as exc:
+        load_portfolio(pf)
+    msg = str(exc.value)
+    assert "4 of 5 room(s) are invalid" in msg
+    assert "rooms[1] (missing).config" in msg and "nope.yaml" in msg
+    assert "max_stepz" in msg and "rooms[2] (typo)" in msg
+    assert "used twice" in msg
+    assert "rooms[4] (model)" in msg
+    assert main(["batch", str(pf), "--out", str(tmp_path / "o"), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "nothing was run" in err and "Traceback" not in err
+    assert not (tmp_path / "o").exists()
+
+
+def test_unreachable_scheduler_is_a_user_error(tmp_path, capsys):
+    _write(tmp_path / "room.yaml", TINY)
+    pf = _write(tmp_path / "p.yaml", {"rooms": [{"name": "a", "config": "room.yaml"}]})
+    code = main(
+        ["batch", str(pf), "--scheduler", "tcp://127.0.0.1:9", "--out", str(tmp_path / "o")]
+    )
+    assert code == 2
+    err = capsys.readouterr().err
+    assert "tcp://127.0.0.1:9" in err and "Traceback" not in err
+
+
+def test_shipped_portfolio_validates():
+    from pathlib import Path
+
+    pf = load_portfolio(Path(__file__).parents[1] / "configs" / "portfolio_demo.yaml")
+    assert len(pf.rooms) >= 3
+    assert len({json.dumps(r.raw, sort_keys=True, default=str) for r in pf.rooms}) == len(pf.rooms)

@@ -164,3 +164,33 @@ def test_shipped_portfolio_validates():
     pf = load_portfolio(Path(__file__).parents[1] / "configs" / "portfolio_demo.yaml")
     assert len(pf.rooms) >= 3
     assert len({json.dumps(r.raw, sort_keys=True, default=str) for r in pf.rooms}) == len(pf.rooms)
+
+
+@pytest.mark.browser
+def test_index_sorts_in_headless_chromium(finished):
+    from _report_browser import find_chromium, open_page
+
+    chromium = find_chromium()
+    if chromium is None:
+        pytest.skip("chromium not installed (Debian package 'chromium'; .ci/run installs it)")
+    d, _, _ = finished
+    # click "room" twice (ascending, then descending) and read the first column of rooms
+    js = """(() => {
+      const ths = Array.from(document.querySelectorAll('table.sortable th'));
+      const th = ths.find(h => h.textContent.trim() === 'room');
+      const col = ths.indexOf(th);
+      const rooms = () => Array.from(document.querySelectorAll('table.sortable tbody tr'))
+        .map(r => r.cells[col].textContent.trim());
+      const before = rooms();
+      th.click(); const asc = rooms();
+      th.click(); const desc = rooms();
+      return {before, asc, desc, links: document.querySelectorAll('a[href$="report.html"]').length};
+    })()"""
+    res = open_page(d / "out" / "index.html", chromium=chromium, extra_js=js)
+    assert res.errors == [], res.errors  # CSP: the hashed sort script is allowed
+    external = [u for u in res.requests[1:] if not u.startswith("data:")]
+    assert external == []
+    got = res.dom["extra"]
+    assert got["before"][0] == "bad"  # attention order: the failed room first
+    assert got["asc"] == ["a", "b", "bad"] and got["desc"] == ["bad", "b", "a"]
+    assert got["links"] == 2

@@ -90,8 +90,8 @@ def _catalog_options(cfg: CalibrationConfig, section: str, name: str) -> dict:
     return options
 
 
-def _log_posterior(cfg, prep, section: str, model: RCModel, priors: Mapping) -> LogPosterior:
-    """The log-posterior of ``model`` on the calibration period of a config section."""
+def _parameters(cfg, section: str, model: RCModel, priors: Mapping):
+    """Noise model and parameter set (priors validated) of a config section."""
     sec_cfg = getattr(cfg, section)
     noise = get_noise_model(sec_cfg.noise)
     params = parameters_for(
@@ -103,6 +103,21 @@ def _log_posterior(cfg, prep, section: str, model: RCModel, priors: Mapping) -> 
         air_change_sigma=cfg.air_change_sigma,
         where=f"{section}.priors",
     )
+    return noise, params
+
+
+def check_models(cfg: CalibrationConfig) -> None:
+    """Build every configured model and its priors without reading any data, so that a
+    wrong model name, option or prior fails at once (:class:`ConfigError` naming the key)."""
+    for section in SECTIONS:
+        sec_cfg = getattr(cfg, section)
+        if sec_cfg is not None:
+            _parameters(cfg, section, build_model(cfg, section), sec_cfg.priors)
+
+
+def _log_posterior(cfg, prep, section: str, model: RCModel, priors: Mapping) -> LogPosterior:
+    """The log-posterior of ``model`` on the calibration period of a config section."""
+    noise, params = _parameters(cfg, section, model, priors)
     cal = prep.calibration
     try:
         return LogPosterior(
@@ -229,6 +244,7 @@ def _run_calibration(
     out.mkdir(parents=True, exist_ok=True)
     chash = config_hash(cfg)
     say = _Progress(quiet)
+    check_models(cfg)  # before reading any data
     from heritage_bayes.prepare import prepare
 
     say.say(f"hbayes {__version__}: calibrating {cfg.name!r} -> {out}")

@@ -81,8 +81,6 @@ def render_index(pf: Portfolio, df: pd.DataFrame, out: Path) -> str:
     """The portfolio's ``index.html``: a self-contained page (no network access) with
     one row per room in attention order, sortable by any column, linking each room's
     calibration report."""
-    import base64
-    import hashlib
     import html
 
     from heritage_bayes._version import __version__
@@ -128,12 +126,10 @@ def render_index(pf: Portfolio, df: pd.DataFrame, out: Path) -> str:
         + "".join(body)
         + "</tbody></table></div>"
     )
-    digest = base64.b64encode(hashlib.sha256(_SORT_JS.encode()).digest()).decode()
     return render_page(
-        title=f"Portfolio — {pf.name}",
-        subtitle=html.escape(pf.notes) if pf.notes else "",
-        sections=[("Rooms", intro + table)],
-        script=_SORT_JS,
-        script_hash=f"sha256-{digest}",
+        f"Portfolio — {pf.name}",
+        [("Rooms", intro + table)],
+        subtitle=pf.notes,
         generator=f"heritage_bayes {__version__}",
+        script=_SORT_JS,
     )

@@ -75,6 +75,7 @@ def load_portfolio(path: str | Path) -> Portfolio:
         Listing *every* bad entry (missing or invalid config, duplicate room name,
         invalid overrides, missing projection file), each with its room name and key path.
     """
+    from heritage_bayes.calibrate import check_models
     from heritage_bayes.config import parse_config
 
     p = Path(path)
@@ -134,9 +135,13 @@ def load_portfolio(path: str | Path) -> Portfolio:
                 raise ConfigError(f"{where}.config: {cfile} is not a YAML mapping")
             merged = _deep_merge(_deep_merge(room_raw, defaults), overrides)
             merged.setdefault("name", rname)
-            parse_config(
+            cfg = parse_config(
                 merged, source=f"{where} ({cfile})", base_dir=str(cfile.parent), name=rname
             )
+            try:
+                check_models(cfg)
+            except ConfigError as exc:
+                raise ConfigError(f"{where} ({cfile}): {exc}") from None
         except ConfigError as exc:
             errors.append(str(exc))
             continue

@@ -7,8 +7,8 @@ import pytest
 import yaml
 
 import heritage_bayes as hb
-from heritage_bayes.calibrate import load_run
 from heritage_bayes.cli import main
+from heritage_bayes.run import load_run
 
 TINY = {
     "name": "tiny",

@@ -20,10 +20,14 @@ from heritage_bayes.rc import (
 
 def __getattr__(name):
     # heavier entry points, imported on first use (no side effects at import)
-    if name in ("load_run", "run_calibration"):
-        from heritage_bayes import calibrate
+    if name == "load_run":
+        from heritage_bayes.run import load_run
 
-        return getattr(calibrate, name)
+        return load_run
+    if name == "run_calibration":
+        from heritage_bayes.calibrate import run_calibration
+
+        return run_calibration
     raise AttributeError(f"module 'heritage_bayes' has no attribute {name!r}")
 
 

@@ -23,9 +23,8 @@ import numpy as np
 import yaml
 
 from heritage_bayes._version import __version__
-from heritage_bayes.climate.psychro import saturation_vapour_pressure
-from heritage_bayes.config import CalibrationConfig, chain_tag, config_hash, parse_config
-from heritage_bayes.errors import ConfigError, InputError
+from heritage_bayes.config import CalibrationConfig, chain_tag, config_hash
+from heritage_bayes.errors import InputError
 from heritage_bayes.inference.idata import CONVERGENCE
 from heritage_bayes.inference.likelihoods import get_noise_model
 from heritage_bayes.inference.optimize import find_map
@@ -33,12 +32,11 @@ from heritage_bayes.inference.parameters import parameters_for
 from heritage_bayes.inference.posterior import LogPosterior
 from heritage_bayes.inference.results import atomic_write, atomic_write_text, dump_json
 from heritage_bayes.inference.sampler import run_sampler
-from heritage_bayes.rc.catalog import CATALOG
+from heritage_bayes.models import SECTIONS, _catalog_options, build_model
 from heritage_bayes.rc.catalog import model as catalog_model
 from heritage_bayes.rc.identify import structural_identifiability
 from heritage_bayes.rc.model import RCModel
-from heritage_bayes.rc.network import Network
-from heritage_bayes.rc.simulate import check_inputs
+from heritage_bayes.run import Run, load_run  # re-exported: the run directory's format
 
 __all__ = [
     "LADDERS",
@@ -49,45 +47,6 @@ __all__ = [
     "model_ladder",
     "run_calibration",
 ]
-
-SECTIONS = ("thermal", "hygric")
-_SOLAR = {"thermal_1c", "thermal_2c", "thermal_4a"}
-
-
-def build_model(cfg: CalibrationConfig, section: str) -> RCModel:
-    """The RC model of config section ``thermal`` or ``hygric``.
-
-    Catalogue models get their solar surfaces from ``data.surfaces`` (none when
-    ``data.irradiance: none``); a mapping under ``model:`` is a custom network
-    (:meth:`heritage_bayes.rc.Network.from_dict`).
-    """
-    sec = getattr(cfg, section)
-    where = f"{section}.model"
-    try:
-        if isinstance(sec.model, Mapping):
-            m = Network.from_dict(sec.model, where=where).compile()
-        else:
-            if sec.model not in CATALOG:
-                raise ConfigError(
-                    f"{where}: unknown model {sec.model!r}; available: {sorted(CATALOG)}"
-                )
-            m = catalog_model(sec.model, **_catalog_options(cfg, section, sec.model))
-    except ConfigError:
-        raise
-    except ValueError as exc:
-        raise ConfigError(f"{where}: {exc}") from None
-    if m.domain != section:
-        raise ConfigError(f"{where}: a {m.domain} model cannot be used in the {section!r} section")
-    return m
-
-
-def _catalog_options(cfg: CalibrationConfig, section: str, name: str) -> dict:
-    """Options of catalogue model ``name`` in a section: the configured ones, plus the
-    solar surfaces from ``data.surfaces`` (none when ``data.irradiance: none``)."""
-    options = dict(getattr(cfg, section).options)
-    if name in _SOLAR and "surfaces" not in options:
-        options["surfaces"] = tuple(cfg.data.surfaces) if cfg.data.irradiance != "none" else ()
-    return options
 
 
 def _parameters(cfg, section: str, model: RCModel, priors: Mapping):
@@ -463,134 +422,3 @@ def model_ladder(cfg: CalibrationConfig, prep, section: _Section, *, seed: int) 
             }
         )
     return rows
-
-
-# ----------------------------------------------------------------------------- loading
-@dataclass
-class Run:
-    """A calibration run loaded from its directory.
-
-    Attributes
-    ----------
-    path : Path
-    config : CalibrationConfig
-        The resolved config.
-    idata : arviz.InferenceData
-    summary : dict
-        ``summary.json``.
-    models : dict
-        Section name (``thermal``/``hygric``) -> RCModel.
-    """
-
-    path: Path
-    config: CalibrationConfig
-    idata: object
-    summary: dict
-    models: dict
-
-    @property
-    def sections(self) -> tuple[str, ...]:
-        return tuple(self.models)
-
-    def draws(self, section: str, n: int | None = None, seed: int = 0) -> dict[str, np.ndarray]:
-        """Posterior draws of the model parameters: name -> (K,) arrays [SI units].
-
-        ``n`` draws chosen at random without replacement (default all).
-        """
-        model = self._model(section)
-        post = self.idata.posterior
-        cols = [post[f"{section}.{p}"].values.reshape(-1) for p in model.parameter_names]
-        K = cols[0].size
-        idx = np.arange(K)
-        if n is not None and n < K:
-            idx = np.sort(np.random.default_rng(seed).choice(K, size=n, replace=False))
-        return {p: c[idx] for p, c in zip(model.parameter_names, cols, strict=True)}
-
-    def _model(self, section: str) -> RCModel:
-        if section not in self.models:
-            raise InputError(
-                f"run {self.path} has no {section!r} model; it has {list(self.models)}"
-            )
-        return self.models[section]
-
-    def simulate(
-        self,
-        inputs,
-        section: str = "thermal",
-        n_draws: int | None = 200,
-        seed: int = 0,
-        dt: float | None = None,
-        x0=None,
-        init_window: int | None = None,
-    ) -> np.ndarray:
-        """Simulate posterior draws on new inputs (e.g. future weather).
-
-        Parameters
-        ----------
-        inputs : DataFrame or (N, m) array
-            Model inputs (``model.input_names``), e.g. a morphed weather file prepared
-            like the calibration data.
-        section : {"thermal", "hygric"}
-        n_draws : int or None
-            Number of posterior draws (random, seeded); None for all.
-        dt : float, optional
-            Time step [s]; default the calibration's.
-        init_window : int, optional
-            Steps of inputs averaged for the steady-state initial state (default the
-            calibration's ``periods.init_window``); or give ``x0``.
-
-        Returns
-        -------
-        (K, N, n_out) array of noise-free outputs ([°C] or [Pa]).
-        """
-        from heritage_bayes.rc.discretize import modal_form
-        from heritage_bayes.rc.simulate import modal_simulate
-
-        model = self._model(section)
-        U = check_inputs(model, inputs)
-        dt = float(dt or self.summary.get("dt", 3600.0))
-        draws = self.draws(section, n_draws, seed)
-        P, _ = model.param_array(draws)
-        mf = modal_form(model, P, dt)
-        if x0 is not None:
-            z0 = mf.to_modal(np.asarray(x0, dtype=float))
-        else:
-            w = init_window or int(self.summary.get("init_steps", 720))
-            z0 = mf.steady_state_modal(U[: max(1, w)].mean(axis=0))
-        return modal_simulate(mf, U, np.ascontiguousarray(np.broadcast_to(z0, mf.lam.shape)))
-
-    def simulate_rh(
-        self, thermal_inputs, hygric_inputs, n_draws: int | None = 200, seed: int = 0, **kw
-    ) -> np.ndarray:
-        """Indoor RH [%] from paired thermal and hygric draws: RH = Pi / Psat(Ti)."""
-        Ti = self.simulate(thermal_inputs, "thermal", n_draws, seed, **kw)[..., 0]
-        Pi = self.simulate(hygric_inputs, "hygric", n_draws, seed, **kw)[..., 0]
-        return 100.0 * Pi / saturation_vapour_pressure(Ti)
-
-
-def load_run(path: str | Path) -> Run:
-    """Load a run directory written by ``hbayes calibrate``.
-
-    Raises
-    ------
-    InputError
-        The folder or one of ``posterior.nc``, ``summary.json``, ``config.yaml`` is
-        missing.
-    """
-    import json
-
-    from heritage_bayes._arviz import az
-
-    p = Path(path)
-    for name in ("posterior.nc", "summary.json", "config.yaml"):
-        if not (p / name).is_file():
-            raise InputError(
-                f"{p}: not a complete run directory ({name} is missing); "
-                "run `hbayes calibrate` first"
-            )
-    raw = yaml.safe_load((p / "config.yaml").read_text(encoding="utf-8"))
-    cfg = parse_config(raw, source=str(p / "config.yaml"))
-    summary = json.loads((p / "summary.json").read_text(encoding="utf-8"))
-    idata = az.from_netcdf(str(p / "posterior.nc"), engine="h5netcdf")
-    models = {s: build_model(cfg, s) for s in SECTIONS if getattr(cfg, s) is not None}
-    return Run(path=p, config=cfg, idata=idata, summary=summary, models=models)

@@ -214,8 +214,8 @@ def greensboro_tmy3_path() -> Path:
 @lru_cache(maxsize=2)
 def _inputs(weather_name: str):
     """Weather and model inputs of the demo (cached; callers get copies)."""
+    from heritage_bayes.inputs import annual_mean_temperature, weather_inputs
     from heritage_bayes.io import align, read_tmy3
-    from heritage_bayes.prepare import annual_mean_temperature, weather_inputs
 
     path = greensboro_tmy3_path()
     weather = read_tmy3(path)

@@ -45,14 +45,20 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from heritage_bayes.config import parse_duration
 from heritage_bayes.errors import ConfigError, DataError, InputError
+from heritage_bayes.inputs import (
+    _with_vapour_pressure,
+    annual_mean_temperature,
+    solar_inputs,
+    weather_inputs,
+)
 from heritage_bayes.io._common import to_jsonable
+from heritage_bayes.sources import _ground_column, read_source
 
 __all__ = [
     "INPUT_COLUMNS",
@@ -70,13 +76,6 @@ INPUT_COLUMNS = ("Te", "RHe", "Pe", "ghi", "dni", "dhi", "Tdew", "Ph")
 OUTPUT_COLUMNS = ("Ti", "RHi", "Pi")
 
 _SECTIONS = ("thermal", "hygric")
-_IRRADIANCE = ("ghi", "dni", "dhi")
-_YEAR = pd.Timedelta(days=365)
-#: A 365-day window of daily means counts as complete with this many valid days.
-_MIN_DAYS = 350
-#: Transposition model and ground albedo used for the surfaces.
-_TRANSPOSITION = "perez"
-_ALBEDO = 0.2
 
 
 # ---------------------------------------------------------------------------------------
@@ -227,189 +226,9 @@ def _output_hint(missing: Sequence[str]) -> str:
 
 
 # ---------------------------------------------------------------------------------------
-# Building blocks (also used by heritage_bayes.demo)
-# ---------------------------------------------------------------------------------------
-
-
-def annual_mean_temperature(te: pd.Series, times: pd.DatetimeIndex) -> tuple[np.ndarray, dict]:
-    """Fixed (ground) temperature ``Tf`` from outdoor temperature: the mean of a year.
-
-    Parameters
-    ----------
-    te : pandas.Series
-        Outdoor air temperature [°C] with a tz-aware index: the **whole** weather record
-        (NaN allowed), not only the period to simulate.
-    times : pandas.DatetimeIndex
-        Tz-aware instants at which ``Tf`` is wanted (e.g. the middle of each grid row).
-
-    Returns
-    -------
-    values : numpy.ndarray
-        ``Tf`` [°C] at ``times``.
-    info : dict
-        ``method`` (plain words), ``min``, ``max`` [°C], ``record_days``.
-
-    Notes
-    -----
-    * Record shorter than 365 days (typical-year files such as TMY3/EPW: 8760 hourly
-      values span 364 d 23 h): the mean of all values, a constant.
-    * Otherwise: daily means (UTC days with at least half of the typical number of
-      readings), their 365-day centred running mean where the window holds at least 350
-      valid days, linearly interpolated to ``times`` and held constant before the first
-      and after the last complete window. The result follows slow year-to-year changes
-      but not the seasons.
-    * No complete window (a long record full of gaps): the mean of all values, and
-      ``info["method"]`` says so.
-
-    The ground under a building and thick masonry follow the annual mean outdoor
-    temperature with a seasonal swing that decays with depth; the constant (or slowly
-    varying) annual mean is the usual choice for the fixed node of RC models.
-    """
-    s = pd.Series(np.asarray(te, dtype=float), index=te.index).dropna()
-    if s.empty:
-        raise DataError("outdoor temperature Te has no values: cannot form an annual mean")
-    span = s.index[-1] - s.index[0]
-    days = span / pd.Timedelta(days=1)
-    info = {"record_days": round(float(days), 2)}
-    if span >= _YEAR:
-        daily = s.resample("1D").agg(["mean", "count"])
-        typical = float(daily["count"].median())
-        means = daily["mean"].where(daily["count"] >= 0.5 * typical)
-        roll = means.rolling(365, center=True, min_periods=_MIN_DAYS).mean().dropna()
-        if not roll.empty:
-            centres = (roll.index + pd.Timedelta(hours=12)).asi8.astype(float)
-            t = np.clip(times.asi8.astype(float), centres[0], centres[-1])
-            values = np.interp(t, centres, roll.to_numpy())
-            info["method"] = (
-                "365-day centred running mean of the daily mean Te over the whole weather "
-                "record, held constant beyond the first/last complete window"
-            )
-            info.update(min=float(values.min()), max=float(values.max()))
-            return values, info
-        method = (
-            f"mean of Te over the whole weather record ({days:.0f} days): no 365-day "
-            f"window holds {_MIN_DAYS} valid days"
-        )
-    else:
-        method = f"mean of Te over the whole weather record ({days:.2f} days, less than a year)"
-    value = float(s.mean())
-    info.update(method=method, min=value, max=value)
-    return np.full(len(times), value), info
-
-
-def solar_inputs(
-    weather: pd.DataFrame,
-    site: Mapping,
-    surfaces: Mapping[str, Sequence[float]],
-    mode: str,
-    *,
-    where: str = "data.weather",
-) -> tuple[pd.DataFrame, str, str]:
-    """Irradiance on each solar surface as model inputs ``I_<surface>`` [W/m²].
-
-    Parameters
-    ----------
-    weather : pandas.DataFrame
-        A reader's output (``ghi`` and optionally ``dni``, ``dhi``, with ``attrs``).
-    site : mapping
-        ``latitude``, ``longitude`` [°], ``altitude`` [m].
-    surfaces : mapping
-        ``{name: (tilt, azimuth)}`` [°].
-    mode : {"measured", "clear_sky"}
-        Measured irradiance, or the explicit clear-sky proxy (measured columns, if any,
-        are then dropped and the proxy is labelled).
-
-    Returns
-    -------
-    table : pandas.DataFrame
-        ``I_<name>`` columns, interval averages stamped at the interval end (``attrs``).
-    label : str
-        Short label: ``"measured"`` or ``"clear-sky proxy (pvlib Ineichen)"``.
-    detail : str
-        The full provenance label of :func:`heritage_bayes.climate.surface_irradiance`.
-    """
-    from heritage_bayes.climate.solar import surface_irradiance
-
-    present = [c for c in _IRRADIANCE if c in weather.columns]
-    attrs = dict(weather.attrs)
-    if mode == "measured":
-        if "ghi" not in present:
-            raise DataError(
-                f"{where}: data.irradiance is 'measured' but the weather has no global "
-                f"horizontal irradiance 'ghi' (columns: {list(weather.columns)}); map it in "
-                f"{where}.columns.ghi, or set data.irradiance to 'clear_sky' (a labelled "
-                f"clear-sky proxy) or 'none'"
-            )
-        table = weather[present].copy()
-        table.attrs = attrs
-        kwargs = {}
-        label = "measured"
-    elif mode == "clear_sky":
-        table = weather.drop(columns=present)
-        table.attrs = attrs
-        kwargs = {"clear_sky": True}
-        label = "clear-sky proxy (pvlib Ineichen)"
-    else:
-        raise ValueError(f"mode must be 'measured' or 'clear_sky' (got {mode!r})")
-    try:
-        irr = surface_irradiance(
-            table,
-            dict(site),
-            {k: tuple(v) for k, v in surfaces.items()},
-            model=_TRANSPOSITION,
-            albedo=_ALBEDO,
-            **kwargs,
-        )
-    except DataError as exc:
-        raise DataError(f"{where}: {exc}") from None
-    except InputError as exc:
-        raise ConfigError(f"{where}: {exc}") from None
-    detail = irr.attrs.get("irradiance_source", label)
-    if mode == "clear_sky" and present:
-        detail += f"; measured {present} ignored (data.irradiance: clear_sky)"
-    out = irr.rename(columns={k: f"I_{k}" for k in surfaces})
-    out.attrs = dict(irr.attrs)
-    out.attrs["averaged"] = tuple(f"I_{k}" for k in irr.attrs.get("averaged", ()))
-    out.attrs["units"] = {f"I_{k}": "W/m²" for k in surfaces}
-    out.attrs["irradiance_source"] = detail
-    out.attrs["source"] = f"{attrs.get('source', 'weather')} (irradiance on surfaces)"
-    return out, label, detail
-
-
-def _with_vapour_pressure(df: pd.DataFrame, target: str, where: str) -> pd.DataFrame:
-    """Add ``Pe`` (from Te, RHe) or ``Pi`` (from Ti, RHi) unless already present."""
-    from heritage_bayes.io import add_vapour_pressure
-
-    t, rh = {"Pe": ("Te", "RHe"), "Pi": ("Ti", "RHi")}[target]
-    if target in df.columns or not (t in df.columns and rh in df.columns):
-        return df
-    sub = df[[t, rh]].copy()
-    sub.attrs = dict(df.attrs)
-    try:
-        out = add_vapour_pressure(sub, over="water")
-    except DataError as exc:
-        raise DataError(f"{where}: {exc}") from None
-    res = df.copy()
-    res[target] = out[target]
-    res.attrs = dict(df.attrs)
-    res.attrs["units"] = {**df.attrs.get("units", {}), target: "Pa"}
-    res.attrs["derived"] = {**df.attrs.get("derived", {}), **out.attrs.get("derived", {})}
-    return res
-
-
-def _table(df: pd.DataFrame, columns: Sequence[str]) -> pd.DataFrame:
-    """Columns of a reader's table, keeping (and trimming) its attrs."""
-    out = df[list(columns)].copy()
-    attrs = dict(df.attrs)
-    attrs["averaged"] = tuple(c for c in df.attrs.get("averaged", ()) if c in columns)
-    attrs["units"] = {c: u for c, u in df.attrs.get("units", {}).items() if c in columns}
-    out.attrs = attrs
-    return out
-
-
 def _extra_inputs(cfg) -> list[str]:
     """Model inputs beyond those built here (Te, Pe, Tf, I_<surface>), in model order."""
-    from heritage_bayes.calibrate import build_model  # the models decide their inputs
+    from heritage_bayes.models import build_model  # the models decide their inputs
 
     built = {"Te", "Pe", "Tf"} | {f"I_{s}" for s in cfg.data.surfaces}
     extra: list[str] = []
@@ -422,218 +241,6 @@ def _extra_inputs(cfg) -> list[str]:
     return extra
 
 
-def weather_inputs(
-    weather: pd.DataFrame,
-    *,
-    thermal: bool,
-    hygric: bool,
-    irradiance: str,
-    site: Mapping | None,
-    surfaces: Mapping[str, Sequence[float]],
-    where: str = "data.weather",
-    extra: Sequence[str] = (),
-) -> tuple[list[pd.DataFrame], dict]:
-    """The input tables to align: ``Te`` (thermal), ``Pe`` (hygric), ``I_<surface>``.
-
-    ``extra``: further input columns the models need and the weather table carries
-    as they are (e.g. a measured heating power ``Ph`` [W] for a heated test cell, or the
-    inputs of a custom network); a missing one is reported when the model asks for it.
-
-    Returns the tables and a dict ``{"irradiance_source": short, "irradiance": {...}}``.
-    """
-    need = [c for c in extra if c in weather.columns]
-    if thermal:
-        need.append("Te")
-    if hygric:
-        weather = _with_vapour_pressure(weather, "Pe", where)
-        need.append("Pe")
-    missing = [c for c in need if c not in weather.columns]
-    if missing:
-        why = {
-            "Te": "outdoor temperature Te (thermal section)",
-            "Pe": "outdoor vapour pressure Pe, or Te and RHe to derive it (hygric section)",
-        }
-        raise DataError(
-            f"{where}: no {' and no '.join(why[c] for c in missing)}; the weather has "
-            f"{list(weather.columns)}"
-            + (f"; map them in {where}.columns" if weather.attrs.get("format") == "csv" else "")
-        )
-    tables = [_table(weather, need)] if need else []
-    note: dict = {"irradiance_source": "none", "irradiance": {"mode": "none"}}
-    if thermal and irradiance != "none":
-        if site is None:
-            raise ConfigError(
-                "site: required (latitude, longitude) to compute solar irradiance on the "
-                "surfaces; or set data.irradiance: none"
-            )
-        irr, label, detail = solar_inputs(weather, site, surfaces, irradiance, where=where)
-        tables.append(irr)
-        note = {
-            "irradiance_source": label,
-            "irradiance": {
-                "mode": irradiance,
-                "label": detail,
-                "surfaces": {k: {"tilt": v[0], "azimuth": v[1]} for k, v in surfaces.items()},
-                "transposition": f"{_TRANSPOSITION}, albedo {_ALBEDO:g}",
-                "site": dict(site),
-            },
-        }
-    return tables, note
-
-
-# ---------------------------------------------------------------------------------------
-# Reading configured sources
-# ---------------------------------------------------------------------------------------
-
-
-def _quote(names) -> str:
-    return ", ".join(repr(n) for n in names)
-
-
-def _csv_header(path: Path, src, where: str) -> list[str]:
-    try:
-        header = pd.read_csv(path, nrows=0, sep=src.sep, encoding="utf-8")
-    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
-        raise DataError(f"{where}: {path.name}: cannot read the header line: {exc}") from None
-    return [str(c).strip() for c in header.columns]
-
-
-def _check_csv_columns(path: Path, src, where: str, allowed: Sequence[str]) -> None:
-    """Check the config's column names against the file header (precise key paths)."""
-    from heritage_bayes.io import STANDARD_COLUMNS
-
-    header = _csv_header(path, src, where)
-    tcols = [src.time_column] if isinstance(src.time_column, str) else list(src.time_column)
-    for c in tcols:
-        if c.strip() not in header:
-            raise DataError(
-                f"{where}.time_column: column {c!r} not found in {path.name}; columns are: "
-                f"{_quote(header)}"
-            )
-    for std, col in (src.columns or {}).items():
-        if std not in STANDARD_COLUMNS:
-            raise ConfigError(
-                f"{where}.columns.{std}: not a standard column name; use one of {_quote(allowed)}"
-            )
-        if std not in allowed:
-            role = "weather (model inputs)" if "Te" in allowed else "measurements (outputs)"
-            raise ConfigError(
-                f"{where}.columns.{std}: not a column of the {role}; allowed here: "
-                f"{_quote(allowed)}"
-            )
-        if str(col).strip() not in header:
-            raise DataError(
-                f"{where}.columns.{std}: column {col!r} not found in {path.name}; columns "
-                f"are: {_quote(header)}"
-            )
-
-
-def _csv_kwargs(src) -> dict:
-    kw = {
-        "time_column": src.time_column,
-        "time_format": src.time_format,
-        "timezone": src.timezone,
-        "sep": src.sep,
-        "decimal": src.decimal,
-        "averaged": src.averaged,
-        "interval": src.interval,
-        "label": src.label,
-        "duplicates": src.duplicates,
-        "invalid": src.invalid,
-    }
-    if src.na_values is not None:
-        kw["na_values"] = src.na_values
-    return kw
-
-
-def _resolve_paths(cfg, src, where: str) -> Path | list[Path]:
-    paths = [
-        cfg.path(p).resolve() for p in (src.path if isinstance(src.path, list) else [src.path])
-    ]
-    for p in paths:
-        if not p.is_file():
-            what = "is a directory, expected a data file" if p.is_dir() else "file not found"
-            raise DataError(f"{where}.path: {p}: {what}")
-    return paths if isinstance(src.path, list) else paths[0]
-
-
-def read_source(cfg, src, where: str, allowed: Sequence[str]) -> pd.DataFrame:
-    """Read one configured :class:`~heritage_bayes.config.Source`; errors name ``where``."""
-    from heritage_bayes.io import read_csv, read_epw, read_knmi_hourly, read_tmy3
-
-    path = _resolve_paths(cfg, src, where)
-    try:
-        if src.format == "csv":
-            _check_csv_columns(path, src, where, allowed)
-            df = read_csv(path, columns=src.columns, **_csv_kwargs(src))
-        elif src.format == "epw":
-            df = read_epw(path, year=src.year, invalid=src.invalid)
-        elif src.format == "tmy3":
-            df = read_tmy3(path, year=src.year, invalid=src.invalid)
-        else:
-            df = read_knmi_hourly(path, invalid=src.invalid)
-    except ConfigError:
-        raise
-    except DataError as exc:
-        raise DataError(f"{where}: {exc}") from None
-    except InputError as exc:
-        raise ConfigError(f"{where}: {exc}") from None
-    # columns of the other role picked up by name (no 'columns' mapping) are not used
-    extra = [c for c in df.columns if c not in allowed]
-    out = df.drop(columns=extra)
-    out.attrs = dict(df.attrs)
-    if not len(out.columns):
-        raise DataError(
-            f"{where}: {Path(str(df.attrs.get('source', ''))).name} has none of the columns "
-            f"{_quote(allowed)} (found {_quote(df.columns)})"
-        )
-    return out
-
-
-def _ground_column(cfg, gt, where: str) -> tuple[pd.DataFrame, dict]:
-    """Read the measured ``Tf`` series of ground_temperature mode 'column'."""
-    from heritage_bayes.io import read_csv
-
-    candidates = []
-    if gt.source is not None:
-        candidates.append((gt.source, f"{where}.source"))
-    else:
-        if cfg.data.weather is not None and cfg.data.weather.format == "csv":
-            candidates.append((cfg.data.weather, "data.weather"))
-        for i, m in enumerate(cfg.data.measurements or []):
-            if m.format == "csv":
-                key = "data.measurements" + (f"[{i}]" if len(cfg.data.measurements) > 1 else "")
-                candidates.append((m, key))
-    if not candidates:
-        raise ConfigError(
-            f"{where}.column: mode 'column' needs a CSV table holding {gt.column!r}: give "
-            f"{where}.source, or use CSV weather or measurement files"
-        )
-    seen = []
-    for src, key in candidates:
-        path = _resolve_paths(cfg, src, key)
-        header = _csv_header(path, src, key)
-        if gt.column.strip() not in header:
-            seen.append(f"{path.name}: {_quote(header)}")
-            continue
-        kw = _csv_kwargs(src)
-        kw["averaged"] = None
-        try:
-            df = read_csv(path, columns={"Te": gt.column}, **kw)
-        except DataError as exc:
-            raise DataError(f"{where} (column {gt.column!r} of {key}): {exc}") from None
-        except InputError as exc:
-            raise ConfigError(f"{where} (column {gt.column!r} of {key}): {exc}") from None
-        df = df.rename(columns={"Te": "Tf"})
-        df.attrs["units"] = {"Tf": "°C"}
-        df.attrs["averaged"] = ()
-        return df, {"mode": "column", "column": gt.column, "file": str(path), "key": key}
-    raise DataError(
-        f"{where}.column: column {gt.column!r} not found; columns are: " + "; ".join(seen)
-    )
-
-
-# ---------------------------------------------------------------------------------------
 # Periods
 # ---------------------------------------------------------------------------------------
 

@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 from collections.abc import Mapping
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from heritage_bayes.rc.network import Network, ParameterInfo, as_index_arrays
+if TYPE_CHECKING:  # the network is a description; this module compiles it
+    from heritage_bayes.rc.network import Network, ParameterInfo
 
 __all__ = ["RCModel"]
 
@@ -233,3 +235,27 @@ class RCModel:
         cap, _, _, q = self.network_matrices(P)
         e = q / cap
         return e if batch else e[0]
+
+
+def as_index_arrays(net: Network):
+    """Index arrays that let :class:`RCModel` assemble matrices for many parameter sets.
+
+    Returns a dict of small integer arrays (internal).
+    """
+    pnames = net.parameter_names
+    pidx = {p: i for i, p in enumerate(pnames)}
+    nidx = {n.name: i for i, n in enumerate(net.nodes)}
+    uidx = {u: i for i, u in enumerate(net.inputs)}
+    cap = np.array([pidx[n.C] for n in net.nodes])
+    nn = [(nidx[lk.a], nidx[lk.b], pidx[lk.G]) for lk in net.links if lk.b in nidx]
+    nu = [(nidx[lk.a], uidx[lk.b], pidx[lk.G]) for lk in net.links if lk.b in uidx]
+    nc = [(nidx[lk.a], pidx[lk.b], pidx[lk.G]) for lk in net.links if lk.b in net.constants]
+    src = []
+    for s in net.sources:
+        gain_idx = pidx[s.gain] if isinstance(s.gain, str) else -1
+        gain_val = 1.0 if isinstance(s.gain, str) else float(s.gain)
+        fp = s.fraction_param
+        f_idx, comp = (pidx[fp[0]], fp[1]) if fp else (-1, False)
+        src.append((nidx[s.node], uidx[s.input], gain_idx, gain_val, f_idx, comp))
+    out = np.array([nidx[o] for o in net.outputs])
+    return {"cap": cap, "nn": nn, "nu": nu, "nc": nc, "src": src, "out": out}

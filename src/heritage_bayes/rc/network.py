@@ -29,8 +29,6 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
-import numpy as np
-
 __all__ = ["DOMAINS", "Link", "Network", "Node", "ParameterInfo", "Source"]
 
 #: Units per domain: potential, capacity, conductance, source flow.
@@ -373,27 +371,3 @@ def _no_duplicates(items: Sequence[str], what: str) -> None:
         seen.add(it)
     if dup:
         raise ValueError(f"{what} must be unique; repeated: {dup}")
-
-
-def as_index_arrays(net: Network):
-    """Index arrays that let :class:`RCModel` assemble matrices for many parameter sets.
-
-    Returns a dict of small integer arrays (internal).
-    """
-    pnames = net.parameter_names
-    pidx = {p: i for i, p in enumerate(pnames)}
-    nidx = {n.name: i for i, n in enumerate(net.nodes)}
-    uidx = {u: i for i, u in enumerate(net.inputs)}
-    cap = np.array([pidx[n.C] for n in net.nodes])
-    nn = [(nidx[lk.a], nidx[lk.b], pidx[lk.G]) for lk in net.links if lk.b in nidx]
-    nu = [(nidx[lk.a], uidx[lk.b], pidx[lk.G]) for lk in net.links if lk.b in uidx]
-    nc = [(nidx[lk.a], pidx[lk.b], pidx[lk.G]) for lk in net.links if lk.b in net.constants]
-    src = []
-    for s in net.sources:
-        gain_idx = pidx[s.gain] if isinstance(s.gain, str) else -1
-        gain_val = 1.0 if isinstance(s.gain, str) else float(s.gain)
-        fp = s.fraction_param
-        f_idx, comp = (pidx[fp[0]], fp[1]) if fp else (-1, False)
-        src.append((nidx[s.node], uidx[s.input], gain_idx, gain_val, f_idx, comp))
-    out = np.array([nidx[o] for o in net.outputs])
-    return {"cap": cap, "nn": nn, "nu": nu, "nc": nc, "src": src, "out": out}

@@ -157,7 +157,7 @@ def _is_log(prior: str | None) -> bool:
 @dataclass
 class _RunData:
     path: Path
-    run: object  # heritage_bayes.calibrate.Run
+    run: object  # heritage_bayes.run.Run
     summary: dict
     config_text: str
 
@@ -188,7 +188,7 @@ def _load(run_dir) -> _RunData:
             f"{p / 'summary.json'}: not valid JSON ({exc}); the run "
             "directory is damaged, run `hbayes calibrate` again"
         ) from None
-    from heritage_bayes.calibrate import load_run
+    from heritage_bayes.run import load_run
 
     try:
         run = load_run(p)

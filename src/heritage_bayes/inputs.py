@@ -1,0 +1,263 @@
+"""Model inputs from weather: facade irradiance, vapour pressure, ground temperature.
+
+Building blocks shared by data preparation (:func:`heritage_bayes.prepare.prepare`) and
+the built-in demo (:mod:`heritage_bayes.demo`), so that the demo's inputs are built
+exactly as those of real data. Pure functions on tables; no config, no files.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+import pandas as pd
+
+from heritage_bayes.errors import ConfigError, DataError, InputError
+
+__all__ = ["annual_mean_temperature", "solar_inputs", "weather_inputs"]
+
+_IRRADIANCE = ("ghi", "dni", "dhi")
+_YEAR = pd.Timedelta(days=365)
+#: A 365-day window of daily means counts as complete with this many valid days.
+_MIN_DAYS = 350
+#: Transposition model and ground albedo used for the surfaces.
+_TRANSPOSITION = "perez"
+_ALBEDO = 0.2
+
+
+def annual_mean_temperature(te: pd.Series, times: pd.DatetimeIndex) -> tuple[np.ndarray, dict]:
+    """Fixed (ground) temperature ``Tf`` from outdoor temperature: the mean of a year.
+
+    Parameters
+    ----------
+    te : pandas.Series
+        Outdoor air temperature [°C] with a tz-aware index: the **whole** weather record
+        (NaN allowed), not only the period to simulate.
+    times : pandas.DatetimeIndex
+        Tz-aware instants at which ``Tf`` is wanted (e.g. the middle of each grid row).
+
+    Returns
+    -------
+    values : numpy.ndarray
+        ``Tf`` [°C] at ``times``.
+    info : dict
+        ``method`` (plain words), ``min``, ``max`` [°C], ``record_days``.
+
+    Notes
+    -----
+    * Record shorter than 365 days (typical-year files such as TMY3/EPW: 8760 hourly
+      values span 364 d 23 h): the mean of all values, a constant.
+    * Otherwise: daily means (UTC days with at least half of the typical number of
+      readings), their 365-day centred running mean where the window holds at least 350
+      valid days, linearly interpolated to ``times`` and held constant before the first
+      and after the last complete window. The result follows slow year-to-year changes
+      but not the seasons.
+    * No complete window (a long record full of gaps): the mean of all values, and
+      ``info["method"]`` says so.
+
+    The ground under a building and thick masonry follow the annual mean outdoor
+    temperature with a seasonal swing that decays with depth; the constant (or slowly
+    varying) annual mean is the usual choice for the fixed node of RC models.
+    """
+    s = pd.Series(np.asarray(te, dtype=float), index=te.index).dropna()
+    if s.empty:
+        raise DataError("outdoor temperature Te has no values: cannot form an annual mean")
+    span = s.index[-1] - s.index[0]
+    days = span / pd.Timedelta(days=1)
+    info = {"record_days": round(float(days), 2)}
+    if span >= _YEAR:
+        daily = s.resample("1D").agg(["mean", "count"])
+        typical = float(daily["count"].median())
+        means = daily["mean"].where(daily["count"] >= 0.5 * typical)
+        roll = means.rolling(365, center=True, min_periods=_MIN_DAYS).mean().dropna()
+        if not roll.empty:
+            centres = (roll.index + pd.Timedelta(hours=12)).asi8.astype(float)
+            t = np.clip(times.asi8.astype(float), centres[0], centres[-1])
+            values = np.interp(t, centres, roll.to_numpy())
+            info["method"] = (
+                "365-day centred running mean of the daily mean Te over the whole weather "
+                "record, held constant beyond the first/last complete window"
+            )
+            info.update(min=float(values.min()), max=float(values.max()))
+            return values, info
+        method = (
+            f"mean of Te over the whole weather record ({days:.0f} days): no 365-day "
+            f"window holds {_MIN_DAYS} valid days"
+        )
+    else:
+        method = f"mean of Te over the whole weather record ({days:.2f} days, less than a year)"
+    value = float(s.mean())
+    info.update(method=method, min=value, max=value)
+    return np.full(len(times), value), info
+
+
+def solar_inputs(
+    weather: pd.DataFrame,
+    site: Mapping,
+    surfaces: Mapping[str, Sequence[float]],
+    mode: str,
+    *,
+    where: str = "data.weather",
+) -> tuple[pd.DataFrame, str, str]:
+    """Irradiance on each solar surface as model inputs ``I_<surface>`` [W/m²].
+
+    Parameters
+    ----------
+    weather : pandas.DataFrame
+        A reader's output (``ghi`` and optionally ``dni``, ``dhi``, with ``attrs``).
+    site : mapping
+        ``latitude``, ``longitude`` [°], ``altitude`` [m].
+    surfaces : mapping
+        ``{name: (tilt, azimuth)}`` [°].
+    mode : {"measured", "clear_sky"}
+        Measured irradiance, or the explicit clear-sky proxy (measured columns, if any,
+        are then dropped and the proxy is labelled).
+
+    Returns
+    -------
+    table : pandas.DataFrame
+        ``I_<name>`` columns, interval averages stamped at the interval end (``attrs``).
+    label : str
+        Short label: ``"measured"`` or ``"clear-sky proxy (pvlib Ineichen)"``.
+    detail : str
+        The full provenance label of :func:`heritage_bayes.climate.surface_irradiance`.
+    """
+    from heritage_bayes.climate.solar import surface_irradiance
+
+    present = [c for c in _IRRADIANCE if c in weather.columns]
+    attrs = dict(weather.attrs)
+    if mode == "measured":
+        if "ghi" not in present:
+            raise DataError(
+                f"{where}: data.irradiance is 'measured' but the weather has no global "
+                f"horizontal irradiance 'ghi' (columns: {list(weather.columns)}); map it in "
+                f"{where}.columns.ghi, or set data.irradiance to 'clear_sky' (a labelled "
+                f"clear-sky proxy) or 'none'"
+            )
+        table = weather[present].copy()
+        table.attrs = attrs
+        kwargs = {}
+        label = "measured"
+    elif mode == "clear_sky":
+        table = weather.drop(columns=present)
+        table.attrs = attrs
+        kwargs = {"clear_sky": True}
+        label = "clear-sky proxy (pvlib Ineichen)"
+    else:
+        raise ValueError(f"mode must be 'measured' or 'clear_sky' (got {mode!r})")
+    try:
+        irr = surface_irradiance(
+            table,
+            dict(site),
+            {k: tuple(v) for k, v in surfaces.items()},
+            model=_TRANSPOSITION,
+            albedo=_ALBEDO,
+            **kwargs,
+        )
+    except DataError as exc:
+        raise DataError(f"{where}: {exc}") from None
+    except InputError as exc:
+        raise ConfigError(f"{where}: {exc}") from None
+    detail = irr.attrs.get("irradiance_source", label)
+    if mode == "clear_sky" and present:
+        detail += f"; measured {present} ignored (data.irradiance: clear_sky)"
+    out = irr.rename(columns={k: f"I_{k}" for k in surfaces})
+    out.attrs = dict(irr.attrs)
+    out.attrs["averaged"] = tuple(f"I_{k}" for k in irr.attrs.get("averaged", ()))
+    out.attrs["units"] = {f"I_{k}": "W/m²" for k in surfaces}
+    out.attrs["irradiance_source"] = detail
+    out.attrs["source"] = f"{attrs.get('source', 'weather')} (irradiance on surfaces)"
+    return out, label, detail
+
+
+def _with_vapour_pressure(df: pd.DataFrame, target: str, where: str) -> pd.DataFrame:
+    """Add ``Pe`` (from Te, RHe) or ``Pi`` (from Ti, RHi) unless already present."""
+    from heritage_bayes.io import add_vapour_pressure
+
+    t, rh = {"Pe": ("Te", "RHe"), "Pi": ("Ti", "RHi")}[target]
+    if target in df.columns or not (t in df.columns and rh in df.columns):
+        return df
+    sub = df[[t, rh]].copy()
+    sub.attrs = dict(df.attrs)
+    try:
+        out = add_vapour_pressure(sub, over="water")
+    except DataError as exc:
+        raise DataError(f"{where}: {exc}") from None
+    res = df.copy()
+    res[target] = out[target]
+    res.attrs = dict(df.attrs)
+    res.attrs["units"] = {**df.attrs.get("units", {}), target: "Pa"}
+    res.attrs["derived"] = {**df.attrs.get("derived", {}), **out.attrs.get("derived", {})}
+    return res
+
+
+def _table(df: pd.DataFrame, columns: Sequence[str]) -> pd.DataFrame:
+    """Columns of a reader's table, keeping (and trimming) its attrs."""
+    out = df[list(columns)].copy()
+    attrs = dict(df.attrs)
+    attrs["averaged"] = tuple(c for c in df.attrs.get("averaged", ()) if c in columns)
+    attrs["units"] = {c: u for c, u in df.attrs.get("units", {}).items() if c in columns}
+    out.attrs = attrs
+    return out
+
+
+def weather_inputs(
+    weather: pd.DataFrame,
+    *,
+    thermal: bool,
+    hygric: bool,
+    irradiance: str,
+    site: Mapping | None,
+    surfaces: Mapping[str, Sequence[float]],
+    where: str = "data.weather",
+    extra: Sequence[str] = (),
+) -> tuple[list[pd.DataFrame], dict]:
+    """The input tables to align: ``Te`` (thermal), ``Pe`` (hygric), ``I_<surface>``.
+
+    ``extra``: further input columns the models need and the weather table carries
+    as they are (e.g. a measured heating power ``Ph`` [W] for a heated test cell, or the
+    inputs of a custom network); a missing one is reported when the model asks for it.
+
+    Returns the tables and a dict ``{"irradiance_source": short, "irradiance": {...}}``.
+    """
+    need = [c for c in extra if c in weather.columns]
+    if thermal:
+        need.append("Te")
+    if hygric:
+        weather = _with_vapour_pressure(weather, "Pe", where)
+        need.append("Pe")
+    missing = [c for c in need if c not in weather.columns]
+    if missing:
+        why = {
+            "Te": "outdoor temperature Te (thermal section)",
+            "Pe": "outdoor vapour pressure Pe, or Te and RHe to derive it (hygric section)",
+        }
+        raise DataError(
+            f"{where}: no {' and no '.join(why[c] for c in missing)}; the weather has "
+            f"{list(weather.columns)}"
+            + (f"; map them in {where}.columns" if weather.attrs.get("format") == "csv" else "")
+        )
+    tables = [_table(weather, need)] if need else []
+    note: dict = {"irradiance_source": "none", "irradiance": {"mode": "none"}}
+    if thermal and irradiance != "none":
+        if site is None:
+            raise ConfigError(
+                "site: required (latitude, longitude) to compute solar irradiance on the "
+                "surfaces; or set data.irradiance: none"
+            )
+        irr, label, detail = solar_inputs(weather, site, surfaces, irradiance, where=where)
+        tables.append(irr)
+        note = {
+            "irradiance_source": label,
+            "irradiance": {
+                "mode": irradiance,
+                "label": detail,
+                "surfaces": {k: {"tilt": v[0], "azimuth": v[1]} for k, v in surfaces.items()},
+                "transposition": f"{_TRANSPOSITION}, albedo {_ALBEDO:g}",
+                "site": dict(site),
+            },
+        }
+    return tables, note
+
+
+# ---------------------------------------------------------------------------------------

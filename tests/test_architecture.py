@@ -1,0 +1,158 @@
+"""The package's shape: data flows one way (no import cycle), rooms of readable size.
+
+The import graph holds every ``import`` of every module in ``src/heritage_bayes``,
+including imports inside functions (a lazy import is still a dependency), and the
+implicit dependency of a module on its parent package's ``__init__``.
+"""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+SRC = Path(__file__).resolve().parents[1] / "src" / "heritage_bayes"
+PKG = "heritage_bayes"
+
+
+def _module_name(path: Path) -> str:
+    rel = path.relative_to(SRC.parent).with_suffix("")
+    parts = list(rel.parts)
+    if parts[-1] == "__init__":
+        parts = parts[:-1]
+    return ".".join(parts)
+
+
+def _modules() -> dict[str, Path]:
+    return {_module_name(p): p for p in SRC.rglob("*.py")}
+
+
+def _resolve(name: str, modules: dict[str, Path]) -> str | None:
+    """The module a dotted import name refers to (``a.b.func`` -> ``a.b``)."""
+    while name and name not in modules:
+        name = name.rpartition(".")[0]
+    return name or None
+
+
+def _runtime_nodes(tree: ast.AST):
+    """All nodes except those under ``if TYPE_CHECKING:`` (not imported at run time)."""
+    todo = [tree]
+    while todo:
+        node = todo.pop()
+        yield node
+        for child in ast.iter_child_nodes(node):
+            if isinstance(child, ast.If) and getattr(child.test, "id", None) == "TYPE_CHECKING":
+                todo.extend(child.orelse)
+                continue
+            todo.append(child)
+
+
+def import_graph(modules: dict[str, Path] | None = None) -> dict[str, set[str]]:
+    """module -> modules of this package it imports (anywhere in the file)."""
+    modules = modules if modules is not None else _modules()
+    graph: dict[str, set[str]] = {}
+    for mod, path in modules.items():
+        deps: set[str] = set()
+        is_pkg = path.name == "__init__.py"
+        for node in _runtime_nodes(ast.parse(path.read_text(encoding="utf-8"))):
+            names: list[str] = []
+            if isinstance(node, ast.Import):
+                names = [a.name for a in node.names]
+            elif isinstance(node, ast.ImportFrom):
+                if node.level:
+                    base = mod.split(".")
+                    base = base if is_pkg else base[:-1]
+                    base = base[: len(base) - (node.level - 1)]
+                    prefix = ".".join(base + ([node.module] if node.module else []))
+                else:
+                    prefix = node.module or ""
+                names = [prefix] + [f"{prefix}.{a.name}" for a in node.names]
+            for n in names:
+                if n == PKG or n.startswith(PKG + "."):
+                    target = _resolve(n, modules)
+                    if target and target != mod:
+                        deps.add(target)
+        graph[mod] = deps
+    return graph
+
+
+def find_cycle(graph: dict[str, set[str]]) -> list[str] | None:
+    """One cycle of the graph as a list of modules (first == last), or None."""
+    state: dict[str, int] = {}
+    stack: list[str] = []
+
+    def visit(n: str) -> list[str] | None:
+        state[n] = 1
+        stack.append(n)
+        for m in sorted(graph.get(n, ())):
+            if state.get(m) == 1:
+                return [*stack[stack.index(m) :], m]
+            if m not in state:
+                found = visit(m)
+                if found:
+                    return found
+        stack.pop()
+        state[n] = 2
+        return None
+
+    for n in sorted(graph):
+        if n not in state:
+            found = visit(n)
+            if found:
+                return found
+    return None
+
+
+def _without_package_inits(graph: dict[str, set[str]]) -> dict[str, set[str]]:
+    """Edges into a package ``__init__`` that only re-exports its submodules are not
+    layering: ``heritage_bayes/__init__`` gathers the public API from every layer. Keep
+    edges between real modules and from packages to their children."""
+    inits = {m for m, p in _modules().items() if p.name == "__init__.py"}
+    return {m: {d for d in deps if d not in inits} for m, deps in graph.items()}
+
+
+def test_the_cycle_finder_finds_cycles():
+    assert find_cycle({"a": {"b"}, "b": {"c"}, "c": {"a"}}) == ["a", "b", "c", "a"]
+    assert find_cycle({"a": {"b"}, "b": {"c"}, "c": set()}) is None
+
+
+def test_import_graph_sees_lazy_and_relative_imports(tmp_path):
+    pkg = tmp_path / PKG
+    (pkg / "sub").mkdir(parents=True)
+    (pkg / "__init__.py").write_text("")
+    (pkg / "sub" / "__init__.py").write_text("from .x import f\n")
+    (pkg / "sub" / "x.py").write_text("def f():\n    from heritage_bayes.y import g\n")
+    (pkg / "y.py").write_text("from heritage_bayes.sub.x import f\n")
+    mods = {_module_name_in(p, tmp_path): p for p in pkg.rglob("*.py")}
+    g = import_graph(mods)
+    assert g["heritage_bayes.sub.x"] == {"heritage_bayes.y"}
+    assert g["heritage_bayes.sub"] == {"heritage_bayes.sub.x"}
+    assert find_cycle(g) == ["heritage_bayes.sub.x", "heritage_bayes.y", "heritage_bayes.sub.x"]
+
+
+def _module_name_in(path: Path, root: Path) -> str:
+    parts = list(path.relative_to(root).with_suffix("").parts)
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def test_no_import_cycle_in_the_package():
+    cycle = find_cycle(_without_package_inits(import_graph()))
+    assert cycle is None, "import cycle: " + " -> ".join(cycle)
+
+
+def test_lower_layers_do_not_import_higher_ones():
+    graph = import_graph()
+    layers = {  # lower number = lower layer
+        "rc": 1, "climate": 1, "io": 1, "errors": 0, "_version": 0, "_arviz": 0,
+        "config": 1, "inputs": 2, "models": 2, "sources": 2, "demo": 2, "inference": 2,
+        "prepare": 3, "run": 3, "report": 4, "calibrate": 5, "portfolio": 6, "cli": 7,
+    }  # fmt: skip
+    bad = []
+    for mod, deps in graph.items():
+        top = mod.split(".")[1] if "." in mod else None
+        if top not in layers:
+            continue
+        for d in deps:
+            dtop = d.split(".")[1] if "." in d else None
+            if dtop in layers and layers[dtop] > layers[top]:
+                bad.append(f"{mod} -> {d}")
+    assert bad == [], bad

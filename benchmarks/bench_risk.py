@@ -17,7 +17,7 @@ import numpy as np
 
 from _common import best_of, report
 from heritage_bayes.climate import risk
-from heritage_bayes.climate._risk_vtt import SENSITIVITY, vtt_loop
+from heritage_bayes.climate.risk._vtt import SENSITIVITY, vtt_loop
 
 DRAWS, HOURS = 1000, 8760
 LOOP_SUBSET = 25  # draws timed with the per-draw loop

@@ -9,7 +9,7 @@ import pandas as pd
 import pytest
 
 from heritage_bayes.climate import risk
-from heritage_bayes.climate._risk_vtt import SENSITIVITY, vtt_loop
+from heritage_bayes.climate.risk._vtt import SENSITIVITY, vtt_loop
 from heritage_bayes.errors import InputError
 
 YEAR = 8760

@@ -1,0 +1,524 @@
+"""Every indicator at once: :func:`assess`, :func:`assess_batch`, :func:`summarize`.
+
+Sits on top of the mechanism modules (:mod:`~heritage_bayes.climate.risk.chemical`,
+:mod:`~heritage_bayes.climate.risk.mechanical`, :mod:`~heritage_bayes.climate.risk.biological`,
+:mod:`~heritage_bayes.climate.risk.standards`): it resolves the indicator groups and the
+per-group options (defaults are the keyword defaults of the target functions, looked up
+by name), computes all selected indicators in one pass per draw, and returns tidy tables
+with units and IPI-style ratings.
+"""
+
+from __future__ import annotations
+
+import inspect
+import math
+from collections.abc import Mapping
+
+import numpy as np
+import pandas as pd
+
+from heritage_bayes.climate.risk._inputs import (
+    HOURS_PER_YEAR,
+    Hourly,
+    centred_mean,
+    check_positive,
+    harmonic_mean,
+    hourly,
+)
+
+# The functions named in _OPTION_TARGETS are imported for _defaults(), which reads their
+# keyword defaults by name from this module's globals ("noqa: F401" below).
+from heritage_bayes.climate.risk.biological import (
+    _hours_above,
+    _lim_c,
+    _vtt_args,
+    _vtt_run,
+    hours_above_isopleth,  # noqa: F401
+    vtt_mould_index,  # noqa: F401
+)
+from heritage_bayes.climate.risk.chemical import (
+    _T0,
+    R_GAS,
+    _check_lm,
+    _pi,
+    twlm,  # noqa: F401
+)
+from heritage_bayes.climate.risk.mechanical import (
+    _emc,
+    _minmax,
+    dimensional_change,  # noqa: F401
+)
+from heritage_bayes.climate.risk.standards import (
+    _ashrae_check,
+    _ashrae_core,
+    _en_check,
+    _en_core,
+    _window_half,
+    ashrae_classes,  # noqa: F401
+    en15757_band,  # noqa: F401
+)
+from heritage_bayes.errors import InputError
+
+#: Indicator groups of :func:`assess`; those marked True need at least a year of data.
+INDICATOR_GROUPS = {
+    "chemical": False,
+    "mechanical": False,
+    "mould": True,
+    "ashrae": True,
+    "en15757": True,
+}
+
+_OPTION_TARGETS = {
+    "lm": "twlm",
+    "emc": "dimensional_change",
+    "vtt": "vtt_mould_index",
+    "isopleth": "hours_above_isopleth",
+    "ashrae": "ashrae_classes",
+    "en15757": "en15757_band",
+}
+_NOT_OPTIONS = {"T", "RH", "nan_policy", "per_year"}
+_DEFAULT_EA = {"paper": 100e3, "varnish": 70e3}
+
+
+def _defaults(fname):
+    sig = inspect.signature(globals()[fname])
+    return {
+        k: p.default
+        for k, p in sig.parameters.items()
+        if k not in _NOT_OPTIONS and p.default is not inspect.Parameter.empty
+    }
+
+
+def _resolve_options(func, given: Mapping[str, Mapping | None]):
+    """Merge user options with the defaults of each target function; reject unknowns."""
+    opts = {}
+    for key, fname in _OPTION_TARGETS.items():
+        d = _defaults(fname)
+        if key == "lm":
+            d["Ea"] = dict(_DEFAULT_EA)
+        user = given.get(key) or {}
+        if not isinstance(user, Mapping):
+            raise InputError(
+                f"{func}: {key} must be a dict of options for {fname}(); got {type(user).__name__}"
+            )
+        unknown = sorted(set(user) - set(d))
+        if unknown:
+            raise InputError(
+                f"{func}: unknown option(s) {unknown} in {key}=...; expected some of "
+                f"{sorted(d)} (the keywords of {fname}())"
+            )
+        d.update(user)
+        opts[key] = d
+    # validate each group's options once, before any work
+    lm = opts["lm"]
+    Ea = lm["Ea"]
+    if not isinstance(Ea, Mapping):
+        Ea = {f"Ea={float(check_positive(func, 'Ea', Ea)) / 1e3:g}kJ/mol": Ea}
+    if not Ea:
+        raise InputError(f"{func}: lm Ea must name at least one material; got {{}}")
+    for Ea_i in Ea.values():
+        _check_lm(func, Ea_i, lm["T_ref"], lm["RH_ref"], lm["n"])
+    lm["Ea"] = {str(k): float(v) for k, v in Ea.items()}
+    opts["emc"]["coefficient"] = check_positive(func, "coefficient", opts["emc"]["coefficient"])
+    v = opts["vtt"]
+    opts["vtt"] = {"args": _vtt_args(func, **v), **v}
+    opts["isopleth"]["c"] = _lim_c(func, opts["isopleth"]["growth_rate"])
+    a = opts["ashrae"]
+    a["threshold"], a["classes"] = _ashrae_check(
+        func, a["method"], a["threshold"], a["classes"], a["edges"], a["T_setpoint"],
+        a["RH_setpoint"],
+    )  # fmt: skip
+    e = opts["en15757"]
+    check_positive(func, "ashrae window_days", a["window_days"])
+    check_positive(func, "en15757 window_days", e["window_days"])
+    e["percentiles"], e["min_band"] = _en_check(
+        func, e["percentiles"], e["min_band"], e["min_band_mode"], e["edges"]
+    )
+    return opts
+
+
+def _resolve_groups(func, indicators):
+    if indicators is None:
+        return tuple(INDICATOR_GROUPS)
+    if isinstance(indicators, str):
+        indicators = (indicators,)
+    groups = tuple(indicators)
+    unknown = [g for g in groups if g not in INDICATOR_GROUPS]
+    if unknown or not groups:
+        raise InputError(
+            f"{func}: indicators must be a non-empty selection of {list(INDICATOR_GROUPS)}; "
+            f"got {list(groups)}"
+        )
+    return groups
+
+
+def _check_year(func, groups, n):
+    yearly = [g for g in groups if INDICATOR_GROUPS[g]]
+    if yearly and n < HOURS_PER_YEAR:
+        short = [g for g in groups if not INDICATOR_GROUPS[g]] or ["chemical", "mechanical"]
+        raise InputError(
+            f"{func}: the indicators {yearly} need at least one year of hourly data "
+            f"({HOURS_PER_YEAR} h); got {n} h. For a shorter series pass "
+            f"indicators={short}"
+        )
+
+
+def _assess_core(h: Hourly, groups, opts, nan_policy) -> dict[str, np.ndarray]:
+    """All indicators of the selected groups, one value per draw."""
+    T, RH = h.T, h.RH
+    out: dict[str, np.ndarray] = {}
+    if "chemical" in groups:
+        lm = opts["lm"]
+        with np.errstate(divide="ignore", over="ignore"):
+            u = 1.0 / (T + _T0) - 1.0 / (lm["T_ref"] + _T0)
+            rh_term = lm["n"] * np.log(lm["RH_ref"] / RH)
+            for label, Ea in lm["Ea"].items():
+                val = np.exp(Ea / R_GAS * u + rh_term)
+                out[f"lifetime_multiplier[{label}]"] = harmonic_mean(val, nan_policy)
+        out["twpi"] = harmonic_mean(_pi(T, RH), nan_policy)
+    if "mechanical" in groups:
+        lo, hi = _minmax(_emc(T, RH), nan_policy)
+        out["emc_min"] = lo
+        out["emc_max"] = hi
+        out["emc_range"] = hi - lo
+        out["dimensional_change"] = 100.0 * opts["emc"]["coefficient"] * (hi - lo)
+        out["metal_corrosion"] = hi
+    if "mould" in groups:
+        _, peak = _vtt_run(h, opts["vtt"]["args"], nan_policy, store=False)
+        out["vtt_mould_index_max"] = peak
+        iso = opts["isopleth"]
+        name = f"hours_above_LIM{float(iso['growth_rate']):g}"
+        out[name] = _hours_above(h, iso["c"], True, nan_policy)
+    sRH = None
+    a, e = opts["ashrae"], opts["en15757"]
+    if "ashrae" in groups and "en15757" in groups:
+        if a["window_days"] == e["window_days"] and a["edges"] == e["edges"]:
+            half = _window_half("assess", a["window_days"], h.n_hours)
+            sRH = centred_mean(RH, half, a["edges"], nan_policy)
+    if "ashrae" in groups:
+        sh, _, _, best, _, _ = _ashrae_core(
+            h,
+            window_days=a["window_days"],
+            T_setpoint=a["T_setpoint"],
+            RH_setpoint=a["RH_setpoint"],
+            method=a["method"],
+            threshold=a["threshold"],
+            classes=a["classes"],
+            nested=bool(a["nested"]),
+            edges=a["edges"],
+            nan_policy=nan_policy,
+            sRH=sRH,
+        )
+        for j, c in enumerate(a["classes"]):
+            out[f"ashrae_{c.name}"] = sh[:, j]
+        out["ashrae_best_class"] = np.array(
+            ["none" if b is None else b for b in best], dtype=object
+        )
+    if "en15757" in groups:
+        *_, lo, hi, _, _, share = _en_core(
+            RH,
+            window_days=e["window_days"],
+            percentiles=e["percentiles"],
+            min_band=e["min_band"],
+            min_band_mode=e["min_band_mode"],
+            edges=e["edges"],
+            nan_policy=nan_policy,
+            seasonal=sRH,
+        )
+        out["en15757_outside"] = share
+        out["en15757_lower_offset"] = lo
+        out["en15757_upper_offset"] = hi
+    return out
+
+
+def _unit(name: str) -> str:
+    if name.startswith("lifetime_multiplier") or name == "vtt_mould_index_max":
+        return "-"
+    if name.startswith("hours_above_LIM"):
+        return "h/year"
+    if name.startswith("ashrae_") or name == "en15757_outside":
+        return "% of hours"
+    return {
+        "twpi": "years",
+        "emc_min": "% MC",
+        "emc_max": "% MC",
+        "emc_range": "% MC",
+        "metal_corrosion": "% MC",
+        "dimensional_change": "%",
+        "en15757_lower_offset": "%RH",
+        "en15757_upper_offset": "%RH",
+    }[name]
+
+
+def _rating(name: str, v) -> str:
+    """IPI-style rating of one indicator value ('' where no published scale applies)."""
+    if v is None or (isinstance(v, float) and math.isnan(v)):
+        return ""
+    if name == "twpi":
+        return "good" if v >= 75.0 else ("OK" if v >= 45.0 else "risk")
+    if name == "emc_min":
+        return "OK" if v >= 5.0 else "risk"
+    if name == "emc_max":
+        return "OK" if v <= 12.5 else "risk"
+    if name == "metal_corrosion":
+        return "good" if v < 7.0 else ("OK" if v < 10.5 else "risk")
+    if name == "vtt_mould_index_max":
+        return "good" if v < 1.0 else "risk"
+    return ""
+
+
+def _prepare_assess(func, T, RH, indicators, nan_policy, options):
+    groups = _resolve_groups(func, indicators)
+    opts = _resolve_options(func, options)
+    h = hourly(func, T=T, RH=RH, nan_policy=nan_policy)
+    _check_year(func, groups, h.n_hours)
+    return h, groups, opts
+
+
+def assess(
+    T,
+    RH,
+    *,
+    indicators=None,
+    nan_policy="propagate",
+    lm=None,
+    emc=None,
+    vtt=None,
+    isopleth=None,
+    ashrae=None,
+    en15757=None,
+):
+    r"""All conservation-risk indicators of one hourly series, as a tidy table.
+
+    Parameters
+    ----------
+    T : array_like or pandas.Series
+        Hourly air temperature, shape (hours,). [°C]
+    RH : array_like or pandas.Series
+        Hourly relative humidity, shape (hours,). [%]
+    indicators : iterable of str, optional
+        Groups to compute, any of ``"chemical"`` (lifetime multipliers, TWPI),
+        ``"mechanical"`` (EMC, dimensional change, corrosion), ``"mould"`` (VTT index,
+        hours above LIM), ``"ashrae"``, ``"en15757"``; default all. ``mould``, ``ashrae``
+        and ``en15757`` need at least a year (8760 h).
+    nan_policy : {"propagate", "omit", "raise"}, default "propagate"
+        Missing hours, for every indicator (see the module documentation).
+    lm : dict, optional
+        Options of :func:`twlm`; ``Ea`` is a dict label → activation energy [J/mol],
+        default ``{"paper": 100e3, "varnish": 70e3}`` (one row each).
+    emc : dict, optional
+        Options of :func:`dimensional_change` (``coefficient``).
+    vtt : dict, optional
+        Options of :func:`vtt_mould_index` (``sensitivity``, ``species``, ``surface``,
+        ``M0``, ``frozen``).
+    isopleth : dict, optional
+        Options of :func:`hours_above_isopleth` (``growth_rate``).
+    ashrae : dict, optional
+        Options of :func:`ashrae_classes`.
+    en15757 : dict, optional
+        Options of :func:`en15757_band`.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per indicator, columns ``indicator``, ``value``, ``unit``, ``rating``:
+
+        * ``lifetime_multiplier[<label>]`` — :func:`twlm` [-];
+        * ``twpi`` — :func:`twpi` [years], rated good (≥ 75) / OK (≥ 45) / risk;
+        * ``emc_min``, ``emc_max`` [% MC] — rated OK/risk against 5 and 12.5 %;
+          ``emc_range`` [% MC]; ``dimensional_change`` [%] (:func:`dimensional_change`);
+        * ``metal_corrosion`` — maximum EMC [% MC], rated good (< 7) / OK (< 10.5) /
+          risk;
+        * ``vtt_mould_index_max`` — maximum of :func:`vtt_mould_index` [-], rated good
+          (< 1) / risk;
+        * ``hours_above_LIM0`` — :func:`hours_above_isopleth` [h/year];
+        * ``ashrae_AA`` … ``ashrae_D`` — share of hours per class [% of hours];
+          ``ashrae_best_class`` — share of the best class, whose name is the rating
+          ("none" if no class reaches the threshold);
+        * ``en15757_outside`` [% of hours], ``en15757_lower_offset``,
+          ``en15757_upper_offset`` [%RH] (:func:`en15757_band`).
+
+        Ratings are empty where the field has no published scale.
+
+    Raises
+    ------
+    heritage_bayes.errors.InputError
+        Bad input (RH as a fraction, mismatched shapes, irregular index, a series shorter
+        than a year for the yearly groups, unknown option names or values).
+
+    See Also
+    --------
+    assess_batch : the same for many series at once (draws × hours).
+
+    Notes
+    -----
+    The equations are in the functions named above. Unknown option keys are rejected,
+    never ignored.
+
+    References
+    ----------
+    .. [1] S. Michalski (2002), ICOM-CC 13th Triennial Meeting, Rio de Janeiro, 66-72
+       (lifetime multiplier, :func:`lifetime_multiplier`).
+    .. [2] D. K. Sebera (1994), "Isoperms"; J. M. Reilly et al. (1995), "New Tools for
+       Preservation", Commission on Preservation and Access (PI, TWPI).
+    .. [3] A. J. Hailwood and S. Horrobin (1946), doi:10.1039/TF946420B084; Wood
+       Handbook FPL-GTR-190 (2010), doi:10.2737/FPL-GTR-190 (EMC, dimensional change).
+    .. [4] A. Hukka and H. A. Viitanen (1999), doi:10.1007/s002260050131; T. Ojanen et
+       al. (2010), Buildings XI (VTT mould index).
+    .. [5] L. Zeng et al. (2023), doi:10.1177/01436244221137846 (lowest isopleth).
+    .. [6] ASHRAE Handbook — HVAC Applications, museums chapter (climate classes).
+    .. [7] EN 15757:2010; D. Camuffo et al. (2022), doi:10.3390/atmos13091344.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(8760)
+    >>> T = 12 + 6 * np.sin(2 * np.pi * t / 8760)
+    >>> RH = 60 + 8 * np.sin(2 * np.pi * t / 24)
+    >>> table = assess(T, RH)
+    >>> table.set_index("indicator").loc["ashrae_best_class", "rating"]
+    'B'
+    """
+    func = "assess"
+    options = dict(lm=lm, emc=emc, vtt=vtt, isopleth=isopleth, ashrae=ashrae, en15757=en15757)
+    h, groups, opts = _prepare_assess(func, T, RH, indicators, nan_policy, options)
+    if h.ndim != 1:
+        raise InputError(
+            f"{func}: expected one hourly series (1-D); got shape "
+            f"{(h.T.shape[0], h.n_hours)}. Use assess_batch for draws × hours"
+        )
+    res = _assess_core(h, groups, opts, nan_policy)
+    rows = []
+    for name, v in res.items():
+        if name == "ashrae_best_class":
+            best = v[0]
+            value = float(res[f"ashrae_{best}"][0]) if best != "none" else math.nan
+            rows.append((name, value, _unit(name), best))
+            continue
+        value = float(v[0])
+        rows.append((name, value, _unit(name), _rating(name, value)))
+    return pd.DataFrame(rows, columns=["indicator", "value", "unit", "rating"])
+
+
+def assess_batch(
+    T,
+    RH,
+    *,
+    indicators=None,
+    nan_policy="propagate",
+    chunk_size=128,
+    lm=None,
+    emc=None,
+    vtt=None,
+    isopleth=None,
+    ashrae=None,
+    en15757=None,
+):
+    r"""All indicators for many series at once (posterior draws × hours).
+
+    Parameters
+    ----------
+    T : array_like
+        Hourly air temperature, shape (draws, hours), or (hours,) shared by all draws of
+        ``RH``. [°C]
+    RH : array_like
+        Hourly relative humidity, shape (draws, hours), or (hours,) shared. [%]
+    indicators, nan_policy, lm, emc, vtt, isopleth, ashrae, en15757
+        As in :func:`assess`.
+    chunk_size : int, default 128
+        Draws processed together (bounds the memory of the temporaries). [-]
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per draw (index ``draw``), one column per indicator of :func:`assess`
+        (same names and units; ``df.attrs["units"]`` maps column → unit). The column
+        ``ashrae_best_class`` holds the class name ("none" if none is reached). Use
+        :func:`summarize` for quantiles and ratings.
+
+    Notes
+    -----
+    Vectorised over draws: moving averages by cumulative sums along the hours axis,
+    the VTT recursion compiled with numba. About two seconds for 1000 draws × 8760 h
+    on a laptop-class CPU (``benchmarks/bench_risk.py``). Row *i* equals
+    ``assess(T[i], RH[i])``.
+
+    References
+    ----------
+    See :func:`assess`.
+    """
+    func = "assess_batch"
+    options = dict(lm=lm, emc=emc, vtt=vtt, isopleth=isopleth, ashrae=ashrae, en15757=en15757)
+    h, groups, opts = _prepare_assess(func, T, RH, indicators, nan_policy, options)
+    bad = isinstance(chunk_size, bool) or not isinstance(chunk_size, int | np.integer)
+    if bad or chunk_size < 1:
+        raise InputError(f"{func}: chunk_size must be a positive integer; got {chunk_size!r}")
+    d = h.T.shape[0]
+    parts: list[dict[str, np.ndarray]] = []
+    for start in range(0, d, int(chunk_size)):
+        sl = slice(start, start + int(chunk_size))
+        hc = Hourly(T=h.T[sl], RH=h.RH[sl], index=None, ndim=2)
+        parts.append(_assess_core(hc, groups, opts, nan_policy))
+    cols = {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
+    df = pd.DataFrame(cols, index=pd.RangeIndex(d, name="draw"))
+    df.attrs["units"] = {k: _unit(k) for k in cols}
+    return df
+
+
+def summarize(per_draw: pd.DataFrame, quantiles=(0.05, 0.5, 0.95)) -> pd.DataFrame:
+    r"""Distribution of each indicator over draws, as a tidy table.
+
+    Parameters
+    ----------
+    per_draw : pandas.DataFrame
+        Output of :func:`assess_batch` (one row per draw; units in ``attrs["units"]``).
+    quantiles : sequence of float, default (0.05, 0.5, 0.95)
+        Quantiles to report, each in [0, 1]. [-]
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns ``indicator``, ``unit``, ``mean``, one column per quantile (``q5``,
+        ``q50``, ``q95`` …) and ``rating``: the rating of the median for rated
+        indicators; for ``ashrae_best_class``, the share of draws per best class
+        (e.g. ``"B 80 %, C 20 %"``). NaN draws are left out. Values in the unit of
+        each indicator (``per_draw.attrs["units"]``).
+
+    Notes
+    -----
+    Quantiles by linear interpolation (:func:`numpy.quantile`); the rating of the
+    median uses the same scales as :func:`assess`.
+    """
+    func = "summarize"
+    if not isinstance(per_draw, pd.DataFrame):
+        raise InputError(
+            f"{func}: expected the DataFrame of assess_batch; got {type(per_draw).__name__}"
+        )
+    try:
+        qs = [float(q) for q in quantiles]
+    except (TypeError, ValueError):
+        raise InputError(
+            f"{func}: quantiles must be numbers in [0, 1]; got {quantiles!r}"
+        ) from None
+    if not qs or not all(0.0 <= q <= 1.0 for q in qs):
+        raise InputError(f"{func}: quantiles must be numbers in [0, 1]; got {quantiles!r}")
+    qcols = [f"q{100 * q:g}" for q in qs]
+    units = per_draw.attrs.get("units", {})
+    rows = []
+    for name in per_draw.columns:
+        col = per_draw[name]
+        if name == "ashrae_best_class":
+            freq = col.astype(str).value_counts(normalize=True)
+            rating = ", ".join(f"{k} {100 * v:.0f} %" for k, v in freq.items())
+            rows.append([name, "", math.nan, *([math.nan] * len(qs)), rating])
+            continue
+        x = col.to_numpy(dtype=float)
+        x = x[~np.isnan(x)]
+        if x.size:
+            qv = np.quantile(x, qs)
+            mean = float(x.mean())
+            med = float(np.median(x))
+        else:
+            qv, mean, med = [math.nan] * len(qs), math.nan, math.nan
+        rows.append([name, units.get(name, ""), mean, *map(float, qv), _rating(name, med)])
+    return pd.DataFrame(rows, columns=["indicator", "unit", "mean", *qcols, "rating"])

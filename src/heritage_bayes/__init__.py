@@ -4,31 +4,39 @@ The forward models follow Kramer, van Schijndel & Schellen, "Inverse modeling of
 responses of monumental buildings" (thermal model 4a, hygric model 3).
 """
 
-from heritage_bayes import climate, io
 from heritage_bayes._version import __version__
 from heritage_bayes.errors import ConfigError, DataError, InputError
-from heritage_bayes.rc import (
-    Network,
-    RCModel,
-    available_models,
-    discretize,
-    model,
-    simulate,
-    structural_identifiability,
-)
+
+#: public name -> module that defines it; imported on first use, so that ``hbayes
+#: --version`` and config errors do not wait for numpy, scipy and pandas
+_LAZY = {
+    "climate": "heritage_bayes.climate",
+    "io": "heritage_bayes.io",
+    "Network": "heritage_bayes.rc",
+    "RCModel": "heritage_bayes.rc",
+    "available_models": "heritage_bayes.rc",
+    "discretize": "heritage_bayes.rc",
+    "model": "heritage_bayes.rc",
+    "simulate": "heritage_bayes.rc",
+    "structural_identifiability": "heritage_bayes.rc",
+    "load_run": "heritage_bayes.run",
+    "run_calibration": "heritage_bayes.calibrate",
+}
 
 
 def __getattr__(name):
-    # heavier entry points, imported on first use (no side effects at import)
-    if name == "load_run":
-        from heritage_bayes.run import load_run
+    import importlib
 
-        return load_run
-    if name == "run_calibration":
-        from heritage_bayes.calibrate import run_calibration
+    if name not in _LAZY:
+        raise AttributeError(f"module 'heritage_bayes' has no attribute {name!r}")
+    mod = importlib.import_module(_LAZY[name])
+    value = mod if mod.__name__ == f"{__name__}.{name}" else getattr(mod, name)
+    globals()[name] = value
+    return value
 
-        return run_calibration
-    raise AttributeError(f"module 'heritage_bayes' has no attribute {name!r}")
+
+def __dir__():
+    return sorted([*globals(), *_LAZY])
 
 
 __all__ = [

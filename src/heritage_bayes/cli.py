@@ -1,13 +1,17 @@
 """Command-line interface: ``hbayes``.
 
 Thin: parse arguments, call the library, map errors to exit codes
-(0 success, 2 user error, 1 internal error). Tested by calling :func:`main` directly.
+(0 success, 2 user error, 1 internal error, 130 interrupted by SIGINT or SIGTERM at any
+stage). Tested by calling :func:`main` directly, and as a subprocess
+(``tests/test_faults.py``).
 """
 
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
+import threading
 
 from heritage_bayes._version import __version__
 from heritage_bayes.errors import InputError
@@ -126,8 +130,36 @@ def _cmd_batch(args) -> int:
     return 0 if bad.empty else 1 if (bad["status"] == "error").any() else 2
 
 
+class _Terminated(KeyboardInterrupt):
+    """SIGTERM, handled like Ctrl-C (the chains are saved; exit 130)."""
+
+
+def _on_sigterm(signum, frame):
+    raise _Terminated
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run ``hbayes``; return the exit code."""
+    old = None
+    if threading.current_thread() is threading.main_thread():
+        old = signal.signal(signal.SIGTERM, _on_sigterm)
+    try:
+        return _main(argv)
+    except KeyboardInterrupt as exc:  # before or after a command ran
+        return _interrupted(exc, None)
+    finally:
+        if old is not None:
+            signal.signal(signal.SIGTERM, old)
+
+
+def _interrupted(exc: BaseException, command: str | None) -> int:
+    what = "terminated (SIGTERM)" if isinstance(exc, _Terminated) else "interrupted"
+    hint = " (continue with --resume)" if command == "calibrate" else ""
+    print(f"hbayes: {what}{hint}", file=sys.stderr, flush=True)
+    return 130
+
+
+def _main(argv: list[str] | None) -> int:
     parser = _build_parser()
     try:
         args = parser.parse_args(argv)
@@ -141,10 +173,8 @@ def main(argv: list[str] | None = None) -> int:
     except InputError as exc:
         print(f"hbayes: error: {exc}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
-        hint = " (continue with --resume)" if args.command == "calibrate" else ""
-        print(f"hbayes: interrupted{hint}", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as exc:
+        return _interrupted(exc, args.command)
     except Exception:  # an internal error: a bug, so show where it happened
         import traceback
 

@@ -330,6 +330,7 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
         "alignment": prep.alignment,
         "sources": prep.sources,
         "truth": truth_all or None,
+        "versions": _versions(),
     }
     return idata, summary
 

@@ -15,10 +15,12 @@ modes. The stretch move is available (``moves: stretch``).
 
 Checkpoint: emcee's own HDF5 backend writes every step (several ms each here, more than
 the step itself), so the sampler runs in memory and each chunk is appended to an HDF5
-file (``chain.h5``) together with the random-number state; on Ctrl-C or SIGTERM the
-steps done so far in the current chunk are written too. ``resume=True`` continues the
-same chain exactly (same random stream), losing nothing already sampled; only a hard
-kill (SIGKILL) can lose the current chunk.
+file (``chain.h5``) together with the random-number state, committed by one attribute
+written last (crash-consistent, see :class:`_Checkpoint`); Ctrl-C or SIGTERM stops the
+chain after the current step and commits the steps done so far. ``resume=True``
+continues the same chain exactly (same random stream), losing nothing already sampled;
+only a hard kill (SIGKILL) can lose the current chunk, and a damaged file is detected
+(checksums) and cut back to its valid steps.
 
 References
 ----------
@@ -33,8 +35,11 @@ References
 
 from __future__ import annotations
 
+import json
 import os
 import signal
+import tempfile
+import threading
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -145,98 +150,230 @@ def _tau(chain: np.ndarray) -> np.ndarray:
     return emcee.autocorr.integrated_time(chain, c=5, tol=0, quiet=True)
 
 
+class _DeferSignals:
+    """Record SIGINT and SIGTERM instead of acting on them, for a critical section.
+
+    ``received`` is the first signal number seen (or None). On exit the previous handlers
+    come back and, with ``redeliver=True``, a recorded signal is raised again, so an
+    interrupt during a checkpoint commit takes effect right after it. Only the main
+    thread receives signals in Python; elsewhere this does nothing.
+    """
+
+    SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+    def __init__(self, redeliver: bool = True):
+        self.redeliver = redeliver
+        self.received: int | None = None
+        self._old: dict = {}
+
+    def __enter__(self):
+        self.received = None
+        if threading.current_thread() is threading.main_thread():
+            for s in self.SIGNALS:
+                old = signal.signal(s, self._record)
+                self._old[s] = signal.SIG_DFL if old is None else old
+        return self
+
+    def _record(self, signum, frame):
+        if self.received is None:
+            self.received = signum
+
+    def __exit__(self, *exc):
+        for s, h in self._old.items():
+            signal.signal(s, h)
+        self._old = {}
+        if self.redeliver and self.received is not None and exc[0] is None:
+            signal.raise_signal(self.received)
+        return False
+
+
+@dataclass
+class _Saved:
+    """What a checkpoint holds up to its last commit (see :meth:`_Checkpoint.load`)."""
+
+    chain: np.ndarray
+    log_prob: np.ndarray
+    accepted: np.ndarray
+    random_state: tuple | None
+    tau_history: list
+    problem: str | None = None  # what was wrong with the file, if anything
+
+
 class _Checkpoint:
-    """Appends chain chunks and the RNG state to an HDF5 file."""
+    """Appends chain chunks and the RNG state to an HDF5 file, crash-consistently.
+
+    Every append writes the new rows first and then commits them with a single
+    attribute, ``commit`` (JSON: iteration, acceptance counts, random state, τ
+    history); rows beyond the committed ``iteration`` are ignored on load and
+    overwritten by the next append, so an interrupt at any instant leaves the last
+    commit intact. SIGINT/SIGTERM are deferred until the commit is done. The datasets
+    carry Fletcher-32 checksums, so damaged chunks are detected on load and the valid
+    prefix is kept. The file is created under a unique temporary name (never through
+    a symlink) and renamed into place.
+    """
+
+    FORMAT = 2
 
     def __init__(self, path: Path, tag: str):
         self.path = Path(path)
         self.tag = tag
 
     def create(self, nwalkers: int, ndim: int) -> None:
-        tmp = self.path.with_suffix(".h5.tmp")
-        with h5py.File(tmp, "w") as f:
-            f.attrs["tag"] = self.tag
-            f.attrs["iteration"] = 0
-            f.create_dataset(
-                "chain",
-                (0, nwalkers, ndim),
-                maxshape=(None, nwalkers, ndim),
-                dtype="f8",
-                chunks=(64, nwalkers, ndim),
-            )
-            f.create_dataset(
-                "log_prob",
-                (0, nwalkers),
-                maxshape=(None, nwalkers),
-                dtype="f8",
-                chunks=(64, nwalkers),
-            )
-            f.create_dataset("accepted", data=np.zeros(nwalkers))
-        os.replace(tmp, self.path)
+        fd, tmp = tempfile.mkstemp(
+            prefix=f".{self.path.name}.", suffix=".tmp", dir=self.path.parent
+        )
+        os.close(fd)
+        try:
+            with h5py.File(tmp, "w") as f:
+                f.attrs["tag"] = self.tag
+                f.attrs["format"] = self.FORMAT
+                f.attrs["iteration"] = 0
+                for name, shape in (("chain", (nwalkers, ndim)), ("log_prob", (nwalkers,))):
+                    f.create_dataset(
+                        name,
+                        (0, *shape),
+                        maxshape=(None, *shape),
+                        dtype="f8",
+                        chunks=(64, *shape),
+                        fletcher32=True,
+                    )
+            os.replace(tmp, self.path)
+        except BaseException:
+            Path(tmp).unlink(missing_ok=True)
+            raise
 
     def append(self, chain, log_prob, accepted, random_state, tau_history) -> None:
-        with h5py.File(self.path, "a") as f:
-            n0 = f["chain"].shape[0]
+        """Write ``chain``/``log_prob`` rows after the last commit, then commit them."""
+        with _DeferSignals(), h5py.File(self.path, "a") as f:
+            n0 = int(json.loads(f.attrs["commit"])["iteration"]) if "commit" in f.attrs else 0
             n = chain.shape[0]
-            f["chain"].resize(n0 + n, axis=0)
-            f["log_prob"].resize(n0 + n, axis=0)
-            f["chain"][n0:] = chain
-            f["log_prob"][n0:] = log_prob
-            f["accepted"][...] = accepted
-            for k in [k for k in f.attrs if k.startswith("rng_")]:
-                del f.attrs[k]
+            for name, rows in (("chain", chain), ("log_prob", log_prob)):
+                f[name].resize(n0 + n, axis=0)
+                f[name][n0:] = rows
+            f.flush()
             name, keys, pos, has_gauss, cached = random_state
-            f.attrs["rng_name"] = name
-            f.attrs["rng_keys"] = keys
-            f.attrs["rng_pos"] = pos
-            f.attrs["rng_has_gauss"] = has_gauss
-            f.attrs["rng_cached"] = cached
-            f.attrs["tau_history"] = np.asarray(tau_history, dtype=float).reshape(-1, 2)
-            f.attrs["iteration"] = n0 + n
+            commit = {
+                "iteration": n0 + n,
+                "accepted": np.asarray(accepted, dtype=float).tolist(),
+                "rng": [
+                    str(name),
+                    np.asarray(keys).tolist(),
+                    int(pos),
+                    int(has_gauss),
+                    float(cached),
+                ],
+                "tau_history": np.asarray(tau_history, dtype=float).reshape(-1, 2).tolist(),
+            }
+            f.attrs["commit"] = json.dumps(commit)  # the commit point
+            f.attrs["iteration"] = n0 + n  # informative
+            f.flush()
 
-    def load(self):
-        with h5py.File(self.path, "r") as f:
-            if f.attrs.get("tag") != self.tag:
-                raise InputError(
-                    f"{self.path}: this checkpoint belongs to a different configuration "
-                    "or model; run without --resume (it will be replaced) or restore "
-                    "the config it was made with"
-                )
-            chain = f["chain"][...]
-            log_prob = f["log_prob"][...]
-            accepted = f["accepted"][...]
-            rs = None
-            if "rng_name" in f.attrs:
-                rs = (
-                    str(f.attrs["rng_name"]),
-                    np.asarray(f.attrs["rng_keys"]),
-                    int(f.attrs["rng_pos"]),
-                    int(f.attrs["rng_has_gauss"]),
-                    float(f.attrs["rng_cached"]),
-                )
-            hist = [tuple(r) for r in np.asarray(f.attrs.get("tau_history", []))]
-        return chain, log_prob, accepted, rs, hist
+    def _damaged(self, why: str) -> InputError:
+        return InputError(
+            f"{self.path}: the chain checkpoint is damaged ({why}); it was left as it is. "
+            "Run without --resume to start the chain afresh (the file is then replaced), "
+            "or restore a good copy"
+        )
 
+    def load(self) -> _Saved:
+        """The committed chain; damaged rows cut off (``problem`` says what and where).
 
-class _Interrupt:
-    """Turn SIGTERM into KeyboardInterrupt while sampling (so the chunk is saved)."""
-
-    def __enter__(self):
-        self._old = None
+        Raises
+        ------
+        InputError
+            Not a readable checkpoint, or one made for another configuration.
+        """
         try:
-            self._old = signal.signal(signal.SIGTERM, self._raise)
-        except ValueError:  # not in the main thread
-            self._old = None
-        return self
+            f = h5py.File(self.path, "r")
+        except OSError as exc:
+            raise self._damaged(f"not a readable HDF5 file: {_first_line(exc)}") from None
+        with f:
+            tag = f.attrs.get("tag")
+            if tag is None or "chain" not in f or "log_prob" not in f:
+                raise self._damaged("no tag or chain datasets: not a checkpoint of hbayes")
+            if tag != self.tag:
+                raise InputError(
+                    f"{self.path}: this checkpoint belongs to a different configuration, "
+                    "model or data; run without --resume (it will be replaced) or restore "
+                    "the config and data it was made with"
+                )
+            problem = None
+            rs = None
+            try:
+                if "commit" in f.attrs:
+                    c = json.loads(f.attrs["commit"])
+                    n = int(c["iteration"])
+                    accepted = np.asarray(c["accepted"], dtype=float)
+                    name, keys, pos, has_gauss, cached = c["rng"]
+                    rs = (
+                        str(name),
+                        np.asarray(keys, dtype=np.uint32),
+                        int(pos),
+                        int(has_gauss),
+                        float(cached),
+                    )
+                    hist = [tuple(r) for r in c["tau_history"]]
+                else:  # format 1 (before the commit attribute)
+                    n = int(f.attrs.get("iteration", 0))
+                    accepted = (
+                        f["accepted"][...] if "accepted" in f else np.zeros(f["chain"].shape[1])
+                    )
+                    if "rng_name" in f.attrs:
+                        rs = (
+                            str(f.attrs["rng_name"]),
+                            np.asarray(f.attrs["rng_keys"]),
+                            int(f.attrs["rng_pos"]),
+                            int(f.attrs["rng_has_gauss"]),
+                            float(f.attrs["rng_cached"]),
+                        )
+                    elif n > 0:
+                        problem = "it holds no random-number state"
+                    hist = [tuple(r) for r in np.asarray(f.attrs.get("tau_history", []))]
+            except (KeyError, ValueError, TypeError, OSError) as exc:
+                raise self._damaged(f"unreadable commit record: {_first_line(exc)}") from None
+            n = min(n, f["chain"].shape[0], f["log_prob"].shape[0])
+            chain, lp, bad = _read_prefix(f["chain"], f["log_prob"], n)
+        if bad is not None:
+            problem = (
+                f"steps {bad} to {n} are damaged; kept the {chain.shape[0]} valid steps before them"
+            )
+            rs = None  # the saved random state belongs to the end of the damaged part
+        return _Saved(chain, lp, accepted, rs, hist[: max(0, len(hist))], problem)
 
-    @staticmethod
-    def _raise(signum, frame):
-        raise KeyboardInterrupt
 
-    def __exit__(self, *exc):
-        if self._old is not None:
-            signal.signal(signal.SIGTERM, self._old)
-        return False
+def _first_line(exc: BaseException) -> str:
+    return (str(exc).strip().splitlines() or [type(exc).__name__])[0][:200]
+
+
+def _read_prefix(chain_ds, lp_ds, n: int, block: int = 64):
+    """Rows ``[:n]`` of both datasets, block by block, up to the first damaged block
+    (checksum error, or non-finite coordinates); returns ``(chain, log_prob, bad)``,
+    ``bad`` the first damaged row or None."""
+    xs, lps = [], []
+    for i in range(0, n, block):
+        j = min(n, i + block)
+        try:
+            x, lp = chain_ds[i:j], lp_ds[i:j]
+        except (OSError, RuntimeError, ValueError):
+            return _cat(xs, chain_ds), _cat(lps, lp_ds), i
+        ok = np.isfinite(x).all(axis=(1, 2)) & ~np.isnan(lp).any(axis=1)
+        if not ok.all():
+            k = int(np.argmin(ok))
+            xs.append(x[:k])
+            lps.append(lp[:k])
+            return _cat(xs, chain_ds), _cat(lps, lp_ds), i + k
+        xs.append(x)
+        lps.append(lp)
+    return _cat(xs, chain_ds), _cat(lps, lp_ds), None
+
+
+def _cat(parts, ds):
+    return np.concatenate(parts) if parts else np.zeros((0, *ds.shape[1:]))
+
+
+def _tell(notice, msg: str) -> None:
+    if notice is not None:
+        notice(msg)
 
 
 def run_sampler(logpost, x_map, **kwargs) -> ChainResult:
@@ -264,6 +401,7 @@ def _run_sampler(
     tag: str = "",
     resume: bool = False,
     progress=None,
+    notice=None,
     max_rhat: float | None = 1.01,
     min_ess: float | None = 400.0,
     max_draws: int = 4000,
@@ -285,6 +423,9 @@ def _run_sampler(
         (its ``tag`` must match).
     progress : callable, optional
         Called after every chunk as ``progress(steps_done, max_steps, info_dict)``.
+    notice : callable, optional
+        Called with a message when a resume does not go as asked (no checkpoint, a
+        damaged one: see :class:`_Checkpoint`).
     max_rhat, min_ess : float or None
         Once the chain is long enough for τ, it also runs until the rank-normalised
         R-hat (walkers as chains) is at most ``max_rhat`` and the bulk ESS at least
@@ -307,20 +448,48 @@ def _run_sampler(
     accepted = np.zeros(nwalkers)
     tau_hist: list[tuple[float, float]] = []
     done = 0
-    if resume and ck is not None and ck.path.exists():
-        chain0, lp0, accepted, rs, tau_hist = ck.load()
-        if chain0.shape[1:] != (nwalkers, d):
-            raise InputError(
-                f"{ck.path}: checkpoint has {chain0.shape[1]} walkers × "
-                f"{chain0.shape[2]} parameters, the run needs {nwalkers} × "
-                f"{d}; run without --resume"
-            )
-        if chain0.shape[0] > 0 and rs is not None:
-            chunks_x.append(chain0)
-            chunks_lp.append(lp0)
-            done = chain0.shape[0]
-            state = emcee.State(chain0[-1], log_prob=lp0[-1], random_state=rs)
-            sampler.random_state = rs
+    if resume and ck is not None:
+        if not ck.path.exists():
+            _tell(notice, f"--resume: no checkpoint {ck.path}; starting a new chain")
+        else:
+            saved = ck.load()
+            if saved.chain.shape[1:] != (nwalkers, d):
+                raise InputError(
+                    f"{ck.path}: checkpoint has {saved.chain.shape[1]} walkers × "
+                    f"{saved.chain.shape[2]} parameters, the run needs {nwalkers} × "
+                    f"{d}; run without --resume"
+                )
+            if saved.problem is not None:
+                _tell(notice, f"{ck.path}: {saved.problem}")
+            done = saved.chain.shape[0]
+            if done == 0:
+                _tell(notice, f"--resume: {ck.path} holds no steps yet; starting a new chain")
+            else:
+                rs = saved.random_state
+                if rs is None:  # continue the kept steps with a stream of their own
+                    rs = np.random.RandomState([seed, done]).get_state()
+                    _tell(
+                        notice,
+                        f"{ck.path}: no random-number state for step {done}; continuing "
+                        "with a new random stream (seeded by the seed and the step count): "
+                        "a valid chain, but not bit-identical to an uninterrupted run",
+                    )
+                accepted = saved.accepted
+                tau_hist = [h for h in saved.tau_history if h[0] <= done]
+                if saved.problem is not None:  # keep the damaged file, write a clean one
+                    kept = ck.path.with_name(ck.path.name + ".damaged")
+                    os.replace(ck.path, kept)
+                    ck.create(nwalkers, d)
+                    ck.append(saved.chain, saved.log_prob, accepted, rs, tau_hist)
+                    _tell(
+                        notice,
+                        f"{ck.path}: rewritten from the valid steps; the damaged "
+                        f"file is kept as {kept}",
+                    )
+                chunks_x.append(saved.chain)
+                chunks_lp.append(saved.log_prob)
+                state = emcee.State(saved.chain[-1], log_prob=saved.log_prob[-1], random_state=rs)
+                sampler.random_state = rs
     resumed_from = done
     if done == 0:
         rng = np.random.default_rng(seed)
@@ -351,16 +520,21 @@ def _run_sampler(
         converged = bool(done >= tau_factor * tmax and stable and np.all(np.isfinite(tau)))
         if converged and (max_rhat is not None or min_ess is not None):
             converged = _mixing_ok(np.concatenate(chunks_x), tau, max_rhat, min_ess, max_draws)
-    with _Interrupt():
+    # SIGINT/SIGTERM only set a flag while sampling: the chain stops after the current
+    # step, the steps done are committed, then KeyboardInterrupt (never an exception
+    # inside emcee's likelihood call, which would print the parameter matrix)
+    with _DeferSignals(redeliver=False) as sig:
         while done < max_steps and not converged:
             # chunk boundaries on absolute multiples of check_every (resume-invariant)
             n = min(check_every - done % check_every, max_steps - done)
             sampler.reset()
             try:
-                state = sampler.run_mcmc(state, n, progress=False)
+                for step in sampler.sample(state, iterations=n):  # noqa: B007
+                    if sig.received is not None:
+                        raise KeyboardInterrupt
+                state = step
             except KeyboardInterrupt:
-                k = sampler.backend.iteration
-                if ck is not None and k > 0:
+                if ck is not None and sampler.backend.iteration > 0:
                     ck.append(
                         sampler.get_chain(),
                         sampler.get_log_prob(),
@@ -368,7 +542,7 @@ def _run_sampler(
                         sampler.backend.random_state,
                         tau_hist,
                     )
-                raise
+                raise KeyboardInterrupt from None
             x, lp = sampler.get_chain(), sampler.get_log_prob()
             accepted = accepted + sampler.backend.accepted
             chunks_x.append(x)

@@ -19,6 +19,7 @@ worker. Run from the repository root::
 from __future__ import annotations
 
 import argparse
+import os
 import resource
 import tempfile
 import time
@@ -62,6 +63,7 @@ def main(argv: list[str] | None = None) -> int:
         )
         pf = load_portfolio(pf_path)
 
+        load0 = os.getloadavg()
         t0, c0 = time.perf_counter(), _cpu()
         with threadpool_limits(limits=1, user_api="blas"):
             serial = [_room_task(spec, str(tmp / "serial"), False) for spec in pf.rooms]
@@ -74,6 +76,7 @@ def main(argv: list[str] | None = None) -> int:
         t0 = time.perf_counter()
         df = run(pf, tmp / "dask", workers=args.workers, quiet=True)
         t_dask = time.perf_counter() - t0
+        load1 = os.getloadavg()
         if not (df["status"] == "done").all():
             print("dask arm failed:", df.loc[df["status"] != "done", "message"].iloc[0])
             return 1
@@ -81,10 +84,16 @@ def main(argv: list[str] | None = None) -> int:
     print(f"{args.rooms} demo-sized rooms (configs/demo.yaml, ladder and report off)")
     print(f"  serial, this process           : {t_serial:8.1f} s wall, {c_serial:8.1f} s CPU")
     print(
-        f"  LocalCluster, {args.workers} workers x 1 thread: {t_dask:8.1f} s wall "
-        f"(sum of task wall times in the workers: {df['task_seconds'].sum():.1f} s)"
+        f"  LocalCluster, {args.workers} workers x 1 thread: {t_dask:8.1f} s wall, "
+        f"{df['task_cpu_seconds'].sum():8.1f} s CPU in the tasks "
+        f"(sum of task wall times {df['task_seconds'].sum():.1f} s)"
     )
     print(f"  speed-up: {t_serial / t_dask:.2f}x  (target >= 1.7x on 2 cores)")
+    print(
+        f"  machine load average (1 min) before/after: {load0[0]:.2f} / {load1[0]:.2f} "
+        f"on {os.cpu_count()} cores: a task CPU time close to the serial one with a longer "
+        "wall time means other processes shared the cores"
+    )
     print(
         f"  peak resident memory per worker: {df['worker_peak_rss_mb'].max():.0f} MB "
         f"(median over rooms {df['worker_peak_rss_mb'].median():.0f} MB)"

@@ -31,7 +31,7 @@ def _room_task(spec: RoomSpec, out_dir: str, resume: bool) -> dict:
     """Calibrate one room in a worker; never raises (the row carries the failure)."""
     from heritage_bayes.config import config_hash, parse_config
 
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     run_dir = Path(out_dir) / spec.name
     row: dict[str, Any] = {"room": spec.name, "config": str(spec.config_path)}
     try:
@@ -60,6 +60,7 @@ def _room_task(spec: RoomSpec, out_dir: str, resume: bool) -> dict:
             traceback.format_exception(exc)[-6:]
         )
     row["task_seconds"] = time.perf_counter() - t0
+    row["task_cpu_seconds"] = time.process_time() - c0
     row["worker_peak_rss_mb"] = _peak_rss_mb()
     return row
 

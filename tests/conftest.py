@@ -19,3 +19,14 @@ def shared_data() -> Path:
     if not SHARED_DATA.is_dir():
         pytest.skip(f"real data folder not found at {SHARED_DATA}")
     return SHARED_DATA
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _nothing_left_in_the_checkout():
+    """Tests write into temporary folders only: the checkout's ``reports/`` (the default
+    run folder) must look the same after the session as before it."""
+    reports = Path(__file__).resolve().parents[1] / "reports"
+    before = sorted(p.name for p in reports.iterdir()) if reports.is_dir() else []
+    yield
+    after = sorted(p.name for p in reports.iterdir()) if reports.is_dir() else []
+    assert after == before, f"tests left {sorted(set(after) - set(before))} in {reports}"

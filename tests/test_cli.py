@@ -116,7 +116,15 @@ def test_missing_config_and_bad_yaml_and_bad_data(tmp_path, capsys):
         "irradiance": "none",
         "ground_temperature": {"mode": "constant", "value": 10},
     }
-    code = main(["calibrate", str(_write(tmp_path / "data.yaml", cfg)), "--quiet"])
+    code = main(
+        [
+            "calibrate",
+            str(_write(tmp_path / "data.yaml", cfg)),
+            "--out",
+            str(tmp_path / "data_run"),
+            "--quiet",
+        ]
+    )
     err = capsys.readouterr().err
     assert code == 2
     assert "data.measurements" in err and "TEMP" in err and "Traceback" not in err

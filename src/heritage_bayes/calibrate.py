@@ -13,6 +13,7 @@ for climate-change projections).
 
 from __future__ import annotations
 
+import hashlib
 import sys
 import time
 from collections.abc import Mapping
@@ -36,7 +37,10 @@ from heritage_bayes.models import SECTIONS, _catalog_options, build_model
 from heritage_bayes.rc.catalog import model as catalog_model
 from heritage_bayes.rc.identify import structural_identifiability
 from heritage_bayes.rc.model import RCModel
-from heritage_bayes.run import Run, load_run  # re-exported: the run directory's format
+from heritage_bayes.run import Run, RunWriter, load_run  # Run, load_run: re-exported
+
+#: Seeds are 32-bit (numpy's RandomState), and each model adds 101 × its index.
+MAX_SEED = 2**31 - 1
 
 __all__ = [
     "LADDERS",
@@ -118,9 +122,22 @@ class _Progress:
         if not self.quiet:
             print(msg, file=sys.stderr, flush=True)
 
+    def warn(self, msg: str) -> None:
+        """Shown even with --quiet."""
+        print(f"hbayes: warning: {msg}", file=sys.stderr, flush=True)
+
     def sampler(self, label: str, max_steps: int):
         if self.quiet:
             return None
+        if not sys.stderr.isatty():  # a log file: one plain line per update
+
+            def line(done, total, info):
+                self.say(
+                    f"[{label}] emcee {done}/{total} steps: τmax {info['tau_max']:.0f}, "
+                    f"need {info['needed']:.0f} steps, acc {info['acceptance']:.2f}"
+                )
+
+            return line
         from tqdm.auto import tqdm
 
         bar = tqdm(
@@ -157,6 +174,7 @@ def run_calibration(
     resume: bool = False,
     quiet: bool = False,
     report: bool | None = None,
+    force: bool = False,
 ) -> Path:
     """Calibrate the configured models and write the run directory; return its path.
 
@@ -173,6 +191,10 @@ def run_calibration(
         No progress output.
     report : bool, optional
         Write ``report.html`` (default ``cfg.report``).
+    force : bool
+        Write into an existing folder that is not a run directory (see
+        :class:`~heritage_bayes.run.RunWriter`: the run is written to a staging folder
+        and replaces ``out_dir`` only when complete; a failed run leaves it unchanged).
 
     Notes
     -----
@@ -183,7 +205,9 @@ def run_calibration(
     from threadpoolctl import threadpool_limits
 
     with threadpool_limits(limits=1, user_api="blas"):
-        return _run_calibration(cfg, out_dir, seed=seed, resume=resume, quiet=quiet, report=report)
+        return _run_calibration(
+            cfg, out_dir, seed=seed, resume=resume, quiet=quiet, report=report, force=force
+        )
 
 
 def _run_calibration(
@@ -194,19 +218,53 @@ def _run_calibration(
     resume: bool = False,
     quiet: bool = False,
     report: bool | None = None,
+    force: bool = False,
 ) -> Path:
     """Implementation of :func:`run_calibration` (same parameters)."""
-    t_start = time.perf_counter()
     if seed is not None:
+        if not 0 <= int(seed) <= MAX_SEED:
+            raise InputError(f"--seed: must be within 0..{MAX_SEED} (got {seed})")
         cfg = cfg.model_copy(update={"seed": int(seed)})
     out = Path(out_dir) if out_dir is not None else Path("reports") / (cfg.name or "run")
-    out.mkdir(parents=True, exist_ok=True)
+    writer = RunWriter(out, force=force, resume=resume)
+    writer.check()  # before reading any data: a bad --out fails at once
+    check_models(cfg)
+    with writer:
+        try:
+            _calibrate_into(writer.staging, cfg, out, resume=resume, quiet=quiet, report=report)
+            writer.commit()
+        except BaseException as exc:
+            exc.add_note(writer.left_behind())
+            raise
+    return out
+
+
+def _data_hash(lp: LogPosterior) -> str:
+    """SHA-256 (16 hex digits) of the prepared inputs and observations of a section."""
+    h = hashlib.sha256()
+    for a in (lp.inputs, lp.observed):
+        a = np.ascontiguousarray(a, dtype=float)
+        h.update(str(a.shape).encode())
+        h.update(a.tobytes())
+    return h.hexdigest()[:16]
+
+
+def _calibrate_into(
+    out: Path,
+    cfg: CalibrationConfig,
+    final: Path,
+    *,
+    resume: bool,
+    quiet: bool,
+    report: bool | None,
+) -> None:
+    """Calibrate and write every output into ``out`` (the staging folder of ``final``)."""
+    t_start = time.perf_counter()
     chash = config_hash(cfg)
     say = _Progress(quiet)
-    check_models(cfg)  # before reading any data
     from heritage_bayes.prepare import prepare
 
-    say.say(f"hbayes {__version__}: calibrating {cfg.name!r} -> {out}")
+    say.say(f"hbayes {__version__}: calibrating {cfg.name!r} -> {final}")
     t0 = time.perf_counter()
     prep = prepare(cfg)
     t_prep = time.perf_counter() - t0
@@ -216,8 +274,10 @@ def _run_calibration(
         f"(irradiance: {prep.irradiance_source})"
     )
     atomic_write_text(
-        out / "config.yaml", yaml.safe_dump(cfg.resolved(), sort_keys=False, allow_unicode=True)
+        out / "config.yaml", yaml.safe_dump(cfg.portable(), sort_keys=False, allow_unicode=True)
     )
+    if cfg.source_text is not None:  # the user's own file, comments and all
+        atomic_write_text(out / "config.original.yaml", cfg.source_text)
     sections: list[_Section] = []
     for name in SECTIONS:
         sec_cfg = getattr(cfg, name)
@@ -271,9 +331,10 @@ def _run_calibration(
                 tau_rtol=cfg.sampler.tau_rtol,
                 init_ball=cfg.sampler.init_ball,
                 checkpoint=out / f"chain_{s.name}.h5",
-                tag=f"{chain_tag(cfg)}:{s.name}",
+                tag=f"{chain_tag(cfg)}:{_data_hash(s.logpost)}:{s.name}",
                 resume=resume,
                 progress=update,
+                notice=say.warn,
                 max_rhat=CONVERGENCE["max_rhat"],
                 min_ess=CONVERGENCE["min_ess_bulk"],
                 max_draws=cfg.sampler.max_draws,
@@ -325,9 +386,8 @@ def _run_calibration(
     if cfg.report if report is None else report:
         from heritage_bayes.report import write_report
 
-        path = write_report(out)
-        say.say(f"report: {path}")
-    return out
+        write_report(out)
+        say.say(f"report: {final / 'report.html'}")
 
 
 LADDERS = {

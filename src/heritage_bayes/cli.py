@@ -42,6 +42,12 @@ def _build_parser() -> argparse.ArgumentParser:
     )
     cal.add_argument("--quiet", action="store_true", help="no progress output")
     cal.add_argument("--no-report", action="store_true", help="skip report.html")
+    cal.add_argument(
+        "--force",
+        action="store_true",
+        help="write into an existing folder that is not a run directory (files named like "
+        "the run's outputs are replaced, others kept)",
+    )
     cal.set_defaults(func=_cmd_calibrate)
 
     rep = sub.add_parser(
@@ -89,6 +95,7 @@ def _cmd_calibrate(args) -> int:
         resume=args.resume,
         quiet=args.quiet,
         report=False if args.no_report else None,
+        force=args.force,
     )
     if not args.quiet:
         print(out)
@@ -156,7 +163,14 @@ def _interrupted(exc: BaseException, command: str | None) -> int:
     what = "terminated (SIGTERM)" if isinstance(exc, _Terminated) else "interrupted"
     hint = " (continue with --resume)" if command == "calibrate" else ""
     print(f"hbayes: {what}{hint}", file=sys.stderr, flush=True)
+    _notes(exc)
     return 130
+
+
+def _notes(exc: BaseException) -> None:
+    """What a failed run left behind (added by the library as exception notes)."""
+    for note in getattr(exc, "__notes__", ()):
+        print(f"hbayes: {note}", file=sys.stderr, flush=True)
 
 
 def _main(argv: list[str] | None) -> int:
@@ -172,6 +186,7 @@ def _main(argv: list[str] | None) -> int:
         return int(args.func(args) or 0)
     except InputError as exc:
         print(f"hbayes: error: {exc}", file=sys.stderr)
+        _notes(exc)
         return 2
     except KeyboardInterrupt as exc:
         return _interrupted(exc, args.command)

@@ -52,6 +52,7 @@ from pydantic import (
     BeforeValidator,
     ConfigDict,
     Field,
+    PrivateAttr,
     ValidationError,
     field_validator,
     model_validator,
@@ -451,6 +452,12 @@ class CalibrationConfig(_Strict):
         "orders for the accuracy-vs-identifiability comparison",
     )
     base_dir: str | None = Field(default=None, description="set by load_config")
+    _source_text: str | None = PrivateAttr(default=None)
+
+    @property
+    def source_text(self) -> str | None:
+        """The YAML text the config was read from (set by :func:`load_config`)."""
+        return self._source_text
 
     @model_validator(mode="after")
     def _needs_models(self):
@@ -475,6 +482,21 @@ class CalibrationConfig(_Strict):
     def resolved(self) -> dict:
         """The config with defaults filled in (what ``config.yaml`` in a run holds)."""
         return self.model_dump(mode="json", exclude={"base_dir"})
+
+    def portable(self) -> dict:
+        """:meth:`resolved` with absolute data paths: re-runs from any folder."""
+        d = self.resolved()
+        data = d["data"]
+        sources = [data.get("weather"), *(data.get("measurements") or [])]
+        sources.append((data.get("ground_temperature") or {}).get("source"))
+        for src in sources:
+            if src and src.get("path") is not None:
+                p = src["path"]
+                absolute = [
+                    str(self.path(q).absolute()) for q in ([p] if isinstance(p, str) else p)
+                ]
+                src["path"] = absolute[0] if isinstance(p, str) else absolute
+        return d
 
     def path(self, p: str) -> Path:
         """A data path resolved against the config file's folder."""
@@ -587,12 +609,15 @@ def load_config(path) -> CalibrationConfig:
     if not p.is_file():
         raise ConfigError(f"{p}: config file not found")
     try:
-        raw = yaml.safe_load(p.read_text(encoding="utf-8"))
+        text = p.read_text(encoding="utf-8")
+        raw = yaml.safe_load(text)
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
         raise ConfigError(f"{p}: not valid YAML{where}: {getattr(exc, 'problem', exc)}") from None
-    return parse_config(raw, source=str(p), base_dir=str(p.parent.resolve()), name=p.stem)
+    cfg = parse_config(raw, source=str(p), base_dir=str(p.parent.resolve()), name=p.stem)
+    cfg._source_text = text
+    return cfg
 
 
 def chain_tag(cfg: CalibrationConfig) -> str:

@@ -158,3 +158,198 @@ def load_run(path: str | Path) -> Run:
     idata = az.from_netcdf(str(p / "posterior.nc"), engine="h5netcdf")
     models = {s: build_model(cfg, s) for s in SECTIONS if getattr(cfg, s) is not None}
     return Run(path=p, config=cfg, idata=idata, summary=summary, models=models)
+
+
+# ------------------------------------------------------------------ writing a run
+#: What ``hbayes calibrate`` writes into a run directory (besides ``chain_<model>.h5``).
+RUN_FILES = (
+    "config.yaml",
+    "config.original.yaml",
+    "posterior.nc",
+    "summary.json",
+    "report.html",
+)
+
+
+def _ours(name: str) -> bool:
+    return name in RUN_FILES or (name.startswith("chain_") and ".h5" in name)
+
+
+def is_run_directory(path: str | Path) -> bool:
+    """True for a folder ``hbayes calibrate`` wrote (outputs or chain checkpoints)."""
+    p = Path(path)
+    if not p.is_dir():
+        return False
+    done = (p / "summary.json").is_file() and (p / "posterior.nc").is_file()
+    return done or any(p.glob("chain_*.h5"))
+
+
+def saved_chains(out: str | Path) -> list[Path]:
+    """The chain checkpoints ``--resume`` would continue for the run directory ``out``:
+    those of an unfinished run (its staging folder) or else of the finished one."""
+    out = Path(out)
+    staged = sorted(staging_path(out).glob("chain_*.h5"))
+    return staged or sorted(out.glob("chain_*.h5"))
+
+
+def staging_path(out: Path) -> Path:
+    """Where a run into ``out`` is written until it is complete (a hidden sibling)."""
+    return out.parent / f".{out.name}.partial"
+
+
+class RunWriter:
+    """The writer's side of a run directory: lock, staging folder, swap at the end.
+
+    A run writes into ``.<name>.partial`` beside ``out`` (chains included, so that
+    ``--resume`` continues them) and only a complete run replaces ``out``, by renaming:
+    a failed or interrupted re-run leaves the previous run intact. One run at a time:
+    ``.<name>.lock`` beside ``out`` is locked (``flock``, released by the kernel even
+    when the process is killed) and names the holder. ``out`` must be a run directory,
+    empty or new; anything else is refused unless ``force`` (files named like the
+    run's outputs are then replaced, others kept).
+
+    Use as a context manager: ``with RunWriter(out) as w: ... write into w.staging ...;
+    w.commit()``.
+    """
+
+    def __init__(self, out: str | Path, *, force: bool = False, resume: bool = False):
+        self.out = Path(out).absolute()
+        self.force = force
+        self.resume = resume
+        self.staging = staging_path(self.out)
+        self.lock_path = self.out.parent / f".{self.out.name}.lock"
+        self.committed = False
+        self._fd: int | None = None
+        self._made_parent = False
+
+    # -- checks that need no data: called before anything is read
+    def check(self) -> None:
+        """Raise :class:`InputError` if ``out`` cannot or may not be written."""
+        out = self.out
+        if out.exists() and not out.is_dir():
+            raise InputError(f"--out {out}: is a file, not a folder")
+        anc = out.parent
+        while not anc.exists():
+            anc = anc.parent
+        if not anc.is_dir():
+            raise InputError(f"--out {out}: {anc} is a file, not a folder")
+        import os
+
+        if not os.access(anc, os.W_OK | os.X_OK):
+            raise InputError(f"--out {out}: no permission to write in {anc}")
+        if out.is_dir() and not self.force and not is_run_directory(out):
+            entries = sorted(e.name for e in out.iterdir())
+            if entries:
+                shown = ", ".join(entries[:5]) + (", ..." if len(entries) > 5 else "")
+                raise InputError(
+                    f"--out {out}: the folder exists and is not a run directory of hbayes "
+                    f"(it holds {shown}); choose another folder, or add --force to write "
+                    "into it (files named like the run's outputs are then replaced, "
+                    "others kept)"
+                )
+
+    def __enter__(self):
+        import fcntl
+        import os
+        import shutil
+
+        self.check()
+        self._made_parent = not self.out.parent.exists()
+        try:
+            self.out.parent.mkdir(parents=True, exist_ok=True)
+            self._lock(fcntl, os)
+        except PermissionError as exc:
+            raise InputError(f"--out {self.out}: cannot write ({exc.strerror})") from None
+        old = self.out.parent / f".{self.out.name}.old"
+        if old.is_dir() and not self.out.exists():  # a swap was cut short: undo it
+            os.rename(old, self.out)
+        elif old.is_dir():
+            shutil.rmtree(old, ignore_errors=True)
+        if not self.resume and self.staging.exists():
+            shutil.rmtree(self.staging)
+        self.staging.mkdir(exist_ok=True)
+        if self.resume:  # extend a finished run: its chains the staging folder lacks
+            for p in self.out.glob("chain_*.h5"):
+                if not (self.staging / p.name).exists():
+                    shutil.copy2(p, self.staging / p.name)
+        return self
+
+    def _lock(self, fcntl, os) -> None:
+        import datetime
+        import socket
+
+        while True:
+            fd = os.open(self.lock_path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW, 0o644)
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                holder = os.read(fd, 1000).decode("utf-8", "replace").strip() or "unknown"
+                os.close(fd)
+                raise InputError(
+                    f"--out {self.out}: another hbayes run is writing it ({holder}); "
+                    "wait for it to end or choose another folder"
+                ) from None
+            try:  # the file may have been removed by the holder that just released it
+                same = os.stat(self.lock_path).st_ino == os.fstat(fd).st_ino
+            except FileNotFoundError:
+                same = False
+            if same:
+                break
+            os.close(fd)
+        now = datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds")
+        os.ftruncate(fd, 0)
+        os.write(fd, f"pid {os.getpid()} on {socket.gethostname()}, since {now}".encode())
+        self._fd = fd
+
+    def commit(self) -> None:
+        """Make the staging folder the run directory (keeping the user's other files)."""
+        import os
+        import shutil
+
+        from heritage_bayes.inference.sampler import _DeferSignals
+
+        old = self.out.parent / f".{self.out.name}.old"
+        with _DeferSignals():
+            if self.out.is_dir():
+                for e in self.out.iterdir():
+                    if not _ours(e.name) and not (self.staging / e.name).exists():
+                        os.rename(e, self.staging / e.name)
+                os.rename(self.out, old)
+            os.rename(self.staging, self.out)
+            self.committed = True
+        shutil.rmtree(old, ignore_errors=True)
+
+    def left_behind(self) -> str:
+        """What an unfinished run leaves, for the error message."""
+        chains = sorted(p.name for p in self.staging.glob("chain_*.h5"))
+        prev = (
+            f"{self.out} is unchanged"
+            if self.out.exists()
+            else f"nothing was written to {self.out}"
+        )
+        if chains:
+            return (
+                f"{prev}; the chains so far ({', '.join(chains)}) are kept in "
+                f"{self.staging}, which --resume continues"
+            )
+        return prev
+
+    def __exit__(self, *exc):
+        import os
+        import shutil
+
+        if not self.committed and self.staging.is_dir():
+            if not any(self.staging.glob("chain_*.h5")):
+                shutil.rmtree(self.staging, ignore_errors=True)
+        if self._fd is not None:
+            try:
+                os.unlink(self.lock_path)
+            finally:
+                os.close(self._fd)
+                self._fd = None
+        if self._made_parent and not self.committed:
+            try:  # nothing left: remove the folder this run created
+                self.out.parent.rmdir()
+            except OSError:
+                pass
+        return False

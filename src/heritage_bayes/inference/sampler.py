@@ -38,7 +38,6 @@ from __future__ import annotations
 import json
 import os
 import signal
-import tempfile
 import threading
 import time
 from dataclasses import dataclass, field
@@ -219,11 +218,9 @@ class _Checkpoint:
         self.tag = tag
 
     def create(self, nwalkers: int, ndim: int) -> None:
-        fd, tmp = tempfile.mkstemp(
-            prefix=f".{self.path.name}.", suffix=".tmp", dir=self.path.parent
-        )
-        os.close(fd)
-        try:
+        from heritage_bayes.inference.results import atomic_write
+
+        def write(tmp: Path) -> None:
             with h5py.File(tmp, "w") as f:
                 f.attrs["tag"] = self.tag
                 f.attrs["format"] = self.FORMAT
@@ -237,10 +234,8 @@ class _Checkpoint:
                         chunks=(64, *shape),
                         fletcher32=True,
                     )
-            os.replace(tmp, self.path)
-        except BaseException:
-            Path(tmp).unlink(missing_ok=True)
-            raise
+
+        atomic_write(self.path, write)
 
     def append(self, chain, log_prob, accepted, random_state, tau_history) -> None:
         """Write ``chain``/``log_prob`` rows after the last commit, then commit them."""

@@ -41,8 +41,9 @@ def _room_task(spec: RoomSpec, out_dir: str, resume: bool) -> dict:
             row["message"] = "done in an earlier run (--resume)"
         else:
             from heritage_bayes.calibrate import run_calibration
+            from heritage_bayes.run import saved_chains
 
-            has_chain = any(run_dir.glob("chain_*.h5"))
+            has_chain = bool(saved_chains(run_dir))
             run_calibration(cfg, run_dir, resume=resume and has_chain, quiet=True)
             row["status"] = "done"
             row["message"] = "resumed the saved chains" if resume and has_chain else ""

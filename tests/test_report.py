@@ -26,13 +26,11 @@ from heritage_bayes.config import parse_config
 from heritage_bayes.errors import InputError
 from heritage_bayes.report import write_report
 from heritage_bayes.report._diag import acf, cumulative_periodogram, innovations
-from heritage_bayes.report.build import (
-    SECTIONS,
-    convergence_verdict,
-    fmt,
-    ladder_metrics,
-    prior_text,
-)
+from heritage_bayes.report.build import SECTIONS
+from heritage_bayes.report.format import fmt, prior_text
+from heritage_bayes.report.page import Section, render_page, script_hash
+from heritage_bayes.report.sections.identifiability import ladder_metrics
+from heritage_bayes.report.verdict import convergence_verdict, ess_class, rhat_class, run_notes
 
 ROOM = "<script>alert(1)</script>"
 BUILDING = 'Château "Ter <b>Horst</b>" & Co'
@@ -394,6 +392,59 @@ def test_convergence_verdict_levels():
     assert convergence_verdict(_summary(1.001, 5000, tau_ok=False))["level"] == "amber"
     # NaN R-hat is red, not silently green
     assert convergence_verdict(_summary(float("nan"), 5000))["level"] == "red"
+
+
+def test_verdict_classes_and_notes():
+    assert [rhat_class(r, 1.01) for r in (1.005, 1.03, 1.2, None, float("nan"))] == [
+        "ok",
+        "warn",
+        "bad",
+        "bad",
+        "bad",
+    ]
+    assert [ess_class(e, 400.0) for e in (500, 150, 20, float("nan"))] == [
+        "ok",
+        "warn",
+        "bad",
+        "bad",
+    ]
+    s = {"irradiance_source": "measured (logger)", "parameters": {}, "models": {}}
+    assert run_notes(s, []) == []
+    notes = run_notes(s, ["chain_thermal.h5"], irradiance_setting="clear_sky")
+    assert [n["title"] for n in notes] == [
+        "Solar radiation is a clear-sky proxy",
+        "Chain files missing",
+    ]
+    assert "chain_thermal.h5" in notes[1]["text"]
+
+
+def test_house_page_builder():
+    html = render_page(
+        'A <b>"title"</b>',
+        [
+            ("Plain & simple", "<p>one</p>"),
+            Section("Second", "<p>two</p>", id="two", lead="<div id='lead'>L</div>"),
+        ],
+        subtitle="<sub>",
+        window_title="Tab <x>",
+        header_note="note <y>",
+        generator="heritage_bayes test",
+    )
+    assert "default-src 'none'; img-src data:; style-src 'unsafe-inline'; base-uri" in html
+    assert "<script" not in html and "script-src" not in html
+    assert "<title>Tab &lt;x&gt;</title>" in html
+    assert "A &lt;b&gt;&#34;title&#34;&lt;/b&gt;" in html and "&lt;sub&gt;" in html
+    assert '<div class="muted">note &lt;y&gt;</div>' in html
+    assert re.findall(r'<section id="([^"]+)">', html) == ["plain-simple", "two"]
+    assert '<a href="#two">Second</a>' in html
+    assert html.index("<div id='lead'>L</div>") < html.index("<h2>Second</h2>")
+    assert "<footer>heritage_bayes test</footer>" in html
+    assert "--red-bg" in html  # the house CSS, shared with report.html
+    js = "document.title = 'x';"
+    html = render_page("t", [("s", "")], script=js, footer="done")
+    assert f"script-src '{script_hash(js)}'" in html and f"<script>{js}</script>" in html
+    assert "<footer>done</footer>" in html
+    assert "<title>t</title>" in html and "<nav" not in html  # one section: no contents
 
 
 def test_formatting():

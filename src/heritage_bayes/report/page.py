@@ -1,10 +1,35 @@
-"""The house page: one self-contained HTML page in the calibration report's style.
+"""The house page builder: one self-contained HTML page in the package's style.
 
-For every page the package writes besides the calibration report (portfolio overview,
-and pages of later layers): the same CSS (``templates/house.css``, shared with
-``report.html``), the same Content-Security-Policy (no network access, images only as
-``data:`` URIs), autoescaped titles. Section bodies are HTML the caller built and
-escaped; an optional inline script is allowed by its SHA-256 hash only.
+Every page the package writes is built here: the calibration report
+(:mod:`heritage_bayes.report.build`), the portfolio overview, and the pages of later
+layers (projection, comparison). One function, :func:`render_page`, takes a title and a
+list of sections and returns the page, with
+
+- the house CSS (``templates/house.css``: verdict boxes ``div.verdict.green|amber|red``,
+  notes ``div.note.amber|info``, tables in ``div.scroll``, ``td.num``, ``.ok``/``.warn``/
+  ``.bad`` cells, figures, ``dl.meta``, ``pre.config``, ``table.sortable``);
+- the same Content-Security-Policy: no network access, images only as ``data:`` URIs
+  (embed figures with :func:`heritage_bayes.report.figures.to_png_uri`), no script
+  unless one is passed, which is then allowed by its SHA-256 hash only;
+- autoescaped titles; a table of contents when there is more than one section.
+
+Section bodies are trusted HTML that the caller built: escape every user or run text in
+them (``html.escape``, or a jinja2 template with autoescaping).
+
+Example
+-------
+>>> from heritage_bayes.report.page import Section, render_page
+>>> html = render_page(
+...     "Projection — Castle X",
+...     [
+...         ("Summary", "<p>Warmer by 1.2 °C in 2050.</p>"),
+...         Section("Risk", "<p>…</p>", id="risk", lead="<div class='note amber'>…</div>"),
+...     ],
+...     subtitle="Great hall",
+...     generator="heritage_bayes 0.1.0",
+... )
+>>> html.startswith("<!DOCTYPE html>") and 'id="risk"' in html
+True
 """
 
 from __future__ import annotations
@@ -14,10 +39,33 @@ import hashlib
 import re
 from collections.abc import Sequence
 from functools import lru_cache
+from typing import NamedTuple
 
 from markupsafe import Markup
 
-__all__ = ["render_page", "script_hash"]
+__all__ = ["Section", "render_page", "script_hash"]
+
+
+class Section(NamedTuple):
+    """One section of a house page.
+
+    Attributes
+    ----------
+    title : str
+        Heading (``<h2>``) and table-of-contents entry; plain text (escaped).
+    body : str
+        Trusted HTML under the heading.
+    id : str
+        Anchor of the section (``<section id=…>``); default: a slug of the title.
+    lead : str
+        Trusted HTML above the heading (e.g. the report's verdict box, which must be the
+        first thing a reader sees); default none.
+    """
+
+    title: str
+    body: str
+    id: str = ""
+    lead: str = ""
 
 
 @lru_cache(maxsize=1)
@@ -43,41 +91,59 @@ def _slug(text: str, i: int) -> str:
 
 def render_page(
     title: str,
-    sections: Sequence[tuple[str, str]],
+    sections: Sequence[Section | tuple[str, str]],
     *,
     subtitle: str = "",
     generator: str = "heritage_bayes",
     footer: str = "",
     script: str = "",
+    window_title: str = "",
+    header_note: str = "",
 ) -> str:
     """A self-contained page in the house style.
 
     Parameters
     ----------
     title, subtitle : str
-        Plain text (escaped here).
-    sections : sequence of (title, html)
-        Section titles (plain text) and bodies (trusted HTML: escape user text in them).
-    generator, footer : str
-        Plain text for the ``generator`` meta tag and the footer.
+        The page heading (``<h1>``) and the line under it; plain text (escaped here).
+    sections : sequence of Section or (title, html)
+        The sections in page order: a :class:`Section`, or a ``(title, body)`` pair
+        (plain-text title, trusted-HTML body: escape user text in it).
+    generator : str
+        Plain text for the ``generator`` meta tag (e.g. ``"heritage_bayes 0.1.0"``).
+    footer : str
+        Plain text of the footer; default: ``generator``.
     script : str
         An optional inline script, allowed by its hash in the CSP (no other script runs).
+    window_title : str
+        Plain text of ``<title>`` (the browser tab); default: ``title``.
+    header_note : str
+        Plain text in a muted line under the heading; default none.
 
     Returns
     -------
     str
         The HTML page.
     """
-    secs = [
-        {"id": _slug(t, i), "title": t, "body": Markup(body)}
-        for i, (t, body) in enumerate(sections)
-    ]
+    secs = []
+    for i, sec in enumerate(sections):
+        s = Section(*sec)
+        secs.append(
+            {
+                "id": s.id or _slug(s.title, i),
+                "title": s.title,
+                "body": Markup(s.body),
+                "lead": Markup(s.lead),
+            }
+        )
     return (
         _env()
         .get_template("page.html")
         .render(
             title=title,
+            window_title=window_title or title,
             subtitle=subtitle,
+            header_note=header_note,
             sections=secs,
             generator=generator,
             footer=footer,

@@ -1,0 +1,127 @@
+"""What the report reads from a run directory, and small helpers on it.
+
+:func:`load_run_data` checks the directory (``REQUIRED_FILES``), loads it with
+:func:`heritage_bayes.run.load_run` and returns a :class:`RunData`; the helpers turn
+its ``posterior.nc`` groups and ``summary.json`` into arrays and labels.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from heritage_bayes.errors import InputError
+
+__all__ = [
+    "REQUIRED_FILES",
+    "RunData",
+    "flat_draws",
+    "load_run_data",
+    "measurement_gaps",
+    "model_label",
+    "section_params",
+    "time_axis",
+    "utc64",
+]
+
+#: Files a run directory must hold for a report.
+REQUIRED_FILES = ("posterior.nc", "summary.json", "config.yaml")
+
+
+@dataclass
+class RunData:
+    path: Path
+    run: object  # heritage_bayes.run.Run
+    summary: dict
+    config_text: str
+
+    @property
+    def cfg(self):
+        return self.run.config
+
+    @property
+    def idata(self):
+        return self.run.idata
+
+
+def load_run_data(run_dir) -> RunData:
+    p = Path(run_dir)
+    if not p.is_dir():
+        raise InputError(f"{p}: run directory not found; run `hbayes calibrate` first")
+    missing = [n for n in REQUIRED_FILES if not (p / n).is_file()]
+    if missing:
+        raise InputError(
+            f"{p}: not a complete run directory ({', '.join(missing)} "
+            f"{'is' if len(missing) == 1 else 'are'} missing); run "
+            "`hbayes calibrate` first"
+        )
+    try:
+        json.loads((p / "summary.json").read_text(encoding="utf-8"))
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise InputError(
+            f"{p / 'summary.json'}: not valid JSON ({exc}); the run "
+            "directory is damaged, run `hbayes calibrate` again"
+        ) from None
+    from heritage_bayes.run import load_run
+
+    try:
+        run = load_run(p)
+    except InputError:
+        raise
+    except (OSError, ValueError, KeyError) as exc:
+        raise InputError(
+            f"{p / 'posterior.nc'}: cannot be read ({exc}); the run "
+            "directory is damaged, run `hbayes calibrate` again"
+        ) from None
+    text = (p / "config.yaml").read_text(encoding="utf-8")
+    return RunData(path=p, run=run, summary=run.summary, config_text=text)
+
+
+def time_axis(ds) -> np.ndarray:
+    return np.asarray(ds["time"].values).astype("datetime64[ns]")
+
+
+def utc64(text: str) -> np.datetime64:
+    import pandas as pd
+
+    ts = pd.Timestamp(text)
+    if ts.tzinfo is not None:
+        ts = ts.tz_convert("UTC").tz_localize(None)
+    return np.datetime64(ts.to_datetime64(), "ns")
+
+
+def flat_draws(da) -> np.ndarray:
+    """(chain, draw, time) DataArray -> (chain·draw, time) float array."""
+    v = np.asarray(da.values, dtype=float)
+    return v.reshape(-1, v.shape[-1])
+
+
+def model_label(summary: dict, m: str) -> str:
+    if m == "combined":
+        models = summary.get("models") or {}
+        return " + ".join(str(models[k].get("model", k)) for k in models)
+    return str((summary.get("models") or {}).get(m, {}).get("model", m))
+
+
+def section_params(summary: dict, m: str) -> dict:
+    return {
+        k.split(".", 1)[1]: v
+        for k, v in (summary.get("parameters") or {}).items()
+        if k.startswith(f"{m}.")
+    }
+
+
+def measurement_gaps(rd: RunData, dt: np.timedelta64, column: str | None = None) -> list[tuple]:
+    """Measurement gaps as (start, end) datetime64 pairs (of one column, or of all)."""
+    out = []
+    for g in (rd.summary.get("alignment") or {}).get("measurement_gaps") or []:
+        if column is not None and g.get("column") != column:
+            continue
+        try:
+            out.append((utc64(g["start"]), utc64(g["end"]) + dt))
+        except (KeyError, TypeError, ValueError):
+            continue
+    return sorted(set(out))

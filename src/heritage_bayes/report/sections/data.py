@@ -1,0 +1,219 @@
+"""Section 2, data: the inputs and measurements over time, and what the alignment did."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from heritage_bayes.report.format import fmt_int, fmt_time
+from heritage_bayes.report.page import Section
+from heritage_bayes.report.rundata import RunData, measurement_gaps, time_axis
+from heritage_bayes.report.sections._fragment import render_fragment
+
+ID, TITLE = "data", "2. Data"
+
+
+def _input_units(rd: RunData) -> dict:
+    units = {}
+    for model in rd.run.models.values():
+        for c in model.input_names:
+            try:
+                units[c] = model.network.input_unit(c)
+            except (StopIteration, KeyError, AttributeError):
+                units[c] = ""
+    return units
+
+
+def data_context(rd: RunData) -> dict:
+    import pandas as pd
+
+    from heritage_bayes.report.figures import C_MEAS, fig_data_overview
+
+    idata = rd.idata
+    const = idata.constant_data
+    obs = idata.observed_data
+    times = time_axis(const)
+    codes = np.asarray(const["period"].values)
+    dt = np.median(np.diff(times[:1000])) if times.size > 1 else np.timedelta64(3600, "s")
+    units = _input_units(rd)
+    inputs = [c for c in const.data_vars if c != "period" and not c.startswith("interpolated.")]
+    flags = {
+        c.split(".", 1)[1]: np.asarray(const[c].values).astype(bool)
+        for c in const.data_vars
+        if c.startswith("interpolated.")
+    }
+    used: set[str] = set()
+
+    def series(name, label, style, source):
+        used.add(name)
+        return (name, f"{name} {label}", times, np.asarray(source[name].values, dtype=float), style)
+
+    panels = []
+    temp = [
+        series(c, lab, st, const)
+        for c, lab, st in (
+            ("Te", "(outdoor)", {"color": "#7f8c8d", "lw": 0.6}),
+            ("Tf", "(fixed / ground)", {"color": "#8e44ad", "lw": 1.0, "ls": "--"}),
+        )
+        if c in inputs
+    ]
+    if "Ti" in obs:
+        temp.append(series("Ti", "(indoor, measured)", {"color": C_MEAS, "lw": 0.7}, obs))
+    if temp:
+        panels.append({"ylabel": "temperature [°C]", "series": temp})
+    vap = (
+        [series("Pe", "(outdoor)", {"color": "#7f8c8d", "lw": 0.6}, const)]
+        if "Pe" in inputs
+        else []
+    )
+    vap += [
+        series(c, lab, st, const)
+        for c, lab, st in (("Pf", "(fixed)", {"color": "#8e44ad", "lw": 1.0, "ls": "--"}),)
+        if c in inputs
+    ]
+    if "Pi" in obs:
+        vap.append(series("Pi", "(indoor, measured)", {"color": C_MEAS, "lw": 0.7}, obs))
+    if vap:
+        panels.append({"ylabel": "vapour pressure [Pa]", "series": vap})
+    if "RHi" in obs:
+        panels.append(
+            {
+                "ylabel": "relative humidity [%]",
+                "series": [series("RHi", "(indoor, measured)", {"color": C_MEAS, "lw": 0.7}, obs)],
+            }
+        )
+    irr = [c for c in inputs if units.get(c) == "W/m²" or c.startswith("I_")]
+    if irr:
+        ser = []
+        for c in irr:
+            daily = (
+                pd.Series(np.asarray(const[c].values, dtype=float), index=pd.DatetimeIndex(times))
+                .resample("1D")
+                .mean()
+            )
+            ser.append(
+                (
+                    c,
+                    f"{c} (daily mean)",
+                    daily.index.values + np.timedelta64(12, "h"),
+                    daily.to_numpy(),
+                    {"lw": 1.0},
+                )
+            )
+            used.add(c)
+        panels.append({"ylabel": "solar irradiance [W/m²]", "series": ser})
+    for c in inputs:
+        if c not in used:
+            u = units.get(c, "")
+            panels.append(
+                {
+                    "ylabel": f"{c} [{u}]" if u else c,
+                    "series": [series(c, "(input)", {"color": "#7f8c8d", "lw": 0.6}, const)],
+                }
+            )
+    fig = fig_data_overview(times, codes, panels, measurement_gaps(rd, dt), flags)
+    al = rd.summary.get("alignment") or {}
+    period = al.get("period") or {}
+    rows = []
+    for role, n in (al.get("rows_in") or {}).items():
+        rows.append(
+            {
+                "role": role,
+                "rows_in": fmt_int(n),
+                "dropped": fmt_int((al.get("rows_dropped") or {}).get(role)),
+            }
+        )
+    interp = [
+        {
+            "column": c,
+            "filled": fmt_int(n),
+            "flagged": fmt_int((al.get("flagged_rows") or {}).get(c)),
+        }
+        for c, n in (al.get("interpolated") or {}).items()
+    ]
+    gaps = []
+    for kind, key in (
+        ("input (filled by interpolation)", "input_gaps"),
+        ("measurement", "measurement_gaps"),
+    ):
+        for g in al.get(key) or []:
+            gaps.append(
+                {
+                    "kind": kind,
+                    "column": g.get("column", "?"),
+                    "start": fmt_time(g.get("start")),
+                    "end": fmt_time(g.get("end")),
+                    "length": g.get("length", "?"),
+                    "n": fmt_int(g.get("n_missing")),
+                    "filled": "yes" if g.get("filled") else "no",
+                }
+            )
+    missing = [
+        {"column": c, "n": fmt_int(n)} for c, n in (al.get("measurement_missing") or {}).items()
+    ]
+    sources = []
+    for src in al.get("sources") or []:
+        sources.append(
+            {
+                "role": src.get("role", ""),
+                "source": src.get("source", ""),
+                "columns": ", ".join(map(str, src.get("columns") or [])),
+                "timezone": src.get("timezone", ""),
+                "averaged": ", ".join(map(str, src.get("averaged") or [])),
+            }
+        )
+    n_interp = sum(int(v or 0) for v in (al.get("interpolated") or {}).values())
+    n_flag = sum(int(v or 0) for v in (al.get("flagged_rows") or {}).values())
+    spans: dict[tuple, list[str]] = {}
+    for g in al.get("measurement_gaps") or []:
+        spans.setdefault((g.get("start"), g.get("end")), []).append(str(g.get("column")))
+    n_gap_meas = len(spans)
+    words = (
+        f"The data were aligned on a {period.get('step', '?')} grid from "
+        f"{fmt_time(period.get('start'))} to {fmt_time(period.get('end'))} "
+        f"({fmt_int(period.get('n_rows'))} rows). "
+    )
+    if n_interp:
+        words += (
+            f"{fmt_int(n_interp)} missing input values were filled by interpolation "
+            f"(gaps up to {al.get('max_gap', '?')}), affecting {fmt_int(n_flag)} "
+            "rows (marked × in the figure). "
+        )
+    else:
+        words += "No input value had to be interpolated. "
+    if n_gap_meas:
+        longest = max(
+            (float(g.get("length_hours") or 0) for g in al.get("measurement_gaps") or []),
+            default=0.0,
+        )
+        words += (
+            f"The measurements have {n_gap_meas} "
+            f"{'gap' if n_gap_meas == 1 else 'gaps'} (hatched; the longest "
+            f"{longest:g} h): missing measurements are left out of the likelihood "
+            "and the metrics, never filled. "
+        )
+    else:
+        words += "The measurements have no gaps. "
+    dropped = sum(int(v or 0) for v in (al.get("rows_dropped") or {}).values())
+    if dropped:
+        words += (
+            f"{fmt_int(dropped)} rows of the input tables lie outside this period "
+            "and were not used."
+        )
+    return {
+        "figure": fig,
+        "rows": rows,
+        "interpolated": interp,
+        "gaps": gaps,
+        "missing": missing,
+        "sources": sources,
+        "words": words.strip(),
+        "irradiance": rd.summary.get("irradiance_source", "?"),
+        "ground": ((rd.summary.get("sources") or {}).get("ground_temperature") or {}).get(
+            "method", ""
+        ),
+    }
+
+
+def section(ctx: dict) -> Section:
+    """This section of the page, from the report context (figures already data URIs)."""
+    return Section(TITLE, render_fragment("data.html", ctx), id=ID)

@@ -1,0 +1,242 @@
+"""Section 7, sampler diagnostics: chains, τ history, trace plots, residual checks."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from heritage_bayes.errors import InputError
+from heritage_bayes.report.format import OUT_UNITS, fmt_int, fmt_pct
+from heritage_bayes.report.page import Section
+from heritage_bayes.report.rundata import RunData, section_params
+from heritage_bayes.report.sections._fragment import render_fragment
+
+ID, TITLE = "diagnostics", "7. Sampler diagnostics"
+
+_TRACE_POINTS = 400  # thinned steps per walker in trace plots
+
+
+def _parameter_set(rd: RunData, m: str):
+    """The sampler's ParameterSet of section ``m``, or None if it does not match the run."""
+    from heritage_bayes.inference.likelihoods import get_noise_model
+    from heritage_bayes.inference.parameters import parameters_for
+
+    try:
+        sec = getattr(rd.cfg, m)
+        ps = parameters_for(
+            rd.run.models[m],
+            get_noise_model(sec.noise),
+            sec.priors,
+            room_volume=sec.room_volume or rd.cfg.room_volume,
+            where=f"{m}.priors",
+        )
+    except (InputError, AttributeError, KeyError, ValueError):
+        return None
+    names = list(((rd.summary.get("correlations") or {}).get(m) or {}).get("names") or [])
+    if list(ps.free_names) != names:
+        return None
+    params = section_params(rd.summary, m)
+    for n in names:
+        if ps[n].prior.describe() != (params.get(n) or {}).get("prior"):
+            return None
+    return ps
+
+
+def _traces(rd: RunData, m: str, info: dict):
+    import h5py
+
+    from heritage_bayes.report.figures import fig_traces
+
+    path = rd.path / f"chain_{m}.h5"
+    if not path.is_file():
+        return None
+    try:
+        with h5py.File(path, "r") as f:
+            n = f["chain"].shape[0]
+            stride = max(1, math.ceil(n / _TRACE_POINTS))
+            X = f["chain"][::stride]
+            lp = f["log_prob"][::stride]
+    except (OSError, KeyError) as exc:
+        raise InputError(f"{path}: cannot be read ({exc})") from None
+    steps = np.arange(0, n, stride)[: X.shape[0]]
+    names = list(((rd.summary.get("correlations") or {}).get(m) or {}).get("names") or [])
+    params = section_params(rd.summary, m)
+    ps = _parameter_set(rd, m)
+    S, W, d = X.shape
+    if ps is not None and d == ps.ndim:
+        theta = ps.values(X.reshape(-1, d))
+        idx = [ps.names.index(nm) for nm in ps.free_names]
+        V = theta[:, idx].reshape(S, W, d)
+        labels = []
+        for j, nm in enumerate(ps.free_names):
+            p = ps[nm]
+            unit = p.unit if p.unit and p.unit != "-" else ""
+            if p.prior.log_scale:
+                V[:, :, j] = np.log10(V[:, :, j])
+                labels.append(f"log10 {nm}" + (f" [{unit}]" if unit else ""))
+            else:
+                labels.append(nm + (f" [{unit}]" if unit else " [-]"))
+        coords = "parameter values (log10 where the prior is log-scale)"
+    else:
+        V = X
+        labels = (
+            [f"{nm} (sampler coordinate)" for nm in names]
+            if len(names) == d
+            else [f"x{j}" for j in range(d)]
+        )
+        coords = "the sampler's unconstrained coordinates"
+    del params
+    ch = info.get("chain") or {}
+    fig = fig_traces(
+        steps,
+        V,
+        labels,
+        lp,
+        int(ch.get("burn", 0)),
+        title=f"{m} ({info.get('model', '')}): {W} walkers, every {stride}th step shown",
+    )
+    return {"figure": fig, "coords": coords}
+
+
+def _residual_check(resid: np.ndarray, phi: float | None, dt_hours: float) -> dict:
+    from heritage_bayes.report._diag import acf, cumulative_periodogram, innovations
+
+    max_lag = max(1, round(72 / dt_hours))
+    _, rho, n = acf(resid, max_lag)
+    w = innovations(resid, phi or 0.0)
+    _, rho_w, n_w = acf(w, max_lag)
+    band = 1.96 / math.sqrt(max(n_w, 1))
+    out_share = float(np.mean(np.abs(rho_w[1:]) > band)) if rho_w.size > 1 else float("nan")
+    f, c, kb = cumulative_periodogram(w)
+    dev = float(np.nanmax(np.abs(c - 2 * f))) if c.size else float("nan")
+    adequate = out_share <= 0.10 and (not math.isfinite(dev) or dev <= kb)
+    lag1 = float(rho[1]) if rho.size > 1 else float("nan")
+    return {
+        "lag1": lag1,
+        "phi": phi,
+        "out_share": out_share,
+        "dev": dev,
+        "band": kb,
+        "adequate": adequate,
+    }
+
+
+def diagnostics_context(rd: RunData, fits: list[dict]) -> dict:
+    from heritage_bayes.report.figures import fig_residuals, fig_tau_history
+
+    s = rd.summary
+    dt_hours = float(s.get("dt", 3600.0)) / 3600.0
+    crit = s.get("criteria") or {}
+    models = []
+    missing = []
+    for m, info in (s.get("models") or {}).items():
+        ch = info.get("chain") or {}
+        tr = _traces(rd, m, info)
+        if tr is None:
+            missing.append(f"chain_{m}.h5")
+        models.append(
+            {
+                "section": m,
+                "model": info.get("model", m),
+                "walkers": fmt_int(ch.get("walkers")),
+                "steps": fmt_int(ch.get("steps")),
+                "burn": fmt_int(ch.get("burn")),
+                "thin": fmt_int(ch.get("thin")),
+                "draws": fmt_int(ch.get("draws_per_walker")),
+                "tau_max": fmt_int(ch.get("tau_max")),
+                "needed": fmt_int(float(crit.get("tau_factor", 50)) * ch["tau_max"])
+                if ch.get("tau_max") is not None
+                else "—",
+                "converged_tau": bool(ch.get("converged_tau")),
+                "acceptance": fmt_pct(ch.get("acceptance_mean")),
+                "resumed_from": fmt_int(ch.get("resumed_from")),
+                "trace": tr,
+            }
+        )
+    hist = {
+        m: (i.get("chain") or {}).get("tau_history") or []
+        for m, i in (s.get("models") or {}).items()
+    }
+    tau_fig = (
+        fig_tau_history(hist, float(crit.get("tau_factor", 50.0)))
+        if any(len(h) for h in hist.values())
+        else None
+    )
+    residuals = []
+    for fit in fits:
+        if fit["section"] == "combined":
+            continue  # RH is not a model output: its residuals have no noise model
+        m, o = fit["section"], fit["output"]
+        info = (s.get("models") or {}).get(m) or {}
+        cal = fit["codes"] == 1
+        if cal.sum() < 4:
+            continue
+        phi = None
+        if info.get("noise") == "ar1":
+            pv = (s.get("parameters") or {}).get(f"{m}.phi_{o}") or {}
+            phi = pv.get("median")
+        resid = fit["resid"][cal]
+        check = _residual_check(resid, phi, dt_hours)
+        fig = fig_residuals(
+            fit["times"][cal],
+            resid,
+            output=o,
+            unit=OUT_UNITS.get(o, ""),
+            phi=phi,
+            dt_hours=dt_hours,
+        )
+        if phi is not None:
+            words = (
+                f"Lag-1 autocorrelation of the residuals {check['lag1']:.2f}; the "
+                f"AR(1) noise model expects ≈ φ = {phi:.2f}. "
+            )
+            subject = "the innovations left after the AR(1) model"
+        else:
+            words = (
+                f"Lag-1 autocorrelation of the residuals {check['lag1']:.2f}; the iid "
+                "noise model expects ≈ 0. "
+            )
+            subject = "the residuals"
+        share = fmt_pct(check["out_share"])
+        if check["adequate"]:
+            words += (
+                f"The noise model looks adequate: {subject} are close to white "
+                f"noise ({share} of the lags 1–72 h outside the 95 % band)."
+            )
+        else:
+            words += (
+                f"The noise model is not fully adequate: {subject} are not white "
+                f"({share} of the lags 1–72 h outside the 95 % band"
+                + (
+                    ", cumulative periodogram outside its band"
+                    if math.isfinite(check["dev"]) and check["dev"] > check["band"]
+                    else ""
+                )
+                + "). Correlation the noise model misses (e.g. a daily cycle) makes "
+                "the posterior intervals and predictive bands too narrow."
+            )
+        residuals.append(
+            {
+                "id": f"fig-resid-{m}-{o}",
+                "section": m,
+                "output": o,
+                "model": fit["model"],
+                "figure": fig,
+                "words": words,
+                "adequate": check["adequate"],
+            }
+        )
+    return {
+        "models": models,
+        "tau_fig": tau_fig,
+        "residuals": residuals,
+        "missing": missing,
+        "tau_factor": f"{float(crit.get('tau_factor', 50)):g}",
+        "tau_rtol": fmt_pct(crit.get("tau_rtol"), 0),
+    }
+
+
+def section(ctx: dict) -> Section:
+    """This section of the page, from the report context (figures already data URIs)."""
+    return Section(TITLE, render_fragment("diagnostics.html", ctx), id=ID)

@@ -1,0 +1,115 @@
+"""Section 3, fit: measured vs the posterior-predictive model over the periods.
+
+:func:`fit_outputs` lists the predicted and measured outputs; :func:`fit_context` draws
+one figure per output and keeps the residuals of the posterior-median model for the
+diagnostics (section 7).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from heritage_bayes.report.format import OUT_WORDS
+from heritage_bayes.report.page import Section
+from heritage_bayes.report.rundata import (
+    RunData,
+    flat_draws,
+    measurement_gaps,
+    model_label,
+    time_axis,
+)
+from heritage_bayes.report.sections._fragment import render_fragment
+
+ID, TITLE = "fit", "3. Fit"
+
+
+def fit_outputs(rd: RunData) -> list[dict]:
+    """(section, output, pp var, sim var) for every predicted and measured output."""
+    pp = rd.idata.posterior_predictive
+    obs = rd.idata.observed_data
+    out = []
+    for m, info in (rd.summary.get("models") or {}).items():
+        for o in info.get("output_names", []):
+            if f"{m}.{o}" in pp and f"{m}.{o}_sim" in pp and o in obs:
+                out.append(
+                    {
+                        "section": m,
+                        "output": o,
+                        "pp": f"{m}.{o}",
+                        "sim": f"{m}.{o}_sim",
+                        "model": info.get("model", m),
+                    }
+                )
+    if "RHi" in pp and "RHi_sim" in pp and "RHi" in obs:
+        out.append(
+            {
+                "section": "combined",
+                "output": "RHi",
+                "pp": "RHi",
+                "sim": "RHi_sim",
+                "model": model_label(rd.summary, "combined"),
+            }
+        )
+    return out
+
+
+def fit_context(rd: RunData, outputs: list[dict]) -> list[dict]:
+    from heritage_bayes.report.figures import fig_fit
+
+    pp = rd.idata.posterior_predictive
+    obs = rd.idata.observed_data
+    const = rd.idata.constant_data
+    times_pp = time_axis(pp)
+    codes_all = np.asarray(const["period"].values)
+    t_const = time_axis(const)
+    codes = (
+        codes_all
+        if np.array_equal(t_const, times_pp)
+        else np.asarray(const["period"].reindex(time=times_pp, fill_value=-1).values)
+    )
+    dt = np.median(np.diff(times_pp[:1000])) if times_pp.size > 1 else np.timedelta64(3600, "s")
+    items = []
+    for o in outputs:
+        gaps = measurement_gaps(rd, dt, o["output"])
+        Y = flat_draws(pp[o["pp"]])
+        S = flat_draws(pp[o["sim"]])
+        med = np.median(S, axis=0)
+        q = np.quantile(Y, [0.05, 0.25, 0.75, 0.95], axis=0)
+        y = np.asarray(obs[o["output"]].reindex(time=times_pp).values, dtype=float)
+        fig = fig_fit(
+            times_pp,
+            y,
+            med,
+            (q[1], q[2]),
+            (q[0], q[3]),
+            codes,
+            output=o["output"],
+            model_name=o["model"],
+            gaps=gaps,
+        )
+        what = OUT_WORDS.get(o["output"], o["output"])
+        items.append(
+            {
+                "id": f"fig-fit-{o['section']}-{o['output']}",
+                "title": f"{what} ({o['output']}) — {o['model']}",
+                "figure": fig,
+                "caption": (
+                    f"Measured {what} (black) and the model's posterior "
+                    "median (blue line) with the 50 % and 90 % posterior-"
+                    "predictive bands (model and noise). Shading: warm-up "
+                    "(grey, simulated but not fitted), calibration (green), "
+                    "validation (orange); hatched: measurement gaps. Bottom: "
+                    "two-week details."
+                ),
+                "resid": (y - med),
+                "codes": codes,
+                "times": times_pp,
+                **o,
+            }
+        )
+    return items
+
+
+def section(ctx: dict) -> Section:
+    """This section of the page, from the report context (figures already data URIs)."""
+    return Section(TITLE, render_fragment("fit.html", ctx), id=ID)

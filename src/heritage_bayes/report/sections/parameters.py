@@ -1,0 +1,85 @@
+"""Section 5, parameters: posterior median, interval, contraction and sampler checks."""
+
+from __future__ import annotations
+
+from heritage_bayes.report.format import fmt, fmt_int, fmt_pct, prior_text
+from heritage_bayes.report.page import Section
+from heritage_bayes.report.rundata import RunData, section_params
+from heritage_bayes.report.sections._fragment import render_fragment
+from heritage_bayes.report.verdict import ess_class, rhat_class
+
+ID, TITLE = "parameters", "5. Parameters"
+
+
+def parameter_tables(rd: RunData) -> list[dict]:
+    s = rd.summary
+    crit = s.get("criteria") or {}
+    r_ok = float(crit.get("max_rhat", 1.01))
+    e_ok = float(crit.get("min_ess_bulk", 400.0))
+    tables = []
+    for m, info in (s.get("models") or {}).items():
+        ident = (info.get("identifiability") or {}).get("parameters") or {}
+        params = section_params(s, m)
+        has_truth = any(v.get("truth") is not None for v in params.values())
+        rows = []
+        for name, v in params.items():
+            fixed = v.get("fixed")
+            r, e = v.get("r_hat"), v.get("ess_bulk")
+            idf = ident.get(name)
+            if idf is None:
+                id_text = "noise" if v.get("kind") in ("sigma", "phi") else "—"
+            elif idf.get("identifiable"):
+                id_text = "yes"
+            elif idf.get("identifiable_given_scale"):
+                id_text = "if scale pinned"
+            else:
+                id_text = "no"
+            truth = v.get("truth")
+            inside = None
+            if truth is not None and v.get("q05") is not None:
+                inside = v["q05"] <= truth <= v["q95"]
+            rows.append(
+                {
+                    "name": name,
+                    "description": v.get("description", ""),
+                    "unit": v.get("unit", ""),
+                    "prior": "fixed" if fixed is not None else prior_text(v.get("prior")),
+                    "map": fmt(v.get("map")),
+                    "median": fmt(v.get("median")),
+                    "interval": "—"
+                    if fixed is not None
+                    else f"{fmt(v.get('q05'))} … {fmt(v.get('q95'))}",
+                    "at_bound": v.get("at_bound"),
+                    "truth": fmt(truth) if truth is not None else "—",
+                    "inside": inside,
+                    "contraction": "—"
+                    if v.get("contraction") is None
+                    else fmt_pct(v["contraction"]),
+                    "r_hat": "—" if r is None else f"{r:.3f}",
+                    "r_cls": "" if r is None else rhat_class(r, r_ok),
+                    "ess_bulk": fmt_int(e),
+                    "ess_tail": fmt_int(v.get("ess_tail")),
+                    "e_cls": "" if e is None else ess_class(e, e_ok),
+                    "tau": fmt_int(v.get("tau")),
+                    "ident": id_text,
+                }
+            )
+        mp = info.get("map") or {}
+        tables.append(
+            {
+                "section": m,
+                "model": info.get("model", m),
+                "noise": info.get("noise", "?"),
+                "rows": rows,
+                "has_truth": has_truth,
+                "map_lp": fmt(mp.get("log_posterior")),
+                "map_agreed": f"{mp.get('agreed', '?')} of {mp.get('starts', '?')}",
+                "map_method": mp.get("method", "?"),
+            }
+        )
+    return tables
+
+
+def section(ctx: dict) -> Section:
+    """This section of the page, from the report context (figures already data URIs)."""
+    return Section(TITLE, render_fragment("parameters.html", ctx), id=ID)

@@ -1,0 +1,75 @@
+"""Section 8, reproducibility: seed, config, library versions, timings, files."""
+
+from __future__ import annotations
+
+from heritage_bayes._version import __version__
+from heritage_bayes.report.format import fmt, fmt_time
+from heritage_bayes.report.page import Section
+from heritage_bayes.report.rundata import RunData
+from heritage_bayes.report.sections._fragment import render_fragment
+
+ID, TITLE = "reproducibility", "8. Reproducibility"
+
+_VERSIONS = (
+    "numpy",
+    "scipy",
+    "pandas",
+    "xarray",
+    "emcee",
+    "arviz",
+    "matplotlib",
+    "corner",
+    "pvlib",
+    "numba",
+    "h5py",
+    "jinja2",
+)
+
+
+def library_versions(s: dict) -> tuple[list[dict], str]:
+    from importlib.metadata import PackageNotFoundError, version
+
+    recorded = s.get("versions")
+    if isinstance(recorded, dict) and recorded:
+        return [{"name": k, "version": str(v)} for k, v in recorded.items()], "run"
+    rows = [{"name": "heritage_bayes", "version": __version__}]
+    import platform
+
+    rows.append({"name": "python", "version": platform.python_version()})
+    for name in _VERSIONS:
+        try:
+            rows.append({"name": name, "version": version(name)})
+        except PackageNotFoundError:
+            rows.append({"name": name, "version": "not installed"})
+    return rows, "report"
+
+
+def timings(s: dict) -> list[dict]:
+    rows = []
+    for k, v in (s.get("timings") or {}).items():
+        rows.append({"name": k.removesuffix("_seconds").replace("_", " "), "seconds": fmt(v)})
+    if s.get("wall_seconds") is not None:
+        rows.append({"name": "calibration, total", "seconds": fmt(s["wall_seconds"])})
+    return rows
+
+
+def reproducibility_context(rd: RunData) -> dict:
+    """Seed, config hash, run date, timings, run-directory files and library versions."""
+    versions, when = library_versions(rd.summary)
+    return {
+        "config": rd.config_text,
+        "versions": versions,
+        "versions_from": when,
+        "seed": rd.summary.get("seed"),
+        "config_hash": rd.summary.get("config_hash", "?"),
+        "created_at": fmt_time(rd.summary.get("created_at")),
+        "timings": timings(rd.summary),
+        "files": sorted(
+            p.name for p in rd.path.iterdir() if p.is_file() and not p.name.startswith(".")
+        ),
+    }
+
+
+def section(ctx: dict) -> Section:
+    """This section of the page, from the report context (figures already data URIs)."""
+    return Section(TITLE, render_fragment("reproducibility.html", ctx), id=ID)

@@ -1,0 +1,285 @@
+"""The verdict on a run: convergence level (green/amber/red) and its reasons, and the notes.
+
+Pure functions on the run's ``summary.json`` (a dict) and what the report found in the
+run directory; no HTML here (the summary section renders the verdict box,
+:mod:`heritage_bayes.report.sections.summary`). Change the rules here and every page
+that shows a verdict (report, portfolio) follows.
+
+- :func:`convergence_verdict`: the level, a title, plain-words text, one line per model
+  naming what failed, the statistics and the advice;
+- :func:`run_notes`: amber/info notes shown under the verdict (clear-sky solar input,
+  parameters at a prior bound, non-identifiable directions, missing chain files,
+  synthetic data);
+- :func:`rhat_class`, :func:`ess_class`: the traffic-light class of one R-hat or bulk-ESS
+  value (``"ok"``, ``"warn"``, ``"bad"``) used by the parameter tables.
+"""
+
+from __future__ import annotations
+
+import math
+
+from heritage_bayes.report.format import fmt_int, prior_text
+
+__all__ = ["AMBER", "convergence_verdict", "ess_class", "rhat_class", "run_notes"]
+
+#: "Close to converged" (amber) thresholds; green uses the run's own criteria.
+AMBER = {"max_rhat": 1.05, "min_ess_bulk": 100.0}
+
+
+def convergence_verdict(summary: dict) -> dict:
+    """The plain-words convergence verdict of a run's ``summary.json``.
+
+    Returns
+    -------
+    dict
+        ``level`` (``"green"``: converged — τ criterion met, max R-hat and min bulk ESS
+        within the run's criteria; ``"amber"``: close — max R-hat ≤ 1.05 and min bulk
+        ESS ≥ 100; ``"red"``: not converged), ``title``, ``text``, ``models`` (one
+        plain-words line per model) and ``advice``.
+    """
+    crit = summary.get("criteria") or {}
+    r_ok = float(crit.get("max_rhat", 1.01))
+    e_ok = float(crit.get("min_ess_bulk", 400.0))
+    tf = float(crit.get("tau_factor", 50.0))
+    params = summary.get("parameters") or {}
+    lines = []
+    for m, info in (summary.get("models") or {}).items():
+        pr = {
+            k.split(".", 1)[1]: v
+            for k, v in params.items()
+            if k.startswith(f"{m}.") and v.get("r_hat") is not None
+        }
+        ch = info.get("chain") or {}
+        problems = []
+        steps, tmax = ch.get("steps"), ch.get("tau_max")
+        if not ch.get("converged_tau", False):
+            if steps is not None and tmax is not None and math.isfinite(tmax):
+                problems.append(
+                    f"the chains ran {fmt_int(steps)} steps but need at least "
+                    f"{tf:g} × τ = {fmt_int(tf * tmax)} steps (τ ≈ {fmt_int(tmax)}) with a "
+                    "stable τ"
+                )
+            else:
+                problems.append("the autocorrelation-time (τ) criterion was not met")
+        if pr:
+            worst_r = max(pr, key=lambda k: _nan_low(pr[k].get("r_hat")))
+            worst_e = min(pr, key=lambda k: _nan_high(pr[k].get("ess_bulk")))
+            rmax = _nan_low(pr[worst_r].get("r_hat"))
+            emin = _nan_high(pr[worst_e].get("ess_bulk"))
+            if not rmax <= r_ok:
+                problems.append(
+                    f"the walkers disagree: R-hat up to {rmax:.3f} for "
+                    f"{worst_r} (should be ≤ {r_ok:g})"
+                )
+            if not emin >= e_ok:
+                problems.append(
+                    f"too few independent samples: bulk ESS down to "
+                    f"{fmt_int(emin)} for {worst_e} (should be ≥ {e_ok:g})"
+                )
+        name = f"{m} ({info.get('model', '?')})"
+        if problems:
+            lines.append(f"{name}: " + "; ".join(problems) + ".")
+        else:
+            lines.append(f"{name}: all criteria met.")
+    max_rhat = _nan_low(summary.get("max_rhat"))
+    min_ess = _nan_high(summary.get("min_ess_bulk"))
+    stats = (
+        f"max R-hat {max_rhat:.3f} (target ≤ {r_ok:g}), min bulk ESS "
+        f"{fmt_int(min_ess)} (target ≥ {e_ok:g}), chain length ≥ {tf:g} τ: "
+        f"{'yes' if summary.get('converged_tau') else 'no'}"
+    )
+    green = (
+        bool(summary.get("converged"))
+        and bool(summary.get("converged_tau"))
+        and max_rhat <= r_ok
+        and min_ess >= e_ok
+    )
+    if green:
+        level, title = "green", "Converged"
+        text = (
+            "The sampler met every convergence criterion: the posterior summaries, "
+            "intervals and predictive bands in this report are reliable, within the "
+            "assumptions of the model."
+        )
+        advice = ""
+    elif max_rhat <= AMBER["max_rhat"] and min_ess >= AMBER["min_ess_bulk"]:
+        level, title = "amber", "Nearly converged — use with care"
+        text = (
+            "The chains are close to, but do not meet, the convergence criteria. "
+            "Medians are usable; treat the intervals, bands and tail values as "
+            "approximate."
+        )
+        advice = (
+            "Run the sampler longer before relying on the intervals: raise "
+            "sampler.max_steps in the config and run `hbayes calibrate CONFIG --out "
+            "RUN_DIR --resume`, which continues the saved chains."
+        )
+    else:
+        level, title = "red", "NOT CONVERGED — do not use these results yet"
+        text = (
+            "The sampler did not reach a stable posterior. The parameter values, "
+            "intervals and predictive bands below may be wrong."
+        )
+        advice = (
+            "Run the sampler longer: raise sampler.max_steps in the config and run "
+            "`hbayes calibrate CONFIG --out RUN_DIR --resume`, which continues the saved "
+            "chains; if it still does not converge, the model may be over-parameterised "
+            "for the data (see the identifiability section and the model-order ladder)."
+        )
+    if level != "green" and any(
+        (i.get("identifiability") or {}).get("n_null", 0)
+        for i in (summary.get("models") or {}).values()
+    ):
+        advice += (
+            " Parameter combinations that the data cannot identify (section 6) "
+            "slow the sampler down: pinning them with prior knowledge, e.g. the "
+            "room volume (room_volume), usually helps."
+        )
+    return {
+        "level": level,
+        "title": title,
+        "text": text,
+        "stats": stats,
+        "models": lines,
+        "advice": advice.strip(),
+    }
+
+
+def _nan_low(v) -> float:
+    """NaN/None -> +inf (counts as worst for 'max must be small')."""
+    try:
+        f = float(v)
+    except (TypeError, ValueError):
+        return math.inf
+    return f if math.isfinite(f) else math.inf
+
+
+def _nan_high(v) -> float:
+    try:
+        f = float(v)
+    except (TypeError, ValueError):
+        return -math.inf
+    return f if math.isfinite(f) else -math.inf
+
+
+def _grade(ok: bool, close: bool) -> str:
+    return "ok" if ok else ("warn" if close else "bad")
+
+
+def rhat_class(r, r_ok: float) -> str:
+    """``"ok"`` if R-hat ≤ ``r_ok`` (the run's criterion), ``"warn"`` if ≤ the amber
+    threshold, else ``"bad"`` (NaN counts as bad)."""
+    return _grade(_nan_low(r) <= r_ok, _nan_low(r) <= AMBER["max_rhat"])
+
+
+def ess_class(e, e_ok: float) -> str:
+    """``"ok"`` if the bulk ESS ≥ ``e_ok`` (the run's criterion), ``"warn"`` if ≥ the amber
+    threshold, else ``"bad"`` (NaN counts as bad)."""
+    return _grade(_nan_high(e) >= e_ok, _nan_high(e) >= AMBER["min_ess_bulk"])
+
+
+def run_notes(
+    summary: dict, chains_missing: list[str], *, irradiance_setting: str | None = None
+) -> list[dict]:
+    """Notes on the run to read before its results (under the verdict).
+
+    Parameters
+    ----------
+    summary : dict
+        The run's ``summary.json``.
+    chains_missing : list of str
+        Chain files (``chain_<model>.h5``) not found in the run directory.
+    irradiance_setting : str, optional
+        The config's ``data.irradiance`` (``"clear_sky"`` flags a clear-sky proxy even when
+        the summary does not say so).
+
+    Returns
+    -------
+    list of dict
+        ``level`` (``"amber"`` or ``"info"``), ``title`` and ``text`` (plain text) per note.
+    """
+    s = summary
+    out = []
+    irr = str(s.get("irradiance_source", ""))
+    if "clear" in irr.lower() or irradiance_setting == "clear_sky":
+        out.append(
+            {
+                "level": "amber",
+                "title": "Solar radiation is a clear-sky proxy",
+                "text": "The solar input was computed for a cloudless sky, not measured "
+                f"(source: {irr}). The solar apertures then absorb the missing "
+                "cloudiness (they are biased) and the fit is poorer on cloudy days; "
+                "use measured irradiance when it is available.",
+            }
+        )
+    bound = []
+    for k, v in (s.get("parameters") or {}).items():
+        if v.get("at_bound"):
+            unit = v.get("unit", "")
+            unit = f" {unit}" if unit and unit != "-" else ""
+            bound.append(
+                f"{k} (at the {v['at_bound']} end of its prior {prior_text(v.get('prior'))}{unit})"
+            )
+    if bound:
+        out.append(
+            {
+                "level": "amber",
+                "title": "Parameters pressed against a prior bound",
+                "text": "The data push these parameters to the edge of the allowed "
+                "range, so their interval is cut off by the prior: "
+                + "; ".join(bound)
+                + ". Check the model and data, or widen "
+                "the prior if the bound is not physical.",
+            }
+        )
+    nulls = [
+        m
+        for m, i in (s.get("models") or {}).items()
+        if (i.get("identifiability") or {}).get("n_null", 0)
+    ]
+    if nulls:
+        out.append(
+            {
+                "level": "info",
+                "title": "Not every parameter is identifiable",
+                "text": "For the "
+                + " and ".join(nulls)
+                + (" models" if len(nulls) > 1 else " model")
+                + ", some parameter combinations "
+                "cannot be determined from these data (section 6): read the "
+                "time constants, static gains and ratios, not the absolute "
+                "capacities and conductances, unless prior knowledge pins "
+                "them.",
+            }
+        )
+    if chains_missing:
+        out.append(
+            {
+                "level": "amber",
+                "title": "Chain files missing",
+                "text": "Trace plots are not available: "
+                + ", ".join(chains_missing)
+                + " not found in the run directory.",
+            }
+        )
+    if s.get("truth"):
+        p_truth = any(v.get("truth") is not None for v in (s.get("parameters") or {}).values())
+        d_truth = any(v.get("truth") is not None for v in (s.get("derived") or {}).values())
+        if p_truth:
+            where = "the true values are shown next to the estimates"
+        elif d_truth:
+            where = (
+                "the calibrated model is not the generating one, so true values are shown "
+                "only for the quantities both share (static gains, slowest time constant)"
+            )
+        else:
+            where = "the calibrated model is not the generating one: no true values to compare"
+        out.append(
+            {
+                "level": "info",
+                "title": "Synthetic data",
+                "text": "The measurements were generated from known parameters (the "
+                f"built-in virtual monument): {where}.",
+            }
+        )
+    return out

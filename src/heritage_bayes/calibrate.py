@@ -24,23 +24,16 @@ import numpy as np
 import yaml
 
 from heritage_bayes._version import __version__
-from heritage_bayes.config import CalibrationConfig, chain_tag, config_hash
+from heritage_bayes.config import MAX_SEED, CalibrationConfig, chain_tag, config_hash
 from heritage_bayes.errors import InputError
-from heritage_bayes.inference.idata import CONVERGENCE
 from heritage_bayes.inference.likelihoods import get_noise_model
-from heritage_bayes.inference.optimize import find_map
 from heritage_bayes.inference.parameters import parameters_for
 from heritage_bayes.inference.posterior import LogPosterior
 from heritage_bayes.inference.results import atomic_write, atomic_write_text, dump_json
-from heritage_bayes.inference.sampler import run_sampler
 from heritage_bayes.models import SECTIONS, _catalog_options, build_model
 from heritage_bayes.rc.catalog import model as catalog_model
-from heritage_bayes.rc.identify import structural_identifiability
 from heritage_bayes.rc.model import RCModel
 from heritage_bayes.run import Run, RunWriter, load_run  # Run, load_run: re-exported
-
-#: Seeds are 32-bit (numpy's RandomState), and each model adds 101 × its index.
-MAX_SEED = 2**31 - 1
 
 __all__ = [
     "LADDERS",
@@ -262,7 +255,12 @@ def _calibrate_into(
     t_start = time.perf_counter()
     chash = config_hash(cfg)
     say = _Progress(quiet)
+    # the heavy imports (arviz, scipy.optimize, emcee) only once the config is valid
+    from heritage_bayes.inference.idata import CONVERGENCE
+    from heritage_bayes.inference.optimize import find_map
+    from heritage_bayes.inference.sampler import run_sampler
     from heritage_bayes.prepare import prepare
+    from heritage_bayes.rc.identify import structural_identifiability
 
     say.say(f"hbayes {__version__}: calibrating {cfg.name!r} -> {final}")
     t0 = time.perf_counter()
@@ -406,8 +404,10 @@ def model_ladder(cfg: CalibrationConfig, prep, section: _Section, *, seed: int) 
     log-likelihood, AIC and BIC, and the structural identifiability (rank, null
     directions, condition number of the identifiable part) at the MAP.
     """
+    from heritage_bayes.inference.optimize import find_map
     from heritage_bayes.inference.results import fit_metrics
     from heritage_bayes.rc.discretize import modal_form
+    from heritage_bayes.rc.identify import structural_identifiability
     from heritage_bayes.rc.simulate import modal_simulate
 
     sec_cfg = getattr(cfg, section.name)

@@ -84,10 +84,11 @@ def _build_parser() -> argparse.ArgumentParser:
 
 
 def _cmd_calibrate(args) -> int:
-    from heritage_bayes.calibrate import run_calibration
     from heritage_bayes.config import load_config
 
-    cfg = load_config(args.config)
+    cfg = load_config(args.config)  # config errors before the heavy imports
+    from heritage_bayes.calibrate import run_calibration
+
     out = run_calibration(
         cfg,
         args.out,

@@ -71,7 +71,11 @@ __all__ = [
 
 
 class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=False)
+    model_config = ConfigDict(extra="forbid", frozen=False, allow_inf_nan=False)
+
+
+#: Seeds are 32-bit (numpy's RandomState) and each model adds 101 × its index.
+MAX_SEED = 2**31 - 1
 
 
 def _date_text(v):
@@ -229,7 +233,33 @@ class Source(_Strict):
             raise ValueError("path: the list of files is empty")
         if self.interval is not None:
             _check_duration(self.interval, positive=True)
+        if self.time_format is not None:
+            _check_time_format(self.time_format)
+        if self.sep not in (r"\s+", "\t") and len(self.sep) != 1:
+            raise ValueError(
+                f"sep: one character such as ',' or ';', '\\t' for tabs or '\\s+' for "
+                f"white space (got {self.sep!r})"
+            )
+        if len(self.decimal) != 1 or self.decimal == self.sep:
+            raise ValueError(
+                f"decimal: one character, not the separator {self.sep!r} (got {self.decimal!r})"
+            )
         return self
+
+
+#: strptime directives (Python's): a time_format may use only these.
+_DIRECTIVES = set("aAwdbBmyYHIpMSfzZjUWcxXGuV%")
+
+
+def _check_time_format(fmt: str) -> None:
+    if fmt in ("ISO8601", "mixed"):  # pandas' own
+        return
+    bad = [d for d in re.findall(r"%-?(.?)", fmt) if d not in _DIRECTIVES]
+    if "%" not in fmt or bad:
+        shown = f"'%{bad[0]}' is not a strptime directive" if bad else "no % directive"
+        raise ValueError(
+            f"time_format: {shown}; use e.g. '%Y-%m-%d %H:%M' or '%d/%m/%Y %H:%M' (got {fmt!r})"
+        )
 
 
 class GroundTemperature(_Strict):
@@ -407,7 +437,7 @@ class ModelSection(_Strict):
 
 
 class SamplerSettings(_Strict):
-    walkers: int | None = Field(default=None, ge=4, description="default max(32, 2 d + 2)")
+    walkers: int | None = Field(default=None, ge=4, le=4096, description="default max(32, 2 d + 2)")
     max_steps: int = Field(default=20000, ge=100)
     check_every: int = Field(default=500, ge=50)
     tau_factor: float = Field(default=50.0, ge=10)
@@ -430,7 +460,7 @@ class CalibrationConfig(_Strict):
     building: str = ""
     room: str = ""
     notes: str = ""
-    seed: int = 1
+    seed: int = Field(default=1, ge=0, le=MAX_SEED)
     site: Site | None = None
     room_volume: float | None = Field(default=None, gt=0, description="[m³]")
     air_change_rate: float | None = Field(
@@ -528,6 +558,10 @@ def _allowed_keys(loc) -> list[str]:
     return []
 
 
+#: Names pydantic puts into error locations for the members of a union.
+_TYPE_TAGS = {"str", "int", "float", "bool", "list", "dict", "tuple", "none", "is-instance"}
+
+
 def _key_path(loc, raw: Any) -> str:
     """``data.measurements[1].columns`` from a pydantic error location.
 
@@ -539,6 +573,8 @@ def _key_path(loc, raw: Any) -> str:
     for x in loc:
         if isinstance(x, str) and "[" in x:
             continue
+        if x in _TYPE_TAGS and not (isinstance(node, dict) and x in node):
+            continue  # a union member's tag (``str``, ``int``, ...), not a key
         if isinstance(x, int):
             if isinstance(node, dict):  # a single mapping given where a list is allowed
                 continue
@@ -574,7 +610,21 @@ def _format_error(err: dict, raw: Any) -> str:
         return f"{loc or '(top level)'}: {msg}"
     if "(got " in msg:  # the check already says what it found
         return f"{loc or '(top level)'}: {msg}"
-    return f"{loc or '(top level)'}: {msg} (got {found!r})"
+    return f"{loc or '(top level)'}: {msg} (got {_short(found)})"
+
+
+def _short(value: Any, limit: int = 120) -> str:
+    """``repr`` of a value echoed in a message, cut to a readable length."""
+    import reprlib
+
+    if isinstance(value, str) and len(value) <= limit:
+        return repr(value)
+    r = reprlib.Repr()  # keyword arguments only from Python 3.12
+    r.maxstring = r.maxother = limit
+    r.maxlist = r.maxtuple = r.maxdict = r.maxset = 8
+    r.maxlevel = 3
+    text = r.repr(value)
+    return text if len(text) <= limit + 10 else text[:limit] + "..."
 
 
 def parse_config(
@@ -588,7 +638,19 @@ def parse_config(
     try:
         cfg = CalibrationConfig.model_validate(raw)
     except ValidationError as exc:
-        lines = [_format_error(e, raw) for e in exc.errors()]
+        lines: list[str] = []
+        for e in exc.errors():  # one line per key: union members' messages joined
+            line = _format_error(e, raw)
+            key, _, msg = line.partition(": ")
+            prev = next((i for i, x in enumerate(lines) if x.startswith(f"{key}: ")), None)
+            if prev is not None and msg.startswith("Input should be "):
+                head, got, tail = lines[prev].rpartition(" (got ")
+                extra = msg[len("Input should be ") :].partition(" (got ")[0]
+                lines[prev] = (
+                    f"{head} or {extra} (got {tail}" if got else f"{lines[prev]} or {extra}"
+                )
+                continue
+            lines.append(line)
         raise ConfigError(f"{source}: invalid configuration:\n  " + "\n  ".join(lines)) from None
     cfg.base_dir = base_dir
     if cfg.name is None:
@@ -596,8 +658,103 @@ def parse_config(
     return cfg
 
 
+class _Loader(yaml.SafeLoader):
+    """Safe YAML, stricter: a key given twice in one mapping is an error (YAML would keep
+    the last silently), and an impossible date (``2019-13-02``) stays text, so that the
+    config check names its key instead of failing inside the YAML parser."""
+
+    def construct_mapping(self, node, deep=False):
+        if isinstance(node, yaml.MappingNode):
+            seen: dict[str, int] = {}
+            for key_node, _ in node.value:
+                if key_node.tag == "tag:yaml.org,2002:merge" or not isinstance(
+                    key_node, yaml.ScalarNode
+                ):
+                    continue
+                if key_node.value in seen:
+                    raise yaml.constructor.ConstructorError(
+                        None,
+                        None,
+                        f"duplicate key {key_node.value!r} (first given at line "
+                        f"{seen[key_node.value] + 1})",
+                        key_node.start_mark,
+                    )
+                seen[key_node.value] = key_node.start_mark.line
+        return super().construct_mapping(node, deep=deep)
+
+    def _timestamp(self, node):
+        try:
+            return self.construct_yaml_timestamp(node)
+        except ValueError:
+            return self.construct_scalar(node)
+
+
+_Loader.add_constructor("tag:yaml.org,2002:timestamp", _Loader._timestamp)
+
+#: Limits of a config file: size [bytes], values after expanding anchors, nesting depth.
+_MAX_BYTES = 1_000_000
+_MAX_NODES = 100_000
+_MAX_DEPTH = 40
+
+
+def _check_size(raw: Any, source: str) -> None:
+    """Refuse anchor bombs and absurd nesting before anything walks the structure."""
+    count = 0
+    todo = [(raw, 0)]
+    while todo:
+        v, depth = todo.pop()
+        count += 1
+        if count > _MAX_NODES:
+            raise ConfigError(
+                f"{source}: more than {_MAX_NODES} values after expanding YAML anchors "
+                "(aliases *name); a config is far smaller"
+            )
+        if depth > _MAX_DEPTH:
+            raise ConfigError(f"{source}: nested more than {_MAX_DEPTH} levels deep")
+        if isinstance(v, dict):
+            todo.extend((x, depth + 1) for kv in v.items() for x in kv)
+        elif isinstance(v, list | tuple):
+            todo.extend((x, depth + 1) for x in v)
+
+
+def read_yaml(path, *, what: str = "config file") -> tuple[Any, str]:
+    """Parse a YAML file strictly; return ``(data, text)``.
+
+    Raises
+    ------
+    ConfigError
+        Missing, too large, not UTF-8, invalid YAML (with line and column), a duplicate
+        key, nesting or anchors beyond the limits.
+    """
+    p = Path(path)
+    if not p.is_file():
+        raise ConfigError(f"{p}: {what} not found")
+    size = p.stat().st_size
+    if size > _MAX_BYTES:
+        raise ConfigError(f"{p}: {size} bytes, too large for a {what} (at most {_MAX_BYTES})")
+    data = p.read_bytes()
+    try:
+        text = data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise ConfigError(
+            f"{p}: not UTF-8 text (byte 0x{data[exc.start]:02x} at offset {exc.start}); "
+            "save the file as UTF-8"
+        ) from None
+    try:
+        raw = yaml.load(text, Loader=_Loader)  # a SafeLoader
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+        problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
+        raise ConfigError(f"{p}: not valid YAML{where}: {str(problem)[:200]}") from None
+    except RecursionError:
+        raise ConfigError(f"{p}: nested more than {_MAX_DEPTH} levels deep") from None
+    _check_size(raw, str(p))
+    return raw, text
+
+
 def load_config(path) -> CalibrationConfig:
-    """Read and validate a YAML config file.
+    """Read and validate a YAML config file (see :func:`read_yaml` for the limits).
 
     Raises
     ------
@@ -606,15 +763,7 @@ def load_config(path) -> CalibrationConfig:
         key paths).
     """
     p = Path(path)
-    if not p.is_file():
-        raise ConfigError(f"{p}: config file not found")
-    try:
-        text = p.read_text(encoding="utf-8")
-        raw = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
-        raise ConfigError(f"{p}: not valid YAML{where}: {getattr(exc, 'problem', exc)}") from None
+    raw, text = read_yaml(p)
     cfg = parse_config(raw, source=str(p), base_dir=str(p.parent.resolve()), name=p.stem)
     cfg._source_text = text
     return cfg

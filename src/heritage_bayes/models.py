@@ -6,6 +6,7 @@ needs), by the orchestrator and by the run directory's loader; imports neither.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping
 
 from heritage_bayes.config import CalibrationConfig
@@ -21,6 +22,25 @@ SECTIONS = ("thermal", "hygric")
 _SOLAR = {"thermal_1c", "thermal_2c", "thermal_4a"}
 
 
+#: Names that become variable names in posterior.nc (NetCDF) and input columns.
+_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
+
+
+def _check_names(m: RCModel, where: str) -> None:
+    """Parameter, node and input names of a custom network: letters, digits and '_'."""
+    for kind, names in (
+        ("parameter", m.parameter_names),
+        ("node", m.state_names),
+        ("input", m.input_names),
+    ):
+        bad = [n for n in names if not _NAME.match(n)]
+        if bad:
+            raise ConfigError(
+                f"{where}: {kind} name {bad[0]!r} is not allowed: use letters, digits and "
+                "'_', starting with a letter (names become variables in posterior.nc)"
+            )
+
+
 def build_model(cfg: CalibrationConfig, section: str) -> RCModel:
     """The RC model of config section ``thermal`` or ``hygric``.
 
@@ -33,6 +53,7 @@ def build_model(cfg: CalibrationConfig, section: str) -> RCModel:
     try:
         if isinstance(sec.model, Mapping):
             m = Network.from_dict(sec.model, where=where).compile()
+            _check_names(m, where)
         else:
             if sec.model not in CATALOG:
                 raise ConfigError(
@@ -42,7 +63,8 @@ def build_model(cfg: CalibrationConfig, section: str) -> RCModel:
     except ConfigError:
         raise
     except ValueError as exc:
-        raise ConfigError(f"{where}: {exc}") from None
+        msg = str(exc)
+        raise ConfigError(msg if msg.startswith(f"{where}") else f"{where}: {msg}") from None
     if m.domain != section:
         raise ConfigError(f"{where}: a {m.domain} model cannot be used in the {section!r} section")
     return m

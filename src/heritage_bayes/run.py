@@ -18,10 +18,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import yaml
 
 from heritage_bayes.climate.psychro import saturation_vapour_pressure
-from heritage_bayes.config import CalibrationConfig, parse_config
+from heritage_bayes.config import CalibrationConfig, parse_config, read_yaml
 from heritage_bayes.errors import InputError
 from heritage_bayes.models import SECTIONS, build_model
 from heritage_bayes.rc.model import RCModel
@@ -152,7 +151,7 @@ def load_run(path: str | Path) -> Run:
                 f"{p}: not a complete run directory ({name} is missing); "
                 "run `hbayes calibrate` first"
             )
-    raw = yaml.safe_load((p / "config.yaml").read_text(encoding="utf-8"))
+    raw, _ = read_yaml(p / "config.yaml", what="run config")
     cfg = parse_config(raw, source=str(p / "config.yaml"))
     summary = json.loads((p / "summary.json").read_text(encoding="utf-8"))
     idata = az.from_netcdf(str(p / "posterior.nc"), engine="h5netcdf")

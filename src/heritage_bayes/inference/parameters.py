@@ -122,8 +122,18 @@ class Prior:
         dist = spec.get("dist", default.dist if default else None)
         if dist is None:
             raise ConfigError(f"{where}.dist: required, one of {list(_DISTS)}")
+        if dist not in _DISTS:
+            raise ConfigError(f"{where}.dist: must be one of {list(_DISTS)} (got {dist!r})")
         mu = spec.get("median") if dist == "lognormal" else spec.get("mean")
         sigma = spec.get("sigma")
+        for key, v, positive in (("median", mu, dist == "lognormal"), ("sigma", sigma, True)):
+            if v is None:
+                continue
+            if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
+                raise ConfigError(f"{where}.{key}: expected a finite number (got {v!r})")
+            if positive and not v > 0:
+                what = "the median of a lognormal prior" if key == "median" else "sigma"
+                raise ConfigError(f"{where}.{key}: {what} must be > 0 (got {v:g})")
         lo, up = spec.get("lower"), spec.get("upper")
         if dist == "lognormal" and mu is not None and sigma is not None:
             lo = lo if lo is not None else float(mu) * math.exp(-5 * float(sigma))
@@ -252,6 +262,28 @@ _DEFAULTS: dict[tuple[str, str], Prior] = {
     ("thermal", "phi"): Prior("uniform", 0.0, 0.999),
     ("hygric", "phi"): Prior("uniform", 0.0, 0.999),
 }
+
+
+#: Physical range of a fixed value by parameter kind: (lowest, highest, inclusive?).
+_FIXED_RANGE = {
+    "capacity": (0.0, math.inf, False),  # [J/K], [kg/Pa]: > 0
+    "conductance": (0.0, math.inf, True),  # [W/K], [kg/(s·Pa)]: ≥ 0 (0 = no path)
+    "gain": (0.0, math.inf, True),
+    "fraction": (0.0, 1.0, True),
+    "sigma": (0.0, math.inf, False),
+    "phi": (-1.0, 1.0, False),
+}
+
+
+def _check_fixed(where: str, kind: str, value: float) -> None:
+    """A fixed value within the physical range of its kind (else :class:`ConfigError`)."""
+    if kind not in _FIXED_RANGE:
+        return
+    lo, hi, inclusive = _FIXED_RANGE[kind]
+    ok = (lo <= value <= hi) if inclusive else (lo < value < hi)
+    if not ok:
+        rng = f"[{lo:g}, {hi:g}]" if inclusive else f"({lo:g}, {hi:g})"
+        raise ConfigError(f"{where}: a {kind} must be within {rng} (got {value:g})")
 
 
 def default_prior(domain: str, kind: str) -> Prior:
@@ -536,6 +568,7 @@ def parameters_for(
                     ) from None
                 if not math.isfinite(fixed):
                     raise ConfigError(f"{where}.{name}.fixed: must be finite (got {fixed})")
+                _check_fixed(f"{where}.{name}.fixed", kind, fixed)
             else:
                 base = prior if spec.get("dist", prior.dist) == prior.dist else None
                 prior = Prior.from_spec(spec, where=f"{where}.{name}", default=base)

@@ -5,16 +5,15 @@ See :mod:`heritage_bayes.rc.catalog` for the paper's models.
 
 from heritage_bayes.rc.catalog import CATALOG, available_models, model
 from heritage_bayes.rc.discretize import ModalForm, discretize, modal_form
-from heritage_bayes.rc.identify import (
-    IdentifiabilityResult,
-    NullDirection,
+from heritage_bayes.rc.derived import (
     constant_contributions,
     derived_quantities,
     derived_units,
     static_gains,
-    structural_identifiability,
     time_constants,
 )
+from heritage_bayes.rc.identify import structural_identifiability
+from heritage_bayes.rc.identify_result import IdentifiabilityResult, NullDirection
 from heritage_bayes.rc.model import RCModel
 from heritage_bayes.rc.network import Link, Network, Node, ParameterInfo, Source
 from heritage_bayes.rc.simulate import iter_simulate, simulate

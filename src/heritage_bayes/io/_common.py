@@ -367,3 +367,7 @@ def to_jsonable(obj):
     if isinstance(obj, PurePath):
         return str(obj)
     return str(obj)
+
+
+def _quote_list(names: Iterable[str]) -> str:
+    return ", ".join(repr(n) for n in names)

@@ -5,7 +5,7 @@ value found, e.g. ``priors.Gw.lower: must be < upper (got 500 > 200)``. Relative
 in ``data`` are relative to the config file. How ``data`` and ``periods`` become model
 inputs and outputs: :mod:`heritage_bayes.prepare`.
 
-Why one module of ~640 lines: the schema is one tree of pydantic models whose validators
+Why one module (about 800 lines): the schema is one tree of pydantic models whose validators
 refer to each other (sections, periods, data sources, the cross-section checks of
 :class:`CalibrationConfig`) and share one error formatter that turns pydantic's locations
 into key paths; kept together, a reader finds every key, its default and its check in one

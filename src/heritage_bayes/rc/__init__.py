@@ -4,7 +4,6 @@ See :mod:`heritage_bayes.rc.catalog` for the paper's models.
 """
 
 from heritage_bayes.rc.catalog import CATALOG, available_models, model
-from heritage_bayes.rc.discretize import ModalForm, discretize, modal_form
 from heritage_bayes.rc.derived import (
     constant_contributions,
     derived_quantities,
@@ -12,6 +11,7 @@ from heritage_bayes.rc.derived import (
     static_gains,
     time_constants,
 )
+from heritage_bayes.rc.discretize import ModalForm, discretize, modal_form
 from heritage_bayes.rc.identify import structural_identifiability
 from heritage_bayes.rc.identify_result import IdentifiabilityResult, NullDirection
 from heritage_bayes.rc.model import RCModel

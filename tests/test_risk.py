@@ -558,3 +558,13 @@ def test_orholm_measured_year(shared_data):
     assert shares == sorted(shares)  # nested classes
     assert v["ashrae_D"] == 100.0
     assert table.loc["ashrae_best_class", "rating"] in {"AA", "As", "A", "B", "C", "D"}
+
+
+def test_yearly_indicators_accept_a_typical_year_on_a_grid():
+    """An aligned TMY/EPW year has 8759 hours (issue 12): counted as a year."""
+    T, RH = synthetic_year(n=8759)
+    t = risk.assess(T, RH).set_index("indicator")
+    assert np.isfinite(t.loc["vtt_mould_index_max", "value"])
+    assert np.isfinite(t.loc["en15757_outside", "value"])
+    with pytest.raises(InputError, match=r"at least one year.*8736 h.*got 8735 h"):
+        risk.assess(T[:8735], RH[:8735])

@@ -125,10 +125,12 @@ class Run:
     def simulate_rh(
         self, thermal_inputs, hygric_inputs, n_draws: int | None = 200, seed: int = 0, **kw
     ) -> np.ndarray:
-        """Indoor RH [%] from paired thermal and hygric draws: RH = Pi / Psat(Ti)."""
+        """Indoor RH [%] from paired thermal and hygric draws: RH = Pi / Psat(Ti), capped
+        at 100 % (a vapour pressure above saturation condenses; the cap also keeps
+        rounding from handing the risk indicators 100.01 %)."""
         Ti = self.simulate(thermal_inputs, "thermal", n_draws, seed, **kw)[..., 0]
         Pi = self.simulate(hygric_inputs, "hygric", n_draws, seed, **kw)[..., 0]
-        return 100.0 * Pi / saturation_vapour_pressure(Ti)
+        return np.minimum(100.0 * Pi / saturation_vapour_pressure(Ti), 100.0)
 
 
 def load_run(path: str | Path) -> Run:

@@ -28,7 +28,7 @@ Conventions
   :class:`~pandas.DatetimeIndex` must advance by exactly one hour at every step. A 1-D
   input gives a float per indicator; a 2-D input gives one value per draw.
 * Yearly indicators (ASHRAE classes, EN 15757, hours above the isopleth per year) need at
-  least one year (8760 h).
+  least one year (8736 h: a year less a day, so that a typical year on a grid, 8759 h, counts).
 * ``nan_policy`` (series functions): ``"propagate"`` (default; a NaN anywhere makes the
   aggregate NaN, and the VTT index NaN from the first gap on), ``"omit"`` (skip missing
   hours: aggregates over the valid hours, moving averages over the valid hours of each

@@ -16,6 +16,10 @@ from heritage_bayes.errors import InputError
 
 #: Hours in a (non-leap) year: the minimum length of the yearly indicators [h].
 HOURS_PER_YEAR = 8760
+#: Shortest series the yearly indicators accept [h]: a year less one day, so that a
+#: typical-year file put on a grid (8759 h), or a year whose first or last day is
+#: partial, counts as a year; per-year figures are normalised by the actual length.
+MIN_YEAR_HOURS = HOURS_PER_YEAR - 24
 
 NAN_POLICIES = ("propagate", "omit", "raise")
 EDGES = ("shrink", "wrap")

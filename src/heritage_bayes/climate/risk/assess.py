@@ -18,7 +18,7 @@ import numpy as np
 import pandas as pd
 
 from heritage_bayes.climate.risk._inputs import (
-    HOURS_PER_YEAR,
+    MIN_YEAR_HOURS,
     Hourly,
     centred_mean,
     check_positive,
@@ -154,11 +154,11 @@ def _resolve_groups(func, indicators):
 
 def _check_year(func, groups, n):
     yearly = [g for g in groups if INDICATOR_GROUPS[g]]
-    if yearly and n < HOURS_PER_YEAR:
+    if yearly and n < MIN_YEAR_HOURS:
         short = [g for g in groups if not INDICATOR_GROUPS[g]] or ["chemical", "mechanical"]
         raise InputError(
             f"{func}: the indicators {yearly} need at least one year of hourly data "
-            f"({HOURS_PER_YEAR} h); got {n} h. For a shorter series pass "
+            f"({MIN_YEAR_HOURS} h); got {n} h. For a shorter series pass "
             f"indicators={short}"
         )
 
@@ -300,7 +300,8 @@ def assess(
         Groups to compute, any of ``"chemical"`` (lifetime multipliers, TWPI),
         ``"mechanical"`` (EMC, dimensional change, corrosion), ``"mould"`` (VTT index,
         hours above LIM), ``"ashrae"``, ``"en15757"``; default all. ``mould``, ``ashrae``
-        and ``en15757`` need at least a year (8760 h).
+        and ``en15757`` need at least a year (8736 h: a year less a day, so that an
+        8759-hour typical year counts).
     nan_policy : {"propagate", "omit", "raise"}, default "propagate"
         Missing hours, for every indicator (see the module documentation).
     lm : dict, optional

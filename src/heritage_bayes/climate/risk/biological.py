@@ -12,6 +12,7 @@ import numpy as np
 
 from heritage_bayes.climate.risk._inputs import (
     HOURS_PER_YEAR,
+    MIN_YEAR_HOURS,
     Hourly,
     check_choice,
     hourly,
@@ -244,7 +245,7 @@ def hours_above_isopleth(T, RH, *, growth_rate=0.0, per_year=True, nan_policy="p
         T=T,
         RH=RH,
         nan_policy=nan_policy,
-        min_hours=HOURS_PER_YEAR if per_year else None,
+        min_hours=MIN_YEAR_HOURS if per_year else None,
         what="hours per year above the isopleth",
     )
     return h.reduce(_hours_above(h, c, bool(per_year), nan_policy))

@@ -19,7 +19,7 @@ import pandas as pd
 
 from heritage_bayes.climate.risk._inputs import (
     EDGES,
-    HOURS_PER_YEAR,
+    MIN_YEAR_HOURS,
     centred_mean,
     check_choice,
     check_positive,
@@ -357,7 +357,7 @@ def ashrae_classes(
         T=T,
         RH=RH,
         nan_policy=nan_policy,
-        min_hours=HOURS_PER_YEAR,
+        min_hours=MIN_YEAR_HOURS,
         what="the ASHRAE classes",
     )
     sh, shT, shRH, best, mT, mRH = _ashrae_core(
@@ -535,7 +535,7 @@ def en15757_band(
     """
     func = "en15757_band"
     pct, mb = _en_check(func, percentiles, min_band, min_band_mode, edges)
-    h = hourly(func, RH=RH, nan_policy=nan_policy, min_hours=HOURS_PER_YEAR, what="EN 15757")
+    h = hourly(func, RH=RH, nan_policy=nan_policy, min_hours=MIN_YEAR_HOURS, what="EN 15757")
     seasonal, lower, upper, outside, lo, hi, p_lo, p_hi, share = _en_core(
         h.RH,
         window_days=window_days,

@@ -483,6 +483,7 @@ def prepare(cfg) -> Prepared:
             f"{_iso(frame.index[cal.stop - 1] + step)})"
         )
     _check_observations(frame, cal, val, warmup_steps, thermal, hygric, step)
+    _check_plausible(frame, cfg)
 
     def _span(sl):
         if sl is None:
@@ -534,15 +535,63 @@ def _check_observations(frame, cal, val, warmup_steps, thermal, hygric, step) ->
             raise ConfigError("periods.validation: has no rows on the grid")
         periods.append(("validation", val))
     for what, sl in periods:
+        hours = MIN_OBSERVED_HOURS[what.split()[0]]
+        n_min = max(2, math.ceil(pd.Timedelta(hours=hours) / step))
         for col in needed:
-            if not np.isfinite(frame[col].to_numpy()[sl]).any():
+            n_obs = int(np.isfinite(frame[col].to_numpy()[sl]).sum())
+            if n_obs < n_min:
                 a = frame.index[sl.start] if sl.start < len(frame) else frame.index[-1]
                 b = frame.index[max(sl.stop - 1, 0)] + step
-                raise DataError(
-                    f"data.measurements: no {col} observation in the {what} period "
-                    f"{_iso(a)} to {_iso(b)}; check periods and the measurement file's "
-                    f"time zone"
+                found = (
+                    f"no {col} observation" if n_obs == 0 else f"only {n_obs} {col} observations"
                 )
+                raise DataError(
+                    f"data.measurements: {found} in the {what} period "
+                    f"{_iso(a)} to {_iso(b)}; at least {n_min} ({hours} h of data) are needed "
+                    "for a meaningful fit; check periods and the measurement file's time zone"
+                )
+
+
+#: Least observed time in each period: fewer gives fit figures without meaning.
+MIN_OBSERVED_HOURS = {"calibration": 48, "validation": 24}
+
+
+def _column_origin(cfg, col: str) -> str:
+    """Where a standard column came from, for a message: config key, file, column."""
+    data = cfg.data
+    for i, m in enumerate(data.measurements or []):
+        if m.columns and col in m.columns:
+            return f"data.measurements[{i}] ({m.path}, column {m.columns[col]!r})"
+    if data.weather is not None:
+        return f"data.weather ({data.weather.path})"
+    return col
+
+
+def _check_plausible(frame: pd.DataFrame, cfg) -> None:
+    """Units the physical range checks cannot catch: relative humidity given as a
+    fraction (0-1) instead of percent, temperatures in °F beside ones in °C."""
+    for col in ("RHi", "RHe"):
+        if col in frame:
+            v = frame[col].to_numpy(dtype=float)
+            v = v[np.isfinite(v)]
+            if v.size >= 24 and np.percentile(v, 99) <= 1.0:
+                raise DataError(
+                    f"{_column_origin(cfg, col)}: relative humidity {col} never exceeds "
+                    f"{v.max():.3g}: a fraction (0-1)? hbayes expects percent (0-100); "
+                    "multiply the column by 100"
+                )
+    if {"Ti", "Te"} <= set(frame.columns):
+        ti, te = frame["Ti"].to_numpy(dtype=float), frame["Te"].to_numpy(dtype=float)
+        ok = np.isfinite(ti) & np.isfinite(te)
+        if ok.sum() >= 24:
+            mi, me = float(ti[ok].mean()), float(te[ok].mean())
+            for col, m, other in (("Ti", mi, me), ("Te", me, mi)):
+                if m > 40 and m - other > 20:
+                    raise DataError(
+                        f"{_column_origin(cfg, col)}: {col} averages {m:.1f} °C against "
+                        f"{other:.1f} °C for the other temperature: °F? hbayes expects °C; "
+                        "convert with (F - 32) / 1.8"
+                    )
 
 
 def _source_note(df: pd.DataFrame, fmt: str) -> dict:

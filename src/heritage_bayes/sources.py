@@ -113,6 +113,13 @@ def read_source(cfg, src, where: str, allowed: Sequence[str]) -> pd.DataFrame:
     extra = [c for c in df.columns if c not in allowed]
     out = df.drop(columns=extra)
     out.attrs = dict(df.attrs)
+    if len(out) < 2:
+        files = path if isinstance(path, list | tuple) else [path]
+        rows = "no data rows" if len(out) == 0 else "only one data row"
+        raise DataError(
+            f"{where}: {', '.join(str(p) for p in files)}: {rows} (after dropping invalid "
+            "ones); a time series of at least two readings is needed"
+        )
     if not len(out.columns):
         raise DataError(
             f"{where}: {Path(str(df.attrs.get('source', ''))).name} has none of the columns "

@@ -222,13 +222,26 @@ def validate_ranges(
                 raise DataError(
                     f"{name}: column {src!r} ({col}) line {int(lines[first])}: value "
                     f"{values[first]:g} {unit} is outside the physical range "
-                    f"[{lo_txt:g}, {hi:g}] {unit} ({int(bad.sum())} such values); fix the "
-                    f"file, declare sentinels with na_values=, or pass invalid='nan'"
+                    f"[{lo_txt:g}, {hi:g}] {unit} ({int(bad.sum())} such values)"
+                    f"{_unit_hint(col, values)}; "
+                    f"fix the file, declare sentinels with na_values=, or pass invalid='nan'"
                 )
             values[bad] = np.nan
             counts["out_of_range"] = counts.get("out_of_range", 0) + int(bad.sum())
         frame[col] = values
     return clipped
+
+
+def _unit_hint(col: str, values: np.ndarray) -> str:
+    """A guess at the unit of a temperature column out of range: Kelvin or °F."""
+    if STANDARD_COLUMNS[col][0] != "°C":
+        return ""
+    med = float(np.nanmedian(values)) if np.isfinite(values).any() else float("nan")
+    if 200 <= med <= 340:
+        return f"; the median {med:.1f} looks like Kelvin: subtract 273.15"
+    if 32 <= med <= 130 and np.nanmax(values) > 70:
+        return f"; the median {med:.1f} looks like °F: convert with (F - 32) / 1.8"
+    return ""
 
 
 # ---------------------------------------------------------------------------------------

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import datetime as _dt
 import re
+import zlib
 import zoneinfo
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
@@ -382,5 +383,36 @@ def to_jsonable(obj):
     return str(obj)
 
 
-def _quote_list(names: Iterable[str]) -> str:
-    return ", ".join(repr(n) for n in names)
+def _quote_list(names: Iterable[str], limit: int = 30) -> str:
+    """Names for a message: each cut to 40 characters, at most ``limit`` of them."""
+    names = list(names)
+    shown = [repr(n) if len(str(n)) <= 40 else repr(str(n)[:40]) + "..." for n in names[:limit]]
+    more = f", ... ({len(names)} in all)" if len(names) > limit else ""
+    return ", ".join(shown) + more
+
+
+#: What a damaged or truncated compressed file raises while it is read.
+READ_ERRORS = (OSError, EOFError, zlib.error)
+
+
+def damaged(name: str, exc: BaseException) -> DataError:
+    """The error for a file that cannot be read to its end."""
+    return DataError(f"{name}: cannot read the file (damaged or truncated?): {exc}")
+
+
+def sniff_text(path: Path, name: str, size: int = 1 << 16) -> None:
+    """Refuse a binary file, or one without a line break early on, before pandas reads
+    it whole (a 100 MB 'header' of NUL bytes)."""
+    import gzip
+
+    try:
+        with gzip.open(path, "rb") if path.suffix == ".gz" else open(path, "rb") as fh:
+            head = fh.read(size)
+    except READ_ERRORS as exc:
+        raise damaged(name, exc) from None
+    if b"\x00" in head:
+        raise DataError(
+            f"{name}: a binary file (NUL bytes in the first {len(head)} bytes), not a text table"
+        )
+    if len(head) == size and b"\n" not in head and b"\r" not in head:
+        raise DataError(f"{name}: no line break in the first {size} bytes: not a text table")

@@ -18,15 +18,18 @@ from heritage_bayes.io._common import (
     AVERAGED_BY_DEFAULT,
     DUPLICATE_POLICIES,
     INVALID_POLICIES,
+    READ_ERRORS,
     STANDARD_COLUMNS,
     _quote_list,
     check_choice,
     check_file,
+    damaged,
     finalize,
     localize,
     modal_step,
     order_and_deduplicate,
     parse_timezone,
+    sniff_text,
     source_name,
     validate_ranges,
 )
@@ -167,12 +170,15 @@ def read_csv(
     read_kw = {"sep": sep, "skiprows": skiprows, "encoding": encoding}
 
     # -- header --------------------------------------------------------------------------
+    sniff_text(path, name)
     try:
         header = pd.read_csv(path, nrows=0, **read_kw)
     except pd.errors.EmptyDataError as exc:
         raise DataError(f"{name}: file is empty, expected a header line") from exc
     except (pd.errors.ParserError, UnicodeDecodeError) as exc:
         raise DataError(f"{name}: cannot read the header: {exc}") from exc
+    except READ_ERRORS as exc:
+        raise damaged(name, exc) from None
     stripped = [str(c).strip() for c in header.columns]
 
     if columns is None:
@@ -222,6 +228,8 @@ def read_csv(
         raise DataError(f"{name}: malformed table: {exc}") from exc
     except UnicodeDecodeError as exc:
         raise DataError(f"{name}: not {encoding}-encoded text ({exc}); pass encoding=") from exc
+    except READ_ERRORS as exc:
+        raise damaged(name, exc) from None
     if raw.shape[1] != len(stripped):
         raise DataError(f"{name}: malformed table: rows have more fields than the header")
     raw = raw.iloc[:, usecols]

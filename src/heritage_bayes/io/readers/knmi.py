@@ -17,9 +17,11 @@ import pandas as pd
 from heritage_bayes.errors import DataError, InputError
 from heritage_bayes.io._common import (
     INVALID_POLICIES,
+    READ_ERRORS,
     _quote_list,
     check_choice,
     check_file,
+    damaged,
     finalize,
     order_and_deduplicate,
     source_name,
@@ -113,8 +115,8 @@ def _read_knmi_one(path: Path, invalid: str):
                     break
                 if number > 500:
                     break
-    except (OSError, EOFError) as exc:
-        raise DataError(f"{name}: cannot read the file: {exc}") from exc
+    except READ_ERRORS as exc:
+        raise damaged(name, exc) from None
     if header_line is None:
         raise DataError(
             f"{name}: not a KNMI hourly file: no header line starting with "
@@ -143,6 +145,8 @@ def _read_knmi_one(path: Path, invalid: str):
         )
     except (ValueError, pd.errors.ParserError) as exc:
         raise DataError(f"{name}: malformed KNMI data: {exc}") from exc
+    except READ_ERRORS as exc:
+        raise damaged(name, exc) from None
     if raw.empty:
         raise DataError(f"{name}: no data rows after the header line {number + 1}")
     if raw[["YYYYMMDD", "HH"]].isna().any().any():

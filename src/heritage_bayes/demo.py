@@ -10,9 +10,9 @@ noise, 0.1 resolution and a week-long gap. ``configs/demo.yaml`` calibrates it, 
 the posterior can be compared with the truth.
 
 The inputs are built exactly as :func:`heritage_bayes.prepare.prepare` builds them for
-real data (:func:`~heritage_bayes.prepare.weather_inputs`: vapour pressure from T and
+real data (:func:`~heritage_bayes.inputs.weather_inputs`: vapour pressure from T and
 RH, Perez transposition onto the four vertical facades, :func:`heritage_bayes.io.align`;
-``Tf`` from :func:`~heritage_bayes.prepare.annual_mean_temperature`), so simulating the
+``Tf`` from :func:`~heritage_bayes.inputs.annual_mean_temperature`), so simulating the
 true parameters on the prepared frame reproduces the noise-free series (after the
 warm-up: the demo room starts from the steady state of the first hour of the weather
 file, 2019-01-01 06:00 UTC, a calibration frame usually starts later).

@@ -2,7 +2,8 @@
 
 :func:`prepare` is the bridge between :mod:`heritage_bayes.config` and the calibration
 engine. It reads the weather and measurement files with the readers of
-:mod:`heritage_bayes.io` (or generates the built-in :mod:`~heritage_bayes.demo`), derives
+:mod:`heritage_bayes.io` (or generates the built-in :mod:`~heritage_bayes.demo`; both
+through :func:`heritage_bayes.sources.read_sources`), derives
 vapour pressures, computes the irradiance on the solar surfaces
 (:func:`heritage_bayes.climate.surface_irradiance`), builds the fixed (ground)
 temperature input ``Tf``, and puts everything on one regular UTC grid with
@@ -58,7 +59,13 @@ from heritage_bayes.inputs import (
     weather_inputs,
 )
 from heritage_bayes.io._common import to_jsonable
-from heritage_bayes.sources import _ground_column, read_source
+from heritage_bayes.sources import (
+    INPUT_COLUMNS,
+    OUTPUT_COLUMNS,
+    _ground_column,
+    _iso,
+    read_sources,
+)
 
 __all__ = [
     "INPUT_COLUMNS",
@@ -68,12 +75,6 @@ __all__ = [
     "prepare",
     "solar_inputs",
 ]
-
-#: Standard columns that weather files may provide (model inputs and what they derive from).
-#: ("Ph": a known heat input [W], e.g. measured heating power of a test cell.)
-INPUT_COLUMNS = ("Te", "RHe", "Pe", "ghi", "dni", "dhi", "Tdew", "Ph")
-#: Standard columns that measurement files may provide (model outputs).
-OUTPUT_COLUMNS = ("Ti", "RHi", "Pi")
 
 _SECTIONS = ("thermal", "hygric")
 
@@ -255,10 +256,6 @@ def _rows(t: pd.Timestamp, start: pd.Timestamp, step: pd.Timedelta) -> int:
     return math.ceil((t - start) / step - 1e-9)
 
 
-def _iso(ts: pd.Timestamp) -> str:
-    return ts.tz_convert("UTC").strftime("%Y-%m-%dT%H:%M:%SZ")
-
-
 # ---------------------------------------------------------------------------------------
 # prepare
 # ---------------------------------------------------------------------------------------
@@ -307,47 +304,12 @@ def prepare(cfg) -> Prepared:
     data = cfg.data
     step = parse_duration(data.step)
     surfaces = {k: tuple(v) for k, v in data.surfaces.items()}
-    sources: dict = {}
     truth = None
-    monument = None
 
     # -- read ------------------------------------------------------------------------------
-    if data.demo is not None:
-        monument = _demo(data.demo)
-        weather = monument.weather
-        meas_tables = [monument.measurements]
-        site = dict(monument.info["site"])
-        sources["demo"] = monument.info["settings"] | {
-            "description": monument.info["description"],
-            "weather_file": monument.info["weather_file"],
-            "station": monument.info["station"],
-            "true_Tf": monument.info["Tf"],
-        }
-        sources["weather"] = {
-            "path": monument.info["weather_file"],
-            "format": "tmy3",
-            "note": "shipped with pvlib",
-        }
-        sources["measurements"] = [{"generated": monument.measurements.attrs["source"]}]
-        sources["site"] = site | {"from": "weather file (TMY3 metadata)"}
-    else:
-        weather = read_source(cfg, data.weather, "data.weather", INPUT_COLUMNS)
-        many = len(data.measurements) > 1
-        meas_tables = []
-        for i, src in enumerate(data.measurements):
-            key = "data.measurements" + (f"[{i}]" if many else "")
-            meas_tables.append(read_source(cfg, src, key, OUTPUT_COLUMNS))
-        if cfg.site is not None:
-            site = cfg.site.model_dump()
-            sources["site"] = site | {"from": "config"}
-        else:
-            site = weather.attrs.get("site")
-            if site is not None:
-                sources["site"] = dict(site) | {"from": "weather file"}
-        sources["weather"] = _source_note(weather, data.weather.format)
-        sources["measurements"] = [
-            _source_note(m, s.format) for m, s in zip(meas_tables, data.measurements, strict=True)
-        ]
+    raw = read_sources(cfg)
+    weather, meas_tables, site, monument = raw.weather, raw.measurements, raw.site, raw.monument
+    sources = dict(raw.notes)
 
     # -- inputs ----------------------------------------------------------------------------
     tables, note = weather_inputs(
@@ -592,41 +554,3 @@ def _check_plausible(frame: pd.DataFrame, cfg) -> None:
                         f"{other:.1f} °C for the other temperature: °F? hbayes expects °C; "
                         "convert with (F - 32) / 1.8"
                     )
-
-
-def _source_note(df: pd.DataFrame, fmt: str) -> dict:
-    attrs = df.attrs
-    note = {
-        "path": attrs.get("source"),
-        "format": fmt,
-        "columns": list(df.columns),
-        "rows": len(df),
-        "first": _iso(df.index[0]) if len(df) else None,
-        "last": _iso(df.index[-1]) if len(df) else None,
-    }
-    for key in ("timezone", "dropped", "clipped", "station", "source_columns", "coerced_year"):
-        if attrs.get(key) not in (None, {}, ()):
-            note[key] = attrs[key]
-    return note
-
-
-def _demo(settings):
-    from heritage_bayes.demo import virtual_monument
-
-    truth = settings.truth or {}
-    try:
-        return virtual_monument(
-            seed=settings.seed,
-            weather=settings.weather,
-            sensor_noise_T=settings.sensor_noise_T,
-            sensor_noise_RH=settings.sensor_noise_RH,
-            model_error_T=settings.model_error_T,
-            model_error_P=settings.model_error_P,
-            model_error_phi=settings.model_error_phi,
-            gap=settings.gap,
-            thermal=truth.get("thermal"),
-            hygric=truth.get("hygric"),
-            thermal_model=settings.thermal_model,
-        )
-    except InputError as exc:  # its messages start with the setting's name
-        raise ConfigError(f"data.demo.{exc}") from None

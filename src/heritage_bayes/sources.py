@@ -1,20 +1,30 @@
 """Reading the configured weather, measurement and ground-temperature sources.
 
-``read_source`` dispatches a config ``Source`` (format, path(s), CSV options) to the
-readers of :mod:`heritage_bayes.io`, checking CSV headers against the columns the
-config maps, so that errors name the config key and the file.
+Layer: config → **data**. :func:`read_sources` gives the raw tables of a config: from its
+files, or from the built-in demo (:mod:`heritage_bayes.demo`), a data source beside the
+file readers. :func:`read_source` dispatches one config ``Source`` (format, path(s), CSV
+options) to the readers of :mod:`heritage_bayes.io`, checking CSV headers against the
+columns the config maps, so that errors name the config key and the file.
+:mod:`heritage_bayes.prepare` derives the model inputs from these tables and aligns them.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
+from typing import NamedTuple
 
 import pandas as pd
 
 from heritage_bayes.errors import ConfigError, DataError, InputError
 
-__all__ = ["read_source"]
+__all__ = ["INPUT_COLUMNS", "OUTPUT_COLUMNS", "RawData", "read_source", "read_sources"]
+
+#: Standard columns that weather files may provide (model inputs and what they derive from).
+#: ("Ph": a known heat input [W], e.g. measured heating power of a test cell.)
+INPUT_COLUMNS = ("Te", "RHe", "Pe", "ghi", "dni", "dhi", "Tdew", "Ph")
+#: Standard columns that measurement files may provide (model outputs).
+OUTPUT_COLUMNS = ("Ti", "RHi", "Pi")
 
 
 def _quote(names) -> str:
@@ -172,3 +182,121 @@ def _ground_column(cfg, gt, where: str) -> tuple[pd.DataFrame, dict]:
 
 
 # ---------------------------------------------------------------------------------------
+# All sources of a config: its files, or the built-in demo
+# ---------------------------------------------------------------------------------------
+
+
+class RawData(NamedTuple):
+    """What the configured sources provide, before derivation and alignment.
+
+    Attributes
+    ----------
+    weather : pandas.DataFrame
+        Standard input columns (:data:`INPUT_COLUMNS`), native time stamps (UTC).
+    measurements : list of pandas.DataFrame
+        One table per configured measurement source (standard output columns).
+    site : dict or None
+        ``latitude``, ``longitude`` [°], ``altitude`` [m] when known.
+    notes : dict
+        Provenance: ``weather``, ``measurements``, ``site`` and, for the
+        demo, its settings under ``demo``.
+    monument : heritage_bayes.demo.VirtualMonument or None
+        The demo's dataset (truth, noise) when ``data.demo`` is set.
+    """
+
+    weather: pd.DataFrame
+    measurements: list[pd.DataFrame]
+    site: dict | None
+    notes: dict
+    monument: object | None
+
+
+def read_sources(cfg) -> RawData:
+    """Read the weather and measurement sources of a validated config.
+
+    The built-in demo (``data.demo``, :func:`heritage_bayes.demo.virtual_monument`) is a
+    data source beside the file readers: it yields the same tables as a weather file and
+    a logger file would, and the rest of the preparation does not tell them apart.
+    """
+    data = cfg.data
+    sources: dict = {}
+    monument = None
+    if data.demo is not None:
+        monument = _demo(data.demo)
+        weather = monument.weather
+        meas_tables = [monument.measurements]
+        site = dict(monument.info["site"])
+        sources["demo"] = monument.info["settings"] | {
+            "description": monument.info["description"],
+            "weather_file": monument.info["weather_file"],
+            "station": monument.info["station"],
+            "true_Tf": monument.info["Tf"],
+        }
+        sources["weather"] = {
+            "path": monument.info["weather_file"],
+            "format": "tmy3",
+            "note": "shipped with pvlib",
+        }
+        sources["measurements"] = [{"generated": monument.measurements.attrs["source"]}]
+        sources["site"] = site | {"from": "weather file (TMY3 metadata)"}
+    else:
+        weather = read_source(cfg, data.weather, "data.weather", INPUT_COLUMNS)
+        many = len(data.measurements) > 1
+        meas_tables = []
+        for i, src in enumerate(data.measurements):
+            key = "data.measurements" + (f"[{i}]" if many else "")
+            meas_tables.append(read_source(cfg, src, key, OUTPUT_COLUMNS))
+        if cfg.site is not None:
+            site = cfg.site.model_dump()
+            sources["site"] = site | {"from": "config"}
+        else:
+            site = weather.attrs.get("site")
+            if site is not None:
+                sources["site"] = dict(site) | {"from": "weather file"}
+        sources["weather"] = _source_note(weather, data.weather.format)
+        sources["measurements"] = [
+            _source_note(m, s.format) for m, s in zip(meas_tables, data.measurements, strict=True)
+        ]
+    return RawData(weather, meas_tables, site, sources, monument)
+
+
+def _source_note(df: pd.DataFrame, fmt: str) -> dict:
+    attrs = df.attrs
+    note = {
+        "path": attrs.get("source"),
+        "format": fmt,
+        "columns": list(df.columns),
+        "rows": len(df),
+        "first": _iso(df.index[0]) if len(df) else None,
+        "last": _iso(df.index[-1]) if len(df) else None,
+    }
+    for key in ("timezone", "dropped", "clipped", "station", "source_columns", "coerced_year"):
+        if attrs.get(key) not in (None, {}, ()):
+            note[key] = attrs[key]
+    return note
+
+
+def _demo(settings):
+    from heritage_bayes.demo import virtual_monument
+
+    truth = settings.truth or {}
+    try:
+        return virtual_monument(
+            seed=settings.seed,
+            weather=settings.weather,
+            sensor_noise_T=settings.sensor_noise_T,
+            sensor_noise_RH=settings.sensor_noise_RH,
+            model_error_T=settings.model_error_T,
+            model_error_P=settings.model_error_P,
+            model_error_phi=settings.model_error_phi,
+            gap=settings.gap,
+            thermal=truth.get("thermal"),
+            hygric=truth.get("hygric"),
+            thermal_model=settings.thermal_model,
+        )
+    except InputError as exc:  # its messages start with the setting's name
+        raise ConfigError(f"data.demo.{exc}") from None
+
+
+def _iso(ts: pd.Timestamp) -> str:
+    return ts.tz_convert("UTC").strftime("%Y-%m-%dT%H:%M:%SZ")

@@ -59,8 +59,42 @@ def _build_parser() -> argparse.ArgumentParser:
     rep.add_argument("--quiet", action="store_true")
     rep.set_defaults(func=_cmd_report)
 
-    mod = sub.add_parser("models", help="list the catalogue of RC models")
+    mod = sub.add_parser(
+        "models",
+        help="list the catalogue of RC models, or describe one",
+        description="Without NAME: the catalogue. With NAME: the model's equations in "
+        "words, its parameters with units and default priors (the names for `priors:`), "
+        "inputs and outputs.",
+    )
+    mod.add_argument("name", nargs="?", help="a catalogue model, e.g. thermal_2c")
+    mod.add_argument(
+        "--noise", default="ar1", choices=["ar1", "iid"], help="noise model (default ar1)"
+    )
     mod.set_defaults(func=_cmd_models)
+
+    cmp_ = sub.add_parser(
+        "compare",
+        help="calibrate candidate models and compare accuracy vs identifiability",
+        description="Calibrate each candidate model of one section with full posteriors "
+        "(each in its own run directory) and compare them on accuracy (validation "
+        "FIT/MSE/MAE and ELPD, blocked PSIS-LOO on calibration) and identifiability "
+        "(contraction, structural and practical rank); write comparison.json and "
+        "comparison.html with a recommendation.",
+    )
+    cmp_.add_argument("config", help="YAML configuration file (e.g. configs/demo.yaml)")
+    cmp_.add_argument(
+        "--models",
+        metavar="A,B,...",
+        help="catalogue models of one section (default: thermal_1c,thermal_2c,thermal_4a)",
+    )
+    cmp_.add_argument(
+        "--out", metavar="DIR", help="output folder (default: reports/<config name>-compare/)"
+    )
+    cmp_.add_argument("--seed", type=int, help="random seed (overrides the config's)")
+    cmp_.add_argument("--resume", action="store_true", help="continue saved chains")
+    cmp_.add_argument("--quiet", action="store_true", help="no progress output")
+    cmp_.add_argument("--no-report", action="store_true", help="no report.html per model")
+    cmp_.set_defaults(func=_cmd_compare)
 
     bat = sub.add_parser(
         "batch",
@@ -113,10 +147,46 @@ def _cmd_report(args) -> int:
 
 
 def _cmd_models(args) -> int:
+    from heritage_bayes.models import describe_model
     from heritage_bayes.rc.catalog import available_models
 
-    for name, desc in available_models().items():
-        print(f"{name:<20s} {desc}")
+    if args.name is None:
+        for name, desc in available_models().items():
+            print(f"{name:<20s} {desc}")
+        return 0
+    try:
+        print(describe_model(args.name, noise=args.noise))
+    except ValueError as exc:
+        raise InputError(f"models NAME: {exc}") from None
+    return 0
+
+
+def _cmd_compare(args) -> int:
+    from heritage_bayes.compare import accuracy_rows, identifiability_rows, run_compare
+    from heritage_bayes.config import load_config
+
+    cfg = load_config(args.config)
+    models = args.models.split(",") if args.models else None
+    out = run_compare(
+        cfg,
+        models,
+        args.out,
+        seed=args.seed,
+        quiet=args.quiet,
+        report=False if args.no_report else None,
+        resume=args.resume,
+    )
+    if not args.quiet:
+        import json
+
+        res = json.loads((out / "comparison.json").read_text(encoding="utf-8"))
+        for head, rows in (accuracy_rows(res), identifiability_rows(res)):
+            print(" | ".join(head))
+            for r in rows:
+                print(" | ".join(r))
+            print()
+        print("recommendation:", res["recommendation"]["reason"])
+        print(out / "comparison.html")
     return 0
 
 

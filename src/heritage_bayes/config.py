@@ -451,7 +451,12 @@ class SamplerSettings(_Strict):
     moves: Literal["de_snooker", "stretch", "de"] = "de_snooker"
     init_ball: float = Field(default=1e-3, gt=0, le=1)
     max_draws: int = Field(default=4000, ge=100)
-    n_predictive: int = Field(default=200, ge=10)
+    n_predictive: int = Field(
+        default=1000,
+        ge=10,
+        description="draws (all walkers) saved in posterior.nc, the same in every group "
+        "(posterior, predictive, log-likelihood); PSIS-LOO needs about 1000",
+    )
 
 
 class OptimizerSettings(_Strict):

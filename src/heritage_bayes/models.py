@@ -16,7 +16,7 @@ from heritage_bayes.rc.catalog import model as catalog_model
 from heritage_bayes.rc.model import RCModel
 from heritage_bayes.rc.network import Network
 
-__all__ = ["SECTIONS", "build_model"]
+__all__ = ["SECTIONS", "build_model", "describe_model"]
 
 SECTIONS = ("thermal", "hygric")
 _SOLAR = {"thermal_1c", "thermal_2c", "thermal_4a"}
@@ -77,3 +77,81 @@ def _catalog_options(cfg: CalibrationConfig, section: str, name: str) -> dict:
     if name in _SOLAR and "surfaces" not in options:
         options["surfaces"] = tuple(cfg.data.surfaces) if cfg.data.irradiance != "none" else ()
     return options
+
+
+def describe_model(name: str, noise: str = "ar1") -> str:
+    """A catalogue model in words: balance equations, parameters with units and default
+    priors (the names ``priors:`` accepts), inputs and outputs (``hbayes models NAME``).
+
+    Raises
+    ------
+    ValueError
+        Unknown model or noise name (the message lists the available ones).
+    """
+    from heritage_bayes.inference.likelihoods import get_noise_model
+    from heritage_bayes.inference.parameters import parameters_for
+
+    if name not in CATALOG:
+        raise ValueError(f"unknown model {name!r}; available: {sorted(CATALOG)}")
+    m = catalog_model(name)
+    net = m.network
+    pot = "T" if net.domain == "thermal" else "P"
+    lines = [f"{name}: {CATALOG[name][1]}", "", "Equations (one balance per capacity node):"]
+    for node in net.nodes:
+        terms = []
+        for lk in net.links:
+            if lk.a == node.name:
+                terms.append(f"{lk.G}·({lk.b} − {node.name})")
+            elif lk.b == node.name:
+                terms.append(f"{lk.G}·({lk.a} − {node.name})")
+        for src in net.sources:
+            if src.node != node.name:
+                continue
+            frac = f"{src.fraction}·" if src.fraction else ""
+            frac = f"({src.fraction})·" if src.fraction and "-" in src.fraction else frac
+            gain = f"{src.gain}·" if isinstance(src.gain, str) else ""
+            terms.append(f"{frac}{gain}{src.input}")
+        lines.append(f"  {node.C}·d{node.name}/dt = " + " + ".join(terms))
+    kind = "heat flows [W]" if pot == "T" else "vapour flows [kg/s]"
+    lines.append(
+        f"  (each term is one of the {kind} into the node; outputs: "
+        f"{', '.join(net.outputs)}, measured with noise)"
+    )
+    if net.constants:
+        lines.append(f"  constant potentials to estimate: {', '.join(net.constants)}")
+    nm = get_noise_model(noise)
+    ps = parameters_for(m, nm)
+    lines += ["", f"Parameters (default priors; noise model {noise!r}):"]
+    for p in ps.parameters:
+        lines.append(
+            f"  {p.name:<9s} {'[' + p.unit + ']':<13s} {p.kind:<11s} "
+            f"{p.prior.describe():<28s} {p.description}"
+        )
+    lines += ["", "Inputs (columns of the prepared data):"]
+    for i in m.input_names:
+        lines.append(
+            f"  {i:<9s} {'[' + net.input_unit(i) + ']':<13s} {net.descriptions.get(i, '')}"
+        )
+    lines += ["", "Outputs:"]
+    unit = "°C" if pot == "T" else "Pa"
+    what = "temperature" if pot == "T" else "vapour pressure"
+    for o in m.output_names:
+        lines.append(f"  {o:<9s} {'[' + unit + ']':<13s} measured indoor {what}")
+    lines += [
+        "",
+        "Set a prior in the config, e.g.",
+        f"  {net.domain}:",
+        f"    model: {name}",
+        "    priors:",
+        f"      {ps.parameters[0].name}: {{dist: lognormal, median: <value>, sigma: 1}}",
+        "room_volume [m³] and air_change_rate [1/h] set log-normal priors on Ci and Gfast.",
+        *(
+            [
+                "Options (under options:): ground (true | false | estimate), heating; the "
+                "solar surfaces come from data.surfaces."
+            ]
+            if net.domain == "thermal"
+            else []
+        ),
+    ]
+    return "\n".join(lines)

@@ -46,9 +46,44 @@ def _period_codes(prep) -> np.ndarray:
     return code
 
 
-def _predictive_index(n_chain: int, n_draw: int, n_total: int) -> np.ndarray:
+def _saved_index(n_chain: int, n_draw: int, n_total: int) -> np.ndarray:
+    """Draws per chain kept in ``posterior.nc``: evenly spaced, about ``n_total`` in all."""
     m = max(1, min(n_draw, math.ceil(n_total / n_chain)))
     return np.unique(np.linspace(0, n_draw - 1, m).round().astype(int))
+
+
+def _pointwise(s, pw: np.ndarray, times: np.ndarray, shape) -> dict[str, xr.DataArray]:
+    """Pointwise log-likelihood terms (K, N, n_out) -> one DataArray per output.
+
+    Only hours with a finite term (an observation that enters the likelihood) are kept,
+    on one ``time.<section>.<output>`` axis per output, so that ``az.loo`` uses them all.
+    """
+    out = {}
+    for o, name in enumerate(s.model.output_names):
+        idx = np.flatnonzero(np.isfinite(pw[0, :, o]))
+        if idx.size == 0:
+            continue
+        dim = f"time.{s.name}.{name}"
+        out[f"{s.name}.{name}"] = xr.DataArray(
+            pw[:, idx, o].reshape(*shape, idx.size),
+            dims=("chain", "draw", dim),
+            coords={dim: times[idx]},
+        )
+    return out
+
+
+def _validation_pointwise(s, prep, Ysim, tn) -> np.ndarray:
+    """(K, N, n_out) one-step predictive log densities of the validation observations.
+
+    ``Ysim`` is the simulation over the whole frame (from the calibration's initial
+    state); the noise model conditions each term on the previous validation residual (the
+    first one has the stationary variance), NaN outside the validation period.
+    """
+    obs = np.asarray(prep.observed(s.name, s.model), dtype=float)
+    Yobs = np.full_like(obs, np.nan)
+    if prep.validation is not None:
+        Yobs[prep.validation] = obs[prep.validation]
+    return s.logpost.noise.pointwise(Ysim, np.ascontiguousarray(Yobs), tn)
 
 
 def _prior_variance(prior, rng) -> float:
@@ -74,10 +109,14 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
     times = _times(prep)
     codes = _period_codes(prep)
     W, D = sections[0].X.shape[:2]
-    sel = _predictive_index(W, D, cfg.sampler.n_predictive)
+    # every group holds the same draws (arviz convention: az.loo takes the relative
+    # efficiency from the posterior and the terms from log_likelihood)
+    sel = _saved_index(W, D, cfg.sampler.n_predictive)
+    n_sel = len(sel)
     post: dict[str, xr.DataArray] = {}
     stats: dict[str, xr.DataArray] = {}
     loglik: dict[str, xr.DataArray] = {}
+    loglik_val: dict[str, xr.DataArray] = {}
     pp: dict[str, xr.DataArray] = {}
     summary_params: dict[str, dict] = {}
     summary_derived: dict[str, dict] = {}
@@ -87,25 +126,29 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
     pp_outputs: dict[str, np.ndarray] = {}
     truth_all = prep.truth or {}
     cdims = ("chain", "draw")
-    coords = {"chain": np.arange(W), "draw": np.arange(D)}
+    coords = {"chain": np.arange(W), "draw": np.arange(n_sel)}
     for s in sections:
         ps = s.logpost.params
         names = ps.names
         tm = s.theta[..., : s.logpost.n_model]
         for j, p in enumerate(ps.parameters):
             post[f"{s.name}.{p.name}"] = xr.DataArray(
-                s.theta[..., j],
+                s.theta[:, sel, j],
                 dims=cdims,
                 attrs={"unit": p.unit, "kind": p.kind, "description": p.description},
             )
         dq = derived_quantities(s.model, tm.reshape(-1, tm.shape[-1]))
         units = derived_units(s.model)
+        dq_all = {}
         for k, v in dq.items():
             arr = np.broadcast_to(np.asarray(v, dtype=float), (W * D,)).reshape(W, D)
-            post[f"{s.name}.{k}"] = xr.DataArray(arr, dims=cdims, attrs={"unit": units.get(k, "")})
-        stats[f"{s.name}.lp"] = xr.DataArray(s.lp, dims=cdims)
+            dq_all[k] = arr
+            post[f"{s.name}.{k}"] = xr.DataArray(
+                arr[:, sel], dims=cdims, attrs={"unit": units.get(k, "")}
+            )
+        stats[f"{s.name}.lp"] = xr.DataArray(s.lp[:, sel], dims=cdims)
         stats[f"{s.name}.acceptance_rate"] = xr.DataArray(
-            np.broadcast_to(s.chain.acceptance[:, None], (W, D)).copy(), dims=cdims
+            np.broadcast_to(s.chain.acceptance[:, None], (W, n_sel)).copy(), dims=cdims
         )
         # predictive over the whole frame for the selected draws
         th_sel = s.theta[:, sel].reshape(-1, s.theta.shape[-1])
@@ -116,8 +159,8 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
         Ysim = modal_simulate(mf, U, np.ascontiguousarray(z0))
         noise = s.logpost.noise.sample(rng, tn_sel, U.shape[0], s.model.n_outputs)
         Ypp = Ysim + noise
-        shape = (W, len(sel), U.shape[0])
-        pcoords = {"chain": np.arange(W), "draw": sel, "time": times}
+        shape = (W, n_sel, U.shape[0])
+        pcoords = {"chain": np.arange(W), "draw": np.arange(n_sel), "time": times}
         for o, out in enumerate(s.model.output_names):
             attrs = {"unit": _OUT_UNITS.get(out, "")}
             pp[f"{s.name}.{out}"] = xr.DataArray(
@@ -134,13 +177,9 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
             )
             pp_outputs[out] = (Ypp[..., o], Ysim[..., o])
         pw = s.logpost.pointwise_log_likelihood(th_sel)
-        cal = prep.calibration
-        for o, out in enumerate(s.model.output_names):
-            loglik[f"{s.name}.{out}"] = xr.DataArray(
-                pw[..., o].reshape(W, len(sel), -1),
-                dims=("chain", "draw", "time_cal"),
-                coords={"chain": np.arange(W), "draw": sel, "time_cal": times[cal]},
-            )
+        loglik.update(_pointwise(s, pw, times[prep.calibration], (W, n_sel)))
+        pw = _validation_pointwise(s, prep, Ysim, tn_sel)
+        loglik_val.update(_pointwise(s, pw, times, (W, n_sel)))
         # parameter summaries
         # statistics on all draws the sampler checked; R-hat and ESS in the sampler's
         # coordinates, exactly as its stopping rule computed them (folded R-hat is not
@@ -189,11 +228,11 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
             summary_params[key] = entry
         for k in dq:
             key = f"{s.name}.{k}"
-            x = post[key].values.reshape(-1)
+            x = dq_all[k].reshape(-1)
             summary_derived[key] = {"unit": units.get(k, ""), **_summ(x), "truth": truth_dq.get(k)}
             if np.all(np.isfinite(x)) and np.ptp(x) > 0:
-                summary_derived[key]["r_hat"] = float(az.rhat(post[key].values))
-                summary_derived[key]["ess_bulk"] = float(az.ess(post[key].values, method="bulk"))
+                summary_derived[key]["r_hat"] = float(az.rhat(dq_all[k]))
+                summary_derived[key]["ess_bulk"] = float(az.ess(dq_all[k], method="bulk"))
         # posterior correlations of the free parameters (log scale where the prior is)
         Y = []
         for j, p in enumerate(ps.parameters):
@@ -232,8 +271,8 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
         pi_pp, pi_sim = pp_outputs["Pi"]
         rh_pp = 100.0 * pi_pp / saturation_vapour_pressure(ti_pp)
         rh_sim = 100.0 * pi_sim / saturation_vapour_pressure(ti_sim)
-        shape = (W, len(sel), prep.n_rows)
-        pcoords = {"chain": np.arange(W), "draw": sel, "time": times}
+        shape = (W, n_sel, prep.n_rows)
+        pcoords = {"chain": np.arange(W), "draw": np.arange(n_sel), "time": times}
         pp["RHi"] = xr.DataArray(
             rh_pp.reshape(shape).astype(np.float32),
             dims=("chain", "draw", "time"),
@@ -285,11 +324,15 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
     groups = {
         "posterior": xr.Dataset(post, coords=coords, attrs=attrs),
         "sample_stats": xr.Dataset(stats, coords=coords, attrs=attrs),
-        "log_likelihood": xr.Dataset(loglik, attrs=attrs),
+        "log_likelihood": xr.Dataset(loglik, coords=coords, attrs=attrs),
         "posterior_predictive": xr.Dataset(pp, attrs=attrs),
         "observed_data": xr.Dataset(observed, attrs=attrs),
         "constant_data": xr.Dataset(const, attrs=attrs),
     }
+    if loglik_val:
+        # not an arviz group: the validation period is not conditioned on; its terms
+        # give the expected log predictive density of new data (heritage_bayes.compare)
+        groups["log_likelihood_validation"] = xr.Dataset(loglik_val, coords=coords, attrs=attrs)
     idata = az.InferenceData(**groups)
     free_rhat = [v["r_hat"] for v in summary_params.values() if "r_hat" in v]
     free_ess = [v["ess_bulk"] for v in summary_params.values() if "ess_bulk" in v]

@@ -5,12 +5,19 @@ Run directory (``hbayes calibrate``):
 - ``posterior.nc``: arviz InferenceData (NetCDF4/HDF5). Variables are qualified by the
   calibrated model: ``thermal.Cw``, ``hygric.Ci``, ``thermal.tau_1_h``, ...
 
+  Every group holds the same draws: ``sampler.n_predictive`` (default 1000) evenly
+  spaced retained draws over all walkers (``chain``), with the same ``draw`` labels.
+
   - ``posterior``: parameters (fixed ones included as constants) and derived
-    identifiable quantities (time constants [h], static gains) per walker (``chain``) and
-    retained draw;
+    identifiable quantities (time constants [h], static gains);
   - ``sample_stats``: ``<model>.lp`` (log-posterior), ``<model>.acceptance_rate``;
-  - ``log_likelihood``: pointwise terms over the calibration period for a subset of
-    draws (for LOO; NaN where excluded);
+  - ``log_likelihood``: ``<model>.<output>``, the pointwise terms of the calibration
+    likelihood, only the hours that enter it (axis ``time.<model>.<output>``: no warm-up,
+    no gap), so ``az.loo``/``az.compare`` work on the InferenceData as it is; with AR(1)
+    noise each term is the density of the hour given the previous residual;
+  - ``log_likelihood_validation`` (not an arviz group): the same over the validation
+    period, from the simulation continued past calibration (expected log predictive
+    density of new data);
   - ``observed_data``: ``Ti``, ``Pi``, ``RHi`` on the ``time`` axis;
   - ``constant_data``: the model inputs and a ``period`` code (0 warm-up, 1 calibration,
     2 validation, -1 outside);

@@ -1,0 +1,255 @@
+"""Model comparison (issue 13): arviz conventions of a run, blocked LOO, validation ELPD,
+identifiability measures, the recommendation, `hbayes compare` and `hbayes models NAME`.
+
+A module-scoped fixture runs `hbayes compare` on a tiny virtual monument (thermal_1c and
+thermal_2c, 10 + 5 days, 600 sampler steps: seconds, not converged) once.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import math
+
+import numpy as np
+import pytest
+import yaml
+
+from _report_browser import find_chromium, open_page
+from heritage_bayes._arviz import az
+from heritage_bayes.cli import main
+from heritage_bayes.compare import (
+    _block_se,
+    _practical_rank,
+    _recommend,
+    blocked_loo_data,
+    elpd_validation,
+    load_inference,
+)
+
+TINY = {
+    "name": "tiny",
+    "building": "Virtual <b>monument</b>",
+    "seed": 3,
+    "data": {"demo": {"seed": 7, "gap": ["2019-02-05", "2019-02-06"]}},
+    "periods": {
+        "calibration": {"start": "2019-02-01", "end": "2019-02-11"},
+        "validation": {"start": "2019-02-11", "end": "2019-02-16"},
+        "warmup": "2d",
+        "init_window": "2d",
+    },
+    "room_volume": 400,
+    # Gw exists in thermal_2c only: the thermal_1c candidate runs without it
+    "thermal": {"model": "thermal_2c", "priors": {"Gw": {"lower": 1.0, "upper": 1.0e4}}},
+    "hygric": {"model": "hygric_1c"},
+    "sampler": {"max_steps": 600, "check_every": 200},
+    "optimizer": {"maxiter": 20, "starts": 2, "popsize": 4},
+}
+MODELS = ("thermal_1c", "thermal_2c")
+
+
+@pytest.fixture(scope="module")
+def cfg_path(tmp_path_factory):
+    p = tmp_path_factory.mktemp("cmpcfg") / "tiny.yaml"
+    p.write_text(yaml.safe_dump(TINY))
+    return p
+
+
+@pytest.fixture(scope="module")
+def compared(cfg_path, tmp_path_factory):
+    out = tmp_path_factory.mktemp("compare") / "cmp"
+    args = ["compare", str(cfg_path), "--models", ",".join(MODELS), "--out", str(out)]
+    assert main([*args, "--quiet", "--no-report"]) == 0
+    return out, json.loads((out / "comparison.json").read_text())
+
+
+def test_run_groups_share_draws_and_loglik_has_only_observed_hours(compared):
+    out, _ = compared
+    idata = load_inference([out / "thermal_2c"])["thermal_2c"]
+    post = idata.posterior
+    for g in ("posterior_predictive", "log_likelihood", "log_likelihood_validation"):
+        ds = idata[g]
+        np.testing.assert_array_equal(ds["chain"].values, post["chain"].values)
+        np.testing.assert_array_equal(ds["draw"].values, post["draw"].values)
+    ll = idata.log_likelihood["thermal.Ti"]
+    assert np.all(np.isfinite(ll.values))
+    # warm-up (2 days) and the one-day gap are not in the likelihood: 10 - 2 - 1 days
+    assert ll.shape[-1] == (10 - 2 - 1) * 24
+    lv = idata["log_likelihood_validation"]["thermal.Ti"]
+    assert lv.shape[-1] == 5 * 24 and np.all(np.isfinite(lv.values))
+    # every group holds sampler.n_predictive (default 1000) draws, or all retained ones
+    summ = json.loads((out / "thermal_2c" / "summary.json").read_text())
+    per_walker = summ["models"]["thermal"]["chain"]["draws_per_walker"]
+    assert post.sizes["draw"] == min(per_walker, math.ceil(1000 / post.sizes["chain"]))
+
+
+def test_az_loo_and_compare_on_run_directories_are_finite(compared):
+    out, _ = compared
+    runs = load_inference({m: out / m for m in MODELS})
+    for d in runs.values():
+        loo = az.loo(d)  # one output per run: no var_name needed
+        assert math.isfinite(float(loo.elpd_loo)) and math.isfinite(float(loo.se))
+    table = az.compare(runs)
+    assert set(table.index) == set(MODELS)
+    assert np.all(np.isfinite(table[["elpd_loo", "se", "dse", "weight"]].to_numpy(float)))
+    blocked = {m: blocked_loo_data(d) for m, d in runs.items()}
+    assert blocked["thermal_2c"].log_likelihood["thermal.Ti"].shape[-1] == 7  # daily blocks
+    table = az.compare(blocked)
+    assert np.all(np.isfinite(table[["elpd_loo", "se", "dse"]].to_numpy(float)))
+    # the blocked terms are sums of the hourly ones: the full-data lpd is unchanged
+    h = runs["thermal_2c"].log_likelihood["thermal.Ti"].values.sum(axis=-1)
+    b = blocked["thermal_2c"].log_likelihood["thermal.Ti"].values.sum(axis=-1)
+    np.testing.assert_allclose(h, b, rtol=1e-10)
+
+
+def test_validation_elpd_is_the_log_mean_density(compared):
+    out, _ = compared
+    d = load_inference([out / "thermal_1c"])["thermal_1c"]
+    ev = elpd_validation(d)
+    lv = d["log_likelihood_validation"]["thermal.Ti"].values.reshape(-1, 120)
+    expected = np.log(np.mean(np.exp(lv), axis=0)).sum()
+    assert ev["n"] == 120
+    np.testing.assert_allclose(ev["elpd"], expected, rtol=1e-9)
+    assert ev["se"] > 0
+
+
+def test_comparison_json(compared):
+    out, res = compared
+    assert set(res["models"]) == set(MODELS)
+    for m in MODELS:
+        info = res["models"][m]
+        assert (out / m / "posterior.nc").is_file() and info["model"] == m
+        a = info["accuracy"]
+        assert {"FIT", "MSE", "MAE"} <= set(a["validation"])
+        for k in ("elpd_validation", "loo_blocked"):
+            assert math.isfinite(a[k]["elpd"]) and math.isfinite(a[k]["diff_to_best"])
+        i = info["identifiability"]
+        assert i["structural_rank"] <= i["structural_n_params"]
+        assert 0 <= i["practical_rank"] <= i["n_free_physical"]
+        assert i["widest_interval"]["decades"] > 0
+        assert "tau_1_h" in i["derived"]
+        for e in list(i["parameters"].values()) + list(i["derived"].values()):
+            if not e.get("fixed") and e.get("contraction") is not None:
+                assert e["contraction"] <= 1.0
+    # the configured priors reach the candidates that have the parameter
+    p2 = res["models"]["thermal_2c"]["identifiability"]["parameters"]
+    assert 1.0 <= p2["Gw"]["q05"] and p2["Gw"]["q95"] <= 1.0e4
+    assert "Gw" not in res["models"]["thermal_1c"]["identifiability"]["parameters"]
+    rec = res["recommendation"]
+    assert rec["model"] in MODELS and rec["reason"].startswith(rec["model"] + ":")
+    assert rec["best_accuracy"] in rec["equivalent"]
+    assert (out / "comparison.html").is_file()
+
+
+def test_recommendation_rule():
+    def model(n, diff, dse, taus_bad, params_bad=()):
+        return {
+            "accuracy": {"elpd_validation": {"diff_to_best": diff, "dse_to_best": dse}},
+            "identifiability": {
+                "n_free_physical": n,
+                "time_constants_identified": not taus_bad,
+                "time_constants_not_identified": list(taus_bad),
+                "time_constants_below_step": [],
+                "parameters_not_identified": list(params_bad),
+                "practical_rank": n - len(params_bad),
+            },
+        }
+
+    models = {
+        "thermal_1c": model(7, -40.0, 8.0, []),
+        "thermal_2c": model(10, -3.0, 2.0, []),
+        "thermal_4a": model(13, 0.0, 0.0, ["tau_2_h"], ["Cint"]),
+    }
+    rec = _recommend(models, "elpd_validation")
+    assert rec["model"] == "thermal_2c"
+    assert "within 2 SE of thermal_4a (difference -3.0 ± 2.0)" in rec["reason"]
+    assert "thermal_4a is as accurate but not identified: tau_2_h" in rec["reason"]
+    assert "thermal_1c is less accurate" in rec["reason"]
+    # 2c outside 2 SE: the accurate model is recommended, with its unidentified tau named
+    models["thermal_2c"] = model(10, -5.0, 2.0, [])
+    rec = _recommend(models, "elpd_validation")
+    assert rec["model"] == "thermal_4a" and "tau_2_h" in rec["reason"]
+
+
+def test_block_se_and_practical_rank():
+    rng = np.random.default_rng(5)
+    # iid terms: the block-sum SE estimates sqrt(n) sd; with 400 blocks its relative
+    # sampling error is about 1/sqrt(2 * 399) = 3.5 %, so 15 % is > 4 sd
+    x = rng.standard_normal(400 * 24)
+    t = np.datetime64("2020-01-01T00:00") + np.arange(x.size) * np.timedelta64(1, "h")
+    assert _block_se(x, t, 24.0) == pytest.approx(math.sqrt(x.size), rel=0.15)
+    # AR(1) terms with phi 0.9: the hourly SE formula underrates the sum's sd by
+    # sqrt((1 + phi) / (1 - phi)) = 4.4; daily blocks recover most of it
+    e = np.empty_like(x)
+    e[0] = x[0]
+    for k in range(1, x.size):
+        e[k] = 0.9 * e[k - 1] + math.sqrt(1 - 0.81) * x[k]
+    naive = math.sqrt(x.size) * np.std(e)
+    assert _block_se(e, t, 24.0) > 3.0 * naive
+    post = rng.standard_normal((4000, 3)) * np.array([0.01, 0.05, 0.9])
+    rank, eig = _practical_rank(post, np.ones(3), 0.01)
+    assert rank == 2 and len(eig) == 3
+
+
+@pytest.mark.parametrize(
+    ("models", "needle"),
+    [
+        ("thermal_1c,thermal_9z", "unknown model(s) ['thermal_9z']"),
+        ("thermal_1c,hygric_2c", "['hygric_2c'] are not thermal models"),
+        ("thermal_2c", "at least two models"),
+        ("thermal_1c,thermal_1c", "given more than once"),
+    ],
+)
+def test_bad_models_exit_2_naming_the_option(cfg_path, tmp_path, capsys, models, needle):
+    rc = main(["compare", str(cfg_path), "--models", models, "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err
+    assert rc == 2 and "--models" in err and needle in err and "Traceback" not in err
+    assert not (tmp_path / "o").exists()
+
+
+def test_models_of_a_section_the_config_lacks(tmp_path, capsys):
+    raw = {k: v for k, v in TINY.items() if k != "hygric"}
+    p = tmp_path / "thermal_only.yaml"
+    p.write_text(yaml.safe_dump(raw))
+    rc = main(["compare", str(p), "--models", "hygric_1c,hygric_2c", "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err
+    assert rc == 2 and "no 'hygric' section" in err
+
+
+def test_models_name_describes_the_model(capsys):
+    assert main(["models", "thermal_2c"]) == 0
+    out = capsys.readouterr().out
+    assert "Ci·dTi/dt = Gi·(Tw − Ti) + Gfast·(Te − Ti)" in out
+    for needle in ("Cw ", "[J/K]", "[W/K]", "fI_S", "[m²]", "loguniform", "sigma_Ti", "phi_Ti"):
+        assert needle in out
+    assert "Te " in out and "[W/m²]" in out and "Ti " in out
+    assert main(["models", "hygric_2c", "--noise", "iid"]) == 0
+    out = capsys.readouterr().out
+    assert "[kg/Pa]" in out and "sigma_Pi" in out and "phi_Pi" not in out
+    assert main(["models", "thermal_5x"]) == 2
+    assert "unknown model 'thermal_5x'" in capsys.readouterr().err
+    assert main(["models"]) == 0
+    assert "thermal_4a" in capsys.readouterr().out
+
+
+def test_comparison_page_in_headless_chromium(compared):
+    out, res = compared
+    text = (out / "comparison.html").read_text()
+    assert "<b>monument</b>" not in text and "&lt;b&gt;monument" in text
+    chromium = find_chromium()
+    if chromium is None:
+        pytest.skip("chromium not installed (Debian package 'chromium'; .ci/run installs it)")
+    page = open_page(out / "comparison.html", chromium=chromium, width=1280, height=1400)
+    assert page.errors == [], page.errors
+    external = [u for u in page.requests[1:] if not u.startswith("data:")]
+    assert external == [], external
+    dom = page.dom
+    assert dom["sections"][:3] == ["summary", "accuracy", "identifiability"]
+    assert [f"model-{m}" for m in MODELS] == dom["sections"][3:]
+    assert dom["figures"] == ["fig-tradeoff"] and dom["scripts"] == 0
+    assert all(i["complete"] and i["w"] > 400 for i in dom["images"])
+    import matplotlib.image as mpimg
+
+    img = mpimg.imread(io.BytesIO(page.screenshot), format="png")[..., :3]
+    assert float(np.mean(img.mean(axis=2) < 0.9)) > 0.03, "screenshot is (almost) blank"
+    assert res["recommendation"]["model"] in text

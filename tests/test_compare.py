@@ -165,6 +165,9 @@ def test_recommendation_rule():
     assert "within 2 SE of thermal_4a (difference -3.0 ± 2.0)" in rec["reason"]
     assert "thermal_4a is as accurate but not identified: tau_2_h" in rec["reason"]
     assert "thermal_1c is less accurate" in rec["reason"]
+    assert "Not converged" not in rec["reason"]
+    models["thermal_4a"]["converged"] = False
+    assert "provisional: thermal_4a" in _recommend(models, "elpd_validation")["reason"]
     # 2c outside 2 SE: the accurate model is recommended, with its unidentified tau named
     models["thermal_2c"] = model(10, -5.0, 2.0, [])
     rec = _recommend(models, "elpd_validation")

@@ -540,9 +540,18 @@ def _recommend(models: dict, score: str) -> dict:
                 f"({idf['n_free_physical']} against {ident['n_free_physical']})"
             )
     text = f"{choice}: " + ", ".join(parts) + "."
+    unconverged = [m for m, info in models.items() if info.get("converged") is False]
+    if unconverged:
+        text += f" Not converged (R-hat/ESS/τ criteria), so provisional: {', '.join(unconverged)}."
     if others:
         text += " " + "; ".join(others) + "."
-    return {"model": choice, "reason": text, "best_accuracy": best, "equivalent": equiv}
+    return {
+        "model": choice,
+        "reason": text,
+        "best_accuracy": best,
+        "equivalent": equiv,
+        "not_converged": unconverged,
+    }
 
 
 # ------------------------------------------------------------------ orchestration
@@ -671,7 +680,7 @@ def fig_tradeoff(result: dict):
     least to the most contracted); y: the accuracy score relative to the best model with
     ±2 SE whiskers. Labels give the practical and structural rank.
     """
-    from heritage_bayes.report.figures import C_MODEL, _figure, tex_safe
+    from heritage_bayes.report.figures.style import C_MODEL, _figure, tex_safe
 
     fig = _figure(7.5, 4.2)
     ax = fig.subplots()

@@ -20,6 +20,7 @@ _LAZY = {
     "simulate": "heritage_bayes.rc",
     "structural_identifiability": "heritage_bayes.rc",
     "load_run": "heritage_bayes.run",
+    "project": "heritage_bayes.projection",
     "run_calibration": "heritage_bayes.calibrate",
 }
 
@@ -52,6 +53,7 @@ __all__ = [
     "io",
     "load_run",
     "model",
+    "project",
     "run_calibration",
     "simulate",
     "structural_identifiability",

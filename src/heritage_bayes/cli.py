@@ -59,6 +59,21 @@ def _build_parser() -> argparse.ArgumentParser:
     rep.add_argument("--quiet", action="store_true")
     rep.set_defaults(func=_cmd_report)
 
+    prj = sub.add_parser(
+        "project",
+        help="project a calibrated room's climate and risk onto future weather",
+        description="Run the posterior draws of a calibrated room on future weather "
+        "(KNMI'14 scenarios, morphing, or future files) and turn the indoor climate into "
+        "conservation risk; write projection.nc, projection.json and projection.html.",
+    )
+    prj.add_argument("run_dir", help="a run directory written by `hbayes calibrate`")
+    prj.add_argument("projection", help="projection YAML file (e.g. configs/projection_demo.yaml)")
+    prj.add_argument("--out", metavar="DIR", help="output folder (default: RUN_DIR/projection)")
+    prj.add_argument("--draws", type=int, metavar="N", help="posterior draws (overrides the file)")
+    prj.add_argument("--seed", type=int, metavar="S", help="random seed (overrides the file)")
+    prj.add_argument("--quiet", action="store_true", help="no progress output")
+    prj.set_defaults(func=_cmd_project)
+
     mod = sub.add_parser(
         "models",
         help="list the catalogue of RC models, or describe one",
@@ -143,6 +158,30 @@ def _cmd_report(args) -> int:
     path = write_report(args.run_dir)
     if not args.quiet:
         print(path)
+    return 0
+
+
+def _cmd_project(args) -> int:
+    from heritage_bayes.projection import load_projection_config
+
+    pcfg = load_projection_config(args.projection)  # config errors before heavy imports
+    from heritage_bayes.projection import project
+
+    def say(line: str) -> None:
+        print(f"hbayes project: {line}", file=sys.stderr, flush=True)
+
+    proj = project(
+        args.run_dir,
+        pcfg,
+        out=args.out,
+        draws=args.draws,
+        seed=args.seed,
+        progress=None if args.quiet else say,
+    )
+    if not args.quiet:
+        print(proj.probability_table().to_string(float_format=lambda v: f"{v:.2f}"))
+        for p in proj.paths.values():
+            print(p)
     return 0
 
 

@@ -545,11 +545,13 @@ class CalibrationConfig(_Strict):
         return q if q.is_absolute() or self.base_dir is None else Path(self.base_dir) / q
 
 
-def _allowed_keys(loc) -> list[str]:
-    """Field names of the config section at key path ``loc`` (for error hints)."""
+def _allowed_keys(loc, root: type[BaseModel] | None = None) -> list[str]:
+    """Field names of the config section at key path ``loc`` (for error hints).
+
+    ``root``: the schema the path starts from (default :class:`CalibrationConfig`)."""
     import typing
 
-    cls: Any = CalibrationConfig
+    cls: Any = root or CalibrationConfig
     for key in loc:
         if not (isinstance(cls, type) and issubclass(cls, BaseModel)):
             return []
@@ -600,14 +602,14 @@ def _key_path(loc, raw: Any) -> str:
 _KEY_PREFIX = re.compile(r"^([A-Za-z_]\w*(?:\.[A-Za-z_]\w*)*): ")
 
 
-def _format_error(err: dict, raw: Any) -> str:
+def _format_error(err: dict, raw: Any, root: type[BaseModel] | None = None) -> str:
     loc = _key_path(err["loc"], raw)
     msg = err["msg"]
     if msg.startswith("Value error, "):
         msg = msg[len("Value error, ") :]
     typ = err["type"]
     if typ == "extra_forbidden":
-        allowed = _allowed_keys(err["loc"][:-1])
+        allowed = _allowed_keys(err["loc"][:-1], root)
         hint = f"; allowed keys: {', '.join(allowed)}" if allowed else ""
         return f"{loc}: unknown key{hint}"
     found = err.get("input")

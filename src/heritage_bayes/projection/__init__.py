@@ -1,0 +1,192 @@
+"""Climate-change projections of a calibrated room: ``hbayes project``.
+
+After ``hbayes calibrate``, the posterior draws of the room's thermal and hygric models
+are run on future weather — the KNMI'14 scenarios for Dutch sites, monthly morphing for
+any site, or user-supplied future files (:mod:`heritage_bayes.climate.morph`) — and the
+indoor climate is turned into conservation risk (:mod:`heritage_bayes.climate.risk`).
+
+>>> import heritage_bayes as hb                                    # doctest: +SKIP
+>>> p = hb.project("reports/demo", "configs/projection_demo.yaml")  # doctest: +SKIP
+>>> p.probability_table()                                            # doctest: +SKIP
+
+What it assumes (written into every output): the building and its use stay as
+calibrated (stationary parameters: no renovation, no change of ventilation, heating or
+visitors); the calibrated noise model describes the model error in the future as it did
+in the calibration period; the future weather is a transformation of the baseline
+(same weather sequence, shifted/stretched statistics), so year-to-year variability is
+that of the baseline.
+
+Outputs (``--out``, default ``RUN_DIR/projection``): ``projection.nc`` (xarray: per
+case — the baseline and each scenario × horizon — and draw, every risk indicator, and
+the monthly means of ``Ti`` and ``RHi`` by calendar month; the hourly draws are not
+stored), ``projection.json`` (quantiles, change relative to the baseline, probability
+statements, the uncertainty split, the weather transformations, timings) and
+``projection.html`` (self-contained page).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from heritage_bayes.projection.config import (
+    ProjectionConfig,
+    load_projection_config,
+    parse_projection_config,
+)
+
+__all__ = [
+    "Projection",
+    "ProjectionConfig",
+    "load_projection_config",
+    "parse_projection_config",
+    "project",
+]
+
+ASSUMPTIONS = (
+    "The building and its use stay as calibrated (stationary parameters: no renovation, "
+    "no change of ventilation, heating, moisture sources or visitors).",
+    "The calibrated noise model describes the model error in the future as in the "
+    "calibration period; each draw adds one realisation of it (predictive bands).",
+    "Future weather is a transformation of the baseline weather (same sequence of days, "
+    "changed statistics), so year-to-year variability is that of the baseline.",
+    "The indoor RH is formed from the simulated Ti and Pi and capped at saturation "
+    "(100 %): vapour above saturation condenses.",
+)
+
+
+@dataclass
+class Projection:
+    """The result of :func:`project`."""
+
+    config: ProjectionConfig
+    labels: list[str]
+    horizons: list
+    results: list
+    summary: dict
+    dataset: object = None
+    paths: dict = field(default_factory=dict)
+
+    def probability_table(self):
+        """pandas.DataFrame: probability statements (rows) × cases (columns)."""
+        from heritage_bayes.projection.summary import probability_table
+
+        return probability_table(self.summary, self.labels)
+
+
+def _as_config(config) -> ProjectionConfig:
+    if isinstance(config, ProjectionConfig):
+        return config
+    if isinstance(config, dict):
+        return parse_projection_config(config, source="projection")
+    return load_projection_config(config)
+
+
+def project(
+    run,
+    config,
+    *,
+    out=None,
+    draws: int | None = None,
+    seed: int | None = None,
+    write: bool = True,
+    progress=None,
+) -> Projection:
+    """Project a calibrated room's climate and risk onto future weather.
+
+    Parameters
+    ----------
+    run : str, Path or heritage_bayes.run.Run
+        A run directory written by ``hbayes calibrate`` (or the loaded run).
+    config : str, Path, dict or ProjectionConfig
+        The projection file (see :mod:`heritage_bayes.projection.config`).
+    out : path, optional
+        Output folder; default ``<run>/projection``.
+    draws, seed : int, optional
+        Override the file's ``draws`` and ``seed``.
+    write : bool
+        Write ``projection.nc``, ``projection.json`` and ``projection.html``.
+    progress : callable, optional
+        Called with one line of text per case.
+
+    Returns
+    -------
+    Projection
+
+    Raises
+    ------
+    heritage_bayes.errors.InputError
+        (and its subclasses ConfigError, DataError) for bad input: nothing is written.
+    """
+    from heritage_bayes.projection.engine import select_draws, simulate_case
+    from heritage_bayes.projection.summary import summarize
+    from heritage_bayes.projection.weather import Case, baseline_weather, futures, model_inputs
+    from heritage_bayes.run import Run, load_run
+
+    t_start = time.perf_counter()
+    pcfg = _as_config(config)
+    if draws is not None or seed is not None:
+        upd = {k: v for k, v in (("draws", draws), ("seed", seed)) if v is not None}
+        if draws is not None and draws < 1:
+            from heritage_bayes.errors import ConfigError
+
+            raise ConfigError(f"--draws: expected a positive number (got {draws})")
+        pcfg = pcfg.model_copy(update=upd)
+    r = run if isinstance(run, Run) else load_run(run)
+    sel = select_draws(r, pcfg.draws, pcfg.seed)
+    base, site, base_note = baseline_weather(r, pcfg)
+    cases = [Case(pcfg.baseline_label, None, base, base_note)]
+    cases += futures(r, pcfg, base, site)
+    for c in cases:  # every input checked before the long part
+        where = "baseline" if c.horizon is None else f"scenario {c.label}"
+        c.inputs = model_inputs(r, pcfg, c.weather, site, where)
+    results = []
+    risk_opts = {"indicators": pcfg.risk.indicators} if pcfg.risk.indicators else {}
+    for c in cases:
+        t0 = time.perf_counter()
+        results.append(
+            simulate_case(
+                r,
+                sel,
+                c.inputs,
+                seed=pcfg.seed,
+                noise=pcfg.noise,
+                chunk=pcfg.risk.chunk_draws,
+                risk_options=risk_opts,
+            )
+        )
+        if progress is not None:
+            progress(f"{c.label}: {sel.index.size} draws in {time.perf_counter() - t0:.1f} s")
+    labels = [c.label for c in cases]
+    horizons = [c.horizon for c in cases]
+    units = dict(results[0].predictive.attrs.get("units", {}))
+    summary = summarize(labels, horizons, results, labels[0], pcfg.thresholds, units)
+    summary["cases"] = [
+        {
+            "label": c.label,
+            "scenario": c.scenario,
+            "horizon": c.horizon,
+            "weather": c.note,
+            "mean_Te": float(c.weather["Te"].mean()),
+            "hours": len(c.inputs),
+        }
+        for c in cases
+    ]
+    summary["assumptions"] = list(ASSUMPTIONS)
+    summary["humidity"] = pcfg.humidity
+    summary["run"] = str(r.path)
+    summary["seed"] = pcfg.seed
+    summary["noise"] = {s: nm.name for s, nm in sel.noise_models.items()} if pcfg.noise else None
+    summary["seconds"] = {
+        "total": time.perf_counter() - t_start,
+        **{k: float(sum(res.seconds[k] for res in results)) for k in ("simulate", "noise", "risk")},
+    }
+    proj = Projection(pcfg, labels, horizons, results, summary)
+    from heritage_bayes.projection.output import to_dataset, write_outputs
+
+    proj.dataset = to_dataset(proj, r)
+    if write:
+        dest = Path(out) if out is not None else Path(r.path) / "projection"
+        proj.paths = write_outputs(proj, r, dest)
+    return proj

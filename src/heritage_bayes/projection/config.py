@@ -1,0 +1,204 @@
+"""The projection file (``hbayes project RUN_DIR PROJECTION.yaml``): validated schema.
+
+Example (morphing, for any site)::
+
+    name: demo_2050
+    humidity: constant_rh        # or constant_vapour_pressure, table (morphing only)
+    draws: 200                   # posterior draws (each with its own noise draw)
+    seed: 1
+    morphing:
+      - scenario: moderate
+        horizon: 2050
+        method: shift_stretch    # shift | stretch | shift_stretch
+        deltas:                  # 12 monthly values each, January first (or a CSV path)
+          Te: [1.4, 1.4, 1.3, 1.2, 1.2, 1.4, 1.6, 1.7, 1.5, 1.4, 1.4, 1.5]   # [K]
+          Te_max: [...]          # [K], for shift_stretch
+          Te_min: [...]
+          ghi: [...]             # [%]
+
+KNMI'14 (Dutch sites)::
+
+    knmi14:
+      tables: ../shared/data/knmi14-deltas
+      scenarios: [GL, GH, WL, WH]
+      horizons: [2050, 2085]     # 2030: one table for all four scenarios
+      region: MON                # default: from the KNMI station of the weather file
+
+User-supplied future weather::
+
+    files:
+      - {scenario: rcp85, horizon: 2080, weather: {format: epw, path: future.epw}}
+
+``baseline``: the weather the transformations start from (a ``Source`` as in the
+calibration config); default the calibration's own weather. Relative paths are relative
+to the projection file.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, Literal
+
+import yaml
+from pydantic import Field, ValidationError, field_validator, model_validator
+
+from heritage_bayes.climate.morph import KNMI14_SCENARIOS
+from heritage_bayes.config import GroundTemperature, Source, _format_error, _Strict
+from heritage_bayes.errors import ConfigError
+
+__all__ = ["ProjectionConfig", "load_projection_config", "parse_projection_config"]
+
+Humidity = Literal["constant_rh", "constant_vapour_pressure", "table"]
+
+
+class Knmi14(_Strict):
+    """KNMI'14 transformation (:func:`heritage_bayes.climate.morph.knmi14_transform`)."""
+
+    tables: str = Field(description="folder of the KNMI'14 delta tables")
+    scenarios: list[Literal["GL", "GH", "WL", "WH"]] = Field(default=list(KNMI14_SCENARIOS))
+    horizons: list[Literal[2030, 2050, 2085]] = Field(default=[2050, 2085])
+    region: Literal["NWN", "ZWN", "NON", "MON", "ZON", "NZK"] | None = None
+
+    @field_validator("scenarios", "horizons")
+    @classmethod
+    def _not_empty(cls, v):
+        if not v:
+            raise ValueError("give at least one")
+        if len(set(v)) != len(v):
+            raise ValueError(f"repeated entries (got {v})")
+        return v
+
+
+class Morphing(_Strict):
+    """One morphed future (:func:`heritage_bayes.climate.morph.morph`)."""
+
+    scenario: str
+    horizon: int
+    method: Literal["shift", "stretch", "shift_stretch"] = "shift_stretch"
+    deltas: dict[str, list[float]] | str
+
+
+class FutureFile(_Strict):
+    """A user-supplied future weather file (read like the calibration weather)."""
+
+    scenario: str
+    horizon: int
+    weather: Source
+
+
+class RiskOptions(_Strict):
+    """Options of :func:`heritage_bayes.climate.risk.assess_batch` (see there)."""
+
+    indicators: list[Literal["chemical", "mechanical", "mould", "ashrae", "en15757"]] | None = None
+    chunk_draws: int = Field(default=50, ge=1, description="draws simulated together")
+
+
+class Threshold(_Strict):
+    """A probability statement: P(indicator above / below a value)."""
+
+    indicator: str
+    above: float | None = None
+    below: float | None = None
+
+    @model_validator(mode="after")
+    def _one(self):
+        if (self.above is None) == (self.below is None):
+            raise ValueError("give exactly one of 'above' and 'below'")
+        return self
+
+
+#: Default probability statements (IPI-style risk limits of heritage_bayes.climate.risk).
+DEFAULT_THRESHOLDS = (
+    Threshold(indicator="vtt_mould_index_max", above=1.0),
+    Threshold(indicator="twpi", below=45.0),
+    Threshold(indicator="emc_max", above=12.5),
+    Threshold(indicator="emc_min", below=5.0),
+    Threshold(indicator="en15757_outside", above=10.0),
+)
+
+
+class ProjectionConfig(_Strict):
+    """A validated projection file (see the module docstring)."""
+
+    name: str | None = None
+    baseline: Source | None = None
+    baseline_label: str = "baseline"
+    humidity: Humidity = "constant_rh"
+    ground_temperature: GroundTemperature | None = None
+    knmi14: Knmi14 | None = None
+    morphing: list[Morphing] = Field(default_factory=list)
+    files: list[FutureFile] = Field(default_factory=list)
+    draws: int = Field(default=200, ge=1)
+    seed: int = 0
+    noise: bool = Field(default=True, description="add a draw of each section's noise model")
+    risk: RiskOptions = Field(default_factory=RiskOptions)
+    thresholds: list[Threshold] = Field(default_factory=lambda: list(DEFAULT_THRESHOLDS))
+    base_dir: str | None = Field(default=None, description="set by the loader")
+
+    @model_validator(mode="after")
+    def _some_future(self):
+        if self.knmi14 is None and not self.morphing and not self.files:
+            raise ValueError(
+                "give at least one future: 'knmi14' (Dutch sites), 'morphing' or 'files'"
+            )
+        if self.humidity == "table" and (self.knmi14 is not None or self.files):
+            raise ValueError(
+                "humidity: 'table' takes the RHe change from morphing tables; KNMI'14 and "
+                "future files have none (use constant_rh or constant_vapour_pressure)"
+            )
+        seen = set()
+        for s, h in self.cases():
+            if (s, h) in seen:
+                raise ValueError(f"scenario {s!r} at horizon {h} is given twice")
+            seen.add((s, h))
+            if s == self.baseline_label:
+                raise ValueError(f"scenario name {s!r} is the baseline's label")
+        return self
+
+    def cases(self) -> list[tuple[str, int]]:
+        """(scenario, horizon) of every future, in order."""
+        out: list[tuple[str, int]] = []
+        if self.knmi14 is not None:
+            out += [(s, int(h)) for h in self.knmi14.horizons for s in self.knmi14.scenarios]
+        out += [(m.scenario, m.horizon) for m in self.morphing]
+        out += [(f.scenario, f.horizon) for f in self.files]
+        return out
+
+    def path(self, p: str) -> Path:
+        """A path of the file, relative to the projection file."""
+        q = Path(p).expanduser()
+        return q if q.is_absolute() or self.base_dir is None else Path(self.base_dir) / q
+
+
+def parse_projection_config(
+    raw: Any, *, source: str = "projection", base_dir: str | None = None
+) -> ProjectionConfig:
+    """Validate a parsed YAML mapping; raise :class:`ConfigError` naming key paths."""
+    if not isinstance(raw, dict):
+        raise ConfigError(
+            f"{source}: expected a YAML mapping at the top level (got {type(raw).__name__})"
+        )
+    try:
+        cfg = ProjectionConfig.model_validate(raw)
+    except ValidationError as exc:
+        lines = [_format_error(e, raw, ProjectionConfig) for e in exc.errors()]
+        raise ConfigError(f"{source}: invalid projection file:\n  " + "\n  ".join(lines)) from None
+    cfg.base_dir = base_dir
+    return cfg
+
+
+def load_projection_config(path) -> ProjectionConfig:
+    """Read and validate a projection YAML file."""
+    p = Path(path)
+    if not p.is_file():
+        raise ConfigError(f"{p}: projection file not found")
+    try:
+        raw = yaml.safe_load(p.read_text(encoding="utf-8"))
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+        raise ConfigError(f"{p}: not valid YAML{where}: {getattr(exc, 'problem', exc)}") from None
+    cfg = parse_projection_config(raw, source=str(p), base_dir=str(p.parent.resolve()))
+    if cfg.name is None:
+        cfg.name = p.stem
+    return cfg

@@ -1,0 +1,104 @@
+"""Writing a projection: ``projection.nc``, ``projection.json``, ``projection.html``.
+
+All three are rendered in memory first and written atomically
+(:func:`heritage_bayes.inference.results.atomic_write`) into the output folder, which
+is created only when everything is ready: bad input leaves nothing behind.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from heritage_bayes.inference.results import atomic_write, atomic_write_text
+
+
+def _climatology(x: np.ndarray, months) -> np.ndarray:
+    """(K, n_months) monthly means -> (K, 12) means by calendar month (NaN if absent)."""
+    m = np.asarray(months.month)
+    out = np.full((x.shape[0], 12), np.nan, dtype=np.float32)
+    for k in range(1, 13):
+        sel = m == k
+        if sel.any():
+            out[:, k - 1] = x[:, sel].mean(axis=1)
+    return out
+
+
+def to_dataset(proj, run):
+    """xarray.Dataset: dims ``case`` (coords ``scenario``, ``horizon``), ``draw``,
+    ``month`` (1–12); one variable per risk indicator (predictive and, suffixed
+    ``_parametric``, noise-free), ``Ti_monthly``/``RHi_monthly`` [°C, %]."""
+    import xarray as xr
+
+    from heritage_bayes._version import __version__
+    from heritage_bayes.projection.summary import numeric_columns
+
+    res = proj.results
+    K = len(res[0].predictive)
+    coords = {
+        "case": np.array(proj.labels, dtype=str),
+        "scenario": ("case", np.array([s["scenario"] for s in proj.summary["cases"]], dtype=str)),
+        "horizon": ("case", np.array([h if h is not None else -1 for h in proj.horizons])),
+        "draw": np.arange(K),
+        "month": np.arange(1, 13),
+    }
+    units = res[0].predictive.attrs.get("units", {})
+    data = {}
+    for n in numeric_columns(res[0].predictive):
+        for suffix, attr in (("", "predictive"), ("_parametric", "parametric")):
+            arr = np.stack([getattr(r, attr)[n].to_numpy(float) for r in res])
+            data[n + suffix] = (
+                ("case", "draw"),
+                arr.astype(np.float32),
+                {"unit": units.get(n, ""), "kind": attr},
+            )
+    if "ashrae_best_class" in res[0].predictive.columns:
+        arr = np.stack([r.predictive["ashrae_best_class"].astype(str).to_numpy() for r in res])
+        data["ashrae_best_class"] = (("case", "draw"), arr.astype("U8"), {"unit": "class"})
+    for name, unit in (("Ti", "°C"), ("RHi", "%")):
+        arr = np.stack([_climatology(getattr(r, f"{name}_month"), r.months) for r in res])
+        data[f"{name}_monthly"] = (
+            ("case", "draw", "month"),
+            arr,
+            {"unit": unit, "description": f"mean {name} by calendar month over the case's years"},
+        )
+    ds = xr.Dataset(
+        {k: xr.DataArray(v[1], dims=v[0], attrs=v[2]) for k, v in data.items()}, coords=coords
+    )
+    ds.attrs.update(
+        {
+            "title": "heritage_bayes projection",
+            "run": str(run.path),
+            "heritage_bayes_version": __version__,
+            "seed": int(proj.config.seed),
+            "humidity": proj.config.humidity,
+            "horizon_of_baseline": -1,
+        }
+    )
+    return ds
+
+
+def write_outputs(proj, run, dest: Path) -> dict:
+    """Render everything, then write the three files atomically into ``dest``."""
+    from heritage_bayes.io._common import to_jsonable
+    from heritage_bayes.projection.page import render_projection_page
+
+    dest = Path(dest)
+    if dest.exists() and not dest.is_dir():
+        from heritage_bayes.errors import InputError
+
+        raise InputError(f"--out {dest}: is a file, not a folder")
+    html = render_projection_page(proj, run)
+    import json
+
+    text = json.dumps(to_jsonable(proj.summary), indent=1, ensure_ascii=False, allow_nan=False)
+    paths = {
+        "nc": dest / "projection.nc",
+        "json": dest / "projection.json",
+        "html": dest / "projection.html",
+    }
+    atomic_write(paths["nc"], lambda p: proj.dataset.to_netcdf(p, engine="h5netcdf"))
+    atomic_write_text(paths["json"], text)
+    atomic_write_text(paths["html"], html)
+    return paths

@@ -1,0 +1,212 @@
+"""Baseline and future weather of a projection, and the model inputs built from them.
+
+The baseline is the calibration's own weather (the demo's TMY3 file, or the configured
+``data.weather``) unless the projection file gives ``baseline``. Every future is a
+documented transformation of it (:mod:`heritage_bayes.climate.morph`) or a user file.
+Model inputs are built exactly as for the calibration
+(:func:`heritage_bayes.inputs.weather_inputs`, :func:`heritage_bayes.io.align`,
+:func:`heritage_bayes.inputs.annual_mean_temperature`): same surfaces, irradiance mode,
+grid step and ground-temperature rule, so the building is the calibrated one and only
+the weather changes.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+
+from heritage_bayes.climate.risk._inputs import MIN_YEAR_HOURS
+from heritage_bayes.config import parse_duration
+from heritage_bayes.errors import ConfigError, DataError, InputError
+
+#: Largest distance between the calibration site and a future file's site. [°]
+MAX_SITE_OFFSET_DEG = 0.5
+
+_WEATHER_COLUMNS = ("Te", "RHe", "Pe", "ghi", "dni", "dhi", "Tdew", "Ph")
+
+
+@dataclass
+class Case:
+    """One weather to simulate: the baseline or a (scenario, horizon) future."""
+
+    scenario: str
+    horizon: int | None
+    weather: pd.DataFrame
+    note: dict = field(default_factory=dict)
+    inputs: pd.DataFrame | None = None
+
+    @property
+    def label(self) -> str:
+        return self.scenario if self.horizon is None else f"{self.scenario} {self.horizon}"
+
+
+def _site_of(run, weather: pd.DataFrame) -> dict | None:
+    if run.config.site is not None:
+        return run.config.site.model_dump()
+    site = weather.attrs.get("site")
+    return dict(site) if site else None
+
+
+def baseline_weather(run, pcfg) -> tuple[pd.DataFrame, dict | None, dict]:
+    """The hourly baseline weather table, the site and a provenance note."""
+    from heritage_bayes.prepare import INPUT_COLUMNS
+    from heritage_bayes.sources import read_source
+
+    if pcfg.baseline is not None:
+        weather = read_source(pcfg, pcfg.baseline, "baseline", INPUT_COLUMNS)
+        note = {"from": "projection file (baseline)", "path": weather.attrs.get("source")}
+        site = _site_of(run, weather)
+        if site is None:
+            site = weather.attrs.get("site")
+    elif run.config.data.demo is not None:
+        from heritage_bayes.demo import greensboro_tmy3_path
+        from heritage_bayes.io import read_tmy3
+
+        path = greensboro_tmy3_path()
+        weather = read_tmy3(path)
+        site = dict(weather.attrs["site"])
+        note = {"from": "the calibration's weather (demo)", "path": str(path)}
+    else:
+        weather = read_source(run.config, run.config.data.weather, "data.weather", INPUT_COLUMNS)
+        site = _site_of(run, weather)
+        note = {"from": "the calibration's weather", "path": weather.attrs.get("source")}
+    _check_year(weather, "baseline")
+    note["first"] = str(weather.index[0])
+    note["last"] = str(weather.index[-1])
+    note["hours"] = len(weather)
+    return weather, site, note
+
+
+def _check_year(weather: pd.DataFrame, where: str) -> None:
+    n = len(weather)
+    span_h = (weather.index[-1] - weather.index[0]) / pd.Timedelta(hours=1) + 1 if n else 0
+    if span_h < MIN_YEAR_HOURS:
+        raise DataError(
+            f"{where}: the weather covers {span_h:.0f} h ({weather.index[0]} to "
+            f"{weather.index[-1]}); a projection needs at least a year "
+            f"({MIN_YEAR_HOURS} h, a year less a day) for the yearly risk indicators"
+        )
+
+
+def futures(run, pcfg, base: pd.DataFrame, site: dict | None) -> list[Case]:
+    """Every (scenario, horizon) weather of the projection file, in order."""
+    from heritage_bayes.climate.morph import (
+        knmi14_region,
+        knmi14_transform,
+        morph,
+        read_monthly_deltas,
+    )
+
+    cases: list[Case] = []
+    lat = (site or {}).get("latitude")
+    if pcfg.knmi14 is not None:
+        k = pcfg.knmi14
+        folder = pcfg.path(k.tables)
+        if not folder.is_dir():
+            raise DataError(f"knmi14.tables: {folder}: folder not found")
+        region = k.region
+        if region is None:
+            station = base.attrs.get("station")
+            if not isinstance(station, int | np.integer):
+                raise ConfigError(
+                    "knmi14.region: required (the baseline weather is not a KNMI station "
+                    "file, so its region is unknown); one of NWN, ZWN, NON, MON, ZON, NZK"
+                )
+            region = knmi14_region(folder, int(station))
+        for h in k.horizons:
+            for s in k.scenarios:
+                w = knmi14_transform(
+                    base, folder, s, int(h), region=region, latitude=lat,
+                    humidity=pcfg.humidity, where="knmi14",
+                )  # fmt: skip
+                cases.append(Case(s, int(h), w, dict(w.attrs["transformation"])))
+    for i, m in enumerate(pcfg.morphing):
+        where = f"morphing[{i}]"
+        src = m.deltas if isinstance(m.deltas, dict) else pcfg.path(m.deltas)
+        deltas = read_monthly_deltas(src, f"{where}.deltas")
+        w = morph(base, deltas, method=m.method, humidity=pcfg.humidity, where=where)
+        cases.append(Case(m.scenario, m.horizon, w, dict(w.attrs["transformation"])))
+    for i, f in enumerate(pcfg.files):
+        from heritage_bayes.prepare import INPUT_COLUMNS
+        from heritage_bayes.sources import read_source
+
+        where = f"files[{i}].weather"
+        w = read_source(pcfg, f.weather, where, INPUT_COLUMNS)
+        _check_year(w, where)
+        _check_same_site(w, site, where)
+        note = {"method": "user-supplied future weather file", "path": w.attrs.get("source")}
+        cases.append(Case(f.scenario, f.horizon, w, note))
+    return cases
+
+
+def _check_same_site(w: pd.DataFrame, site: dict | None, where: str) -> None:
+    other = w.attrs.get("site")
+    if not other or not site:
+        return
+    d_lat = abs(float(other["latitude"]) - float(site["latitude"]))
+    d_lon = abs(float(other["longitude"]) - float(site["longitude"]))
+    if max(d_lat, d_lon) > MAX_SITE_OFFSET_DEG:
+        raise InputError(
+            f"{where}: the file is for another site ({other['latitude']:.2f}°N, "
+            f"{other['longitude']:.2f}°E); the room was calibrated at "
+            f"{site['latitude']:.2f}°N, {site['longitude']:.2f}°E (expected within "
+            f"{MAX_SITE_OFFSET_DEG}°)"
+        )
+
+
+def model_inputs(run, pcfg, weather: pd.DataFrame, site: dict | None, where: str) -> pd.DataFrame:
+    """Model inputs on the run's grid from a weather table (as for the calibration).
+
+    Returns a frame with every input column of the run's models (``Te``, ``I_<surface>``,
+    ``Tf``, ``Pe``, ...), regular UTC index.
+    """
+    from heritage_bayes.inputs import annual_mean_temperature, weather_inputs
+    from heritage_bayes.io import align
+    from heritage_bayes.prepare import _extra_inputs
+
+    cfg = run.config
+    data = cfg.data
+    thermal, hygric = "thermal" in run.models, "hygric" in run.models
+    step = parse_duration(data.step)
+    tables, _ = weather_inputs(
+        weather[[c for c in weather.columns if c in _WEATHER_COLUMNS]],
+        thermal=thermal,
+        hygric=hygric,
+        irradiance=data.irradiance,
+        site=site,
+        surfaces={k: tuple(v) for k, v in data.surfaces.items()},
+        where=where,
+        extra=_extra_inputs(cfg),
+    )
+    try:
+        aligned = align(tables, None, step=step, max_gap=parse_duration(data.max_gap))
+    except (DataError, InputError) as exc:
+        raise DataError(f"{where}: putting the weather on the run's grid: {exc}") from None
+    frame = aligned.frame.copy()
+    if thermal:
+        gt = pcfg.ground_temperature or data.ground_temperature
+        if gt.mode == "constant":
+            frame["Tf"] = float(gt.value)
+        elif gt.mode == "annual_mean":
+            frame["Tf"], _ = annual_mean_temperature(weather["Te"], frame.index + step / 2)
+        else:
+            raise ConfigError(
+                "ground_temperature: the run measured its ground temperature (mode "
+                "'column'), which has no future; give ground_temperature: {mode: "
+                "annual_mean} or {mode: constant, value: ...} in the projection file"
+            )
+    for section, model in run.models.items():
+        missing = [c for c in model.input_names if c not in frame.columns]
+        if missing:
+            raise DataError(
+                f"{where}: the {section} model needs {missing}, which this weather does "
+                f"not provide (columns {list(weather.columns)})"
+            )
+    if len(frame) < MIN_YEAR_HOURS:
+        raise DataError(
+            f"{where}: {len(frame)} rows on the grid; a projection needs at least "
+            f"{MIN_YEAR_HOURS} h"
+        )
+    return frame

@@ -51,8 +51,7 @@ def _site_of(run, weather: pd.DataFrame) -> dict | None:
 
 def baseline_weather(run, pcfg) -> tuple[pd.DataFrame, dict | None, dict]:
     """The hourly baseline weather table, the site and a provenance note."""
-    from heritage_bayes.prepare import INPUT_COLUMNS
-    from heritage_bayes.sources import read_source
+    from heritage_bayes.sources import INPUT_COLUMNS, read_source
 
     if pcfg.baseline is not None:
         weather = read_source(pcfg, pcfg.baseline, "baseline", INPUT_COLUMNS)
@@ -60,18 +59,12 @@ def baseline_weather(run, pcfg) -> tuple[pd.DataFrame, dict | None, dict]:
         site = _site_of(run, weather)
         if site is None:
             site = weather.attrs.get("site")
-    elif run.config.data.demo is not None:
-        from heritage_bayes.demo import greensboro_tmy3_path
-        from heritage_bayes.io import read_tmy3
+    else:  # the calibration's own weather source (a file, or the demo's generator)
+        from heritage_bayes.sources import read_sources
 
-        path = greensboro_tmy3_path()
-        weather = read_tmy3(path)
-        site = dict(weather.attrs["site"])
-        note = {"from": "the calibration's weather (demo)", "path": str(path)}
-    else:
-        weather = read_source(run.config, run.config.data.weather, "data.weather", INPUT_COLUMNS)
-        site = _site_of(run, weather)
-        note = {"from": "the calibration's weather", "path": weather.attrs.get("source")}
+        raw = read_sources(run.config)
+        weather, site = raw.weather, (dict(raw.site) if raw.site else None)
+        note = {"from": "the calibration's weather"} | dict(raw.notes.get("weather", {}))
     _check_year(weather, "baseline")
     note["first"] = str(weather.index[0])
     note["last"] = str(weather.index[-1])
@@ -129,8 +122,7 @@ def futures(run, pcfg, base: pd.DataFrame, site: dict | None) -> list[Case]:
         w = morph(base, deltas, method=m.method, humidity=pcfg.humidity, where=where)
         cases.append(Case(m.scenario, m.horizon, w, dict(w.attrs["transformation"])))
     for i, f in enumerate(pcfg.files):
-        from heritage_bayes.prepare import INPUT_COLUMNS
-        from heritage_bayes.sources import read_source
+        from heritage_bayes.sources import INPUT_COLUMNS, read_source
 
         where = f"files[{i}].weather"
         w = read_source(pcfg, f.weather, where, INPUT_COLUMNS)

@@ -102,8 +102,54 @@ class _Section:
     theta: np.ndarray | None = None  # (walkers, draws, P), common across models
     theta_kept: np.ndarray | None = None  # (walkers, draws, P), all retained draws
     X_kept: np.ndarray | None = None  # the same in sampler coordinates
+    laplace: object = None  # LaplaceResult at the MAP (practical identifiability)
+    map_at_bound: list = field(default_factory=list)  # (name, "lower"/"upper")
     lp: np.ndarray | None = None
     timings: dict = field(default_factory=dict)
+
+
+def _say_findings(say: _Progress, s: _Section) -> None:
+    """Before sampling: a MAP on a prior bound, and parameters the data do not pin.
+
+    Both are findings about the prior or the model, shown as warnings (and kept in
+    the summary); the sampler starts inside the support regardless.
+    """
+    s.map_at_bound = s.logpost.params.at_bound(s.map.x)
+    if s.map_at_bound:
+        what = ", ".join(f"{n} ({side})" for n, side in s.map_at_bound)
+        say.warn(
+            f"[{s.name}] the MAP lies on a prior bound for {what}: the data push "
+            "these parameters to the edge of the allowed range. Check the prior (is the "
+            "bound physical? widen it if not) and the model (a missing input or node "
+            "often shows up this way)"
+        )
+    ident = s.identifiability
+    # the overall scale of C and G (no known heat input) is a null direction only a
+    # prior closes: reported in the identifiability section, not flagged here
+    ok = ident.identifiable_given_scale if ident.has_scale_direction else ident.identifiable
+    structural = [p for p, good in ok.items() if not good]
+    practical = list(s.laplace.unidentified) if s.laplace is not None else []
+    poor = [p for p in practical if p in s.model.parameter_names]
+    if structural or poor:
+        parts = []
+        if structural:
+            parts.append(f"structurally not identifiable: {', '.join(structural)}")
+        if poor:
+            parts.append(
+                "practically not identified at the MAP (Laplace sd > 25 % of the prior "
+                f"range): {', '.join(poor)}"
+            )
+        ladder = LADDERS.get(s.name, ())
+        k = ladder.index(s.model.name) if s.model.name in ladder else 0
+        smaller = ladder[k - 1] if k > 0 else None
+        say.warn(
+            f"[{s.name}] {s.model.name} is over-parameterised for these data ("
+            + "; ".join(parts)
+            + "). The chain will mix slowly and these posteriors will be their priors. "
+            f"Choose: fix them ({s.name}.priors: {{NAME: {{fixed: VALUE}}}}), add an "
+            "informative prior (room_volume, air_change_rate, or a lognormal prior on "
+            "them)" + (f", or use the smaller model ({s.name}.model: {smaller})" if smaller else "")
+        )
 
 
 class _Progress:
@@ -126,15 +172,15 @@ class _Progress:
 
             def line(done, total, info):
                 self.say(
-                    f"[{label}] emcee {done}/{total} steps: τmax {info['tau_max']:.0f}, "
-                    f"need {info['needed']:.0f} steps, acc {info['acceptance']:.2f}"
+                    f"[{label}] emcee {done} steps, {info['seconds']:.0f} s: τmax "
+                    f"{info['tau_max']:.0f}, need ~{total} steps, acc {info['acceptance']:.2f}"
                 )
 
             return line
         from tqdm.auto import tqdm
 
         bar = tqdm(
-            total=max_steps,
+            total=None,
             desc=f"[{label}] emcee",
             unit="step",
             file=sys.stderr,
@@ -143,6 +189,7 @@ class _Progress:
         )
 
         def update(done, total, info):
+            bar.total = total  # the chain's own estimate of the length it needs
             bar.n = done
             bar.set_postfix_str(
                 f"τmax {info['tau_max']:.0f}, need {info['needed']:.0f} "
@@ -257,7 +304,7 @@ def _calibrate_into(
     say = _Progress(quiet)
     # the heavy imports (arviz, scipy.optimize, emcee) only once the config is valid
     from heritage_bayes.inference.idata import CONVERGENCE
-    from heritage_bayes.inference.optimize import find_map
+    from heritage_bayes.inference.optimize import find_map, laplace
     from heritage_bayes.inference.sampler import run_sampler
     from heritage_bayes.prepare import prepare
     from heritage_bayes.rc.identify import structural_identifiability
@@ -313,7 +360,10 @@ def _calibrate_into(
         s.identifiability = structural_identifiability(
             s.model, dict(zip(s.model.parameter_names, tm, strict=True)), dt=prep.dt, fixed=fixed
         )
+        ref = s.identifiability.scale_reference
+        s.laplace = laplace(s.logpost, s.map.x, given=(ref,) if ref else ())
         s.timings["identifiability_seconds"] = time.perf_counter() - t0
+        _say_findings(say, s)
         t0 = time.perf_counter()
         update = say.sampler(s.name, cfg.sampler.max_steps)
         try:
@@ -324,6 +374,8 @@ def _calibrate_into(
                 nwalkers=nwalkers,
                 moves=cfg.sampler.moves,
                 max_steps=cfg.sampler.max_steps,
+                max_seconds=cfg.sampler.max_seconds,
+                bounds=s.logpost.params.bounds,
                 check_every=cfg.sampler.check_every,
                 tau_factor=cfg.sampler.tau_factor,
                 tau_rtol=cfg.sampler.tau_rtol,
@@ -340,7 +392,15 @@ def _calibrate_into(
         finally:
             say.close()
         s.timings["sampling_seconds"] = time.perf_counter() - t0
+        s.timings["sampling_cpu_seconds"] = s.chain.cpu_seconds
         verdict = "converged" if s.chain.converged else "NOT converged"
+        if s.chain.stopped_by == "max_seconds":
+            say.warn(
+                f"[{s.name}] the time budget sampler.max_time = {cfg.sampler.max_time} ran "
+                f"out after {s.chain.steps} steps (τmax {np.nanmax(s.chain.tau):.0f}, "
+                f"about {cfg.sampler.tau_factor * np.nanmax(s.chain.tau):.0f} steps needed): "
+                "raise it, or run again with --resume to continue the chain"
+            )
         say.say(f"[{s.name}] {s.chain.steps} steps, τmax {np.nanmax(s.chain.tau):.0f}: {verdict}")
     # the draws each sampler checked (R-hat, ESS) give the summaries; the posterior
     # group holds a common number per walker, so draw i of one model pairs with draw i

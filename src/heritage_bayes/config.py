@@ -38,7 +38,7 @@ Layout (see ``configs/demo.yaml`` for a complete, commented example)::
       warmup: 14d                  # durations: 1h, 30min, 14d (see parse_duration)
     thermal: {model: thermal_4a, noise: ar1, priors: {Gf: {fixed: 0}}}
     hygric: {model: hygric_2c_fixed, noise: ar1}
-    sampler: {max_steps: 20000}
+    sampler: {max_time: 30min}          # wall-time budget per model; the chain decides
     optimizer: {method: differential_evolution}
 """
 
@@ -443,8 +443,15 @@ class ModelSection(_Strict):
 
 
 class SamplerSettings(_Strict):
+    """emcee settings. Run length comes from the chain (τ, R-hat, ESS); ``max_time`` is
+    the wall-time budget per model (a duration, e.g. ``10min``, or ``none``) and
+    ``max_steps`` a safety cap on memory."""
+
     walkers: int | None = Field(default=None, ge=4, le=4096, description="default max(32, 2 d + 2)")
-    max_steps: int = Field(default=20000, ge=100)
+    max_steps: int = Field(default=200_000, ge=100)
+    max_time: str | float | None = Field(
+        default="30min", description="wall-time budget per model: a duration, or seconds"
+    )
     check_every: int = Field(default=500, ge=50)
     tau_factor: float = Field(default=50.0, ge=10)
     tau_rtol: float = Field(default=0.05, gt=0, le=1)
@@ -457,6 +464,22 @@ class SamplerSettings(_Strict):
         description="draws (all walkers) saved in posterior.nc, the same in every group "
         "(posterior, predictive, log-likelihood); PSIS-LOO needs about 1000",
     )
+
+    @field_validator("max_time")
+    @classmethod
+    def _budget(cls, v):
+        if v is None or (isinstance(v, str) and v.strip().lower() == "none"):
+            return None
+        if isinstance(v, int | float) and not isinstance(v, bool):
+            if not v > 0:
+                raise ValueError(f"must be a positive number of seconds or a duration (got {v})")
+            return f"{float(v):g}s"
+        return _check_duration(v, positive=True)
+
+    @property
+    def max_seconds(self) -> float | None:
+        """``max_time`` in seconds (None: no budget)."""
+        return None if self.max_time is None else parse_duration(self.max_time).total_seconds()
 
 
 class OptimizerSettings(_Strict):

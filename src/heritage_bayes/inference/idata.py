@@ -263,7 +263,15 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
                 "tau_history": [list(map(float, r)) for r in s.chain.tau_history],
                 "acceptance_mean": float(np.mean(s.chain.acceptance)),
                 "resumed_from": int(s.chain.resumed_from),
+                "stopped_by": getattr(s.chain, "stopped_by", ""),
+                "cpu_seconds": float(getattr(s.chain, "cpu_seconds", 0.0)),
             },
+            # findings before sampling: a MAP on a prior bound, and practical
+            # identifiability from the Laplace approximation at the MAP
+            "map_at_bound": [list(b) for b in getattr(s, "map_at_bound", [])],
+            "practical_identifiability": (
+                s.laplace.to_dict(ps.free_names) if getattr(s, "laplace", None) else None
+            ),
         }
     # combined RH from paired thermal and hygric draws
     if "Ti" in pp_outputs and "Pi" in pp_outputs:

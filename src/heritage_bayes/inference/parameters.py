@@ -427,6 +427,35 @@ class ParameterSet:
                 return p
         raise KeyError(name)
 
+    @property
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """The support in sampling coordinates: (lo, hi), each (d,).
+
+        log θ (log-scale priors) or θ between the prior bounds; ±inf for the logit
+        coordinates, which are unbounded.
+        """
+        lo = np.where(self._logit, -np.inf, self._a)
+        hi = np.where(self._logit, np.inf, self._a + self._w)
+        return lo, hi
+
+    def at_bound(self, X: np.ndarray, rel: float = 1e-3) -> list[tuple[str, str]]:
+        """Free parameters within ``rel`` × their (sampling-coordinate) range of a bound.
+
+        Returns ``(name, "lower" | "upper")`` pairs for the point ``X`` (d,), e.g. a MAP
+        pressed against its prior. Logit coordinates count as at a bound beyond
+        ``|x| > log(1/rel)`` (θ within ``rel`` of the range's end).
+        """
+        x = np.asarray(X, dtype=float).ravel()
+        y = np.where(self._logit, expit(x) * self._w + self._a, x)
+        pos = (y - self._a) / self._w
+        out = []
+        for k, j in enumerate(self._free_idx):
+            if pos[k] <= rel:
+                out.append((self.parameters[j].name, "lower"))
+            elif pos[k] >= 1 - rel:
+                out.append((self.parameters[j].name, "upper"))
+        return out
+
     def transform(self, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Unconstrained (K, d) -> values (K, P) and log-prior + log-Jacobian (K,)."""
         X = np.atleast_2d(X)

@@ -1,10 +1,14 @@
 """emcee driver: moves, convergence monitoring, HDF5 checkpoint and resume.
 
-The ensemble starts in a small ball around the MAP (in the unconstrained space, so
-inside the bounds) and runs in chunks of ``check_every`` steps until converged: the
-chain is longer than ``tau_factor`` × the integrated autocorrelation time τ of every
-parameter, and τ changed by less than ``tau_rtol`` since the previous check (Foreman-
-Mackey et al.'s recipe), or ``max_steps`` is reached.
+The ensemble starts in a small ball around the MAP, kept inside the prior's support
+whatever the MAP (see :func:`start_ensemble`: a MAP on or next to a bound is moved
+inward and the ball reflected off the walls), and runs in chunks of ``check_every``
+steps until converged: the chain is longer than ``tau_factor`` × the integrated
+autocorrelation time τ of every parameter, and τ changed by less than ``tau_rtol``
+since the previous check (Foreman-Mackey et al.'s recipe), and R-hat/bulk ESS meet
+their targets; or the wall-time budget ``max_seconds`` or ``max_steps`` runs out
+(run length comes from the chain: the step cap is a safety net, the time budget is
+what a user sets).
 
 Default moves: a mix of differential-evolution moves, 80 % ``DEMove`` and 20 %
 ``DESnookerMove`` (ter Braak & Vrugt 2008). RC-model posteriors are ridge-shaped (ratios
@@ -49,7 +53,7 @@ import numpy as np
 
 from heritage_bayes.errors import InputError
 
-__all__ = ["ChainResult", "make_moves", "run_sampler"]
+__all__ = ["ChainResult", "make_moves", "run_sampler", "start_ensemble"]
 
 
 def make_moves(name: str):
@@ -83,6 +87,10 @@ class ChainResult:
         Burn-in and thinning derived from τ.
     wall_seconds : float
         Sampling time of this call (resumed runs: only the new part).
+    cpu_seconds : float
+        Process CPU time (user + system) of the same part.
+    stopped_by : str
+        ``"converged"``, ``"max_steps"`` or ``"max_seconds"`` (the time budget).
     """
 
     chain: np.ndarray
@@ -95,6 +103,8 @@ class ChainResult:
     thin: int = 1
     wall_seconds: float = 0.0
     resumed_from: int = 0
+    cpu_seconds: float = 0.0
+    stopped_by: str = ""  # "converged", "max_steps", "max_seconds"
 
     @property
     def steps(self) -> int:
@@ -143,6 +153,20 @@ def _mixing_ok(chain, tau, max_rhat, min_ess, max_draws) -> bool:
     if max_rhat is not None and float(az.rhat(ds)["x"].max()) > max_rhat:
         return False
     return min_ess is None or float(az.ess(ds, method="bulk")["x"].min()) >= min_ess
+
+
+def _next_check(done: int, check_every: int) -> int:
+    """The first convergence check after step ``done``.
+
+    Checks come every ``check_every`` steps, then every 10 % of the chain (in whole
+    multiples of ``check_every``), so that the cost of estimating τ on the whole
+    chain stays a small fraction of sampling on long runs. The sequence depends only
+    on ``check_every``, so a resumed chain checks at the same steps.
+    """
+    b = 0
+    while b <= done:
+        b += check_every * max(1, b // (10 * check_every))
+    return b
 
 
 def _tau(chain: np.ndarray) -> np.ndarray:
@@ -366,6 +390,89 @@ def _cat(parts, ds):
     return np.concatenate(parts) if parts else np.zeros((0, *ds.shape[1:]))
 
 
+def start_ensemble(
+    logpost,
+    x_map: np.ndarray,
+    nwalkers: int,
+    rng: np.random.Generator,
+    *,
+    init_ball: float = 1e-3,
+    bounds: tuple[np.ndarray, np.ndarray] | None = None,
+    margin: float = 0.01,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Initial walkers inside the support, around the MAP, whatever the MAP.
+
+    The centre is the MAP moved at least ``margin`` × the width of each bounded
+    coordinate away from its bounds (a MAP on a bound is a finding about prior or
+    model, reported elsewhere, not a reason to fail); the walkers are the centre plus
+    ``init_ball`` × (the width, or 1 for unbounded coordinates) × standard normal
+    draws, reflected off the bounds into the interior. Walkers whose log-posterior
+    is still -inf (a wall the bounds do not describe, e.g. an unstable network) are
+    redrawn with a ball twice as wide each round.
+
+    Parameters
+    ----------
+    logpost : callable
+        Vectorised log-posterior on (K, d).
+    x_map : (d,) array
+    nwalkers : int
+    rng : numpy Generator
+    init_ball : float
+        Relative size of the ball.
+    bounds : (lo, hi) arrays of shape (d,), optional
+        The support in sampler coordinates (±inf where unbounded).
+    margin : float
+        Smallest distance of the centre from a bound, relative to the width.
+
+    Returns
+    -------
+    p0 : (nwalkers, d) array
+    lp0 : (nwalkers,) array, all finite
+
+    Raises
+    ------
+    InputError
+        No finite log-posterior anywhere near the (moved) MAP: the data or the
+        likelihood, not the start, are at fault (e.g. NaN in a column).
+    """
+    x_map = np.asarray(x_map, dtype=float)
+    d = x_map.size
+    if bounds is None:
+        lo, hi = np.full(d, -np.inf), np.full(d, np.inf)
+    else:
+        lo, hi = (np.asarray(b, dtype=float) for b in bounds)
+    width = hi - lo
+    finite = np.isfinite(width)
+    scale = np.where(finite, width, 1.0)
+    pad = np.where(finite, margin * width, 0.0)
+    centre = np.clip(x_map, lo + pad, hi - pad)
+
+    def draw(k: int, ball: float) -> np.ndarray:
+        p = centre + ball * scale * rng.standard_normal((k, d))
+        # reflect off the walls (a ball wider than the box folds back inside)
+        for _ in range(4):
+            p = np.where(p < lo, 2 * lo - p, p)
+            p = np.where(p > hi, 2 * hi - p, p)
+        return np.clip(p, lo, hi)
+
+    ball = init_ball
+    p0 = draw(nwalkers, ball)
+    lp0 = np.asarray(logpost(p0), dtype=float)
+    for _ in range(30):
+        bad = ~np.isfinite(lp0)
+        if not bad.any():
+            return p0, lp0
+        ball = min(2 * ball, 0.25)
+        p0[bad] = draw(int(bad.sum()), ball)
+        lp0[bad] = logpost(p0[bad])
+    raise InputError(
+        "could not start the walkers: the log-posterior is -inf everywhere tried around "
+        f"the MAP, inside the prior bounds (balls up to {ball:g} × the prior ranges); "
+        "the likelihood cannot be evaluated there: check the data (non-finite values) "
+        "and the noise model"
+    )
+
+
 def _tell(notice, msg: str) -> None:
     if notice is not None:
         notice(msg)
@@ -387,7 +494,9 @@ def _run_sampler(
     seed: int,
     nwalkers: int | None = None,
     moves: str = "de_snooker",
-    max_steps: int = 20000,
+    max_steps: int = 200_000,
+    max_seconds: float | None = None,
+    bounds: tuple[np.ndarray, np.ndarray] | None = None,
     check_every: int = 500,
     tau_factor: float = 50.0,
     tau_rtol: float = 0.05,
@@ -413,11 +522,20 @@ def _run_sampler(
         Seeds the initial ball and emcee's random stream: same seed, same chain.
     nwalkers : int, optional
         Default ``max(32, 2 d + 2)`` (even).
+    max_steps : int
+        Safety cap on the chain length [steps].
+    max_seconds : float, optional
+        Wall-time budget of this call [s]: no chunk starts after it is spent (the
+        chain is then returned unconverged, ``stopped_by="max_seconds"``).
+    bounds : (lo, hi) arrays, optional
+        Support in sampler coordinates, for the start (see :func:`start_ensemble`).
     checkpoint : path, optional
         HDF5 file for the chain; with ``resume=True`` an existing file is continued
         (its ``tag`` must match).
     progress : callable, optional
-        Called after every chunk as ``progress(steps_done, max_steps, info_dict)``.
+        Called after every chunk as ``progress(steps_done, total, info_dict)``, ``total``
+        the current estimate of the chain length needed (τ × ``tau_factor``, at most
+        ``max_steps``); ``info_dict`` also holds ``seconds`` (wall time so far).
     notice : callable, optional
         Called with a message when a resume does not go as asked (no checkpoint, a
         damaged one: see :class:`_Checkpoint`).
@@ -488,24 +606,16 @@ def _run_sampler(
     resumed_from = done
     if done == 0:
         rng = np.random.default_rng(seed)
-        p0 = x_map + init_ball * rng.standard_normal((nwalkers, d))
-        lp_init = logpost(p0)
-        for _ in range(100):  # redraw walkers that start outside the support
-            bad = ~np.isfinite(lp_init)
-            if not bad.any():
-                break
-            p0[bad] = x_map + init_ball * rng.standard_normal((int(bad.sum()), d))
-            lp_init[bad] = logpost(p0[bad])
-        else:
-            raise InputError(
-                "could not start the walkers: the log-posterior is -inf "
-                "around the MAP (check priors and data)"
-            )
+        p0, lp_init = start_ensemble(
+            logpost, x_map, nwalkers, rng, init_ball=init_ball, bounds=bounds
+        )
         sampler.random_state = np.random.RandomState(seed).get_state()
         state = emcee.State(p0, log_prob=lp_init, random_state=sampler.random_state)
         if ck is not None:
             ck.create(nwalkers, d)
     t0 = time.perf_counter()
+    c0 = time.process_time()
+    out_of_time = False
     converged = False
     tau = np.full(d, np.nan)
     if done > 0:  # resumed: the saved chain may already be long enough
@@ -520,8 +630,13 @@ def _run_sampler(
     # inside emcee's likelihood call, which would print the parameter matrix)
     with _DeferSignals(redeliver=False) as sig:
         while done < max_steps and not converged:
-            # chunk boundaries on absolute multiples of check_every (resume-invariant)
-            n = min(check_every - done % check_every, max_steps - done)
+            # the budget is checked between chunks (at least one chunk runs)
+            spent = time.perf_counter() - t0
+            if max_seconds is not None and done > resumed_from and spent >= max_seconds:
+                out_of_time = True
+                break
+            # chunk boundaries at fixed step counts (resume-invariant)
+            n = min(_next_check(done, check_every) - done, max_steps - done)
             sampler.reset()
             try:
                 for step in sampler.sample(state, iterations=n):  # noqa: B007
@@ -555,8 +670,9 @@ def _run_sampler(
             if progress is not None:
                 progress(
                     done,
-                    max_steps,
+                    int(min(max_steps, max(done, tau_factor * tmax))),
                     {
+                        "seconds": time.perf_counter() - t0,
                         "tau_max": tmax,
                         "needed": tau_factor * tmax,
                         "acceptance": float(np.mean(accepted) / done),
@@ -578,4 +694,6 @@ def _run_sampler(
         thin=thin,
         wall_seconds=time.perf_counter() - t0,
         resumed_from=resumed_from,
+        cpu_seconds=time.process_time() - c0,
+        stopped_by="converged" if converged else "max_seconds" if out_of_time else "max_steps",
     )

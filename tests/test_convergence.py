@@ -1,0 +1,179 @@
+"""Sampler start inside the support, run length from the chain and a time budget,
+MAP-on-bound findings and the Laplace (practical identifiability) check."""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import pytest
+
+from heritage_bayes.errors import InputError
+from heritage_bayes.inference.optimize import find_map, laplace
+from heritage_bayes.inference.sampler import _next_check, run_sampler, start_ensemble
+from test_inference import _problem
+
+
+class _BoxGauss:
+    """N(mu, diag(sd²)) restricted to a box (hard walls), vectorised, with ``params``."""
+
+    def __init__(self, mu, sd, lo, hi):
+        self.mu, self.sd = np.asarray(mu, float), np.asarray(sd, float)
+        self.lo, self.hi = np.asarray(lo, float), np.asarray(hi, float)
+        self.calls = 0
+
+    def __call__(self, X):
+        self.calls += 1
+        X = np.atleast_2d(X)
+        inside = np.all((X >= self.lo) & (X <= self.hi), axis=1)
+        lp = -0.5 * np.sum(((X - self.mu) / self.sd) ** 2, axis=1)
+        return np.where(inside, lp, -np.inf)
+
+
+def test_walkers_start_inside_the_support_when_the_map_is_on_or_beyond_a_bound():
+    # the density peaks beyond the upper wall of x0 and at the lower wall of x1:
+    # the MAP (on the walls) has half its neighbourhood outside the support
+    f = _BoxGauss(mu=[2.0, 0.0], sd=[0.5, 0.5], lo=[-1.0, 0.0], hi=[1.0, 3.0])
+    for x_map in ([1.0, 0.0], [1.5, -0.2]):  # on the bounds; outside them
+        p0, lp0 = start_ensemble(
+            f, np.array(x_map), 40, np.random.default_rng(3), bounds=(f.lo, f.hi)
+        )
+        assert p0.shape == (40, 2) and np.all(np.isfinite(lp0))
+        assert np.all(p0 > f.lo) and np.all(p0 < f.hi)
+        # centred near the (clipped) MAP: within the margin plus a few ball radii
+        np.testing.assert_allclose(np.median(p0, axis=0), np.clip(x_map, f.lo, f.hi), atol=0.05)
+    # the old start (a 1e-3 ball about a MAP on the wall) lost half the walkers:
+    # the new one is valid at the first draw, in one call of the log-posterior
+    f.calls = 0
+    start_ensemble(f, np.array([1.0, 0.0]), 40, np.random.default_rng(4), bounds=(f.lo, f.hi))
+    assert f.calls == 1
+    # same seed, same start
+    a = start_ensemble(f, np.array([1.0, 0.0]), 8, np.random.default_rng(5), bounds=(f.lo, f.hi))
+    b = start_ensemble(f, np.array([1.0, 0.0]), 8, np.random.default_rng(5), bounds=(f.lo, f.hi))
+    np.testing.assert_array_equal(a[0], b[0])
+
+
+def test_start_fails_with_a_data_message_only_when_nothing_is_finite():
+    def never(X):
+        return np.full(np.atleast_2d(X).shape[0], -np.inf)
+
+    with pytest.raises(InputError, match="check the data"):
+        start_ensemble(never, np.zeros(2), 8, np.random.default_rng(0))
+
+
+def test_sampler_runs_from_a_map_on_a_bound_and_samples_the_truncated_posterior():
+    # 1-d half-normal on [0, inf) in 2 independent copies (walls at 0): the MAP is 0
+    f = _BoxGauss(mu=[0.0, 0.0], sd=[1.0, 1.0], lo=[0.0, 0.0], hi=[np.inf, np.inf])
+    res = run_sampler(
+        f,
+        np.zeros(2),
+        seed=2,
+        bounds=(f.lo, f.hi),
+        nwalkers=16,
+        max_steps=3000,
+        check_every=500,
+        tau_factor=30,
+        moves="stretch",
+    )
+    X, _ = res.draws()
+    x = X.reshape(-1, 2)
+    # half-normal mean sqrt(2/π) = 0.798, sd 0.603; ESS-based tolerance (≥ 400 ESS: 4 SE)
+    n_eff = max(400.0, x.shape[0] / 10)
+    assert np.all(x >= 0)
+    np.testing.assert_allclose(x.mean(axis=0), np.sqrt(2 / np.pi), atol=4 * 0.603 / np.sqrt(n_eff))
+    assert res.stopped_by in ("converged", "max_steps")
+
+
+def test_time_budget_stops_the_chain_between_chunks():
+    f = _BoxGauss(mu=[0.0], sd=[1.0], lo=[-np.inf], hi=[np.inf])
+    res = run_sampler(
+        f, np.zeros(1), seed=1, nwalkers=8, max_steps=10_000, check_every=100, max_seconds=1e-9
+    )
+    # one chunk always runs; then the (spent) budget stops it, unconverged
+    assert res.steps == 100 and res.stopped_by == "max_seconds" and not res.converged
+    assert res.cpu_seconds > 0
+
+
+def test_convergence_checks_space_out_with_the_chain_and_do_not_depend_on_resume():
+    seq = [0]
+    while seq[-1] < 20_000:
+        seq.append(_next_check(seq[-1], 500))
+    steps = np.diff(seq)
+    assert steps[0] == 500 and np.all(steps % 500 == 0)
+    assert np.all(steps[1:] >= steps[:-1])  # non-decreasing spacing
+    assert np.all(steps[10:] <= 0.1 * np.array(seq[10:-1]) + 500)  # about 10 % of the chain
+    # from any step inside a chunk, the next check is the same boundary
+    for b0, b1 in itertools.pairwise(seq):
+        assert _next_check(b0, 500) == b1 and _next_check(b1 - 1, 500) == b1
+
+
+def test_at_bound_names_map_parameters_pressed_against_their_prior():
+    lp, _ = _problem()
+    ps = lp.params
+    lo, hi = ps.bounds
+    x = 0.5 * (np.where(np.isfinite(lo), lo, -1) + np.where(np.isfinite(hi), hi, 1))
+    assert ps.at_bound(x) == []
+    i = ps.free_names.index("Ge")
+    x[i] = lo[i]
+    j = ps.free_names.index("phi_Ti")  # logit coordinate: far out counts as the end
+    x[j] = 30.0
+    assert ps.at_bound(x) == [("Ge", "lower"), ("phi_Ti", "upper")]
+
+
+def test_laplace_hessian_is_the_inverse_covariance_of_a_gaussian():
+    rng = np.random.default_rng(0)
+    A = rng.normal(size=(3, 3))
+    cov = A @ A.T + 0.5 * np.eye(3)
+    P = np.linalg.inv(cov)
+    mu = np.array([0.3, -0.2, 0.1])
+
+    class Gauss:
+        params = type(
+            "P",
+            (),
+            {"bounds": (np.full(3, -50.0), np.full(3, 50.0)), "free_names": ("a", "b", "c")},
+        )()
+
+        def __call__(self, X):
+            D = np.atleast_2d(X) - mu
+            return -0.5 * np.einsum("ki,ij,kj->k", D, P, D)
+
+    res = laplace(Gauss(), mu)
+    # central second differences are exact on a quadratic (rounding only)
+    np.testing.assert_allclose(res.hessian, P, rtol=1e-5, atol=1e-6 * np.abs(P).max())
+    np.testing.assert_allclose(res.sd, np.sqrt(np.diag(cov)), rtol=1e-5)
+    assert res.unidentified == []  # sd ≤ 2 of a prior range of 100
+    # conditional sd given "a": the inverse of the Hessian without a's row and column
+    r = laplace(Gauss(), mu, given=("a",))
+    np.testing.assert_allclose(r.sd[1:], np.sqrt(np.diag(np.linalg.inv(P[1:, 1:]))), rtol=1e-5)
+    assert r.sd[0] == 0
+
+
+def test_laplace_sees_the_scale_ridge_and_a_coordinate_the_data_do_not_pin():
+    lp, _ = _problem()
+    x_map = find_map(lp, seed=1, maxiter=40, starts=1).x
+    res = laplace(lp, x_map)
+    w = np.linalg.eigvalsh(res.hessian)
+    # the 1c room without a known heat input: C and G scale together (one flat direction)
+    assert abs(w[0]) < 1e-5 * w[-1] and w[1] > 1e-4 * w[-1]
+    assert "Ci" in res.unidentified
+    # given the scale (Ci pinned, as calibrate does through the scale reference): all pinned
+    assert laplace(lp, x_map, given=("Ci",)).unidentified == []
+
+    class Padded:  # plus a coordinate the likelihood ignores: its sd is its prior's
+        params = type(
+            "P",
+            (),
+            {
+                "bounds": (np.r_[lp.params.bounds[0], 0.0], np.r_[lp.params.bounds[1], 1.0]),
+                "free_names": (*lp.params.free_names, "extra"),
+            },
+        )()
+
+        def __call__(self, X):
+            X = np.atleast_2d(X)
+            inside = (X[:, -1] >= 0) & (X[:, -1] <= 1)
+            return np.where(inside, lp(X[:, :-1]), -np.inf)
+
+    r2 = laplace(Padded(), np.r_[x_map, 0.5], given=("Ci",))
+    assert r2.unidentified == ["extra"]

@@ -471,14 +471,18 @@ def test_orholm_config(shared_data):
     prep = prepare(load_config(CONFIGS / "orholm.yaml"))
     f = prep.frame
     assert list(f.columns) == ["Te", "Tf", "Pe", "Ti", "Pi", "RHi"]
-    assert len(f) == 8760 and f.index[0] == pd.Timestamp("2019-01-01", tz="UTC")
+    assert len(f) == 17544 and f.index[0] == pd.Timestamp("2015-01-01", tz="UTC")
     assert prep.irradiance_source == "none"
     assert 9 < f["Tf"].min() <= f["Tf"].max() < 11.5  # running annual mean of DMI
     assert f["Ti"].notna().mean() > 0.99
     m = hb.model("thermal_4a_nosolar")
     assert np.isfinite(prep.model_inputs("thermal", m)).all()
-    dropped = prep.sources["measurements"][0]["dropped"]
-    assert dropped["nonexistent_dst"] > 0  # local clock handled by the reader
+    # the humidistat's control input: the measured indoor temperature, gaps filled
+    mh = hb.model("hygric_2c", humidistat="band")
+    U = prep.model_inputs("hygric", mh)
+    assert np.isfinite(U).all()
+    ok = f["Ti"].notna().to_numpy()
+    np.testing.assert_array_equal(U[ok, 1], f["Ti"].to_numpy()[ok])
 
 
 @pytest.mark.shared_data

@@ -466,9 +466,7 @@ def model_ladder(cfg: CalibrationConfig, prep, section: _Section, *, seed: int) 
     """
     from heritage_bayes.inference.optimize import find_map
     from heritage_bayes.inference.results import fit_metrics
-    from heritage_bayes.rc.discretize import modal_form
     from heritage_bayes.rc.identify import structural_identifiability
-    from heritage_bayes.rc.simulate import modal_simulate
 
     sec_cfg = getattr(cfg, section.name)
     names = list(LADDERS[section.name]) if isinstance(sec_cfg.model, str) else []
@@ -507,9 +505,9 @@ def model_ladder(cfg: CalibrationConfig, prep, section: _Section, *, seed: int) 
             model, dict(zip(model.parameter_names, tm, strict=True)), dt=prep.dt, fixed=fixed
         )
         U = prep.model_inputs(section.name, model)
-        mf = modal_form(model, tm[None], prep.dt)
-        z0 = mf.steady_state_modal(U[: max(1, prep.init_steps)].mean(axis=0))
-        ysim = modal_simulate(mf, U, np.ascontiguousarray(z0))[0]
+        ysim = model.forward(
+            tm[None], U, prep.dt, u_init=U[: max(1, prep.init_steps)].mean(axis=0)
+        )[0][0]
         obs = prep.observed(section.name, model)
         fit = {}
         for period in ("calibration", "validation"):

@@ -192,6 +192,7 @@ def _cmd_models(args) -> int:
     if args.name is None:
         for name, desc in available_models().items():
             print(f"{name:<20s} {desc}")
+        print(_CONTROL_HELP)
         return 0
     try:
         print(describe_model(args.name, noise=args.noise))
@@ -227,6 +228,25 @@ def _cmd_compare(args) -> int:
         print("recommendation:", res["recommendation"]["reason"])
         print(out / "comparison.html")
     return 0
+
+
+_CONTROL_HELP = """
+Options (YAML: <section>.options), any catalogue model:
+  thermal: surfaces, ground (true | false | estimate), heating (known power Ph [W])
+  control of the air node (a heated or humidity-controlled room):
+    thermostat: true            ideal heating to an estimated set-point Tset [°C]
+    thermostat: {power_limit: true, schedule: COLUMN, conservation: true}
+                                Pmax [W] maximum power; Tset_use [°C] in the hours of
+                                use (input COLUMN: 1 in use, 0 not); conservation
+                                heating: RH kept <= RH_ch [-] (input Pi, measured)
+    humidistat: band | dehumidifier | humidifier | setpoint   (hygric)
+                                RH at the indoor temperature (input Ti, measured) held
+                                in [RH_lo, RH_hi] [-] (or at RH_set)
+    humidistat: {mode: band, capacity: true}
+                                M_dehum, M_hum [kg/s] capacities (otherwise ideal)
+    source: true                constant heat gain Qs [W] or moisture source Ms [kg/s]
+  Projections can switch control off: Run.simulate(..., control=False) or
+  control={"humidistat": False} (see heritage_bayes.rc.control)."""
 
 
 def _cmd_batch(args) -> int:

@@ -154,7 +154,12 @@ class Prepared:
                 f"prepared data do not provide ({_input_hint(missing, self)}); inputs "
                 f"available: {[c for c in self.frame.columns if c not in OUTPUT_COLUMNS]}"
             )
-        U = self.frame.loc[:, list(names)].to_numpy(dtype=float)
+        U = np.array(self.frame.loc[:, list(names)].to_numpy(dtype=float))
+        for j, c in enumerate(names):
+            if c in OUTPUT_COLUMNS:
+                # a measured indoor quantity as a control input (the humidistat's Ti,
+                # conservation heating's Pi): gaps interpolated linearly in time
+                U[:, j] = _filled(U[:, j], section, c)
         if not np.isfinite(U).all():  # align fills or rejects input gaps: internal error
             col = names[int(np.argwhere(~np.isfinite(U))[0, 1])]
             raise RuntimeError(f"prepared input {col!r} has non-finite values")
@@ -183,6 +188,20 @@ class Prepared:
         """Timestamps of the ``"calibration"`` or ``"validation"`` rows."""
         sl = {"calibration": self.calibration, "validation": self.validation}[which]
         return self.frame.index[sl] if sl is not None else self.frame.index[:0]
+
+
+def _filled(v: np.ndarray, section: str, name: str) -> np.ndarray:
+    """``v`` with NaN gaps interpolated linearly (held at the ends)."""
+    ok = np.isfinite(v)
+    if not ok.any():
+        raise DataError(
+            f"{section}.model: the control input {name!r} (measured indoor data) has no "
+            "values in the prepared period"
+        )
+    if ok.all():
+        return v
+    idx = np.arange(v.size)
+    return np.interp(idx, idx[ok], v[ok])
 
 
 def _check_section(section: str) -> None:
@@ -237,7 +256,7 @@ def _extra_inputs(cfg) -> list[str]:
         if getattr(cfg, section) is None:
             continue
         for name in build_model(cfg, section).input_names:
-            if name not in built and name not in extra:
+            if name not in built and name not in extra and name not in OUTPUT_COLUMNS:
                 extra.append(name)
     return extra
 

@@ -85,6 +85,7 @@ class Run:
         dt: float | None = None,
         x0=None,
         init_window: int | None = None,
+        control: bool | dict = True,
     ) -> np.ndarray:
         """Simulate posterior draws on new inputs (e.g. future weather).
 
@@ -101,26 +102,27 @@ class Run:
         init_window : int, optional
             Steps of inputs averaged for the steady-state initial state (default the
             calibration's ``periods.init_window``); or give ``x0``.
+        control : bool or mapping, default True
+            For a controlled room (thermostat, humidistat, sources; see
+            :mod:`heritage_bayes.rc.control`): keep the calibrated control (True), run
+            the room free-running (False), or switch components, e.g.
+            ``{"humidistat": False}`` ("what if the dehumidifier fails?"). The inputs
+            still need the control's columns (``Ti`` for a humidistat).
 
         Returns
         -------
         (K, N, n_out) array of noise-free outputs ([°C] or [Pa]).
         """
-        from heritage_bayes.rc.discretize import modal_form
-        from heritage_bayes.rc.simulate import modal_simulate
-
         model = self._model(section)
         U = check_inputs(model, inputs)
         dt = float(dt or self.summary.get("dt", 3600.0))
         draws = self.draws(section, n_draws, seed)
         P, _ = model.param_array(draws)
-        mf = modal_form(model, P, dt)
-        if x0 is not None:
-            z0 = mf.to_modal(np.asarray(x0, dtype=float))
-        else:
-            w = init_window or int(self.summary.get("init_steps", 720))
-            z0 = mf.steady_state_modal(U[: max(1, w)].mean(axis=0))
-        return modal_simulate(mf, U, np.ascontiguousarray(np.broadcast_to(z0, mf.lam.shape)))
+        if control is not True:
+            model = model.with_control(control)
+        w = init_window or int(self.summary.get("init_steps", 720))
+        u0 = U[: max(1, w)].mean(axis=0)
+        return model.forward(P, U, dt, u_init=u0, x0=x0)[0]
 
     def simulate_rh(
         self, thermal_inputs, hygric_inputs, n_draws: int | None = 200, seed: int = 0, **kw

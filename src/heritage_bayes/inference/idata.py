@@ -19,9 +19,7 @@ from heritage_bayes._arviz import az
 from heritage_bayes._version import __version__
 from heritage_bayes.climate.psychro import saturation_vapour_pressure
 from heritage_bayes.inference.results import coverage, fit_metrics
-from heritage_bayes.rc.discretize import modal_form
 from heritage_bayes.rc.identify import derived_quantities, derived_units
-from heritage_bayes.rc.simulate import modal_simulate
 
 __all__ = ["CONVERGENCE", "build_run_outputs"]
 
@@ -154,9 +152,9 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
         th_sel = s.theta[:, sel].reshape(-1, s.theta.shape[-1])
         tm_sel, tn_sel = th_sel[:, : s.logpost.n_model], th_sel[:, s.logpost.n_model :]
         U = prep.model_inputs(s.name, s.model)
-        mf = modal_form(s.model, tm_sel, prep.dt)
-        z0 = mf.steady_state_modal(U[: max(1, prep.init_steps)].mean(axis=0))
-        Ysim = modal_simulate(mf, U, np.ascontiguousarray(z0))
+        Ysim, _ = s.model.forward(
+            tm_sel, U, prep.dt, u_init=U[: max(1, prep.init_steps)].mean(axis=0)
+        )
         noise = s.logpost.noise.sample(rng, tn_sel, U.shape[0], s.model.n_outputs)
         Ypp = Ysim + noise
         shape = (W, n_sel, U.shape[0])

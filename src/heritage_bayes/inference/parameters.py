@@ -256,6 +256,18 @@ _DEFAULTS: dict[tuple[str, str], Prior] = {
     ("hygric", "fraction"): Prior("uniform", 0.0, 1.0),
     # fixed vapour pressure [Pa]: 0 to saturation at ~33 °C
     ("hygric", "constant"): Prior("uniform", 0.0, 5000.0),
+    # control of the air node (heritage_bayes.rc.control): heating set-points [°C] from
+    # frost protection to a warm church; heating power [W] from a radiator (1 kW) to a
+    # cathedral's plant (10 MW); RH limits [-]; humidistat capacities [kg/s] from a
+    # small dehumidifier (1e-6 kg/s = 0.1 L/day) to a plant (1 kg/s); constant sources:
+    # heat [W] (0.01 W to 10 MW) and moisture [kg/s] (a few people emit 1e-5 kg/s)
+    ("thermal", "setpoint"): Prior("uniform", 0.0, 30.0),
+    ("thermal", "power"): Prior("loguniform", 1.0, 1e7),
+    ("thermal", "rh"): Prior("uniform", 0.3, 0.95),
+    ("thermal", "source"): Prior("loguniform", 1e-2, 1e7),
+    ("hygric", "rh"): Prior("uniform", 0.05, 0.98),
+    ("hygric", "moisture_capacity"): Prior("loguniform", 1e-7, 1.0),
+    ("hygric", "source"): Prior("loguniform", 1e-9, 1e-1),
     # noise: σ [K] or [Pa], AR(1) coefficient φ [-]
     ("thermal", "sigma"): Prior("loguniform", 1e-3, 10.0),
     ("hygric", "sigma"): Prior("loguniform", 1e-1, 1e3),

@@ -24,7 +24,6 @@ from heritage_bayes.inference.likelihoods import NoiseModel
 from heritage_bayes.inference.parameters import ParameterSet
 from heritage_bayes.rc.discretize import modal_form
 from heritage_bayes.rc.model import RCModel
-from heritage_bayes.rc.simulate import modal_simulate
 
 __all__ = ["LogPosterior"]
 
@@ -89,15 +88,21 @@ class LogPosterior:
     ) -> tuple[np.ndarray, np.ndarray]:
         """Noise-free outputs (K, N, n_out) and validity (K,) for model parameters."""
         U = self.inputs if inputs is None else inputs
-        mf = modal_form(self.model, theta_model, self.dt)
-        z0 = mf.steady_state_modal(self.u_init if u_init is None else u_init)
-        z0 = np.where(np.isfinite(z0), z0, 0.0)
-        Y = modal_simulate(mf, U, z0)
-        return Y, mf.valid
+        u0 = self.u_init if u_init is None else u_init
+        return self.model.forward(theta_model, U, self.dt, u_init=u0)
 
     def _loglik(self, theta: np.ndarray) -> np.ndarray:
         """(K,) log-likelihood for valid-shaped values (K, P); -inf where invalid."""
         tm, tn = self.split(theta)
+        if self.model.control is not None:
+            # a controlled room: a nonlinear simulator batched over walkers, then the
+            # noise model's likelihood of the simulated outputs
+            with np.errstate(all="ignore"):
+                Y, valid = self.simulate(tm)
+                ll = self.noise.loglik(Y, self.observed, tn)
+            ll[~valid] = -np.inf
+            ll[~np.isfinite(ll)] = -np.inf
+            return ll
         with np.errstate(all="ignore"):
             mf = modal_form(self.model, tm, self.dt)
             z0 = mf.steady_state_modal(self.u_init)

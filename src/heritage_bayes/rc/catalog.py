@@ -38,12 +38,21 @@ unknown but steady temperature, or the net effect of minimal heating),
 ``heating`` (bool, default False: an input ``Ph`` [W] of known gain 1 into the air node,
 e.g. measured heating power in a test cell; it makes the absolute scale of C and G
 identifiable).
+
+Control of the air node (a heated, humidity-controlled or occupied room; see
+:mod:`heritage_bayes.rc.control`): ``thermostat`` (true, or a mapping with
+``power_limit``, ``schedule``, ``conservation``), ``humidistat`` (true, a mode
+``band``/``dehumidifier``/``humidifier``/``setpoint``, or a mapping with ``mode`` and
+``capacity``) and ``source`` (true: a constant heat gain ``Qs`` [W] or moisture source
+``Ms`` [kg/s]). Any catalogue model takes them, e.g.
+``model("thermal_2c", thermostat={"power_limit": True})``.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 
+from heritage_bayes.rc.control import _parse_control, controlled
 from heritage_bayes.rc.model import RCModel
 from heritage_bayes.rc.network import Link, Network, Node, Source
 
@@ -222,7 +231,9 @@ def model(name: str, **options) -> RCModel:
     name : str
         One of :func:`available_models` (``"thermal_4a"``, ``"hygric_2c"``, ...).
     **options
-        ``surfaces``, ``ground``, ``heating`` for thermal models (see module docstring).
+        ``surfaces``, ``ground``, ``heating`` for thermal models (see module docstring);
+        the control of the air node: ``thermostat`` (thermal), ``humidistat``
+        (hygric), ``source`` (both); see :mod:`heritage_bayes.rc.control`.
 
     Raises
     ------
@@ -232,13 +243,16 @@ def model(name: str, **options) -> RCModel:
     if name not in CATALOG:
         raise ValueError(f"unknown model {name!r}; available: {sorted(CATALOG)}")
     factory = CATALOG[name][0]
+    options = dict(options)
+    control = _parse_control(name.split("_")[0], name, options)
     try:
         net = factory(**options)
     except TypeError as exc:
         import inspect
 
-        allowed = list(inspect.signature(factory).parameters)
+        allowed = [*inspect.signature(factory).parameters, "source"]
+        allowed += ["thermostat"] if name.startswith("thermal") else ["humidistat"]
         raise ValueError(
             f"model {name!r}: unknown option(s) in {sorted(options)}; allowed: {allowed}"
         ) from exc
-    return RCModel(net)
+    return controlled(net, control)

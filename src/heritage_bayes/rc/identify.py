@@ -77,6 +77,7 @@ References
 from __future__ import annotations
 
 from collections.abc import Iterable
+from dataclasses import replace
 
 import numpy as np
 
@@ -216,6 +217,27 @@ def structural_identifiability(
             f"not a batch (got {P.shape[0]} sets)"
         )
     model.check_values(P)
+    if model.control is not None:
+        # a controlled room: the network's check, and the control's parameters described
+        from heritage_bayes.rc.control import control_identifiability
+        from heritage_bayes.rc.model import RCModel
+
+        net = RCModel(model.network)
+        n_net = len(net.parameter_names)
+        fixed = tuple(fixed)
+        res = structural_identifiability(
+            net,
+            P[0, :n_net],
+            dt,
+            n_freq=n_freq,
+            longest_period=longest_period,
+            rtol=rtol,
+            threshold=threshold,
+            fixed=[f for f in fixed if f in net.parameter_names],
+        )
+        point = dict(res.point) | dict(zip(model.parameter_names, P[0].tolist(), strict=True))
+        notes = control_identifiability(model, res.has_scale_direction, fixed)
+        return replace(res, model_name=model.name, point=point, control=notes)
     p0 = P[0]
     all_names = model.parameter_names
     all_kinds = [info.kind for info in model.parameters]

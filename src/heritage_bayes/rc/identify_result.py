@@ -126,6 +126,10 @@ class IdentifiabilityResult:
     null_loading: dict[str, float]
     loading_given_scale: dict[str, float]
     jacobian: np.ndarray = field(repr=False)
+    #: Control parameters of a controlled room (:mod:`heritage_bayes.rc.control`), name
+    #: -> what pins them (they act only while the control does, outside the linear
+    #: frequency-response check, which covers the free-running network).
+    control: dict[str, str] = field(default_factory=dict)
 
     # ------------------------------------------------------------------ summaries
     @property

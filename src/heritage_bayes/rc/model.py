@@ -24,6 +24,10 @@ class RCModel:
     Use :func:`heritage_bayes.model` to get catalogue models by name.
     """
 
+    #: Control of the air node (:class:`heritage_bayes.rc.control.Control`); None for a
+    #: free-running room.
+    control = None
+
     def __init__(self, network: Network):
         self.network = network
         self._ix = as_index_arrays(network)
@@ -175,7 +179,7 @@ class RCModel:
         """
         ix = self._ix
         K = P.shape[0]
-        n, m = self.n_states, self.n_inputs
+        n, m = self.n_states, len(self.network.inputs)
         cap = P[:, ix["cap"]]
         G = np.zeros((K, n, n))
         Gu = np.zeros((K, n, m))
@@ -222,10 +226,46 @@ class RCModel:
         A = -G / cap[:, :, None]
         B = Gu / cap[:, :, None]
         Cm = self.output_matrix()
-        D = np.zeros((self.n_outputs, self.n_inputs))
+        D = np.zeros((self.n_outputs, B.shape[-1]))
         if not batch:
             A, B = A[0], B[0]
         return A, B, Cm, D
+
+    def with_control(self, enabled=True) -> RCModel:
+        """This model with control components switched (a free-running model has none:
+        returns itself; see :meth:`heritage_bayes.rc.control.ControlledModel.with_control`)."""
+        return self
+
+    def forward(self, P, U, dt, *, u_init=None, x0=None):
+        """Simulate a batch of parameter sets: outputs (K, N, n_out) and validity (K,).
+
+        The one entry point for simulating a (possibly controlled) model from a
+        parameter array.
+
+        Parameters
+        ----------
+        P : (K, n_params) array, SI units
+        U : (N, m) array of :attr:`input_names` columns
+        dt : float
+            Time step [s].
+        u_init : (m,) array, optional
+            Inputs whose steady state is the initial state (default ``U[0]``).
+        x0 : (n,) or (K, n) array, optional
+            Initial state [°C] or [Pa] instead.
+        """
+        from heritage_bayes.rc.discretize import modal_form
+        from heritage_bayes.rc.simulate import modal_simulate
+
+        P = np.atleast_2d(np.asarray(P, dtype=float))
+        mf = modal_form(self, P, dt)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            if x0 is not None:
+                z0 = mf.to_modal(np.asarray(x0, dtype=float))
+            else:
+                z0 = mf.steady_state_modal(U[0] if u_init is None else u_init)
+        z0 = np.where(np.isfinite(z0), z0, 0.0)
+        z0 = np.ascontiguousarray(np.broadcast_to(z0, mf.lam.shape))
+        return modal_simulate(mf, U, z0), mf.valid
 
     def offset(self, params: Mapping[str, object]) -> np.ndarray:
         """Affine term e [potential/s] of :math:`\\dot x = Ax + Bu + e` (zero unless

@@ -180,6 +180,9 @@ def iter_simulate(
         x0s = x0
         if x0 is not None and np.ndim(x0) == 2:
             x0s = np.asarray(x0)[sl]
+        if model.control is not None:  # a controlled room (heating, humidistat, sources)
+            yield sl, model.forward(P[sl], U, dt, x0=x0s)[0]
+            continue
         z0 = _initial_modal(mf, U, x0s)
         yield sl, modal_simulate(mf, U, z0, max_block=max_block)
 

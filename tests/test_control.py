@@ -1,0 +1,192 @@
+"""Controlled rooms (heritage_bayes.rc.control): thermostat, humidistat, sources.
+
+- Exactness: the controlled recursion equals the linear model driven by the control
+  flow it chose (ZOH, to rounding), and an ideal thermostat holds the set-point.
+- Recovery: on synthetic data with known set-point, power limit and humidistat band,
+  the MAP lies within 5 standard errors (from the numerical Hessian of the
+  log-likelihood at the MAP) of the truth.
+- Options: catalogue/YAML options, errors, switching control off, identifiability notes.
+"""
+
+import numpy as np
+import pytest
+
+import heritage_bayes as hb
+from heritage_bayes.climate.psychro import saturation_vapour_pressure
+from heritage_bayes.inference.likelihoods import get_noise_model
+from heritage_bayes.inference.optimize import find_map
+from heritage_bayes.inference.parameters import parameters_for
+from heritage_bayes.inference.posterior import LogPosterior
+from heritage_bayes.rc.identify import structural_identifiability
+
+DT = 3600.0
+NET_T = dict(Cw=4e8, Ci=4e6, Gw=300.0, Gi=600.0, Gfast=150.0)
+NET_H = dict(Cw=2e-2, Ci=2e-4, Gw=5e-9, Gi=4e-8, Gfast=3e-8)
+
+
+def _weather(N, seed=0):
+    rng = np.random.default_rng(seed)
+    t = np.arange(N)
+    te = 4 + 6 * np.sin(2 * np.pi * (t - 2000) / 8760) + 3 * np.sin(2 * np.pi * (t - 14) / 24)
+    te = te + np.cumsum(rng.normal(0, 0.3, N)) * 0.2
+    return te, rng
+
+
+def test_thermostat_exact_zoh_and_holds_setpoint():
+    N = 24 * 60
+    te, _ = _weather(N)
+    m = hb.model("thermal_2c", surfaces=(), ground=False, thermostat={"power_limit": True})
+    assert m.parameter_names == (*NET_T, "Tset", "Pmax")
+    p = dict(NET_T, Tset=12.0, Pmax=5000.0)
+    P, _ = m.param_array(p)
+    x0 = np.array([6.0, 8.0])
+    Y, valid, Q = m.forward(P, te[:, None], DT, x0=x0, effort=True)
+    assert valid.all() and Q.min() >= 0 and Q.max() == pytest.approx(5000.0)
+    # the linear model with the chosen power as a known input reproduces it exactly
+    mh = hb.model("thermal_2c", surfaces=(), ground=False, heating=True)
+    yl = hb.simulate(mh, NET_T, np.column_stack([te, Q[0]]), x0=x0)
+    np.testing.assert_allclose(Y[0, :, 0], yl[:, 0], rtol=0, atol=1e-9)
+    # power below the limit: the air ends the step exactly at the set-point
+    k = np.flatnonzero((Q[0, :-1] > 0) & (Q[0, :-1] < 5000.0))
+    assert k.size > 10
+    np.testing.assert_allclose(Y[0, k + 1, 0], 12.0, atol=1e-9)
+    # an ideal thermostat never lets the air below the set-point (after the start)
+    mi = hb.model("thermal_2c", surfaces=(), ground=False, thermostat=True)
+    yi = hb.simulate(mi, dict(NET_T, Tset=12.0), te[:, None], x0=x0)
+    assert yi[1:, 0].min() >= 12.0 - 1e-9
+    free = hb.simulate(hb.model("thermal_2c", surfaces=(), ground=False), NET_T, te[:, None])
+    assert free[:, 0].min() < 10.0  # the control matters in this weather
+
+
+def test_switching_control_off_gives_the_free_running_room():
+    N = 24 * 30
+    te, _ = _weather(N)
+    m = hb.model("thermal_2c", surfaces=(), ground=False, thermostat=True, source=True)
+    p = dict(NET_T, Tset=14.0, Qs=300.0)
+    off = m.with_control(False)
+    assert off.parameter_names == m.parameter_names
+    free = hb.simulate(hb.model("thermal_2c", surfaces=(), ground=False), NET_T, te[:, None])
+    np.testing.assert_allclose(hb.simulate(off, p, te[:, None]), free, atol=1e-9)
+    # the source alone: the linear model with a constant heating input
+    src = m.with_control({"thermostat": False})
+    mh = hb.model("thermal_2c", surfaces=(), ground=False, heating=True)
+    ref = hb.simulate(mh, NET_T, np.column_stack([te, np.full(N, 300.0)]))
+    np.testing.assert_allclose(hb.simulate(src, p, te[:, None]), ref, atol=1e-9)
+    with pytest.raises(ValueError, match="unknown component"):
+        m.with_control({"dehumidifier": False})
+
+
+def _se(lp, theta, names):
+    """Standard errors of ``names`` (Gauss-Newton: Fisher information J^T J / sigma^2 of
+    the simulated output's sensitivities, central differences)."""
+    idx = [lp.params.names.index(n) for n in names]
+    sigma = theta[lp.params.names.index("sigma_" + lp.model.output_names[0])]
+    ok = np.isfinite(lp.observed[:, 0])
+    cols = []
+    for i in idx:
+        h = 1e-4 * max(abs(theta[i]), 1e-6)
+        tp, tm = theta.copy(), theta.copy()
+        tp[i] += h
+        tm[i] -= h
+        Y, _ = lp.simulate(np.stack([tp, tm])[:, : lp.n_model])
+        cols.append((Y[0, ok, 0] - Y[1, ok, 0]) / (2 * h))
+    J = np.column_stack(cols)
+    return np.sqrt(np.diag(np.linalg.inv(J.T @ J / sigma**2)))
+
+
+def _fit(m, truth, U, y, free, seed):
+    noise = get_noise_model("iid")
+    priors = {k: {"fixed": v} for k, v in truth.items() if k not in free}
+    ps = parameters_for(m, noise, priors)
+    lp = LogPosterior(m, ps, noise, U, y[:, None], warmup=48, init_window=1)
+    mp = find_map(lp, seed=seed, maxiter=100, starts=2)
+    return lp, mp.theta
+
+
+def test_recovers_setpoint_and_power_limit():
+    N = 24 * 90
+    te, rng = _weather(N, seed=3)
+    m = hb.model("thermal_2c", surfaces=(), ground=False, thermostat={"power_limit": True})
+    truth = dict(NET_T, Tset=11.5, Pmax=2200.0)
+    sd = 0.1
+    y = hb.simulate(m, truth, te[:, None])[:, 0] + rng.normal(0, sd, N)
+    lp, th = _fit(m, truth, te[:, None], y, ("Tset", "Pmax", "Gfast"), seed=1)
+    names = ("Tset", "Pmax", "Gfast")
+    se = _se(lp, th, names)
+    for n, s in zip(names, se, strict=True):
+        est = th[lp.params.names.index(n)]
+        assert abs(est - truth[n]) < 5 * s, (n, est, truth[n], s)
+    assert se[0] < 0.05 and se[1] / truth["Pmax"] < 0.05  # informative data
+
+
+def test_recovers_humidistat_band_and_capacity():
+    N = 24 * 90
+    te, rng = _weather(N, seed=5)
+    ti = 12 + 0.6 * (te - 4)  # indoor temperature [°C] (given, as in calibration)
+    pe = 0.8 * saturation_vapour_pressure(te) + 150 * np.sin(np.arange(N) / 97.0)
+    m = hb.model("hygric_2c", humidistat={"mode": "band", "capacity": True})
+    assert m.input_names == ("Pe", "Ti")
+    truth = dict(NET_H, RH_lo=0.38, RH_hi=0.46, M_dehum=5e-6, M_hum=2e-6)
+    U = np.column_stack([pe, ti])
+    Y, _, Q = m.forward(m.param_array(truth)[0], U, DT, effort=True)
+    assert (Q < 0).mean() > 0.1 and (Q > 0).mean() > 0.05  # both sides act
+    assert (Q == -5e-6).mean() > 0.05 and (Q == 2e-6).mean() > 0.05  # both capacities bind
+    sd = 5.0  # [Pa]
+    y = Y[0, :, 0] + rng.normal(0, sd, N)
+    free = ("RH_lo", "RH_hi", "M_dehum", "M_hum")
+    lp, th = _fit(m, truth, U, y, free, seed=2)
+    se = _se(lp, th, free)
+    for n, s in zip(free, se, strict=True):
+        est = th[lp.params.names.index(n)]
+        assert abs(est - truth[n]) < 5 * s, (n, est, truth[n], s)
+    assert se[0] < 0.01 and se[1] < 0.01
+
+
+def test_options_errors_and_identifiability_notes():
+    with pytest.raises(ValueError, match="thermostat needs a thermal model"):
+        hb.model("hygric_2c", thermostat=True)
+    with pytest.raises(ValueError, match=r"humidistat\.mode"):
+        hb.model("hygric_2c", humidistat={"mode": "sometimes"})
+    with pytest.raises(ValueError, match=r"unknown thermostat option\(s\) \['pmax'\]"):
+        hb.model("thermal_2c", thermostat={"pmax": True})
+    m = hb.model(
+        "thermal_1c",
+        surfaces=(),
+        ground=False,
+        thermostat={"schedule": "in_use", "conservation": True},
+    )
+    assert m.input_names == ("Te", "in_use", "Pi")
+    assert m.parameter_names[-3:] == ("Tset", "Tset_use", "RH_ch")
+    with pytest.raises(ValueError, match="RH_lo <= RH_hi"):
+        hb.simulate(
+            hb.model("hygric_1c", humidistat="band"),
+            dict(Ci=1e-3, Gfast=1e-8, RH_lo=0.6, RH_hi=0.5),
+            np.full((5, 2), 800.0),
+        )
+    ms = hb.model("hygric_2c", humidistat="dehumidifier", source=True)
+    r = structural_identifiability(ms, dict(NET_H, RH_hi=0.55, Ms=1e-5), DT)
+    assert set(r.control) == {"RH_hi", "Ms"}
+    assert "overall-scale" in r.control["Ms"] and "hours in which" in r.control["RH_hi"]
+    assert r.has_scale_direction  # the network part is still free-running
+
+
+def test_schedule_and_conservation_heating():
+    N = 24 * 40
+    te, _ = _weather(N)
+    use = ((np.arange(N) % 168) // 24 == 6) & ((np.arange(N) % 24 >= 8) & (np.arange(N) % 24 < 12))
+    pv = np.full(N, 900.0)  # vapour pressure [Pa]
+    m = hb.model(
+        "thermal_2c",
+        surfaces=(),
+        ground=False,
+        thermostat={"schedule": "in_use", "conservation": True},
+    )
+    p = dict(NET_T, Tset=5.0, Tset_use=18.0, RH_ch=0.6)
+    U = np.column_stack([te, use.astype(float), pv])
+    y = hb.simulate(m, p, U)[:, 0]
+    # conservation heating: RH at the simulated temperature never above 60 %
+    rh = pv[1:] / saturation_vapour_pressure(y[1:])
+    assert rh.max() <= 0.6 + 2e-3  # Magnus inverse vs IAPWS: within 0.1 K
+    # in the hours of use the service set-point holds (ideal heating)
+    k = np.flatnonzero(use[:-1])
+    assert y[k + 1].min() >= 18.0 - 1e-9

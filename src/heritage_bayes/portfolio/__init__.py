@@ -41,6 +41,7 @@ import contextlib
 import json
 import logging
 import os
+import sys
 import time
 from pathlib import Path
 
@@ -159,10 +160,12 @@ def run(
             for spec in pf.rooms
         ]
         bar = None
-        if not quiet:
+        if not quiet and sys.stderr.isatty():
             from tqdm import tqdm
 
-            bar = tqdm(total=len(futures), desc=pf.name, unit="room", mininterval=1.0)
+            bar = tqdm(
+                total=len(futures), desc=pf.name, unit="room", mininterval=1.0, file=sys.stderr
+            )
         try:
             for fut in as_completed(futures):
                 row = fut.result()
@@ -170,6 +173,13 @@ def run(
                 if bar is not None:
                     bar.set_postfix_str(f"{row['room']}: {row['status']}", refresh=False)
                     bar.update(1)
+                elif not quiet:  # a log file: one plain line per room
+                    print(
+                        f"[{pf.name}] {len(rows)}/{len(futures)} rooms: {row['room']} "
+                        f"{row['status']} ({row['task_seconds']:.0f} s)",
+                        file=sys.stderr,
+                        flush=True,
+                    )
                 _write_outputs(pf, out, rows, time.perf_counter() - t0)
         finally:
             if bar is not None:

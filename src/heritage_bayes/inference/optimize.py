@@ -27,7 +27,14 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import differential_evolution, minimize
 
-__all__ = ["LaplaceResult", "MAPResult", "find_map", "laplace"]
+__all__ = [
+    "AffineCoordinates",
+    "LaplaceResult",
+    "MAPResult",
+    "affine_coordinates",
+    "find_map",
+    "laplace",
+]
 
 _EPS = 1e-9
 
@@ -318,3 +325,44 @@ def laplace(
     rel = sd / scale
     flagged = [n for n, r in zip(names, rel, strict=True) if r > threshold]
     return LaplaceResult(x0, H, sd, rel, flagged)
+
+
+@dataclass
+class AffineCoordinates:
+    """Whitened sampling coordinates from the Laplace approximation: x = x0 + L z.
+
+    ``L`` is a square root of the Laplace covariance H⁻¹ (eigenvalues floored so that
+    flat or negatively curved directions, e.g. the scale ridge, get at most the prior's
+    width). The density in z is the density in x times |det L|, a constant, so the
+    posterior is the same distribution; :meth:`__call__` returns log p(x(z)) +
+    log|det L|.
+
+    Note: emcee's stretch and differential-evolution moves are affine invariant
+    (Goodman & Weare 2010; ter Braak & Vrugt 2008), so with them this changes the
+    chain only through DE's tiny isotropic jitter and the snooker update's metric;
+    ``benchmarks/bench_sampling.py`` measures it.
+    """
+
+    logpost: object
+    x0: np.ndarray
+    L: np.ndarray
+    log_det: float
+
+    def __call__(self, Z: np.ndarray) -> np.ndarray:
+        return self.logpost(self.to_x(Z)) + self.log_det
+
+    def to_x(self, Z: np.ndarray) -> np.ndarray:
+        return self.x0 + np.atleast_2d(Z) @ self.L.T
+
+    def to_z(self, X: np.ndarray) -> np.ndarray:
+        return np.linalg.solve(self.L, (np.atleast_2d(X) - self.x0).T).T
+
+
+def affine_coordinates(logpost, lap: LaplaceResult) -> AffineCoordinates:
+    """Whitening transform about ``lap.x`` from its Hessian (see :class:`AffineCoordinates`)."""
+    lo, hi = logpost.params.bounds
+    width = np.where(np.isfinite(hi - lo), hi - lo, 4.0)
+    w, V = np.linalg.eigh(0.5 * (lap.hessian + lap.hessian.T))
+    floor = 1.0 / float(np.max(width)) ** 2  # at most the widest prior range
+    L = V * (1.0 / np.sqrt(np.maximum(w, floor)))
+    return AffineCoordinates(logpost, lap.x.copy(), L, float(np.linalg.slogdet(L)[1]))

@@ -245,3 +245,38 @@ def test_projection_page_in_headless_chromium(proj):
     assert dom["figures"] == ["fig-fans", "fig-risk"]
     assert dom["scripts"] == 0
     assert all(i["complete"] and i["w"] > 400 and i["h"] > 200 for i in dom["images"])
+
+
+# ------------------------------------------------------------------ shipped configs
+CONFIGS = Path(__file__).resolve().parents[1] / "configs"
+
+
+def test_shipped_projection_files_validate():
+    from heritage_bayes.projection import load_projection_config
+
+    demo = load_projection_config(CONFIGS / "projection_demo.yaml")
+    assert [h for _, h in demo.cases()] == [2050, 2050, 2085, 2085]
+    knmi = load_projection_config(CONFIGS / "projection_knmi.yaml")
+    assert len(knmi.cases()) == 8 and knmi.knmi14.region is None  # from the station
+
+
+def test_debilt_demo_config():
+    from heritage_bayes.config import load_config
+
+    cfg = load_config(CONFIGS / "debilt_demo.yaml")
+    assert cfg.data.demo.weather == "debilt_knmi"
+    raw = yaml.safe_load((CONFIGS / "debilt_demo.yaml").read_text())
+    del raw["data"]["demo"]["weather_path"]
+    with pytest.raises(ConfigError, match=r"data\.demo\.weather_path: required"):
+        parse_config(raw)
+
+
+def test_debilt_demo_weather(shared_data):
+    """The De Bilt demo: KNMI hourly weather at De Bilt's coordinates, 10 years."""
+    from heritage_bayes.demo import virtual_monument
+
+    path = shared_data / "knmi-debilt" / "uurgeg_260_2011-2020.txt.gz"
+    w, meas, _, info = virtual_monument(weather="debilt_knmi", weather_path=str(path))
+    assert info["site"]["latitude"] == pytest.approx(52.10)
+    assert w.index[0].year == 2011 and len(meas) > 8 * 8760
+    assert info["station"] == "260"

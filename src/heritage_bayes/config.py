@@ -157,7 +157,10 @@ class DemoData(_Strict):
     """
 
     seed: int = 7
-    weather: Literal["greensboro_tmy3"] = "greensboro_tmy3"
+    weather: Literal["greensboro_tmy3", "debilt_knmi"] = "greensboro_tmy3"
+    weather_path: str | list[str] | None = Field(
+        default=None, description="KNMI hourly file(s) for weather 'debilt_knmi'"
+    )
     thermal_model: Literal["thermal_4a", "thermal_2c"] = "thermal_4a"
     sensor_noise_T: float = Field(default=0.1, ge=0, description="[K] sd of white noise")
     sensor_noise_RH: float = Field(default=1.0, ge=0, description="[%RH] sd of white noise")
@@ -173,6 +176,17 @@ class DemoData(_Strict):
         if v is not None:
             _check_dates(*v)
         return v
+
+    @model_validator(mode="after")
+    def _weather_path(self):
+        if self.weather == "debilt_knmi" and self.weather_path is None:
+            raise ValueError(
+                "weather_path: required for weather 'debilt_knmi' (the KNMI hourly file of "
+                "De Bilt, e.g. ../shared/data/knmi-debilt/uurgeg_260_2011-2020.txt.gz)"
+            )
+        if self.weather != "debilt_knmi" and self.weather_path is not None:
+            raise ValueError(f"weather_path: only for weather 'debilt_knmi' (got {self.weather!r})")
+        return self
 
 
 _CSV_ONLY = (
@@ -529,7 +543,8 @@ class CalibrationConfig(_Strict):
             raise ValueError("give at least one of 'thermal' and 'hygric'")
         if self.data.demo is not None and self.site is not None:
             raise ValueError(
-                "site: the demo uses the site of its weather file (Greensboro, NC); remove 'site'"
+                "site: the demo uses the site of its weather file (Greensboro, NC; De Bilt "
+                "for debilt_knmi); remove 'site'"
             )
         site_in_file = self.data.weather is not None and self.data.weather.format in (
             "epw",

@@ -222,7 +222,7 @@ def read_sources(cfg) -> RawData:
     sources: dict = {}
     monument = None
     if data.demo is not None:
-        monument = _demo(data.demo)
+        monument = _demo(data.demo, cfg)
         weather = monument.weather
         meas_tables = [monument.measurements]
         site = dict(monument.info["site"])
@@ -276,14 +276,28 @@ def _source_note(df: pd.DataFrame, fmt: str) -> dict:
     return note
 
 
-def _demo(settings):
+def _demo(settings, cfg):
     from heritage_bayes.demo import virtual_monument
+
+    path = settings.weather_path
+    if path is not None:
+        where = "data.demo.weather_path"
+        paths = [cfg.path(p).resolve() for p in (path if isinstance(path, list) else [path])]
+        for p in paths:
+            if not p.is_file():
+                raise DataError(f"{where}: {p}: file not found")
+        path = (
+            tuple(str(p) for p in paths)
+            if isinstance(settings.weather_path, list)
+            else str(paths[0])
+        )
 
     truth = settings.truth or {}
     try:
         return virtual_monument(
             seed=settings.seed,
             weather=settings.weather,
+            weather_path=path,
             sensor_noise_T=settings.sensor_noise_T,
             sensor_noise_RH=settings.sensor_noise_RH,
             model_error_T=settings.model_error_T,

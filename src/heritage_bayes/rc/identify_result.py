@@ -231,6 +231,7 @@ class IdentifiabilityResult:
             "point": {k: float(v) for k, v in self.point.items()},
             "fixed": list(self.fixed),
             "transforms": dict(self.transforms),
+            "control": dict(self.control),
             "method": {
                 "observables": "frequency response C(iωI-A)^-1 B on the grid incl. ω=0, "
                 "constant-boundary contributions",

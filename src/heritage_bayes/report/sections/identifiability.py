@@ -106,6 +106,7 @@ def identifiability_context(rd: RunData) -> list[dict]:
                 "model": info.get("model", m),
                 "verdict": verdict,
                 "nulls": nulls,
+                "control": sorted((idf.get("control") or {}).items()),
                 "lines": summ_lines,
                 "cond": fmt(idf.get("condition_number_identifiable")),
                 "corr_fig": fig_c,

@@ -293,7 +293,7 @@ def laplace(
     bounded = np.isfinite(width)
     scale = np.where(bounded, width, 4.0)
     h = rel_step * np.where(bounded, width, 1.0)
-    pad = np.where(bounded, 2 * h, 0.0)
+    pad = np.where(bounded, 3 * h, 0.0)
     x0 = np.clip(np.asarray(x_map, dtype=float), lo + pad, hi - pad)
     d = x0.size
     pts = [x0]
@@ -316,10 +316,12 @@ def laplace(
     keep = np.array([n not in given for n in names])
     Hk = 0.5 * (H + H.T)[np.ix_(keep, keep)]
     w, V = np.linalg.eigh(Hk)
-    tiny = 1e-12 * max(float(np.max(np.abs(w))), 1e-300)
-    inv_w = np.where(w > tiny, 1.0 / np.where(w > tiny, w, 1.0), np.inf)
-    with np.errstate(invalid="ignore"):
-        var = np.where(np.abs(V) > 1e-8, V**2, 0.0) @ np.where(np.isinf(inv_w), 1e300, inv_w)
+    # variance along each eigendirection, capped at the widest prior range squared:
+    # flat or negatively curved directions (a ridge, or a MAP on a bound where the
+    # optimum is not stationary) count as unpinned, in proportion to each loading
+    cap = float(np.max(scale[keep])) ** 2 if keep.any() else 1.0
+    var_dir = np.where(w > 1.0 / cap, 1.0 / np.where(w > 1.0 / cap, w, 1.0), cap)
+    var = V**2 @ var_dir
     sd = np.zeros(d)
     sd[keep] = np.sqrt(var)
     rel = sd / scale

@@ -218,3 +218,28 @@ def test_laplace_coordinates_keep_the_distribution_and_their_jacobian_integrates
         p = stats.ks_2samp(xa @ v, xb @ v).pvalue
         assert p > 1e-3
     np.testing.assert_allclose(xb.mean(0), f.mu, atol=4 * 0.2 / np.sqrt(400))
+
+
+def test_report_notes_name_a_map_on_a_bound_over_parameterisation_and_a_spent_budget():
+    from heritage_bayes.report.verdict import run_notes
+
+    s = {
+        "irradiance_source": "measured",
+        "parameters": {},
+        "models": {
+            "thermal": {
+                "map_at_bound": [["Cint", "lower"]],
+                "practical_identifiability": {"unidentified": ["Gint", "phi_Ti"]},
+                "chain": {"stopped_by": "max_seconds"},
+            },
+            "hygric": {"map_at_bound": [], "practical_identifiability": None, "chain": {}},
+        },
+    }
+    notes = run_notes(s, [])
+    assert [n["title"] for n in notes] == [
+        "The thermal MAP lies on a prior bound",
+        "The thermal model is over-parameterised for these data",
+        "The thermal chain ran out of time",
+    ]
+    assert "Cint (lower)" in notes[0]["text"]
+    assert "Gint" in notes[1]["text"] and "phi_Ti" not in notes[1]["text"]

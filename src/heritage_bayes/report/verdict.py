@@ -232,6 +232,48 @@ def run_notes(
                 "the prior if the bound is not physical.",
             }
         )
+    for m, i in (s.get("models") or {}).items():
+        on_bound = [f"{n} ({side})" for n, side in i.get("map_at_bound") or []]
+        if on_bound:
+            out.append(
+                {
+                    "level": "amber",
+                    "title": f"The {m} MAP lies on a prior bound",
+                    "text": "The most probable parameter set presses against the prior "
+                    f"for {', '.join(on_bound)}: a finding about the prior (is the bound "
+                    "physical? widen it if not) or the model (a node or input the data do "
+                    "not support often shows up this way). The sampler started inside the "
+                    "bounds regardless.",
+                }
+            )
+        flagged = [
+            n
+            for n in (i.get("practical_identifiability") or {}).get("unidentified") or []
+            if not n.startswith(("sigma_", "phi_"))
+        ]
+        if flagged:
+            out.append(
+                {
+                    "level": "amber",
+                    "title": f"The {m} model is over-parameterised for these data",
+                    "text": "At the MAP the data leave "
+                    + ", ".join(flagged)
+                    + " almost as uncertain as their priors (Laplace standard deviation "
+                    "above 25 % of the prior range, with the overall scale held fixed): "
+                    "their posteriors are mostly prior and slow the chain. Choose: fix "
+                    "them, add an informative prior, or use the smaller model of the "
+                    "ladder.",
+                }
+            )
+        if (i.get("chain") or {}).get("stopped_by") == "max_seconds":
+            out.append(
+                {
+                    "level": "amber",
+                    "title": f"The {m} chain ran out of time",
+                    "text": "The wall-time budget sampler.max_time ended the chain before "
+                    "it converged: raise the budget, or continue it with --resume.",
+                }
+            )
     nulls = [
         m
         for m, i in (s.get("models") or {}).items()

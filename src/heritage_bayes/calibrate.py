@@ -29,7 +29,12 @@ from heritage_bayes.errors import InputError
 from heritage_bayes.inference.likelihoods import get_noise_model
 from heritage_bayes.inference.parameters import parameters_for
 from heritage_bayes.inference.posterior import LogPosterior
-from heritage_bayes.inference.results import atomic_write, atomic_write_text, dump_json
+from heritage_bayes.inference.results import (
+    atomic_write,
+    atomic_write_text,
+    dump_json,
+    ensure_free_space,
+)
 from heritage_bayes.models import SECTIONS, _catalog_options, build_model
 from heritage_bayes.rc.catalog import model as catalog_model
 from heritage_bayes.rc.model import RCModel
@@ -434,6 +439,7 @@ def _calibrate_into(
         "outputs_seconds": t_out,
     }
     summary["wall_seconds"] = time.perf_counter() - t_start
+    ensure_free_space(out / "posterior.nc", sum(int(idata[g].nbytes) for g in idata.groups()))
     atomic_write(out / "posterior.nc", lambda p: idata.to_netcdf(str(p), engine="h5netcdf"))
     dump_json(out / "summary.json", summary)
     say.say(

@@ -9,6 +9,7 @@ stage). Tested by calling :func:`main` directly, and as a subprocess
 from __future__ import annotations
 
 import argparse
+import errno
 import signal
 import sys
 import threading
@@ -320,15 +321,30 @@ def _main(argv: list[str] | None) -> int:
         return 2
     except KeyboardInterrupt as exc:
         return _interrupted(exc, args.command)
+    except OSError as exc:
+        if exc.errno not in _DISK_ERRORS:
+            return _internal_error()
+        where = f" ({exc.filename})" if exc.filename else ""
+        print(f"hbayes: error: {exc.strerror}{where}", file=sys.stderr)
+        _notes(exc)
+        return 2
     except Exception:  # an internal error: a bug, so show where it happened
-        import traceback
+        return _internal_error()
 
-        traceback.print_exc()
-        print(
-            "hbayes: internal error (exit code 1); please report it with the traceback above",
-            file=sys.stderr,
-        )
-        return 1
+
+#: A full or read-only disk: the user's to fix, not a bug.
+_DISK_ERRORS = (errno.ENOSPC, errno.EDQUOT, errno.EROFS)
+
+
+def _internal_error() -> int:
+    import traceback
+
+    traceback.print_exc()
+    print(
+        "hbayes: internal error (exit code 1); please report it with the traceback above",
+        file=sys.stderr,
+    )
+    return 1
 
 
 if __name__ == "__main__":  # pragma: no cover

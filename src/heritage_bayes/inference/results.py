@@ -45,7 +45,13 @@ import numpy as np
 
 from heritage_bayes.io._common import to_jsonable
 
-__all__ = ["atomic_write", "atomic_write_text", "coverage", "fit_metrics"]
+__all__ = [
+    "atomic_write",
+    "atomic_write_text",
+    "coverage",
+    "ensure_free_space",
+    "fit_metrics",
+]
 
 
 def atomic_write(path: str | Path, write: Callable[[Path], None]) -> Path:
@@ -69,6 +75,30 @@ def atomic_write(path: str | Path, write: Callable[[Path], None]) -> Path:
         tmp_path.unlink(missing_ok=True)
         raise
     return path
+
+
+def ensure_free_space(path: str | Path, nbytes: int, margin: int = 4 << 20) -> None:
+    """Raise :class:`~heritage_bayes.errors.InputError` unless the file system of
+    ``path`` has ``nbytes`` + ``margin`` bytes free.
+
+    Checked before HDF5/NetCDF writes: a full disk in the middle of one leaves the HDF5
+    library in a state that can crash the interpreter at exit.
+    """
+    from heritage_bayes.errors import InputError
+
+    folder = Path(path).parent
+    try:
+        st = os.statvfs(folder)
+    except (OSError, AttributeError):  # no statvfs (not POSIX): let the write try
+        return
+    free = st.f_bavail * st.f_frsize
+    need = int(nbytes) + margin
+    if free < need:
+        raise InputError(
+            f"{folder}: not enough free disk space to write {Path(path).name} "
+            f"({free / 2**20:.1f} MiB free, about {need / 2**20:.1f} MiB needed); free some "
+            "space or choose another --out"
+        )
 
 
 def atomic_write_text(path: str | Path, text: str) -> Path:

@@ -242,7 +242,9 @@ class _Checkpoint:
         self.tag = tag
 
     def create(self, nwalkers: int, ndim: int) -> None:
-        from heritage_bayes.inference.results import atomic_write
+        from heritage_bayes.inference.results import atomic_write, ensure_free_space
+
+        ensure_free_space(self.path, 2 * 64 * nwalkers * (ndim + 1) * 8)
 
         def write(tmp: Path) -> None:
             with h5py.File(tmp, "w") as f:
@@ -263,6 +265,10 @@ class _Checkpoint:
 
     def append(self, chain, log_prob, accepted, random_state, tau_history) -> None:
         """Write ``chain``/``log_prob`` rows after the last commit, then commit them."""
+        from heritage_bayes.inference.results import ensure_free_space
+
+        chunk = 64 * int(np.prod(chain.shape[1:])) * 8  # one HDF5 chunk [bytes]
+        ensure_free_space(self.path, chain.nbytes + log_prob.nbytes + 2 * chunk)
         with _DeferSignals(), h5py.File(self.path, "a") as f:
             n0 = int(json.loads(f.attrs["commit"])["iteration"]) if "commit" in f.attrs else 0
             n = chain.shape[0]

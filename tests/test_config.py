@@ -44,7 +44,7 @@ def _csv_data(**extra) -> dict:
 # ---------------------------------------------------------------------------------------
 
 
-@pytest.mark.parametrize("name", ["demo", "orholm", "trh1_attic"])
+@pytest.mark.parametrize("name", ["demo", "orholm", "annisse", "trh1_attic"])
 def test_example_configs_load(name):
     cfg = load_config(CONFIGS / f"{name}.yaml")
     assert cfg.name == name

@@ -190,3 +190,18 @@ def test_schedule_and_conservation_heating():
     # in the hours of use the service set-point holds (ideal heating)
     k = np.flatnonzero(use[:-1])
     assert y[k + 1].min() >= 18.0 - 1e-9
+
+
+@pytest.mark.parametrize("name", ["orholm", "annisse"])
+def test_case_study_configs_build_controlled_models(name):
+    from pathlib import Path
+
+    from heritage_bayes.calibrate import check_models
+    from heritage_bayes.config import load_config
+    from heritage_bayes.models import build_model
+
+    cfg = load_config(Path(__file__).resolve().parents[1] / "configs" / f"{name}.yaml")
+    check_models(cfg)  # models and priors build without data
+    th = build_model(cfg, "thermal")
+    assert "Tset" in th.parameter_names and "Qs" in th.parameter_names
+    assert th.with_control(False).control.enabled == frozenset()

@@ -33,6 +33,16 @@ TINY = {
 }
 
 
+PROJECTION = {  # a uniform warming of 2 K (morphing shift), few draws
+    "draws": 20,
+    "seed": 2,
+    "morphing": [
+        {"scenario": "warm", "horizon": 2050, "method": "shift", "deltas": {"Te": [2.0] * 12}}
+    ],
+    "thresholds": [{"indicator": "twpi", "below": 1000}],
+}
+
+
 def _write(path, obj):
     path.write_text(yaml.safe_dump(obj, sort_keys=False), encoding="utf-8")
     return path
@@ -46,7 +56,7 @@ def portfolio_dir(tmp_path_factory):
         "name": "three",
         "defaults": {"report": True},
         "rooms": [
-            {"name": "a", "config": "room.yaml"},
+            {"name": "a", "config": "room.yaml", "projection": "projection.yaml"},
             {"name": "b", "config": "room.yaml", "overrides": {"data": {"demo": {"seed": 11}}}},
             # valid config, but its periods lie outside the demo's weather year: fails
             # while it runs (data), and must not stop the others
@@ -62,6 +72,7 @@ def portfolio_dir(tmp_path_factory):
             },
         ],
     }
+    _write(d / "projection.yaml", PROJECTION)
     return d, _write(d / "portfolio.yaml", pf)
 
 
@@ -92,12 +103,20 @@ def test_three_rooms_two_workers_one_bad(finished):
         assert by.loc[room, "converged"] == summary["converged"]
         assert (out / room / "report.html").is_file()
         assert by.loc[room, "twpi_years"] > 0  # risk of the measured climate
+    # room a was projected: the warmer case shortens its chemical lifetime (TWPI)
+    assert by.loc["a", "proj.case"] == "warm 2050"
+    assert by.loc["a", "proj.twpi.change"] < 0 and by.loc["a", "proj.twpi.p_worse"] > 0.5
+    assert by.loc["a", "proj.statement"] == "P(twpi < 1000)"
+    assert 0 <= by.loc["a", "proj.probability"] <= 1
+    assert (out / "a" / "projection" / "projection.json").is_file()
+    assert pd.isna(by.loc["b", "proj.case"])
     # the two good rooms differ (different logger seeds)
     assert by.loc["a", "thermal.Ti.FIT_cal"] != by.loc["b", "thermal.Ti.FIT_cal"]
     meta = json.loads((out / "portfolio.json").read_text())
     assert meta["rooms_total"] == 3 and len(meta["rows"]) == 3
     page = (out / "index.html").read_text()
     assert "href='a/report.html'" in page and "href='b/report.html'" in page
+    assert "href='a/projection/projection.html'" in page
     assert "not covered by every input" in page
     assert "script-src 'sha256-" in page  # the sort script is the only one allowed
     assert not list(out.rglob("*.tmp"))

@@ -55,6 +55,14 @@ _COLUMNS = [
     ("emc_range_pct", "EMC range [% MC]", "{:.1f}"),
     ("mould_index_max", "mould index max", "{:.2f}"),
     ("en15757_outside_pct", "outside EN 15757 band [% h]", "{:.1f}"),
+    ("proj.case", "projection: most severe case", "{}"),
+    ("proj.twpi.change", "Δ TWPI [years]", "{:+.1f}"),
+    ("proj.twpi.p_worse", "P(TWPI worse)", "{:.2f}"),
+    ("proj.vtt_mould_index_max.change", "Δ mould index max", "{:+.2f}"),
+    ("proj.vtt_mould_index_max.p_worse", "P(mould worse)", "{:.2f}"),
+    ("proj.en15757_outside.change", "Δ outside EN 15757 [% h]", "{:+.1f}"),
+    ("proj.probability", "P(statement)", "{:.2f}"),
+    ("proj.statement", "statement", "{}"),
     ("message", "message", "{}"),
 ]
 
@@ -99,6 +107,9 @@ def render_index(pf: Portfolio, df: pd.DataFrame, out: Path) -> str:
             if key == "room" and r.get("report"):
                 rel = os.path.relpath(str(r["report"]), start=str(out))
                 text = f"<a href='{html.escape(Path(rel).as_posix())}'>{text}</a>"
+            if key == "proj.case" and isinstance(r.get("projection"), str) and r["projection"]:
+                rel = os.path.relpath(str(r["projection"]), start=str(out))
+                text = f"<a href='{html.escape(Path(rel).as_posix())}'>{text}</a>"
             if key == "message":
                 text = f"<span class='pre-wrap'>{html.escape(str(r.get(key) or '')[:600])}</span>"
             cls = " class='num'" if fmt != "{}" else ""
@@ -117,7 +128,11 @@ def render_index(pf: Portfolio, df: pd.DataFrame, out: Path) -> str:
         "then the shortest time-weighted preservation index (TWPI). The risk columns are "
         "computed from each room's <em>measured</em> indoor climate over its data period; "
         "the mould index, ASHRAE classes and the EN 15757 band need a year of data and show "
-        "“–” for shorter logs. Click a column header to sort by it.</p>"
+        "“–” for shorter logs. Rooms with a projection file add the projected change of "
+        "their most severe case (the warmest scenario and horizon) relative to their "
+        "baseline: the median change over the paired draws (noise included) and the "
+        "probability that the indicator gets worse; the case links to the projection page. "
+        "Click a column header to sort by it.</p>"
     )
     table = (
         "<div class='scroll'><table class='sortable'><thead><tr>"

@@ -75,17 +75,54 @@ def _peak_rss_mb() -> float:
         return float("nan")
 
 
+#: Indicators whose projected change the portfolio table carries (median and P(worse)).
+PROJECTED = ("twpi", "vtt_mould_index_max", "en15757_outside", "emc_range")
+
+
 def _project_room(run_dir: Path, projection: Path, resume: bool) -> dict:
-    """Run the room's projection (when the projection layer is installed) and keep a few
-    headline numbers for the table."""
-    try:
-        from heritage_bayes import projection as proj_mod
-    except ImportError:  # pragma: no cover - the projection layer ships with the package
-        raise InputError(
-            f"{projection}: this installation has no projection layer (heritage_bayes."
-            "projection); remove 'projection' from the portfolio entry"
-        ) from None
-    return proj_mod.portfolio_columns(run_dir, projection, resume=resume)
+    """Run the room's projection (``hbayes project``) into ``<run>/projection`` and keep
+    its headline numbers for the table.
+
+    The columns describe the *most severe* case of the projection: the scenario and
+    horizon with the warmest mean outdoor temperature. For each indicator of
+    :data:`PROJECTED`: the median change relative to the baseline (paired draws, noise
+    included) and the probability that it changes for the worse; the first probability
+    statement of the projection file, for that case. With ``resume``, an existing
+    ``projection.json`` of the same run is reused.
+    """
+    from heritage_bayes.projection import project
+
+    dest = run_dir / "projection"
+    summary_path = dest / "projection.json"
+    summary = None
+    if resume and summary_path.is_file():
+        try:
+            summary = json.loads(summary_path.read_text(encoding="utf-8"))
+        except ValueError:
+            summary = None
+    if summary is None:
+        summary = project(run_dir, projection, out=dest).summary
+    cases = [c for c in summary.get("cases", []) if c.get("horizon") is not None]
+    row: dict[str, Any] = {
+        "projection": str(dest / "projection.html") if (dest / "projection.html").is_file() else ""
+    }
+    if not cases:
+        return row
+    worst = max(cases, key=lambda c: c.get("mean_Te", float("-inf")))
+    label = worst["label"]
+    row["proj.case"] = label
+    for ind in PROJECTED:
+        entry = summary.get("indicators", {}).get(ind)
+        change = (entry or {}).get("change", {}).get(label)
+        if change:
+            row[f"proj.{ind}.change"] = change.get("q50", change.get("median", float("nan")))
+            row[f"proj.{ind}.p_worse"] = change.get("p_worse", float("nan"))
+    probs = summary.get("probabilities") or []
+    if probs:
+        p0 = probs[0]
+        row["proj.statement"] = f"P({p0['indicator']} {p0['op']} {p0['value']:g})"
+        row["proj.probability"] = p0["cases"].get(label, {}).get("p", float("nan"))
+    return row
 
 
 def _get(d: Mapping, *keys, default=float("nan")):

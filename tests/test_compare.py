@@ -97,7 +97,7 @@ def test_az_loo_and_compare_on_run_directories_are_finite(compared):
     table = az.compare(blocked)
     assert np.all(np.isfinite(table[["elpd_loo", "se", "dse"]].to_numpy(float)))
     # the blocked terms are sums of the hourly ones: the full-data lpd is unchanged
-    h = runs["thermal_2c"].log_likelihood["thermal.Ti"].values.sum(axis=-1)
+    h = runs["thermal_2c"].log_likelihood["thermal.Ti"].values.astype(float).sum(axis=-1)
     b = blocked["thermal_2c"].log_likelihood["thermal.Ti"].values.sum(axis=-1)
     np.testing.assert_allclose(h, b, rtol=1e-10)
 
@@ -106,7 +106,7 @@ def test_validation_elpd_is_the_log_mean_density(compared):
     out, _ = compared
     d = load_inference([out / "thermal_1c"])["thermal_1c"]
     ev = elpd_validation(d)
-    lv = d["log_likelihood_validation"]["thermal.Ti"].values.reshape(-1, 120)
+    lv = d["log_likelihood_validation"]["thermal.Ti"].values.astype(float).reshape(-1, 120)
     expected = np.log(np.mean(np.exp(lv), axis=0)).sum()
     assert ev["n"] == 120
     np.testing.assert_allclose(ev["elpd"], expected, rtol=1e-9)
@@ -126,6 +126,8 @@ def test_comparison_json(compared):
         i = info["identifiability"]
         assert i["structural_rank"] <= i["structural_n_params"]
         assert 0 <= i["practical_rank"] <= i["n_free_physical"]
+        lo, hi = i["practical_rank_band"]
+        assert lo <= i["practical_rank"] <= hi
         assert i["widest_interval"]["decades"] > 0
         assert "tau_1_h" in i["derived"]
         for e in list(i["parameters"].values()) + list(i["derived"].values()):

@@ -146,7 +146,7 @@ def _block_codes(times: np.ndarray, hours: float) -> np.ndarray:
 def _block_sum(da: xr.DataArray, hours: float) -> xr.DataArray:
     dim = da.dims[-1]
     codes = _block_codes(da[dim].values, hours)
-    vals = da.values
+    vals = np.asarray(da.values, dtype=float)
     uniq, inv = np.unique(codes, return_inverse=True)
     out = np.zeros((*vals.shape[:-1], uniq.size))
     for i in range(uniq.size):  # few hundred blocks: a loop over blocks is fine
@@ -175,7 +175,7 @@ def blocked_loo_data(idata, var_name: str | None = None, block_hours: float = 24
 
 def _logmeanexp(a: np.ndarray) -> np.ndarray:
     """log mean exp over the first two axes (chain, draw)."""
-    flat = a.reshape(-1, *a.shape[2:])
+    flat = np.asarray(a, dtype=float).reshape(-1, *a.shape[2:])
     m = np.max(flat, axis=0)
     return m + np.log(np.mean(np.exp(flat - m), axis=0))
 
@@ -311,6 +311,9 @@ def _identifiability(run, section: str, *, seed: int, identified_factor: float, 
         derived[k] = entry
     post = np.column_stack(post_cols) if post_cols else np.zeros((1, 0))
     prank, eig = _practical_rank(post, np.asarray(prior_var), ratio)
+    ev = np.asarray(eig)
+    # how the practical rank depends on its threshold: ratio / 10 to ratio x 10
+    prank_band = [int(np.sum(ev < ratio / 10)), int(np.sum(ev < ratio * 10))]
     ident = summ["models"][section].get("identifiability") or {}
     widest = None
     for name in free:
@@ -333,6 +336,7 @@ def _identifiability(run, section: str, *, seed: int, identified_factor: float, 
         "structural_n_params": ident.get("n_params"),
         "practical_rank": prank,
         "practical_eigenvalues": eig,
+        "practical_rank_band": prank_band,
         "widest_interval": widest,
         "time_constants_identified": all(v["identified"] for v in taus.values()),
         "time_constants_not_identified": sorted(k for k, v in taus.items() if not v["identified"]),
@@ -540,11 +544,11 @@ def _recommend(models: dict, score: str) -> dict:
                 f"({idf['n_free_physical']} against {ident['n_free_physical']})"
             )
     text = f"{choice}: " + ", ".join(parts) + "."
+    if others:
+        text += " " + "; ".join(others) + "."
     unconverged = [m for m, info in models.items() if info.get("converged") is False]
     if unconverged:
         text += f" Not converged (R-hat/ESS/τ criteria), so provisional: {', '.join(unconverged)}."
-    if others:
-        text += " " + "; ".join(others) + "."
     return {
         "model": choice,
         "reason": text,
@@ -676,39 +680,50 @@ def run_compare(
 def fig_tradeoff(result: dict):
     """The paper's trade-off: accuracy against identifiability, one point per model.
 
-    x: posterior contraction of the free physical parameters (median, whiskers from the
-    least to the most contracted); y: the accuracy score relative to the best model with
-    ±2 SE whiskers. Labels give the practical and structural rank.
+    x: the share of well-identified directions, practical rank / number of free physical
+    parameters (whiskers: the same with the variance-ratio threshold ten times stricter
+    and ten times looser); y: the accuracy score relative to the best model, ±2 SE. The
+    legend gives each model's practical and structural rank.
     """
-    from heritage_bayes.report.figures.style import C_MODEL, _figure, tex_safe
+    from heritage_bayes.report.figures.style import C_ALT, C_MODEL, _figure, tex_safe
 
     fig = _figure(7.5, 4.2)
     ax = fig.subplots()
     score = result["accuracy_score"]
     what = "validation ELPD" if score == "elpd_validation" else "blocked LOO ELPD"
     rec = result["recommendation"]["model"]
-    for m, info in result["models"].items():
+    markers = "osD^v<>p"
+    others = ["0.35", C_ALT, "#2e8b57", "#8e44ad", "#b8860b"]
+    for i, (m, info) in enumerate(result["models"].items()):
         idf = info["identifiability"]
+        n = max(idf["n_free_physical"], 1)
         a = info["accuracy"][score]
-        x = idf["contraction_median"]
-        if x is None:
-            continue
+        x = idf["practical_rank"] / n
+        lo, hi = (r / n for r in idf.get("practical_rank_band", [idf["practical_rank"]] * 2))
         y, dse = a.get("diff_to_best", 0.0), a.get("dse_to_best") or 0.0
-        xerr = [[x - idf["contraction_min"]], [idf["contraction_max"] - x]]
-        colour = C_MODEL if m == rec else "0.45"
-        ax.errorbar(x, y, xerr=xerr, yerr=2 * dse, fmt="o", color=colour, capsize=3, ms=7)
-        ax.annotate(
-            f"{tex_safe(m)}\nrank {idf['practical_rank']} practical / "
-            f"{idf['structural_rank']} structural of {idf['n_free_physical']}",
-            (x, y),
-            textcoords="offset points",
-            xytext=(6, 6),
-            fontsize=8,
+        colour = C_MODEL if m == rec else others[i % len(others)]
+        label = (
+            f"{tex_safe(m)}{' (recommended)' if m == rec else ''}: rank "
+            f"{idf['practical_rank']} practical, {idf['structural_rank']} structural, "
+            f"{idf['n_free_physical']} parameters"
+        )
+        ax.errorbar(
+            x,
+            y,
+            xerr=[[x - lo], [hi - x]],
+            yerr=2 * dse,
+            fmt=markers[i % len(markers)],
+            color=colour,
+            capsize=4,
+            ms=9 if m == rec else 7,
+            label=label,
         )
     ax.axhline(0.0, color="0.7", lw=0.8)
-    ax.set_xlabel("posterior contraction of the physical parameters [-] (median, min–max)")
+    ax.set_xlim(-0.05, 1.05)
+    ax.set_xlabel("well-identified directions: practical rank / parameters [-]")
     ax.set_ylabel(f"{what} − best [-] (±2 SE)")
-    ax.set_title(f"accuracy vs identifiability (recommended: {tex_safe(rec)})")
+    ax.set_title("accuracy vs identifiability (full posteriors)")
+    ax.legend(loc="best", fontsize=8)
     return fig
 
 
@@ -782,8 +797,9 @@ def identifiability_rows(result: dict) -> tuple[list[str], list[list[str]]]:
         "practical rank",
         "contraction (median)",
         "widest 90 % interval",
+        "parameters identified",
         "time constants identified",
-        "not identified",
+        "derived not identified",
     ]
     rows = []
     for m, info in result["models"].items():
@@ -797,9 +813,13 @@ def identifiability_rows(result: dict) -> tuple[list[str], list[list[str]]]:
                 str(i["practical_rank"]),
                 _f(i["contraction_median"], "{:.2f}"),
                 f"{w['parameter']}: {w['decades']:.1f} decades" if w else "–",
+                f"{i['n_free_physical'] - len(i['parameters_not_identified'])} of "
+                f"{i['n_free_physical']}",
                 _f(i["time_constants_identified"]),
                 ", ".join(
-                    i["time_constants_not_identified"] + [p for p in i["parameters_not_identified"]]
+                    k + (" (< time step)" if k in i["time_constants_below_step"] else "")
+                    for k, e in i["derived"].items()
+                    if not e["identified"]
                 )
                 or "–",
             ]
@@ -853,8 +873,9 @@ def render_comparison(result: dict) -> str:
         f"practical rank: {html.escape(s['method']['practical_rank'])}.</p>"
         f"<figure id='fig-tradeoff'><img src='{to_png_uri(fig)}' alt='accuracy against "
         "identifiability, one point per model'><figcaption>Accuracy (relative to the best "
-        "model, ±2 SE) against the posterior contraction of the physical parameters "
-        "(median, least to most contracted); the recommended model in blue.</figcaption>"
+        "model, ±2 SE) against the share of parameter directions the data identify "
+        "(practical rank over the number of physical parameters; whiskers: threshold "
+        "ten times stricter and looser).</figcaption>"
         "</figure>"
     )
     ha, ra = accuracy_rows(result)

@@ -4,9 +4,9 @@
 The streamed engine (:func:`heritage_bayes.projection.engine.simulate_case`: chunks of
 draws, each chunk simulated over the whole series, noise added, RH capped, reduced at
 once to indicators and monthly means) against a naive loop in the same run: one draw
-at a time through the public one-series functions (``rc.simulate``, the noise model's
-``sample`` for one draw, ``risk.assess`` twice: predictive and noise-free), timed on a
-few draws and scaled. Both produce the same per-draw indicators (checked).
+at a time (``model.forward`` for one parameter set, the noise model's ``sample`` for
+one draw, ``risk.assess`` twice: predictive and noise-free), timed on a few draws and
+scaled. Both produce the same per-draw indicators (checked).
 
 The weather is the demo's TMY3 year (Greensboro, NC) repeated; the scenarios add 1–4 K
 to Te and Tf at constant outdoor RH. Target of the issue: 1000 draws in ≤ 60 s and
@@ -71,14 +71,14 @@ def _draws(models, K: int, seed: int = 0) -> Draws:
 
 
 def _naive(run, draws: Draws, inputs: pd.DataFrame, k: int, seed: int):
-    """One draw at a time through the public one-series functions."""
+    """One draw at a time: the model, one noise draw, ``risk.assess`` twice."""
     rows = []
     rng = np.random.default_rng([seed, k])
     out = {}
     for s, m in run.models.items():
         U = inputs[list(m.input_names)].to_numpy(float)
-        params = dict(zip(m.parameter_names, draws.model[s][k], strict=True))
-        y = hb.simulate(m, params, U, dt=3600.0)[:, 0]
+        u0 = U[:720].mean(axis=0)  # the same initial state as the engine
+        y = m.forward(draws.model[s][k : k + 1], U, 3600.0, u_init=u0)[0][0, :, 0]
         e = draws.noise_models[s].sample(rng, draws.noise[s][k : k + 1], len(U), 1)[0, :, 0]
         out[s] = (y, e)
     Ts, Ps = out["thermal"][0], out["hygric"][0]

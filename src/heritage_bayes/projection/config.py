@@ -39,11 +39,10 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, Literal
 
-import yaml
 from pydantic import Field, ValidationError, field_validator, model_validator
 
 from heritage_bayes.climate.morph import KNMI14_SCENARIOS
-from heritage_bayes.config import GroundTemperature, Source, _format_error, _Strict
+from heritage_bayes.config import GroundTemperature, Source, _format_error, _Strict, read_yaml
 from heritage_bayes.errors import ConfigError
 
 __all__ = ["ProjectionConfig", "load_projection_config", "parse_projection_config"]
@@ -188,16 +187,10 @@ def parse_projection_config(
 
 
 def load_projection_config(path) -> ProjectionConfig:
-    """Read and validate a projection YAML file."""
+    """Read (strictly, :func:`heritage_bayes.config.read_yaml`) and validate a projection
+    YAML file."""
     p = Path(path)
-    if not p.is_file():
-        raise ConfigError(f"{p}: projection file not found")
-    try:
-        raw = yaml.safe_load(p.read_text(encoding="utf-8"))
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
-        raise ConfigError(f"{p}: not valid YAML{where}: {getattr(exc, 'problem', exc)}") from None
+    raw, _ = read_yaml(p, what="projection file")
     cfg = parse_projection_config(raw, source=str(p), base_dir=str(p.parent.resolve()))
     if cfg.name is None:
         cfg.name = p.stem

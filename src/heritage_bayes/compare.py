@@ -47,7 +47,8 @@ computed from daily block sums for the same reason (hourly terms are correlated)
 
 **Recommendation** (computed from the numbers): the models whose accuracy score
 (validation ELPD, or blocked LOO without a validation period) is within 2 standard
-errors of the best are equivalent in accuracy; among them, the simplest one whose time
+errors of the best, or within 4 nats (a negligible difference [4]_), are equivalent in
+accuracy; among them, the simplest one whose time
 constants are all identified is recommended; if none is, the best-identified one is,
 with a warning.
 
@@ -62,6 +63,8 @@ References
 .. [3] R. Kramer, J. van Schijndel, H. Schellen, "Inverse modeling of simplified
    hygrothermal building models to predict and characterize indoor climates", Building
    and Environment 68 (2013) 87–99, doi:10.1016/j.buildenv.2013.06.019.
+.. [4] T. Sivula, M. Magnusson, A. Vehtari, "Uncertainty in Bayesian leave-one-out
+   cross-validation based model comparison", arXiv:2008.10296 (2020).
 """
 
 from __future__ import annotations
@@ -86,6 +89,10 @@ __all__ = [
     "run_compare",
     "write_comparison",
 ]
+
+#: ELPD differences smaller than this are negligible whatever their SE (two nearly
+#: identical models have a tiny SE of their difference) [nats]; Sivula et al. (2020).
+NEGLIGIBLE_ELPD = 4.0
 
 #: Candidates when ``--models`` is not given: the model orders of each section.
 DEFAULT_MODELS = {
@@ -494,7 +501,7 @@ def _recommend(models: dict, score: str) -> dict:
     for m, info in models.items():
         a = info["accuracy"][score]
         diff, dse = a.get("diff_to_best", 0.0), a.get("dse_to_best", 0.0)
-        equivalent = diff >= -2.0 * (dse or 0.0)
+        equivalent = diff >= -max(2.0 * (dse or 0.0), NEGLIGIBLE_ELPD)
         rows[m] = (diff, dse or 0.0, equivalent, info["identifiability"])
     best = max(rows, key=lambda m: rows[m][0])
     equiv = [m for m in rows if rows[m][2]]
@@ -515,7 +522,10 @@ def _recommend(models: dict, score: str) -> dict:
     if choice == best:
         parts.append(f"the best {what} of the candidates")
     else:
-        parts.append(f"{what} within 2 SE of {best} (difference {diff:.1f} ± {dse:.1f})")
+        parts.append(
+            f"{what} within 2 SE or {NEGLIGIBLE_ELPD:g} of {best} "
+            f"(difference {diff:.1f} ± {dse:.1f})"
+        )
     if ident["time_constants_identified"]:
         fast = ident["time_constants_below_step"]
         parts.append(

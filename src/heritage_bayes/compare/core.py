@@ -1,0 +1,240 @@
+"""Side by side: the comparison of candidate runs and the recommendation.
+
+Part of :mod:`heritage_bayes.compare` (see its documentation).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Mapping
+from pathlib import Path
+
+import numpy as np
+
+from heritage_bayes._arviz import az
+from heritage_bayes.compare.identifiability import _identifiability
+from heritage_bayes.compare.scores import _block_se, blocked_loo_data, elpd_validation
+from heritage_bayes.errors import InputError
+
+#: ELPD differences smaller than this are negligible whatever their SE (two nearly
+#: identical models have a tiny SE of their difference) [nats]; Sivula et al. (2020).
+NEGLIGIBLE_ELPD = 4.0
+
+#: Candidates when ``--models`` is not given: the model orders of each section.
+DEFAULT_MODELS = {
+    "thermal": ("thermal_1c", "thermal_2c", "thermal_4a"),
+    "hygric": ("hygric_1c", "hygric_2c", "hygric_2c_fixed"),
+}
+
+
+def compare_runs(
+    run_dirs: Mapping[str, str | Path],
+    section: str,
+    *,
+    block_hours: float = 24.0,
+    identified_factor: float = 2.0,
+    practical_ratio: float = 0.01,
+    seed: int = 0,
+) -> dict:
+    """Compare calibrated runs of one section on accuracy and identifiability.
+
+    Parameters
+    ----------
+    run_dirs : mapping label -> run directory
+        Runs of the same data, each with a model of ``section``.
+    section : {"thermal", "hygric"}
+    block_hours : float
+        Block length of the blocked LOO and of the standard errors [h].
+    identified_factor : float
+        A quantity is identified when its 90 % interval spans at most this factor.
+    practical_ratio : float
+        Posterior/prior variance ratio below which a direction counts in the practical
+        rank.
+    seed : int
+        Seed of the prior draws of the derived quantities.
+
+    Returns
+    -------
+    dict
+        ``models`` (per label: accuracy, identifiability, convergence), ``loo_compare``
+        (``az.compare`` on the blocked LOO), ``recommendation`` and the settings.
+    """
+    from heritage_bayes.run import load_run
+
+    runs = {k: load_run(p) for k, p in run_dirs.items()}
+    out_models: dict[str, dict] = {}
+    val_pw: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+    loo_data = {}
+    for label, run in runs.items():
+        if section not in run.models:
+            raise InputError(f"{run.path}: the run has no {section!r} model")
+        model = run.models[section]
+        var = f"{section}.{model.output_names[0]}"
+        acc: dict = {}
+        met = (run.summary.get("metrics") or {}).get(section, {}).get(model.output_names[0], {})
+        for period in ("calibration", "validation"):
+            if period in met:
+                acc[period] = {k: met[period].get(k) for k in ("FIT", "MSE", "MAE", "coverage90")}
+        ev = elpd_validation(run.idata, var, block_hours)
+        if ev is not None:
+            acc["elpd_validation"] = {k: ev[k] for k in ("elpd", "se", "n")}
+            val_pw[label] = (ev["pointwise"], ev["times"])
+        loo_data[label] = blocked_loo_data(run.idata, var, block_hours)
+        with warnings.catch_warnings():  # high Pareto k: recorded below, not printed
+            warnings.simplefilter("ignore", UserWarning)
+            loo = az.loo(loo_data[label], var_name=var)
+        k = np.asarray(loo.pareto_k)
+        acc["loo_blocked"] = {
+            "elpd": float(loo.elpd_loo),
+            "se": float(loo.se),
+            "p_loo": float(loo.p_loo),
+            "n_blocks": int(k.size),
+            "max_pareto_k": float(np.max(k)),
+            "share_k_above_0.7": float(np.mean(k > 0.7)),
+        }
+        ident = _identifiability(
+            run, section, seed=seed, identified_factor=identified_factor, ratio=practical_ratio
+        )
+        out_models[label] = {
+            "model": model.name,
+            "run_dir": str(run.path),
+            "noise": run.summary["models"][section].get("noise"),
+            "periods": run.summary.get("periods"),
+            "converged": bool(run.summary.get("converged")),
+            "max_rhat": run.summary.get("max_rhat"),
+            "min_ess_bulk": run.summary.get("min_ess_bulk"),
+            "n_draws": int(run.idata.posterior.sizes["chain"] * run.idata.posterior.sizes["draw"]),
+            "accuracy": acc,
+            "identifiability": ident,
+        }
+    # differences in validation ELPD against the best, SE from daily block sums
+    if len(val_pw) == len(runs) and val_pw:
+        best = max(val_pw, key=lambda m: out_models[m]["accuracy"]["elpd_validation"]["elpd"])
+        pb, tb = val_pw[best]
+        for label, (pw, t) in val_pw.items():
+            common, ia, ib = np.intersect1d(t, tb, return_indices=True)
+            d = pw[ia] - pb[ib]
+            ev = out_models[label]["accuracy"]["elpd_validation"]
+            ev["diff_to_best"] = float(d.sum())
+            ev["dse_to_best"] = 0.0 if label == best else _block_se(d, common, block_hours)
+        score = "elpd_validation"
+    else:
+        score = "loo_blocked"
+    with warnings.catch_warnings():  # Pareto k (recorded) and arviz's pandas notices
+        warnings.simplefilter("ignore")
+        cmp = az.compare(loo_data, ic="loo")
+    loo_table = {
+        str(m): {
+            c: _num(cmp.loc[m, c])
+            for c in ("rank", "elpd_loo", "p_loo", "elpd_diff", "se", "dse", "weight")
+        }
+        for m in cmp.index
+    }
+    for m, row in loo_table.items():
+        out_models[m]["accuracy"]["loo_blocked"]["diff_to_best"] = -row["elpd_diff"]
+        out_models[m]["accuracy"]["loo_blocked"]["dse_to_best"] = row["dse"]
+    rec = _recommend(out_models, score)
+    return {
+        "section": section,
+        "models": out_models,
+        "loo_compare": loo_table,
+        "accuracy_score": score,
+        "recommendation": rec,
+        "settings": {
+            "block_hours": block_hours,
+            "identified_factor": identified_factor,
+            "practical_ratio": practical_ratio,
+            "seed": seed,
+            "method": {
+                "calibration": f"blocked PSIS-LOO, blocks of {block_hours:g} h (az.loo over "
+                "block sums of the pointwise log-likelihood)",
+                "validation": "sum over validation hours of the log posterior-mean one-step "
+                "predictive density (elpd_val); SE from block sums",
+                "identified": f"90 % interval within a factor {identified_factor:g}",
+                "practical_rank": f"directions with posterior/prior variance < {practical_ratio:g}",
+            },
+        },
+    }
+
+
+def _num(x):
+    try:
+        x = float(x)
+    except (TypeError, ValueError):
+        return None
+    return x if math.isfinite(x) else None
+
+
+def _recommend(models: dict, score: str) -> dict:
+    """The simplest accuracy-equivalent model whose time constants are identified."""
+    what = "validation ELPD" if score == "elpd_validation" else "blocked LOO ELPD"
+    rows = {}
+    for m, info in models.items():
+        a = info["accuracy"][score]
+        diff, dse = a.get("diff_to_best", 0.0), a.get("dse_to_best", 0.0)
+        equivalent = diff >= -max(2.0 * (dse or 0.0), NEGLIGIBLE_ELPD)
+        rows[m] = (diff, dse or 0.0, equivalent, info["identifiability"])
+    best = max(rows, key=lambda m: rows[m][0])
+    equiv = [m for m in rows if rows[m][2]]
+    ok = [m for m in equiv if rows[m][3]["time_constants_identified"]]
+    by_size = sorted(ok or equiv, key=lambda m: (rows[m][3]["n_free_physical"], -rows[m][0]))
+    if ok:
+        choice = by_size[0]
+    else:
+        choice = max(
+            equiv,
+            key=lambda m: (
+                -len(rows[m][3]["time_constants_not_identified"]),
+                rows[m][3]["practical_rank"],
+            ),
+        )
+    diff, dse, _, ident = rows[choice]
+    parts = []
+    if choice == best:
+        parts.append(f"the best {what} of the candidates")
+    else:
+        parts.append(
+            f"{what} within 2 SE or {NEGLIGIBLE_ELPD:g} of {best} "
+            f"(difference {diff:.1f} ± {dse:.1f})"
+        )
+    if ident["time_constants_identified"]:
+        fast = ident["time_constants_below_step"]
+        parts.append(
+            "all its time constants identified"
+            + (f" ({', '.join(fast)} shorter than the time step)" if fast else "")
+        )
+    else:
+        parts.append(
+            "but not all its time constants are identified ("
+            + ", ".join(ident["time_constants_not_identified"])
+            + "; no candidate of equal accuracy has all of them)"
+        )
+    others = []
+    for m, (d, se, eq, idf) in rows.items():
+        if m == choice:
+            continue
+        if not eq:
+            others.append(f"{m} is less accurate ({what} {d:.1f} ± {se:.1f} below the best)")
+            continue
+        bad = idf["time_constants_not_identified"]
+        if bad:
+            others.append(f"{m} is as accurate but not identified: {', '.join(bad)}")
+        else:
+            others.append(
+                f"{m} is as accurate and identified but has more parameters "
+                f"({idf['n_free_physical']} against {ident['n_free_physical']})"
+            )
+    text = f"{choice}: " + ", ".join(parts) + "."
+    if others:
+        text += " " + "; ".join(others) + "."
+    unconverged = [m for m, info in models.items() if info.get("converged") is False]
+    if unconverged:
+        text += f" Not converged (R-hat/ESS/τ criteria), so provisional: {', '.join(unconverged)}."
+    return {
+        "model": choice,
+        "reason": text,
+        "best_accuracy": best,
+        "equivalent": equiv,
+        "not_converged": unconverged,
+    }

@@ -1,0 +1,130 @@
+"""Calibrating the candidates of a config, each in its own run directory.
+
+Part of :mod:`heritage_bayes.compare` (see its documentation).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+
+from heritage_bayes.compare.core import DEFAULT_MODELS, compare_runs
+from heritage_bayes.compare.page import write_comparison
+from heritage_bayes.errors import ConfigError
+
+
+def _section_of(cfg, models: Sequence[str] | None) -> tuple[str, list[str]]:
+    """The section and candidate names; ConfigError naming ``--models`` when bad."""
+    from heritage_bayes.rc.catalog import CATALOG
+
+    if not models:
+        section = "thermal" if cfg.thermal is not None else "hygric"
+        return section, list(DEFAULT_MODELS[section])
+    names = [m.strip() for m in models if m.strip()]
+    unknown = [m for m in names if m not in CATALOG]
+    if unknown:
+        raise ConfigError(
+            f"--models: unknown model(s) {unknown}; available: {sorted(CATALOG)} "
+            "(`hbayes models NAME` describes one)"
+        )
+    dup = sorted({m for m in names if names.count(m) > 1})
+    if dup:
+        raise ConfigError(f"--models: {dup} given more than once")
+    if len(names) < 2:
+        raise ConfigError(f"--models: give at least two models to compare (got {names})")
+    domains = {m: m.split("_")[0] for m in names}
+    section = domains[names[0]]
+    wrong = [m for m in names if domains[m] != section]
+    if wrong:
+        raise ConfigError(
+            f"--models: {wrong} are not {section} models like {names[0]!r}; the candidates "
+            "of one comparison describe the same output (thermal: Ti, hygric: Pi)"
+        )
+    if getattr(cfg, section) is None:
+        raise ConfigError(
+            f"--models: {section} models, but the config has no {section!r} section "
+            "(it gives the noise model, priors and options of the candidates)"
+        )
+    return section, names
+
+
+def _candidate_config(cfg, section: str, name: str):
+    """The config calibrating only ``name`` in ``section`` (same data, noise, knowledge)."""
+    from heritage_bayes.models import SECTIONS
+
+    sec = getattr(cfg, section)
+    # the configured priors whose parameters exist in this model (as the ladder does)
+    from heritage_bayes.calibrate import _parameters
+    from heritage_bayes.models import _catalog_options
+    from heritage_bayes.rc.catalog import model as catalog_model
+
+    try:
+        model = catalog_model(name, **_catalog_options(cfg, section, name))
+    except ValueError as exc:
+        raise ConfigError(f"--models: {name}: {exc}") from None
+    keep = set(model.parameter_names) | {"sigma", "phi"}
+    priors = {k: v for k, v in sec.priors.items() if k in keep or k.split("_")[0] in keep}
+    new_sec = sec.model_copy(update={"model": name, "priors": priors})
+    cand = cfg.model_copy(
+        update={
+            section: new_sec,
+            **{s: None for s in SECTIONS if s != section},
+            "ladder": False,
+            "name": f"{cfg.name or 'run'}-{name}",
+        }
+    )
+    _parameters(cand, section, model, priors)  # a prior that does not fit fails now
+    return cand
+
+
+def run_compare(
+    cfg,
+    models: Sequence[str] | None = None,
+    out_dir: str | Path | None = None,
+    *,
+    seed: int | None = None,
+    quiet: bool = False,
+    report: bool | None = None,
+    resume: bool = False,
+) -> Path:
+    """Calibrate each candidate model and write the comparison; return its folder.
+
+    Parameters
+    ----------
+    cfg : CalibrationConfig
+        Data, periods, noise model, priors and knowledge of the room; the model of the
+        compared section is replaced by each candidate in turn (the other section is left
+        out), with the calibration engine's defaults.
+    models : sequence of str, optional
+        Catalogue names, all of one section (default: 1c, 2c and the paper's model of
+        the config's thermal section, or of its hygric section without one).
+    out_dir : path, optional
+        Default ``reports/<config name>-compare/``; each candidate's run directory is
+        ``<out_dir>/<model>/``; the comparison is ``comparison.json`` and
+        ``comparison.html``.
+    seed, quiet, report, resume
+        As for :func:`heritage_bayes.calibrate.run_calibration` (applied to every
+        candidate).
+
+    Raises
+    ------
+    ConfigError
+        Unknown model, models of different sections, or a section the config lacks.
+    """
+    from heritage_bayes.calibrate import run_calibration
+
+    section, names = _section_of(cfg, models)
+    cands = {n: _candidate_config(cfg, section, n) for n in names}
+    out = Path(out_dir) if out_dir is not None else Path("reports") / f"{cfg.name or 'run'}-compare"
+    out.mkdir(parents=True, exist_ok=True)
+    dirs = {}
+    for n, c in cands.items():
+        if not quiet:
+            import sys
+
+            print(f"hbayes compare: calibrating {n}", file=sys.stderr, flush=True)
+        dirs[n] = run_calibration(c, out / n, seed=seed, quiet=quiet, report=report, resume=resume)
+    result = compare_runs(dirs, section, seed=cfg.seed if seed is None else int(seed))
+    result["config"] = {"name": cfg.name, "building": cfg.building, "room": cfg.room}
+    write_comparison(result, out)
+    return out

@@ -32,8 +32,15 @@ def _quote(names) -> str:
 
 
 def _csv_header(path: Path, src, where: str) -> list[str]:
+    from heritage_bayes.io._common import READ_ERRORS, damaged, sniff_text
+
     try:
+        sniff_text(path, path.name)  # binary, damaged or truncated: say so at once
         header = pd.read_csv(path, nrows=0, sep=src.sep, encoding="utf-8")
+    except DataError as exc:
+        raise DataError(f"{where}: {exc}") from None
+    except READ_ERRORS as exc:
+        raise DataError(f"{where}: {damaged(path.name, exc)}") from None
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
         raise DataError(f"{where}: {path.name}: cannot read the header line: {exc}") from None
     return [str(c).strip() for c in header.columns]
@@ -116,7 +123,8 @@ def read_source(cfg, src, where: str, allowed: Sequence[str]) -> pd.DataFrame:
     except ConfigError:
         raise
     except DataError as exc:
-        raise DataError(f"{where}: {exc}") from None
+        msg = str(exc)  # the header checks already name the key
+        raise DataError(msg if msg.startswith(where) else f"{where}: {msg}") from None
     except InputError as exc:
         raise ConfigError(f"{where}: {exc}") from None
     # columns of the other role picked up by name (no 'columns' mapping) are not used

@@ -193,6 +193,8 @@ class _DeferSignals:
         self.received = None
         if threading.current_thread() is threading.main_thread():
             for s in self.SIGNALS:
+                if signal.getsignal(s) is signal.SIG_IGN:
+                    continue  # ignored on purpose (nohup, a background job): keep it so
                 old = signal.signal(s, self._record)
                 self._old[s] = signal.SIG_DFL if old is None else old
         return self

@@ -281,11 +281,28 @@ def main(argv: list[str] | None = None) -> int:
     old = None
     if threading.current_thread() is threading.main_thread():
         old = signal.signal(signal.SIGTERM, _on_sigterm)
+    swallowed: list = []
+    old_hook = sys.unraisablehook
+
+    def hook(u):  # an interrupt inside a callback (e.g. of the import system) is lost
+        if isinstance(u.exc_value, KeyboardInterrupt):
+            swallowed.append(u.exc_value)
+        else:
+            old_hook(u)
+
+    sys.unraisablehook = hook
     try:
-        return _main(argv)
+        code = _main(argv)
+        if swallowed and code == 0:
+            print(
+                "hbayes: the interrupt came too late to stop it: the run is complete",
+                file=sys.stderr,
+            )
+        return code
     except KeyboardInterrupt as exc:  # before or after a command ran
         return _interrupted(exc, None)
     finally:
+        sys.unraisablehook = old_hook
         if old is not None:
             signal.signal(signal.SIGTERM, old)
 

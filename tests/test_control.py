@@ -205,3 +205,18 @@ def test_case_study_configs_build_controlled_models(name):
     th = build_model(cfg, "thermal")
     assert "Tset" in th.parameter_names and "Qs" in th.parameter_names
     assert th.with_control(False).control.enabled == frozenset()
+
+
+def test_derived_quantities_of_a_controlled_model_are_the_networks():
+    """A humidistat adds the input Ti, which is not a column of the linear network's B:
+    the static gains are those of the free-running network (configs/orholm.yaml)."""
+    from heritage_bayes.rc.catalog import model
+    from heritage_bayes.rc.derived import derived_quantities, derived_units
+
+    m = model("hygric_2c", humidistat="band")
+    assert m.input_names == ("Pe", "Ti")
+    p = dict(Cw=0.5, Ci=0.03, Gw=2e-8, Gi=1e-6, Gfast=4.2e-7, RH_lo=0.4, RH_hi=0.6)
+    d = derived_quantities(m, p)
+    assert set(d) == set(derived_units(m)) == {"tau_1_h", "tau_2_h", "gain_Pi_Pe"}
+    free = derived_quantities(model("hygric_2c"), {k: v for k, v in p.items() if "RH" not in k})
+    assert d["gain_Pi_Pe"] == pytest.approx(free["gain_Pi_Pe"]) and d["gain_Pi_Pe"] > 0.99

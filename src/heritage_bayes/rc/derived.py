@@ -177,7 +177,7 @@ def derived_units(model) -> dict[str, str]:
     du = _diff_unit(model)
     net = model.network
     for o in model.output_names:
-        for u in model.input_names:
+        for u in net.inputs:  # the linear network's inputs (a control's own are not gains)
             units[f"gain_{o}_{u}"] = _per(du, net.input_unit(u))
     for o in model.output_names:
         for j in _constant_indices(model):
@@ -226,7 +226,9 @@ def derived_quantities(model, params) -> dict[str, np.ndarray]:
     for k in range(model.n_states):
         out[f"tau_{k + 1}_h"] = tau_h[:, k].copy()
     for o, oname in enumerate(model.output_names):
-        for i, uname in enumerate(model.input_names):
+        # the columns of B: the linear network's inputs; a controlled model's extra
+        # inputs (Ti of a humidistat, a schedule) enter the control, not the gains
+        for i, uname in enumerate(model.network.inputs):
             out[f"gain_{oname}_{uname}"] = gains[:, o, i].copy()
     if offs is not None:
         consts = [model.parameter_names[j] for j in _constant_indices(model)]

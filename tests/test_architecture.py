@@ -10,6 +10,8 @@ from __future__ import annotations
 import ast
 from pathlib import Path
 
+import pytest
+
 SRC = Path(__file__).resolve().parents[1] / "src" / "heritage_bayes"
 PKG = "heritage_bayes"
 
@@ -158,3 +160,20 @@ def test_lower_layers_do_not_import_higher_ones():
             if dtop in layers and layers[dtop] > layers[top]:
                 bad.append(f"{mod} -> {d}")
     assert bad == [], bad
+
+
+MAX_LINES = 600
+
+
+@pytest.mark.parametrize("path", sorted(SRC.rglob("*.py")), ids=lambda p: str(p.relative_to(SRC)))
+def test_modules_are_of_readable_size(path):
+    """No module above ~600 lines without a reason stated in its docstring."""
+    text = path.read_text(encoding="utf-8")
+    n = len(text.splitlines())
+    if n <= MAX_LINES:
+        return
+    doc = ast.get_docstring(ast.parse(text)) or ""
+    assert "Why one module" in doc, (
+        f"{path.relative_to(SRC)} has {n} lines (> {MAX_LINES}) and no 'Why one module' "
+        "paragraph in its docstring: split it by topic or say why it stays whole"
+    )

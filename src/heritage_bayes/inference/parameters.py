@@ -1,5 +1,10 @@
 """Parameters, bounded priors and the transform to an unconstrained sampling space.
 
+Why one module (about 620 lines): the prior families, the transform of each kind of
+parameter and the :class:`ParameterSet` that applies them are one contract (the prior's
+bounds are the transform's walls and its log-density carries the Jacobian); splitting
+them would put one formula on either side of a module boundary.
+
 Every estimated quantity (each C, G, solar aperture, split fraction, constant boundary,
 and the noise parameters) is a :class:`Parameter` with a name, unit, kind and a bounded
 :class:`Prior`. Sampling happens in a transformed space ``x``:

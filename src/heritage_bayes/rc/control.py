@@ -1,5 +1,10 @@
 """Controlled rooms: thermostats, humidistats and constant sources on an RC network.
 
+Why one module (about 620 lines): the control options, the :class:`ControlledModel`
+that adds their parameters and inputs, and the compiled piecewise-linear step that
+solves for the control flow share one set of index conventions (which node is
+controlled, which input column is Ti or the schedule); they change together.
+
 Most logged monuments are not free-running: churches are heated for services, stores
 have a heating floor and a dehumidifier. A :class:`ControlledModel` is an
 :class:`~heritage_bayes.rc.model.RCModel` whose controlled node (the first output: the

@@ -78,9 +78,9 @@ def test_demo_config_values():
     assert cfg.data.demo.gap == ("2019-03-10", "2019-03-17")
     assert cfg.periods.calibration.start == "2019-01-02"  # a YAML date kept as text
     assert cfg.room_volume == 400 and cfg.air_change_rate == 0.5
-    assert cfg.thermal.model == "thermal_2c" and cfg.thermal.noise == "ar1"
+    assert cfg.thermal.model == "thermal_2c" and cfg.thermal.noise == "ar1_white"
     assert cfg.hygric.priors["Gw"]["dist"] == "lognormal"
-    assert cfg.hygric.model == "hygric_2c" and cfg.hygric.noise == "ar1"
+    assert cfg.hygric.model == "hygric_2c" and cfg.hygric.noise == "ar1_white"
 
 
 def test_yaml_dates_and_offsets_are_accepted():
@@ -145,7 +145,9 @@ def test_wrong_type_says_what_was_found():
 def test_durations_are_normalised_for_pandas():
     cfg = parse_config(_with(periods={"warmup": "3d", "init_window": "36H"}))
     assert (cfg.periods.warmup, cfg.periods.init_window) == ("3D", "36h")
-    assert cfg.periods.warmup == Periods().warmup.replace("14", "3")
+    assert cfg.periods.init_window == Periods().init_window.replace("30D", "36h")
+    # no warm-up unless asked for or a model starts from the steady state
+    assert Periods().warmup is None
 
 
 def test_bad_duration():

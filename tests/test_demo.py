@@ -122,7 +122,11 @@ def test_observation_model(demo_room, prepared):
     assert monument.truth["thermal"]["phi_Ti"] == pytest.approx(0.9 * 0.04 / expected**2, abs=0.1)
     # the calibration period's values in prepare() come from the same function
     rows = prepared.frame.index[prepared.calibration][prepared.warmup_steps :]
-    assert prepared.truth["thermal"]["sigma_Ti"] == nominal_noise(monument, "Ti", rows)["sigma_Ti"]
+    ref = nominal_noise(monument, "Ti", rows, noise="ar1_white")  # configs/demo.yaml
+    assert prepared.truth["thermal"]["sigma_Ti"] == ref["sigma_Ti"]
+    # ar1_white: the model error and the reading error separately
+    assert ref["phi_Ti"] == pytest.approx(0.9, abs=0.05)
+    assert ref["sigma_meas_Ti"] == pytest.approx(np.sqrt(0.1**2 + 0.1**2 / 12), rel=0.1)
 
 
 def test_noise_free_settings_give_the_model_output():

@@ -35,7 +35,7 @@ from heritage_bayes.inference.results import (
     dump_json,
     ensure_free_space,
 )
-from heritage_bayes.models import SECTIONS, _catalog_options, build_model
+from heritage_bayes.models import SECTIONS, _catalog_options, build_model, initial_state_of
 from heritage_bayes.rc.catalog import model as catalog_model
 from heritage_bayes.rc.model import RCModel
 from heritage_bayes.run import Run, RunWriter, load_run  # Run, load_run: re-exported
@@ -73,12 +73,19 @@ def check_models(cfg: CalibrationConfig) -> None:
     for section in SECTIONS:
         sec_cfg = getattr(cfg, section)
         if sec_cfg is not None:
-            _parameters(cfg, section, build_model(cfg, section), sec_cfg.priors)
+            model = build_model(cfg, section)
+            _parameters(cfg, section, model, sec_cfg.priors)
+            initial_state_of(cfg, section, model)
 
 
-def _log_posterior(cfg, prep, section: str, model: RCModel, priors: Mapping) -> LogPosterior:
-    """The log-posterior of ``model`` on the calibration period of a config section."""
+def _log_posterior(
+    cfg, prep, section: str, model: RCModel, priors: Mapping, initial_state=None
+) -> LogPosterior:
+    """The log-posterior of ``model`` on the calibration period of a config section
+    (initial state as configured unless ``initial_state`` is given)."""
     noise, params = _parameters(cfg, section, model, priors)
+    if initial_state is None:
+        initial_state = initial_state_of(cfg, section, model)
     cal = prep.calibration
     try:
         return LogPosterior(
@@ -90,6 +97,8 @@ def _log_posterior(cfg, prep, section: str, model: RCModel, priors: Mapping) -> 
             dt=prep.dt,
             warmup=prep.warmup_steps,
             init_window=prep.init_steps,
+            initial_state=initial_state,
+            initial_state_sd=getattr(cfg, section).initial_state_sd,
         )
     except ValueError as exc:
         raise InputError(f"{section}: {exc}") from None
@@ -496,7 +505,11 @@ def model_ladder(cfg: CalibrationConfig, prep, section: _Section, *, seed: int) 
                 for k, v in sec_cfg.priors.items()
                 if k in model.parameter_names or k.split("_")[0] in ("sigma", "phi")
             }
-            lp = _log_posterior(cfg, prep, section.name, model, priors)
+            mode = section.logpost.initial_state
+            if isinstance(mode, Mapping) or model.control is not None:
+                # fixed nodes belong to the configured model: the others estimate theirs
+                mode = "steady" if model.control is not None else "estimate"
+            lp = _log_posterior(cfg, prep, section.name, model, priors, initial_state=mode)
             mp = find_map(
                 lp,
                 seed=seed,
@@ -511,9 +524,7 @@ def model_ladder(cfg: CalibrationConfig, prep, section: _Section, *, seed: int) 
             model, dict(zip(model.parameter_names, tm, strict=True)), dt=prep.dt, fixed=fixed
         )
         U = prep.model_inputs(section.name, model)
-        ysim = model.forward(
-            tm[None], U, prep.dt, u_init=U[: max(1, prep.init_steps)].mean(axis=0)
-        )[0][0]
+        ysim = lp.simulate_frame(mp.theta[None], U, prep.calibration.start)[0][0]
         obs = prep.observed(section.name, model)
         fit = {}
         for period in ("calibration", "validation"):

@@ -84,7 +84,10 @@ def _build_parser() -> argparse.ArgumentParser:
     )
     mod.add_argument("name", nargs="?", help="a catalogue model, e.g. thermal_2c")
     mod.add_argument(
-        "--noise", default="ar1", choices=["ar1", "iid"], help="noise model (default ar1)"
+        "--noise",
+        default="ar1_white",
+        choices=["ar1_white", "ar1", "iid"],
+        help="noise model (default ar1_white)",
     )
     mod.set_defaults(func=_cmd_models)
 

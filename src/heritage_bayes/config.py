@@ -407,21 +407,23 @@ class Periods(_Strict):
 
     Default (no periods): the common period of all data, its first 2/3 for calibration
     and the rest for validation. ``warmup``: the first part of the calibration period
-    simulated but excluded from the likelihood (absorbs the initial state);
-    ``init_window``: the initial state is the steady state of the mean inputs over the
-    first ``init_window`` of the simulation (default 30 days: slow modes with time
-    constants of weeks start near their level; the fast ones settle within the warm-up).
+    simulated but excluded from the likelihood. Default: none when every model estimates
+    its initial state (``initial_state: estimate``, the default of linear models), 14
+    days when one starts from the steady state (a controlled room, or
+    ``initial_state: steady``). ``init_window``: the mean inputs over the first
+    ``init_window`` give the steady state that is the initial state's prior mean (or the
+    initial state itself with ``steady``); default 30 days.
     """
 
     calibration: Period | None = None
     validation: Period | None = None
-    warmup: str = "14D"
+    warmup: str | None = None
     init_window: str = "30D"
 
     @field_validator("warmup", "init_window")
     @classmethod
     def _duration(cls, v):
-        return _check_duration(v)
+        return v if v is None else _check_duration(v)
 
     @model_validator(mode="after")
     def _check(self):
@@ -438,7 +440,7 @@ class Periods(_Strict):
                 )
         if self.calibration is not None:
             length = _utc(self.calibration.end) - _utc(self.calibration.start)
-            if parse_duration(self.warmup) >= length:
+            if self.warmup is not None and parse_duration(self.warmup) >= length:
                 raise ValueError(
                     f"warmup: {self.warmup} is not shorter than the calibration period "
                     f"({self.calibration.start} to {self.calibration.end})"
@@ -451,7 +453,15 @@ class ModelSection(_Strict):
 
     model: str | dict[str, Any]
     options: dict[str, Any] = Field(default_factory=dict)
-    noise: Literal["ar1", "iid"] = "ar1"
+    noise: Literal["ar1_white", "ar1", "iid"] = "ar1_white"
+    initial_state: Literal["estimate", "steady"] | dict[str, float] | None = Field(
+        default=None,
+        description="'estimate' (integrated out exactly; default for linear models), "
+        "'steady' (default for controlled rooms) or {node: value} [°C or Pa]",
+    )
+    initial_state_sd: float | None = Field(
+        default=None, gt=0, description="[K] or [Pa] prior sd of the estimated initial state"
+    )
     priors: dict[str, dict[str, Any]] = Field(default_factory=dict)
     room_volume: float | None = Field(default=None, gt=0, description="[m³]")
 

@@ -314,8 +314,10 @@ def _ar1_stats(r: np.ndarray) -> tuple[float, float]:
     return sigma, (num / den if den > 0 else 0.0)
 
 
-def nominal_noise(monument: VirtualMonument, output: str, rows=None) -> dict[str, float]:
-    """Nominal AR(1) noise parameters of the realised demo noise.
+def nominal_noise(
+    monument: VirtualMonument, output: str, rows=None, noise: str = "ar1"
+) -> dict[str, float]:
+    """Nominal noise parameters of the realised demo noise.
 
     Parameters
     ----------
@@ -323,15 +325,20 @@ def nominal_noise(monument: VirtualMonument, output: str, rows=None) -> dict[str
     output : {"Ti", "Pi"}
     rows : pandas.DatetimeIndex, optional
         Instants to use (e.g. the calibration period after the warm-up); default all.
+    noise : {"ar1", "iid", "ar1_white"}
+        The noise model whose parameters are wanted.
 
     Returns
     -------
     dict
-        ``{"sigma_<output>": RMS [K or Pa], "phi_<output>": lag-1 autocorrelation}`` of
-        the residual *observed − noise-free model* at ``rows`` (missing readings skipped).
-        They are **nominal**: the noise is AR(1) model error plus white sensor noise plus
-        rounding, not exactly AR(1); these are the AR(1) parameters with the same
-        variance and lag-1 autocorrelation.
+        ``ar1``/``iid``: ``{"sigma_<output>": RMS [K or Pa], "phi_<output>": lag-1
+        autocorrelation}`` of the residual *observed − noise-free model* at ``rows``
+        (missing readings skipped). They are **nominal**: the noise is AR(1) model error
+        plus white sensor noise plus rounding, not exactly AR(1); these are the AR(1)
+        parameters with the same variance and lag-1 autocorrelation. ``ar1_white``: the
+        realised model error *room − model* (RMS ``sigma``, lag-1 ``phi``) and the RMS of
+        the reading error *observed − room* (``sigma_meas``: sensor noise and rounding),
+        which that noise model describes exactly (up to rounding not being Gaussian).
     """
     from heritage_bayes.climate.psychro import vapour_pressure
 
@@ -345,8 +352,19 @@ def nominal_noise(monument: VirtualMonument, output: str, rows=None) -> dict[str
     else:
         obs = vapour_pressure(meas["Ti"].to_numpy(), meas["RHi"].to_numpy())
     r = obs - model.reindex(idx).to_numpy()
+    if noise == "ar1_white":
+        room = monument.info[f"{output}_room"].reindex(idx).to_numpy()
+        sigma, phi = _ar1_stats(room - model.reindex(idx).to_numpy())
+        meas_err = obs - room
+        ok = np.isfinite(meas_err)
+        return {
+            f"sigma_{output}": sigma,
+            f"phi_{output}": phi,
+            f"sigma_meas_{output}": float(np.sqrt(np.mean(meas_err[ok] ** 2))),
+        }
     sigma, phi = _ar1_stats(r)
-    return {f"sigma_{output}": sigma, f"phi_{output}": phi}
+    out = {f"sigma_{output}": sigma, f"phi_{output}": phi}
+    return {f"sigma_{output}": sigma} if noise == "iid" else out
 
 
 def virtual_monument(
@@ -498,6 +516,8 @@ def virtual_monument(
         "inputs": inputs,
         "Ti_model": pd.Series(T_model, index=index, name="Ti"),
         "Pi_model": pd.Series(P_model, index=index, name="Pi"),
+        "Ti_room": pd.Series(T_room, index=index, name="Ti"),
+        "Pi_room": pd.Series(P_room, index=index, name="Pi"),
         "states": states,
         "Tf": tf,
         "Tf_method": tf_info["method"],

@@ -70,6 +70,41 @@ def build_model(cfg: CalibrationConfig, section: str) -> RCModel:
     return m
 
 
+def initial_state_of(cfg: CalibrationConfig, section: str, model: RCModel | None = None):
+    """The initial state of a section: ``initial_state`` as configured, else
+    ``"estimate"`` for a linear model and ``"steady"`` for a controlled room (its
+    simulator is not linear in the state). :class:`ConfigError` for an estimated state
+    on a controlled room."""
+    sec = getattr(cfg, section)
+    m = model if model is not None else build_model(cfg, section)
+    mode = sec.initial_state
+    if mode is None:
+        return "steady" if m.control is not None else "estimate"
+    if mode != "steady" and m.control is not None:
+        raise ConfigError(
+            f"{section}.initial_state: {mode!r} needs a model that is linear in its state; "
+            f"this {m.name} room is controlled (thermostat/humidistat): use 'steady' (with "
+            "periods.warmup) or leave initial_state out"
+        )
+    if isinstance(mode, Mapping):
+        unknown = [k for k in mode if k not in m.state_names]
+        if unknown:
+            raise ConfigError(
+                f"{section}.initial_state: unknown node(s) {unknown}; the nodes of "
+                f"{m.name} are {list(m.state_names)}"
+            )
+    return mode
+
+
+def default_warmup(cfg: CalibrationConfig) -> str:
+    """``periods.warmup`` when not configured: none when every model estimates its
+    initial state, 14 days when one starts from the steady state."""
+    steady = any(
+        initial_state_of(cfg, s) == "steady" for s in SECTIONS if getattr(cfg, s) is not None
+    )
+    return "14D" if steady else "0h"
+
+
 def _catalog_options(cfg: CalibrationConfig, section: str, name: str) -> dict:
     """Options of catalogue model ``name`` in a section: the configured ones, plus the
     solar surfaces from ``data.surfaces`` (none when ``data.irradiance: none``)."""
@@ -79,7 +114,7 @@ def _catalog_options(cfg: CalibrationConfig, section: str, name: str) -> dict:
     return options
 
 
-def describe_model(name: str, noise: str = "ar1") -> str:
+def describe_model(name: str, noise: str = "ar1_white") -> str:
     """A catalogue model in words: balance equations, parameters with units and default
     priors (the names ``priors:`` accepts), inputs and outputs (``hbayes models NAME``).
 

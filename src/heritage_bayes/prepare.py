@@ -454,12 +454,15 @@ def prepare(cfg) -> Prepared:
         cal, val = slice(0, k), slice(k, n)
         period_note = "default: first 2/3 of the common period of all data, then the rest"
     dt = float(step.total_seconds())
-    warmup_steps = math.ceil(parse_duration(per.warmup) / step - 1e-9)
+    from heritage_bayes.models import default_warmup
+
+    warmup = per.warmup if per.warmup is not None else default_warmup(cfg)
+    warmup_steps = math.ceil(parse_duration(warmup) / step - 1e-9)
     init_steps = math.ceil(parse_duration(per.init_window) / step - 1e-9)
     cal_rows = cal.stop - cal.start
     if warmup_steps >= cal_rows:
         raise ConfigError(
-            f"periods.warmup: {per.warmup} ({warmup_steps} rows) is not shorter than the "
+            f"periods.warmup: {warmup} ({warmup_steps} rows) is not shorter than the "
             f"calibration period ({cal_rows} rows, {_iso(frame.index[cal.start])} to "
             f"{_iso(frame.index[cal.stop - 1] + step)})"
         )
@@ -479,7 +482,7 @@ def prepare(cfg) -> Prepared:
         "from": period_note,
         "calibration": _span(cal),
         "validation": _span(val),
-        "warmup": per.warmup,
+        "warmup": warmup,
         "warmup_steps": warmup_steps,
         "init_window": per.init_window,
         "init_steps": init_steps,
@@ -490,8 +493,10 @@ def prepare(cfg) -> Prepared:
 
         truth = {sec: dict(vals) for sec, vals in monument.truth.items()}
         rows = frame.index[cal.start + warmup_steps : cal.stop]
-        truth["thermal"].update(nominal_noise(monument, "Ti", rows))
-        truth["hygric"].update(nominal_noise(monument, "Pi", rows))
+        for sec, out in (("thermal", "Ti"), ("hygric", "Pi")):
+            sec_cfg = getattr(cfg, sec)
+            kind = sec_cfg.noise if sec_cfg is not None else "ar1_white"
+            truth[sec].update(nominal_noise(monument, out, rows, noise=kind))
 
     return Prepared(
         frame=frame,

@@ -50,6 +50,15 @@ def _saved_index(n_chain: int, n_draw: int, n_total: int) -> np.ndarray:
     return np.unique(np.linspace(0, n_draw - 1, m).round().astype(int))
 
 
+def _initial_state_text(lp) -> str:
+    """How the initial state of a log-posterior was obtained, in words."""
+    mode = lp.initial_state
+    if mode == "steady":
+        return "steady state of the mean inputs, not estimated"
+    fixed = ", ".join(f"{lp.model.state_names[i]} = {v:g}" for i, v in lp.x0_fixed.items())
+    return "estimated, integrated out exactly" + (f"; fixed: {fixed}" if fixed else "")
+
+
 def _pointwise(s, pw: np.ndarray, times: np.ndarray, shape) -> dict[str, xr.DataArray]:
     """Pointwise log-likelihood terms (K, N, n_out) -> one DataArray per output.
 
@@ -151,11 +160,22 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
         )
         # predictive over the whole frame for the selected draws
         th_sel = s.theta[:, sel].reshape(-1, s.theta.shape[-1])
-        tm_sel, tn_sel = th_sel[:, : s.logpost.n_model], th_sel[:, s.logpost.n_model :]
+        tn_sel = th_sel[:, s.logpost.n_model :]
         U = prep.model_inputs(s.name, s.model)
-        Ysim, _ = s.model.forward(
-            tm_sel, U, prep.dt, u_init=U[: max(1, prep.init_steps)].mean(axis=0)
-        )
+        # the initial state: a draw from its conditional posterior for each draw
+        x0 = s.logpost.initial_states(th_sel, rng)
+        if x0 is not None:
+            for i, node in enumerate(s.model.state_names):
+                post[f"{s.name}.x0_{node}"] = xr.DataArray(
+                    x0[:, i].reshape(W, n_sel),
+                    dims=cdims,
+                    attrs={
+                        "unit": "°C" if s.model.domain == "thermal" else "Pa",
+                        "description": f"state of node {node} at the first calibration "
+                        f"step ({_initial_state_text(s.logpost)})",
+                    },
+                )
+        Ysim, _ = s.logpost.simulate_frame(th_sel, U, prep.calibration.start, x0=x0)
         noise = s.logpost.noise.sample(rng, tn_sel, U.shape[0], s.model.n_outputs)
         Ypp = Ysim + noise
         shape = (W, n_sel, U.shape[0])
@@ -249,6 +269,19 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
             "input_names": list(s.model.input_names),
             "output_names": list(s.model.output_names),
             "noise": s.logpost.noise.name,
+            "initial_state": {
+                "mode": s.logpost.initial_state
+                if isinstance(s.logpost.initial_state, str)
+                else dict(s.logpost.initial_state),
+                "how": _initial_state_text(s.logpost),
+                "prior_sd": s.logpost.initial_state_sd,
+                "unit": "°C" if s.model.domain == "thermal" else "Pa",
+                "nodes": (
+                    {node: _summ(x0[:, i]) for i, node in enumerate(s.model.state_names)}
+                    if x0 is not None
+                    else None
+                ),
+            },
             "map": s.map.to_dict(names),
             "identifiability": s.identifiability.to_dict(),
             "chain": {

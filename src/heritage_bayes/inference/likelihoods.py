@@ -2,12 +2,20 @@
 
 A noise model turns simulated outputs and observations into a log-likelihood, batched
 over parameter sets, with missing observations (NaN) masked, not interpolated. Each
-output gets its own noise parameters (``sigma_<output>``, and ``phi_<output>`` for AR(1)).
+output gets its own noise parameters: ``sigma_<output>`` (all), ``phi_<output>`` (``ar1``,
+``ar1_white``) and ``sigma_meas_<output>`` (``ar1_white``, the default).
+
+The three are one Gaussian residual process, a stationary AR(1) model error plus white
+measurement noise, evaluated exactly by a scalar Kalman filter (``_kf_kernel``,
+``_fused_kf``): ``iid`` has no AR part, ``ar1`` no white part. The fused pass also
+returns the statistics with which :class:`~heritage_bayes.inference.posterior.LogPosterior`
+integrates the initial state out exactly.
 
 Interface (what :class:`~heritage_bayes.inference.posterior.LogPosterior` calls):
 
-- ``parameter_specs(output_names)`` -> list of (name, kind) with kind ``"sigma"`` or
-  ``"phi"``; units follow the output (``sigma`` in [K] or [Pa], ``phi`` [-]);
+- ``parameter_specs(output_names)`` -> list of (name, kind, output) with kind
+  ``"sigma"``, ``"phi"`` or ``"sigma_meas"``; units follow the output (``sigma``,
+  ``sigma_meas`` in [K] or [Pa], ``phi`` [-] per time step);
 - ``loglik(Ysim, Yobs, noise)`` -> (K,) log-likelihood, ``Ysim`` (K, N, n_out) simulated,
   ``Yobs`` (N, n_out) observed with NaN = missing/excluded, ``noise`` (K, q) values;
 - ``pointwise(Ysim, Yobs, noise)`` -> (K, N, n_out) log-likelihood terms (NaN where
@@ -15,8 +23,8 @@ Interface (what :class:`~heritage_bayes.inference.posterior.LogPosterior` calls)
 - ``sample(rng, noise, N)`` -> (K, N, n_out) noise realisations for posterior predictive
   bands.
 
-A Kalman-filter (stochastic state-space) likelihood fits the same interface: it would
-also need the modal form and the inputs, which the posterior can pass as ``context``.
+- ``filter_modal(mf, U, z0, Yobs, noise, basis=...)`` -> sufficient statistics straight
+  from a modal form (the sampler's hot path), ``loglik_modal`` their log-likelihood.
 
 References
 ----------
@@ -28,55 +36,16 @@ References
 from __future__ import annotations
 
 import math
+from typing import ClassVar
 
 import numba
 import numpy as np
 
-__all__ = ["NOISE_MODELS", "AR1Noise", "IIDNoise", "NoiseModel", "get_noise_model"]
+from heritage_bayes.inference.parameters import Prior
+
+__all__ = ["NOISE_MODELS", "AR1Noise", "AR1WhiteNoise", "IIDNoise", "NoiseModel", "get_noise_model"]
 
 _LOG2PI = math.log(2.0 * math.pi)
-
-
-@numba.njit(cache=True, nogil=True)
-def _ar1_kernel(Ysim, yobs, sigma, phi, point, want_point):  # pragma: no cover
-    """Exact AR(1) Gaussian log-likelihood of residuals r = yobs - ysim with gaps.
-
-    ``sigma`` is the *marginal* standard deviation of the residual process, so for two
-    observations d steps apart the conditional mean is phi**d r_prev and the conditional
-    variance sigma² (1 - phi**(2d)); the first observation has variance sigma².
-    """
-    K, N = Ysim.shape
-    out = np.empty(K)
-    for p in range(K):
-        s2 = sigma[p] * sigma[p]
-        ph = phi[p]
-        tot = 0.0
-        prev = 0.0
-        last = -1
-        for k in range(N):
-            y = yobs[k]
-            if y != y:  # NaN: missing or excluded
-                if want_point:
-                    point[p, k] = np.nan
-                continue
-            r = y - Ysim[p, k]
-            if last < 0:
-                m = 0.0
-                v = s2
-            else:
-                d = k - last
-                phd = ph if d == 1 else ph**d
-                m = phd * prev
-                v = s2 * (1.0 - phd * phd)
-            e = r - m
-            term = -0.5 * (_LOG2PI + math.log(v) + e * e / v)
-            tot += term
-            if want_point:
-                point[p, k] = term
-            prev = r
-            last = k
-        out[p] = tot
-    return out
 
 
 @numba.njit(cache=True, nogil=True)
@@ -94,58 +63,165 @@ def _ar1_sample(z, phi, sigma, out):  # pragma: no cover
 
 
 @numba.njit(cache=True, nogil=True)
-def _fused_ar1(ad, W, z, Cz, yobs, k0, sigma, phi, prev, last, tot):  # pragma: no cover
-    """Modal recursion + AR(1) log-likelihood in one pass over a block of rows.
+def _kf_kernel(Ysim, yobs, sigma, phi, w, point, want_point):  # pragma: no cover
+    """Exact log-likelihood of r = yobs - ysim for AR(1) model error + white noise.
+
+    The residual is :math:`r_k = \\eta_k + \\varepsilon_k` with :math:`\\eta` a stationary
+    AR(1) of marginal sd ``sigma`` and coefficient ``phi``, :math:`\\varepsilon` white with
+    sd ``w``: a scalar Kalman filter (prediction over d steps across a gap: mean
+    :math:`\\phi^d m`, variance :math:`\\phi^{2d}P + \\sigma^2(1-\\phi^{2d})`). With
+    ``w = 0`` it is exactly the AR(1) likelihood of ``_ar1_kernel``.
+    """
+    K, N = Ysim.shape
+    out = np.empty(K)
+    for p in range(K):
+        s2 = sigma[p] * sigma[p]
+        w2 = w[p] * w[p]
+        ph = phi[p]
+        tot = 0.0
+        m = 0.0
+        P = s2
+        last = -1
+        for k in range(N):
+            y = yobs[k]
+            if y != y:
+                if want_point:
+                    point[p, k] = np.nan
+                continue
+            if last < 0:
+                mp = 0.0
+                Pp = s2
+            else:
+                d = k - last
+                phd = ph if d == 1 else ph**d
+                mp = phd * m
+                Pp = phd * phd * P + s2 * (1.0 - phd * phd)
+            F = Pp + w2
+            e = (y - Ysim[p, k]) - mp
+            term = -0.5 * (_LOG2PI + math.log(F) + e * e / F)
+            tot += term
+            if want_point:
+                point[p, k] = term
+            g = Pp / F
+            m = mp + g * e
+            P = Pp * w2 / F
+            last = k
+        out[p] = tot
+    return out
+
+
+@numba.njit(cache=True, nogil=True)
+def _fused_kf(
+    ad, W, z, pw, Cz, yobs, k0, sigma, phi, w, mres, mbas, Pv, last, conv, acc
+):  # pragma: no cover
+    """Modal recursion + Gaussian noise filter + initial-state statistics, one pass.
 
     Mode-major layout so that the loops over parameter sets are contiguous (SIMD):
-    ad, z (n*K,) with index j*K + p; W (Nb, n*K) forcing rows k0..k0+Nb-1;
-    Cz (n_out, n, K); yobs (N, n_out) with NaN = excluded; sigma, phi, prev, tot
-    (n_out, K); last (n_out,) index of the previous observation (shared by all
-    parameter sets, since the observation mask is). Same likelihood as ``_ar1_kernel``.
+    ad, z, pw (n*K,) with index j*K + p (``pw`` = ad**k, the free response of a unit
+    modal initial perturbation); W (Nb, n*K) forcing rows k0..k0+Nb-1; Cz (n_out, n, K);
+    yobs (N, n_out) with NaN = excluded; sigma, phi, w, mres, Pv (n_out, K) noise
+    parameters, filter mean of the residual and filter variance; mbas (n_out, nb, K)
+    filter means of the nb basis series (nb = n when the initial state is estimated,
+    else 0); last (n_out,) previous observed row; conv (n_out, 3, K) the converged
+    filter (log 2 pi F, 1/F, gain) once the scalar Riccati recursion is stationary, with
+    conv[o, 0, 0] = nan until then (reset by a gap). ``acc`` (3 + nb + nb*nb, K)
+    collects sum log(2 pi F), sum e0²/F, (unused), g_j = sum e0 eb_j/F and the lower
+    triangle of H_ij = sum eb_i eb_j/F, where e0 are the innovations of the residual
+    with the mean initial state and eb_j those of basis series j, so that the
+    log-likelihood with modal initial offset dz is ``-0.5 (acc0 + acc1 - 2 g.dz +
+    dz.H.dz)`` (the gains do not depend on the data).
     """
     Nb, Kn = W.shape
     n_out, n, K = Cz.shape
+    nb = mbas.shape[1]
     s2 = sigma * sigma
-    v1 = s2 * (1.0 - phi * phi)
-    lv1 = np.log(v1) + _LOG2PI
-    iv1 = 1.0 / v1
-    acc = np.empty(K)
+    w2 = w * w
+    ysim = np.empty(K)
+    eb = np.empty((nb, K))
+    ph_b = np.empty(K)
+    g_b = np.empty(K)
+    iF_b = np.empty(K)
+    e_b = np.empty(K)
     for k in range(Nb):
         kk = k0 + k
         for o in range(n_out):
             y = yobs[kk, o]
             if y != y:
                 continue
-            acc[:] = 0.0
+            ysim[:] = 0.0
             for j in range(n):
                 for p in range(K):
-                    acc[p] += Cz[o, j, p] * z[j * K + p]
+                    ysim[p] += Cz[o, j, p] * z[j * K + p]
             lk = last[o]
-            if lk >= 0 and kk - lk == 1:
+            if lk >= 0 and kk - lk == 1 and conv[o, 0, 0] == conv[o, 0, 0]:
+                # stationary filter: constant variance, gain and log-determinant
                 for p in range(K):
-                    r = y - acc[p]
-                    e = r - phi[o, p] * prev[o, p]
-                    tot[o, p] -= 0.5 * (lv1[o, p] + e * e * iv1[o, p])
-                    prev[o, p] = r
+                    ph = phi[o, p]
+                    e0 = (y - ysim[p]) - ph * mres[o, p]
+                    mres[o, p] = ph * mres[o, p] + conv[o, 2, p] * e0
+                    acc[0, p] += conv[o, 0, p]
+                    acc[1, p] += e0 * e0 * conv[o, 1, p]
+                    ph_b[p] = ph
+                    g_b[p] = conv[o, 2, p]
+                    iF_b[p] = conv[o, 1, p]
+                    e_b[p] = e0 * conv[o, 1, p]
             else:
+                d = kk - lk
+                stat = lk >= 0 and d == 1
                 for p in range(K):
-                    r = y - acc[p]
                     if lk < 0:
-                        v = s2[o, p]
-                        e = r
+                        phd = 0.0
+                        Pp = s2[o, p]
                     else:
-                        phd = phi[o, p] ** (kk - lk)
-                        v = s2[o, p] * (1.0 - phd * phd)
-                        e = r - phd * prev[o, p]
-                    tot[o, p] -= 0.5 * (_LOG2PI + math.log(v) + e * e / v)
-                    prev[o, p] = r
+                        phd = phi[o, p] if d == 1 else phi[o, p] ** d
+                        Pp = phd * phd * Pv[o, p] + s2[o, p] * (1.0 - phd * phd)
+                    F = Pp + w2[o, p]
+                    iF = 1.0 / F
+                    g = Pp * iF
+                    lF = _LOG2PI + math.log(F)
+                    e0 = (y - ysim[p]) - phd * mres[o, p]
+                    mres[o, p] = phd * mres[o, p] + g * e0
+                    Pnew = Pp * w2[o, p] * iF
+                    if abs(Pnew - Pv[o, p]) > 1e-13 * (Pnew + 1e-300):
+                        stat = False
+                    Pv[o, p] = Pnew
+                    acc[0, p] += lF
+                    acc[1, p] += e0 * e0 * iF
+                    ph_b[p] = phd
+                    g_b[p] = g
+                    iF_b[p] = iF
+                    e_b[p] = e0 * iF
+                    conv[o, 0, p] = lF
+                    conv[o, 1, p] = iF
+                    conv[o, 2, p] = g
+                if not stat:
+                    conv[o, 0, 0] = np.nan
+            for j in range(nb):
+                for p in range(K):
+                    e = Cz[o, j, p] * pw[j * K + p] - ph_b[p] * mbas[o, j, p]
+                    mbas[o, j, p] = ph_b[p] * mbas[o, j, p] + g_b[p] * e
+                    eb[j, p] = e
+                    acc[3 + j, p] += e_b[p] * e
+            for i in range(nb):
+                for j in range(i + 1):
+                    r = 3 + nb + i * nb + j
+                    for p in range(K):
+                        acc[r, p] += eb[i, p] * eb[j, p] * iF_b[p]
             last[o] = kk
         for i in range(Kn):
             z[i] = ad[i] * z[i] + W[k, i]
+        if nb:
+            for i in range(Kn):
+                pw[i] *= ad[i]
 
 
 class NoiseModel:
-    """Base class: see the module docstring for the interface."""
+    """Base class: see the module docstring for the interface.
+
+    All noise models here are special cases of one Gaussian residual process, AR(1)
+    model error plus white measurement noise, evaluated exactly by a scalar Kalman
+    filter: ``iid`` has no AR part, ``ar1`` no white part.
+    """
 
     name = "base"
     kinds: tuple[str, ...] = ()
@@ -155,21 +231,67 @@ class NoiseModel:
         return [(f"{k}_{o}", k, o) for o in output_names for k in self.kinds]
 
     def _split(self, noise: np.ndarray, o: int):
+        """(sigma, phi, sigma_meas) of output ``o``, each (K,) (zeros where absent)."""
         q = len(self.kinds)
-        sigma = np.ascontiguousarray(noise[:, q * o])
-        phi = np.ascontiguousarray(noise[:, q * o + 1]) if q > 1 else np.zeros(noise.shape[0])
-        return sigma, phi
+        zero = np.zeros(noise.shape[0])
+        return tuple(
+            np.ascontiguousarray(noise[:, q * o + self.kinds.index(k)]) if k in self.kinds else zero
+            for k in ("sigma", "phi", "sigma_meas")
+        )
 
     def loglik(self, Ysim, Yobs, noise, context=None) -> np.ndarray:
         K, _, n_out = Ysim.shape
         total = np.zeros(K)
         dummy = np.empty((1, 1))
         for o in range(n_out):
-            sigma, phi = self._split(noise, o)
-            total += _ar1_kernel(
-                Ysim[:, :, o], np.ascontiguousarray(Yobs[:, o]), sigma, phi, dummy, False
+            sigma, phi, w = self._split(noise, o)
+            yo = np.ascontiguousarray(Yobs[:, o])
+            total += _kf_kernel(
+                np.ascontiguousarray(Ysim[:, :, o]), yo, sigma, phi, w, dummy, False
             )
         return total
+
+    def filter_modal(
+        self, mf, U, z0, Yobs, noise, *, basis: bool = False, max_block: int = 2**20
+    ) -> np.ndarray:
+        """Sufficient statistics of the log-likelihood straight from a modal form.
+
+        One compiled pass over time: the modal recursion from ``z0`` (K, n), the noise
+        filter, and with ``basis=True`` the statistics of the free responses of the n
+        modal initial offsets (see ``_fused_kf``), from which the initial state is
+        estimated or integrated out exactly.
+
+        Returns
+        -------
+        (3 + nb + nb², K) array
+            Row 0: sum of log(2 pi F); row 1: sum of e²/F; rows 3..3+nb: g; then the
+            lower triangle of H (row-major, nb × nb). nb = n if ``basis`` else 0.
+        """
+        K, n = mf.lam.shape
+        n_out = mf.Cz.shape[1]
+        nb = n if basis else 0
+        pars = [self._split(noise, o) for o in range(n_out)]
+        sigma, phi, w = (np.ascontiguousarray(np.stack([p[i] for p in pars])) for i in range(3))
+        Bcat = np.swapaxes(mf.Bdz, 0, 1).reshape(n * K, -1).T  # (m, n*K)
+        ecat = mf.edz.T.reshape(n * K)
+        ad = np.ascontiguousarray(mf.ad.T.reshape(n * K))
+        z = np.ascontiguousarray(z0.T.reshape(n * K))
+        pw = np.ones(n * K)
+        Cz = np.ascontiguousarray(np.transpose(mf.Cz, (1, 2, 0)))
+        Yobs = np.ascontiguousarray(Yobs)
+        mres = np.zeros((n_out, K))
+        mbas = np.zeros((n_out, nb, K))
+        Pv = np.zeros((n_out, K))
+        last = np.full(n_out, -1, dtype=np.int64)
+        conv = np.full((n_out, 3, K), np.nan)
+        acc = np.zeros((3 + nb + nb * nb, K))
+        rows = max(256, max_block // max(K * n, 1))
+        for k0 in range(0, U.shape[0], rows):
+            W = U[k0 : k0 + rows] @ Bcat
+            if ecat.any():
+                W += ecat
+            _fused_kf(ad, W, z, pw, Cz, Yobs, k0, sigma, phi, w, mres, mbas, Pv, last, conv, acc)
+        return acc
 
     def loglik_modal(self, mf, U, z0, Yobs, noise, max_block: int = 2**20) -> np.ndarray:
         """(K,) log-likelihood straight from a modal form, without storing outputs.
@@ -177,36 +299,24 @@ class NoiseModel:
         Equivalent to ``loglik(modal_simulate(mf, U, z0), Yobs, noise)``, fused into one
         compiled pass over time (the hot path of the sampler).
         """
-        K, n = mf.lam.shape
-        n_out = mf.Cz.shape[1]
-        q = len(self.kinds)
-        # mode-major (j, p) layouts for the compiled pass
-        sigma = np.ascontiguousarray(noise[:, 0::q][:, :n_out].T)
-        phi = np.ascontiguousarray(noise[:, 1::q][:, :n_out].T) if q > 1 else np.zeros((n_out, K))
-        Bcat = np.swapaxes(mf.Bdz, 0, 1).reshape(n * K, -1).T  # (m, n*K)
-        ecat = mf.edz.T.reshape(n * K)
-        ad = np.ascontiguousarray(mf.ad.T.reshape(n * K))
-        z = np.ascontiguousarray(z0.T.reshape(n * K))
-        Cz = np.ascontiguousarray(np.transpose(mf.Cz, (1, 2, 0)))
-        Yobs = np.ascontiguousarray(Yobs)
-        prev = np.zeros((n_out, K))
-        last = np.full(n_out, -1, dtype=np.int64)
-        tot = np.zeros((n_out, K))
-        rows = max(256, max_block // max(K * n, 1))
-        for k0 in range(0, U.shape[0], rows):
-            W = U[k0 : k0 + rows] @ Bcat
-            if ecat.any():
-                W += ecat
-            _fused_ar1(ad, W, z, Cz, Yobs, k0, sigma, phi, prev, last, tot)
-        return tot.sum(axis=0)
+        acc = self.filter_modal(mf, U, z0, Yobs, noise, max_block=max_block)
+        return -0.5 * (acc[0] + acc[1])
 
     def pointwise(self, Ysim, Yobs, noise, context=None) -> np.ndarray:
         K, N, n_out = Ysim.shape
         out = np.empty((K, N, n_out))
         for o in range(n_out):
-            sigma, phi = self._split(noise, o)
+            sigma, phi, w = self._split(noise, o)
             point = np.empty((K, N))
-            _ar1_kernel(Ysim[:, :, o], np.ascontiguousarray(Yobs[:, o]), sigma, phi, point, True)
+            _kf_kernel(
+                np.ascontiguousarray(Ysim[:, :, o]),
+                np.ascontiguousarray(Yobs[:, o]),
+                sigma,
+                phi,
+                w,
+                point,
+                True,
+            )
             out[:, :, o] = point
         return out
 
@@ -214,10 +324,12 @@ class NoiseModel:
         K = noise.shape[0]
         out = np.empty((K, N, n_out))
         for o in range(n_out):
-            sigma, phi = self._split(noise, o)
+            sigma, phi, w = self._split(noise, o)
             z = rng.standard_normal((K, N))
             e = np.empty((K, N))
             _ar1_sample(z, phi, sigma, e)
+            if "sigma_meas" in self.kinds:
+                e += w[:, None] * rng.standard_normal((K, N))
             out[:, :, o] = e
         return out
 
@@ -248,7 +360,48 @@ class AR1Noise(NoiseModel):
     kinds = ("sigma", "phi")
 
 
-NOISE_MODELS: dict[str, type[NoiseModel]] = {"iid": IIDNoise, "ar1": AR1Noise}
+class AR1WhiteNoise(NoiseModel):
+    """Model error plus sensor noise: a latent stationary AR(1) process
+    :math:`\\eta_k` (marginal sd ``sigma_<output>``, coefficient ``phi_<output>``) plus
+    white measurement noise :math:`\\varepsilon_k` (sd ``sigma_meas_<output>``):
+    :math:`r_k = \\eta_k + \\varepsilon_k`.
+
+    This is the shape of real logs: a slowly varying model error (what the RC model
+    does not resolve: an unmodelled heat source, a wrong solar aperture on one day) on
+    top of the logger's own noise and rounding. A single AR(1) fitted to such residuals
+    estimates a compromise coefficient (0.4-0.75 where 0.90-0.95 was generated; issue
+    10) and under-weights slow errors: its intervals come out too narrow. The exact
+    likelihood is a scalar Kalman filter on the residual process (ARMA(1,1) in
+    disguise [1]_, [3]_), exact across gaps; its cost is one more division and
+    logarithm per observation than AR(1).
+
+    References
+    ----------
+    .. [3] J. Durbin, S.J. Koopman, *Time Series Analysis by State Space Methods*,
+       2nd ed., Oxford University Press, 2012, ch. 4.
+    """
+
+    name = "ar1_white"
+    kinds = ("sigma", "phi", "sigma_meas")
+    #: The model error's correlation time is capped at about a day: phi <= 0.96 per
+    #: step (tau_e = -dt/ln phi <= 24.5 h at hourly steps). Without a cap the likelihood
+    #: prefers a near-random-walk error that carries the slow (seasonal) response while
+    #: the simulated room goes flat (issue 10; configs/orholm.yaml 2015, thermal: phi ->
+    #: 0.998 and MAP simulation FIT 68 % vs 81 % with iid; with the cap 80 %). What
+    #: persists for longer than a day is the model's to explain; a posterior piled up at
+    #: the cap says the model misses a slow process (the report says so). Override with a
+    #: prior on ``phi_<output>``.
+    prior_overrides: ClassVar[dict] = {
+        ("thermal", "phi"): Prior("uniform", 0.0, 0.96),
+        ("hygric", "phi"): Prior("uniform", 0.0, 0.96),
+    }
+
+
+NOISE_MODELS: dict[str, type[NoiseModel]] = {
+    "iid": IIDNoise,
+    "ar1": AR1Noise,
+    "ar1_white": AR1WhiteNoise,
+}
 
 
 def get_noise_model(name: str) -> NoiseModel:

@@ -278,6 +278,9 @@ _DEFAULTS: dict[tuple[str, str], Prior] = {
     ("hygric", "sigma"): Prior("loguniform", 1e-1, 1e3),
     ("thermal", "phi"): Prior("uniform", 0.0, 0.999),
     ("hygric", "phi"): Prior("uniform", 0.0, 0.999),
+    # white measurement noise of noise: ar1_white: sensor noise and rounding
+    ("thermal", "sigma_meas"): Prior("loguniform", 1e-3, 10.0),
+    ("hygric", "sigma_meas"): Prior("loguniform", 1e-1, 1e3),
 }
 
 
@@ -288,7 +291,15 @@ _FIXED_RANGE = {
     "gain": (0.0, math.inf, True),
     "fraction": (0.0, 1.0, True),
     "sigma": (0.0, math.inf, False),
+    "sigma_meas": (0.0, math.inf, False),
     "phi": (-1.0, 1.0, False),
+}
+
+#: What the noise parameters are, by kind (for descriptions and units).
+_NOISE_DESCRIPTION = {
+    "sigma": "marginal sd of the model error of",
+    "phi": "AR(1) coefficient (per time step) of the model error of",
+    "sigma_meas": "sd of the white measurement noise of",
 }
 
 
@@ -575,13 +586,17 @@ def parameters_for(
         (
             n,
             k,
-            out_units[o] if k == "sigma" else "-",
-            f"{'marginal sd' if k == 'sigma' else 'AR(1) coefficient'} of the residuals of {o}",
+            out_units[o] if k.startswith("sigma") else "-",
+            f"{_NOISE_DESCRIPTION.get(k, k)} {o}",
         )
         for n, k, o in noise_specs
     ]
+    noise_names = {n for n, _, _ in noise_specs}
+    overrides = getattr(noise, "prior_overrides", {})
     for name, kind, unit, desc in entries:
         prior = default_prior(domain, kind)
+        if name in noise_names and (domain, kind) in overrides:
+            prior = overrides[(domain, kind)]
         if name == "Ci" and room_volume is not None and kind == "capacity":
             prior = air_capacity_prior(domain, room_volume)
         if name == "Gfast" and air_change_rate is not None and kind == "conductance":

@@ -7,16 +7,47 @@ discretization, one BLAS product for the modal forcing, the compiled modal recur
 and the compiled noise-model likelihood. Non-physical or non-finite parameter sets give
 ``-inf``, never an exception.
 
-Initial state: the steady state of the mean input over the first ``init_window`` steps
-(30 days by default in configs), followed by a warm-up period (``warmup`` steps, default two weeks)
-whose observations are excluded from the likelihood. This absorbs the start-up
-transient of all but the slowest modes without adding the initial states as parameters;
-for envelopes with time constants of months, lengthen the warm-up.
+Initial state (``initial_state``)
+----------------------------------
+``"estimate"`` (the default for linear models): the state at the first calibration step
+is :math:`x_0 = \\bar x + \\delta x`, :math:`\\bar x` the steady state of the mean inputs
+over the first ``init_window`` steps and :math:`\\delta x \\sim N(0, s_0^2 I)` with
+:math:`s_0` = ``initial_state_sd`` (10 K, 500 Pa by default: weakly informative). The
+outputs are linear in :math:`x_0` and every noise model here is Gaussian, so
+:math:`\\delta x` is **integrated out exactly** for each parameter set: one compiled pass
+gives the filter innovations of the residual and of the n free responses
+:math:`C A_d^k`, hence the quadratic form in :math:`\\delta x`, and
+
+.. math::
+
+    \\log p(y\\mid\\theta) = \\ell_0 + \\tfrac12 g^T M^{-1} g - \\tfrac12\\log\\det M
+    - \\tfrac{n}{2}\\log s_0^2, \\qquad M = H + I/s_0^2 .
+
+Why integrate rather than sample or profile: sampling adds n strongly correlated
+dimensions to emcee (the slow node's start trades against the static gains); profiling
+(the maximum over :math:`\\delta x`) ignores its uncertainty and is biased for short
+records; the marginal costs about one more simulated series per state and keeps the
+posterior of :math:`\\theta` exact. The conditional posterior
+:math:`N(M^{-1}g, M^{-1})` of :math:`\\delta x` is drawn per posterior draw
+(:meth:`LogPosterior.initial_states`) and reported. No warm-up is needed: a slow
+envelope that starts weeks away from equilibrium (thick masonry, a test cell opened
+the day before) is estimated, not assumed away [1]_. ``"steady"``: the old start,
+:math:`x_0 = \\bar x`, usually with a warm-up excluded from the likelihood (the only
+choice for controlled rooms, whose simulator is not linear in the state). A mapping
+``{node: value}`` fixes those nodes [°C or Pa] and estimates the others.
+
+References
+----------
+.. [1] N.R. Kristensen, H. Madsen, S.B. Jørgensen, "Parameter estimation in stochastic
+   grey-box models", *Automatica* 40 (2004) 225-237 (initial states estimated with the
+   parameters).
 """
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -48,7 +79,12 @@ class LogPosterior:
     warmup : int
         Number of initial steps excluded from the likelihood.
     init_window : int
-        Steps averaged for the steady-state initial condition.
+        Steps averaged for the steady-state initial condition (the prior mean of the
+        initial state).
+    initial_state : {"estimate", "steady"} or mapping node -> value
+        See the module docstring.
+    initial_state_sd : float, optional
+        Prior sd of the estimated initial deviation [K] or [Pa] (default 10 K / 500 Pa).
     """
 
     model: RCModel
@@ -59,6 +95,8 @@ class LogPosterior:
     dt: float = 3600.0
     warmup: int = 336
     init_window: int = 720
+    initial_state: Any = "steady"
+    initial_state_sd: float | None = None
 
     def __post_init__(self):
         self.inputs = np.ascontiguousarray(self.inputs, dtype=float)
@@ -71,6 +109,44 @@ class LogPosterior:
         self.u_init = self.inputs[: max(1, self.init_window)].mean(axis=0)
         if np.all(np.isnan(obs)):
             raise ValueError("no observations left after the warm-up period")
+        self._setup_initial_state()
+
+    def _setup_initial_state(self) -> None:
+        """Resolve ``initial_state`` into fixed node values and estimated nodes."""
+        states = self.model.state_names
+        mode = self.initial_state
+        self.x0_fixed: dict[int, float] = {}
+        if isinstance(mode, Mapping):
+            unknown = [k for k in mode if k not in states]
+            if unknown:
+                raise ValueError(
+                    f"initial_state: unknown node(s) {unknown}; the nodes of "
+                    f"{self.model.name!r} are {list(states)}"
+                )
+            self.x0_fixed = {states.index(k): float(v) for k, v in mode.items()}
+            free = [i for i in range(len(states)) if i not in self.x0_fixed]
+        elif mode == "estimate":
+            free = list(range(len(states)))
+        elif mode == "steady":
+            free = []
+        else:
+            raise ValueError(
+                f"initial_state: expected 'estimate', 'steady' or a mapping node -> value "
+                f"(got {mode!r})"
+            )
+        if free and self.model.control is not None:
+            raise ValueError(
+                f"initial_state: {mode!r} needs a model that is linear in its state; "
+                f"{self.model.name!r} is controlled (thermostat/humidistat), use 'steady' "
+                "with a warm-up"
+            )
+        self.x0_free = np.array(free, dtype=int)
+        sd = self.initial_state_sd
+        if sd is None:
+            sd = 10.0 if self.model.domain == "thermal" else 500.0
+        if not sd > 0:
+            raise ValueError(f"initial_state_sd: must be > 0 (got {sd})")
+        self.initial_state_sd = float(sd)
 
     @property
     def ndim(self) -> int:
@@ -85,11 +161,46 @@ class LogPosterior:
         theta_model: np.ndarray,
         inputs: np.ndarray | None = None,
         u_init: np.ndarray | None = None,
+        x0: np.ndarray | None = None,
     ) -> tuple[np.ndarray, np.ndarray]:
-        """Noise-free outputs (K, N, n_out) and validity (K,) for model parameters."""
+        """Noise-free outputs (K, N, n_out) and validity (K,) for model parameters,
+        from initial states ``x0`` (K, n) if given, else the steady state of ``u_init``."""
         U = self.inputs if inputs is None else inputs
         u0 = self.u_init if u_init is None else u_init
-        return self.model.forward(theta_model, U, self.dt, u_init=u0)
+        return self.model.forward(theta_model, U, self.dt, u_init=u0, x0=x0)
+
+    def simulate_frame(
+        self,
+        theta: np.ndarray,
+        inputs: np.ndarray,
+        start: int = 0,
+        rng: np.random.Generator | None = None,
+        x0: np.ndarray | None = None,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Noise-free outputs (K, N, n_out) over a whole frame of ``inputs`` (N, m)
+        whose row ``start`` is the first calibration step, for parameter values (K, P).
+
+        From row ``start`` on, the simulation starts from :meth:`initial_states` (a draw
+        of the estimated initial state with ``rng``, else its conditional mean); rows
+        before it (a validation period that precedes the calibration) are simulated
+        from the steady state of their own first ``init_window`` inputs. ``x0`` (K, n)
+        overrides the initial states.
+        """
+        theta = np.atleast_2d(np.asarray(theta, dtype=float))
+        tm = theta[:, : self.n_model]
+        U = np.ascontiguousarray(inputs, dtype=float)
+        if x0 is None:
+            x0 = self.initial_states(theta, rng)
+        if x0 is None:  # controlled: its own start from the mean inputs
+            u0 = U[start : start + max(1, self.init_window)].mean(axis=0)
+            Y, valid = self.model.forward(tm, U[start:], self.dt, u_init=u0)
+        else:
+            Y, valid = self.model.forward(tm, U[start:], self.dt, x0=x0)
+        if start > 0:
+            u0 = U[: max(1, self.init_window)].mean(axis=0)
+            Yb, vb = self.model.forward(tm, U[:start], self.dt, u_init=u0)
+            Y, valid = np.concatenate([Yb, Y], axis=1), valid & vb
+        return Y, valid
 
     def _loglik(self, theta: np.ndarray) -> np.ndarray:
         """(K,) log-likelihood for valid-shaped values (K, P); -inf where invalid."""
@@ -105,12 +216,90 @@ class LogPosterior:
             return ll
         with np.errstate(all="ignore"):
             mf = modal_form(self.model, tm, self.dt)
-            z0 = mf.steady_state_modal(self.u_init)
-            z0 = np.where(np.isfinite(z0), z0, 0.0)
-            ll = self.noise.loglik_modal(mf, self.inputs, z0, self.observed, tn)
+            ll = self._marginal(mf, tn)[0]
         ll[~mf.valid] = -np.inf
         ll[~np.isfinite(ll)] = -np.inf
         return ll
+
+    def _x0_mean(self, mf) -> np.ndarray:
+        """(K, n) prior mean of the initial state [°C or Pa]: the steady state of the
+        mean inputs over ``init_window``, with the fixed nodes set."""
+        x = np.einsum("kij,kj->ki", mf.T, mf.steady_state_modal(self.u_init))
+        for i, v in self.x0_fixed.items():
+            x[:, i] = v
+        return np.where(np.isfinite(x), x, 0.0)
+
+    def _marginal(self, mf, tn: np.ndarray, conditional: bool = False):
+        """(K,) log-likelihood with the initial-state deviation integrated out, and with
+        ``conditional`` its conditional posterior mean (K, nf) and covariance
+        (K, nf, nf) [°C or Pa] for the estimated nodes ``x0_free``."""
+        xm = self._x0_mean(mf)
+        z0 = mf.to_modal(xm)
+        free = self.x0_free
+        nf = free.size
+        acc = self.noise.filter_modal(mf, self.inputs, z0, self.observed, tn, basis=nf > 0)
+        ll = -0.5 * (acc[0] + acc[1])
+        if nf == 0:
+            return ll, None, None
+        K, n = mf.lam.shape
+        g = acc[3 : 3 + n].T  # (K, n) modal
+        H = np.zeros((K, n, n))
+        tri = acc[3 + n :].T.reshape(K, n, n)
+        il = np.tril_indices(n)
+        H[:, il[0], il[1]] = tri[:, il[0], il[1]]
+        H = H + np.swapaxes(np.tril(H, -1), 1, 2)
+        # modal offset dz = Tinv dx: the statistics in physical coordinates [°C, Pa]
+        Bx = mf.Tinv[:, :, free]  # (K, n, nf)
+        gx = np.einsum("kjf,kj->kf", Bx, g)
+        Hx = np.swapaxes(Bx, 1, 2) @ H @ Bx
+        s2 = self.initial_state_sd**2
+        M = Hx + np.eye(nf) / s2
+        ok = np.all(np.isfinite(M), axis=(1, 2)) & np.isfinite(ll)
+        M[~ok] = np.eye(nf)
+        gx[~ok] = 0.0
+        try:
+            L = np.linalg.cholesky(M)
+        except np.linalg.LinAlgError:
+            L = np.empty_like(M)
+            for k in range(K):
+                try:
+                    L[k] = np.linalg.cholesky(M[k])
+                except np.linalg.LinAlgError:
+                    L[k] = np.eye(nf)
+                    ok[k] = False
+        w = np.linalg.solve(L, gx[..., None])[..., 0]
+        logdet = 2.0 * np.log(np.diagonal(L, axis1=1, axis2=2)).sum(axis=1)
+        ll = ll + 0.5 * (w * w).sum(axis=1) - 0.5 * logdet - 0.5 * nf * np.log(s2)
+        ll[~ok] = -np.inf
+        if not conditional:
+            return ll, None, None
+        Minv = np.linalg.inv(M)
+        mean = np.einsum("kij,kj->ki", Minv, gx)
+        return ll, xm[:, free] + mean, Minv
+
+    def initial_states(
+        self, theta: np.ndarray, rng: np.random.Generator | None = None
+    ) -> np.ndarray | None:
+        """(K, n) initial states [°C or Pa] at the first calibration step for parameter
+        values (K, P) (model then noise): the conditional posterior mean of the estimated
+        nodes, or a draw from it with ``rng``; the steady state with ``"steady"``. None
+        for a controlled model (its simulator finds its own start from ``u_init``).
+        """
+        theta = np.atleast_2d(np.asarray(theta, dtype=float))
+        if self.model.control is not None:
+            return None
+        tm, tn = self.split(theta)
+        with np.errstate(all="ignore"):
+            mf = modal_form(self.model, tm, self.dt)
+            x0 = self._x0_mean(mf)
+            if self.x0_free.size:
+                _, mean, cov = self._marginal(mf, tn, conditional=True)
+                if rng is not None:
+                    cov = 0.5 * (cov + np.swapaxes(cov, 1, 2))
+                    Lc = np.linalg.cholesky(cov + 1e-12 * np.eye(cov.shape[-1]))
+                    mean = mean + np.einsum("kij,kj->ki", Lc, rng.standard_normal(mean.shape))
+                x0[:, self.x0_free] = mean
+        return x0
 
     def __call__(self, X: np.ndarray) -> np.ndarray:
         X = np.asarray(X, dtype=float)
@@ -134,6 +323,7 @@ class LogPosterior:
 
     def pointwise_log_likelihood(self, theta: np.ndarray) -> np.ndarray:
         """(K, N, n_out) log-likelihood terms (NaN where excluded), for LOO."""
-        tm, tn = self.split(np.atleast_2d(theta))
-        Y, _ = self.simulate(tm)
+        theta = np.atleast_2d(theta)
+        tm, tn = self.split(theta)
+        Y, _ = self.simulate(tm, x0=self.initial_states(theta))
         return self.noise.pointwise(Y, self.observed, tn)

@@ -99,7 +99,10 @@ class ModalForm:
 
     def to_modal(self, x0: np.ndarray) -> np.ndarray:
         """Physical state(s) ``x0`` ((n,) or (K, n)) -> modal (K, n)."""
-        return np.einsum("kij,...j->ki", self.Tinv, x0)
+        x0 = np.asarray(x0, dtype=float)
+        if x0.ndim == 1:
+            return np.einsum("kij,j->ki", self.Tinv, x0)
+        return np.einsum("kij,kj->ki", self.Tinv, x0)
 
 
 def modal_form(model, P: np.ndarray, dt: float) -> ModalForm:

@@ -173,7 +173,7 @@ def diagnostics_context(rd: RunData, fits: list[dict]) -> dict:
         if cal.sum() < 4:
             continue
         phi = None
-        if info.get("noise") == "ar1":
+        if info.get("noise") in ("ar1", "ar1_white"):
             pv = (s.get("parameters") or {}).get(f"{m}.phi_{o}") or {}
             phi = pv.get("median")
         resid = fit["resid"][cal]

@@ -27,7 +27,7 @@ def parameter_tables(rd: RunData) -> list[dict]:
             r, e = v.get("r_hat"), v.get("ess_bulk")
             idf = ident.get(name)
             if idf is None:
-                id_text = "noise" if v.get("kind") in ("sigma", "phi") else "—"
+                id_text = "noise" if v.get("kind") in ("sigma", "phi", "sigma_meas") else "—"
             elif idf.get("identifiable"):
                 id_text = "yes"
             elif idf.get("identifiable_given_scale"):

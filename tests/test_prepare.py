@@ -69,7 +69,8 @@ def test_demo_frame_columns_grid_and_periods(demo):
     assert demo.dt == 3600.0
     assert demo.calibration == slice(0, 2136)  # 2019-01-02 .. 2019-04-01
     assert demo.validation == slice(2136, 3192)  # .. 2019-05-15
-    assert demo.warmup_steps == 14 * 24 and demo.init_steps == 30 * 24
+    # no warm-up: both demo models estimate their initial state
+    assert demo.warmup_steps == 0 and demo.init_steps == 30 * 24
     assert f.index[demo.validation.start] == pd.Timestamp("2019-04-01", tz="UTC")
     assert list(demo.flags.columns) == list(f.columns)
     assert not demo.flags.to_numpy().any()
@@ -96,13 +97,15 @@ def test_demo_gap_left_as_nan(demo):
 def test_demo_truth_and_labels(demo):
     assert set(demo.truth) == {"thermal", "hygric"}
     # configs/demo.yaml generates the room with thermal_2c
-    assert set(demo.truth["thermal"]) - {"sigma_Ti", "phi_Ti"} == set(
+    assert set(demo.truth["thermal"]) - {"sigma_Ti", "phi_Ti", "sigma_meas_Ti"} == set(
         hb.model("thermal_2c").parameter_names
     )
     assert demo.sources["demo"]["models"]["thermal"] == "thermal_2c"
     assert {"Cw", "Ci", "Gw", "Gi", "Gfast"} <= set(demo.truth["hygric"])
+    # noise: ar1_white: the model error (AR(1), phi 0.9, sd 0.2 K) and the reading error
     assert 0.15 < demo.truth["thermal"]["sigma_Ti"] < 0.35
-    assert 0.5 < demo.truth["thermal"]["phi_Ti"] < 0.9
+    assert 0.8 < demo.truth["thermal"]["phi_Ti"] < 0.97
+    assert 0.08 < demo.truth["thermal"]["sigma_meas_Ti"] < 0.13
     assert 10 < demo.truth["hygric"]["sigma_Pi"] < 60
     assert 0 < demo.truth["hygric"]["phi_Pi"] < 1
     assert demo.irradiance_source.startswith("measured (TMY3")

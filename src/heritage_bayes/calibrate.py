@@ -129,6 +129,18 @@ def _say_findings(say: _Progress, s: _Section) -> None:
     the summary); the sampler starts inside the support regardless.
     """
     s.map_at_bound = s.logpost.params.at_bound(s.map.x)
+    capped = [n for n, side in s.map_at_bound if n.startswith("phi_") and side == "upper"]
+    if capped and s.logpost.noise.name == "ar1_white":
+        ph = s.logpost.params.parameters[s.logpost.params.names.index(capped[0])].prior.upper
+        hours = -s.logpost.dt / 3600.0 / np.log(ph)
+        say.warn(
+            f"[{s.name}] {', '.join(capped)} at its cap {ph:g}: the misfit stays correlated "
+            f"for longer than the noise model allows (about {hours:.0f} h), so the model "
+            "misses a slow process (a missing input such as solar gains, a heat or "
+            "moisture source, a controlled climate). The simulation is kept responsible "
+            "for the slow response; widen the cap with a prior on "
+            f"{capped[0]} only if the slow misfit is measurement drift"
+        )
     if s.map_at_bound:
         what = ", ".join(f"{n} ({side})" for n, side in s.map_at_bound)
         say.warn(

@@ -40,7 +40,16 @@ TRUTH = dict(
     fsol=0.7,
     sigma_Ti=0.25,
     phi_Ti=0.8,
+    sigma_meas_Ti=0.1,
 )
+
+#: (noise model, initial state) variants timed against the AR(1) steady-state path
+VARIANTS = [
+    ("ar1", "estimate"),
+    ("ar1_white", "steady"),
+    ("ar1_white", "estimate"),
+    ("iid", "estimate"),
+]
 
 
 def problem(n: int = 8760, seed: int = 0) -> LogPosterior:
@@ -97,6 +106,23 @@ def main() -> None:
     print(f"{'ratio naive / vectorised':<58s} {t_ref / t:9.1f} x")
     diff = np.abs(naive_logpost(lp, sub) - lp(sub)).max()
     print(f"{'max |difference| of the two log-posteriors':<58s} {diff:9.2e}")
+    print("\nnoise model and initial state (same problem and batch; ratio to AR(1), steady):")
+    for name, init in VARIANTS:
+        noise = get_noise_model(name)
+        v = LogPosterior(
+            lp.model,
+            parameters_for(lp.model, noise, room_volume=400),
+            noise,
+            lp.inputs,
+            lp.observed,
+            initial_state=init,
+        )
+        xv = v.params.to_unconstrained(np.array([[TRUTH[n] for n in v.params.names]]))
+        Xv = xv + 0.05 * np.random.default_rng(1).standard_normal((32, v.ndim))
+        v(Xv)  # compile
+        tv = best_of(lambda v=v, Xv=Xv: v(Xv), repeat=20, number=5)
+        label = f"  {name}, initial state {init}"
+        print(f"{label:<58s} {32 / tv:9.0f} /s  ({t / tv:.2f} x)")
 
 
 if __name__ == "__main__":

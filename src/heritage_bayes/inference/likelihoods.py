@@ -112,7 +112,7 @@ def _kf_kernel(Ysim, yobs, sigma, phi, w, point, want_point):  # pragma: no cove
 
 @numba.njit(cache=True, nogil=True)
 def _fused_kf(
-    ad, W, z, pw, Cz, yobs, k0, sigma, phi, w, mres, mbas, Pv, last, conv, acc
+    ad, W, z, pw, Cz, yobs, k0, sigma, phi, w, mres, mbas, Pv, last, conv, act, acc
 ):  # pragma: no cover
     """Modal recursion + Gaussian noise filter + initial-state statistics, one pass.
 
@@ -129,7 +129,10 @@ def _fused_kf(
     triangle of H_ij = sum eb_i eb_j/F, where e0 are the innovations of the residual
     with the mean initial state and eb_j those of basis series j, so that the
     log-likelihood with modal initial offset dz is ``-0.5 (acc0 + acc1 - 2 g.dz +
-    dz.H.dz)`` (the gains do not depend on the data).
+    dz.H.dz)`` (the gains do not depend on the data). ``act`` (1,) is the number of
+    basis series still alive: modes come sorted from slow to fast (``eigh``), and a fast
+    mode's free response and filter means reach exactly zero within a few hundred steps
+    (means below 1e-280 are flushed), after which it adds nothing and is skipped.
     """
     Nb, Kn = W.shape
     n_out, n, K = Cz.shape
@@ -142,6 +145,7 @@ def _fused_kf(
     g_b = np.empty(K)
     iF_b = np.empty(K)
     e_b = np.empty(K)
+    nba = act[0]
     for k in range(Nb):
         kk = k0 + k
         for o in range(n_out):
@@ -155,16 +159,24 @@ def _fused_kf(
             lk = last[o]
             if lk >= 0 and kk - lk == 1 and conv[o, 0, 0] == conv[o, 0, 0]:
                 # stationary filter: constant variance, gain and log-determinant
-                for p in range(K):
-                    ph = phi[o, p]
-                    e0 = (y - ysim[p]) - ph * mres[o, p]
-                    mres[o, p] = ph * mres[o, p] + conv[o, 2, p] * e0
-                    acc[0, p] += conv[o, 0, p]
-                    acc[1, p] += e0 * e0 * conv[o, 1, p]
-                    ph_b[p] = ph
-                    g_b[p] = conv[o, 2, p]
-                    iF_b[p] = conv[o, 1, p]
-                    e_b[p] = e0 * conv[o, 1, p]
+                if nba == 0:
+                    for p in range(K):
+                        ph = phi[o, p]
+                        e0 = (y - ysim[p]) - ph * mres[o, p]
+                        mres[o, p] = ph * mres[o, p] + conv[o, 2, p] * e0
+                        acc[0, p] += conv[o, 0, p]
+                        acc[1, p] += e0 * e0 * conv[o, 1, p]
+                else:
+                    for p in range(K):
+                        ph = phi[o, p]
+                        e0 = (y - ysim[p]) - ph * mres[o, p]
+                        mres[o, p] = ph * mres[o, p] + conv[o, 2, p] * e0
+                        acc[0, p] += conv[o, 0, p]
+                        acc[1, p] += e0 * e0 * conv[o, 1, p]
+                        ph_b[p] = ph
+                        g_b[p] = conv[o, 2, p]
+                        iF_b[p] = conv[o, 1, p]
+                        e_b[p] = e0 * conv[o, 1, p]
             else:
                 d = kk - lk
                 stat = lk >= 0 and d == 1
@@ -196,13 +208,13 @@ def _fused_kf(
                     conv[o, 2, p] = g
                 if not stat:
                     conv[o, 0, 0] = np.nan
-            for j in range(nb):
+            for j in range(nba):
                 for p in range(K):
                     e = Cz[o, j, p] * pw[j * K + p] - ph_b[p] * mbas[o, j, p]
                     mbas[o, j, p] = ph_b[p] * mbas[o, j, p] + g_b[p] * e
                     eb[j, p] = e
                     acc[3 + j, p] += e_b[p] * e
-            for i in range(nb):
+            for i in range(nba):
                 for j in range(i + 1):
                     r = 3 + nb + i * nb + j
                     for p in range(K):
@@ -210,9 +222,25 @@ def _fused_kf(
             last[o] = kk
         for i in range(Kn):
             z[i] = ad[i] * z[i] + W[k, i]
-        if nb:
-            for i in range(Kn):
+        if nba:
+            for i in range(nba * K):
                 pw[i] *= ad[i]
+            j = nba - 1
+            dead = True
+            for p in range(K):
+                if pw[j * K + p] != 0.0:
+                    dead = False
+                    break
+            if dead:
+                for o in range(n_out):
+                    for p in range(K):
+                        if abs(mbas[o, j, p]) < 1e-280:
+                            mbas[o, j, p] = 0.0
+                        else:
+                            dead = False
+            if dead:
+                nba -= 1
+    act[0] = nba
 
 
 class NoiseModel:
@@ -284,13 +312,16 @@ class NoiseModel:
         Pv = np.zeros((n_out, K))
         last = np.full(n_out, -1, dtype=np.int64)
         conv = np.full((n_out, 3, K), np.nan)
+        act = np.array([nb], dtype=np.int64)
         acc = np.zeros((3 + nb + nb * nb, K))
         rows = max(256, max_block // max(K * n, 1))
         for k0 in range(0, U.shape[0], rows):
             W = U[k0 : k0 + rows] @ Bcat
             if ecat.any():
                 W += ecat
-            _fused_kf(ad, W, z, pw, Cz, Yobs, k0, sigma, phi, w, mres, mbas, Pv, last, conv, acc)
+            _fused_kf(
+                ad, W, z, pw, Cz, Yobs, k0, sigma, phi, w, mres, mbas, Pv, last, conv, act, acc
+            )
         return acc
 
     def loglik_modal(self, mf, U, z0, Yobs, noise, max_block: int = 2**20) -> np.ndarray:

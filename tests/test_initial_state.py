@@ -142,3 +142,26 @@ def test_initial_state_config_errors():
     cfg = parse_config({**base, "thermal": ctl})
     assert initial_state_of(cfg, "thermal") == "steady"
     assert default_warmup(cfg) == "14D"
+
+
+def test_free_run_error_fit_recovers_a_slow_error():
+    """The predictive error model (fitted after calibration, phi up to 0.999) recovers a
+    slow AR(1) + white process; tolerances: 5 asymptotic standard errors of the AR(1)
+    estimates for n = 6000 (sd(phi) ~ sqrt((1 - phi²)/n), relative sd(sigma) ~
+    sqrt((1 + phi²) / (2 n (1 - phi²))))."""
+    from scipy.signal import lfilter
+
+    from heritage_bayes.inference.likelihoods import fit_free_run_error
+
+    rng = np.random.default_rng(0)
+    n, phi, sigma, w = 6000, 0.99, 0.5, 0.1
+    # stationary start, then the AR(1) recursion
+    shocks = np.r_[rng.normal(0, sigma), rng.normal(0, sigma * np.sqrt(1 - phi**2), n - 1)]
+    e = lfilter([1.0], [1.0, -phi], shocks)
+    r = e + rng.normal(0, w, n)
+    r[100:300] = np.nan
+    fit = fit_free_run_error(r)
+    assert fit["phi"] == pytest.approx(phi, abs=5 * np.sqrt((1 - phi**2) / n))
+    rel = np.sqrt((1 + phi**2) / (2 * n * (1 - phi**2)))
+    assert fit["sigma"] == pytest.approx(sigma, rel=5 * rel)
+    assert fit["sigma_meas"] == pytest.approx(w, rel=0.2)

@@ -50,6 +50,47 @@ def _saved_index(n_chain: int, n_draw: int, n_total: int) -> np.ndarray:
     return np.unique(np.linspace(0, n_draw - 1, m).round().astype(int))
 
 
+def _predictive_noise(s, prep, Ysim: np.ndarray, tn: np.ndarray):
+    """Noise parameters of the predictive bands, and what was changed (or None).
+
+    When the posterior of an ``ar1_white`` correlation sits at its cap, the noise model
+    of the likelihood describes only the misfit's fast part: bands drawn from it would
+    leave out the slow misfit (configs/orholm.yaml: a 90 % band covering 49 % of the
+    hours). The error of *prediction* is then the free-run error: AR(1) + white noise
+    fitted by maximum likelihood (phi up to 0.999) to the calibration residuals of the
+    posterior-median simulation (:func:`fit_free_run_error`), used for every draw's
+    predictive noise. The posterior (and the likelihood) are unchanged.
+    """
+    from heritage_bayes.inference.likelihoods import fit_free_run_error
+
+    nm = s.logpost.noise
+    if "phi" not in nm.kinds or "sigma_meas" not in nm.kinds:
+        return tn, None
+    q = len(nm.kinds)
+    ps = s.logpost.params.parameters[s.logpost.n_model :]
+    obs = np.asarray(prep.observed(s.name, s.model), dtype=float)
+    cal = prep.calibration
+    rows = slice(cal.start + prep.warmup_steps, cal.stop)
+    out, info = tn, {}
+    for o, name in enumerate(s.model.output_names):
+        i_phi = q * o + nm.kinds.index("phi")
+        cap = ps[i_phi].prior.upper
+        if not np.median(tn[:, i_phi]) > cap - 0.05 * (1.0 - cap):
+            continue
+        r = obs[rows, o] - np.median(Ysim[:, rows, o], axis=0)
+        fit = fit_free_run_error(r)
+        out = out.copy() if out is tn else out
+        for kind in ("sigma", "phi", "sigma_meas"):
+            out[:, q * o + nm.kinds.index(kind)] = fit[kind]
+        info[name] = {
+            **fit,
+            "reason": f"phi_{name} at its cap {cap:g}: bands use the free-run error "
+            "(AR(1) + white fitted to the calibration residuals of the posterior-median "
+            "simulation)",
+        }
+    return out, (info or None)
+
+
 def _initial_state_text(lp) -> str:
     """How the initial state of a log-posterior was obtained, in words."""
     mode = lp.initial_state
@@ -176,7 +217,8 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
                     },
                 )
         Ysim, _ = s.logpost.simulate_frame(th_sel, U, prep.calibration.start, x0=x0)
-        noise = s.logpost.noise.sample(rng, tn_sel, U.shape[0], s.model.n_outputs)
+        tn_pred, pred_info = _predictive_noise(s, prep, Ysim, tn_sel)
+        noise = s.logpost.noise.sample(rng, tn_pred, U.shape[0], s.model.n_outputs)
         Ypp = Ysim + noise
         shape = (W, n_sel, U.shape[0])
         pcoords = {"chain": np.arange(W), "draw": np.arange(n_sel), "time": times}
@@ -263,6 +305,7 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
         # fit metrics per output and period
         metrics[s.name] = _metrics_for(prep, codes, s.model.output_names, pp_outputs)
         sec_info[s.name] = {
+            "predictive_noise": pred_info,
             "model": s.model.name,
             "domain": s.model.domain,
             "state_names": list(s.model.state_names),

@@ -43,7 +43,15 @@ import numpy as np
 
 from heritage_bayes.inference.parameters import Prior
 
-__all__ = ["NOISE_MODELS", "AR1Noise", "AR1WhiteNoise", "IIDNoise", "NoiseModel", "get_noise_model"]
+__all__ = [
+    "NOISE_MODELS",
+    "AR1Noise",
+    "AR1WhiteNoise",
+    "IIDNoise",
+    "NoiseModel",
+    "fit_free_run_error",
+    "get_noise_model",
+]
 
 _LOG2PI = math.log(2.0 * math.pi)
 
@@ -433,6 +441,55 @@ NOISE_MODELS: dict[str, type[NoiseModel]] = {
     "ar1": AR1Noise,
     "ar1_white": AR1WhiteNoise,
 }
+
+
+def fit_free_run_error(residual: np.ndarray, phi_max: float = 0.999) -> dict[str, float]:
+    """Maximum-likelihood AR(1) + white parameters of a free-run residual series.
+
+    The error model of *prediction*: with the model's parameters fixed, the residual of
+    its free-run simulation (gaps as NaN) is described by an AR(1) error (marginal sd
+    ``sigma``, coefficient ``phi`` up to ``phi_max``) plus white noise ``sigma_meas``.
+    Fitted after calibration, it cannot flatten the model (the model is fixed), so its
+    correlation need not be capped; its marginal sd is the size of the slow misfit that
+    a capped noise model leaves out of its bands.
+    """
+    from scipy.optimize import minimize
+
+    r = np.ascontiguousarray(residual, dtype=float)
+    ok = np.isfinite(r)
+    if ok.sum() < 10:
+        raise ValueError("fewer than 10 finite residuals to fit a free-run error model")
+    ysim = np.zeros((1, r.size))  # the residual is the series itself
+    dummy = np.empty((1, 1))
+    sd = float(np.sqrt(np.mean(r[ok] ** 2)))
+
+    def unpack(x):
+        return (
+            np.array([math.exp(x[0])]),
+            np.array([phi_max / (1.0 + math.exp(-x[1]))]),
+            np.array([math.exp(x[2])]),
+        )
+
+    def nll(x):
+        sigma, phi, w = unpack(x)
+        v = -_kf_kernel(ysim, r, sigma, phi, w, dummy, False)
+        return float(v[0]) if np.isfinite(v[0]) else 1e300
+
+    best = None
+    for phi0 in (0.5, 0.9, 0.99):
+        x0 = [math.log(sd), math.log(phi0 / (phi_max - phi0)), math.log(0.2 * sd)]
+        res = minimize(
+            nll, x0, method="Nelder-Mead", options={"xatol": 1e-6, "fatol": 1e-6, "maxiter": 4000}
+        )
+        if best is None or res.fun < best.fun:
+            best = res
+    sigma, phi, w = unpack(best.x)
+    return {
+        "sigma": float(sigma[0]),
+        "phi": float(phi[0]),
+        "sigma_meas": float(w[0]),
+        "log_likelihood": float(-best.fun),
+    }
 
 
 def get_noise_model(name: str) -> NoiseModel:

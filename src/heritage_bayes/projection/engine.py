@@ -77,6 +77,13 @@ def select_draws(run, n: int | None, seed: int) -> Draws:
         names = [name for name, _, _ in nm.parameter_specs(m.output_names)]
         cols = [post[f"{section}.{name}"].values.reshape(-1)[idx] for name in names]
         noise[section] = np.column_stack(cols) if cols else np.zeros((len(idx), 0))
+        # the calibration's predictive error model, where it replaced the posterior's
+        pred = ((run.summary.get("models") or {}).get(section) or {}).get("predictive_noise")
+        for out, fit in (pred or {}).items():
+            for kind in ("sigma", "phi", "sigma_meas"):
+                name = f"{kind}_{out}"
+                if name in names:
+                    noise[section][:, names.index(name)] = fit[kind]
         nms[section] = nm
     return Draws(index=idx, model=model, noise=noise, noise_models=nms)
 

@@ -88,6 +88,17 @@ def fit_context(rd: RunData, outputs: list[dict]) -> list[dict]:
             gaps=gaps,
         )
         what = OUT_WORDS.get(o["output"], o["output"])
+        models = rd.summary.get("models") or {}
+        pred = ((models.get(o["section"]) or {}).get("predictive_noise") or {}).get(o["output"])
+        band_note = ""
+        if pred:
+            band_note = (
+                f" The noise model's correlation sits at its cap (about a day), so its "
+                "error model leaves out the slow misfit; the bands use the free-run "
+                f"error instead: AR(1) of sd {pred['sigma']:.3g} with hourly coefficient "
+                f"{pred['phi']:.3f} plus white noise of sd {pred['sigma_meas']:.3g}, fitted "
+                "to the calibration residuals of the posterior-median simulation."
+            )
         items.append(
             {
                 "id": f"fig-fit-{o['section']}-{o['output']}",
@@ -100,7 +111,8 @@ def fit_context(rd: RunData, outputs: list[dict]) -> list[dict]:
                     "(grey, simulated but not fitted), calibration (green), "
                     "validation (orange); hatched: measurement gaps. Bottom: "
                     "two-week details."
-                ),
+                )
+                + band_note,
                 "resid": (y - med),
                 "codes": codes,
                 "times": times_pp,

@@ -165,3 +165,28 @@ def test_free_run_error_fit_recovers_a_slow_error():
     rel = np.sqrt((1 + phi**2) / (2 * n * (1 - phi**2)))
     assert fit["sigma"] == pytest.approx(sigma, rel=5 * rel)
     assert fit["sigma_meas"] == pytest.approx(w, rel=0.2)
+
+
+def test_predicted_vapour_pressure_is_limited_to_saturation():
+    """Pi above saturation at the paired Ti condenses (capped), below 0 is floored; the
+    shares of samples and hours where the limit acted are reported."""
+    from types import SimpleNamespace
+
+    from heritage_bayes.climate.psychro import saturation_vapour_pressure
+    from heritage_bayes.inference.idata import _condensation_cap
+
+    s = SimpleNamespace(model=SimpleNamespace(output_names=("Pi",)))
+    ti = np.array([[10.0, 10.0, 20.0, 20.0], [10.0, 10.0, 20.0, 20.0]])
+    ps = saturation_vapour_pressure(ti)
+    factor = np.array([[0.5, 1.2, 0.9, 1.1], [0.5, 1.3, 0.9, 0.9]])  # draws x hours
+    Ysim = (ps * factor)[..., None]
+    Ypp = Ysim.copy()
+    Ypp[0, 0, 0] = -5.0
+    info = _condensation_cap(s, None, Ysim, Ypp, {"Ti": (ti, ti)})
+    assert np.all(Ypp[..., 0] <= ps + 1e-9) and np.all(Ypp >= 0)
+    assert np.all(Ysim[..., 0] <= ps + 1e-9)
+    rh = 100 * Ypp[..., 0] / ps
+    assert rh.min() == 0.0 and rh.max() == pytest.approx(100.0)
+    assert info["share_noise_free_samples"] == pytest.approx(3 / 8)
+    assert info["share_hours_median_saturated"] == pytest.approx(1 / 4)  # hour 1 only
+    assert info["share_predictive_below_zero"] == pytest.approx(1 / 8)

@@ -50,6 +50,46 @@ def _saved_index(n_chain: int, n_draw: int, n_total: int) -> np.ndarray:
     return np.unique(np.linspace(0, n_draw - 1, m).round().astype(int))
 
 
+def _condensation_cap(s, prep, Ysim: np.ndarray, Ypp: np.ndarray, pp_outputs: dict):
+    """Limit predicted vapour pressure to [0, saturation at the indoor temperature].
+
+    Air cannot hold more vapour than saturation: the excess condenses (on the coldest
+    surfaces first, so the cap at the air temperature is the generous one). The
+    temperature is the thermal model's paired draw (predictive for the predictive
+    series, noise-free for the noise-free one) when the run calibrates one, else the
+    measured ``Ti`` (hours without it are left as they are). In place on ``Ysim`` and
+    ``Ypp``; returns how often the cap acted (shares of draws × hours), or None for a
+    thermal section.
+    """
+    if "Pi" not in s.model.output_names:
+        return None
+    o = s.model.output_names.index("Pi")
+    if "Ti" in pp_outputs:
+        ti_pp, ti_sim = pp_outputs["Ti"]
+        source = "the thermal model's paired draws"
+    elif "Ti" in prep.frame:
+        ti_pp = ti_sim = prep.frame["Ti"].to_numpy(dtype=float)[None, :]
+        source = "the measured indoor temperature"
+    else:
+        return None
+    with np.errstate(invalid="ignore"):
+        ps_pp = saturation_vapour_pressure(ti_pp)
+        ps_sim = saturation_vapour_pressure(ti_sim)
+        over_pp = Ypp[..., o] > ps_pp
+        over_sim = Ysim[..., o] > ps_sim
+        below = Ypp[..., o] < 0.0
+        Ypp[..., o] = np.where(over_pp, ps_pp, np.maximum(Ypp[..., o], 0.0))
+        Ysim[..., o] = np.where(over_sim, ps_sim, np.maximum(Ysim[..., o], 0.0))
+    med_over = np.mean(over_sim, axis=0) > 0.5
+    return {
+        "temperature": source,
+        "share_predictive_samples": float(np.mean(over_pp)),
+        "share_noise_free_samples": float(np.mean(over_sim)),
+        "share_hours_median_saturated": float(np.mean(med_over)),
+        "share_predictive_below_zero": float(np.mean(below)),
+    }
+
+
 def _predictive_noise(s, prep, Ysim: np.ndarray, tn: np.ndarray):
     """Noise parameters of the predictive bands, and what was changed (or None).
 
@@ -220,6 +260,7 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
         tn_pred, pred_info = _predictive_noise(s, prep, Ysim, tn_sel)
         noise = s.logpost.noise.sample(rng, tn_pred, U.shape[0], s.model.n_outputs)
         Ypp = Ysim + noise
+        saturation = _condensation_cap(s, prep, Ysim, Ypp, pp_outputs)
         shape = (W, n_sel, U.shape[0])
         pcoords = {"chain": np.arange(W), "draw": np.arange(n_sel), "time": times}
         for o, out in enumerate(s.model.output_names):
@@ -306,6 +347,7 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
         metrics[s.name] = _metrics_for(prep, codes, s.model.output_names, pp_outputs)
         sec_info[s.name] = {
             "predictive_noise": pred_info,
+            "saturation": saturation,
             "model": s.model.name,
             "domain": s.model.domain,
             "state_names": list(s.model.state_names),

@@ -99,6 +99,21 @@ def fit_context(rd: RunData, outputs: list[dict]) -> list[dict]:
                 f"{pred['phi']:.3f} plus white noise of sd {pred['sigma_meas']:.3g}, fitted "
                 "to the calibration residuals of the posterior-median simulation."
             )
+        sat = (models.get(o["section"]) or {}).get("saturation")
+        if sat and o["output"] == "Pi":
+            band_note += (
+                " Predicted vapour pressure is limited to saturation at the predicted "
+                f"indoor temperature ({sat['temperature']}): the excess would condense. "
+                f"The limit acted on {100 * sat['share_predictive_samples']:.1f} % of the "
+                "predictive samples and on the noise-free median in "
+                f"{100 * sat['share_hours_median_saturated']:.1f} % of the hours"
+                + (
+                    ": the model predicts condensation conditions that often; check them "
+                    "against the measured RH before trusting its dampest hours."
+                    if sat["share_hours_median_saturated"] > 0.01
+                    else "."
+                )
+            )
         items.append(
             {
                 "id": f"fig-fit-{o['section']}-{o['output']}",

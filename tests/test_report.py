@@ -263,7 +263,7 @@ def test_diagnostics_and_reproducibility(report, run_dir):
     diag = html[
         html.index('<section id="diagnostics">') : html.index('<section id="reproducibility">')
     ]
-    assert "AR(1) noise model expects" in diag and "φ =" in diag
+    assert "AR(1) + white noise model expects about" in diag  # the default noise model
     assert "not met" in diag  # τ criterion of a 600-step run
     repro = html[html.index('<section id="reproducibility">') :]
     for lib in (
@@ -518,3 +518,37 @@ def test_report_in_headless_chromium(report):
     assert float(np.mean(rgb.mean(axis=2) < 0.9)) > 0.03, "screenshot is (almost) blank"
     red = (rgb[..., 0] > 0.55) & (rgb[..., 1] < 0.3) & (rgb[..., 2] < 0.3)
     assert red.sum() > 500, "the red verdict banner is not visible"
+
+
+def test_verdict_green_only_when_the_noise_model_checks_pass():
+    """Converged is not enough: white innovations and a validation coverage within the
+    binomial range for the effective number of hours (phi 0.9: n_eff = n/19)."""
+    s = _summary(1.004, 1200)
+    s["parameters"]["thermal.phi_Ti"] = {"median": 0.9}
+    ok_resid = [{"section": "thermal", "output": "Ti", "adequate": True, "check": {}}]
+    s["metrics"] = {"thermal": {"Ti": {"validation": {"coverage90": 0.88, "n": 1900}}}}
+    v = convergence_verdict(s, ok_resid)
+    assert v["level"] == "green" and v["checks"] == []
+    # 1900 hours at phi 0.9: 100 independent; 0.90 +- 2.58 * 0.3 / 10 = +- 0.077
+    s["metrics"]["thermal"]["Ti"]["validation"]["coverage90"] = 0.80
+    v = convergence_verdict(s, ok_resid)
+    assert v["level"] == "amber" and "noise model" in v["title"]
+    assert "covers 80 % of the validation hours (expected 90 ± 8 %" in v["checks"][0]
+    s["metrics"]["thermal"]["Ti"]["validation"]["coverage90"] = 0.84
+    assert convergence_verdict(s, ok_resid)["level"] == "green"
+    bad = [
+        {
+            "section": "thermal",
+            "output": "Ti",
+            "adequate": False,
+            "check": {"out_share": 0.4, "worst_rho": 0.31, "worst_lag_h": 24.0},
+        }
+    ]
+    v = convergence_verdict(s, bad)
+    assert v["level"] == "amber"
+    assert v["checks"] == [
+        "thermal Ti: the noise model leaves correlated innovations (40 % of the lags "
+        "1-72 h outside the 95 % band; largest 0.31 at 24 h)"
+    ]
+    # a run that did not converge stays red whatever the checks
+    assert convergence_verdict(_summary(1.2, 40, tau_ok=False), bad)["level"] == "red"

@@ -93,7 +93,7 @@ def build_context(run_dir) -> dict:
         ctx = {
             "sections": SECTIONS,
             "header": summary.header_context(rd),
-            "verdict": convergence_verdict(rd.summary),
+            "verdict": convergence_verdict(rd.summary, diag["residuals"]),
             "warnings": run_notes(
                 rd.summary, diag["missing"], irradiance_setting=rd.cfg.data.irradiance
             ),

@@ -99,12 +99,21 @@ def _traces(rd: RunData, m: str, info: dict):
     return {"figure": fig, "coords": coords}
 
 
-def _residual_check(resid: np.ndarray, phi: float | None, dt_hours: float) -> dict:
-    from heritage_bayes.report._diag import acf, cumulative_periodogram, innovations
+def _residual_check(
+    resid: np.ndarray, phi: float | None, dt_hours: float, white: tuple | None = None
+) -> dict:
+    """Whiteness of what the noise model leaves: AR(1) innovations, or with ``white``
+    = (sigma, phi, sigma_meas) the standardised Kalman innovations of ``ar1_white``."""
+    from heritage_bayes.report._diag import (
+        acf,
+        cumulative_periodogram,
+        innovations,
+        kalman_innovations,
+    )
 
     max_lag = max(1, round(72 / dt_hours))
     _, rho, n = acf(resid, max_lag)
-    w = innovations(resid, phi or 0.0)
+    w = kalman_innovations(resid, *white) if white else innovations(resid, phi or 0.0)
     _, rho_w, n_w = acf(w, max_lag)
     band = 1.96 / math.sqrt(max(n_w, 1))
     out_share = float(np.mean(np.abs(rho_w[1:]) > band)) if rho_w.size > 1 else float("nan")
@@ -112,8 +121,11 @@ def _residual_check(resid: np.ndarray, phi: float | None, dt_hours: float) -> di
     dev = float(np.nanmax(np.abs(c - 2 * f))) if c.size else float("nan")
     adequate = out_share <= 0.10 and (not math.isfinite(dev) or dev <= kb)
     lag1 = float(rho[1]) if rho.size > 1 else float("nan")
+    worst = int(np.nanargmax(np.abs(rho_w[1:]))) + 1 if rho_w.size > 1 else 0
     return {
         "lag1": lag1,
+        "worst_lag_h": worst * dt_hours,
+        "worst_rho": float(rho_w[worst]) if worst else float("nan"),
         "phi": phi,
         "out_share": out_share,
         "dev": dev,
@@ -172,12 +184,17 @@ def diagnostics_context(rd: RunData, fits: list[dict]) -> dict:
         cal = fit["codes"] == 1
         if cal.sum() < 4:
             continue
-        phi = None
+        phi, white = None, None
+        pars = s.get("parameters") or {}
         if info.get("noise") in ("ar1", "ar1_white"):
-            pv = (s.get("parameters") or {}).get(f"{m}.phi_{o}") or {}
-            phi = pv.get("median")
+            phi = (pars.get(f"{m}.phi_{o}") or {}).get("median")
+        if info.get("noise") == "ar1_white":
+            white = tuple(
+                (pars.get(f"{m}.{k}_{o}") or {}).get("median", 0.0)
+                for k in ("sigma", "phi", "sigma_meas")
+            )
         resid = fit["resid"][cal]
-        check = _residual_check(resid, phi, dt_hours)
+        check = _residual_check(resid, phi, dt_hours, white)
         fig = fig_residuals(
             fit["times"][cal],
             resid,
@@ -186,7 +203,14 @@ def diagnostics_context(rd: RunData, fits: list[dict]) -> dict:
             phi=phi,
             dt_hours=dt_hours,
         )
-        if phi is not None:
+        if white is not None:
+            words = (
+                f"Lag-1 autocorrelation of the residuals {check['lag1']:.2f}; the "
+                f"AR(1) + white noise model expects about "
+                f"{phi * white[0] ** 2 / (white[0] ** 2 + white[2] ** 2):.2f}. "
+            )
+            subject = "the standardised one-step innovations of the AR(1) + white model"
+        elif phi is not None:
             words = (
                 f"Lag-1 autocorrelation of the residuals {check['lag1']:.2f}; the "
                 f"AR(1) noise model expects ≈ φ = {phi:.2f}. "
@@ -213,8 +237,15 @@ def diagnostics_context(rd: RunData, fits: list[dict]) -> dict:
                     if math.isfinite(check["dev"]) and check["dev"] > check["band"]
                     else ""
                 )
-                + "). Correlation the noise model misses (e.g. a daily cycle) makes "
-                "the posterior intervals and predictive bands too narrow."
+                + f"; the largest at a lag of {check['worst_lag_h']:g} h: "
+                f"{check['worst_rho']:.2f}"
+                + (
+                    ", a daily cycle the model misses"
+                    if check["worst_lag_h"] in (24, 48, 72)
+                    else ""
+                )
+                + "). Correlation the noise model misses makes the posterior intervals "
+                "and predictive bands too narrow."
             )
         residuals.append(
             {
@@ -225,6 +256,7 @@ def diagnostics_context(rd: RunData, fits: list[dict]) -> dict:
                 "figure": fig,
                 "words": words,
                 "adequate": check["adequate"],
+                "check": check,
             }
         )
     return {

@@ -9,6 +9,8 @@ filter with statsmodels' unobserved-components model (AR(1) + irregular): both t
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from scipy.stats import multivariate_normal
@@ -173,7 +175,7 @@ def test_predicted_vapour_pressure_is_limited_to_saturation():
     from types import SimpleNamespace
 
     from heritage_bayes.climate.psychro import saturation_vapour_pressure
-    from heritage_bayes.inference.idata import _condensation_cap
+    from heritage_bayes.inference.predictive import condensation_cap
 
     s = SimpleNamespace(model=SimpleNamespace(output_names=("Pi",)))
     ti = np.array([[10.0, 10.0, 20.0, 20.0], [10.0, 10.0, 20.0, 20.0]])
@@ -182,7 +184,7 @@ def test_predicted_vapour_pressure_is_limited_to_saturation():
     Ysim = (ps * factor)[..., None]
     Ypp = Ysim.copy()
     Ypp[0, 0, 0] = -5.0
-    info = _condensation_cap(s, None, Ysim, Ypp, {"Ti": (ti, ti)})
+    info = condensation_cap(s, None, Ysim, Ypp, {"Ti": (ti, ti)})
     assert np.all(Ypp[..., 0] <= ps + 1e-9) and np.all(Ypp >= 0)
     assert np.all(Ysim[..., 0] <= ps + 1e-9)
     rh = 100 * Ypp[..., 0] / ps
@@ -190,3 +192,35 @@ def test_predicted_vapour_pressure_is_limited_to_saturation():
     assert info["share_noise_free_samples"] == pytest.approx(3 / 8)
     assert info["share_hours_median_saturated"] == pytest.approx(1 / 4)  # hour 1 only
     assert info["share_predictive_below_zero"] == pytest.approx(1 / 8)
+
+
+ARMADILLO = Path(__file__).resolve().parents[2] / "shared" / "data" / "armadillo"
+
+
+@pytest.mark.skipif(not ARMADILLO.is_dir(), reason="needs ../shared/data/armadillo")
+def test_armadillo_from_yaml_fits_with_its_initial_state_estimated():
+    """configs/armadillo.yaml (pySIP's TwTi_RoRi as a custom network): the cell starts
+    far from the steady state of its mean inputs; with the start estimated the MAP
+    simulation fits within pySIP's RMSE (0.85 K), the steady start does not."""
+    from heritage_bayes.calibrate import _log_posterior
+    from heritage_bayes.config import load_config
+    from heritage_bayes.inference.optimize import find_map
+    from heritage_bayes.models import build_model
+    from heritage_bayes.prepare import prepare
+
+    cfg = load_config(Path(__file__).resolve().parents[1] / "configs" / "armadillo.yaml")
+    prep = prepare(cfg)
+    m = build_model(cfg, "thermal")
+    rmse = {}
+    for mode in ("estimate", "steady"):
+        lp = _log_posterior(cfg, prep, "thermal", m, cfg.thermal.priors, initial_state=mode)
+        mp = find_map(lp, seed=1, method="differential_evolution", maxiter=100)
+        y = lp.simulate_frame(mp.theta[None], prep.model_inputs("thermal", m), 0)[0][0, :, 0]
+        obs = prep.observed("thermal", m)[:, 0]
+        rmse[mode] = float(np.sqrt(np.nanmean((obs - y) ** 2)))
+        if mode == "estimate":
+            x0 = lp.initial_states(mp.theta[None])[0]
+            assert np.isfinite(obs).sum() == 232
+            assert abs(x0[m.state_names.index("Ti")] - obs[0]) < 1.0  # the start, found
+    assert rmse["estimate"] <= 0.85
+    assert rmse["steady"] > rmse["estimate"]

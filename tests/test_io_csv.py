@@ -304,3 +304,31 @@ def test_averaged_override_and_interval(tmp_path):
 def test_standard_columns_have_units():
     for name, (unit, description, (lo, hi)) in STANDARD_COLUMNS.items():
         assert unit and description and lo < hi, name
+
+
+def test_elapsed_seconds_since_an_origin(tmp_path):
+    """Test-cell exports count seconds (pySIP's ``Time``): ``time_origin`` anchors them."""
+    path = write(
+        tmp_path, "cell.csv", "Time,T_ext,I_sol\n0.0,15.4,14.2\n1800.0,15.0,0\n3600,14.9,3\n"
+    )
+    df = read_csv(
+        path,
+        time_column="Time",
+        time_origin="2020-01-01 00:00",
+        timezone="UTC+1",
+        columns={"Te": "T_ext", "Isol": "I_sol"},
+        averaged=(),
+    )
+    assert list(df.index) == list(
+        pd.date_range("2019-12-31 23:00", periods=3, freq="30min", tz="UTC")
+    )
+    assert df["Te"].tolist() == [15.4, 15.0, 14.9] and df["Isol"].tolist() == [14.2, 0.0, 3.0]
+    with pytest.raises(DataError, match="line 3"):
+        bad = write(tmp_path, "bad.csv", "Time,T_ext\n0,1\nx,2\n")
+        read_csv(
+            bad,
+            time_column="Time",
+            time_origin="2020-01-01",
+            timezone="UTC",
+            columns={"Te": "T_ext"},
+        )

@@ -24,7 +24,13 @@ import numpy as np
 import yaml
 
 from heritage_bayes._version import __version__
-from heritage_bayes.config import MAX_SEED, CalibrationConfig, chain_tag, config_hash
+from heritage_bayes.config import (
+    MAX_SEED,
+    CalibrationConfig,
+    chain_tag,
+    config_hash,
+    parse_duration,
+)
 from heritage_bayes.errors import InputError
 from heritage_bayes.inference.likelihoods import get_noise_model
 from heritage_bayes.inference.parameters import parameters_for
@@ -63,6 +69,7 @@ def _parameters(cfg, section: str, model: RCModel, priors: Mapping):
         air_change_rate=cfg.air_change_rate,
         air_change_sigma=cfg.air_change_sigma,
         where=f"{section}.priors",
+        dt=parse_duration(cfg.data.step).total_seconds(),
     )
     return noise, params
 

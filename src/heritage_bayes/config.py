@@ -192,6 +192,7 @@ class DemoData(_Strict):
 _CSV_ONLY = (
     "time_column",
     "time_format",
+    "time_origin",
     "timezone",
     "columns",
     "sep",
@@ -218,6 +219,9 @@ class Source(_Strict):
     path: str | list[str]
     time_column: str | list[str] | None = None
     time_format: str | None = None
+    time_origin: str | None = Field(
+        default=None, description="the time column holds seconds elapsed since this instant"
+    )
     timezone: str | None = None
     columns: dict[str, str] | None = None
     sep: str = ","
@@ -255,6 +259,16 @@ class Source(_Strict):
             _check_duration(self.interval, positive=True)
         if self.time_format is not None:
             _check_time_format(self.time_format)
+        if self.time_origin is not None:
+            if self.time_format is not None:
+                raise ValueError("time_format: not used with time_origin (elapsed seconds)")
+            try:
+                pd.Timestamp(self.time_origin)
+            except (ValueError, TypeError):
+                raise ValueError(
+                    f"time_origin: expected an instant such as '2016-03-01 00:00' "
+                    f"(got {self.time_origin!r})"
+                ) from None
         if self.sep not in (r"\s+", "\t") and len(self.sep) != 1:
             raise ValueError(
                 f"sep: one character such as ',' or ';', '\\t' for tabs or '\\s+' for "

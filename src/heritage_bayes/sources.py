@@ -22,7 +22,7 @@ __all__ = ["INPUT_COLUMNS", "OUTPUT_COLUMNS", "RawData", "read_source", "read_so
 
 #: Standard columns that weather files may provide (model inputs and what they derive from).
 #: ("Ph": a known heat input [W], e.g. measured heating power of a test cell.)
-INPUT_COLUMNS = ("Te", "RHe", "Pe", "ghi", "dni", "dhi", "Tdew", "Ph")
+INPUT_COLUMNS = ("Te", "RHe", "Pe", "ghi", "dni", "dhi", "Tdew", "Ph", "Isol")
 #: Standard columns that measurement files may provide (model outputs).
 OUTPUT_COLUMNS = ("Ti", "RHi", "Pi")
 
@@ -80,6 +80,7 @@ def _csv_kwargs(src) -> dict:
     kw = {
         "time_column": src.time_column,
         "time_format": src.time_format,
+        "time_origin": src.time_origin,
         "timezone": src.timezone,
         "sep": src.sep,
         "decimal": src.decimal,

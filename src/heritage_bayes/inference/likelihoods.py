@@ -36,7 +36,6 @@ References
 from __future__ import annotations
 
 import math
-from typing import ClassVar
 
 import numba
 import numpy as np
@@ -422,18 +421,20 @@ class AR1WhiteNoise(NoiseModel):
 
     name = "ar1_white"
     kinds = ("sigma", "phi", "sigma_meas")
-    #: The model error's correlation time is capped at about a day: phi <= 0.96 per
-    #: step (tau_e = -dt/ln phi <= 24.5 h at hourly steps). Without a cap the likelihood
-    #: prefers a near-random-walk error that carries the slow (seasonal) response while
-    #: the simulated room goes flat (issue 10; configs/orholm.yaml 2015, thermal: phi ->
-    #: 0.998 and MAP simulation FIT 68 % vs 81 % with iid; with the cap 80 %). What
-    #: persists for longer than a day is the model's to explain; a posterior piled up at
-    #: the cap says the model misses a slow process (the report says so). Override with a
-    #: prior on ``phi_<output>``.
-    prior_overrides: ClassVar[dict] = {
-        ("thermal", "phi"): Prior("uniform", 0.0, 0.96),
-        ("hygric", "phi"): Prior("uniform", 0.0, 0.96),
-    }
+    #: The model error's correlation time tau_e = -dt/ln(phi) is capped at about a day
+    #: (24.5 h: phi <= 0.96 at hourly steps, 0.98 at half-hourly ones). Without a cap the
+    #: likelihood prefers a near-random-walk error that carries the slow (seasonal)
+    #: response while the simulated room goes flat (issue 10; configs/orholm.yaml 2015,
+    #: thermal: phi -> 0.998 and MAP simulation FIT 68 % vs 81 % with iid; with the cap
+    #: 80 %). What persists for longer than a day is the model's to explain; a posterior
+    #: piled up at the cap says the model misses a slow process (the run says so).
+    #: Override with a prior on ``phi_<output>``.
+    TAU_MAX_H = 24.5
+
+    def priors_for(self, dt: float = 3600.0) -> dict:
+        """Default priors that depend on the time step ``dt`` [s]: phi's cap."""
+        cap = round(math.exp(-dt / 3600.0 / self.TAU_MAX_H), 4)
+        return {(dom, "phi"): Prior("uniform", 0.0, cap) for dom in ("thermal", "hygric")}
 
 
 NOISE_MODELS: dict[str, type[NoiseModel]] = {

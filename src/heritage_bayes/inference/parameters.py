@@ -543,8 +543,10 @@ def parameters_for(
     air_change_rate: float | None = None,
     air_change_sigma: float = 1.0,
     where: str = "priors",
+    dt: float = 3600.0,
 ) -> ParameterSet:
-    """The :class:`ParameterSet` of a model and its noise model.
+    """The :class:`ParameterSet` of a model and its noise model (``dt`` [s]: the time
+    step, for noise priors defined per time, e.g. ``ar1_white``'s cap on phi).
 
     Parameters
     ----------
@@ -592,7 +594,7 @@ def parameters_for(
         for n, k, o in noise_specs
     ]
     noise_names = {n for n, _, _ in noise_specs}
-    overrides = getattr(noise, "prior_overrides", {})
+    overrides = noise.priors_for(dt) if hasattr(noise, "priors_for") else {}
     for name, kind, unit, desc in entries:
         prior = default_prior(domain, kind)
         if name in noise_names and (domain, kind) in overrides:

@@ -40,11 +40,17 @@ STANDARD_COLUMNS: dict[str, tuple[str, str, tuple[float, float]]] = {
     "Tdew": ("°C", "outdoor dew-point temperature", (-80.0, 70.0)),
     "Tf": ("°C", "fixed (ground, neighbouring room) temperature", (-60.0, 70.0)),
     "Ph": ("W", "known heat input into the air node (heating power)", (-1e7, 1e7)),
+    "Isol": (
+        "W/m²",
+        "measured irradiance used as a model input as is (a pyranometer in the plane of "
+        "the glazing, a test cell's solar sensor)",
+        (0.0, 1500.0),
+    ),
 }
 
 #: Columns that are interval averages (stamped at the interval end) unless told otherwise.
 AVERAGED_BY_DEFAULT = ("ghi", "dni", "dhi", "Ph")
-IRRADIANCE = ("ghi", "dni", "dhi")
+IRRADIANCE = ("ghi", "dni", "dhi", "Isol")
 #: Negative irradiance down to this value [W/m²] is sensor noise (thermopile night
 #: offset) and is set to 0; below it the value is invalid.
 IRRADIANCE_NOISE = 10.0

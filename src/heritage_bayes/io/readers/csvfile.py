@@ -46,6 +46,7 @@ def read_csv(
     columns: Mapping[str, str] | None = None,
     time_format: str | None = None,
     timezone=None,
+    time_origin: str | None = None,
     sep: str = ",",
     decimal: str = ".",
     averaged: Iterable[str] | None = None,
@@ -77,6 +78,10 @@ def read_csv(
     time_format : str, optional
         :func:`~datetime.datetime.strptime` format, e.g. ``"%d-%m-%Y %H:%M"``. Default:
         inferred from the first timestamp (and every row must then match it).
+    time_origin : str, optional
+        The time column holds elapsed **seconds** since this instant (e.g.
+        ``"2016-03-01 00:00"``, on the clock of ``timezone``), as test-cell and
+        simulation exports do (pySIP's ``Time``). ``time_format`` is then not used.
     timezone : str or tzinfo, optional
         Clock of the naive timestamps: ``"UTC"``, a fixed offset (``"UTC+2"``,
         ``"UTC-03:30"``; no DST) or an IANA zone with DST (``"Europe/Copenhagen"``).
@@ -248,10 +253,15 @@ def read_csv(
     text = parts[0]
     for part in parts[1:]:
         text = text + " " + part
-    try:
-        stamps = pd.to_datetime(text, format=time_format, errors="coerce")
-    except ValueError:  # mixed UTC offsets
-        stamps = pd.to_datetime(text, format=time_format, errors="coerce", utc=True)
+    if time_origin is not None:
+        secs = pd.to_numeric(text, errors="coerce")
+        stamps = pd.Timestamp(time_origin) + pd.to_timedelta(secs, unit="s")
+        time_format = "seconds since " + str(time_origin)
+    else:
+        try:
+            stamps = pd.to_datetime(text, format=time_format, errors="coerce")
+        except ValueError:  # mixed UTC offsets
+            stamps = pd.to_datetime(text, format=time_format, errors="coerce", utc=True)
     bad = stamps.isna().to_numpy()
     if bad.any():
         i = int(np.flatnonzero(bad)[0])

@@ -30,6 +30,7 @@ def _parameter_set(rd: RunData, m: str):
             sec.priors,
             room_volume=sec.room_volume or rd.cfg.room_volume,
             where=f"{m}.priors",
+            dt=float(rd.summary.get("dt", 3600.0)),
         )
     except (InputError, AttributeError, KeyError, ValueError):
         return None

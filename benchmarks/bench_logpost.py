@@ -41,6 +41,9 @@ TRUTH = dict(
     sigma_Ti=0.25,
     phi_Ti=0.8,
     sigma_meas_Ti=0.1,
+    q_Tw=0.05,
+    q_Ti=0.05,
+    q_Tint=0.05,
 )
 
 #: (noise model, initial state) variants timed against the AR(1) steady-state path
@@ -49,6 +52,7 @@ VARIANTS = [
     ("ar1_white", "steady"),
     ("ar1_white", "estimate"),
     ("iid", "estimate"),
+    ("kalman", "estimate"),
 ]
 
 

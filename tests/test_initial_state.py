@@ -224,3 +224,12 @@ def test_armadillo_from_yaml_fits_with_its_initial_state_estimated():
             assert abs(x0[m.state_names.index("Ti")] - obs[0]) < 1.0  # the start, found
     assert rmse["estimate"] <= 0.85
     assert rmse["steady"] > rmse["estimate"]
+    # pySIP's own likelihood (process noise on the nodes): its log-likelihood, ~ +329
+    kal = cfg.thermal.model_copy(update={"noise": "kalman"})
+    cfg = cfg.model_copy(update={"thermal": kal})
+    lp = _log_posterior(cfg, prep, "thermal", m, cfg.thermal.priors)
+    mp = find_map(lp, seed=1, method="differential_evolution", maxiter=100)
+    assert lp.log_likelihood(mp.theta[None])[0] >= 325
+    x0 = lp.initial_states(mp.theta[None])
+    y = lp.simulate_frame(mp.theta[None], prep.model_inputs("thermal", m), 0, x0=x0)[0][0, :, 0]
+    assert np.sqrt(np.nanmean((prep.observed("thermal", m)[:, 0] - y) ** 2)) <= 0.85

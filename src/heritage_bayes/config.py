@@ -467,7 +467,7 @@ class ModelSection(_Strict):
 
     model: str | dict[str, Any]
     options: dict[str, Any] = Field(default_factory=dict)
-    noise: Literal["ar1_white", "ar1", "iid"] = "ar1_white"
+    noise: Literal["ar1_white", "ar1", "iid", "kalman"] = "ar1_white"
     initial_state: Literal["estimate", "steady"] | dict[str, float] | None = Field(
         default=None,
         description="'estimate' (integrated out exactly; default for linear models), "

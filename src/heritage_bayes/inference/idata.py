@@ -24,6 +24,7 @@ from heritage_bayes.inference.predictive import (
     predictive_noise,
 )
 from heritage_bayes.inference.results import coverage, fit_metrics
+from heritage_bayes.rc.discretize import modal_form
 from heritage_bayes.rc.identify import derived_quantities, derived_units
 
 __all__ = ["CONVERGENCE", "build_run_outputs"]
@@ -173,7 +174,13 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
                 )
         Ysim, _ = s.logpost.simulate_frame(th_sel, U, prep.calibration.start, x0=x0)
         tn_pred, pred_info = predictive_noise(s, prep, Ysim, tn_sel)
-        noise = s.logpost.noise.sample(rng, tn_pred, U.shape[0], s.model.n_outputs)
+        if getattr(s.logpost.noise, "statespace", False):
+            mf = modal_form(s.model, th_sel[:, : s.logpost.n_model], prep.dt)
+            noise = s.logpost.noise.sample_statespace(
+                rng, mf, tn_pred, U.shape[0], s.model.n_outputs
+            )
+        else:
+            noise = s.logpost.noise.sample(rng, tn_pred, U.shape[0], s.model.n_outputs)
         Ypp = Ysim + noise
         saturation = condensation_cap(s, prep, Ysim, Ypp, pp_outputs)
         shape = (W, n_sel, U.shape[0])

@@ -281,6 +281,9 @@ _DEFAULTS: dict[tuple[str, str], Prior] = {
     # white measurement noise of noise: ar1_white: sensor noise and rounding
     ("thermal", "sigma_meas"): Prior("loguniform", 1e-3, 10.0),
     ("hygric", "sigma_meas"): Prior("loguniform", 1e-1, 1e3),
+    # process-noise diffusion of a node (noise: kalman) [K/√h], [Pa/√h]
+    ("thermal", "diffusion"): Prior("loguniform", 1e-4, 10.0),
+    ("hygric", "diffusion"): Prior("loguniform", 1e-2, 1e3),
 }
 
 
@@ -300,6 +303,7 @@ _NOISE_DESCRIPTION = {
     "sigma": "marginal sd of the model error of",
     "phi": "AR(1) coefficient (per time step) of the model error of",
     "sigma_meas": "sd of the white measurement noise of",
+    "diffusion": "process-noise diffusion (per square root of an hour) of node",
 }
 
 
@@ -568,7 +572,11 @@ def parameters_for(
     priors = dict(priors or {})
     domain = model.domain
     specs: list[Parameter] = []
-    noise_specs = noise.parameter_specs(model.output_names)
+    noise_specs = (
+        noise.parameter_specs(model.output_names, model.state_names)
+        if getattr(noise, "statespace", False)
+        else noise.parameter_specs(model.output_names)
+    )
     known = set(model.parameter_names) | {n for n, _, _ in noise_specs}
     unknown = sorted(set(priors) - known)
     if unknown:
@@ -588,7 +596,11 @@ def parameters_for(
         (
             n,
             k,
-            out_units[o] if k.startswith("sigma") else "-",
+            out_units[o]
+            if k.startswith("sigma")
+            else f"{'K' if domain == 'thermal' else 'Pa'}/√h"
+            if k == "diffusion"
+            else "-",
             f"{_NOISE_DESCRIPTION.get(k, k)} {o}",
         )
         for n, k, o in noise_specs

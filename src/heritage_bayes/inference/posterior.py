@@ -134,6 +134,11 @@ class LogPosterior:
                 f"initial_state: expected 'estimate', 'steady' or a mapping node -> value "
                 f"(got {mode!r})"
             )
+        if self.model.control is not None and getattr(self.noise, "statespace", False):
+            raise ValueError(
+                f"noise: {self.noise.name!r} filters a model that is linear in its state; "
+                f"{self.model.name!r} is controlled (thermostat/humidistat): use ar1_white"
+            )
         if free and self.model.control is not None:
             raise ValueError(
                 f"initial_state: {mode!r} needs a model that is linear in its state; "
@@ -216,7 +221,12 @@ class LogPosterior:
             return ll
         with np.errstate(all="ignore"):
             mf = modal_form(self.model, tm, self.dt)
-            ll = self._marginal(mf, tn)[0]
+            if getattr(self.noise, "statespace", False):
+                ll = self.noise.filter(
+                    self.model, mf, self.inputs, self.observed, tn, *self._x0_prior(mf)
+                )
+            else:
+                ll = self._marginal(mf, tn)[0]
         ll[~mf.valid] = -np.inf
         ll[~np.isfinite(ll)] = -np.inf
         return ll
@@ -228,6 +238,55 @@ class LogPosterior:
         for i, v in self.x0_fixed.items():
             x[:, i] = v
         return np.where(np.isfinite(x), x, 0.0)
+
+    def _x0_prior(self, mf) -> tuple[np.ndarray, np.ndarray]:
+        """Initial-state prior: mean (K, n) and covariance (K, n, n) [°C², Pa²]."""
+        xm = self._x0_mean(mf)
+        K, n = xm.shape
+        P0 = np.zeros((K, n, n))
+        f = self.x0_free
+        P0[:, f, f] = self.initial_state_sd**2
+        return xm, P0
+
+    def _statespace_x0(self, mf, tn, xm):
+        """Conditional posterior of the estimated initial nodes under ``noise: kalman``:
+        mean (K, nf) and covariance (K, nf, nf) [°C or Pa].
+
+        With the start fixed, the filter's log-likelihood is exactly quadratic in it (the
+        gains do not depend on the data), so its gradient g and curvature H follow from
+        filter runs at the prior mean and at unit offsets of each node (and pairs), and
+        the posterior is N(M⁻¹g, M⁻¹) with M = H + I/s0² around the prior mean.
+        """
+        K, n = xm.shape
+        free = list(self.x0_free)
+        zero = np.zeros((K, n, n))
+
+        def ll(offset):
+            return self.noise.filter(
+                self.model, mf, self.inputs, self.observed, tn, xm + offset, zero
+            )
+
+        def unit(*idx):
+            d = np.zeros((K, n))
+            for i, sgn in idx:
+                d[:, i] += sgn
+            return d
+
+        nf = len(free)
+        l0 = ll(np.zeros((K, n)))
+        lp = {i: ll(unit((i, 1.0))) for i in free}
+        lm = {i: ll(unit((i, -1.0))) for i in free}
+        g = np.stack([(lp[i] - lm[i]) / 2.0 for i in free], axis=1)
+        H = np.zeros((K, nf, nf))
+        for a, i in enumerate(free):
+            H[:, a, a] = -(lp[i] + lm[i] - 2.0 * l0)
+            for b in range(a):
+                j = free[b]
+                hij = -(ll(unit((i, 1.0), (j, 1.0))) - lp[i] - lp[j] + l0)
+                H[:, a, b] = H[:, b, a] = hij
+        M = H + np.eye(nf) / self.initial_state_sd**2
+        cov = np.linalg.inv(M)
+        return xm[:, free] + np.einsum("kij,kj->ki", cov, g), cov
 
     def _marginal(self, mf, tn: np.ndarray, conditional: bool = False):
         """(K,) log-likelihood with the initial-state deviation integrated out, and with
@@ -292,7 +351,13 @@ class LogPosterior:
         with np.errstate(all="ignore"):
             mf = modal_form(self.model, tm, self.dt)
             x0 = self._x0_mean(mf)
-            if self.x0_free.size:
+            if self.x0_free.size and getattr(self.noise, "statespace", False):
+                mean, cov = self._statespace_x0(mf, tn, x0)
+                if rng is not None:
+                    Lc = np.linalg.cholesky(cov + 1e-12 * np.eye(cov.shape[-1]))
+                    mean = mean + np.einsum("kij,kj->ki", Lc, rng.standard_normal(mean.shape))
+                x0[:, self.x0_free] = mean
+            elif self.x0_free.size:
                 _, mean, cov = self._marginal(mf, tn, conditional=True)
                 if rng is not None:
                     cov = 0.5 * (cov + np.swapaxes(cov, 1, 2))
@@ -325,5 +390,10 @@ class LogPosterior:
         """(K, N, n_out) log-likelihood terms (NaN where excluded), for LOO."""
         theta = np.atleast_2d(theta)
         tm, tn = self.split(theta)
+        if getattr(self.noise, "statespace", False):  # one-step predictive densities
+            mf = modal_form(self.model, tm, self.dt)
+            return self.noise.filter(
+                self.model, mf, self.inputs, self.observed, tn, *self._x0_prior(mf), True
+            )[1]
         Y, _ = self.simulate(tm, x0=self.initial_states(theta))
         return self.noise.pointwise(Y, self.observed, tn)

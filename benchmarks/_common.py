@@ -20,3 +20,30 @@ def report(label: str, seconds: float, target: float | None = None) -> None:
     verdict = "" if target is None else ("  [ok]" if seconds <= target else "  [SLOW]")
     tgt = "" if target is None else f"  (target <= {target * 1e3:.0f} ms)"
     print(f"{label:<58s} {seconds * 1e3:9.2f} ms{tgt}{verdict}")
+
+
+def config_map(cfg, section: str):
+    """Prepared data, model, log-posterior and MAP of one section of a config, with the
+    config's optimiser settings and seed (what ``hbayes calibrate`` does before sampling).
+    """
+    from threadpoolctl import threadpool_limits
+
+    from heritage_bayes.calibrate import _log_posterior
+    from heritage_bayes.inference.optimize import find_map
+    from heritage_bayes.models import build_model
+    from heritage_bayes.prepare import prepare
+
+    opt = cfg.optimizer
+    with threadpool_limits(limits=1, user_api="blas"):
+        prep = prepare(cfg)
+        m = build_model(cfg, section)
+        lp = _log_posterior(cfg, prep, section, m, getattr(cfg, section).priors)
+        mp = find_map(
+            lp,
+            seed=cfg.seed,
+            method=opt.method,
+            popsize=opt.popsize,
+            maxiter=opt.maxiter,
+            starts=opt.starts,
+        )
+    return prep, m, lp, mp

@@ -13,13 +13,9 @@ from __future__ import annotations
 import sys
 
 import numpy as np
-from threadpoolctl import threadpool_limits
 
-from heritage_bayes.calibrate import _log_posterior
+from _common import config_map
 from heritage_bayes.config import load_config
-from heritage_bayes.inference.optimize import find_map
-from heritage_bayes.models import build_model
-from heritage_bayes.prepare import prepare
 from heritage_bayes.rc.derived import derived_quantities
 
 QUANTITIES = ("tau_1_h", "gain_Ti_Te", "tau_2_h")
@@ -33,19 +29,7 @@ def main(seeds: list[int]) -> None:
         cfg = cfg0.model_copy(
             update={"data": cfg0.data.model_copy(update={"demo": demo}), "hygric": None}
         )
-        opt = cfg.optimizer
-        with threadpool_limits(limits=1, user_api="blas"):
-            prep = prepare(cfg)
-            m = build_model(cfg, "thermal")
-            lp = _log_posterior(cfg, prep, "thermal", m, cfg.thermal.priors)
-            mp = find_map(
-                lp,
-                seed=cfg.seed,
-                method=opt.method,
-                popsize=opt.popsize,
-                maxiter=opt.maxiter,
-                starts=opt.starts,
-            )
+        prep, m, lp, mp = config_map(cfg, "thermal")
         truth = prep.truth["thermal"]
         est = derived_quantities(m, mp.theta[None, : lp.n_model])
         ref = derived_quantities(m, np.array([[truth[k] for k in m.parameter_names]]))

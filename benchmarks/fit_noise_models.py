@@ -17,14 +17,10 @@ import argparse
 import time
 
 import numpy as np
-from threadpoolctl import threadpool_limits
 
-from heritage_bayes.calibrate import _log_posterior
+from _common import config_map
 from heritage_bayes.config import load_config
-from heritage_bayes.inference.optimize import find_map
 from heritage_bayes.inference.results import fit_metrics
-from heritage_bayes.models import build_model
-from heritage_bayes.prepare import prepare
 
 
 def _acf(r: np.ndarray, lag: int) -> float:
@@ -46,18 +42,7 @@ def fit(cfg, section: str, model: str, noise: str) -> dict:
     sec = sec.model_copy(update={"noise": name, "model": model, "priors": priors})
     cfg = cfg.model_copy(update={section: sec, other: None})
     t0 = time.process_time()
-    prep = prepare(cfg)
-    m = build_model(cfg, section)
-    lp = _log_posterior(cfg, prep, section, m, priors)
-    opt = cfg.optimizer
-    mp = find_map(
-        lp,
-        seed=cfg.seed,
-        method=opt.method,
-        popsize=opt.popsize,
-        maxiter=opt.maxiter,
-        starts=opt.starts,
-    )
+    prep, m, lp, mp = config_map(cfg, section)
     y = lp.simulate_frame(mp.theta[None], prep.model_inputs(section, m), prep.calibration.start)
     y = y[0][0]
     obs = prep.observed(section, m)
@@ -94,18 +79,17 @@ def main() -> None:
     args = ap.parse_args()
     cfg = load_config(args.config)
     print(f"{args.config} [{args.section}]: MAP simulation FIT cal / val [%]")
-    with threadpool_limits(limits=1, user_api="blas"):
-        for model in args.models.split(","):
-            for noise in args.noise.split(","):
-                r = fit(cfg, args.section, model, noise)
-                fits = " / ".join(f"{f:.1f}" for f in r["fit"])
-                nz = ", ".join(f"{k} {v:.3g}" for k, v in r["noise"].items())
-                bound = ", ".join(f"{n} ({side})" for n, side in r["at_bound"]) or "none"
-                print(
-                    f"  {model:16s} {noise:16s} FIT {fits:13s} {nz}; at a bound: {bound}; "
-                    f"log-lik {r['loglik']:.1f}; residual ACF 24 h {r['acf'][24]:.2f}, "
-                    f"168 h {r['acf'][168]:.2f}; {r['cpu']:.0f} s CPU"
-                )
+    for model in args.models.split(","):
+        for noise in args.noise.split(","):
+            r = fit(cfg, args.section, model, noise)
+            fits = " / ".join(f"{f:.1f}" for f in r["fit"])
+            nz = ", ".join(f"{k} {v:.3g}" for k, v in r["noise"].items())
+            bound = ", ".join(f"{n} ({side})" for n, side in r["at_bound"]) or "none"
+            print(
+                f"  {model:16s} {noise:16s} FIT {fits:13s} {nz}; at a bound: {bound}; "
+                f"log-lik {r['loglik']:.1f}; residual ACF 24 h {r['acf'][24]:.2f}, "
+                f"168 h {r['acf'][168]:.2f}; {r['cpu']:.0f} s CPU"
+            )
 
 
 if __name__ == "__main__":

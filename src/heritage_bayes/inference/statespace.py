@@ -75,14 +75,47 @@ def _kalman_modal(ad, W, Qd, Cz, yobs, R, z, P, point, want_point):  # pragma: n
     ``point`` (K, N, n_out) gets the one-step log predictive density of each
     observation when ``want_point``. Outputs are filtered one at a time (sequential
     processing, exact for independent measurement errors).
+
+    Steady state: the covariance recursion does not depend on the data, only on which
+    observations are present. Once a fully observed step leaves the predicted
+    covariance unchanged to rounding (relative change ≤ 1e-15 of its largest entry),
+    the gains of the following fully observed steps are those of that step, so only
+    the mean is propagated (the result is the same to rounding); a missing value
+    restarts the covariance recursion.
     """
     K, n = ad.shape
     N, n_out = yobs.shape
     out = np.zeros(K)
     PC = np.empty(n)
+    Pold = np.empty((n, n))
+    Gs = np.empty((n_out, n))  # steady gains P C^T / S per output
+    Ss = np.empty(n_out)  # steady innovation variances
     for p in range(K):
         tot = 0.0
+        steady = False
+        fullprev = False
         for k in range(N):
+            full = True
+            for o in range(n_out):
+                if yobs[k, o] != yobs[k, o]:
+                    full = False
+            if full and steady:
+                for o in range(n_out):
+                    yhat = 0.0
+                    for i in range(n):
+                        yhat += Cz[p, o, i] * z[p, i]
+                    S = Ss[o]
+                    e = yobs[k, o] - yhat
+                    term = -0.5 * (_LOG2PI + math.log(S) + e * e / S)
+                    tot += term
+                    if want_point:
+                        point[p, k, o] = term
+                    for i in range(n):
+                        z[p, i] += Gs[o, i] * e
+                for i in range(n):
+                    z[p, i] = ad[p, i] * z[p, i] + W[k, p, i]
+                continue
+            steady = False
             for o in range(n_out):
                 y = yobs[k, o]
                 if y != y:
@@ -104,7 +137,9 @@ def _kalman_modal(ad, W, Qd, Cz, yobs, R, z, P, point, want_point):  # pragma: n
                 tot += term
                 if want_point:
                     point[p, k, o] = term
+                Ss[o] = S
                 for i in range(n):
+                    Gs[o, i] = PC[i] / S
                     z[p, i] += PC[i] * e / S
                 for i in range(n):
                     for j in range(n):
@@ -112,9 +147,18 @@ def _kalman_modal(ad, W, Qd, Cz, yobs, R, z, P, point, want_point):  # pragma: n
             # predict to the next step
             for i in range(n):
                 z[p, i] = ad[p, i] * z[p, i] + W[k, p, i]
+            dmax = 0.0
+            pmax = 0.0
             for i in range(n):
                 for j in range(n):
-                    P[p, i, j] = ad[p, i] * ad[p, j] * P[p, i, j] + Qd[p, i, j]
+                    v = ad[p, i] * ad[p, j] * P[p, i, j] + Qd[p, i, j]
+                    dmax = max(dmax, abs(v - Pold[i, j]))
+                    pmax = max(pmax, abs(v))
+                    Pold[i, j] = v
+                    P[p, i, j] = v
+            # two consecutive fully observed steps with the same predicted covariance
+            steady = full and k > 0 and dmax <= 1e-15 * pmax and fullprev
+            fullprev = full
         out[p] = tot
     return out
 
@@ -145,7 +189,10 @@ class KalmanNoise(NoiseModel):
         n_out = mf.Cz.shape[1]
         R, q = self.split_statespace(noise, n_out)
         Qd = modal_process_noise(mf, q)
-        W = np.einsum("nm,kjm->nkj", U, mf.Bdz) + mf.edz[None]
+        n_in = U.shape[1]
+        W = (U @ mf.Bdz.reshape(K * n, n_in).T).reshape(U.shape[0], K, n)  # (N, K, n)
+        if mf.ez.any():
+            W += mf.edz[None]
         z = np.ascontiguousarray(mf.to_modal(x0_mean))
         Ti = mf.Tinv
         P = np.ascontiguousarray(Ti @ P0 @ np.swapaxes(Ti, 1, 2))

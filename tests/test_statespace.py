@@ -141,9 +141,13 @@ def test_kalman_steady_gains_match_statsmodels(gaps):
     assert lp.log_likelihood(theta[None])[0] == pytest.approx(ref, rel=1e-8)
     # the one-step terms agree with statsmodels' too (llf_obs), gaps excluded
     pw = lp.pointwise_log_likelihood(theta[None])[0, :, 0]
-    llf_obs = mod.ssm.filter().llf_obs
+    res = mod.ssm.filter()
     ok = np.isfinite(y)
-    assert np.allclose(pw[ok], llf_obs[ok], rtol=1e-8, atol=1e-10)
+    assert np.allclose(pw[ok], res.llf_obs[ok], rtol=1e-8, atol=1e-10)
+    # one-step-ahead predictive mean and variance at every row (gaps included)
+    mean, var = lp.noise.one_step(lp, theta[None])
+    assert np.allclose(mean[0, :, 0], res.forecasts[0], rtol=1e-10, atol=1e-8)
+    assert np.allclose(var[0, :, 0], res.forecasts_error_cov[0, 0], rtol=1e-8)
 
 
 def test_free_run_predictive_noise_moments():

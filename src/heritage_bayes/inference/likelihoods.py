@@ -495,10 +495,8 @@ def fit_free_run_error(residual: np.ndarray, phi_max: float = 0.999) -> dict[str
 
 def get_noise_model(name: str) -> NoiseModel:
     """Noise model by name (``"ar1_white"``, ``"ar1"``, ``"iid"`` or ``"kalman"``)."""
-    if name == "kalman":  # the state-space likelihood lives in its own module
-        from heritage_bayes.inference.statespace import KalmanNoise
-
-        return KalmanNoise()
+    # "kalman" (inference/statespace.py) registers itself in NOISE_MODELS; the package
+    # imports that module, so no import back from here (no import cycle)
     try:
         return NOISE_MODELS[name]()
     except KeyError:

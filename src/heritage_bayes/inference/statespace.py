@@ -44,7 +44,8 @@ import math
 import numba
 import numpy as np
 
-from heritage_bayes.inference.likelihoods import NoiseModel
+from heritage_bayes.inference.likelihoods import NOISE_MODELS, NoiseModel
+from heritage_bayes.rc.discretize import modal_form
 
 __all__ = ["KalmanNoise", "modal_process_noise"]
 
@@ -66,15 +67,17 @@ def modal_process_noise(mf, q: np.ndarray) -> np.ndarray:
 
 
 @numba.njit(cache=True, nogil=True)
-def _kalman_modal(ad, W, Qd, Cz, yobs, R, z, P, point, want_point):  # pragma: no cover
+def _kalman_modal(ad, W, Qd, Cz, yobs, R, z, P, point, pred, want_point):  # pragma: no cover
     """Kalman filter on decoupled modes, batched over K parameter sets.
 
     ad (K, n); W (N, K, n) deterministic modal forcing per step; Qd (K, n, n); Cz (K,
     n_out, n); yobs (N, n_out) NaN = missing; R (K, n_out) measurement variances; z (K,
     n), P (K, n, n) the state at step 0 (updated in place). Returns (K,) log-likelihood;
     ``point`` (K, N, n_out) gets the one-step log predictive density of each
-    observation when ``want_point``. Outputs are filtered one at a time (sequential
-    processing, exact for independent measurement errors).
+    observation when ``want_point``, and ``pred`` (2, K, N, n_out) the one-step-ahead
+    predictive mean and variance of every output (missing ones included). Outputs are
+    filtered one at a time (sequential processing, exact for independent measurement
+    errors).
 
     Steady state: the covariance recursion does not depend on the data, only on which
     observations are present. Once a fully observed step leaves the predicted
@@ -110,6 +113,8 @@ def _kalman_modal(ad, W, Qd, Cz, yobs, R, z, P, point, want_point):  # pragma: n
                     tot += term
                     if want_point:
                         point[p, k, o] = term
+                        pred[0, p, k, o] = yhat
+                        pred[1, p, k, o] = S
                     for i in range(n):
                         z[p, i] += Gs[o, i] * e
                 for i in range(n):
@@ -118,9 +123,7 @@ def _kalman_modal(ad, W, Qd, Cz, yobs, R, z, P, point, want_point):  # pragma: n
             steady = False
             for o in range(n_out):
                 y = yobs[k, o]
-                if y != y:
-                    if want_point:
-                        point[p, k, o] = np.nan
+                if y != y and not want_point:
                     continue
                 yhat = 0.0
                 for i in range(n):
@@ -132,6 +135,12 @@ def _kalman_modal(ad, W, Qd, Cz, yobs, R, z, P, point, want_point):  # pragma: n
                         acc += P[p, i, j] * Cz[p, o, j]
                     PC[i] = acc
                     S += Cz[p, o, i] * acc
+                if want_point:
+                    pred[0, p, k, o] = yhat
+                    pred[1, p, k, o] = S
+                    if y != y:
+                        point[p, k, o] = np.nan
+                        continue
                 e = y - yhat
                 term = -0.5 * (_LOG2PI + math.log(S) + e * e / S)
                 tot += term
@@ -182,9 +191,14 @@ class KalmanNoise(NoiseModel):
         return sig * sig, q
 
     def filter(self, model, mf, U, Yobs, noise, x0_mean, P0, want_point=False):
-        """(K,) log-likelihood (and (K, N, n_out) pointwise terms with ``want_point``)
-        from a modal form, inputs ``U`` (N, m), initial mean ``x0_mean`` (K, n) and
-        covariance ``P0`` (K, n, n) in physical coordinates."""
+        """(K,) log-likelihood from a modal form, inputs ``U`` (N, m), initial mean
+        ``x0_mean`` (K, n) and covariance ``P0`` (K, n, n) in physical coordinates.
+
+        With ``want_point``: ``(loglik, point, mean, var)``, the (K, N, n_out) one-step
+        log predictive densities (NaN where missing) and the one-step-ahead predictive
+        mean and variance of each output given the observations before it (the
+        measurement noise included; defined at missing rows too).
+        """
         K, n = mf.lam.shape
         n_out = mf.Cz.shape[1]
         R, q = self.split_statespace(noise, n_out)
@@ -196,7 +210,8 @@ class KalmanNoise(NoiseModel):
         z = np.ascontiguousarray(mf.to_modal(x0_mean))
         Ti = mf.Tinv
         P = np.ascontiguousarray(Ti @ P0 @ np.swapaxes(Ti, 1, 2))
-        point = np.empty((K, Yobs.shape[0], n_out) if want_point else (1, 1, 1))
+        shape = (K, Yobs.shape[0], n_out) if want_point else (1, 1, 1)
+        point, pred = np.empty(shape), np.empty((2, *shape))
         ll = _kalman_modal(
             np.ascontiguousarray(mf.ad),
             np.ascontiguousarray(W),
@@ -207,9 +222,31 @@ class KalmanNoise(NoiseModel):
             z,
             P,
             point,
+            pred,
             want_point,
         )
-        return (ll, point) if want_point else ll
+        return (ll, point, pred[0], pred[1]) if want_point else ll
+
+    def one_step(self, logpost, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """One-step-ahead predictive mean and variance (K, N, n_out) [°C, K²] or [Pa,
+        Pa²] of the outputs over a posterior's record for values ``theta`` (K, P): the
+        filter's prediction of each row from the observations before it (initial state
+        from its prior), measurement noise included. Bands: mean ± z·√var."""
+        theta = np.atleast_2d(np.asarray(theta, dtype=float))
+        tm, tn = logpost.split(theta)
+        with np.errstate(all="ignore"):
+            mf = modal_form(logpost.model, tm, logpost.dt)
+            _, _, mean, var = self.filter(
+                logpost.model,
+                mf,
+                logpost.inputs,
+                logpost.observed,
+                tn,
+                *logpost._x0_prior(mf),
+                True,
+            )
+        mean[~mf.valid], var[~mf.valid] = np.nan, np.nan
+        return mean, var
 
     def sample_statespace(self, rng, mf, noise, N: int, n_out: int) -> np.ndarray:
         """(K, N, n_out) free-run predictive noise: the process noise propagated through
@@ -224,3 +261,6 @@ class KalmanNoise(NoiseModel):
             out[:, k, :] = np.einsum("koj,kj->ko", mf.Cz, d)
             d = mf.ad * d + np.einsum("kij,kj->ki", L, rng.standard_normal((K, n)))
         return out + np.sqrt(R)[:, None, :] * rng.standard_normal((K, N, n_out))
+
+
+NOISE_MODELS["kalman"] = KalmanNoise  # get_noise_model("kalman")

@@ -77,18 +77,26 @@ def _pointwise(s, pw: np.ndarray, times: np.ndarray, shape) -> dict[str, xr.Data
     return out
 
 
-def _validation_pointwise(s, prep, Ysim, tn) -> np.ndarray:
+def _validation_pointwise(s, prep, Ysim, tn, th=None) -> np.ndarray:
     """(K, N, n_out) one-step predictive log densities of the validation observations.
 
     ``Ysim`` is the simulation over the whole frame (from the calibration's initial
     state); the noise model conditions each term on the previous validation residual (the
-    first one has the stationary variance), NaN outside the validation period.
+    first one has the stationary variance), NaN outside the validation period. Under
+    ``noise: kalman`` the filter runs over the frame from the initial-state prior with
+    only the validation hours observed (``th``: the full parameter values).
     """
     obs = np.asarray(prep.observed(s.name, s.model), dtype=float)
     Yobs = np.full_like(obs, np.nan)
     if prep.validation is not None:
         Yobs[prep.validation] = obs[prep.validation]
-    return s.logpost.noise.pointwise(Ysim, np.ascontiguousarray(Yobs), tn)
+    Yobs = np.ascontiguousarray(Yobs)
+    lp = s.logpost
+    if getattr(lp.noise, "statespace", False) and th is not None:
+        mf = modal_form(s.model, th[:, : lp.n_model], prep.dt)
+        U = np.ascontiguousarray(prep.model_inputs(s.name, s.model), dtype=float)
+        return lp.noise.filter(s.model, mf, U, Yobs, tn, *lp._x0_prior(mf), True)[1]
+    return lp.noise.pointwise(Ysim, Yobs, tn)
 
 
 def _prior_variance(prior, rng) -> float:
@@ -202,7 +210,7 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
             pp_outputs[out] = (Ypp[..., o], Ysim[..., o])
         pw = s.logpost.pointwise_log_likelihood(th_sel)
         loglik.update(_pointwise(s, pw, times[prep.calibration], (W, n_sel)))
-        pw = _validation_pointwise(s, prep, Ysim, tn_sel)
+        pw = _validation_pointwise(s, prep, Ysim, tn_sel, th_sel)
         loglik_val.update(_pointwise(s, pw, times, (W, n_sel)))
         # parameter summaries
         # statistics on all draws the sampler checked; R-hat and ESS in the sampler's

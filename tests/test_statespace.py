@@ -63,12 +63,11 @@ def _x0_prior(lp, theta):
     return xm[0], P0[0]
 
 
-def test_kalman_matches_statsmodels():
+def _statsmodels(lp, theta, y):
+    """statsmodels' Kalman filter on the same discrete state space (the reference)."""
     sm = pytest.importorskip("statsmodels.tsa.statespace.mlemodel")
-    lp, theta = _problem()
     Ad, Bd, C, Qd = _discrete(lp, theta)
     xm, P0 = _x0_prior(lp, theta)
-    y = lp.observed[:, 0]
     n = Ad.shape[0]
     mod = sm.MLEModel(y, k_states=n, k_posdef=n)
     mod["design"] = C
@@ -78,6 +77,12 @@ def test_kalman_matches_statsmodels():
     mod["state_cov"] = Qd
     mod["state_intercept"] = Bd @ lp.inputs.T  # (n, N): the input of step k moves k -> k+1
     mod.initialize_known(xm, P0 + 1e-300 * np.eye(n))
+    return mod
+
+
+def test_kalman_matches_statsmodels():
+    lp, theta = _problem()
+    mod = _statsmodels(lp, theta, lp.observed[:, 0])
     ref = mod.loglike([])
     ll = lp.log_likelihood(theta[None])[0]
     assert ll == pytest.approx(ref, rel=1e-8)
@@ -119,24 +124,13 @@ def test_kalman_steady_gains_match_statsmodels(gaps):
     """Long gap-free stretches: the filter switches to its steady-state gains once the
     covariance has converged (and back to the full recursion after a gap); the
     log-likelihood still equals statsmodels' full recursion to 1e-8."""
-    sm = pytest.importorskip("statsmodels.tsa.statespace.mlemodel")
     lp, theta = _problem(n=1500)
     y = np.random.default_rng(4).normal(12, 1.0, 1500)
     if gaps:
         y[700:730] = np.nan
         y[1100] = np.nan
     lp.observed[:, 0] = y
-    Ad, Bd, C, Qd = _discrete(lp, theta)
-    xm, P0 = _x0_prior(lp, theta)
-    n = Ad.shape[0]
-    mod = sm.MLEModel(y, k_states=n, k_posdef=n)
-    mod["design"] = C
-    mod["obs_cov"] = np.array([[0.2**2]])
-    mod["transition"] = Ad
-    mod["selection"] = np.eye(n)
-    mod["state_cov"] = Qd
-    mod["state_intercept"] = Bd @ lp.inputs.T
-    mod.initialize_known(xm, P0 + 1e-300 * np.eye(n))
+    mod = _statsmodels(lp, theta, y)
     ref = mod.loglike([])
     assert lp.log_likelihood(theta[None])[0] == pytest.approx(ref, rel=1e-8)
     # the one-step terms agree with statsmodels' too (llf_obs), gaps excluded

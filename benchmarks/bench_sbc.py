@@ -157,6 +157,7 @@ def replicate(args) -> dict:
 
     name, rep, variants, seed, max_steps = args[:5]
     cal_days = args[5] if len(args) > 5 else CAL_DAYS
+    priors = args[6] if len(args) > 6 else {}
     rng = np.random.default_rng([seed, rep])
     opts = {"surfaces": ("S",)} if name in ("thermal_2c", "thermal_4a") else {}
     model = hb.model(name, **opts)
@@ -190,7 +191,8 @@ def replicate(args) -> dict:
         noise_name, init = variant.split(":")
         t0 = time.process_time()
         noise = get_noise_model(noise_name)
-        ps = parameters_for(model, noise, room_volume=VOLUME, air_change_rate=ACH)
+        known = {k: v for k, v in priors.items() if k in model.parameter_names}
+        ps = parameters_for(model, noise, known, room_volume=VOLUME, air_change_rate=ACH)
         lp = LogPosterior(
             model,
             ps,
@@ -279,6 +281,14 @@ def main() -> None:
     ap.add_argument("--jobs", type=int, default=1)
     ap.add_argument("--seed", type=int, default=2026)
     ap.add_argument("--log", help="append each replicate's result as a JSON line")
+    ap.add_argument(
+        "--prior",
+        action="append",
+        default=[],
+        metavar="NAME=MEDIAN,SIGMA",
+        help="a log-normal prior given to every fit (e.g. Gf=14,0.6: knowledge of the "
+        "ground coupling), to see what a weakly identified parameter's prior does",
+    )
     ap.add_argument("--table", help="only tabulate a --log file of an earlier study")
     ap.add_argument(
         "--max-steps",
@@ -297,8 +307,13 @@ def main() -> None:
             for line in table(results, v):
                 print(line)
         return
+    priors = {}
+    for spec in args.prior:
+        name, _, vals = spec.partition("=")
+        median, sigma = (float(v) for v in vals.split(","))
+        priors[name] = {"dist": "lognormal", "median": median, "sigma": sigma}
     tasks = [
-        (m, r, variants, args.seed, args.max_steps)
+        (m, r, variants, args.seed, args.max_steps, CAL_DAYS, priors)
         for r in range(args.reps)
         for m in args.models.split(",")
     ]  # models interleaved: a study cut short still covers every model

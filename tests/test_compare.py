@@ -261,3 +261,18 @@ def test_comparison_page_in_headless_chromium(compared):
     img = mpimg.imread(io.BytesIO(page.screenshot), format="png")[..., :3]
     assert float(np.mean(img.mean(axis=2) < 0.9)) > 0.03, "screenshot is (almost) blank"
     assert res["recommendation"]["model"] in text
+
+
+def test_a_candidate_folder_that_is_not_a_run_needs_force(cfg_path, tmp_path, capsys):
+    out = tmp_path / "o"
+    (out / "thermal_1c").mkdir(parents=True)
+    (out / "thermal_1c" / "notes.txt").write_text("mine")
+    args = ["compare", str(cfg_path), "--models", ",".join(MODELS), "--out", str(out)]
+    assert main([*args, "--quiet", "--no-report"]) == 2
+    err = capsys.readouterr().err
+    assert "thermal_1c" in err and "--force" in err and "Traceback" not in err
+    assert (out / "thermal_1c" / "notes.txt").read_text() == "mine"
+    assert not (out / "comparison.json").exists()
+    assert main([*args, "--quiet", "--no-report", "--force"]) == 0
+    assert (out / "comparison.json").is_file()
+    assert (out / "thermal_1c" / "summary.json").is_file()

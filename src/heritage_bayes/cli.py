@@ -111,6 +111,11 @@ def _build_parser() -> argparse.ArgumentParser:
     )
     cmp_.add_argument("--seed", type=int, help="random seed (overrides the config's)")
     cmp_.add_argument("--resume", action="store_true", help="continue saved chains")
+    cmp_.add_argument(
+        "--force",
+        action="store_true",
+        help="let a candidate's run replace a folder <out>/<model>/ that is not a run directory",
+    )
     cmp_.add_argument("--quiet", action="store_true", help="no progress output")
     cmp_.add_argument("--no-report", action="store_true", help="no report.html per model")
     cmp_.set_defaults(func=_cmd_compare)
@@ -219,6 +224,7 @@ def _cmd_compare(args) -> int:
         quiet=args.quiet,
         report=False if args.no_report else None,
         resume=args.resume,
+        force=args.force,
     )
     if not args.quiet:
         import json

@@ -86,6 +86,7 @@ def run_compare(
     quiet: bool = False,
     report: bool | None = None,
     resume: bool = False,
+    force: bool = False,
 ) -> Path:
     """Calibrate each candidate model and write the comparison; return its folder.
 
@@ -102,9 +103,10 @@ def run_compare(
         Default ``reports/<config name>-compare/``; each candidate's run directory is
         ``<out_dir>/<model>/``; the comparison is ``comparison.json`` and
         ``comparison.html``.
-    seed, quiet, report, resume
+    seed, quiet, report, resume, force
         As for :func:`heritage_bayes.calibrate.run_calibration` (applied to every
-        candidate).
+        candidate; ``force`` lets a candidate's run replace an existing folder
+        ``<out_dir>/<model>/`` that is not a run directory).
 
     Raises
     ------
@@ -123,7 +125,9 @@ def run_compare(
             import sys
 
             print(f"hbayes compare: calibrating {n}", file=sys.stderr, flush=True)
-        dirs[n] = run_calibration(c, out / n, seed=seed, quiet=quiet, report=report, resume=resume)
+        dirs[n] = run_calibration(
+            c, out / n, seed=seed, quiet=quiet, report=report, resume=resume, force=force
+        )
     result = compare_runs(dirs, section, seed=cfg.seed if seed is None else int(seed))
     result["config"] = {"name": cfg.name, "building": cfg.building, "room": cfg.room}
     write_comparison(result, out)

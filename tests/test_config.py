@@ -72,6 +72,23 @@ def test_example_config_paths_resolve_beside_the_repo():
     assert os.path.normpath(weather) == os.path.normpath(expected)
 
 
+def test_portable_config_makes_every_data_path_absolute():
+    """A run's config.yaml re-runs (and projects) from any folder: the KNMI weather file
+    of a demo driven by De Bilt weather too (a relative path was resolved against the
+    run directory: right only for runs two levels below the checkout)."""
+    cfg = load_config(CONFIGS / "debilt_demo.yaml")
+    rel = cfg.data.demo.weather_path
+    assert not os.path.isabs(rel if isinstance(rel, str) else rel[0])
+    d = cfg.portable()
+    p = d["data"]["demo"]["weather_path"]
+    p = p if isinstance(p, str) else p[0]
+    assert os.path.isabs(p)
+    expected = CONFIGS.parents[1] / "shared" / "data" / "knmi-debilt"
+    assert os.path.normpath(os.path.dirname(p)) == os.path.normpath(expected)
+    # and the portable config is itself valid wherever it is parsed
+    assert parse_config(d, base_dir="/").data.demo.weather_path == d["data"]["demo"]["weather_path"]
+
+
 def test_demo_config_values():
     cfg = load_config(CONFIGS / "demo.yaml")
     assert cfg.data.demo is not None and cfg.site is None

@@ -599,6 +599,11 @@ class CalibrationConfig(_Strict):
                     str(self.path(q).absolute()) for q in ([p] if isinstance(p, str) else p)
                 ]
                 src["path"] = absolute[0] if isinstance(p, str) else absolute
+        demo = data.get("demo") or {}
+        if demo.get("weather_path") is not None:  # the demo's KNMI weather file(s)
+            p = demo["weather_path"]
+            absolute = [str(self.path(q).absolute()) for q in ([p] if isinstance(p, str) else p)]
+            demo["weather_path"] = absolute[0] if isinstance(p, str) else absolute
         return d
 
     def path(self, p: str) -> Path:

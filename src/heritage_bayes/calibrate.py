@@ -29,11 +29,8 @@ from heritage_bayes.config import (
     CalibrationConfig,
     chain_tag,
     config_hash,
-    parse_duration,
 )
 from heritage_bayes.errors import InputError
-from heritage_bayes.inference.likelihoods import get_noise_model
-from heritage_bayes.inference.parameters import parameters_for
 from heritage_bayes.inference.posterior import LogPosterior
 from heritage_bayes.inference.results import (
     atomic_write,
@@ -44,7 +41,12 @@ from heritage_bayes.inference.results import (
 from heritage_bayes.models import SECTIONS, _catalog_options, build_model, initial_state_of
 from heritage_bayes.rc.catalog import model as catalog_model
 from heritage_bayes.rc.model import RCModel
-from heritage_bayes.run import Run, RunWriter, load_run  # Run, load_run: re-exported
+from heritage_bayes.run import (  # Run, load_run: re-exported
+    Run,
+    RunWriter,
+    load_run,
+    section_parameters,
+)
 
 __all__ = [
     "LADDERS",
@@ -58,20 +60,9 @@ __all__ = [
 
 
 def _parameters(cfg, section: str, model: RCModel, priors: Mapping):
-    """Noise model and parameter set (priors validated) of a config section."""
-    sec_cfg = getattr(cfg, section)
-    noise = get_noise_model(sec_cfg.noise)
-    params = parameters_for(
-        model,
-        noise,
-        priors,
-        room_volume=sec_cfg.room_volume or cfg.room_volume,
-        air_change_rate=cfg.air_change_rate,
-        air_change_sigma=cfg.air_change_sigma,
-        where=f"{section}.priors",
-        dt=parse_duration(cfg.data.step).total_seconds(),
-    )
-    return noise, params
+    """Noise model and parameter set (priors validated) of a config section
+    (:func:`heritage_bayes.run.section_parameters`)."""
+    return section_parameters(cfg, section, model, priors)
 
 
 def check_models(cfg: CalibrationConfig) -> None:

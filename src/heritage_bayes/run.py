@@ -26,7 +26,45 @@ from heritage_bayes.models import SECTIONS, build_model
 from heritage_bayes.rc.model import RCModel
 from heritage_bayes.rc.simulate import check_inputs
 
-__all__ = ["Run", "load_run"]
+__all__ = ["Run", "load_run", "section_parameters"]
+
+
+def section_parameters(cfg: CalibrationConfig, section: str, model: RCModel, priors=None):
+    """Noise model and :class:`~heritage_bayes.inference.parameters.ParameterSet` of a
+    config section, priors validated: the one place a config maps to the sampler's
+    parameters (room volume and air-change priors, ``data.step`` for per-step noise
+    priors).
+
+    Parameters
+    ----------
+    cfg : CalibrationConfig
+    section : {"thermal", "hygric"}
+    model : RCModel
+        The section's model.
+    priors : mapping, optional
+        Prior overrides (default: the section's ``priors``).
+
+    Returns
+    -------
+    (NoiseModel, ParameterSet)
+    """
+    from heritage_bayes.config import parse_duration
+    from heritage_bayes.inference.likelihoods import get_noise_model
+    from heritage_bayes.inference.parameters import parameters_for
+
+    sec_cfg = getattr(cfg, section)
+    noise = get_noise_model(sec_cfg.noise)
+    params = parameters_for(
+        model,
+        noise,
+        sec_cfg.priors if priors is None else priors,
+        room_volume=sec_cfg.room_volume or cfg.room_volume,
+        air_change_rate=cfg.air_change_rate,
+        air_change_sigma=cfg.air_change_sigma,
+        where=f"{section}.priors",
+        dt=parse_duration(cfg.data.step).total_seconds(),
+    )
+    return noise, params
 
 
 @dataclass
@@ -68,6 +106,35 @@ class Run:
         if n is not None and n < K:
             idx = np.sort(np.random.default_rng(seed).choice(K, size=n, replace=False))
         return {p: c[idx] for p, c in zip(model.parameter_names, cols, strict=True)}
+
+    def prior_pushforward(
+        self, section: str, n: int, seed: int = 0
+    ) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+        """Prior draws of the model parameters and their derived quantities.
+
+        The prior of a derived quantity (time constant, static gain) is the push-forward
+        of the parameter priors: ``n`` draws of every parameter from its prior (fixed ones
+        repeated; :meth:`ParameterSet.sample_prior` with ``default_rng(seed)``) through
+        :func:`heritage_bayes.rc.identify.derived_quantities`.
+
+        Returns
+        -------
+        P : (n, P) array
+            Model parameters in ``model.parameter_names`` order [SI units] (the noise
+            parameters' draws are left out).
+        derived : dict name -> (n,) array
+            ``tau_1_h`` [h] ..., ``gain_<out>_<in>``, ``offset_<out>_<const>``; NaN where
+            a draw is not admissible.
+        """
+        from heritage_bayes.rc.identify import derived_quantities
+
+        model = self._model(section)
+        _, params = section_parameters(self.config, section, model)
+        theta = params.sample_prior(np.random.default_rng(seed), n)
+        P = theta[:, : len(model.parameter_names)]
+        with np.errstate(all="ignore"):
+            dq = derived_quantities(model, P)
+        return P, {k: np.broadcast_to(np.asarray(v, dtype=float), (n,)) for k, v in dq.items()}
 
     def _model(self, section: str) -> RCModel:
         if section not in self.models:

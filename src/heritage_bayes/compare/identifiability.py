@@ -17,21 +17,9 @@ def _posterior_flat(idata, names: Sequence[str]) -> np.ndarray:
 
 
 def _prior_pushforward(run, section: str, n: int, seed: int):
-    """Prior draws of the model parameters (K, P) and their derived quantities."""
-    from heritage_bayes.calibrate import _parameters
-    from heritage_bayes.rc.identify import derived_quantities
-
-    cfg = run.config
-    model = run.models[section]
-    _, params = _parameters(cfg, section, model, getattr(cfg, section).priors)
-    rng = np.random.default_rng(seed)
-    cols = []
-    for p in params.parameters[: len(model.parameter_names)]:
-        cols.append(np.full(n, p.fixed) if p.fixed is not None else p.prior.sample(rng, n))
-    P = np.column_stack(cols)
-    with np.errstate(all="ignore"):
-        dq = derived_quantities(model, P)
-    return P, {k: np.broadcast_to(np.asarray(v, dtype=float), (n,)) for k, v in dq.items()}
+    """Prior draws of the model parameters (K, P) and their derived quantities
+    (:meth:`heritage_bayes.run.Run.prior_pushforward`, shared with the report)."""
+    return run.prior_pushforward(section, n, seed)
 
 
 def _contraction(post: np.ndarray, prior: np.ndarray) -> float | None:

@@ -8,7 +8,7 @@ its ``posterior.nc`` groups and ``summary.json`` into arrays and labels.
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -22,6 +22,7 @@ __all__ = [
     "load_run_data",
     "measurement_gaps",
     "model_label",
+    "parameter_set",
     "section_params",
     "time_axis",
     "utc64",
@@ -37,6 +38,8 @@ class RunData:
     run: object  # heritage_bayes.run.Run
     summary: dict
     config_text: str
+    #: values computed once and shared by several sections (e.g. identifiable coordinates)
+    cache: dict = field(default_factory=dict, repr=False)
 
     @property
     def cfg(self):
@@ -112,6 +115,26 @@ def section_params(summary: dict, m: str) -> dict:
         for k, v in (summary.get("parameters") or {}).items()
         if k.startswith(f"{m}.")
     }
+
+
+def parameter_set(rd: RunData, m: str):
+    """The sampler's ParameterSet of section ``m`` (the run's config through
+    :func:`heritage_bayes.run.section_parameters`), or None if it does not match the run
+    (other free parameters or priors than ``summary.json`` records)."""
+    from heritage_bayes.run import section_parameters
+
+    try:
+        _, ps = section_parameters(rd.cfg, m, rd.run.models[m])
+    except (InputError, AttributeError, KeyError, ValueError):  # ConfigError is one
+        return None
+    names = list(((rd.summary.get("correlations") or {}).get(m) or {}).get("names") or [])
+    if list(ps.free_names) != names:
+        return None
+    params = section_params(rd.summary, m)
+    for n in names:
+        if ps[n].prior.describe() != (params.get(n) or {}).get("prior"):
+            return None
+    return ps
 
 
 def measurement_gaps(rd: RunData, dt: np.timedelta64, column: str | None = None) -> list[tuple]:

@@ -12,16 +12,27 @@ input and output names, escaped for mathtext by :func:`tex_safe`.
 One module per topic: :mod:`~heritage_bayes.report.figures.style` (settings, colours,
 shading, :func:`to_png_uri`: the house style for every page's figures),
 :mod:`~heritage_bayes.report.figures.series` (data overview, fit),
-:mod:`~heritage_bayes.report.figures.posterior` (correlation, corner),
-:mod:`~heritage_bayes.report.figures.diagnostics` (traces, τ history, residuals) and
+:mod:`~heritage_bayes.report.figures.posterior` (correlation, corner, prior vs
+posterior),
+:mod:`~heritage_bayes.report.figures.diagnostics` (traces, τ history, rank
+plots, residuals) and
 :mod:`~heritage_bayes.report.figures.ladder`; every name is importable from here.
 """
 
 from __future__ import annotations
 
-from heritage_bayes.report.figures.diagnostics import fig_residuals, fig_tau_history, fig_traces
+from heritage_bayes.report.figures.diagnostics import (
+    fig_rank,
+    fig_residuals,
+    fig_tau_history,
+    fig_traces,
+)
 from heritage_bayes.report.figures.ladder import fig_ladder
-from heritage_bayes.report.figures.posterior import fig_corner, fig_correlation
+from heritage_bayes.report.figures.posterior import (
+    fig_corner,
+    fig_correlation,
+    fig_prior_posterior,
+)
 from heritage_bayes.report.figures.series import fig_data_overview, fig_fit
 from heritage_bayes.report.figures.style import (
     C_ALT,
@@ -46,6 +57,8 @@ __all__ = [
     "fig_data_overview",
     "fig_fit",
     "fig_ladder",
+    "fig_prior_posterior",
+    "fig_rank",
     "fig_residuals",
     "fig_tau_history",
     "fig_traces",

@@ -1,4 +1,5 @@
-"""Sampler and noise-model diagnostics: traces, τ history, residual checks (section 7)."""
+"""Sampler and noise-model diagnostics: traces, τ history, rank plots, residual checks
+(section 7)."""
 
 from __future__ import annotations
 
@@ -185,4 +186,55 @@ def fig_residuals(
     a2.set_ylabel("cumulative periodogram [-]")
     a2.set_title("cumulative periodogram")
     a2.legend(loc="lower right")
+    return fig
+
+
+def fig_rank(panels: Sequence[dict], *, title: str):
+    """Rank plots (Vehtari et al. 2021): one rank histogram per group of walkers.
+
+    Parameters
+    ----------
+    panels : dicts with ``label`` (the quantity), ``counts`` ((G, B) draws per rank bin
+        and group), ``band`` ((2,) central 99 % interval of one bin's count under
+        uniform ranks) and ``expected`` (the uniform count per bin), as returned by
+        :func:`heritage_bayes.report.identifiable.rank_counts`.
+    title : str
+
+    Groups that sample the same distribution give flat histograms inside the grey band;
+    a group above the band at the left or right holds too many of the lowest or highest
+    draws (it explores another part of the posterior or mixes slowly).
+    """
+    from matplotlib.figure import Figure
+
+    n = len(panels)
+    ncols = min(3, max(n, 1))
+    nrows = math.ceil(n / ncols)
+    height = 1.9 * nrows + 0.8
+    fig = Figure(figsize=(11.5, height), dpi=80)
+    fig.subplots_adjust(
+        left=0.06, right=0.99, top=1 - 0.55 / height, bottom=0.5 / height, wspace=0.22, hspace=0.6
+    )
+    axes = fig.subplots(nrows, ncols, squeeze=False).ravel()
+    colours = [C_MODEL, C_ALT, "#2e8b57", "#8e44ad", "#d68910"]
+    for ax, p in zip(axes, panels, strict=False):
+        counts = np.asarray(p["counts"], dtype=float)
+        G, B = counts.shape
+        x = np.arange(B + 1) / B
+        ax.axhspan(p["band"][0], p["band"][1], color="#d0d0d0", lw=0, label="99 % band if uniform")
+        ax.axhline(p["expected"], color="#555555", lw=0.8, ls="--")
+        for g in range(G):
+            ax.stairs(counts[g], x, color=colours[g % len(colours)], lw=1.1, label=f"group {g + 1}")
+        ax.set_xlim(0, 1)
+        ax.set_ylim(0, max(float(counts.max()), float(p["band"][1])) * 1.12)
+        ax.set_title(tex_safe(p["label"]), fontsize=9)
+        ax.grid(False)
+    for ax in axes[max(0, n - ncols) : n]:
+        ax.set_xlabel("rank among all draws / number of draws [-]", fontsize=8)
+    for k in range(0, n, ncols):
+        axes[k].set_ylabel("draws per bin [-]", fontsize=8)
+    for ax in axes[n:]:
+        ax.set_visible(False)
+    h, lb = axes[0].get_legend_handles_labels()
+    fig.legend(h, lb, loc="upper right", ncols=len(lb), fontsize=8)
+    fig.suptitle(title, x=0.06, ha="left")
     return fig

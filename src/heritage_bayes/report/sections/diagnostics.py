@@ -1,4 +1,14 @@
-"""Section 7, sampler diagnostics: chains, τ history, trace plots, residual checks."""
+"""Section 7, sampler diagnostics: chains, τ history, trace and rank plots, residual checks.
+
+Rank plots (Vehtari et al. 2021, doi:10.1214/20-BA1221) are drawn for the slowest time
+constant, the static gains and the scale coordinate (the coordinates of
+:mod:`heritage_bayes.report.identifiable`: a raw C or G would only show the scale ridge
+again). They use the draws of ``posterior.nc``, the thinned post-burn-in draws the
+tables' R-hat, ESS and MCSE come from, rather than the chain file: the same draws as
+every number beside them, and no second read of a large file. Its ``chain`` dimension
+holds the emcee walkers, each with about 30 draws, too few for a histogram of its own:
+the walkers are grouped into 4 blocks (:func:`~heritage_bayes.report.identifiable.rank_groups`).
+"""
 
 from __future__ import annotations
 
@@ -9,39 +19,12 @@ import numpy as np
 from heritage_bayes.errors import InputError
 from heritage_bayes.report.format import OUT_UNITS, fmt_int, fmt_pct
 from heritage_bayes.report.page import Section
-from heritage_bayes.report.rundata import RunData, section_params
+from heritage_bayes.report.rundata import RunData, parameter_set, section_params
 from heritage_bayes.report.sections._fragment import render_fragment
 
 ID, TITLE = "diagnostics", "7. Sampler diagnostics"
 
 _TRACE_POINTS = 400  # thinned steps per walker in trace plots
-
-
-def _parameter_set(rd: RunData, m: str):
-    """The sampler's ParameterSet of section ``m``, or None if it does not match the run."""
-    from heritage_bayes.inference.likelihoods import get_noise_model
-    from heritage_bayes.inference.parameters import parameters_for
-
-    try:
-        sec = getattr(rd.cfg, m)
-        ps = parameters_for(
-            rd.run.models[m],
-            get_noise_model(sec.noise),
-            sec.priors,
-            room_volume=sec.room_volume or rd.cfg.room_volume,
-            where=f"{m}.priors",
-            dt=float(rd.summary.get("dt", 3600.0)),
-        )
-    except (InputError, AttributeError, KeyError, ValueError):
-        return None
-    names = list(((rd.summary.get("correlations") or {}).get(m) or {}).get("names") or [])
-    if list(ps.free_names) != names:
-        return None
-    params = section_params(rd.summary, m)
-    for n in names:
-        if ps[n].prior.describe() != (params.get(n) or {}).get("prior"):
-            return None
-    return ps
 
 
 def _traces(rd: RunData, m: str, info: dict):
@@ -63,7 +46,7 @@ def _traces(rd: RunData, m: str, info: dict):
     steps = np.arange(0, n, stride)[: X.shape[0]]
     names = list(((rd.summary.get("correlations") or {}).get(m) or {}).get("names") or [])
     params = section_params(rd.summary, m)
-    ps = _parameter_set(rd, m)
+    ps = parameter_set(rd, m)
     S, W, d = X.shape
     if ps is not None and d == ps.ndim:
         theta = ps.values(X.reshape(-1, d))
@@ -98,6 +81,43 @@ def _traces(rd: RunData, m: str, info: dict):
         title=f"{m} ({info.get('model', '')}): {W} walkers, every {stride}th step shown",
     )
     return {"figure": fig, "coords": coords}
+
+
+def _ranks(rd: RunData, m: str, info: dict) -> dict | None:
+    """Rank plot of the slowest τ, the gains and the scale of section ``m`` (or None)."""
+    from heritage_bayes.report.figures import fig_rank
+    from heritage_bayes.report.identifiable import (
+        identifiable_coordinates,
+        rank_counts,
+        rank_groups,
+    )
+
+    coords = [
+        c
+        for c in identifiable_coordinates(rd, m)
+        if c.name in ("tau_1_h", "scale") or not c.name.startswith("tau_")
+    ]
+    if not coords:
+        return None
+    n_chain, n_draw = coords[0].draws.shape
+    groups = rank_groups(n_chain)
+    if len(groups) < 2 or n_draw * len(groups[0]) < 20:
+        return None
+    panels = []
+    for c in coords:
+        counts, band, expected = rank_counts(c.draws, groups)
+        panels.append({"label": c.label, "counts": counts, "band": band, "expected": expected})
+    fig = fig_rank(
+        panels,
+        title=f"{m} ({info.get('model', '')}): rank plots, {len(groups)} groups of "
+        f"{len(groups[0])} walkers",
+    )
+    return {
+        "figure": fig,
+        "groups": len(groups),
+        "per_group": len(groups[0]),
+        "n_draws": fmt_int(n_chain * n_draw),
+    }
 
 
 def _residual_check(
@@ -146,6 +166,7 @@ def diagnostics_context(rd: RunData, fits: list[dict]) -> dict:
     for m, info in (s.get("models") or {}).items():
         ch = info.get("chain") or {}
         tr = _traces(rd, m, info)
+        rk = _ranks(rd, m, info)
         if tr is None:
             missing.append(f"chain_{m}.h5")
         models.append(
@@ -165,6 +186,7 @@ def diagnostics_context(rd: RunData, fits: list[dict]) -> dict:
                 "acceptance": fmt_pct(ch.get("acceptance_mean")),
                 "resumed_from": fmt_int(ch.get("resumed_from")),
                 "trace": tr,
+                "rank": rk,
             }
         )
     hist = {

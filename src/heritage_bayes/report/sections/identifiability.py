@@ -1,9 +1,22 @@
 """Section 6, identifiability: structural check, derived quantities, correlations, ladder.
 
 What the data can determine: the non-identifiable directions of each model, the
-identifiable derived quantities (time constants, static gains), the posterior
-correlation and corner plots, and the model-order ladder (MAP fits of the neighbouring
-orders: accuracy vs identifiability).
+identifiable derived quantities (time constants, static gains, with the Monte-Carlo
+standard errors of their medians and 5 %/95 % quantiles), the posterior correlation
+matrix and corner plot, their priors against their posteriors, and the model-order
+ladder (MAP fits of the neighbouring orders: accuracy vs identifiability).
+
+The correlation matrix and the corner plot are drawn in *identifiable coordinates*
+(:mod:`heritage_bayes.report.identifiable`): log10 of the time constants, the static
+gains and one scale coordinate, log10 ΣC. In raw log-parameters, with only indoor
+values measured, every C, G and aperture moves together along the scale ridge: their
+correlations are all ±1.00 and a corner plot of them shows that ridge, not what the
+data determined. The raw correlation matrix stays, smaller and after the others, for
+what only it shows: which raw parameters ride on the ridge (±1) and which the data
+leave to their prior (near 0, e.g. an aperture the irradiance cannot inform), and the
+correlations between the noise parameters. The raw corner plot is dropped: its
+diagonal is now the prior-versus-posterior figure of section 5 and its off-diagonal
+panels were the ridge.
 """
 
 from __future__ import annotations
@@ -13,6 +26,12 @@ import math
 import numpy as np
 
 from heritage_bayes.report.format import fmt, fmt_int, is_log_prior
+from heritage_bayes.report.identifiable import (
+    identifiable_coordinates,
+    identifiable_correlation,
+    mcse_cells,
+    mcse_table,
+)
 from heritage_bayes.report.page import Section
 from heritage_bayes.report.rundata import RunData, section_params
 from heritage_bayes.report.sections._fragment import render_fragment
@@ -23,10 +42,9 @@ _CORNER_MAX = 3000  # posterior samples in a corner plot
 
 
 def identifiability_context(rd: RunData) -> list[dict]:
-    from heritage_bayes.report.figures import fig_corner, fig_correlation
+    from heritage_bayes.report.figures import fig_correlation
 
     s = rd.summary
-    post = rd.idata.posterior
     out = []
     for m, info in (s.get("models") or {}).items():
         idf = info.get("identifiability") or {}
@@ -62,44 +80,17 @@ def identifiability_context(rd: RunData) -> list[dict]:
             verdict = "The structural check was not recorded for this run."
         corr = (s.get("correlations") or {}).get(m) or {}
         names = list(corr.get("names") or [])
-        logs = [is_log_prior((params.get(n) or {}).get("prior")) for n in names]
-        fig_c = None
+        fig_raw = None
         if len(names) > 1:
-            labels = [f"log {n}" if lg else n for n, lg in zip(names, logs, strict=True)]
-            fig_c = fig_correlation(
-                labels,
+            logs = [is_log_prior((params.get(n) or {}).get("prior")) for n in names]
+            fig_raw = fig_correlation(
+                [f"log {n}" if lg else n for n, lg in zip(names, logs, strict=True)],
                 np.asarray(corr.get("matrix"), dtype=float),
-                title=f"{m} ({info.get('model', '')}): posterior "
-                "correlations (log scale where the prior is)",
+                title=f"{m}: raw parameters (log where the prior is)",
+                max_size=5.5,
             )
-        fig_k = None
-        has_truth = False
-        cols, labels, truths = [], [], []
-        for n, lg in zip(names, logs, strict=True):
-            key = f"{m}.{n}"
-            if key not in post:
-                continue
-            x = np.asarray(post[key].values, dtype=float).reshape(-1)
-            unit = (params.get(n) or {}).get("unit", "")
-            t = (params.get(n) or {}).get("truth")
-            if lg:
-                with np.errstate(divide="ignore", invalid="ignore"):
-                    x = np.log10(x)
-                t = math.log10(t) if t is not None and t > 0 else None
-                labels.append(f"log10 {n}\n[{unit}]" if unit and unit != "-" else f"log10 {n}")
-            else:
-                labels.append(f"{n}\n[{unit}]" if unit and unit != "-" else f"{n}\n[-]")
-            cols.append(x)
-            truths.append(t)
-        if len(cols) > 1:
-            X = np.column_stack(cols)
-            X = X[np.all(np.isfinite(X), axis=1)]
-            if X.shape[0] > _CORNER_MAX:
-                idx = np.linspace(0, X.shape[0] - 1, _CORNER_MAX).round().astype(int)
-                X = X[idx]
-            has_truth = any(t is not None for t in truths)
-            if X.shape[0] > X.shape[1]:
-                fig_k = fig_corner(X, labels, truths if has_truth else None)
+        coords = identifiable_coordinates(rd, m)
+        figs = _coordinate_figures(coords, f"{m} ({info.get('model', '')})")
         out.append(
             {
                 "section": m,
@@ -109,16 +100,84 @@ def identifiability_context(rd: RunData) -> list[dict]:
                 "control": sorted((idf.get("control") or {}).items()),
                 "lines": summ_lines,
                 "cond": fmt(idf.get("condition_number_identifiable")),
-                "corr_fig": fig_c,
-                "corner_fig": fig_k,
-                "corner_truth": has_truth,
-                "derived": _derived_rows(s, m, info),
+                "corr_raw_fig": fig_raw,
+                **figs,
+                "scale": _scale_words(rd, m, idf, coords),
+                "derived": _derived_rows(s, m, info, mcse_table(rd, _derived_keys(s, m))),
             }
         )
     return out
 
 
-def _derived_rows(s: dict, m: str, info: dict) -> dict:
+def _coordinate_figures(coords: list, title: str) -> dict:
+    """Correlation matrix, corner plot and prior-vs-posterior figure of the identifiable
+    coordinates (figures None where there is too little to draw)."""
+    from heritage_bayes.report.figures import fig_corner, fig_correlation, fig_prior_posterior
+
+    out = {"corr_fig": None, "corner_fig": None, "corner_truth": False, "prior_fig": None}
+    if not coords:
+        return out
+    labels = [c.label for c in coords]
+    # two-line corner labels: the quantity, then its unit
+    corner_labels = [lb.replace(" [", "\n[") for lb in labels]
+    truths = [c.truth for c in coords]
+    out["corner_truth"] = any(t is not None for t in truths)
+    if len(coords) > 1:
+        out["corr_fig"] = fig_correlation(
+            labels,
+            identifiable_correlation(coords),
+            title=f"{title}: posterior correlations of τ, gains and scale",
+        )
+        X = np.column_stack([c.draws.reshape(-1) for c in coords])
+        X = X[np.all(np.isfinite(X), axis=1)]
+        if X.shape[0] > _CORNER_MAX:
+            idx = np.linspace(0, X.shape[0] - 1, _CORNER_MAX).round().astype(int)
+            X = X[idx]
+        if X.shape[0] > X.shape[1]:
+            out["corner_fig"] = fig_corner(
+                X, corner_labels, truths if out["corner_truth"] else None, panel=1.3
+            )
+    out["prior_fig"] = fig_prior_posterior(
+        [
+            {
+                "label": c.label,
+                "post": c.draws.reshape(-1),
+                "prior_draws": c.prior,
+                "truth": c.truth,
+            }
+            for c in coords
+        ],
+        title=f"{title}: prior (push-forward, line) and posterior (histogram)",
+    )
+    return out
+
+
+def _scale_words(rd: RunData, m: str, idf: dict, coords: list) -> str:
+    """Why the scale coordinate is there, for the figure captions ('' without one)."""
+    from heritage_bayes.report.identifiable import scale_capacities
+
+    if not coords or coords[-1].name != "scale":
+        return ""
+    caps = " + ".join(scale_capacities(rd.summary, m))
+    if idf.get("has_scale_direction") is False:
+        return (
+            f"Scale: log10 ΣC = log10({caps}), the total capacity; this model's inputs "
+            "fix it (no scale direction in the structural check)."
+        )
+    return (
+        f"Scale: log10 ΣC = log10({caps}), the total capacity. Scaling every capacity, "
+        "conductance and aperture together leaves the simulated indoor climate "
+        "unchanged, so the data cannot fix this direction: without a known heat or "
+        "moisture input, only a prior on the room volume (the air capacity) or a "
+        "measured air change rate does. The time constants and gains are free of it."
+    )
+
+
+def _derived_keys(s: dict, m: str) -> list[str]:
+    return [k for k in (s.get("derived") or {}) if k.startswith(f"{m}.")]
+
+
+def _derived_rows(s: dict, m: str, info: dict, mc: dict | None = None) -> dict:
     taus, gains = [], []
     outs = list(info.get("output_names") or [])
     for key, v in (s.get("derived") or {}).items():
@@ -137,6 +196,7 @@ def _derived_rows(s: dict, m: str, info: dict) -> dict:
             "truth": fmt(truth) if truth is not None else "—",
             "truth_d": fmt(_div(truth, 24)) if truth is not None else "—",
             "inside": inside,
+            **mcse_cells((mc or {}).get(key)),
         }
         if name.startswith("tau_") and name.endswith("_h"):
             k = name[4:-2]

@@ -560,3 +560,127 @@ def test_verdict_green_only_when_the_noise_model_checks_pass():
     ]
     # a run that did not converge stays red whatever the checks
     assert convergence_verdict(_summary(1.2, 40, tau_ok=False), bad)["level"] == "red"
+
+
+# ----------------------------------------------- identifiable coordinates (issue 11)
+def _row(table: str, marker: str) -> str:
+    i = table.index(marker)
+    return table[table.rindex("<tr", 0, i) : table.index("</tr>", i)]
+
+
+def test_mcse_columns_equal_arviz(report, run_dir):
+    import arviz as az
+
+    _, html = report
+    summary = json.loads((run_dir / "summary.json").read_text())
+    post = az.from_netcdf(run_dir / "posterior.nc").posterior
+
+    def cells(key):
+        da = post[key]
+        med = float(az.mcse(da.values, method="median"))
+        q05 = float(az.mcse(da.values, method="quantile", prob=0.05))
+        q95 = float(az.mcse(da.values, method="quantile", prob=0.95))
+        return fmt(med), f"{fmt(q05)} / {fmt(q95)}"
+
+    for m in ("thermal", "hygric"):
+        table = html[html.index(f'id="table-params-{m}"') :]
+        table = table[: table.index("</table>")]
+        assert "MCSE median</th>" in table and "MCSE 5 % / 95 %</th>" in table
+        for key, v in summary["parameters"].items():
+            if key.startswith(m + ".") and v.get("fixed") is None:
+                med, q = cells(key)
+                row = _row(table, f"<strong>{key.split('.', 1)[1]}</strong>")
+                assert f'<td class="num">{med}</td>' in row, (key, med)
+                assert f'<td class="num nowrap">{q}</td>' in row, (key, q)
+        # derived: the slowest time constant [h] and the gain from the outdoor potential
+        tau = html[html.index(f'id="table-tau-{m}"') :]
+        tau = tau[: tau.index("</table>")]
+        med, q = cells(f"{m}.tau_1_h")
+        row = _row(tau, "<td>τ1</td>")
+        assert f'<td class="num">{med}</td>' in row and q in row
+        assert "MCSE median [h]" in tau
+
+
+def test_identifiable_coordinates_are_tau_gains_and_scale(run_dir):
+    from heritage_bayes.report.identifiable import (
+        N_PRIOR,
+        identifiable_coordinates,
+        identifiable_correlation,
+        scale_capacities,
+    )
+    from heritage_bayes.report.rundata import load_run_data
+
+    rd = load_run_data(run_dir)
+    post = rd.idata.posterior
+    for m, boundary in (("thermal", "gain_Ti_Te"), ("hygric", None)):
+        coords = identifiable_coordinates(rd, m)
+        names = [c.name for c in coords]
+        assert names[0] == "tau_1_h" and names[-1] == "scale"
+        assert boundary is None or boundary in names
+        # hygric_1c: the gain from its only boundary is 1 by structure, not shown
+        assert "gain_Pi_Pe" not in names
+        caps = scale_capacities(rd.summary, m)
+        assert caps and all(
+            rd.summary["parameters"][f"{m}.{c}"]["kind"] == "capacity" for c in caps
+        )
+        # the matrix from the posterior variables themselves, rebuilt here
+        cols = []
+        for n in names:
+            if n == "scale":
+                x = np.log10(sum(post[f"{m}.{c}"].values for c in caps))
+            else:
+                x = post[f"{m}.{n}"].values
+                x = np.log10(x) if n.startswith("tau_") or n.startswith("gain_Ti_I") else x
+            cols.append(np.asarray(x, dtype=float).reshape(-1))
+        X = np.column_stack(cols)
+        X = X[np.all(np.isfinite(X), axis=1)]
+        C = identifiable_correlation(coords)
+        np.testing.assert_allclose(C, np.corrcoef(X, rowvar=False), atol=1e-12)
+        assert C.shape == (len(names), len(names))
+        # no raw C or G among them: the ridge's ±1 would dominate again
+        assert not set(names) & set(rd.run.models[m].parameter_names)
+        # the push-forward prior of the scale: the same draws as Run.prior_pushforward
+        P, _ = rd.run.prior_pushforward(m, N_PRIOR, 0)
+        idx = [list(rd.run.models[m].parameter_names).index(c) for c in caps]
+        np.testing.assert_allclose(coords[-1].prior, np.log10(P[:, idx].sum(axis=1)))
+    # the thermal gains from the outdoor air and the ground sum to one: correlation -1
+    th = identifiable_coordinates(rd, "thermal")
+    i, j = ([c.name for c in th].index(n) for n in ("gain_Ti_Te", "gain_Ti_Tf"))
+    assert identifiable_correlation(th)[i, j] < -0.99
+
+
+def test_prior_density_is_the_prior():
+    from scipy.stats import truncnorm
+
+    from heritage_bayes.inference.parameters import Prior
+    from heritage_bayes.report.identifiable import prior_density
+
+    x, p = prior_density(Prior("loguniform", 1e4, 1e12), log10=True)
+    np.testing.assert_allclose(p, 1 / 8)  # uniform over 8 decades
+    ln = Prior("lognormal", 1e4, 1e8, mu=1e6, sigma=1.0)
+    x, p = prior_density(ln, log10=True, n=2001)
+    s = 1.0 / math.log(10)
+    ref = truncnorm.pdf(x, (4 - 6) / s, (8 - 6) / s, loc=6, scale=s)
+    np.testing.assert_allclose(p, ref, rtol=1e-4)
+    x, p = prior_density(Prior("normal", 0.0, 1.0, mu=0.3, sigma=0.2), log10=False)
+    assert abs(float(np.sum(0.5 * (p[1:] + p[:-1]) * np.diff(x))) - 1) < 1e-12
+    assert x[np.argmax(p)] == pytest.approx(0.3, abs=2e-3)
+
+
+def test_rank_counts_flag_a_shifted_group():
+    from heritage_bayes.report.identifiable import rank_counts, rank_groups
+
+    assert [g.tolist() for g in rank_groups(8)] == [[0, 1], [2, 3], [4, 5], [6, 7]]
+    assert len(rank_groups(6)) == 3 and len(rank_groups(7)) == 1
+    rng = np.random.default_rng(11)
+    x = rng.normal(size=(32, 64))
+    groups = rank_groups(32)
+    counts, band, expected = rank_counts(x, groups)
+    assert counts.shape == (4, 20) and expected == 512 / 20
+    assert (counts.sum(axis=1) == 512).all()
+    # pooled over the groups the ranks are uniform by construction
+    assert np.ptp(counts.sum(axis=0)) <= 1
+    assert ((counts >= band[0]) & (counts <= band[1])).mean() > 0.95
+    x[24:] += 1.0  # the last 8 walkers sample a shifted distribution
+    counts, band, _ = rank_counts(x, groups)
+    assert counts[3, -3:].min() > band[1] and counts[3, :3].max() < band[0]

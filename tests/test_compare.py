@@ -164,7 +164,7 @@ def test_recommendation_rule():
     }
     rec = _recommend(models, "elpd_validation")
     assert rec["model"] == "thermal_2c"
-    assert "within 2 SE or 4 of thermal_4a (difference -3.0 ± 2.0)" in rec["reason"]
+    assert "within 2 SE or 4 nats of thermal_4a (difference -3.0 ± 2.0)" in rec["reason"]
     assert "thermal_4a is as accurate but not identified: tau_2_h" in rec["reason"]
     assert "thermal_1c is less accurate" in rec["reason"]
     assert "Not converged" not in rec["reason"]

@@ -195,7 +195,7 @@ def _recommend(models: dict, score: str) -> dict:
         parts.append(f"the best {what} of the candidates")
     else:
         parts.append(
-            f"{what} within 2 SE or {NEGLIGIBLE_ELPD:g} of {best} "
+            f"{what} within 2 SE or {NEGLIGIBLE_ELPD:g} nats of {best} "
             f"(difference {diff:.1f} ± {dse:.1f})"
         )
     if ident["time_constants_identified"]:

@@ -161,3 +161,56 @@ def test_free_run_predictive_noise_moments():
         P = Ad @ P @ Ad.T + Qd
     assert np.all(np.abs(e.mean(0)) < 5 * np.sqrt(var / K))
     assert np.all(np.abs(e.var(0, ddof=1) - var) < 5 * var * np.sqrt(2 / (K - 1)))
+
+
+def test_kalman_run_has_one_step_bands(tmp_path):
+    """A calibration with ``noise: kalman`` stores one-step-ahead predictive samples
+    (the filter's prediction of each hour from the measurements before it), their band
+    coverage per period, and the report shows them beside the free-run band."""
+    import json
+
+    import yaml
+
+    from heritage_bayes._arviz import az
+    from heritage_bayes.cli import main
+
+    cfg = {
+        "name": "tiny_kalman",
+        "seed": 3,
+        "data": {"demo": {"seed": 7}},
+        "periods": {
+            "calibration": {"start": "2019-02-01", "end": "2019-02-11"},
+            "validation": {"start": "2019-02-11", "end": "2019-02-16"},
+        },
+        "room_volume": 400,
+        "air_change_rate": 0.5,
+        "thermal": {"model": "thermal_1c", "noise": "kalman"},
+        "ladder": False,
+        "sampler": {"max_steps": 400, "check_every": 200, "n_predictive": 64},
+        "optimizer": {"maxiter": 20, "starts": 2, "popsize": 4},
+    }
+    p = tmp_path / "k.yaml"
+    p.write_text(yaml.safe_dump(cfg))
+    out = tmp_path / "run"
+    assert main(["calibrate", str(p), "--out", str(out), "--quiet"]) == 0
+    idata = az.from_netcdf(out / "posterior.nc")
+    pp = idata.posterior_predictive
+    y1 = pp["thermal.Ti_1step"].values.reshape(-1, pp.sizes["time"])
+    yf = pp["thermal.Ti"].values.reshape(-1, pp.sizes["time"])
+    obs = idata.observed_data["Ti"].reindex(time=pp["time"]).values
+    assert np.isfinite(y1).all()
+    # the filter tracks the measurements: one-step bands much narrower than free-run
+    w1 = np.subtract(*np.quantile(y1, [0.95, 0.05], axis=0))
+    wf = np.subtract(*np.quantile(yf, [0.95, 0.05], axis=0))
+    assert np.median(w1) < np.median(wf)
+    # its one-step mean of one draw is KalmanNoise.one_step's (calibration frame)
+    s = json.loads((out / "summary.json").read_text())
+    met = s["metrics"]["thermal"]["Ti"]
+    for period in ("calibration", "validation"):
+        c = met[period]["coverage90_1step"]
+        codes = idata.constant_data["period"].reindex(time=pp["time"]).values
+        rows = (codes == (1 if period == "calibration" else 2)) & np.isfinite(obs)
+        lo, hi = np.quantile(y1[:, rows], [0.05, 0.95], axis=0)
+        assert c == pytest.approx(np.mean((obs[rows] >= lo) & (obs[rows] <= hi)), abs=1e-9)
+    html = (out / "report.html").read_text()
+    assert "fig-fit-thermal-Ti-1step" in html and "one step ahead" in html

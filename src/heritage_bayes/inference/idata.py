@@ -99,6 +99,29 @@ def _validation_pointwise(s, prep, Ysim, tn, th=None) -> np.ndarray:
     return lp.noise.pointwise(Ysim, Yobs, tn)
 
 
+def _one_step_sample(s, prep, th, rng) -> np.ndarray:
+    """(K, N, n_out) one-step-ahead predictive samples of a state-space noise model.
+
+    The Kalman filter of ``noise: kalman`` runs over the whole frame with every
+    measurement (calibration and validation), from the initial-state prior, as
+    :func:`_validation_pointwise` does; each row's sample is the filter's prediction from
+    the measurements before it plus a draw of its predictive variance (measurement noise
+    included): the band a forecaster updating with the logger would quote, where the
+    free-run band is what the model claims without measurements (N. R. Kristensen,
+    H. Madsen, S. B. Jørgensen, "Parameter estimation in stochastic grey-box models",
+    Automatica 40 (2004) 225-237).
+    """
+    lp = s.logpost
+    obs = np.ascontiguousarray(prep.observed(s.name, s.model), dtype=float)
+    mf = modal_form(s.model, th[:, : lp.n_model], prep.dt)
+    U = np.ascontiguousarray(prep.model_inputs(s.name, s.model), dtype=float)
+    tn = th[:, lp.n_model :]
+    with np.errstate(all="ignore"):
+        _, _, mean, var = lp.noise.filter(s.model, mf, U, obs, tn, *lp._x0_prior(mf), True)
+    mean[~mf.valid], var[~mf.valid] = np.nan, np.nan
+    return mean + np.sqrt(np.maximum(var, 0.0)) * rng.standard_normal(mean.shape)
+
+
 def _prior_variance(prior, rng) -> float:
     y = prior.sample(rng, 20000)
     y = np.log(y) if prior.log_scale else y
@@ -137,6 +160,7 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
     sec_info: dict[str, dict] = {}
     correlations: dict[str, dict] = {}
     pp_outputs: dict[str, np.ndarray] = {}
+    one_step: dict[str, np.ndarray] = {}  # output -> (K, N) one-step samples (kalman)
     truth_all = prep.truth or {}
     cdims = ("chain", "draw")
     coords = {"chain": np.arange(W), "draw": np.arange(n_sel)}
@@ -191,6 +215,10 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
             noise = s.logpost.noise.sample(rng, tn_pred, U.shape[0], s.model.n_outputs)
         Ypp = Ysim + noise
         saturation = condensation_cap(s, prep, Ysim, Ypp, pp_outputs)
+        Y1 = None
+        if getattr(s.logpost.noise, "statespace", False):
+            # its own stream: the free-run outputs above do not depend on it
+            Y1 = _one_step_sample(s, prep, th_sel, np.random.default_rng([seed, 17]))
         shape = (W, n_sel, U.shape[0])
         pcoords = {"chain": np.arange(W), "draw": np.arange(n_sel), "time": times}
         for o, out in enumerate(s.model.output_names):
@@ -208,6 +236,14 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
                 attrs=attrs,
             )
             pp_outputs[out] = (Ypp[..., o], Ysim[..., o])
+            if Y1 is not None:
+                pp[f"{s.name}.{out}_1step"] = xr.DataArray(
+                    Y1[..., o].reshape(shape).astype(np.float32),
+                    dims=("chain", "draw", "time"),
+                    coords=pcoords,
+                    attrs={**attrs, "description": "one-step-ahead predictive samples"},
+                )
+                one_step[out] = Y1[..., o]
         pw = s.logpost.pointwise_log_likelihood(th_sel)
         loglik.update(_pointwise(s, pw, times[prep.calibration], (W, n_sel)))
         pw = _validation_pointwise(s, prep, Ysim, tn_sel, th_sel)
@@ -274,7 +310,7 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
         corr = np.corrcoef(np.array(Y)) if len(Y) > 1 else np.ones((1, 1))
         correlations[s.name] = {"names": list(ps.free_names), "matrix": corr.tolist()}
         # fit metrics per output and period
-        metrics[s.name] = _metrics_for(prep, codes, s.model.output_names, pp_outputs)
+        metrics[s.name] = _metrics_for(prep, codes, s.model.output_names, pp_outputs, one_step)
         sec_info[s.name] = {
             "predictive_noise": pred_info,
             "saturation": saturation,
@@ -514,7 +550,11 @@ def _periods(prep) -> dict:
     return out
 
 
-def _metrics_for(prep, codes, outputs, pp_outputs) -> dict:
+def _metrics_for(prep, codes, outputs, pp_outputs, one_step=None) -> dict:
+    """Fit criteria of the posterior-median simulation and band coverage per period;
+    with ``one_step`` (output -> (K, N) one-step-ahead samples of a state-space noise
+    model) also the coverage of the one-step bands (``coverage50_1step``,
+    ``coverage90_1step``)."""
     res: dict[str, dict] = {}
     for out in outputs:
         if out not in prep.frame:
@@ -530,5 +570,8 @@ def _metrics_for(prep, codes, outputs, pp_outputs) -> dict:
             m = fit_metrics(meas[rows], med[rows])
             m["coverage50"] = coverage(meas[rows], ypp[:, rows], 0.5)
             m["coverage90"] = coverage(meas[rows], ypp[:, rows], 0.9)
+            if one_step and out in one_step:
+                m["coverage50_1step"] = coverage(meas[rows], one_step[out][:, rows], 0.5)
+                m["coverage90_1step"] = coverage(meas[rows], one_step[out][:, rows], 0.9)
             res[out][pname] = m
     return res

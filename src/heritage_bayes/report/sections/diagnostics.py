@@ -202,6 +202,8 @@ def diagnostics_context(rd: RunData, fits: list[dict]) -> dict:
     for fit in fits:
         if fit["section"] == "combined":
             continue  # RH is not a model output: its residuals have no noise model
+        if fit.get("resid") is None:
+            continue  # a one-step-ahead band: its residuals are the filter's innovations
         m, o = fit["section"], fit["output"]
         info = (s.get("models") or {}).get(m) or {}
         cal = fit["codes"] == 1

@@ -134,7 +134,53 @@ def fit_context(rd: RunData, outputs: list[dict]) -> list[dict]:
                 **o,
             }
         )
+        if f"{o['pp']}_1step" in pp:
+            items.append(_one_step_item(rd, o, pp, times_pp, y, codes, gaps, what))
     return items
+
+
+def _one_step_item(rd: RunData, o: dict, pp, times, y, codes, gaps, what: str) -> dict:
+    """The one-step-ahead band of a state-space noise model (``noise: kalman``)."""
+    from heritage_bayes.report.figures import fig_fit
+
+    Y1 = flat_draws(pp[f"{o['pp']}_1step"])
+    q = np.quantile(Y1, [0.05, 0.25, 0.5, 0.75, 0.95], axis=0)
+    fig = fig_fit(
+        times,
+        y,
+        q[2],
+        (q[1], q[3]),
+        (q[0], q[4]),
+        codes,
+        output=o["output"],
+        model_name=o["model"],
+        gaps=gaps,
+    )
+    met = ((rd.summary.get("metrics") or {}).get(o["section"]) or {}).get(o["output"]) or {}
+    cov = []
+    for period in ("calibration", "validation"):
+        c = (met.get(period) or {}).get("coverage90_1step")
+        if c is not None:
+            cov.append(f"{period} {100 * c:.0f} %")
+    return {
+        "id": f"fig-fit-{o['section']}-{o['output']}-1step",
+        "title": f"{what} ({o['output']}), one step ahead — {o['model']}",
+        "figure": fig,
+        "caption": (
+            f"Measured {what} (black) and the Kalman filter's one-step-ahead prediction "
+            "of each hour from the measurements before it (median, 50 % and 90 % bands "
+            "over posterior draws; process and measurement noise): what the model can "
+            "claim when it is updated with the logger, as in a forecast. The free-run "
+            "bands above are what it claims without measurements (a projection); their "
+            "process noise accumulates over the slowest time constant. "
+            + (f"90 % one-step band coverage: {', '.join(cov)}." if cov else "")
+        ),
+        # the diagnostics (section 7) read the free-run item's residuals, not these
+        "resid": None,
+        "codes": codes,
+        "times": times,
+        **o,
+    }
 
 
 def section(ctx: dict) -> Section:

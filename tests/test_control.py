@@ -220,3 +220,110 @@ def test_derived_quantities_of_a_controlled_model_are_the_networks():
     assert set(d) == set(derived_units(m)) == {"tau_1_h", "tau_2_h", "gain_Pi_Pe"}
     free = derived_quantities(model("hygric_2c"), {k: v for k, v in p.items() if "RH" not in k})
     assert d["gain_Pi_Pe"] == pytest.approx(free["gain_Pi_Pe"]) and d["gain_Pi_Pe"] > 0.99
+
+
+# ---------------------------------------------------------------------------------------
+# weekly hours of use (heritage_bayes.rc.calendar)
+# ---------------------------------------------------------------------------------------
+
+
+def test_weekly_calendar_fractions_are_exact():
+    import pandas as pd
+
+    from heritage_bayes.rc.calendar import parse_weekly
+
+    cal = parse_weekly({"weekly": ["Sun 08:30-10", "Mon-Fri 23-24", "Sat,Sun 14-15"]})
+    assert cal.hours_per_week == pytest.approx(1.5 + 5 + 2)
+    idx = pd.date_range("2024-01-07 07:00", periods=4, freq="1h", tz="UTC")  # a Sunday
+    np.testing.assert_allclose(cal.fraction(idx, 3600.0), [0.0, 0.5, 1.0, 0.0], atol=1e-12)
+    # any step: the integral over whole weeks is the hours of use (10-min and 7-h steps)
+    for freq, dt in (("10min", 600.0), ("7h", 25200.0)):
+        idx = pd.date_range("2024-01-01", periods=int(2 * 7 * 86400 / dt), freq=freq, tz="UTC")
+        assert cal.fraction(idx, dt).sum() * dt / 3600 == pytest.approx(2 * cal.hours_per_week)
+    # the local clock: fixed offset vs daylight-saving time
+    sun = parse_weekly({"weekly": ["Sun 10-11"], "timezone": "Europe/Copenhagen"})
+    win = pd.DatetimeIndex(["2024-01-07 09:00"], tz="UTC")  # 10:00 CET
+    summ = pd.DatetimeIndex(["2024-07-07 08:00"], tz="UTC")  # 10:00 CEST
+    assert sun.fraction(win, 3600.0)[0] == 1.0 and sun.fraction(summ, 3600.0)[0] == 1.0
+    fixed = parse_weekly({"weekly": ["Sun 10-11"], "timezone": "UTC+1"})
+    assert fixed.fraction(summ, 3600.0)[0] == 0.0
+    for bad, match in (
+        ({"weekly": ["Sun 12-08"]}, r"weekly\[0\].*not after the start"),
+        ({"weekly": ["Sunday 8-12"]}, r"weekly\[0\].*not 'DAYS"),
+        ({"weekly": ["Sun 8-12", "Xyz 1-2"]}, r"weekly\[1\].*unknown day 'Xyz'"),
+        ({"weekly": ["Sun 8-25"]}, r"00:00-24:00"),
+        ({"weekly": []}, r"weekly: expected a list"),
+        ({"weekly": ["Sun 8-12"], "clock": "UTC"}, r"unknown key\(s\) \['clock'\]"),
+        ({"weekly": ["Sun 8-12"], "timezone": "Mars/Olympus"}, r"timezone: unknown timezone"),
+    ):
+        with pytest.raises(ValueError, match=match):
+            parse_weekly(bad, "thermostat.schedule")
+
+
+def test_recovers_service_setpoint_of_a_weekly_schedule():
+    """A church heated to Tset_use on Sunday mornings (local UTC+1 clock), Tset otherwise,
+    with a power limit: the set-points and the power are recovered from 90 days (MAP
+    within 5 standard errors of the truth, as above)."""
+    import pandas as pd
+
+    from heritage_bayes.inputs import calendar_inputs
+
+    N = 24 * 90
+    te, rng = _weather(N, seed=7)
+    opts = {"power_limit": True, "schedule": {"weekly": ["Sun 08-12"], "timezone": "UTC+1"}}
+    m = hb.model("thermal_2c", surfaces=(), ground=False, thermostat=opts)
+    assert m.input_names == ("Te", "hours_of_use")
+    idx = pd.date_range("2016-01-04", periods=N, freq="1h", tz="UTC")  # a Monday
+    use = calendar_inputs([m], idx, DT)["hours_of_use"]
+    assert use.sum() == 4 * 12 and use[24 * 6 + 7 : 24 * 6 + 11].min() == 1.0  # 08-12 UTC+1
+    truth = dict(NET_T, Tset=10.0, Tset_use=14.0, Pmax=9000.0)
+    U = np.column_stack([te, use])
+    Y, _, Q = m.forward(m.param_array(truth)[0], U, DT, effort=True)
+    k = np.flatnonzero(use[:-1] > 0)
+    # informative data: in the hours of use the heating is either at its limit (the
+    # warm-up) or holds the service set-point
+    limited = Q[0, k] == 9000.0
+    held = np.abs(Y[0, k + 1, 0] - 14.0) < 1e-9
+    assert 0.2 < limited.mean() < 0.8 and (limited | held).all()
+    sd = 0.1
+    y = Y[0, :, 0] + rng.normal(0, sd, N)
+    free = ("Tset", "Tset_use", "Pmax")
+    lp, th = _fit(m, truth, U, y, free, seed=3)
+    se = _se(lp, th, free)
+    for n, s in zip(free, se, strict=True):
+        est = th[lp.params.names.index(n)]
+        assert abs(est - truth[n]) < 5 * s, (n, est, truth[n], s)
+    assert se[0] < 0.01 and se[1] < 0.1 and se[2] / truth["Pmax"] < 0.01
+
+
+def test_weekly_schedule_from_a_config_builds_its_input_and_names_key_paths():
+    from heritage_bayes.config import parse_config
+    from heritage_bayes.errors import ConfigError
+    from heritage_bayes.models import build_model
+    from heritage_bayes.prepare import prepare
+
+    def cfg(schedule):
+        return parse_config(
+            {
+                "data": {"demo": {}},
+                "thermal": {
+                    "model": "thermal_2c",
+                    "options": {"ground": False, "thermostat": {"schedule": schedule}},
+                },
+                "periods": {
+                    "calibration": {"start": "2019-01-02", "end": "2019-01-20"},
+                    "validation": {"start": "2019-01-20", "end": "2019-01-27"},
+                },
+            }
+        )
+
+    prep = prepare(cfg({"weekly": ["Sun 09-12"], "timezone": "Europe/Amsterdam"}))
+    use = prep.frame["hours_of_use"]
+    sundays = use[use > 0].index.tz_convert("Europe/Amsterdam")
+    assert set(sundays.day_name()) == {"Sunday"} and set(sundays.hour) == {9, 10, 11}
+    assert prep.sources["calendar"]["hours_of_use"]["hours_per_week"] == 3.0
+    m = build_model(cfg({"weekly": ["Sun 09-12"]}), "thermal")
+    assert m.input_names[-1] == "hours_of_use"
+    np.testing.assert_array_equal(prep.model_inputs("thermal", m)[:, -1], use.to_numpy())
+    with pytest.raises(ConfigError, match=r"^thermal\.options\.thermostat\.schedule\.weekly\[0\]"):
+        build_model(cfg({"weekly": ["Sun 9-"]}), "thermal")

@@ -249,6 +249,10 @@ Options (YAML: <section>.options), any catalogue model:
                                 Pmax [W] maximum power; Tset_use [°C] in the hours of
                                 use (input COLUMN: 1 in use, 0 not); conservation
                                 heating: RH kept <= RH_ch [-] (input Pi, measured)
+    thermostat: {schedule: {weekly: ["Sun 08-12", "Wed 19-21"], timezone: Europe/Copenhagen}}
+                                the hours of use from a weekly calendar in a local
+                                clock (DAYS HH[:MM]-HH[:MM]; DAYS Sun, Mon-Fri or
+                                Sat,Sun): generated input hours_of_use [-]
     humidistat: band | dehumidifier | humidifier | setpoint   (hygric)
                                 RH at the indoor temperature (input Ti, measured) held
                                 in [RH_lo, RH_hi] [-] (or at RH_set)

@@ -14,7 +14,7 @@ import pandas as pd
 
 from heritage_bayes.errors import ConfigError, DataError, InputError
 
-__all__ = ["annual_mean_temperature", "solar_inputs", "weather_inputs"]
+__all__ = ["annual_mean_temperature", "calendar_inputs", "solar_inputs", "weather_inputs"]
 
 _IRRADIANCE = ("ghi", "dni", "dhi")
 _YEAR = pd.Timedelta(days=365)
@@ -89,6 +89,32 @@ def annual_mean_temperature(te: pd.Series, times: pd.DatetimeIndex) -> tuple[np.
     value = float(s.mean())
     info.update(method=method, min=value, max=value)
     return np.full(len(times), value), info
+
+
+def calendar_inputs(models, index: pd.DatetimeIndex, dt: float) -> dict[str, np.ndarray]:
+    """Input columns that the models generate from a calendar, on a time grid.
+
+    Parameters
+    ----------
+    models : iterable of RCModel
+        Models whose ``calendar_inputs`` (e.g. a thermostat's weekly hours of use,
+        :mod:`heritage_bayes.rc.calendar`) are wanted.
+    index : pandas.DatetimeIndex
+        Step starts (tz-aware; UTC in the prepared data).
+    dt : float
+        Step [s].
+
+    Returns
+    -------
+    dict
+        Column name -> (N,) array: the fraction of each step ``[t_k, t_k + dt)`` in the
+        hours of use [-] (zero-order-hold mean, the convention of every input).
+    """
+    out: dict[str, np.ndarray] = {}
+    for m in models:
+        for name, cal in getattr(m, "calendar_inputs", {}).items():
+            out[name] = cal.fraction(index, dt)
+    return out
 
 
 def solar_inputs(

@@ -64,6 +64,8 @@ def build_model(cfg: CalibrationConfig, section: str) -> RCModel:
         raise
     except ValueError as exc:
         msg = str(exc)
+        if msg.startswith(("thermostat.", "humidistat.")):  # a control option's key path
+            raise ConfigError(f"{section}.options.{msg}") from None
         raise ConfigError(msg if msg.startswith(f"{where}") else f"{where}: {msg}") from None
     if m.domain != section:
         raise ConfigError(f"{where}: a {m.domain} model cannot be used in the {section!r} section")

@@ -55,6 +55,7 @@ from heritage_bayes.errors import ConfigError, DataError, InputError
 from heritage_bayes.inputs import (
     _with_vapour_pressure,
     annual_mean_temperature,
+    calendar_inputs,
     solar_inputs,
     weather_inputs,
 )
@@ -255,7 +256,11 @@ def _extra_inputs(cfg) -> list[str]:
     for section in ("thermal", "hygric"):
         if getattr(cfg, section) is None:
             continue
-        for name in build_model(cfg, section).input_names:
+        m = build_model(cfg, section)
+        generated = set(getattr(m, "calendar_inputs", {}))  # from the time grid
+        for name in m.input_names:
+            if name in generated:
+                continue
             if name not in built and name not in extra and name not in OUTPUT_COLUMNS:
                 extra.append(name)
     return extra
@@ -410,6 +415,20 @@ def prepare(cfg) -> Prepared:
             sources["ground_temperature"] = {"mode": "annual_mean"} | info
         frame["Tf"] = tf
         flags["Tf"] = False
+    from heritage_bayes.models import build_model
+
+    sections = [s for s in _SECTIONS if getattr(cfg, s) is not None]
+    models = [build_model(cfg, s) for s in sections]
+    for name, col in calendar_inputs(models, frame.index, step.total_seconds()).items():
+        frame[name] = col  # hours of use from a weekly calendar (thermostat.schedule)
+        flags[name] = False
+    for m in models:
+        for name, cal in getattr(m, "calendar_inputs", {}).items():
+            sources.setdefault("calendar", {})[name] = {
+                "weekly": list(cal.entries),
+                "timezone": cal.timezone,
+                "hours_per_week": cal.hours_per_week,
+            }
     if "Pi" not in frame.columns and {"Ti", "RHi"} <= set(frame.columns):
         from heritage_bayes.climate.psychro import vapour_pressure
 
@@ -429,6 +448,7 @@ def prepare(cfg) -> Prepared:
         **{c: "W/m²" for c in order if c.startswith("I_")},
         **({"Tf": "°C"} if "Tf" in order else {}),
         **({"Pi": "Pa"} if "Pi" in order else {}),
+        **{c: "-" for m in models for c in getattr(m, "calendar_inputs", {})},
     }
 
     # -- period rows -----------------------------------------------------------------------

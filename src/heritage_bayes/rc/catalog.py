@@ -41,7 +41,8 @@ identifiable).
 
 Control of the air node (a heated, humidity-controlled or occupied room; see
 :mod:`heritage_bayes.rc.control`): ``thermostat`` (true, or a mapping with
-``power_limit``, ``schedule``, ``conservation``), ``humidistat`` (true, a mode
+``power_limit``, ``schedule`` (an input column, or a weekly calendar
+``{weekly: ["Sun 08-12"], timezone: ...}``), ``conservation``), ``humidistat`` (true, a mode
 ``band``/``dehumidifier``/``humidifier``/``setpoint``, or a mapping with ``mode`` and
 ``capacity``) and ``source`` (true: a constant heat gain ``Qs`` [W] or moisture source
 ``Ms`` [kg/s]). Any catalogue model takes them, e.g.

@@ -1,6 +1,6 @@
 """Controlled rooms: thermostats, humidistats and constant sources on an RC network.
 
-Why one module (about 620 lines): the control options, the :class:`ControlledModel`
+Why one module (about 630 lines): the control options, the :class:`ControlledModel`
 that adds their parameters and inputs, and the compiled piecewise-linear step that
 solves for the control flow share one set of index conventions (which node is
 controlled, which input column is Ti or the schedule); they change together.
@@ -31,9 +31,11 @@ Components (options of :func:`heritage_bayes.model`):
   adds the maximum heating power ``Pmax`` [W] (otherwise ideal); ``schedule: COLUMN``
   adds a calendar input (1 in the hours of use, 0 otherwise, fractions allowed) and the
   service set-point ``Tset_use`` [°C] that applies while it is 1 (intermittent heating of
-  a church); ``conservation: true`` adds conservation heating: the set-point is raised to
-  the temperature at which the RH of the measured vapour pressure (input ``Pi``) is
-  ``RH_ch`` [-].
+  a church); ``schedule: {weekly: ["Sun 08-12"], timezone: UTC+1}`` generates that input
+  (column ``hours_of_use``) from a weekly calendar of the hours of use
+  (:mod:`heritage_bayes.rc.calendar`); ``conservation: true`` adds conservation
+  heating: the set-point is raised to the temperature at which the RH of the measured
+  vapour pressure (input ``Pi``) is ``RH_ch`` [-].
 - ``humidistat`` (hygric): the air's RH at the indoor temperature (input ``Ti``, the
   measured one in calibration, a predicted one in projections) held within
   ``[RH_lo, RH_hi]`` [-] (``mode: band``), below ``RH_hi`` (``mode: dehumidifier``),
@@ -66,10 +68,14 @@ from dataclasses import dataclass, replace
 import numba
 import numpy as np
 
+from heritage_bayes.rc.calendar import WeeklyCalendar, parse_weekly
 from heritage_bayes.rc.model import RCModel
 from heritage_bayes.rc.network import Network, ParameterInfo
 
-__all__ = ["COMPONENTS", "Control", "ControlledModel", "controlled"]
+__all__ = ["COMPONENTS", "HOURS_OF_USE", "Control", "ControlledModel", "controlled"]
+
+#: Input column generated from a weekly calendar (``thermostat.schedule.weekly``) [-].
+HOURS_OF_USE = "hours_of_use"
 
 #: Control components, the domain they belong to.
 COMPONENTS = {"thermostat": "thermal", "humidistat": "hygric", "source": None}
@@ -87,6 +93,8 @@ class Control:
         Estimated maximum heating power ``Pmax`` [W]; otherwise ideal.
     schedule : str or None
         Input column of the hours of use (1 in use, 0 not) for ``Tset_use``.
+    calendar : WeeklyCalendar or None
+        The weekly calendar that generates the schedule column :data:`HOURS_OF_USE`.
     conservation : bool
         Conservation heating: the set-point also keeps RH <= ``RH_ch`` (input ``Pi``).
     humidistat : str or None
@@ -102,6 +110,7 @@ class Control:
     thermostat: bool = False
     power_limit: bool = False
     schedule: str | None = None
+    calendar: WeeklyCalendar | None = None
     conservation: bool = False
     humidistat: str | None = None
     capacity: bool = False
@@ -135,9 +144,13 @@ def _parse_control(domain: str, name: str, options: dict) -> Control:
                 "['conservation', 'power_limit', 'schedule']"
             )
         sched = spec.get("schedule")
-        if sched is not None and (not isinstance(sched, str) or not sched):
+        if isinstance(sched, dict):
+            kw["calendar"] = parse_weekly(sched, "thermostat.schedule")
+            sched = HOURS_OF_USE
+        elif sched is not None and (not isinstance(sched, str) or not sched):
             raise ValueError(
-                f"model {name!r}: thermostat.schedule must be an input column name (got {sched!r})"
+                f"model {name!r}: thermostat.schedule must be an input column name or a "
+                f"weekly calendar {{weekly: ['Sun 08-12'], timezone: UTC+1}} (got {sched!r})"
             )
         for key in ("power_limit", "conservation"):
             if not isinstance(spec.get(key, False), bool):
@@ -276,6 +289,13 @@ class ControlledModel(RCModel):
     @property
     def n_inputs(self) -> int:
         return len(self.input_names)
+
+    @property
+    def calendar_inputs(self) -> dict[str, WeeklyCalendar]:
+        """Input columns generated from a calendar (name -> :class:`WeeklyCalendar`);
+        the data layer computes them from the time grid."""
+        c = self.control
+        return {c.schedule: c.calendar} if c.calendar is not None else {}
 
     def input_unit(self, name: str) -> str:
         """Unit of input column ``name``."""

@@ -280,3 +280,31 @@ def test_debilt_demo_weather(shared_data):
     assert info["site"]["latitude"] == pytest.approx(52.10)
     assert w.index[0].year == 2011 and len(meas) > 8 * 8760
     assert info["station"] == "260"
+
+
+def test_projection_of_a_run_with_a_weekly_calendar(tmp_path):
+    """A thermostat with weekly hours of use: the projection generates ``hours_of_use``
+    on its own dates (the calibrated use goes on) instead of stopping for a missing
+    input."""
+    import copy
+
+    from heritage_bayes.run import load_run
+
+    raw = copy.deepcopy(TINY)
+    raw["thermal"] = {
+        "model": "thermal_1c",
+        "options": {"thermostat": {"schedule": {"weekly": ["Sun 08-12"], "timezone": "UTC"}}},
+    }
+    out = tmp_path / "run"
+    run_calibration(parse_config(raw), out_dir=out, report=False, quiet=True)
+    p = project(out, {**PROJ, "draws": 8}, out=tmp_path / "p")
+    assert np.isfinite(p.dataset["Ti_monthly"].values).all()
+    run = load_run(out)
+    from heritage_bayes.projection.weather import baseline_weather, model_inputs
+
+    pcfg = parse_projection_config({**PROJ, "draws": 8})
+    weather, site, _ = baseline_weather(run, pcfg)
+    U = model_inputs(run, pcfg, weather, site, "baseline")
+    use = U["hours_of_use"].to_numpy()
+    sunday_morning = (U.index.day_of_week == 6) & (U.index.hour >= 8) & (U.index.hour < 12)
+    assert np.array_equal(use, sunday_morning.astype(float))

@@ -154,7 +154,7 @@ def model_inputs(run, pcfg, weather: pd.DataFrame, site: dict | None, where: str
     Returns a frame with every input column of the run's models (``Te``, ``I_<surface>``,
     ``Tf``, ``Pe``, ...), regular UTC index.
     """
-    from heritage_bayes.inputs import annual_mean_temperature, weather_inputs
+    from heritage_bayes.inputs import annual_mean_temperature, calendar_inputs, weather_inputs
     from heritage_bayes.io import align
     from heritage_bayes.prepare import _extra_inputs
 
@@ -189,6 +189,12 @@ def model_inputs(run, pcfg, weather: pd.DataFrame, site: dict | None, where: str
                 "'column'), which has no future; give ground_temperature: {mode: "
                 "annual_mean} or {mode: constant, value: ...} in the projection file"
             )
+    # inputs the models make from a calendar (a thermostat's weekly hours of use): the
+    # calibrated use goes on into the future, on the projection's own dates
+    for name, col in calendar_inputs(
+        run.models.values(), frame.index, step.total_seconds()
+    ).items():
+        frame[name] = col
     for section, model in run.models.items():
         missing = [c for c in model.input_names if c not in frame.columns]
         if missing:

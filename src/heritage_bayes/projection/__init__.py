@@ -108,7 +108,7 @@ def project(
     write : bool
         Write ``projection.nc``, ``projection.json`` and ``projection.html``.
     progress : callable, optional
-        Called with one line of text per case.
+        Called with one line of text per chunk of draws (all cases).
 
     Returns
     -------
@@ -119,7 +119,7 @@ def project(
     heritage_bayes.errors.InputError
         (and its subclasses ConfigError, DataError) for bad input: nothing is written.
     """
-    from heritage_bayes.projection.engine import select_draws, simulate_case
+    from heritage_bayes.projection.engine import select_draws, simulate_cases
     from heritage_bayes.projection.summary import summarize
     from heritage_bayes.projection.weather import Case, baseline_weather, futures, model_inputs
     from heritage_bayes.run import Run, load_run
@@ -141,23 +141,17 @@ def project(
     for c in cases:  # every input checked before the long part
         where = "baseline" if c.horizon is None else f"scenario {c.label}"
         c.inputs = model_inputs(r, pcfg, c.weather, site, where)
-    results = []
     risk_opts = {"indicators": pcfg.risk.indicators} if pcfg.risk.indicators else {}
-    for c in cases:
-        t0 = time.perf_counter()
-        results.append(
-            simulate_case(
-                r,
-                sel,
-                c.inputs,
-                seed=pcfg.seed,
-                noise=pcfg.noise,
-                chunk=pcfg.risk.chunk_draws,
-                risk_options=risk_opts,
-            )
-        )
-        if progress is not None:
-            progress(f"{c.label}: {sel.index.size} draws in {time.perf_counter() - t0:.1f} s")
+    results = simulate_cases(
+        r,
+        sel,
+        [c.inputs for c in cases],
+        seed=pcfg.seed,
+        noise=pcfg.noise,
+        chunk=pcfg.risk.chunk_draws,
+        risk_options=risk_opts,
+        progress=progress,
+    )
     labels = [c.label for c in cases]
     horizons = [c.horizon for c in cases]
     units = dict(results[0].predictive.attrs.get("units", {}))

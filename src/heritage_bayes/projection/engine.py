@@ -5,8 +5,9 @@ whole weather of one case, a draw of each section's noise model is added (so ban
 predictive, not only parametric), the indoor RH is formed from the coupled ``Ti`` and
 ``Pi`` and capped at saturation, and the chunk is reduced at once to what is kept:
 the risk indicators of every draw (of the predictive series and of the noise-free one,
-for the uncertainty split) and monthly means of ``Ti`` and ``RHi``. Peak memory is a
-few arrays of ``chunk × hours`` doubles, whatever the number of draws.
+for the uncertainty split) and monthly means of ``Ti`` and ``RHi``. Peak memory is the
+noise of one chunk (two arrays of ``chunk × hours`` doubles) and a few series per
+thread, whatever the number of draws.
 
 The same parameter draws and the same noise realisations (seeded per chunk) are used
 for every case: differences between scenarios are then paired, not blurred by noise.
@@ -117,30 +118,81 @@ def simulate_case(
     init_steps: int | None = None,
     risk_options: dict | None = None,
 ) -> CaseResult:
-    """Predictive simulation and risk of every draw on one weather (streamed by chunks).
+    """Predictive simulation and risk of every draw on one weather.
 
-    Parameters
-    ----------
-    run : heritage_bayes.run.Run
-    draws : Draws
-    inputs : pandas.DataFrame
-        Model inputs on an hourly grid (:func:`heritage_bayes.projection.weather.model_inputs`).
-    seed : int
-        Seed of the noise draws (chunk ``i`` uses ``(seed, i)``: identical across cases).
-    noise : bool
-        Add a draw of each section's noise model (predictive); False: noise-free only.
-    chunk : int
-        Draws simulated together (bounds memory: ~8 arrays of ``chunk × hours`` doubles).
-    init_steps : int, optional
-        Rows averaged for the steady-state initial state (default the calibration's).
-    risk_options : dict, optional
-        Keywords of :func:`heritage_bayes.climate.risk.assess_batch`.
+    :func:`simulate_cases` for one case (see there for the parameters).
 
     Returns
     -------
     CaseResult
     """
-    from heritage_bayes.climate.risk import assess_batch
+    return simulate_cases(
+        run,
+        draws,
+        [inputs],
+        seed=seed,
+        noise=noise,
+        chunk=chunk,
+        init_steps=init_steps,
+        risk_options=risk_options,
+    )[0]
+
+
+def simulate_cases(
+    run,
+    draws: Draws,
+    inputs: list[pd.DataFrame],
+    *,
+    seed: int,
+    noise: bool = True,
+    chunk: int = 50,
+    init_steps: int | None = None,
+    risk_options: dict | None = None,
+    progress=None,
+) -> list[CaseResult]:
+    """Predictive simulation and risk of every draw on each weather (streamed by chunks).
+
+    Parameters
+    ----------
+    run : heritage_bayes.run.Run
+    draws : Draws
+    inputs : list of pandas.DataFrame
+        Model inputs of each case on an hourly grid
+        (:func:`heritage_bayes.projection.weather.model_inputs`).
+    seed : int
+        Seed of the noise draws: chunk ``i`` uses ``(seed, i)``, for every case (cases
+        of the same length share the very same draws: paired differences).
+    noise : bool
+        Add a draw of each section's noise model (predictive); False: noise-free only.
+    chunk : int
+        Draws per chunk: the noise of a chunk (two arrays of ``chunk × hours`` doubles)
+        is drawn once and used for every case; the work arrays are ~8 series per
+        thread, whatever the chunk.
+    init_steps : int, optional
+        Rows averaged for the steady-state initial state (default the calibration's).
+    risk_options : dict, optional
+        Keywords of :func:`heritage_bayes.climate.risk.assess_batch`.
+    progress : callable, optional
+        Called with one line of text per chunk.
+
+    Returns
+    -------
+    list of CaseResult
+        In the order of ``inputs``. ``seconds``: ``simulate`` (modal forms, and
+        ``model.forward`` of controlled models), ``noise`` (the noise draws, shared
+        equally by the cases that use them) and ``risk`` (the compiled pass: simulation
+        of free-running models, RH, indicators, monthly means).
+
+    Notes
+    -----
+    The compiled pass (:mod:`heritage_bayes.projection._stream`) gives, per draw, the
+    indicators of :func:`~heritage_bayes.climate.risk.assess_batch` on the same series
+    (to rounding, see :mod:`heritage_bayes.climate.risk.fused`); a draw whose series
+    that function would reject or that has a missing hour is recomputed with it.
+    """
+    import numba
+
+    from heritage_bayes.climate.risk.fused import fused_plan
 
     if set(run.models) != {"thermal", "hygric"}:
         raise ConfigError(
@@ -153,53 +205,190 @@ def simulate_case(
             f"run {run.path}: data.step is {dt:g} s; the risk indicators need an hourly grid"
         )
     w = int(init_steps or run.summary.get("init_steps", 720))
-    U = {
-        s: np.ascontiguousarray(inputs[list(m.input_names)].to_numpy(dtype=float))
-        for s, m in run.models.items()
-    }
-    starts, months = _month_starts(inputs.index)
-    K = draws.index.size
-    N = len(inputs)
-    pred, par, tm, rm = [], [], [], []
-    sec = {"simulate": 0.0, "noise": 0.0, "risk": 0.0}
     opts = dict(risk_options or {})
+    plan_opts = {k: v for k, v in opts.items() if k not in ("nan_policy", "chunk_size")}
+    cases = []
+    for inp in inputs:
+        U = {
+            s: np.ascontiguousarray(inp[list(m.input_names)].to_numpy(dtype=float))
+            for s, m in run.models.items()
+        }
+        starts, months = _month_starts(inp.index)
+        plan = fused_plan(len(inp), func="assess_batch", **plan_opts)  # checks options
+        Ut = {s: np.ascontiguousarray(u.T) for s, u in U.items()}
+        cases.append(_Case(U, Ut, starts, months, plan, len(inp)))
+    K = draws.index.size
+    out = [_CaseOut.empty(c, K) for c in cases]
+    slots = max(1, min(numba.get_num_threads(), chunk, K))
+    work: dict = {}
     for i, s0 in enumerate(range(0, K, chunk)):
+        t_chunk = time.perf_counter()
         sl = slice(s0, min(s0 + chunk, K))
-        rng = np.random.default_rng([seed, i])
-        out = {}
-        for s, m in run.models.items():
-            t0 = time.perf_counter()
-            u0 = U[s][: max(1, w)].mean(axis=0)  # steady state of the first window
-            y = m.forward(draws.model[s][sl], U[s], dt, u_init=u0)[0][..., 0]
-            t1 = time.perf_counter()
-            e = None
-            if noise:
-                e = draws.noise_models[s].sample(rng, draws.noise[s][sl], N, 1)[..., 0]
-            sec["simulate"] += t1 - t0
-            sec["noise"] += time.perf_counter() - t1
-            out[s] = (y, e)
         t0 = time.perf_counter()
-        Ts, Ps = out["thermal"][0], out["hygric"][0]
-        RHs = _relative_humidity(Ts, Ps)
-        par.append(assess_batch(Ts, RHs, **opts))
-        if noise:
-            T = Ts + out["thermal"][1]
-            RH = _relative_humidity(T, Ps + out["hygric"][1])
-            pred.append(assess_batch(T, RH, **opts))
-        else:
-            T, RH = Ts, RHs
-            pred.append(par[-1])
-        tm.append(_monthly(T, starts))
-        rm.append(_monthly(RH, starts))
-        sec["risk"] += time.perf_counter() - t0
-    return CaseResult(
-        predictive=_concat(pred),
-        parametric=_concat(par),
-        months=months,
-        Ti_month=np.concatenate(tm),
-        RHi_month=np.concatenate(rm),
-        seconds=sec,
+        modal = {s: _modal_form(m, draws.model[s][sl], dt) for s, m in run.models.items()}
+        t_modal = (time.perf_counter() - t0) / len(cases)
+        for N in sorted({c.N for c in cases}):
+            same = [j for j, c in enumerate(cases) if c.N == N]
+            t0 = time.perf_counter()
+            e = _noise(draws, sl, N, seed, i) if noise else None
+            t_noise = (time.perf_counter() - t0) / len(same)
+            for j in same:
+                c, o = cases[j], out[j]
+                o.seconds["noise"] += t_noise
+                key = (N, c.plan.pad)
+                if key not in work:
+                    work[key] = _work(c.plan, slots, N)
+                _run_chunk(run, draws, c, o, sl, modal, e, dt, w, work[key], t_modal, opts)
+        if progress is not None:
+            progress(
+                f"draws {s0 + 1}-{sl.stop} of {K}: {len(cases)} case(s) in "
+                f"{time.perf_counter() - t_chunk:.1f} s"
+            )
+    return [o.result(c) for c, o in zip(cases, out, strict=True)]
+
+
+@dataclass
+class _Case:
+    U: dict  # section -> (hours, inputs)
+    Ut: dict  # section -> (inputs, hours)
+    starts: np.ndarray
+    months: pd.DatetimeIndex
+    plan: object
+    N: int
+
+
+@dataclass
+class _CaseOut:
+    par: np.ndarray
+    pred: np.ndarray
+    Tm: np.ndarray
+    RHm: np.ndarray
+    seconds: dict
+
+    @classmethod
+    def empty(cls, c: _Case, K: int) -> _CaseOut:
+        nm = c.starts.size
+        return cls(
+            par=np.empty((K, c.plan.width)),
+            pred=np.empty((K, c.plan.width)),
+            Tm=np.empty((K, nm), np.float32),
+            RHm=np.empty((K, nm), np.float32),
+            seconds={"simulate": 0.0, "noise": 0.0, "risk": 0.0},
+        )
+
+    def result(self, c: _Case) -> CaseResult:
+        return CaseResult(
+            predictive=c.plan.frame(self.pred),
+            parametric=c.plan.frame(self.par),
+            months=c.months,
+            Ti_month=self.Tm,
+            RHi_month=self.RHm,
+            seconds=self.seconds,
+        )
+
+
+def _modal_form(m, P: np.ndarray, dt: float):
+    """The modal form of a free-running model (None for a controlled one: it is
+    simulated by its own ``forward``)."""
+    from heritage_bayes.rc.discretize import modal_form
+    from heritage_bayes.rc.model import RCModel
+
+    if type(m).forward is not RCModel.forward or m.n_states > _MAX_MODES:
+        return None
+    return modal_form(m, P, dt)
+
+
+def _modal_arrays(mf, u0: np.ndarray) -> tuple:
+    """(ad, Bdz, edz, Cz of the first output, z0) as ``RCModel.forward`` sets them up."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        z0 = mf.steady_state_modal(u0)
+    z0 = np.where(np.isfinite(z0), z0, 0.0)
+    z0 = np.ascontiguousarray(np.broadcast_to(z0, mf.lam.shape))
+    c = np.ascontiguousarray
+    return c(mf.ad), c(mf.Bdz), c(mf.edz), c(mf.Cz[:, 0, :]), z0
+
+
+_MAX_MODES = 64
+_NO_MODAL = (np.zeros((0, 1)), np.zeros((0, 1, 1)), np.zeros((0, 1)), np.zeros((0, 1)),
+             np.zeros((0, 1)))  # fmt: skip
+
+
+def _noise(draws: Draws, sl: slice, N: int, seed: int, i: int) -> dict:
+    """The noise of chunk ``i`` for series of ``N`` hours, section by section."""
+    rng = np.random.default_rng([seed, i])
+    return {
+        s: np.ascontiguousarray(nm.sample(rng, draws.noise[s][sl], N, 1)[..., 0])
+        for s, nm in draws.noise_models.items()
+    }
+
+
+def _work(plan, slots: int, N: int) -> tuple:
+    """Work arrays of the compiled pass: the plan's, four series and the modal state
+    and forcing of each slot."""
+    from heritage_bayes.climate.risk._fused import BLOCK
+
+    return (
+        *plan.workspace(slots),
+        np.empty((slots, 4, N)),
+        np.empty((slots, _MAX_MODES)),
+        np.empty((slots, _MAX_MODES, BLOCK)),
     )
+
+
+def _run_chunk(run, draws, c: _Case, o: _CaseOut, sl, modal, e, dt, w, work, t_modal, opts):
+    from heritage_bayes.projection._stream import chunk_kernel
+
+    t0 = time.perf_counter()
+    Y, M, U = {}, {}, {}
+    for s, m in run.models.items():
+        u0 = c.U[s][: max(1, w)].mean(axis=0)  # steady state of the first window
+        if modal[s] is None:
+            Y[s] = np.ascontiguousarray(
+                m.forward(draws.model[s][sl], c.U[s], dt, u_init=u0)[0][..., 0]
+            )
+            M[s], U[s] = _NO_MODAL, np.zeros((1, 1))
+        else:
+            Y[s], M[s], U[s] = np.zeros((0, 0)), _modal_arrays(modal[s], u0), c.Ut[s]
+    o.seconds["simulate"] += time.perf_counter() - t0 + t_modal
+    t0 = time.perf_counter()
+    k = sl.stop - sl.start
+    spar = np.zeros(k, np.int64)
+    spred = np.zeros(k, np.int64)
+    dummy = np.zeros((0, 0))
+    eT = e["thermal"] if e is not None else dummy
+    eP = e["hygric"] if e is not None else dummy
+    ws, tmp, btmp, hist, sbuf, zbuf, wbuf = work
+    chunk_kernel(
+        Y["thermal"], Y["hygric"], M["thermal"], M["hygric"], U["thermal"], U["hygric"],
+        eT, eP, e is not None, c.starts, *c.plan.arrays, ws, tmp, btmp, hist, sbuf, zbuf, wbuf,
+        o.par[sl], o.pred[sl], spar, spred, o.Tm[sl], o.RHm[sl],
+    )  # fmt: skip
+    bad = np.flatnonzero((spar != 0) | (spred != 0))
+    if bad.size:
+        _recompute(run, draws, c, o, sl, bad, e, dt, w, opts)
+    o.seconds["risk"] += time.perf_counter() - t0
+
+
+def _recompute(run, draws, c: _Case, o: _CaseOut, sl, bad, e, dt, w, opts):
+    """Draws the compiled pass handed back (a missing hour, or a series that
+    :func:`assess_batch` rejects): the numpy path, with its NaN policy and its errors."""
+    from heritage_bayes.climate.risk import assess_batch
+
+    rows = np.arange(sl.start, sl.stop)[bad]
+    ys = {}
+    for s, m in run.models.items():
+        u0 = c.U[s][: max(1, w)].mean(axis=0)
+        ys[s] = m.forward(draws.model[s][rows], c.U[s], dt, u_init=u0)[0][..., 0]
+    Ts, Ps = ys["thermal"], ys["hygric"]
+    o.par[rows] = c.plan.values(assess_batch(Ts, _relative_humidity(Ts, Ps), **opts))
+    if e is None:
+        o.pred[rows] = o.par[rows]
+        return
+    T = Ts + e["thermal"][bad]
+    RH = _relative_humidity(T, Ps + e["hygric"][bad])
+    o.pred[rows] = c.plan.values(assess_batch(T, RH, **opts))
+    o.Tm[rows] = _monthly(T, c.starts)
+    o.RHm[rows] = _monthly(RH, c.starts)
 
 
 def _concat(parts: list[pd.DataFrame]) -> pd.DataFrame:

@@ -1,0 +1,583 @@
+"""Every indicator of :func:`~heritage_bayes.climate.risk.assess` for one hourly series,
+in one compiled function (numba).
+
+Private module; the plan (the options turned into arrays) and the Python entry points
+are in :mod:`heritage_bayes.climate.risk.fused`. :func:`series_indicators` reads the
+series a few times (hours in blocks of :data:`BLOCK`, so the temporaries stay in the
+CPU cache) and writes one row of indicators; it is callable from other compiled code
+(the projection kernel calls it twice per posterior draw).
+
+Same arithmetic as the numpy code of the mechanism modules, with these differences, all
+at the level of rounding (relative ≤ 1e-15 per hour, checked against
+:func:`~heritage_bayes.climate.risk.assess_batch` by ``tests/test_fused_risk.py``):
+
+* exp, log and cosh are the vectorisable versions of :mod:`heritage_bayes.climate._vecmath`
+  (within 2 ulp of the C library); the reciprocals of the lifetime multiplier and of the
+  preservation index are computed as ``exp(-x)`` instead of ``1 / exp(x)``;
+* the harmonic means sum the hours in blocks (numpy: pairwise summation).
+
+Bit for bit the same as numpy: the moving averages (sequential cumulative sums, as
+``np.cumsum``), the annual means (numpy's pairwise summation, re-implemented), the ASHRAE
+and EN 15757 comparisons, the EMC, the VTT recursion and the percentiles (exact order
+statistics found by a histogram of the values, then numpy's linear interpolation).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from heritage_bayes.climate import _vecmath
+from heritage_bayes.climate._vecmath import stamp_cache, vcosh, vexp, vlog
+
+#: Hours processed together by the vectorised loops.
+BLOCK = 512
+#: Bins of the histogram that locates the EN 15757 percentiles.
+N_BINS = 4096
+_EPS = 1e-9  # as heritage_bayes.climate.risk.standards._EPS (tolerance on limits)
+_T0 = 273.15
+
+# integer parameters (ipar)
+(I_CHEM, I_MECH, I_MOULD, I_ASHRAE, I_EN, I_NEA, I_HALF_A, I_WRAP_A, I_HALF_E, I_WRAP_E,
+ I_SHARED, I_METHOD, I_NESTED, I_NCLS, I_EN_WIDTH, I_FROZEN, I_HAS_TSP,
+ I_HAS_RHSP) = range(18)  # fmt: skip
+N_IPAR = 18
+# float parameters (fpar)
+(F_TREF_INV, F_RHREF, F_N, F_COEF, F_K1LO, F_K1HI, F_A, F_B, F_C, F_RHMIN, F_CMAT, F_W,
+ F_SQ, F_M0, F_LIMC, F_THR, F_TSP, F_RHSP, F_QLO, F_QHI, F_MINBAND) = range(21)  # fmt: skip
+N_FPAR = 21
+# columns of the class table (cls): raw ClimateClass values, NaN for None
+C_TS, C_TDOWN, C_TUP, C_TSMAX, C_TMAX, C_RS, C_RDOWN, C_RUP, C_RLO, C_RHI = range(10)
+N_CLS = 10
+# kinds of set-point check (see standards._setpoint_ok)
+K_NONE, K_MEAN, K_SEASON, K_SETPOINT = range(4)
+
+
+@njit(cache=True, error_model="numpy")
+def _pairwise_leaf(a, lo, n):  # pragma: no cover - compiled
+    """numpy's pairwise summation of ``a[lo:lo + n]`` for ``n <= 128`` (no split)."""
+    if n < 8:
+        res = 0.0
+        for i in range(n):
+            res += a[lo + i]
+        return res
+    r0, r1, r2, r3 = a[lo], a[lo + 1], a[lo + 2], a[lo + 3]
+    r4, r5, r6, r7 = a[lo + 4], a[lo + 5], a[lo + 6], a[lo + 7]
+    i = 8
+    while i < n - (n % 8):
+        r0 += a[lo + i]
+        r1 += a[lo + i + 1]
+        r2 += a[lo + i + 2]
+        r3 += a[lo + i + 3]
+        r4 += a[lo + i + 4]
+        r5 += a[lo + i + 5]
+        r6 += a[lo + i + 6]
+        r7 += a[lo + i + 7]
+        i += 8
+    res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+    while i < n:
+        res += a[lo + i]
+        i += 1
+    return res
+
+
+@njit(cache=True, error_model="numpy")
+def pairwise_sum(a, lo, n):  # pragma: no cover - compiled
+    """numpy's pairwise summation of ``a[lo:lo + n]`` (the same result, bit for bit).
+
+    numpy splits a sum of more than 128 terms at ``n2 = n // 2 - (n // 2) % 8`` and adds
+    the two halves; the recursion is unrolled here onto an explicit stack (a cached
+    numba function that calls a recursive one does not load from the cache).
+    """
+    if n <= 128:
+        return _pairwise_leaf(a, lo, n)
+    depth = 64
+    s_lo = np.empty(depth, np.int64)
+    s_n = np.empty(depth, np.int64)
+    s_phase = np.zeros(depth, np.int64)  # 0: not split yet, 1: left pending, 2: right
+    s_left = np.empty(depth)
+    sp = 0
+    s_lo[0] = lo
+    s_n[0] = n
+    while True:
+        cn = s_n[sp]
+        if cn > 128 and s_phase[sp] == 0:
+            n2 = cn // 2
+            n2 -= n2 % 8
+            s_phase[sp] = 1
+            sp += 1
+            s_lo[sp] = s_lo[sp - 1]
+            s_n[sp] = n2
+            s_phase[sp] = 0
+            continue
+        r = _pairwise_leaf(a, s_lo[sp], cn)
+        sp -= 1
+        while sp >= 0:  # hand the result to the parents
+            if s_phase[sp] == 1:
+                s_left[sp] = r
+                s_phase[sp] = 2
+                pn = s_n[sp]
+                n2 = pn // 2
+                n2 -= n2 % 8
+                sp += 1
+                s_lo[sp] = s_lo[sp - 1] + n2
+                s_n[sp] = pn - n2
+                s_phase[sp] = 0
+                break
+            r = s_left[sp] + r
+            sp -= 1
+        if sp < 0:
+            return r
+
+
+@njit(cache=True, fastmath={"reassoc", "nsz"})
+def _bsum(a, m):  # pragma: no cover - compiled
+    """Sum of ``a[:m]`` (vectorised: the order of the additions is the compiler's)."""
+    s = 0.0
+    for t in range(m):
+        s += a[t]
+    return s
+
+
+@njit(cache=True, fastmath={"nnan", "nsz"})
+def _bminmax(a, m, lo, hi):  # pragma: no cover - compiled
+    """(min, max) of ``a[:m]`` and the running ``lo``, ``hi`` (finite values: exact)."""
+    for t in range(m):
+        v = a[t]
+        lo = v if v < lo else lo
+        hi = v if v > hi else hi
+    return lo, hi
+
+
+@njit(cache=True, error_model="numpy")
+def _bad_hours(T, RH, n):  # pragma: no cover - compiled
+    """Hours that ``hourly()`` would reject or that are missing, and the RH ranges."""
+    bad = 0
+    above1 = 0
+    above0 = 0
+    for t in range(n):
+        x = T[t]
+        r = RH[t]
+        bad += 0 if (x >= -100.0 and x <= 100.0 and r >= 0.0 and r <= 100.0) else 1
+        above1 += 1 if r > 1.0 else 0
+        above0 += 1 if r > 0.0 else 0
+    return bad, above1, above0
+
+
+@njit(cache=True, error_model="numpy")
+def _pointwise(T, RH, b0, m, fpar, ipar, ea_r, tmp, sums):  # pragma: no cover - compiled
+    """Chemical and mechanical indicators and the isopleth count of one block.
+
+    ``sums``: [1/LM per activation energy..., 1/PI, EMC min, EMC max, hours above LIM].
+    """
+    nea = ipar[I_NEA]
+    u = tmp[0]
+    lr = tmp[1]
+    w = tmp[2]
+    Tb = T[b0 : b0 + m]  # views: the loops below index from 0 (vectorised)
+    RHb = RH[b0 : b0 + m]
+    if ipar[I_CHEM]:
+        tref_inv = fpar[F_TREF_INV]
+        rh_ref = fpar[F_RHREF]
+        n_exp = fpar[F_N]
+        for t in range(m):
+            x = Tb[t]
+            r = RHb[t]
+            TK = x + _T0
+            u[t] = 1.0 / TK - tref_inv
+            lr[t] = n_exp * vlog(rh_ref / r)
+            # 1 / PI with PI = exp(a) / 365 (chemical._pi)
+            w[t] = 365.0 * vexp(-((95220.0 - 134.9 * r) / (8.314 * TK) + 0.0284 * r - 28.023))
+        sums[nea] += _bsum(w, m)
+        for k in range(nea):
+            e = ea_r[k]
+            for t in range(m):
+                w[t] = vexp(-(e * u[t] + lr[t]))  # 1 / LM
+            sums[k] += _bsum(w, m)
+    if ipar[I_MECH]:
+        for t in range(m):
+            x = Tb[t]
+            h = RHb[t] / 100.0  # mechanical._emc, term by term
+            W = 349.0 + 1.29 * x + 0.0135 * x * x
+            K = 0.805 + 7.36e-4 * x - 2.73e-6 * x * x
+            K1 = 6.27 - 9.38e-3 * x - 3.03e-4 * x * x
+            K2 = 1.91 + 0.0407 * x - 2.93e-4 * x * x
+            Kh = K * h
+            KKh = K1 * Kh
+            KKKh2 = K1 * K2 * Kh * Kh
+            w[t] = (1800.0 / W) * (Kh / (1.0 - Kh) + (KKh + 2.0 * KKKh2) / (1.0 + KKh + KKKh2))
+        lo, hi = _bminmax(w, m, sums[nea + 1], sums[nea + 2])
+        sums[nea + 1] = lo
+        sums[nea + 2] = hi
+    if ipar[I_MOULD]:
+        c = fpar[F_LIMC]
+        cnt = 0
+        for t in range(m):
+            x = Tb[t]
+            cnt += 1 if RHb[t] > 100.0 * (0.02633 * vcosh(0.10083 * (x - 30.0)) + c) else 0
+        sums[nea + 3] += cnt
+
+
+@njit(cache=True, error_model="numpy")
+def _vtt_peak(T, RH, n, fpar, frozen_decline):  # pragma: no cover - compiled
+    """Maximum VTT mould index of one complete series (the recursion of ``_vtt``)."""
+    k1_lo, k1_hi = fpar[F_K1LO], fpar[F_K1HI]
+    A, B, C, RH_min, C_mat = fpar[F_A], fpar[F_B], fpar[F_C], fpar[F_RHMIN], fpar[F_CMAT]
+    W, SQ = fpar[F_W], fpar[F_SQ]
+    M = fpar[F_M0]
+    dry = 0
+    mx = -1.0
+    for t in range(n):
+        Ti = T[t]
+        Ri = RH[t]
+        grow = Ti > 0.0 and Ti < 50.0
+        RHc = RH_min
+        if grow:
+            if Ti <= 20.0:
+                RHc = -0.00267 * Ti**3 + 0.160 * Ti**2 - 3.13 * Ti + 100.0
+                if RHc < RH_min:
+                    RHc = RH_min
+            grow = Ri >= RHc
+        if grow:
+            x = (RHc - Ri) / (RHc - 100.0)
+            M_max = A + B * x - C * x * x
+            k1 = k1_lo if M < 1.0 else k1_hi
+            k2 = 1.0 - math.exp(2.3 * (M - M_max))
+            if k2 < 0.0:
+                k2 = 0.0
+            M += (
+                k1
+                * k2
+                * math.exp(0.68 * math.log(Ti) + 13.9 * math.log(Ri) - 0.14 * W + 0.33 * SQ - 66.02)
+                / 168.0
+            )
+            dry = 0
+        elif Ti <= 0.0 and not frozen_decline:
+            pass
+        else:
+            dry += 1
+            if dry <= 6:
+                M -= 0.00133 * C_mat
+            elif dry > 24:
+                M -= 0.000667 * C_mat
+            if M < 0.0:
+                M = 0.0
+        if M > mx:
+            mx = M
+    return mx
+
+
+@njit(cache=True, error_model="numpy")
+def _cumsum(x, n, half, wrap, cs):  # pragma: no cover - compiled
+    """Cumulative sums of ``x`` (padded periodically by ``half`` when ``wrap``) into
+    ``cs``, as ``_inputs.centred_mean`` builds them (``np.cumsum``: sequential)."""
+    cs[0] = 0.0
+    s = 0.0
+    j = 1
+    if wrap:
+        for t in range(n - half, n):
+            s = s + x[t]
+            cs[j] = s
+            j += 1
+    for t in range(n):
+        s = s + x[t]
+        cs[j] = s
+        j += 1
+    if wrap:
+        for t in range(half):
+            s = s + x[t]
+            cs[j] = s
+            j += 1
+
+
+@njit(cache=True, error_model="numpy")
+def _centred(cs, b0, m, n, half, wrap, dst):  # pragma: no cover - compiled
+    """Centred moving average of hours ``b0 … b0 + m`` from the sums ``cs``."""
+    w = np.float64(2 * half + 1)
+    if wrap:
+        hi = cs[b0 + 2 * half + 1 : b0 + 2 * half + 1 + m]
+        lo = cs[b0 : b0 + m]
+        for t in range(m):
+            dst[t] = (hi[t] - lo[t]) / w
+        return
+    # full windows for b0 + t in [half, n - half - 1]; truncated ones at the ends
+    t0 = min(max(half - b0, 0), m)
+    t1 = max(min(n - half - b0, m), t0)
+    for t in range(t0):
+        i = b0 + t
+        a = max(i - half, 0)
+        b = min(i + half + 1, n)
+        dst[t] = (cs[b] - cs[a]) / np.float64(b - a)
+    hi = cs[b0 + t0 + half + 1 : b0 + t1 + half + 1]
+    lo = cs[b0 + t0 - half : b0 + t1 - half]
+    d = dst[t0:t1]
+    for t in range(t1 - t0):
+        d[t] = (hi[t] - lo[t]) / w
+    for t in range(t1, m):
+        i = b0 + t
+        a = max(i - half, 0)
+        b = min(i + half + 1, n)
+        dst[t] = (cs[b] - cs[a]) / np.float64(b - a)
+
+
+@njit(cache=True, error_model="numpy")
+def _var_pass(
+    kind, x, s, m, mean, short, down, up, smax, vmin, vmax, below, nested
+):  # pragma: no cover
+    """One variable of one class over a block: ``below[t]`` becomes "hour t meets the
+    class's limits on this variable" (standards._setpoint_ok and the absolute bounds
+    ``[vmin, vmax]``), and also the previous content of ``below`` when ``nested``."""
+    keep = not nested  # 1: ignore what ``below`` held
+    lim = short + _EPS
+    lo = vmin - _EPS
+    hi = vmax + _EPS
+    if kind == K_NONE:
+        for t in range(m):
+            v = x[t]
+            below[t] = (v >= lo) & (v <= hi) & ((below[t] != 0) | keep)
+    elif kind == K_MEAN:
+        for t in range(m):
+            v = x[t]
+            ok = abs(v - mean) <= lim
+            below[t] = ok & (v >= lo) & (v <= hi) & ((below[t] != 0) | keep)
+    elif kind == K_SEASON:
+        dlo = -down - _EPS
+        dhi = up + _EPS
+        top = smax + _EPS
+        for t in range(m):
+            v = x[t]
+            st = s[t]
+            ds = st - mean
+            ok = (abs(v - st) <= lim) & (ds >= dlo) & (ds <= dhi) & (st <= top)
+            below[t] = ok & (v >= lo) & (v <= hi) & ((below[t] != 0) | keep)
+    else:  # set point following the season, clipped to the seasonal limits
+        dlo = -down
+        for t in range(m):
+            v = x[t]
+            sp = min(mean + min(max(s[t] - mean, dlo), up), smax)
+            ok = abs(v - sp) <= lim
+            below[t] = ok & (v >= lo) & (v <= hi) & ((below[t] != 0) | keep)
+
+
+@njit(cache=True, error_model="numpy")
+def _ashrae_block(
+    T, RH, b0, m, sT, sRH, mT, mRH, ipar, kinds, cls, btmp, counts
+):  # pragma: no cover
+    """Hours of the block meeting each class (T and RH, nested), added to ``counts``."""
+    belowT, belowRH = btmp[0], btmp[1]
+    nested = ipar[I_NESTED] != 0
+    Tb = T[b0 : b0 + m]
+    RHb = RH[b0 : b0 + m]
+    for t in range(m):
+        belowT[t] = 1
+        belowRH[t] = 1
+    for j in range(ipar[I_NCLS] - 1, -1, -1):  # from the most lenient class up
+        _var_pass(kinds[j, 0], Tb, sT, m, mT, cls[j, C_TS], cls[j, C_TDOWN], cls[j, C_TUP],
+                  cls[j, C_TSMAX], -math.inf, cls[j, C_TMAX], belowT, nested)  # fmt: skip
+        _var_pass(kinds[j, 1], RHb, sRH, m, mRH, cls[j, C_RS], cls[j, C_RDOWN],
+                  cls[j, C_RUP], math.inf, cls[j, C_RLO], cls[j, C_RHI], belowRH,
+                  nested)  # fmt: skip
+        cnt = 0
+        for t in range(m):
+            cnt += belowT[t] & belowRH[t]
+        counts[j] += cnt
+
+
+@njit(cache=True, error_model="numpy")
+def _bin(v, fmin, scale):  # pragma: no cover - compiled
+    b = np.int64((v - fmin) * scale)
+    return b if b < N_BINS else N_BINS - 1
+
+
+@njit(cache=True, error_model="numpy")
+def _rank_bin(hist, r):  # pragma: no cover - compiled
+    """(bin holding the value of rank ``r``, number of values in the bins before it)."""
+    c = 0
+    for b in range(N_BINS):
+        if c + hist[b] > r:
+            return b, c
+        c += hist[b]
+    return N_BINS - 1, c - hist[N_BINS - 1]
+
+
+@njit(cache=True, error_model="numpy")
+def _percentiles(f, n, q, hist, sel):  # pragma: no cover - compiled
+    """``np.percentile(f[:n], 100 q)`` (method "linear") for the two values of ``q``.
+
+    Exact order statistics: a histogram of the values on ``N_BINS`` bins (the bin index
+    is monotone in the value) locates the bin of each rank; only that bin's values are
+    sorted.
+    """
+    fmin, fmax = _bminmax(f, n, math.inf, -math.inf)
+    out = np.empty(2)
+    ranks = np.empty(4, np.int64)
+    gam = np.empty(2)
+    for k in range(2):
+        v = (n - 1) * q[k]  # numpy's virtual index
+        p = math.floor(v)
+        gam[k] = v - p
+        if v >= n - 1:
+            ranks[2 * k] = n - 1
+            ranks[2 * k + 1] = n - 1
+        else:
+            ranks[2 * k] = np.int64(p)
+            ranks[2 * k + 1] = np.int64(p) + 1
+    val = np.empty(4)
+    scale = N_BINS / (fmax - fmin)
+    if fmax == fmin:
+        val[:] = fmin
+    elif not math.isfinite(scale):
+        s = np.sort(f[:n])
+        for i in range(4):
+            val[i] = s[ranks[i]]
+    else:
+        fv = f[:n]
+        hist[:] = 0
+        for t in range(n):
+            hist[_bin(fv[t], fmin, scale)] += 1
+        b_lo0, before0 = _rank_bin(hist, ranks[0])
+        b_hi0, _ = _rank_bin(hist, ranks[1])
+        b_lo1, before1 = _rank_bin(hist, ranks[2])
+        b_hi1, _ = _rank_bin(hist, ranks[3])
+        c0 = 0
+        for b in range(b_lo0, b_hi0 + 1):
+            c0 += hist[b]
+        c = 0
+        c1 = c0
+        for t in range(n):  # the values of those bins, one region per percentile
+            v = fv[t]
+            b = _bin(v, fmin, scale)
+            if b >= b_lo0 and b <= b_hi0:
+                sel[c] = v
+                c += 1
+            if b >= b_lo1 and b <= b_hi1:
+                sel[c1] = v
+                c1 += 1
+        part = sel[:c0]
+        part.sort()
+        val[0] = part[ranks[0] - before0]
+        val[1] = part[ranks[1] - before0]
+        part = sel[c0:c1]
+        part.sort()
+        val[2] = part[ranks[2] - before1]
+        val[3] = part[ranks[3] - before1]
+    for k in range(2):
+        a = val[2 * k]
+        b = val[2 * k + 1]
+        t = gam[k]
+        d = b - a  # numpy's _lerp
+        out[k] = b - d * (1.0 - t) if t >= 0.5 else a + d * t
+    return out[0], out[1]
+
+
+@njit(cache=True, error_model="numpy")
+def series_indicators(
+    T, RH, n, ea_r, fpar, ipar, kinds, cls, ws, tmp, btmp, hist, out
+):  # pragma: no cover
+    """All indicators of the plan for the series ``T[:n]`` [°C], ``RH[:n]`` [%].
+
+    Writes ``out`` (the plan's columns; the best ASHRAE class as its index, -1 for none)
+    and returns 0, or 1 without computing anything when an hour is missing or outside
+    what :func:`~heritage_bayes.climate.risk.assess_batch` accepts (the caller then
+    uses that function for this series). ``ws`` (5, n + 2 pad + 1), ``tmp`` (3, BLOCK),
+    ``btmp`` (4, BLOCK) uint8 and ``hist`` (N_BINS,) are work arrays.
+    """
+    bad, above1, above0 = _bad_hours(T, RH, n)
+    if bad > 0 or (above1 == 0 and above0 > 0):
+        return 1
+    nea = ipar[I_NEA]
+    sums = np.zeros(nea + 4)
+    sums[nea + 1] = math.inf
+    sums[nea + 2] = -math.inf
+    for b0 in range(0, n, BLOCK):
+        _pointwise(T, RH, b0, min(BLOCK, n - b0), fpar, ipar, ea_r, tmp, sums)
+    col = 0
+    if ipar[I_CHEM]:
+        for k in range(nea + 1):  # lifetime multipliers, then TWPI: harmonic means
+            out[col] = n / sums[k]
+            col += 1
+    if ipar[I_MECH]:
+        lo, hi = sums[nea + 1], sums[nea + 2]
+        out[col] = lo
+        out[col + 1] = hi
+        out[col + 2] = hi - lo
+        out[col + 3] = 100.0 * fpar[F_COEF] * (hi - lo)
+        out[col + 4] = hi
+        col += 5
+    if ipar[I_MOULD]:
+        out[col] = _vtt_peak(T, RH, n, fpar, ipar[I_FROZEN] != 0)
+        out[col + 1] = 100.0 * sums[nea + 3] / n / 100.0 * 8760.0  # share → h/year
+        col += 2
+    if not (ipar[I_ASHRAE] or ipar[I_EN]):
+        return 0
+    csT, csRH, csE, f, sel = ws[0], ws[1], ws[2], ws[3], ws[4]
+    sT, sRH, sE = tmp[0], tmp[1], tmp[2]
+    half_a, wrap_a = ipar[I_HALF_A], ipar[I_WRAP_A] != 0
+    half_e, wrap_e = ipar[I_HALF_E], ipar[I_WRAP_E] != 0
+    shared = ipar[I_SHARED] != 0
+    ncls = ipar[I_NCLS]
+    counts = np.zeros(max(ncls, 1), np.int64)
+    if ipar[I_ASHRAE]:
+        _cumsum(T, n, half_a, wrap_a, csT)
+        _cumsum(RH, n, half_a, wrap_a, csRH)
+        mT = fpar[F_TSP] if ipar[I_HAS_TSP] else pairwise_sum(T, 0, n) / n
+        mRH = fpar[F_RHSP] if ipar[I_HAS_RHSP] else pairwise_sum(RH, 0, n) / n
+    if ipar[I_EN] and not shared:
+        _cumsum(RH, n, half_e, wrap_e, csE)
+    for b0 in range(0, n, BLOCK):
+        m = min(BLOCK, n - b0)
+        if ipar[I_ASHRAE]:
+            _centred(csT, b0, m, n, half_a, wrap_a, sT)
+            _centred(csRH, b0, m, n, half_a, wrap_a, sRH)
+            _ashrae_block(T, RH, b0, m, sT, sRH, mT, mRH, ipar, kinds, cls, btmp, counts)
+        if ipar[I_EN]:
+            if shared:
+                sE[:m] = sRH[:m]
+            else:
+                _centred(csE, b0, m, n, half_e, wrap_e, sE)
+            fb = f[b0 : b0 + m]
+            RHb = RH[b0 : b0 + m]
+            for t in range(m):
+                fb[t] = RHb[t] - sE[t]
+    if ipar[I_ASHRAE]:
+        best = -1
+        for j in range(ncls):
+            share = 100.0 * counts[j] / n
+            out[col + j] = share
+            if best < 0 and share >= fpar[F_THR] - _EPS:
+                best = j
+        out[col + ncls] = best
+        col += ncls + 1
+    if ipar[I_EN]:
+        q = np.empty(2)
+        q[0] = fpar[F_QLO]
+        q[1] = fpar[F_QHI]
+        p_lo, p_hi = _percentiles(f, n, q, hist, sel)
+        mb = fpar[F_MINBAND]
+        if ipar[I_EN_WIDTH]:
+            mid = 0.5 * (p_lo + p_hi)
+            narrow = (p_hi - p_lo) < mb
+            lo = mid - 0.5 * mb if narrow else p_lo
+            hi = mid + 0.5 * mb if narrow else p_hi
+        else:
+            lo = min(p_lo, -mb)
+            hi = max(p_hi, mb)
+        cnt = 0
+        cs = csE if not shared else csRH
+        half, wrap = (half_e, wrap_e) if not shared else (half_a, wrap_a)
+        for b0 in range(0, n, BLOCK):
+            m = min(BLOCK, n - b0)
+            _centred(cs, b0, m, n, half, wrap, sE)
+            RHb = RH[b0 : b0 + m]
+            for t in range(m):
+                r = RHb[t]
+                cnt += 1 if (r < sE[t] + lo) or (r > sE[t] + hi) else 0
+        out[col] = 100.0 * cnt / n
+        out[col + 1] = lo
+        out[col + 2] = hi
+    return 0
+
+
+stamp_cache(globals(), _vecmath)

@@ -1,0 +1,149 @@
+"""The compiled hot path of a projection: one chunk of posterior draws on one weather.
+
+Private module (used by :mod:`heritage_bayes.projection.engine`). For each draw of the
+chunk, on one thread (numba ``prange`` over work slots, one slot per thread):
+
+1. the noise-free indoor temperature ``Ti`` [°C] and vapour pressure ``Pi`` [Pa]:
+   simulated here for a free-running model (the modal recursion of
+   :func:`heritage_bayes.rc.simulate.modal_simulate`, one draw at a time), or copied from
+   ``model.forward`` for a controlled one;
+2. the noise-free RH [%] (capped at saturation), and every risk indicator of that
+   series (:func:`heritage_bayes.climate.risk._fused.series_indicators`);
+3. with noise: ``Ti + e_T``, the RH from ``Pi + e_P``, their indicators, and the monthly
+   means of ``Ti`` and ``RHi`` (numpy's pairwise summation, as ``np.add.reduceat``).
+
+A draw's series live in four arrays of the slot (≈ 8 MB for 30 years of hours) and in
+the CPU cache while they are reduced: nothing of size draws × hours is formed apart
+from the noise draws, which the caller shares between cases.
+"""
+
+from __future__ import annotations
+
+from numba import njit, prange
+
+from heritage_bayes.climate import _vecmath
+from heritage_bayes.climate._vecmath import psat_water, stamp_cache
+from heritage_bayes.climate.risk import _fused
+from heritage_bayes.climate.risk._fused import BLOCK, pairwise_sum, series_indicators
+
+
+@njit(cache=True, error_model="numpy")
+def _modal(ad, Bdz, edz, Cz, z0, Ut, y, z, W):  # pragma: no cover - compiled
+    """One draw of the modal recursion: ``y[k] = Cz·z[k]``, ``z[k+1] = ad z[k] + Bdz u[k]
+    + edz``, with the inputs by column (``Ut``: inputs × hours).
+
+    The arithmetic of :func:`heritage_bayes.rc.simulate.modal_simulate` (forcing summed
+    over the inputs, plus the constant term, then the recursion), with the forcing of a
+    block of hours computed first (vectorised) in ``W`` (modes × BLOCK).
+    """
+    n = ad.size
+    m, N = Ut.shape
+    for j in range(n):
+        z[j] = z0[j]
+    for b0 in range(0, N, BLOCK):
+        nb = min(BLOCK, N - b0)
+        for j in range(n):
+            wj = W[j]
+            for t in range(nb):
+                wj[t] = 0.0
+            for q in range(m):
+                u = Ut[q, b0 : b0 + nb]
+                bq = Bdz[j, q]
+                for t in range(nb):
+                    wj[t] += u[t] * bq
+            e = edz[j]
+            for t in range(nb):
+                wj[t] += e
+        yb = y[b0 : b0 + nb]
+        if n == 2:  # the two-capacity models: the states in registers
+            z_0, z_1 = z[0], z[1]
+            a0, a1, c0, c1 = ad[0], ad[1], Cz[0], Cz[1]
+            w0, w1 = W[0], W[1]
+            for t in range(nb):
+                yb[t] = 0.0 + c0 * z_0 + c1 * z_1
+                z_0 = a0 * z_0 + w0[t]
+                z_1 = a1 * z_1 + w1[t]
+            z[0], z[1] = z_0, z_1
+        else:
+            for t in range(nb):
+                acc = 0.0
+                for j in range(n):
+                    acc += Cz[j] * z[j]
+                yb[t] = acc
+                for j in range(n):
+                    z[j] = ad[j] * z[j] + W[j, t]
+
+
+@njit(inline="always", cache=True, error_model="numpy")
+def _rh(T, P):
+    """RH [%] from T [°C] and vapour pressure [Pa], capped to 0–100 % (NaN kept)."""
+    r = 100.0 * P / psat_water(T)
+    r = 0.0 if r < 0.0 else r
+    return 100.0 if r > 100.0 else r
+
+
+@njit(cache=True, error_model="numpy")
+def _monthly(x, starts, out):  # pragma: no cover - compiled
+    """Monthly means of ``x`` (months begin at ``starts``; the last ends at ``x.size``)."""
+    nm = starts.size
+    for j in range(nm):
+        a = starts[j]
+        b = starts[j + 1] if j + 1 < nm else x.size
+        out[j] = (x[a] + pairwise_sum(x, a + 1, b - a - 1)) / (b - a)
+
+
+@njit(parallel=True, cache=True, error_model="numpy")
+def chunk_kernel(
+    YT, YP, mT, mP, UT, UP, eT, eP, noise, starts,
+    ea_r, fpar, ipar, kinds, cls, ws, tmp, btmp, hist, sbuf, zbuf, wbuf,
+    par, pred, spar, spred, Tm, RHm,
+):  # fmt: skip  # pragma: no cover - compiled
+    """Indicators (noise-free → ``par``, predictive → ``pred``; status 0/1 in ``spar``,
+    ``spred``) and monthly means (``Tm``, ``RHm``) of every draw of the chunk.
+
+    ``YT``/``YP``: (draws, hours) outputs of ``model.forward``, or (0, 0) to simulate
+    here from the modal arrays ``mT``/``mP`` = (ad, Bdz, edz, Cz, z0) with inputs
+    ``UT``/``UP`` (inputs × hours); ``eT``/``eP``: (draws, hours) noise (used when ``noise``).
+    """
+    c = par.shape[0]
+    N = sbuf.shape[2]
+    slots = ws.shape[0]
+    simT = YT.shape[0] == 0
+    simP = YP.shape[0] == 0
+    for s in prange(slots):
+        Ts, Ps, Tx, RHx = sbuf[s, 0], sbuf[s, 1], sbuf[s, 2], sbuf[s, 3]
+        for i in range(s, c, slots):
+            if simT:
+                _modal(mT[0][i], mT[1][i], mT[2][i], mT[3][i], mT[4][i], UT, Ts, zbuf[s], wbuf[s])
+            else:
+                Ts[:] = YT[i]
+            if simP:
+                _modal(mP[0][i], mP[1][i], mP[2][i], mP[3][i], mP[4][i], UP, Ps, zbuf[s], wbuf[s])
+            else:
+                Ps[:] = YP[i]
+            for t in range(N):
+                RHx[t] = _rh(Ts[t], Ps[t])
+            spar[i] = series_indicators(
+                Ts, RHx, N, ea_r, fpar, ipar, kinds, cls, ws[s], tmp[s], btmp[s], hist[s],
+                par[i],
+            )  # fmt: skip
+            if noise:
+                ei = eT[i]
+                pi = eP[i]
+                for t in range(N):
+                    x = Ts[t] + ei[t]
+                    Tx[t] = x
+                    RHx[t] = _rh(x, Ps[t] + pi[t])
+                spred[i] = series_indicators(
+                    Tx, RHx, N, ea_r, fpar, ipar, kinds, cls, ws[s], tmp[s], btmp[s],
+                    hist[s], pred[i],
+                )  # fmt: skip
+                _monthly(Tx, starts, Tm[i])
+            else:
+                spred[i] = spar[i]
+                pred[i, :] = par[i, :]
+                _monthly(Ts, starts, Tm[i])
+            _monthly(RHx, starts, RHm[i])
+
+
+stamp_cache(globals(), _fused, _vecmath)

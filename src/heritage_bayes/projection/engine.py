@@ -18,6 +18,7 @@ keeps its calibrated control.
 from __future__ import annotations
 
 import time
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -221,29 +222,39 @@ def simulate_cases(
     out = [_CaseOut.empty(c, K) for c in cases]
     slots = max(1, min(numba.get_num_threads(), chunk, K))
     work: dict = {}
-    for i, s0 in enumerate(range(0, K, chunk)):
-        t_chunk = time.perf_counter()
-        sl = slice(s0, min(s0 + chunk, K))
+    lengths = sorted({c.N for c in cases})
+    chunks = [slice(s0, min(s0 + chunk, K)) for s0 in range(0, K, chunk)]
+
+    def draw_noise(i: int) -> tuple[dict, float]:
         t0 = time.perf_counter()
-        modal = {s: _modal_form(m, draws.model[s][sl], dt) for s, m in run.models.items()}
-        t_modal = (time.perf_counter() - t0) / len(cases)
-        for N in sorted({c.N for c in cases}):
-            same = [j for j, c in enumerate(cases) if c.N == N]
+        e = {N: _noise(draws, chunks[i], N, seed, i) for N in lengths} if noise else {}
+        return e, time.perf_counter() - t0
+
+    # the noise of the next chunk is drawn while this one is reduced (numpy's generator
+    # and the compiled pass release the GIL): two chunks of noise in memory at most
+    with ThreadPoolExecutor(max_workers=1) as pool:
+        ahead = pool.submit(draw_noise, 0)
+        for i, sl in enumerate(chunks):
+            t_chunk = time.perf_counter()
+            e_all, t_noise = ahead.result()
+            if i + 1 < len(chunks):
+                ahead = pool.submit(draw_noise, i + 1)
             t0 = time.perf_counter()
-            e = _noise(draws, sl, N, seed, i) if noise else None
-            t_noise = (time.perf_counter() - t0) / len(same)
-            for j in same:
-                c, o = cases[j], out[j]
-                o.seconds["noise"] += t_noise
-                key = (N, c.plan.pad)
+            modal = {s: _modal_form(m, draws.model[s][sl], dt) for s, m in run.models.items()}
+            t_modal = (time.perf_counter() - t0) / len(cases)
+            for c, o in zip(cases, out, strict=True):
+                o.seconds["noise"] += t_noise / sum(cc.N == c.N for cc in cases)
+                key = (c.N, c.plan.pad)
                 if key not in work:
-                    work[key] = _work(c.plan, slots, N)
+                    work[key] = _work(c.plan, slots, c.N)
+                e = e_all.get(c.N) if noise else None
                 _run_chunk(run, draws, c, o, sl, modal, e, dt, w, work[key], t_modal, opts)
-        if progress is not None:
-            progress(
-                f"draws {s0 + 1}-{sl.stop} of {K}: {len(cases)} case(s) in "
-                f"{time.perf_counter() - t_chunk:.1f} s"
-            )
+            del e_all
+            if progress is not None:
+                progress(
+                    f"draws {sl.start + 1}-{sl.stop} of {K}: {len(cases)} case(s) in "
+                    f"{time.perf_counter() - t_chunk:.1f} s"
+                )
     return [o.result(c) for c, o in zip(cases, out, strict=True)]
 
 

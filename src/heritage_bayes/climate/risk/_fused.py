@@ -221,15 +221,16 @@ def _pointwise(T, RH, b0, m, fpar, ipar, ea_r, tmp, sums):  # pragma: no cover -
 
 
 @njit(cache=True, error_model="numpy")
-def _vtt_peak(T, RH, n, fpar, frozen_decline):  # pragma: no cover - compiled
-    """Maximum VTT mould index of one complete series (the recursion of ``_vtt``)."""
+def _vtt_block(T, RH, m, fpar, frozen_decline, state):  # pragma: no cover - compiled
+    """The VTT mould-index recursion (of ``_vtt``) over the hours ``T[:m]``, ``RH[:m]``
+    of a complete series, carrying ``state`` = [M, hours of the dry spell, max M]."""
     k1_lo, k1_hi = fpar[F_K1LO], fpar[F_K1HI]
     A, B, C, RH_min, C_mat = fpar[F_A], fpar[F_B], fpar[F_C], fpar[F_RHMIN], fpar[F_CMAT]
     W, SQ = fpar[F_W], fpar[F_SQ]
-    M = fpar[F_M0]
-    dry = 0
-    mx = -1.0
-    for t in range(n):
+    M = state[0]
+    dry = np.int64(state[1])
+    mx = state[2]
+    for t in range(m):
         Ti = T[t]
         Ri = RH[t]
         grow = Ti > 0.0 and Ti < 50.0
@@ -266,7 +267,18 @@ def _vtt_peak(T, RH, n, fpar, frozen_decline):  # pragma: no cover - compiled
                 M = 0.0
         if M > mx:
             mx = M
-    return mx
+    state[0] = M
+    state[1] = dry
+    state[2] = mx
+
+
+@njit(cache=True, error_model="numpy")
+def _cumsum_block(x, m, cs):  # pragma: no cover - compiled
+    """``cs[t + 1] = cs[t] + x[t]`` for the block (``cs[0]`` holds the running sum)."""
+    s = cs[0]
+    for t in range(m):
+        s = s + x[t]
+        cs[t + 1] = s
 
 
 @njit(cache=True, error_model="numpy")
@@ -362,26 +374,67 @@ def _var_pass(
 
 
 @njit(cache=True, error_model="numpy")
+def _bounds(kind, short, down, up, smax):  # pragma: no cover - compiled
+    """The decomposition check of one variable as five bounds: within them is
+    ``|x − m| ≤ a``, ``|x − s| ≤ b``, ``c ≤ s − m ≤ d``, ``s ≤ e`` (unused ones infinite,
+    so that they always hold; the same comparisons as standards._setpoint_ok)."""
+    inf = math.inf
+    if kind == K_MEAN:
+        return short + _EPS, inf, -inf, inf, inf
+    if kind == K_SEASON:
+        return inf, short + _EPS, -down - _EPS, up + _EPS, smax + _EPS
+    return inf, inf, -inf, inf, inf
+
+
+@njit(cache=True, error_model="numpy")
 def _ashrae_block(
     T, RH, b0, m, sT, sRH, mT, mRH, ipar, kinds, cls, btmp, counts
 ):  # pragma: no cover
     """Hours of the block meeting each class (T and RH, nested), added to ``counts``."""
     belowT, belowRH = btmp[0], btmp[1]
     nested = ipar[I_NESTED] != 0
+    keep = not nested  # 1: a class is checked on its own limits only
     Tb = T[b0 : b0 + m]
     RHb = RH[b0 : b0 + m]
     for t in range(m):
         belowT[t] = 1
         belowRH[t] = 1
     for j in range(ipar[I_NCLS] - 1, -1, -1):  # from the most lenient class up
-        _var_pass(kinds[j, 0], Tb, sT, m, mT, cls[j, C_TS], cls[j, C_TDOWN], cls[j, C_TUP],
-                  cls[j, C_TSMAX], -math.inf, cls[j, C_TMAX], belowT, nested)  # fmt: skip
-        _var_pass(kinds[j, 1], RHb, sRH, m, mRH, cls[j, C_RS], cls[j, C_RDOWN],
-                  cls[j, C_RUP], math.inf, cls[j, C_RLO], cls[j, C_RHI], belowRH,
-                  nested)  # fmt: skip
+        if ipar[I_METHOD] != 0:  # "setpoint": one variable at a time
+            _var_pass(kinds[j, 0], Tb, sT, m, mT, cls[j, C_TS], cls[j, C_TDOWN],
+                      cls[j, C_TUP], cls[j, C_TSMAX], -math.inf, cls[j, C_TMAX], belowT,
+                      nested)  # fmt: skip
+            _var_pass(kinds[j, 1], RHb, sRH, m, mRH, cls[j, C_RS], cls[j, C_RDOWN],
+                      cls[j, C_RUP], math.inf, cls[j, C_RLO], cls[j, C_RHI], belowRH,
+                      nested)  # fmt: skip
+            cnt = 0
+            for t in range(m):
+                cnt += belowT[t] & belowRH[t]
+            counts[j] += cnt
+            continue
+        # "decomposition": both variables and the count in one vectorised loop
+        ta, tb, tc, td, te = _bounds(kinds[j, 0], cls[j, C_TS], cls[j, C_TDOWN],
+                                     cls[j, C_TUP], cls[j, C_TSMAX])  # fmt: skip
+        ra, rb, rc, rd, re = _bounds(kinds[j, 1], cls[j, C_RS], cls[j, C_RDOWN],
+                                     cls[j, C_RUP], math.inf)  # fmt: skip
+        tmax = cls[j, C_TMAX] + _EPS
+        rlo = cls[j, C_RLO] - _EPS
+        rhi = cls[j, C_RHI] + _EPS
         cnt = 0
         for t in range(m):
-            cnt += belowT[t] & belowRH[t]
+            x = Tb[t]
+            st = sT[t]
+            ds = st - mT
+            a = (abs(x - mT) <= ta) & (abs(x - st) <= tb) & (ds >= tc) & (ds <= td)
+            a = a & (st <= te) & (x <= tmax) & ((belowT[t] != 0) | keep)
+            r = RHb[t]
+            sr = sRH[t]
+            dr = sr - mRH
+            b = (abs(r - mRH) <= ra) & (abs(r - sr) <= rb) & (dr >= rc) & (dr <= rd)
+            b = b & (sr <= re) & (r >= rlo) & (r <= rhi) & ((belowRH[t] != 0) | keep)
+            belowT[t] = a
+            belowRH[t] = b
+            cnt += a & b
         counts[j] += cnt
 
 
@@ -479,20 +532,53 @@ def series_indicators(
     """All indicators of the plan for the series ``T[:n]`` [°C], ``RH[:n]`` [%].
 
     Writes ``out`` (the plan's columns; the best ASHRAE class as its index, -1 for none)
-    and returns 0, or 1 without computing anything when an hour is missing or outside
-    what :func:`~heritage_bayes.climate.risk.assess_batch` accepts (the caller then
-    uses that function for this series). ``ws`` (5, n + 2 pad + 1), ``tmp`` (3, BLOCK),
-    ``btmp`` (4, BLOCK) uint8 and ``hist`` (N_BINS,) are work arrays.
+    and returns 0, or 1 when an hour is missing or outside what
+    :func:`~heritage_bayes.climate.risk.assess_batch` accepts (``out`` is then not
+    meaningful: the caller uses that function for this series). ``ws`` (5, n + 2 pad +
+    1), ``tmp`` (3, BLOCK), ``btmp`` (4, BLOCK) uint8 and ``hist`` (N_BINS,) are work
+    arrays.
     """
-    bad, above1, above0 = _bad_hours(T, RH, n)
-    if bad > 0 or (above1 == 0 and above0 > 0):
-        return 1
     nea = ipar[I_NEA]
     sums = np.zeros(nea + 4)
     sums[nea + 1] = math.inf
     sums[nea + 2] = -math.inf
-    for b0 in range(0, n, BLOCK):
-        _pointwise(T, RH, b0, min(BLOCK, n - b0), fpar, ipar, ea_r, tmp, sums)
+    mould = ipar[I_MOULD] != 0
+    frozen = ipar[I_FROZEN] != 0
+    vtt = np.empty(3)  # M, dry hours, max M
+    vtt[0] = fpar[F_M0]
+    vtt[1] = 0.0
+    vtt[2] = -1.0
+    csT, csRH, csE, f, sel = ws[0], ws[1], ws[2], ws[3], ws[4]
+    half_a, wrap_a = ipar[I_HALF_A], ipar[I_WRAP_A] != 0
+    half_e, wrap_e = ipar[I_HALF_E], ipar[I_WRAP_E] != 0
+    shared = ipar[I_SHARED] != 0
+    ashrae = ipar[I_ASHRAE] != 0
+    en = ipar[I_EN] != 0
+    # cumulative sums of the truncated ("shrink") moving averages, in the same pass
+    sum_T = ashrae and not wrap_a
+    sum_RH = sum_T or (en and not shared and not wrap_e)
+    csT[0] = 0.0
+    csRH[0] = 0.0
+    bad = 0
+    above1 = 0
+    above0 = 0
+    for b0 in range(0, n, BLOCK):  # one pass: every hourly term, the recursions, the sums
+        m = min(BLOCK, n - b0)
+        Tb = T[b0 : b0 + m]
+        RHb = RH[b0 : b0 + m]
+        nb, a1, a0 = _bad_hours(Tb, RHb, m)
+        bad += nb
+        above1 += a1
+        above0 += a0
+        _pointwise(T, RH, b0, m, fpar, ipar, ea_r, tmp, sums)
+        if mould:
+            _vtt_block(Tb, RHb, m, fpar, frozen, vtt)
+        if sum_T:
+            _cumsum_block(Tb, m, csT[b0 : b0 + m + 1])
+        if sum_RH:
+            _cumsum_block(RHb, m, csRH[b0 : b0 + m + 1])
+    if bad > 0 or (above1 == 0 and above0 > 0):
+        return 1
     col = 0
     if ipar[I_CHEM]:
         for k in range(nea + 1):  # lifetime multipliers, then TWPI: harmonic means
@@ -506,33 +592,33 @@ def series_indicators(
         out[col + 3] = 100.0 * fpar[F_COEF] * (hi - lo)
         out[col + 4] = hi
         col += 5
-    if ipar[I_MOULD]:
-        out[col] = _vtt_peak(T, RH, n, fpar, ipar[I_FROZEN] != 0)
+    if mould:
+        out[col] = vtt[2]
         out[col + 1] = 100.0 * sums[nea + 3] / n / 100.0 * 8760.0  # share → h/year
         col += 2
-    if not (ipar[I_ASHRAE] or ipar[I_EN]):
+    if not (ashrae or en):
         return 0
-    csT, csRH, csE, f, sel = ws[0], ws[1], ws[2], ws[3], ws[4]
     sT, sRH, sE = tmp[0], tmp[1], tmp[2]
-    half_a, wrap_a = ipar[I_HALF_A], ipar[I_WRAP_A] != 0
-    half_e, wrap_e = ipar[I_HALF_E], ipar[I_WRAP_E] != 0
-    shared = ipar[I_SHARED] != 0
     ncls = ipar[I_NCLS]
     counts = np.zeros(max(ncls, 1), np.int64)
-    if ipar[I_ASHRAE]:
-        _cumsum(T, n, half_a, wrap_a, csT)
-        _cumsum(RH, n, half_a, wrap_a, csRH)
+    if ashrae:
+        if wrap_a:  # periodic padding: sums of the padded series
+            _cumsum(T, n, half_a, True, csT)
+            _cumsum(RH, n, half_a, True, csRH)
         mT = fpar[F_TSP] if ipar[I_HAS_TSP] else pairwise_sum(T, 0, n) / n
         mRH = fpar[F_RHSP] if ipar[I_HAS_RHSP] else pairwise_sum(RH, 0, n) / n
-    if ipar[I_EN] and not shared:
-        _cumsum(RH, n, half_e, wrap_e, csE)
+    if en and not shared:
+        if wrap_e or (ashrae and wrap_a):
+            _cumsum(RH, n, half_e, wrap_e, csE)
+        else:
+            csE = csRH  # the sums of the truncated windows do not depend on their width
     for b0 in range(0, n, BLOCK):
         m = min(BLOCK, n - b0)
-        if ipar[I_ASHRAE]:
+        if ashrae:
             _centred(csT, b0, m, n, half_a, wrap_a, sT)
             _centred(csRH, b0, m, n, half_a, wrap_a, sRH)
             _ashrae_block(T, RH, b0, m, sT, sRH, mT, mRH, ipar, kinds, cls, btmp, counts)
-        if ipar[I_EN]:
+        if en:
             if shared:
                 sE[:m] = sRH[:m]
             else:

@@ -159,6 +159,14 @@ def main() -> int:
         f"  speed-up        : wall {wall_n / n_naive * K / wall:.1f}x, "
         f"CPU {cpu_n / n_naive * K / cpu:.1f}x (naive / streamed, same run)"
     )
+    # The weather repeats one year: past the start-up the noise-free indoor climate is
+    # periodic, so the EN 15757 band edges (order statistics of RH minus its seasonal
+    # mean) are tied by up to one hour per repeated year, and whether those hours lie
+    # outside the band is decided by the last bit of the series (which differs between
+    # model.forward and the compiled simulation, <= 1e-12 relative): up to two edges ×
+    # one hour per year may change side.
+    en_tol = 2 * args.years * 100.0 / N  # [% of hours]
+    worst_en = 0.0
     for case_rows, res in zip(rows, results, strict=True):
         for k, (_, free) in enumerate(case_rows):
             ref = free.set_index("indicator")["value"]
@@ -168,8 +176,16 @@ def main() -> int:
                     assert free.set_index("indicator").loc[name, "rating"] == eng[name]
                     continue
                 a, b = float(ref[name]), float(eng[name])
+                if name == "en15757_outside":
+                    worst_en = max(worst_en, abs(a - b))
+                    assert abs(a - b) <= en_tol, (name, a, b)
+                    continue
                 assert abs(a - b) <= 1e-9 * max(1.0, abs(a)), (name, a, b)
-    print("  check: naive and streamed noise-free indicators agree (every indicator, 1e-9)")
+    print(
+        f"  check: naive and streamed noise-free indicators agree (1e-9 relative; "
+        f"en15757_outside within {en_tol:.4f} % of hours for the ties of the repeated "
+        f"year, largest difference {worst_en:.4f} %)"
+    )
     full = wall * scale
     ok = full <= TARGET_S and peak <= TARGET_GB
     print(

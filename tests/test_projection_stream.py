@@ -11,7 +11,8 @@ Tolerances: the simulated series agree with ``model.forward`` to 1e-11 relative
 (the forcing is summed over the inputs in another order than the BLAS product: ~1e-16
 per step, carried by modes with poles below 1); the RH differs by ≤ 2e-14 relative (the
 saturation pressure). The indicators, computed on series that differ at that level,
-agree to 1e-9 relative, and the monthly means (float32) to 1 float32 ulp (6e-8).
+agree to 1e-9 relative (the EN 15757 share to the hours tied at the band edges, see
+``assert_close``), and the monthly means (float32) to 1 float32 ulp (6e-8).
 """
 
 from __future__ import annotations
@@ -84,9 +85,16 @@ def reference(run, draws, inputs, noise=True):
 
 
 def assert_close(ref: pd.DataFrame, got: pd.DataFrame):
+    """1e-9 relative; the EN 15757 share to 4 hours: the weather repeats one year, so
+    past the start-up the noise-free climate is periodic and the band edges (order
+    statistics) are tied by one hour per year; whether those hours lie outside is decided
+    by the last bit of the series (two edges × two years)."""
     assert list(got.columns) == list(ref.columns)
+    n = 17_518
     for c in ref.columns:
-        if pd.api.types.is_float_dtype(ref[c]):
+        if c == "en15757_outside":
+            np.testing.assert_allclose(got[c], ref[c], rtol=0, atol=4 * 100 / n, err_msg=c)
+        elif pd.api.types.is_float_dtype(ref[c]):
             np.testing.assert_allclose(got[c], ref[c], rtol=1e-9, atol=1e-12, err_msg=c)
         else:
             assert (got[c].astype(str) == ref[c].astype(str)).all(), c

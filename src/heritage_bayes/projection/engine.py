@@ -1,18 +1,26 @@
 """Predictive simulation of posterior draws on each weather, streamed, with risk.
 
-For each chunk of posterior draws the thermal and hygric models are simulated over the
-whole weather of one case, a draw of each section's noise model is added (so bands are
-predictive, not only parametric), the indoor RH is formed from the coupled ``Ti`` and
-``Pi`` and capped at saturation, and the chunk is reduced at once to what is kept:
-the risk indicators of every draw (of the predictive series and of the noise-free one,
-for the uncertainty split) and monthly means of ``Ti`` and ``RHi``. Peak memory is the
-noise of one chunk (two arrays of ``chunk × hours`` doubles) and a few series per
-thread, whatever the number of draws.
+For each chunk of posterior draws and each case (the baseline, every scenario), the
+thermal and hygric models are simulated over the whole weather, a draw of each section's
+noise model is added (so bands are predictive, not only parametric), the indoor RH is
+formed from the coupled ``Ti`` and ``Pi`` and capped at saturation, and each draw is
+reduced at once to what is kept: the risk indicators (of the predictive series and of
+the noise-free one, for the uncertainty split) and monthly means of ``Ti`` and ``RHi``.
 
-The same parameter draws and the same noise realisations (seeded per chunk) are used
-for every case: differences between scenarios are then paired, not blurred by noise.
-Models are simulated with ``model.forward``: a controlled room (thermostat, humidistat)
-keeps its calibrated control.
+The per-draw work is one compiled pass (:mod:`heritage_bayes.projection._stream`, numba,
+draws in parallel over the threads): the modal recursion of a free-running model, the
+RH, and every indicator of :func:`~heritage_bayes.climate.risk.assess_batch` by
+:mod:`heritage_bayes.climate.risk.fused` (the same values, to rounding; a series that
+function rejects or with a missing hour is handed to it). Peak memory is the noise of
+two chunks (two arrays of ``chunk × hours`` doubles each: the next chunk's is drawn
+while this one is reduced) and about ten series per thread, whatever the number of
+draws.
+
+The same parameter draws and the same noise realisations (seeded per chunk, drawn once
+per chunk and used for every case of the same length) are used for every case:
+differences between scenarios are then paired, not blurred by noise. A controlled room
+(thermostat, humidistat) is simulated by its ``model.forward`` and keeps its calibrated
+control.
 """
 
 from __future__ import annotations

@@ -14,7 +14,10 @@ the indicators the heritage field uses:
 * climate specifications: ASHRAE museum classes (:func:`ashrae_classes`) and the
   EN 15757 seasonal RH band (:func:`en15757_band`);
 * everything at once: :func:`assess` (one series → tidy table) and :func:`assess_batch`
-  (draws × hours → one row per draw), summarised by :func:`summarize`.
+  (draws × hours → one row per draw), summarised by :func:`summarize`;
+  :func:`assess_fused` gives the table of :func:`assess_batch` from one compiled pass
+  per series (numba, draws in parallel, no draws × hours temporaries; the same values
+  to rounding; :mod:`~heritage_bayes.climate.risk.fused`).
 
 Conventions
 -----------
@@ -39,7 +42,8 @@ Layout (one module per mechanism, :func:`assess` on top; every name below is imp
 from this package): :mod:`~heritage_bayes.climate.risk.chemical`,
 :mod:`~heritage_bayes.climate.risk.mechanical`, :mod:`~heritage_bayes.climate.risk.biological`,
 :mod:`~heritage_bayes.climate.risk.standards` and :mod:`~heritage_bayes.climate.risk.assess`;
-input checking in ``_inputs``, the compiled VTT recursion in ``_vtt``.
+input checking in ``_inputs``, the compiled VTT recursion in ``_vtt``, the fused pass in
+:mod:`~heritage_bayes.climate.risk.fused` (kernel in ``_fused``).
 
 Where the formulas or limits were not read in a primary source (ASHRAE compliance
 algorithm and table, EN 15757 minimum band), the function says so and the choice is a
@@ -67,6 +71,7 @@ from heritage_bayes.climate.risk.chemical import (
     twlm,
     twpi,
 )
+from heritage_bayes.climate.risk.fused import assess_fused
 from heritage_bayes.climate.risk.mechanical import (
     EMCRange,
     dimensional_change,
@@ -94,6 +99,7 @@ __all__ = [
     "ashrae_classes",
     "assess",
     "assess_batch",
+    "assess_fused",
     "dimensional_change",
     "emc_range",
     "emc_wood",

@@ -411,6 +411,8 @@ def _ashrae_block(
             for t in range(m):
                 cnt += belowT[t] & belowRH[t]
             counts[j] += cnt
+            if nested and cnt == 0:
+                break
             continue
         # "decomposition": both variables and the count in one vectorised loop
         ta, tb, tc, td, te = _bounds(kinds[j, 0], cls[j, C_TS], cls[j, C_TDOWN],
@@ -436,6 +438,8 @@ def _ashrae_block(
             belowRH[t] = b
             cnt += a & b
         counts[j] += cnt
+        if nested and cnt == 0:  # no hour of the block meets this class: nor a stricter one
+            break
 
 
 @njit(cache=True, error_model="numpy")

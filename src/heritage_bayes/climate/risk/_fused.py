@@ -20,6 +20,12 @@ Bit for bit the same as numpy: the moving averages (sequential cumulative sums, 
 ``np.cumsum``), the annual means (numpy's pairwise summation, re-implemented), the ASHRAE
 and EN 15757 comparisons, the EMC, the VTT recursion and the percentiles (exact order
 statistics found by a histogram of the values, then numpy's linear interpolation).
+
+Why one module: :func:`series_indicators` and its block helpers are one compiled
+algorithm over shared parameter layouts (the ``I_``/``F_``/``C_`` indices of the plan's
+arrays), and numba caches a compiled function by its own source file: a helper moved to
+another file is a dependency whose edits the cache of this one would not see (see
+:func:`heritage_bayes.climate._vecmath.stamp_cache`).
 """
 
 from __future__ import annotations

@@ -1,22 +1,25 @@
 """Elementary functions that the compiler can vectorise, for numba kernels.
 
 Private module. ``math.exp``, ``math.log`` and ``math.cosh`` compile to calls of the C
-library, one value at a time (about 4 ns each here); a loop that calls them is never
-vectorised. The functions below are plain arithmetic (range reduction by bit
-manipulation of the IEEE-754 double, a polynomial, the exponent put back by bit
+library, one value at a time; a loop that calls them is never vectorised (numba has no
+vector maths library here). The functions below are plain arithmetic (range reduction
+by bit manipulation of the IEEE-754 double, a polynomial, the exponent put back by bit
 manipulation), so a loop over an array of hours compiles to SIMD code (eight doubles
-per instruction with AVX-512): about 1 ns per value including the memory traffic.
+per instruction with AVX-512).
 
-Accuracy: within 2 units in the last place of the C library's result over the whole
-double range (measured by ``tests/test_fused_risk.py`` on random arguments: relative
-error ≤ 4.5e-16), with the special values of the C library (``vexp(-inf) = 0``,
-``vexp(inf) = inf``, ``vlog(0) = -inf``, ``vlog(x < 0) = nan``, NaN propagated;
-subnormal arguments and results handled).
+Accuracy: within 2 units in the last place of numpy's result for normal results
+(``tests/test_fused_risk.py`` asserts a relative error ≤ 4.5e-16 on random arguments
+over the whole normal range), with the special values of the C library
+(``vexp(-inf) = 0``, ``vexp(inf) = inf``, ``vlog(0) = -inf``, ``vlog(x < 0) = nan``,
+NaN propagated; subnormal arguments of ``vlog`` and subnormal results of ``vexp``
+handled, the latter with the few-ulp error any subnormal result has).
 
 ``psat_water`` is :func:`heritage_bayes.climate.psychro.saturation_vapour_pressure`
 (over water, Wagner & Pruß 1993) in this form: the fractional powers
 :math:`\\vartheta^{1.5}, \\vartheta^{3.5}, \\vartheta^{7.5}` are products with
-:math:`\\sqrt{\\vartheta}` instead of ``pow`` calls (relative difference ≤ 1e-15).
+:math:`\\sqrt{\\vartheta}` instead of ``pow`` calls, and products with ``1 / T``: relative
+difference ≤ 2e-14 from numpy (asserted by ``tests/test_fused_risk.py`` on 200 000
+random temperatures, −60…99 °C).
 """
 
 from __future__ import annotations
@@ -179,7 +182,7 @@ _A1, _A2, _A3, _A4, _A5, _A6 = (
 def psat_water(T):
     """Saturation vapour pressure over water [Pa] at T [°C], vectorisable."""
     TK = T + 273.15
-    th = 1.0 - TK / _TC
+    th = 1.0 - TK * (1.0 / _TC)
     sq = math.sqrt(th)
     th3 = th * th * th
     poly = (
@@ -190,4 +193,4 @@ def psat_water(T):
         + _A5 * (th3 * th)
         + _A6 * (th3 * th3 * th * sq)
     )
-    return _PC * vexp(_TC / TK * poly)
+    return _PC * vexp(_TC * (1.0 / TK) * poly)

@@ -13,8 +13,8 @@ RH, and every indicator of :func:`~heritage_bayes.climate.risk.assess_batch` by
 :mod:`heritage_bayes.climate.risk.fused` (the same values, to rounding; a series that
 function rejects or with a missing hour is handed to it). Peak memory is the noise of
 two chunks (two arrays of ``chunk × hours`` doubles each: the next chunk's is drawn
-while this one is reduced) and about ten series per thread, whatever the number of
-draws.
+while this one is reduced) and nine arrays of the series length per thread, whatever
+the number of draws.
 
 The same parameter draws and the same noise realisations (seeded per chunk, drawn once
 per chunk and used for every case of the same length) are used for every case:
@@ -175,7 +175,7 @@ def simulate_cases(
         Add a draw of each section's noise model (predictive); False: noise-free only.
     chunk : int
         Draws per chunk: the noise of a chunk (two arrays of ``chunk × hours`` doubles)
-        is drawn once and used for every case; the work arrays are ~8 series per
+        is drawn once and used for every case; the work arrays are nine series per
         thread, whatever the chunk.
     init_steps : int, optional
         Rows averaged for the steady-state initial state (default the calibration's).

@@ -3,9 +3,8 @@ pass per series: :func:`assess_fused`, and the plan that compiled callers use.
 
 :func:`~heritage_bayes.climate.risk.assess_batch` evaluates each indicator with numpy
 over the whole (draws × hours) block: a few dozen temporaries of that size, each
-written and read once. On 30 years of hours that is memory traffic, not arithmetic, and
-it made the batch slower per draw than :func:`~heritage_bayes.climate.risk.assess` on
-one series. Here each series is reduced by one compiled function
+written and read once; on 30 years of hours that is memory traffic more than
+arithmetic. Here each series is reduced by one compiled function
 (:func:`heritage_bayes.climate.risk._fused.series_indicators`) that walks the hours in
 blocks of 512 (the temporaries stay in the CPU cache), with vectorised exp/log, and the
 draws run in parallel (numba ``prange``).
@@ -83,7 +82,7 @@ class FusedPlan:
     def workspace(self, slots: int) -> tuple:
         """Work arrays of ``slots`` parallel slots: ``(ws, tmp, btmp, hist)``.
 
-        About ``5 × (n_hours + 2 pad + 1)`` doubles per slot (≈ 10 MB for 30 years).
+        ``5 × (n_hours + 2 pad + 1)`` doubles per slot (10.5 MB for 262 770 h).
         """
         L = self.n_hours + 2 * self.pad + 1
         return (
@@ -317,8 +316,8 @@ def assess_fused(
     -----
     Same values as :func:`assess_batch` up to rounding (see the module docstring);
     draws with a missing hour are computed by :func:`assess_batch`. Uses the numba
-    threads (``numba.set_num_threads``); work arrays of about 10 MB per thread for 30
-    years of hours, whatever the number of draws.
+    threads (``numba.set_num_threads``); five work arrays of the series length per
+    thread, whatever the number of draws.
     """
     func = "assess_fused"
     options = dict(lm=lm, emc=emc, vtt=vtt, isopleth=isopleth, ashrae=ashrae, en15757=en15757)

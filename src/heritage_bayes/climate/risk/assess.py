@@ -440,9 +440,10 @@ def assess_batch(
     Notes
     -----
     Vectorised over draws: moving averages by cumulative sums along the hours axis,
-    the VTT recursion compiled with numba. About two seconds for 1000 draws × 8760 h
-    on a laptop-class CPU (``benchmarks/bench_risk.py``). Row *i* equals
-    ``assess(T[i], RH[i])``.
+    the VTT recursion compiled with numba (timed by ``benchmarks/bench_risk.py``).
+    Row *i* equals ``assess(T[i], RH[i])``. :func:`~heritage_bayes.climate.risk.assess_fused`
+    returns the same indicators from one compiled pass per series (the projection's
+    path, ``benchmarks/bench_projection.py``).
 
     References
     ----------

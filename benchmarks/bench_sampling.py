@@ -35,6 +35,7 @@ import numpy as np
 from heritage_bayes._arviz import az
 from heritage_bayes.calibrate import _log_posterior
 from heritage_bayes.config import load_config
+from heritage_bayes.errors import InputError
 from heritage_bayes.inference.optimize import affine_coordinates, find_map, laplace
 from heritage_bayes.inference.sampler import run_sampler
 from heritage_bayes.models import build_model
@@ -101,7 +102,15 @@ def main() -> None:
         ref = lp.params.free_names.index("Ci") if "Ci" in lp.params.free_names else None
         lap = laplace(lp, m.x, given=() if ref is None else ("Ci",))
         aff = affine_coordinates(lp, lap)
-        c_aff, r_aff = _run("laplace", aff, aff.to_z(m.x)[0], aff.to_x, None, cfg, args.max_time)
+        try:
+            c_aff, r_aff = _run(
+                "laplace", aff, aff.to_z(m.x)[0], aff.to_x, None, cfg, args.max_time
+            )
+        except InputError as exc:
+            # a near-singular Laplace approximation (a parameter the data leave to its
+            # prior) stretches the start ball in z far outside the prior's support
+            print(f"  laplace  could not start: {exc}", flush=True)
+            continue
         print(f"  laplace / log: CPU {c_aff / c_log:.2f}, ESS/CPU-s {r_aff / r_log:.2f}")
 
 

@@ -233,3 +233,22 @@ def test_armadillo_from_yaml_fits_with_its_initial_state_estimated():
     x0 = lp.initial_states(mp.theta[None])
     y = lp.simulate_frame(mp.theta[None], prep.model_inputs("thermal", m), 0, x0=x0)[0][0, :, 0]
     assert np.sqrt(np.nanmean((prep.observed("thermal", m)[:, 0] - y) ** 2)) <= 0.85
+
+
+def test_a_frozen_node_is_named():
+    """A node whose time constant is many records long keeps its start value: the check
+    that warns before sampling (heritage_bayes.rc.derived.frozen_time_constant)."""
+    from heritage_bayes.demo import TRUE_THERMAL
+    from heritage_bayes.rc.derived import FROZEN_RECORDS, frozen_time_constant, time_constants
+
+    m = hb.model("thermal_2c")
+    truth = {k: TRUE_THERMAL[k] for k in m.parameter_names}
+    record = 90 * 86400.0  # three months [s]
+    assert frozen_time_constant(m, truth, record) is None  # the demo room: τ1 104 h
+    frozen = {**truth, "Cw": truth["Cw"] * 1e4, "Gw": truth["Gw"] * 1e-2}
+    tau = time_constants(m, frozen)[0]
+    assert tau > FROZEN_RECORDS * record
+    assert frozen_time_constant(m, frozen, record) == pytest.approx(tau)
+    # the threshold is the record times FROZEN_RECORDS, exactly
+    assert frozen_time_constant(m, frozen, tau / FROZEN_RECORDS * 1.001) is None
+    assert frozen_time_constant(m, frozen, tau / FROZEN_RECORDS * 0.999) == pytest.approx(tau)

@@ -40,6 +40,7 @@ from heritage_bayes.inference.results import (
 )
 from heritage_bayes.models import SECTIONS, _catalog_options, build_model, initial_state_of
 from heritage_bayes.rc.catalog import model as catalog_model
+from heritage_bayes.rc.derived import frozen_time_constant
 from heritage_bayes.rc.model import RCModel
 from heritage_bayes.run import (  # Run, load_run: re-exported
     Run,
@@ -138,6 +139,23 @@ def _say_findings(say: _Progress, s: _Section) -> None:
             "moisture source, a controlled climate). The simulation is kept responsible "
             "for the slow response; widen the cap with a prior on "
             f"{capped[0]} only if the slow misfit is measurement drift"
+        )
+    lp = s.logpost
+    record = lp.observed.shape[0] * lp.dt
+    tau = frozen_time_constant(s.model, s.map.theta[: lp.n_model], record)
+    if tau is not None:  # a frozen node (see frozen_time_constant)
+        free = lp.initial_state == "estimate" or isinstance(lp.initial_state, Mapping)
+        say.warn(
+            f"[{s.name}] the slowest time constant at the MAP, {tau / 3600:.3g} h, is "
+            f"{tau / record:.0f} times the calibration record: that node barely moves, a "
+            "constant standing in for a fixed node, a missing input or a missing node; "
+            + (
+                "its start is estimated, so it is a free offset: compare with "
+                "initial_state: steady (and periods.warmup)"
+                if free
+                else "it stays at its steady-state start"
+            )
+            + ", or model the fixed node (thermal: options.ground; hygric: hygric_2c_fixed)"
         )
     if s.map_at_bound:
         what = ", ".join(f"{n} ({side})" for n, side in s.map_at_bound)

@@ -250,3 +250,9 @@ def test_report_notes_name_a_map_on_a_bound_over_parameterisation_and_a_spent_bu
     ]
     assert "Cint (lower)" in notes[0]["text"]
     assert "Gint" in notes[1]["text"] and "phi_Ti" not in notes[1]["text"]
+    # a frozen node (heritage_bayes.rc.derived.frozen_time_constant) is named too
+    s["models"]["thermal"]["frozen_node"] = {"tau_h": 5.4e4, "records": 25.3, "start_free": True}
+    notes = run_notes(s, [])
+    frozen = [n for n in notes if n["title"] == "A thermal node barely moves over the record"]
+    assert len(frozen) == 1
+    assert "5.4e+04 h, 25 times" in frozen[0]["text"] and "free offset" in frozen[0]["text"]

@@ -117,6 +117,7 @@ class _Section:
     X_kept: np.ndarray | None = None  # the same in sampler coordinates
     laplace: object = None  # LaplaceResult at the MAP (practical identifiability)
     map_at_bound: list = field(default_factory=list)  # (name, "lower"/"upper")
+    frozen_node: dict | None = None  # the MAP's slowest mode, when many records long
     lp: np.ndarray | None = None
     timings: dict = field(default_factory=dict)
 
@@ -145,6 +146,7 @@ def _say_findings(say: _Progress, s: _Section) -> None:
     tau = frozen_time_constant(s.model, s.map.theta[: lp.n_model], record)
     if tau is not None:  # a frozen node (see frozen_time_constant)
         free = lp.initial_state == "estimate" or isinstance(lp.initial_state, Mapping)
+        s.frozen_node = {"tau_h": tau / 3600.0, "records": tau / record, "start_free": free}
         say.warn(
             f"[{s.name}] the slowest time constant at the MAP, {tau / 3600:.3g} h, is "
             f"{tau / record:.0f} times the calibration record: that node barely moves, a "

@@ -352,6 +352,7 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
             # findings before sampling: a MAP on a prior bound, and practical
             # identifiability from the Laplace approximation at the MAP
             "map_at_bound": [list(b) for b in getattr(s, "map_at_bound", [])],
+            "frozen_node": getattr(s, "frozen_node", None),
             "practical_identifiability": (
                 s.laplace.to_dict(ps.free_names) if getattr(s, "laplace", None) else None
             ),

@@ -310,6 +310,24 @@ def run_notes(
                     "bounds regardless.",
                 }
             )
+        fz = i.get("frozen_node")
+        if fz:
+            out.append(
+                {
+                    "level": "amber",
+                    "title": f"A {m} node barely moves over the record",
+                    "text": f"At the MAP the slowest time constant is {fz['tau_h']:.3g} h, "
+                    f"{fz['records']:.0f} times the calibration record: that node keeps its "
+                    "start value, a constant standing in for a fixed node, a missing input "
+                    "or a missing node"
+                    + (
+                        "; its start is estimated, so it acts as a free offset (compare with "
+                        "initial_state: steady and a warm-up)."
+                        if fz.get("start_free")
+                        else "."
+                    ),
+                }
+            )
         flagged = [
             n
             for n in (i.get("practical_identifiability") or {}).get("unidentified") or []

@@ -148,6 +148,7 @@ def simulate_reference(model, params, U: np.ndarray) -> np.ndarray:
 def replicate(args) -> dict:
     """One room: generate, calibrate, and rank the truth of each quantity."""
     import heritage_bayes as hb
+    from heritage_bayes.config import ModelSection
     from heritage_bayes.inference.likelihoods import get_noise_model
     from heritage_bayes.inference.optimize import find_map
     from heritage_bayes.inference.parameters import parameters_for
@@ -202,6 +203,8 @@ def replicate(args) -> dict:
             warmup=336 if init == "steady" else 0,
             init_window=720,
             initial_state=init,
+            # the defaults of hbayes calibrate (the soft cap on time constants)
+            time_constant_cap=ModelSection(model=name).cap_seconds(model.domain),
         )
         mp = find_map(lp, seed=rep, method="differential_evolution", popsize=15, maxiter=200)
         chain = run_sampler(

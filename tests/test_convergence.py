@@ -256,3 +256,15 @@ def test_report_notes_name_a_map_on_a_bound_over_parameterisation_and_a_spent_bu
     frozen = [n for n in notes if n["title"] == "A thermal node barely moves over the record"]
     assert len(frozen) == 1
     assert "5.4e+04 h, 25 times" in frozen[0]["text"] and "free offset" in frozen[0]["text"]
+    assert "posterior has two modes" not in frozen[0]["text"]
+    # held to the steady state (the damped start), and a second posterior branch
+    s["models"]["thermal"]["frozen_node"]["start_free"] = False
+    s["models"]["thermal"]["frozen_share"] = 0.21
+    text = next(n for n in run_notes(s, []) if n["title"] == frozen[0]["title"])["text"]
+    assert "held to the steady state" in text and "21% of the posterior draws" in text
+    # no frozen MAP, but a branch of the posterior: a note of its own; 4 % is noise
+    s["models"]["thermal"]["frozen_node"] = None
+    titles = [n["title"] for n in run_notes(s, [])]
+    assert "Some thermal draws freeze a node" in titles and frozen[0]["title"] not in titles
+    s["models"]["thermal"]["frozen_share"] = 0.04
+    assert "Some thermal draws freeze a node" not in [n["title"] for n in run_notes(s, [])]

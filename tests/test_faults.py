@@ -632,3 +632,32 @@ def test_disk_full_is_a_clean_exit_2(tiny_fs, tmp_path):
     rc, err = _hbayes("calibrate", cfg, "--out", tiny_fs / "run")
     assert rc == 2, err  # not a traceback, not a crash at exit
     assert "not enough free disk space" in err and _clean(err), err
+
+
+def test_a_reader_of_the_chain_file_does_not_end_the_run(tmp_path):
+    """HDF5 locks the file: a user reading the running chain (h5py, another process)
+    made the next append fail with BlockingIOError and ended a 4-minute run; the
+    append now waits for the reader."""
+    from heritage_bayes.inference.backend import _Checkpoint
+
+    path = tmp_path / "chain_thermal.h5"
+    ck = _Checkpoint(path, "tag")
+    ck.create(4, 2)
+    reader = subprocess.Popen(
+        [
+            sys.executable,
+            "-c",
+            f"import h5py, time, sys; f = h5py.File({str(path)!r}, 'r'); "
+            "print('open', flush=True); time.sleep(2.0)",
+        ],
+        stdout=subprocess.PIPE,
+        text=True,
+    )
+    assert reader.stdout.readline().strip() == "open"  # the reader holds the lock
+    rng = np.random.default_rng(0)
+    state = ("MT19937", np.zeros(624, dtype=np.uint32), 0, 0, 0.0)
+    ck.append(rng.normal(size=(5, 4, 2)), rng.normal(size=(5, 4)), np.zeros(4), state, [])
+    assert reader.wait(timeout=30) == 0
+    with h5py.File(path, "r") as f:
+        assert f["chain"].shape == (5, 4, 2)
+        assert json.loads(f.attrs["commit"])["iteration"] == 5

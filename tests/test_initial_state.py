@@ -9,6 +9,7 @@ filter with statsmodels' unobserved-components model (AR(1) + irregular): both t
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -49,6 +50,20 @@ def _problem(noise_name, mode, n=240, seed=1):
     return lp, theta
 
 
+def _start_cov(lp: LogPosterior, tm: np.ndarray) -> np.ndarray:
+    """Prior covariance of the free start deviation, from the eigen-decomposition of
+    the continuous A (independent of the modal form): s0² (W W^T) on the free block,
+    W = V diag(a) V⁻¹, a = (1 + (τ/h)²)^-1/2."""
+    A = lp.model.state_space(dict(zip(lp.model.parameter_names, tm, strict=True)))[0]
+    w, V = np.linalg.eig(A)
+    tau = -1.0 / w.real
+    a = 1.0 / np.sqrt(1.0 + (tau / lp.initial_state_horizon) ** 2)
+    W = (V * a) @ np.linalg.inv(V)
+    f = lp.x0_free
+    P = lp.initial_state_sd**2 * (W @ W.T).real
+    return P[np.ix_(f, f)] + (1e-6 * lp.initial_state_sd) ** 2 * np.eye(f.size)
+
+
 def _dense(lp: LogPosterior, theta: np.ndarray) -> float:
     """The same log-likelihood as one multivariate normal density (reference)."""
     m, U, y = lp.model, lp.inputs, lp.observed[:, 0]
@@ -66,7 +81,7 @@ def _dense(lp: LogPosterior, theta: np.ndarray) -> float:
     lag = np.abs(idx[:, None] - idx[None, :])
     cov = noise["sigma_Ti"] ** 2 * noise.get("phi_Ti", 0.0) ** lag
     cov = cov + noise.get("sigma_meas_Ti", 0.0) ** 2 * np.eye(idx.size)
-    cov = cov + lp.initial_state_sd**2 * S[idx] @ S[idx].T
+    cov = cov + S[idx] @ _start_cov(lp, tm) @ S[idx].T
     return float(multivariate_normal(y0[idx], cov).logpdf(y[idx]))
 
 
@@ -252,3 +267,106 @@ def test_a_frozen_node_is_named():
     # the threshold is the record times FROZEN_RECORDS, exactly
     assert frozen_time_constant(m, frozen, tau / FROZEN_RECORDS * 1.001) is None
     assert frozen_time_constant(m, frozen, tau / FROZEN_RECORDS * 0.999) == pytest.approx(tau)
+
+
+def test_slow_modes_start_near_their_steady_state():
+    """The start prior damps each mode by a = (1 + (τ/h)²)^-1/2 (h: the horizon, by
+    default the record): the isotropic s0² I when nothing is slower than the horizon,
+    and a frozen mode (τ = 100 h) cannot act as a free offset."""
+    lp, theta = _problem("ar1_white", "estimate")
+    m = lp.model
+    tm = theta[: lp.n_model]
+    frozen = tm.copy()
+    names = list(m.parameter_names)
+    frozen[names.index("Cw")] *= 1e4
+    frozen[names.index("Gw")] *= 1e-2
+    for h, horizon in ((lp.initial_state_horizon, "record"), (math.inf, "none")):
+        lp_h = LogPosterior(
+            m,
+            lp.params,
+            lp.noise,
+            lp.inputs,
+            lp.observed,
+            warmup=0,
+            init_window=48,
+            initial_state="estimate",
+            initial_state_sd=2.5,
+            initial_state_horizon=h,
+        )
+        assert lp_h.initial_state_horizon == (240 * 3600.0 if horizon == "record" else h)
+        mf = modal_form(m, np.stack([tm, frozen]), lp.dt)
+        P = lp_h._x0_cov(mf)
+        # the slow modal coordinate z = Tinv x: its prior variance is (s0 a)², a of its τ
+        tau = 1.0 / mf.lam
+        z = mf.Tinv @ P @ np.swapaxes(mf.Tinv, 1, 2)
+        for k in range(2):
+            j = int(np.argmax(tau[k]))
+            a = 1.0 / np.hypot(1.0, tau[k, j] / h)
+            zz = mf.Tinv[k] @ (2.5**2 * np.eye(2)) @ mf.Tinv[k].T
+            assert z[k, j, j] == pytest.approx(a**2 * zz[j, j], rel=1e-4)
+        if horizon == "none":
+            np.testing.assert_allclose(P, np.broadcast_to(2.5**2 * np.eye(2), P.shape), atol=1e-9)
+        else:  # frozen: the slow mode's start sd is below s0 / 10
+            assert tau[1].max() > 10 * h
+    with pytest.raises(ValueError, match="initial_state_horizon"):
+        LogPosterior(
+            m,
+            lp.params,
+            lp.noise,
+            lp.inputs,
+            lp.observed,
+            warmup=0,
+            initial_state="estimate",
+            initial_state_horizon=0.0,
+        )
+
+
+def test_time_constant_cap_is_a_soft_prior_on_every_mode():
+    """log p = -Σ log(1 + (τ_j/cap)²), added to the log-posterior and not to the
+    likelihood; a frozen envelope (τ1 ≈ 1.7e5 h) pays about 6 nats with a one-year
+    cap, the demo-like room (τ1 63 h) 5e-5; the config's defaults: a year for thermal
+    models, none for hygric ones."""
+    from heritage_bayes.config import ModelSection
+    from heritage_bayes.rc.derived import time_constants
+
+    lp, theta = _problem("ar1_white", "estimate")
+    cap = 365 * 86400.0
+    capped = LogPosterior(
+        lp.model,
+        lp.params,
+        lp.noise,
+        lp.inputs,
+        lp.observed,
+        warmup=0,
+        init_window=48,
+        initial_state="estimate",
+        initial_state_sd=2.5,
+        time_constant_cap=cap,
+    )
+    tm = theta[: lp.n_model]
+    frozen = tm.copy()
+    names = list(lp.model.parameter_names)
+    frozen[names.index("Cw")] *= 1e3
+    frozen[names.index("Gw")] *= 1e-2
+    th = np.stack([theta, np.concatenate([frozen, theta[lp.n_model :]])])
+    tau = time_constants(lp.model, th[:, : lp.n_model])  # [s]
+    expected = -np.log1p((tau / cap) ** 2).sum(axis=1)
+    got = capped.time_constant_log_prior(th[:, : lp.n_model])
+    np.testing.assert_allclose(got, expected, rtol=1e-10)
+    assert got[0] > -1e-3 and got[1] < -5.0
+    X = lp.params.to_unconstrained(th)
+    np.testing.assert_allclose(capped(X) - lp(X), expected, rtol=1e-9)
+    np.testing.assert_array_equal(capped.log_likelihood(th), lp.log_likelihood(th))
+    assert np.all(lp.time_constant_log_prior(th[:, : lp.n_model]) == 0.0)
+    assert ModelSection(model="thermal_2c").cap_seconds("thermal") == cap
+    assert ModelSection(model="hygric_2c").cap_seconds("hygric") == math.inf
+    assert (
+        ModelSection(model="thermal_2c", time_constant_cap="none").cap_seconds("thermal")
+        == math.inf
+    )
+    assert (
+        ModelSection(model="thermal_2c", time_constant_cap="90d").cap_seconds("thermal")
+        == 90 * 86400.0
+    )
+    with pytest.raises(ValueError, match="duration"):
+        ModelSection(model="thermal_2c", time_constant_cap="a year")

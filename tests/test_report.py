@@ -230,6 +230,11 @@ def test_parameter_tables(report, run_dir):
             assert prior_text(v["prior"]) in table
         # thermal_1c/hygric_1c are not the demo's generating models: no parameter truth
         assert '<th class="num">truth</th>' not in table
+    # the joint prior on time constants is stated where it acts (thermal: a year)
+    assert summary["models"]["thermal"]["time_constant_cap_h"] == 8760.0
+    assert summary["models"]["hygric"]["time_constant_cap_h"] is None
+    assert 'id="tau-cap-thermal"' in html and "(τ / 8760 h)²" in html
+    assert 'id="tau-cap-hygric"' not in html
     # ... but the model-independent quantities have one (gains, slowest time constant)
     gains = html[html.index('id="table-gains-thermal"') :]
     gains = gains[: gains.index("</table>")]

@@ -98,6 +98,8 @@ def _log_posterior(
             init_window=prep.init_steps,
             initial_state=initial_state,
             initial_state_sd=getattr(cfg, section).initial_state_sd,
+            initial_state_horizon=getattr(cfg, section).horizon_seconds,
+            time_constant_cap=getattr(cfg, section).cap_seconds(model.domain),
         )
     except ValueError as exc:
         raise InputError(f"{section}: {exc}") from None
@@ -146,16 +148,24 @@ def _say_findings(say: _Progress, s: _Section) -> None:
     tau = frozen_time_constant(s.model, s.map.theta[: lp.n_model], record)
     if tau is not None:  # a frozen node (see frozen_time_constant)
         free = lp.initial_state == "estimate" or isinstance(lp.initial_state, Mapping)
-        s.frozen_node = {"tau_h": tau / 3600.0, "records": tau / record, "start_free": free}
+        sd = lp.initial_state_sd / np.hypot(1.0, tau / lp.initial_state_horizon) if free else 0.0
+        unit = "K" if s.model.domain == "thermal" else "Pa"
+        s.frozen_node = {
+            "tau_h": tau / 3600.0,
+            "records": tau / record,
+            "start_free": bool(free and sd > 0.5 * lp.initial_state_sd),
+            "start_sd": sd,
+            "unit": unit,
+        }
         say.warn(
             f"[{s.name}] the slowest time constant at the MAP, {tau / 3600:.3g} h, is "
             f"{tau / record:.0f} times the calibration record: that node barely moves, a "
             "constant standing in for a fixed node, a missing input or a missing node; "
             + (
-                "its start is estimated, so it is a free offset: compare with "
-                "initial_state: steady (and periods.warmup)"
-                if free
-                else "it stays at its steady-state start"
+                "its start is estimated freely, so it is a free offset: compare with "
+                "the default initial_state_horizon or initial_state: steady"
+                if s.frozen_node["start_free"]
+                else f"its start is held to the steady state (prior sd {sd:.2g} {unit})"
             )
             + ", or model the fixed node (thermal: options.ground; hygric: hygric_2c_fixed)"
         )

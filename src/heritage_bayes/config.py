@@ -47,6 +47,7 @@ from __future__ import annotations
 import datetime as _dt
 import hashlib
 import json
+import math
 import re
 from pathlib import Path
 from typing import Annotated, Any, Literal
@@ -476,8 +477,43 @@ class ModelSection(_Strict):
     initial_state_sd: float | None = Field(
         default=None, gt=0, description="[K] or [Pa] prior sd of the estimated initial state"
     )
+    initial_state_horizon: str | None = Field(
+        default=None,
+        description="a duration (e.g. 90d) or 'none': modes slower than it have their "
+        "estimated start pulled to the steady state (default: the calibration record)",
+    )
+    time_constant_cap: str | None = Field(
+        default=None,
+        description="a duration or 'none': soft prior 1/(1 + (τ/cap)²) on every time "
+        "constant (default: 365d for thermal models, none for hygric ones)",
+    )
     priors: dict[str, dict[str, Any]] = Field(default_factory=dict)
     room_volume: float | None = Field(default=None, gt=0, description="[m³]")
+
+    @field_validator("initial_state_horizon", "time_constant_cap")
+    @classmethod
+    def _horizon(cls, v):
+        if v is None or v.strip().lower() == "none":
+            return v if v is None else "none"
+        return _check_duration(v, positive=True)
+
+    def cap_seconds(self, domain: str) -> float:
+        """``time_constant_cap`` in seconds (``inf`` for none); the default by domain:
+        a year for thermal models (no building node relaxes slower), none for hygric
+        ones (deep moisture buffers can take years)."""
+        h = self.time_constant_cap
+        if h is None:
+            return 365 * 86400.0 if domain == "thermal" else math.inf
+        return math.inf if h == "none" else parse_duration(h).total_seconds()
+
+    @property
+    def horizon_seconds(self) -> float | None:
+        """``initial_state_horizon`` in seconds: None for the calibration record's
+        length, ``inf`` for ``none`` (no slow-mode shrinkage)."""
+        h = self.initial_state_horizon
+        if h is None:
+            return None
+        return math.inf if h == "none" else parse_duration(h).total_seconds()
 
 
 class SamplerSettings(_Strict):

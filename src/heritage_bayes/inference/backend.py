@@ -21,6 +21,21 @@ import numpy as np
 from heritage_bayes.errors import InputError
 
 
+def _open_for_append(path, tries: int = 60, wait: float = 0.5):
+    """The chain file opened for appending. HDF5 locks the file: while another process
+    reads it (a user looking at the running chain with h5py), opening it for writing
+    fails with ``BlockingIOError``; wait for the reader (up to ``tries`` × ``wait`` s)
+    rather than end a run of many minutes for it."""
+    import time
+
+    for _ in range(tries - 1):
+        try:
+            return h5py.File(path, "a")
+        except BlockingIOError:
+            time.sleep(wait)
+    return h5py.File(path, "a")
+
+
 class _DeferSignals:
     """Record SIGINT and SIGTERM instead of acting on them, for a critical section.
 
@@ -119,7 +134,7 @@ class _Checkpoint:
 
         chunk = 64 * int(np.prod(chain.shape[1:])) * 8  # one HDF5 chunk [bytes]
         ensure_free_space(self.path, chain.nbytes + log_prob.nbytes + 2 * chunk)
-        with _DeferSignals(), h5py.File(self.path, "a") as f:
+        with _DeferSignals(), _open_for_append(self.path) as f:
             n0 = int(json.loads(f.attrs["commit"])["iteration"]) if "commit" in f.attrs else 0
             n = chain.shape[0]
             for name, rows in (("chain", chain), ("log_prob", log_prob)):

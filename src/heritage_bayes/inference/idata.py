@@ -326,6 +326,7 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
                 else dict(s.logpost.initial_state),
                 "how": initial_state_text(s.logpost),
                 "prior_sd": s.logpost.initial_state_sd,
+                "horizon_h": s.logpost.initial_state_horizon / 3600.0,
                 "unit": "°C" if s.model.domain == "thermal" else "Pa",
                 "nodes": (
                     {node: _summ(x0[:, i]) for i, node in enumerate(s.model.state_names)}
@@ -353,6 +354,9 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
             # identifiability from the Laplace approximation at the MAP
             "map_at_bound": [list(b) for b in getattr(s, "map_at_bound", [])],
             "frozen_node": getattr(s, "frozen_node", None),
+            # the share of draws whose slowest mode is frozen (a second posterior branch)
+            "frozen_share": _frozen_share(dq_all.get("tau_1_h"), s.logpost),
+            "time_constant_cap_h": _hours(s.logpost.time_constant_cap),
             "practical_identifiability": (
                 s.laplace.to_dict(ps.free_names) if getattr(s, "laplace", None) else None
             ),
@@ -504,6 +508,22 @@ def _truth_for(cfg, prep, section) -> tuple[dict, dict]:
     if gen != section.model.name:
         dq = {k: v for k, v in dq.items() if not k.startswith("tau_") or k == "tau_1_h"}
     return params_truth, dq
+
+
+def _hours(seconds: float | None) -> float | None:
+    """Seconds -> hours; None for none or infinity (JSON has no infinity)."""
+    return None if seconds is None or not np.isfinite(seconds) else seconds / 3600.0
+
+
+def _frozen_share(tau_h, lp) -> float | None:
+    """Share of the draws whose slowest time constant [h] exceeds ``FROZEN_RECORDS``
+    calibration records (:func:`heritage_bayes.rc.derived.frozen_time_constant`)."""
+    from heritage_bayes.rc.derived import FROZEN_RECORDS
+
+    if tau_h is None:
+        return None
+    record_h = lp.observed.shape[0] * lp.dt / 3600.0
+    return float(np.mean(np.asarray(tau_h).reshape(-1) > FROZEN_RECORDS * record_h))
 
 
 def _versions() -> dict:

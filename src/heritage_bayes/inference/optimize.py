@@ -3,9 +3,10 @@
 The maximum a posteriori point is sought in the *unit cube* of the prior ranges: each
 free parameter's position between its bounds, on the log scale for log-scale priors.
 The objective is the log-likelihood plus the log prior density with respect to that
-scale (flat for uniform/log-uniform priors), i.e. the MAP of the log-parameters, the
-natural scale of capacities and conductances; it does not depend on the sampler's logit
-transform.
+scale (flat for uniform/log-uniform priors) and the joint prior on the time constants
+(:meth:`~heritage_bayes.inference.posterior.LogPosterior.time_constant_log_prior`), i.e.
+the MAP of the log-parameters, the natural scale of capacities and conductances; it does
+not depend on the sampler's logit transform.
 
 Global step: :func:`scipy.optimize.differential_evolution` (vectorised, seeded), as the
 paper used global optimisation because the surface has several minima; or seeded
@@ -104,6 +105,9 @@ class _Objective:
         theta, lprior = self.values(S)
         with np.errstate(all="ignore"):
             ll = self.lp.log_likelihood(theta)
+            joint = getattr(self.lp, "time_constant_log_prior", None)  # a joint prior
+            if joint is not None:
+                lprior = lprior + joint(theta[:, : self.lp.n_model])
         val = -(ll + lprior)
         return np.where(np.isfinite(val), val, 1e300)
 

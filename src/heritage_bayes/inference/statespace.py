@@ -24,7 +24,8 @@ and the Kalman filter runs on the decoupled modes (n ≤ 4 states), batched over
 in one compiled pass; missing observations are prediction-only steps. The initial
 state is part of the filter: mean and covariance from
 :class:`~heritage_bayes.inference.posterior.LogPosterior`'s initial-state prior (the
-steady state of the mean inputs, sd ``initial_state_sd`` on the estimated nodes), so
+steady state of the mean inputs, sd ``initial_state_sd`` on the estimated nodes, damped
+for modes slower than ``initial_state_horizon``), so
 it is integrated out exactly as with the other noise models.
 
 References

@@ -310,7 +310,14 @@ def run_notes(
                     "bounds regardless.",
                 }
             )
-        fz = i.get("frozen_node")
+        fz, share = i.get("frozen_node"), i.get("frozen_share")
+        branch = (
+            f" {share:.0%} of the posterior draws lie on this branch (the slowest time "
+            "constant beyond ten records), the rest on one where every node moves: the "
+            "posterior has two modes, and the intervals of the time constants span both."
+            if share and share >= 0.05
+            else ""
+        )
         if fz:
             out.append(
                 {
@@ -321,11 +328,22 @@ def run_notes(
                     "start value, a constant standing in for a fixed node, a missing input "
                     "or a missing node"
                     + (
-                        "; its start is estimated, so it acts as a free offset (compare with "
-                        "initial_state: steady and a warm-up)."
+                        "; its start is estimated freely, so it acts as a free offset "
+                        "(compare with the default initial_state_horizon or "
+                        "initial_state: steady)."
                         if fz.get("start_free")
-                        else "."
-                    ),
+                        else "; its start is held to the steady state of the first "
+                        "window's mean inputs."
+                    )
+                    + branch,
+                }
+            )
+        elif branch:
+            out.append(
+                {
+                    "level": "amber",
+                    "title": f"Some {m} draws freeze a node",
+                    "text": "The MAP's nodes all move over the record, but" + branch,
                 }
             )
         flagged = [

@@ -90,6 +90,9 @@ def parameter_tables(rd: RunData) -> list[dict]:
                 "map_agreed": f"{mp.get('agreed', '?')} of {mp.get('starts', '?')}",
                 "map_method": mp.get("method", "?"),
                 "prior_fig": _prior_figure(rd, m, info),
+                "cap_h": None
+                if info.get("time_constant_cap_h") is None
+                else fmt(info["time_constant_cap_h"]),
             }
         )
     return tables

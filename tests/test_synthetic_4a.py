@@ -1,0 +1,69 @@
+"""The paper's model 4a on a room it generated, and the smaller 2c on the same room
+(issue 11).
+
+The demo room with ``data.demo.thermal_model: thermal_4a`` (the truth of
+``heritage_bayes.demo``: envelope, air and interior mass; three months of hourly logs
+with AR(1) model error, sensor noise, rounding and a week-long gap) is calibrated on the
+defaults (``ar1_white``, the start estimated) with:
+
+- ``thermal_4a``: must converge within the test's budget and recover what hourly
+  temperatures identify: every static gain and the two time constants above the step
+  within their 90 % intervals. The third (truth 0.31 h, below the hourly step) is not
+  identified: its interval spans more than a decade, which is the honest answer.
+- ``thermal_2c``: must converge and its 90 % band must cover the validation period's
+  hours at a rate within [0.80, 0.97]. Without the damped start of slow modes
+  (``initial_state_horizon: none``) its envelope node froze into a free offset
+  (validation coverage 0.34).
+
+Both runs are deterministic (seeded): the assertions hold for this seed, and the
+tolerances are the issue's.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+import yaml
+
+from heritage_bayes.calibrate import run_calibration
+from heritage_bayes.config import parse_config
+
+DEMO = Path(__file__).resolve().parents[1] / "configs" / "demo.yaml"
+
+
+def _calibrate(tmp_path: Path, model: str) -> dict:
+    raw = yaml.safe_load(DEMO.read_text())
+    raw["name"] = f"room_4a_{model}"
+    raw["data"]["demo"]["thermal_model"] = "thermal_4a"
+    raw["thermal"]["model"] = model
+    raw.pop("hygric")
+    raw["ladder"] = False
+    raw["sampler"] = {"max_time": "8min"}  # the budget; convergence is asserted
+    cfg = parse_config(raw, base_dir=str(DEMO.parent))
+    out = run_calibration(cfg, out_dir=tmp_path / model, report=False, quiet=True)
+    return json.loads((out / "summary.json").read_text())
+
+
+def _inside(d: dict) -> bool:
+    return d["q05"] <= d["truth"] <= d["q95"]
+
+
+@pytest.mark.parametrize("model", ["thermal_4a", "thermal_2c"])
+def test_a_4a_room_calibrated_with_4a_and_2c(tmp_path, model):
+    s = _calibrate(tmp_path, model)
+    assert s["converged"], (s["max_rhat"], s["min_ess_bulk"], s["converged_tau"])
+    d = s["derived"]
+    gains = {k: v for k, v in d.items() if k.startswith("thermal.gain_")}
+    assert len(gains) == 6  # Te, four facades, Tf
+    missed = [k for k, v in gains.items() if not _inside(v)]
+    assert not missed, {k: gains[k] for k in missed}
+    assert _inside(d["thermal.tau_1_h"]), d["thermal.tau_1_h"]
+    if model == "thermal_4a":
+        assert _inside(d["thermal.tau_2_h"]), d["thermal.tau_2_h"]
+        t3 = d["thermal.tau_3_h"]
+        assert t3["truth"] < 1.0 and t3["q95"] / t3["q05"] > 10.0, t3
+    else:
+        val = s["metrics"]["thermal"]["Ti"]["validation"]
+        assert 0.80 <= val["coverage90"] <= 0.97, val

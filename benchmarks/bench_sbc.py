@@ -46,6 +46,7 @@ from scipy.linalg import expm
 SHARED = Path(__file__).resolve().parents[2] / "shared" / "data"
 KNMI = SHARED / "knmi-debilt" / "uurgeg_260_2011-2020.txt.gz"
 VOLUME, ACH = 400.0, 0.5  # [m³], [1/h]: the prior knowledge given to every replicate
+FLOOR = 80.0  # [m²]: the floor of a 400 m³ hall 5 m high (the demo's room)
 CAL_DAYS, MAX_SPIN_DAYS = 90, 56
 DT = 3600.0
 
@@ -91,10 +92,17 @@ def _solve_capacity(A_of_cw, target_tau_h: float) -> float:
     return float(np.sqrt(lo * hi))
 
 
-def truth(model, rng) -> dict[str, float]:
+def truth(model, rng, floor_area: float | None = None) -> dict[str, float]:
     """True parameters: air capacity and ventilation near the prior knowledge, the rest
-    log-uniform, and the envelope capacity set for a slow tau of 2-3 weeks."""
-    from heritage_bayes.inference.parameters import air_capacity_prior, ventilation_prior
+    log-uniform, and the envelope capacity set for a slow tau of 2-3 weeks. With
+    ``floor_area`` [m²] the ground coupling Gf too is drawn near the prior knowledge
+    (its median times exp(N(0, 0.5)), like Ci and Gfast); without, log-uniform on
+    5-40 W/K (the study before the floor-area prior)."""
+    from heritage_bayes.inference.parameters import (
+        air_capacity_prior,
+        ground_prior,
+        ventilation_prior,
+    )
 
     dom = model.domain
     ci, gf = air_capacity_prior(dom, VOLUME), ventilation_prior(dom, VOLUME, ACH)
@@ -117,6 +125,8 @@ def truth(model, rng) -> dict[str, float]:
         if "Pf" in model.parameter_names:
             p.update(Gf=float(np.exp(rng.uniform(np.log(2e-8), np.log(2e-7)))))
             p.update(Pf=float(rng.uniform(900, 1400)))
+    if floor_area and dom == "thermal":
+        p["Gf"] = ground_prior(floor_area).mu * float(np.exp(rng.normal(0, 0.5)))
     target = rng.uniform(336, 504)
 
     def A_of(cw):
@@ -159,10 +169,11 @@ def replicate(args) -> dict:
     name, rep, variants, seed, max_steps = args[:5]
     cal_days = args[5] if len(args) > 5 else CAL_DAYS
     priors = args[6] if len(args) > 6 else {}
+    floor = args[7] if len(args) > 7 else None
     rng = np.random.default_rng([seed, rep])
     opts = {"surfaces": ("S",)} if name in ("thermal_2c", "thermal_4a") else {}
     model = hb.model(name, **opts)
-    p = truth(model, rng)
+    p = truth(model, rng, floor)
     w = weather(int(rng.integers(2**31)))
     U = np.column_stack(
         [w[c] if c in w else np.full(len(w["Te"]), 10.0) for c in model.input_names]
@@ -193,7 +204,9 @@ def replicate(args) -> dict:
         t0 = time.process_time()
         noise = get_noise_model(noise_name)
         known = {k: v for k, v in priors.items() if k in model.parameter_names}
-        ps = parameters_for(model, noise, known, room_volume=VOLUME, air_change_rate=ACH)
+        ps = parameters_for(
+            model, noise, known, room_volume=VOLUME, air_change_rate=ACH, floor_area=floor
+        )
         lp = LogPosterior(
             model,
             ps,
@@ -292,6 +305,14 @@ def main() -> None:
         help="a log-normal prior given to every fit (e.g. Gf=14,0.6: knowledge of the "
         "ground coupling), to see what a weakly identified parameter's prior does",
     )
+    ap.add_argument(
+        "--floor-area",
+        type=float,
+        default=FLOOR,
+        help="floor area on the ground [m²] given to every fit (a log-normal prior on Gf) "
+        "and used to draw the true Gf; 0: neither, Gf log-uniform on 5-40 W/K as in the "
+        f"study before that prior (default {FLOOR:g})",
+    )
     ap.add_argument("--table", help="only tabulate a --log file of an earlier study")
     ap.add_argument(
         "--max-steps",
@@ -316,7 +337,7 @@ def main() -> None:
         median, sigma = (float(v) for v in vals.split(","))
         priors[name] = {"dist": "lognormal", "median": median, "sigma": sigma}
     tasks = [
-        (m, r, variants, args.seed, args.max_steps, CAL_DAYS, priors)
+        (m, r, variants, args.seed, args.max_steps, CAL_DAYS, priors, args.floor_area or None)
         for r in range(args.reps)
         for m in args.models.split(",")
     ]  # models interleaved: a study cut short still covers every model

@@ -257,3 +257,38 @@ def test_sampler_same_seed_same_chain_and_resume_continues_it(tmp_path):
     np.testing.assert_array_equal(c.chain, a.chain)
     with pytest.raises(InputError, match="different configuration"):
         run_sampler(lp, x0, checkpoint=tmp_path / "c.h5", tag="other", resume=True, **kw)
+
+
+def test_floor_area_sets_the_ground_prior_of_thermal_models_only():
+    """floor_area [m²]: Gf ~ lognormal(median 0.4 W/(m²K) × area, σ_log 1) on thermal
+    models; a hygric model's Gf (to a fixed vapour pressure) keeps its default; the
+    config key reaches the parameters; a bad area is a ConfigError naming it."""
+    import heritage_bayes as hb
+    from heritage_bayes.config import parse_config
+    from heritage_bayes.errors import ConfigError
+    from heritage_bayes.inference.likelihoods import get_noise_model
+    from heritage_bayes.inference.parameters import U_GROUND, ground_prior, parameters_for
+    from heritage_bayes.run import section_parameters
+
+    noise = get_noise_model("ar1_white")
+    th = hb.model("thermal_2c", surfaces=("S",))
+    ps = parameters_for(th, noise, room_volume=400, floor_area=80)
+    gf = ps.parameters[ps.names.index("Gf")].prior
+    assert gf.dist == "lognormal" and gf.mu == pytest.approx(U_GROUND * 80) and gf.sigma == 1.0
+    default = parameters_for(th, noise).parameters[ps.names.index("Gf")].prior
+    assert default.dist == "loguniform"
+    hy = hb.model("hygric_2c_fixed")
+    hps = parameters_for(hy, noise, floor_area=80)
+    assert hps.parameters[hps.names.index("Gf")].prior.dist == "loguniform"
+    with pytest.raises(ConfigError, match="floor_area"):
+        ground_prior(0.0)
+    raw = {
+        "data": {"demo": {"seed": 7}},
+        "floor_area": 80,
+        "thermal": {"model": "thermal_2c"},
+    }
+    cfg = parse_config(raw)
+    _, ps2 = section_parameters(cfg, "thermal", hb.model("thermal_2c"), {})
+    assert ps2.parameters[ps2.names.index("Gf")].prior.mu == pytest.approx(32.0)
+    with pytest.raises(ConfigError, match="floor_area"):
+        parse_config({**raw, "floor_area": -5})

@@ -3,7 +3,8 @@
 Eight rooms shaped like real logs (AR(1) model error + sensor noise + rounding + a gap,
 a start far from equilibrium, De Bilt weather), generated with scipy's matrix
 exponential and calibrated with the package's defaults (``ar1_white``, initial state
-integrated out). For each identifiable quantity, the number of truths outside the 90 %
+integrated out) and the survey knowledge of the benchmark (room volume, air change rate,
+floor area). For each identifiable quantity, the number of truths outside the 90 %
 interval must not exceed the binomial 99.9 % quantile for 8 replicates at a 10 % miss
 rate: a calibrated posterior fails this test with probability below 0.1 % per quantity;
 a posterior whose intervals cover only 50 % fails it with probability ~ 64 %.
@@ -33,7 +34,8 @@ REPS = 8
 def test_small_sbc_thermal_2c_intervals_cover_the_truth():
     variant = "ar1_white:estimate"
     results = [
-        bench_sbc.replicate(("thermal_2c", rep, [variant], 7, 4000, 28)) for rep in range(REPS)
+        bench_sbc.replicate(("thermal_2c", rep, [variant], 7, 4000, 28, {}, bench_sbc.FLOOR))
+        for rep in range(REPS)
     ]
     limit = int(stats.binom.ppf(0.999, REPS, 0.10))
     for q in ("tau_1_h", "gain_Ti_Te", "gain_Ti_I_S"):

@@ -20,6 +20,7 @@ Layout (see ``configs/demo.yaml`` for a complete, commented example)::
     seed: 1
     site: {latitude: 52.1, longitude: 5.18, altitude: 2}
     room_volume: 800               # [m³], optional: log-normal prior on each model's Ci
+    floor_area: 160                # [m²] on the ground, optional: log-normal prior on Gf
     data:
       demo: {seed: 7, gap: [2019-03-10, 2019-03-17]}   # the built-in virtual monument
                                    # (heritage_bayes.demo), or real files:
@@ -576,6 +577,9 @@ class CalibrationConfig(_Strict):
     )
     air_change_sigma: float = Field(
         default=1.0, gt=0, le=5, description="[-] sd of log(air change rate)"
+    )
+    floor_area: float | None = Field(
+        default=None, gt=0, description="[m²] floor on the ground: log-normal prior on thermal Gf"
     )
     data: Data
     periods: Periods = Field(default_factory=Periods)

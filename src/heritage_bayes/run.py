@@ -61,6 +61,7 @@ def section_parameters(cfg: CalibrationConfig, section: str, model: RCModel, pri
         room_volume=sec_cfg.room_volume or cfg.room_volume,
         air_change_rate=cfg.air_change_rate,
         air_change_sigma=cfg.air_change_sigma,
+        floor_area=cfg.floor_area,
         where=f"{section}.priors",
         dt=parse_duration(cfg.data.step).total_seconds(),
     )

@@ -9,6 +9,7 @@ filter with statsmodels' unobserved-components model (AR(1) + irregular): both t
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from pathlib import Path
 
@@ -269,6 +270,16 @@ def test_a_frozen_node_is_named():
     assert frozen_time_constant(m, frozen, tau / FROZEN_RECORDS * 0.999) == pytest.approx(tau)
 
 
+def _frozen(lp: LogPosterior, tm: np.ndarray, cw_factor: float) -> np.ndarray:
+    """Model parameters ``tm`` with the envelope made far slower: Cw × ``cw_factor``,
+    Gw / 100."""
+    out = tm.copy()
+    names = list(lp.model.parameter_names)
+    out[names.index("Cw")] *= cw_factor
+    out[names.index("Gw")] *= 1e-2
+    return out
+
+
 def test_slow_modes_start_near_their_steady_state():
     """The start prior damps each mode by a = (1 + (τ/h)²)^-1/2 (h: the horizon, by
     default the record): the isotropic s0² I when nothing is slower than the horizon,
@@ -276,23 +287,9 @@ def test_slow_modes_start_near_their_steady_state():
     lp, theta = _problem("ar1_white", "estimate")
     m = lp.model
     tm = theta[: lp.n_model]
-    frozen = tm.copy()
-    names = list(m.parameter_names)
-    frozen[names.index("Cw")] *= 1e4
-    frozen[names.index("Gw")] *= 1e-2
+    frozen = _frozen(lp, tm, 1e4)
     for h, horizon in ((lp.initial_state_horizon, "record"), (math.inf, "none")):
-        lp_h = LogPosterior(
-            m,
-            lp.params,
-            lp.noise,
-            lp.inputs,
-            lp.observed,
-            warmup=0,
-            init_window=48,
-            initial_state="estimate",
-            initial_state_sd=2.5,
-            initial_state_horizon=h,
-        )
+        lp_h = dataclasses.replace(lp, initial_state_horizon=h)
         assert lp_h.initial_state_horizon == (240 * 3600.0 if horizon == "record" else h)
         mf = modal_form(m, np.stack([tm, frozen]), lp.dt)
         P = lp_h._x0_cov(mf)
@@ -309,16 +306,7 @@ def test_slow_modes_start_near_their_steady_state():
         else:  # frozen: the slow mode's start sd is below s0 / 10
             assert tau[1].max() > 10 * h
     with pytest.raises(ValueError, match="initial_state_horizon"):
-        LogPosterior(
-            m,
-            lp.params,
-            lp.noise,
-            lp.inputs,
-            lp.observed,
-            warmup=0,
-            initial_state="estimate",
-            initial_state_horizon=0.0,
-        )
+        dataclasses.replace(lp, initial_state_horizon=0.0)
 
 
 def test_time_constant_cap_is_a_soft_prior_on_every_mode():
@@ -331,23 +319,9 @@ def test_time_constant_cap_is_a_soft_prior_on_every_mode():
 
     lp, theta = _problem("ar1_white", "estimate")
     cap = 365 * 86400.0
-    capped = LogPosterior(
-        lp.model,
-        lp.params,
-        lp.noise,
-        lp.inputs,
-        lp.observed,
-        warmup=0,
-        init_window=48,
-        initial_state="estimate",
-        initial_state_sd=2.5,
-        time_constant_cap=cap,
-    )
+    capped = dataclasses.replace(lp, time_constant_cap=cap)
     tm = theta[: lp.n_model]
-    frozen = tm.copy()
-    names = list(lp.model.parameter_names)
-    frozen[names.index("Cw")] *= 1e3
-    frozen[names.index("Gw")] *= 1e-2
+    frozen = _frozen(lp, tm, 1e3)
     th = np.stack([theta, np.concatenate([frozen, theta[lp.n_model :]])])
     tau = time_constants(lp.model, th[:, : lp.n_model])  # [s]
     expected = -np.log1p((tau / cap) ** 2).sum(axis=1)

@@ -144,7 +144,7 @@ def _say_findings(say: _Progress, s: _Section) -> None:
             f"{capped[0]} only if the slow misfit is measurement drift"
         )
     lp = s.logpost
-    record = lp.observed.shape[0] * lp.dt
+    record = lp.record_seconds
     tau = frozen_time_constant(s.model, s.map.theta[: lp.n_model], record)
     if tau is not None:  # a frozen node (see frozen_time_constant)
         free = lp.initial_state == "estimate" or isinstance(lp.initial_state, Mapping)

@@ -123,6 +123,11 @@ def _check_duration(v: str, *, positive: bool = False) -> str:
     return _normalise_duration(v)
 
 
+def _seconds_or_inf(v: str) -> float:
+    """A validated duration or ``'none'`` in seconds (``inf`` for none)."""
+    return math.inf if v == "none" else parse_duration(v).total_seconds()
+
+
 def _normalise_duration(v):
     return _HOUR_UNIT.sub("h", _DAY_UNIT.sub("D", v.strip())) if isinstance(v, str) else v
 
@@ -502,19 +507,16 @@ class ModelSection(_Strict):
         """``time_constant_cap`` in seconds (``inf`` for none); the default by domain:
         a year for thermal models (no building node relaxes slower), none for hygric
         ones (deep moisture buffers can take years)."""
-        h = self.time_constant_cap
-        if h is None:
+        if self.time_constant_cap is None:
             return 365 * 86400.0 if domain == "thermal" else math.inf
-        return math.inf if h == "none" else parse_duration(h).total_seconds()
+        return _seconds_or_inf(self.time_constant_cap)
 
     @property
     def horizon_seconds(self) -> float | None:
         """``initial_state_horizon`` in seconds: None for the calibration record's
         length, ``inf`` for ``none`` (no slow-mode shrinkage)."""
         h = self.initial_state_horizon
-        if h is None:
-            return None
-        return math.inf if h == "none" else parse_duration(h).total_seconds()
+        return None if h is None else _seconds_or_inf(h)
 
 
 class SamplerSettings(_Strict):

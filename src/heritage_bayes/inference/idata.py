@@ -522,7 +522,7 @@ def _frozen_share(tau_h, lp) -> float | None:
 
     if tau_h is None:
         return None
-    record_h = lp.observed.shape[0] * lp.dt / 3600.0
+    record_h = lp.record_seconds / 3600.0
     return float(np.mean(np.asarray(tau_h).reshape(-1) > FROZEN_RECORDS * record_h))
 
 

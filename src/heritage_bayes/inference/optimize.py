@@ -105,9 +105,7 @@ class _Objective:
         theta, lprior = self.values(S)
         with np.errstate(all="ignore"):
             ll = self.lp.log_likelihood(theta)
-            joint = getattr(self.lp, "time_constant_log_prior", None)  # a joint prior
-            if joint is not None:
-                lprior = lprior + joint(theta[:, : self.lp.n_model])
+            lprior = lprior + self.lp.time_constant_log_prior(theta[:, : self.lp.n_model])
         val = -(ll + lprior)
         return np.where(np.isfinite(val), val, 1e300)
 

@@ -174,7 +174,7 @@ class LogPosterior:
         self.initial_state_sd = float(sd)
         h = self.initial_state_horizon
         if h is None:
-            h = self.inputs.shape[0] * self.dt
+            h = self.record_seconds
         if not h > 0:
             raise ValueError(f"initial_state_horizon: must be > 0 s (got {h})")
         self.initial_state_horizon = float(h)
@@ -207,6 +207,11 @@ class LogPosterior:
             lam = np.linalg.eigvalsh(r[:, :, None] * G * r[:, None, :])
             out = -np.log1p((1.0 / (lam * cap)) ** 2).sum(axis=1)
         return np.where(np.isfinite(out), out, -np.inf)
+
+    @property
+    def record_seconds(self) -> float:
+        """Length of the calibration record [s] (warm-up included)."""
+        return self.inputs.shape[0] * self.dt
 
     @property
     def ndim(self) -> int:

@@ -274,17 +274,27 @@ def table(results: list[dict], variant: str) -> list[str]:
         ]
         for k in keys:
             v = [
-                r["variants"][variant]["ranks"][k]
+                (r["variants"][variant]["ranks"][k], r["variants"][variant]["converged"])
                 for r in rs
                 if k in r["variants"][variant]["ranks"]
             ]
             n = len(v)
-            c50 = np.mean([x["in50"] for x in v])
-            c90 = np.mean([x["in90"] for x in v])
-            counts = np.histogram([x["rank"] for x in v], bins=10, range=(0, 1))[0]
+            c50 = np.mean([x["in50"] for x, _ in v])
+            c90 = np.mean([x["in90"] for x, _ in v])
+            counts = np.histogram([x["rank"] for x, _ in v], bins=10, range=(0, 1))[0]
             p = stats.chisquare(counts).pvalue if n >= 20 else float("nan")
+            # the fits a user would be told to trust (a run that did not converge is
+            # flagged red in its report): their coverage separately
+            ok = [x for x, c in v if c]
+            conv_cov = (
+                f"; converged ({len(ok)}) {np.mean([x['in50'] for x in ok]):4.2f} / "
+                f"{np.mean([x['in90'] for x in ok]):4.2f}"
+                if ok and len(ok) < n
+                else ""
+            )
             lines.append(
-                f"    {k:16s} n {n:3d}   50 %: {c50:5.2f}   90 %: {c90:5.2f}   rank chi² p {p:5.3f}"
+                f"    {k:16s} n {n:3d}   50 %: {c50:5.2f}   90 %: {c90:5.2f}   "
+                f"rank chi² p {p:5.3f}{conv_cov}"
             )
     return lines
 
@@ -292,6 +302,14 @@ def table(results: list[dict], variant: str) -> list[str]:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--reps", type=int, default=50)
+    ap.add_argument(
+        "--first-rep",
+        type=int,
+        default=0,
+        help="number of the first replicate (each replicate's room and weather come from "
+        "(seed, replicate)): --first-rep 50 --reps 50 --log same.jsonl extends a 50-replicate "
+        "study to 100, tabulated with --table",
+    )
     ap.add_argument("--models", default="thermal_2c,hygric_2c")
     ap.add_argument("--noise", action="append", help="NAME:INIT (repeatable)")
     ap.add_argument("--jobs", type=int, default=1)
@@ -338,7 +356,7 @@ def main() -> None:
         priors[name] = {"dist": "lognormal", "median": median, "sigma": sigma}
     tasks = [
         (m, r, variants, args.seed, args.max_steps, CAL_DAYS, priors, args.floor_area or None)
-        for r in range(args.reps)
+        for r in range(args.first_rep, args.first_rep + args.reps)
         for m in args.models.split(",")
     ]  # models interleaved: a study cut short still covers every model
     t0 = time.perf_counter()

@@ -21,6 +21,8 @@ posterior is calibrated; reported as a chi-square test on 10 bins (p-value).
 
     python benchmarks/bench_sbc.py --reps 50 --jobs 2
     python benchmarks/bench_sbc.py --reps 10 --models thermal_2c --noise ar1:steady
+    python benchmarks/bench_sbc.py --room 64 --reps 24 --models thermal_2c \
+        --noise ar1_white:estimate --without rounding,gap --jobs 2
 
 ``--noise NAME:INIT`` pairs a noise model with an initial state (``estimate`` or
 ``steady``; ``steady`` adds the old 14-day warm-up). Default: the new default
@@ -47,6 +49,7 @@ SHARED = Path(__file__).resolve().parents[2] / "shared" / "data"
 KNMI = SHARED / "knmi-debilt" / "uurgeg_260_2011-2020.txt.gz"
 VOLUME, ACH = 400.0, 0.5  # [m³], [1/h]: the prior knowledge given to every replicate
 FLOOR = 80.0  # [m²]: the floor of a 400 m³ hall 5 m high (the demo's room)
+ENVELOPE = 259.0  # [m²]: its walls (8.9 m square, 5 m high) and roof
 CAL_DAYS, MAX_SPIN_DAYS = 90, 56
 DT = 3600.0
 
@@ -170,6 +173,10 @@ def replicate(args) -> dict:
     cal_days = args[5] if len(args) > 5 else CAL_DAYS
     priors = args[6] if len(args) > 6 else {}
     floor = args[7] if len(args) > 7 else None
+    # (noise draw, components left out): the same room, weather and start with fresh
+    # observation noise (see repeat_room); None: the study's own draw, every component
+    redraw, without = args[8] if len(args) > 8 else (None, ())
+    envelope = args[9] if len(args) > 9 else None
     rng = np.random.default_rng([seed, rep])
     opts = {"surfaces": ("S",)} if name in ("thermal_2c", "thermal_4a") else {}
     model = hb.model(name, **opts)
@@ -188,24 +195,35 @@ def replicate(args) -> dict:
     thermal = model.domain == "thermal"
     phi = rng.uniform(0.90, 0.95)
     sd = rng.uniform(0.15, 0.30) * (1.0 if thermal else 100.0)
+    nr = rng if redraw is None else np.random.default_rng([seed, rep, 1 + redraw])
     e = np.empty(y_true.size)
-    e[0] = rng.normal(0, sd)
-    z = rng.normal(0, sd * np.sqrt(1 - phi**2), y_true.size)
+    e[0] = nr.normal(0, sd)
+    z = nr.normal(0, sd * np.sqrt(1 - phi**2), y_true.size)
     for k in range(1, e.size):
         e[k] = phi * e[k - 1] + z[k]
+    if "model_error" in without:
+        e[:] = 0.0
     sensor = 0.1 if thermal else 12.0  # [K]; [Pa] ~ 1 %RH at 10 °C
-    y = np.round(y_true + e + rng.normal(0, sensor, e.size), 1)[rows]
-    g0 = int(rng.integers(7 * 24, cal_days * 24 - 14 * 24))
-    y[g0 : g0 + 7 * 24] = np.nan
+    y = y_true + e + nr.normal(0, sensor, e.size)
+    y = (y if "rounding" in without else np.round(y, 1))[rows]
+    g0 = int(nr.integers(7 * 24, cal_days * 24 - 14 * 24))
+    if "gap" not in without:
+        y[g0 : g0 + 7 * 24] = np.nan
     dq_true = {k: float(np.ravel(v)[0]) for k, v in derived_quantities(model, p).items()}
-    result = {"model": name, "rep": rep, "truth": dq_true, "variants": {}}
+    result = {"model": name, "rep": rep, "truth": dq_true, "truth_parameters": p, "variants": {}}
     for variant in variants:
         noise_name, init = variant.split(":")
         t0 = time.process_time()
         noise = get_noise_model(noise_name)
         known = {k: v for k, v in priors.items() if k in model.parameter_names}
         ps = parameters_for(
-            model, noise, known, room_volume=VOLUME, air_change_rate=ACH, floor_area=floor
+            model,
+            noise,
+            known,
+            room_volume=VOLUME,
+            air_change_rate=ACH,
+            floor_area=floor,
+            envelope_area=envelope,
         )
         lp = LogPosterior(
             model,
@@ -241,10 +259,13 @@ def replicate(args) -> dict:
                 "in50": bool(lo50 <= t <= hi50),
                 "in90": bool(lo90 <= t <= hi90),
                 "rank": float(np.mean(d < t)),
+                "median": float(np.median(d)),
+                "sd": float(np.std(d)),
             }
         result["variants"][variant] = {
             "ranks": ranks,
             "converged": bool(chain.converged),
+            "map": dict(zip(ps.names, map(float, mp.theta), strict=True)),
             "steps": int(chain.steps),
             "cpu": time.process_time() - t0,
         }
@@ -299,6 +320,42 @@ def table(results: list[dict], variant: str) -> list[str]:
     return lines
 
 
+def repeat_room(results: list[dict], variant: str) -> list[str]:
+    """One room observed afresh many times (``--room``): for each quantity the spread
+    of the posterior medians over the observation draws against the mean posterior sd
+    (1 if the intervals have the right width), and the z-score of the truth
+    (median - truth) / sd: rms 1 and mean 0 (standard error 1/sqrt(n)) if calibrated
+    for this room; a mean away from 0 is a bias of this room's posterior."""
+    lines = []
+    rs = [r["variants"][variant] for r in results if variant in r["variants"]]
+    conv = sum(r["converged"] for r in rs)
+    lines.append(f"  [{variant}]: {len(rs)} observation draws, {conv} converged")
+    maps = [r["map"] for r in rs if "map" in r]
+    if maps:
+        t = results[0]["truth_parameters"]
+        lines.append(
+            "    MAP over the draws (min-max; truth): "
+            + ", ".join(
+                f"{n} {min(m[n] for m in maps):.3g}-{max(m[n] for m in maps):.3g} ({t[n]:.3g})"
+                for n in t
+            )
+        )
+    for k in QUANTITIES.get(results[0]["model"], ()):
+        v = [r["ranks"][k] for r in rs if k in r["ranks"]]
+        if len(v) < 2:
+            continue
+        t = results[0]["truth"][k]
+        med = np.array([x["median"] for x in v])
+        sd = np.array([x["sd"] for x in v])
+        z = (med - t) / sd
+        lines.append(
+            f"    {k:16s} spread of medians / posterior sd {med.std(ddof=1) / sd.mean():5.2f}"
+            f"   z rms {np.sqrt(np.mean(z**2)):5.2f}   mean {z.mean():+5.2f}"
+            f" ± {1 / np.sqrt(len(z)):.2f}   90 %: {np.mean([x['in90'] for x in v]):4.2f}"
+        )
+    return lines
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--reps", type=int, default=50)
@@ -331,7 +388,27 @@ def main() -> None:
         "and used to draw the true Gf; 0: neither, Gf log-uniform on 5-40 W/K as in the "
         f"study before that prior (default {FLOOR:g})",
     )
+    ap.add_argument(
+        "--envelope-area",
+        type=float,
+        default=ENVELOPE,
+        help="exterior area of walls and roof [m²] given to every fit (upper bounds on Gw "
+        f"and Cw); 0: none, as in the studies before those bounds (default {ENVELOPE:g})",
+    )
     ap.add_argument("--table", help="only tabulate a --log file of an earlier study")
+    ap.add_argument(
+        "--room",
+        type=int,
+        help="one replicate's room (truth, weather, start) observed afresh --reps times: "
+        "is this room's posterior calibrated, and which part of the observation model "
+        "(see --without) matters?",
+    )
+    ap.add_argument(
+        "--without",
+        default="",
+        help="with --room: comma-separated parts of the observation model left out: "
+        "model_error, rounding, gap",
+    )
     ap.add_argument(
         "--max-steps",
         type=int,
@@ -354,8 +431,43 @@ def main() -> None:
         name, _, vals = spec.partition("=")
         median, sigma = (float(v) for v in vals.split(","))
         priors[name] = {"dist": "lognormal", "median": median, "sigma": sigma}
+    floor = args.floor_area or None
+    envelope = args.envelope_area or None
+    if args.room is not None:
+        without = tuple(w for w in args.without.split(",") if w)
+        unknown = set(without) - {"model_error", "rounding", "gap"}
+        if unknown:
+            ap.error(f"--without: unknown {sorted(unknown)}; use model_error, rounding, gap")
+        tasks = [
+            (
+                args.models.split(",")[0],
+                args.room,
+                variants,
+                args.seed,
+                args.max_steps,
+                CAL_DAYS,
+                priors,
+                floor,
+                (k, without),
+                envelope,
+            )
+            for k in range(args.first_rep, args.first_rep + args.reps)
+        ]
+        with ProcessPoolExecutor(max(1, args.jobs)) as ex:
+            results = list(ex.map(replicate, tasks))
+        if args.log:
+            with open(args.log, "a") as f:
+                f.writelines(json.dumps(r) + "\n" for r in results)
+        print(
+            f"room {args.room} of {results[0]['model']}, {len(results)} observation draws"
+            f" without {list(without) or 'nothing'}"
+        )
+        for v in variants:
+            for line in repeat_room(results, v):
+                print(line)
+        return
     tasks = [
-        (m, r, variants, args.seed, args.max_steps, CAL_DAYS, priors, args.floor_area or None)
+        (m, r, variants, args.seed, args.max_steps, CAL_DAYS, priors, floor, (None, ()), envelope)
         for r in range(args.first_rep, args.first_rep + args.reps)
         for m in args.models.split(",")
     ]  # models interleaved: a study cut short still covers every model

@@ -292,3 +292,51 @@ def test_floor_area_sets_the_ground_prior_of_thermal_models_only():
     assert ps2.parameters[ps2.names.index("Gf")].prior.mu == pytest.approx(32.0)
     with pytest.raises(ConfigError, match="floor_area"):
         parse_config({**raw, "floor_area": -5})
+
+
+def test_envelope_area_bounds_the_envelope_node_of_thermal_models_only():
+    """envelope_area [m²]: Gw ≤ 25 W/(m²K) × area (the exterior film, EN ISO 6946) and
+    Cw ≤ 7.5 MJ/(m²K) × area (3 m of granite), lower bounds and family the defaults';
+    4a's interior mass and a hygric model's Gw/Cw keep their defaults; the config key
+    reaches the parameters; the sampler's support follows the bound; an area that puts
+    a bound below the default's lower one is a ConfigError naming the key."""
+    import heritage_bayes as hb
+    from heritage_bayes.config import parse_config
+    from heritage_bayes.errors import ConfigError
+    from heritage_bayes.inference.likelihoods import get_noise_model
+    from heritage_bayes.inference.parameters import (
+        C_ENVELOPE_MAX,
+        H_EXTERIOR,
+        default_prior,
+        envelope_priors,
+        parameters_for,
+    )
+    from heritage_bayes.run import section_parameters
+
+    noise = get_noise_model("ar1_white")
+    th = hb.model("thermal_4a", surfaces=("S",))
+    ps = parameters_for(th, noise, envelope_area=259.0)
+    prior = {p.name: p.prior for p in ps.parameters}
+    assert prior["Gw"].upper == pytest.approx(25.0 * 259.0) == H_EXTERIOR * 259.0
+    assert prior["Cw"].upper == pytest.approx(7.5e6 * 259.0) == C_ENVELOPE_MAX * 259.0
+    for name, kind in (("Gw", "conductance"), ("Cw", "capacity")):
+        d = default_prior("thermal", kind)
+        assert (prior[name].dist, prior[name].lower) == (d.dist, d.lower)
+        assert prior[name].upper < d.upper
+    assert prior["Cint"] == default_prior("thermal", "capacity")
+    assert prior["Gi"] == default_prior("thermal", "conductance")
+    # the sampler cannot leave the bounded support
+    lo, hi = ps.bounds
+    j = ps.free_names.index("Gw")
+    assert np.exp(hi[j]) == pytest.approx(H_EXTERIOR * 259.0)
+    hy = hb.model("hygric_2c")
+    hps = parameters_for(hy, noise, envelope_area=259.0)
+    assert hps.parameters[hps.names.index("Gw")].prior == default_prior("hygric", "conductance")
+    with pytest.raises(ConfigError, match="envelope_area"):
+        envelope_priors(1e-4)
+    raw = {"data": {"demo": {"seed": 7}}, "envelope_area": 259, "thermal": {"model": "thermal_2c"}}
+    cfg = parse_config(raw)
+    _, ps2 = section_parameters(cfg, "thermal", hb.model("thermal_2c"), {})
+    assert ps2.parameters[ps2.names.index("Gw")].prior.upper == pytest.approx(6475.0)
+    with pytest.raises(ConfigError, match="envelope_area"):
+        parse_config({**raw, "envelope_area": 0})

@@ -21,6 +21,7 @@ Layout (see ``configs/demo.yaml`` for a complete, commented example)::
     site: {latitude: 52.1, longitude: 5.18, altitude: 2}
     room_volume: 800               # [m³], optional: log-normal prior on each model's Ci
     floor_area: 160                # [m²] on the ground, optional: log-normal prior on Gf
+    envelope_area: 420             # [m²] walls + roof outside, optional: bounds Gw, Cw
     data:
       demo: {seed: 7, gap: [2019-03-10, 2019-03-17]}   # the built-in virtual monument
                                    # (heritage_bayes.demo), or real files:
@@ -582,6 +583,11 @@ class CalibrationConfig(_Strict):
     )
     floor_area: float | None = Field(
         default=None, gt=0, description="[m²] floor on the ground: log-normal prior on thermal Gf"
+    )
+    envelope_area: float | None = Field(
+        default=None,
+        gt=0,
+        description="[m²] exterior area of walls and roof: upper bounds on thermal Gw and Cw",
     )
     data: Data
     periods: Periods = Field(default_factory=Periods)

@@ -62,6 +62,7 @@ def section_parameters(cfg: CalibrationConfig, section: str, model: RCModel, pri
         air_change_rate=cfg.air_change_rate,
         air_change_sigma=cfg.air_change_sigma,
         floor_area=cfg.floor_area,
+        envelope_area=cfg.envelope_area,
         where=f"{section}.priors",
         dt=parse_duration(cfg.data.step).total_seconds(),
     )

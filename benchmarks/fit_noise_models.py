@@ -31,6 +31,7 @@ import pandas as pd
 from _common import config_map
 from heritage_bayes.config import load_config
 from heritage_bayes.inference.results import fit_metrics
+from heritage_bayes.rc.derived import time_constants
 
 
 def _acf(r: np.ndarray, lag: int) -> float:
@@ -52,9 +53,7 @@ def _error_faster_than_model(out: str):
 
     def constrained(self, theta):
         theta = np.atleast_2d(theta)
-        c, G, _, _ = self.model.network_matrices(theta[:, : self.n_model])
-        r = 1.0 / np.sqrt(c)
-        tau1 = 1.0 / np.linalg.eigvalsh(r[:, :, None] * G * r[:, None, :]).min(axis=1)
+        tau1 = time_constants(self.model, theta[:, : self.n_model])[:, 0]  # [s], NaN: invalid
         phi = theta[:, self.params.names.index(f"phi_{out}")]
         return np.where(-self.dt / np.log(phi) <= tau1, plain(self, theta), -np.inf)
 
@@ -114,9 +113,7 @@ def fit(cfg, section: str, model: str, noise: str) -> dict:
         if "Te" in frame
         else {}
     )
-    c, G, _, _ = m.network_matrices(mp.theta[None, : lp.n_model])
-    isq = 1.0 / np.sqrt(c)
-    tau = 1.0 / np.linalg.eigvalsh(isq[:, :, None] * G * isq[:, None, :])[0] / 3600.0
+    tau = time_constants(m, mp.theta[: lp.n_model]) / 3600.0  # slowest first
     for period in ("calibration", "validation"):
         sl = getattr(prep, period)
         if sl is None:
@@ -132,7 +129,7 @@ def fit(cfg, section: str, model: str, noise: str) -> dict:
         "acf": acf,
         "monthly": (float(monthly.min()), float(monthly.max())),
         "sun": sun,
-        "tau_h": np.sort(tau)[::-1],
+        "tau_h": tau,
         "cpu": time.process_time() - t0,
     }
 

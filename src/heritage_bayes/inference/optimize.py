@@ -56,9 +56,6 @@ class MAPResult:
         Polished candidates and how many reached the best value within 1 unit.
     candidates : list of float
         Final objective of each polished start, best first.
-    candidate_x : list of (d,) arrays
-        Where each polished start ended (sampler coordinates), in the same order: the
-        local optima of a multimodal posterior.
     n_evaluations : int
     """
 
@@ -68,7 +65,6 @@ class MAPResult:
     n_starts: int
     n_agreed: int
     candidates: list[float] = field(default_factory=list)
-    candidate_x: list = field(default_factory=list)
     n_evaluations: int = 0
     method: str = ""
 
@@ -210,7 +206,6 @@ def _find_map(
     agreed = sum(1 for f, _ in finals if f - best_f <= 1.0)
     theta, _ = obj.values(best_s[None])
     x = logpost.params.to_unconstrained(theta)[0]
-    ends = logpost.params.to_unconstrained(obj.values(np.array([s for _, s in finals]))[0])
     return MAPResult(
         x=x,
         theta=theta[0],
@@ -218,7 +213,6 @@ def _find_map(
         n_starts=len(finals),
         n_agreed=agreed,
         candidates=[-f for f, _ in finals],
-        candidate_x=list(ends),
         n_evaluations=obj.n,
         method=method,
     )

@@ -210,6 +210,9 @@ _CSV_ONLY = (
     "label",
     "duplicates",
     "na_values",
+    "skiprows",
+    "encoding",
+    "units",
 )
 
 
@@ -241,6 +244,17 @@ class Source(_Strict):
     na_values: list[str | float] | None = None
     invalid: Literal["raise", "nan"] = "raise"
     year: int | None = None
+    skiprows: int | list[int] = Field(
+        default=0,
+        description="lines before the header, or the 0-based numbers of the lines to skip "
+        "(logger metadata lines)",
+    )
+    encoding: str = Field(default="utf-8", description="text encoding, e.g. utf-8-sig, cp1252")
+    units: dict[str, str] | None = Field(
+        default=None,
+        description="{standard name: unit in the file} for temperatures in °F or K and "
+        "relative humidity as a fraction (converted on reading)",
+    )
 
     @model_validator(mode="after")
     def _options_fit_format(self):

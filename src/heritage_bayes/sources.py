@@ -36,7 +36,9 @@ def _csv_header(path: Path, src, where: str) -> list[str]:
 
     try:
         sniff_text(path, path.name)  # binary, damaged or truncated: say so at once
-        header = pd.read_csv(path, nrows=0, sep=src.sep, encoding="utf-8")
+        header = pd.read_csv(
+            path, nrows=0, sep=src.sep, encoding=src.encoding, skiprows=src.skiprows
+        )
     except DataError as exc:
         raise DataError(f"{where}: {exc}") from None
     except READ_ERRORS as exc:
@@ -89,6 +91,8 @@ def _csv_kwargs(src) -> dict:
         "label": src.label,
         "duplicates": src.duplicates,
         "invalid": src.invalid,
+        "skiprows": src.skiprows,
+        "encoding": src.encoding,
     }
     if src.na_values is not None:
         kw["na_values"] = src.na_values
@@ -114,7 +118,7 @@ def read_source(cfg, src, where: str, allowed: Sequence[str]) -> pd.DataFrame:
     try:
         if src.format == "csv":
             _check_csv_columns(path, src, where, allowed)
-            df = read_csv(path, columns=src.columns, **_csv_kwargs(src))
+            df = read_csv(path, columns=src.columns, units=src.units, **_csv_kwargs(src))
         elif src.format == "epw":
             df = read_epw(path, year=src.year, invalid=src.invalid)
         elif src.format == "tmy3":

@@ -777,6 +777,9 @@ def parse_config(
         raise ConfigError(
             f"{source}: expected a YAML mapping at the top level (got {type(raw).__name__})"
         )
+    from heritage_bayes.questions import check_answered
+
+    check_answered(raw, source)  # `hbayes init`'s '??' values: named before the schema
     try:
         cfg = CalibrationConfig.model_validate(raw)
     except ValidationError as exc:

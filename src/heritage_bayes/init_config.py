@@ -1,0 +1,609 @@
+"""``hbayes init``: a commented configuration from a logger file and a weather file.
+
+:func:`init_config` inspects the files with :mod:`heritage_bayes.io` (the export's layout
+with :func:`~heritage_bayes.io.loggers.inspect_table`, the clocks with
+:mod:`heritage_bayes.io.clock`), decides what it can — time column and format, the clock
+of each file checked against the sun and the outdoor daily cycle, the columns of
+temperature, relative humidity and irradiance and their units, the step, the gaps, the
+longest stretch of overlapping data for the calibration and validation periods, the
+models to start with — and writes a ``config.yaml`` whose comments say what was guessed
+and why. What it cannot decide becomes a marked question (a value starting with ``??``,
+see :mod:`heritage_bayes.questions`) that ``hbayes calibrate`` refuses until answered.
+The written file is validated by the same schema as any config
+(:func:`heritage_bayes.config.parse_config`).
+
+Example
+-------
+::
+
+    hbayes init logger.csv --weather fmi.csv --latitude 60.21 --longitude 24.66 \\
+        --name attic -o attic/config.yaml
+    hbayes calibrate attic/config.yaml
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import yaml
+
+from heritage_bayes.errors import DataError, InputError
+from heritage_bayes.io import clock as _clock
+from heritage_bayes.io.loggers import TableLayout, inspect_table
+from heritage_bayes.questions import MARK
+
+__all__ = ["InitResult", "init_config"]
+
+#: Weather formats ``init`` reads besides CSV (by the readers of :mod:`heritage_bayes.io`).
+WEATHER_FORMATS = ("csv", "epw", "knmi", "tmy3")
+#: Longest gap [h] bridged inside a period (the config's ``data.max_gap``).
+MAX_GAP_H = 6
+#: A stretch this long [days] or longer is split 8 months / 4 months (a year); shorter
+#: ones 2/3 / 1/3.
+YEAR_DAYS = 365
+
+
+@dataclass
+class InitResult:
+    """What :func:`init_config` wrote and found.
+
+    ``text``: the YAML written; ``findings``: what was guessed and why (one line each);
+    ``questions``: what is left open (key path: question).
+    """
+
+    path: Path
+    text: str
+    findings: list[str] = field(default_factory=list)
+    questions: list[str] = field(default_factory=list)
+
+
+def _q(text: str) -> str:
+    return f"{MARK} {text}"
+
+
+def _yaml_value(v) -> str:
+    text = yaml.safe_dump(v, default_flow_style=True, allow_unicode=True, width=10_000).strip()
+    return text[:-4].strip() if text.endswith("\n...") else text.removesuffix("...").strip()
+
+
+def _weather_format(path: Path, given: str | None) -> str:
+    if given is not None:
+        if given not in WEATHER_FORMATS:
+            raise InputError(
+                f"--weather-format: one of {', '.join(WEATHER_FORMATS)} (got {given!r})"
+            )
+        return given
+    name = path.name.lower()
+    if name.endswith(".epw"):
+        return "epw"
+    if name.startswith("uurgeg") or name.endswith(".txt.gz"):
+        return "knmi"
+    head = path.read_bytes()[:2000].decode("latin-1")
+    if head.startswith("# STN") or "YYYYMMDD" in head[:2000]:
+        return "knmi"
+    return "csv"
+
+
+def _read_naive(layout: TableLayout, columns: dict[str, str], units: dict) -> pd.DataFrame:
+    """The table on the file's own clock (read as if UTC), for inspection only."""
+    from heritage_bayes.io import read_csv
+
+    return read_csv(
+        layout.path,
+        time_column=layout.time_column,
+        columns=columns,
+        time_format=None if layout.time_format == "ISO8601" else layout.time_format,
+        timezone=None if layout.time_format == "ISO8601" else "UTC",
+        sep=layout.sep,
+        decimal=layout.decimal,
+        skiprows=layout.skiprows,
+        encoding=layout.encoding,
+        units=units or None,
+        averaged=(),
+        duplicates="first",
+        sort=True,
+        invalid="nan",
+    )
+
+
+def _pick(layout: TableLayout, kinds: dict[str, str], findings: list[str], what: str):
+    """``{standard: column}`` and ``{standard: unit}`` from the layout's guesses."""
+    columns, units = {}, {}
+    for std, kind in kinds.items():
+        found = layout.all(kind)
+        if not found:
+            continue
+        c = found[0]
+        columns[std] = c.name
+        if c.unit in ("°F", "K", "fraction"):
+            units[std] = c.unit
+        also = (
+            f" (also {', '.join(repr(x.name) for x in found[1:])}: not used)" if found[1:] else ""
+        )
+        findings.append(f"{what}: {std} = column {c.name!r}: {c.why}{also}")
+    return columns, units
+
+
+def _fmt_h(h: float) -> str:
+    sign = "+" if h >= 0 else "-"
+    m = round(abs(h) * 60)
+    return f"UTC{sign}{m // 60}" + (f":{m % 60:02d}" if m % 60 else "")
+
+
+def _declared_offsets(zone: str, index: pd.DatetimeIndex) -> tuple[float, float | None]:
+    """(winter offset, summer offset or None) [h] of a declared zone over ``index``."""
+    from heritage_bayes.io import parse_timezone
+
+    tz = parse_timezone(zone)
+    off = [
+        pd.Timestamp(year=int(index[0].year), month=m, day=15, tz="UTC")
+        .tz_convert(tz)
+        .utcoffset()
+        .total_seconds()
+        / 3600
+        for m in (1, 7)
+    ]
+    return off[0], (off[1] if off[1] != off[0] else None)
+
+
+def _weather_clock(df, lon, declared, findings, where):
+    """The weather file's clock: (timezone, irradiance label, question or None)."""
+    irr = next((c for c in ("ghi", "dhi") if c in df.columns), None)
+    if lon is None:
+        if declared:
+            findings.append(f"{where}: clock {declared} (from the file); not checked (no site)")
+            return declared, "end", None
+        return (
+            None,
+            "end",
+            "the weather file's clock (e.g. UTC, UTC+2); give --longitude to measure it",
+        )
+    if irr is not None:
+        est = {
+            lab: _clock.solar_clock_offset(df.index, df[irr], lon, label=lab)
+            for lab in ("end", "instant", "start")
+        }
+        if est["end"].offset_h is None:
+            irr = None
+    if irr is None:
+        e = _clock.outdoor_cycle_offset(df.index, df["Te"], lon)
+        findings.append(f"{where}: clock measured from the outdoor daily cycle ({e.describe()})")
+        if e.offset_h is None:
+            return declared, "end", None if declared else "the weather file's clock"
+        if declared:
+            w, s = _declared_offsets(declared, df.index)
+            if abs(e.offset_h - w) <= 1.5:
+                return declared, "end", None
+            return (
+                declared,
+                "end",
+                (
+                    f"declared {declared} but the outdoor daily cycle says {_fmt_h(e.offset_h)} "
+                    f"({e.describe()}); which clock does the file keep?"
+                ),
+            )
+        return (
+            None,
+            "end",
+            f"the weather file's clock: the daily cycle says about {_fmt_h(e.offset_h)}",
+        )
+    for lab, e in est.items():
+        findings.append(f"{where}: the sun in {irr} read as '{lab}' values: {e.describe()}")
+    if declared:
+        w, s = _declared_offsets(declared, df.index)
+        e = est["end"]
+        if s is not None and e.follows_dst is False:
+            return (
+                declared,
+                "end",
+                (
+                    f"declared {declared} (UTC{w:+g}, UTC{s:+g} in summer) but the file keeps a "
+                    f"fixed clock: the sun gives {e.describe()}; use a fixed offset such as "
+                    f"{_fmt_h(round(est['instant'].offset_h))}"
+                ),
+            )
+        for lab in ("end", "instant", "start"):
+            if abs(est[lab].offset_h - w) < 0.34:
+                findings.append(
+                    f"{where}: clock {declared} confirmed by the sun, irradiance as "
+                    + {
+                        "end": "means of the interval ending at the stamp",
+                        "instant": "values at the stamp (or centred means)",
+                        "start": "means of the interval starting at the stamp",
+                    }[lab]
+                )
+                return declared, lab, None
+        return (
+            declared,
+            "end",
+            (
+                f"declared {declared} but the sun says {_fmt_h(est['end'].offset_h)} (irradiance "
+                f"as means ending at the stamp; {_fmt_h(est['instant'].offset_h)} as values at "
+                f"the stamp): {est['end'].describe()}; which clock does the file keep?"
+            ),
+        )
+    if est["end"].follows_dst:
+        return (
+            None,
+            "end",
+            (
+                f"the weather file keeps a daylight-saving clock ({est['end'].describe()}): "
+                "name its zone, e.g. Europe/Helsinki"
+            ),
+        )
+    lab = min(
+        est, key=lambda k: abs(est[k].offset_h - round(est[k].offset_h)) + 0.01 * (k != "end")
+    )
+    zone = _fmt_h(round(est[lab].offset_h))
+    findings.append(f"{where}: no clock named in the file; the sun says {zone} ('{lab}' values)")
+    return zone, lab, None
+
+
+def _stretch(ti: pd.Series, te: pd.Series) -> tuple[pd.Timestamp, pd.Timestamp, list[str]]:
+    """Longest run of hours with both Ti and Te, gaps up to MAX_GAP_H bridged [UTC]."""
+    a = ti.dropna().index.floor("h").unique()
+    b = te.dropna().index.floor("h").unique()
+    both = a.intersection(b).sort_values()
+    if len(both) < 48:
+        raise DataError(
+            f"the logger and weather files overlap in {len(both)} hour(s) only "
+            f"(logger {ti.index[0]} to {ti.index[-1]}, weather {te.index[0]} to {te.index[-1]})"
+        )
+    gap_h = np.diff(both) / pd.Timedelta(hours=1)
+    gaps = np.flatnonzero(gap_h > MAX_GAP_H)
+    starts = np.r_[0, gaps + 1]
+    ends = np.r_[gaps, len(both) - 1]
+    k = int(np.argmax(both[ends] - both[starts]))
+    notes = [f"gap of {gap_h[g]:.0f} h from {both[g]:%Y-%m-%d %H:%M} UTC" for g in gaps[:5]] + (
+        [f"... {len(gaps) - 5} more"] if len(gaps) > 5 else []
+    )
+    return both[starts[k]], both[ends[k]] + pd.Timedelta(hours=1), notes
+
+
+def _periods(s: pd.Timestamp, e: pd.Timestamp) -> tuple[str, str, str, str, str]:
+    """Calibration [s, m) and validation [m, end) in whole days (UTC), and why."""
+    day = pd.Timedelta(days=1)
+    s0 = s.ceil("D")
+    if s0.day != 1 and (e - s0).days >= YEAR_DAYS + 31:
+        s0 = (s0 + pd.offsets.MonthBegin(1)).normalize()
+    e0 = e.floor("D")
+    if (e0 - s0).days >= YEAR_DAYS:
+        end = s0 + pd.DateOffset(months=12)
+        mid = s0 + pd.DateOffset(months=8)
+        why = "the first whole year of the longest stretch: 8 months to calibrate, 4 to validate"
+    else:
+        end = e0
+        mid = s0 + day * round((e0 - s0).days * 2 / 3)
+        why = "the longest stretch: its first 2/3 to calibrate, the rest to validate"
+    f = "%Y-%m-%d"
+    return s0.strftime(f), mid.strftime(f), mid.strftime(f), end.strftime(f), why
+
+
+def _logger_clock(layout, df_naive, declared, lon, findings, where):
+    """Check a logger's declared clock: DST structure and the daily peak vs the sun."""
+    question = None
+    if declared is None:
+        return _q(
+            "the logger's clock: UTC, a fixed offset such as UTC+1, or a zone with "
+            "daylight-saving time such as Europe/Amsterdam (see its settings or the "
+            "software it was read out with)"
+        )
+    from heritage_bayes.io import parse_timezone
+
+    tz = parse_timezone(declared)
+    if not isinstance(tz, _dt.timezone):  # a DST zone: does the file follow its changes?
+        times = _raw_times(layout)
+        st = _clock.dst_structure(times, declared)
+        findings.append(f"{where}: {st.describe()}")
+        if st.verdict == "fixed":
+            w, _ = _declared_offsets(declared, df_naive.index)
+            question = _q(
+                f"declared {declared}, but the file keeps a fixed clock ({st.describe()}); "
+                f"the winter offset would be UTC{w:+g}"
+            )
+    if lon is not None and "Ti" in df_naive:
+        from heritage_bayes.io._common import localize
+
+        utc = localize(df_naive.index.tz_localize(None), tz).utc
+        peak = _clock.daily_cycle_phase(utc, df_naive["Ti"].to_numpy()[: len(utc)], min_range=1.0)
+        lag = _clock._wrap(peak - _clock.solar_noon_utc(pd.DatetimeIndex(peak.index), lon))
+        if np.isfinite(lag).sum() >= 5:
+            med = float(np.nanmedian(lag))
+            findings.append(
+                f"{where}: the indoor temperature peaks {med:+.1f} h after solar noon on the "
+                f"declared clock (median of {int(np.isfinite(lag).sum())} days)"
+            )
+            if med < -0.5 and question is None:
+                question = _q(
+                    f"declared {declared}, but the indoor temperature peaks {-med:.1f} h "
+                    "before solar noon on that clock: no room warms before the sun and the "
+                    "outdoor air do; is the logger's clock ahead of the declared one?"
+                )
+    return question or declared
+
+
+def _raw_times(layout: TableLayout) -> pd.DatetimeIndex:
+    """The stamps as written, in file order (for the DST structure)."""
+    names = [layout.time_column] if isinstance(layout.time_column, str) else layout.time_column
+    raw = pd.read_csv(
+        layout.path,
+        sep=layout.sep,
+        skiprows=layout.skiprows,
+        encoding=layout.encoding,
+        dtype=str,
+        usecols=lambda c: str(c).strip() in names,
+    )
+    raw.columns = [str(c).strip() for c in raw.columns]
+    text = raw[names[0]].str.strip()
+    for n in names[1:]:
+        text = text + " " + raw[n].str.strip()
+    fmt = None if layout.time_format == "ISO8601" else layout.time_format
+    return pd.DatetimeIndex(pd.to_datetime(text, format=fmt, errors="coerce").dropna())
+
+
+def _source_lines(
+    key: str, layout: TableLayout, rel: str, zone, columns, units, label
+) -> list[str]:
+    out = [f"  {key}:", "    format: csv", f"    path: {_yaml_value(rel)}"]
+    tc = layout.time_column
+    out.append(f"    time_column: {_yaml_value(tc)}")
+    if layout.time_format != "ISO8601":
+        out.append(f"    time_format: {_yaml_value(layout.time_format)}")
+        out.append(f"    timezone: {_yaml_value(zone)}")
+    if layout.sep != ",":
+        out.append(f"    sep: {_yaml_value(layout.sep)}")
+    if layout.decimal != ".":
+        out.append(f"    decimal: {_yaml_value(layout.decimal)}")
+    if layout.skiprows:
+        out.append(f"    skiprows: {_yaml_value(layout.skiprows)}   # {layout.layout} layout")
+    if layout.encoding != "utf-8":
+        out.append(f"    encoding: {layout.encoding}")
+    out.append(f"    columns: {_yaml_value(columns)}")
+    if units:
+        out.append(f"    units: {_yaml_value(units)}   # converted on reading")
+    if label == "instant":
+        out.append("    averaged: []   # irradiance values at the stamp (see the clock check)")
+    elif label == "start":
+        out.append("    label: start   # irradiance means of the hour starting at the stamp")
+    return out
+
+
+def init_config(
+    indoor,
+    weather,
+    *,
+    output,
+    weather_format: str | None = None,
+    latitude: float | None = None,
+    longitude: float | None = None,
+    name: str | None = None,
+    timezone: str | None = None,
+    weather_timezone: str | None = None,
+    force: bool = False,
+) -> InitResult:
+    """Inspect a logger file and a weather file; write a commented configuration.
+
+    Parameters
+    ----------
+    indoor : path-like
+        The logger export (indoor T and RH): generic CSV/TSV (any header, decimal comma)
+        or a HOBO, Hanwell, Meaco, Tinytag or Rotronic export
+        (:mod:`heritage_bayes.io.loggers`).
+    weather : path-like
+        The weather file: CSV (outdoor T, RH, measured irradiance when available), EPW,
+        KNMI hourly or TMY3.
+    output : path-like
+        The configuration to write; paths in it are relative to its folder.
+    weather_format : {"csv", "epw", "knmi", "tmy3"}, optional
+        Default: from the file name and first line.
+    latitude, longitude : float, optional
+        The site [° north, ° east]; needed for the sun (irradiance on the facades) and
+        to measure the files' clocks. EPW and TMY3 files carry their own.
+    name : str, optional
+        Run name (default: the output file's stem, or its folder's name for
+        ``config.yaml``).
+    timezone, weather_timezone : str, optional
+        The clocks of the logger and weather files when their headers do not name them
+        (``UTC+1``, ``Europe/Amsterdam``): checked against the data either way.
+    force : bool
+        Replace an existing ``output``.
+
+    Returns
+    -------
+    InitResult
+
+    Raises
+    ------
+    heritage_bayes.errors.InputError
+        ``output`` exists (without ``force``), a file cannot be read as a table, no
+        indoor temperature column, no overlap of the two files.
+    """
+    from heritage_bayes.inference.results import atomic_write_text
+
+    output = Path(output)
+    if output.exists() and not force:
+        raise InputError(f"{output}: exists; pass --force to replace it")
+    if output.is_dir():
+        raise InputError(f"{output}: is a folder; give the configuration file's name")
+    indoor, weather = Path(indoor), Path(weather)
+    findings: list[str] = []
+    questions: list[str] = []
+    base = output.resolve().parent
+
+    def rel(p: Path) -> str:
+        return Path(os.path.relpath(p.resolve(), base)).as_posix()
+
+    # -- the logger --------------------------------------------------------------------------
+    lay = inspect_table(indoor, what="logger file")
+    findings.append(
+        f"logger: {lay.layout} layout, separator {lay.sep!r}, decimal {lay.decimal!r}, time "
+        f"column {lay.time_column!r} as {lay.time_format!r}"
+        + (f", clock {lay.timezone} (named in the header)" if lay.timezone else "")
+    )
+    findings += [f"logger: {n}" for n in lay.notes]
+    icols, iunits = _pick(lay, {"Ti": "T", "RHi": "RH"}, findings, "logger")
+    if "Ti" not in icols:
+        raise DataError(
+            f"{indoor.name}: no indoor temperature column found; columns: "
+            + "; ".join(f"{c.name!r} ({c.why})" for c in lay.columns)
+        )
+    din = _read_naive(lay, icols, iunits)
+    step = _clock_step(din.index)
+    findings.append(
+        f"logger: {len(din)} rows, step {step}, {din.index[0]:%Y-%m-%d} to {din.index[-1]:%Y-%m-%d} (file clock)"
+    )
+
+    # -- the weather -------------------------------------------------------------------------
+    wfmt = _weather_format(weather, weather_format)
+    site_lines: list[str]
+    lat, lon = latitude, longitude
+    wlay = None
+    wlabel = "end"
+    wzone = weather_timezone
+    if wfmt == "csv":
+        wlay = inspect_table(weather, what="weather file")
+        findings.append(
+            f"weather: {wlay.layout} layout, time column {wlay.time_column!r} as "
+            f"{wlay.time_format!r}"
+            + (f", clock {wlay.timezone} (named in the header)" if wlay.timezone else "")
+        )
+        wcols, wunits = _pick(
+            wlay,
+            {"Te": "T", "RHe": "RH", "ghi": "ghi", "dhi": "dhi", "dni": "dni"},
+            findings,
+            "weather",
+        )
+        if "Te" not in wcols:
+            raise DataError(
+                f"{weather.name}: no outdoor temperature column found (columns {wlay.header})"
+            )
+        dw = _read_naive(wlay, wcols, wunits)
+        declared = weather_timezone or wlay.timezone
+        wzone, wlabel, wq = _weather_clock(dw, lon, declared, findings, "weather")
+        if wq:
+            wzone = _q(wq)
+            questions.append(f"data.weather.timezone: {wq}")
+        te_utc = _to_utc(dw["Te"], wzone)
+        irr = "measured" if {"ghi"} <= set(wcols) or {"ghi", "dhi"} & set(wcols) else None
+    else:
+        from heritage_bayes.io import read_epw, read_knmi_hourly, read_tmy3
+
+        reader = {"epw": read_epw, "knmi": read_knmi_hourly, "tmy3": read_tmy3}[wfmt]
+        dw = reader(weather)
+        te_utc = dw["Te"]
+        site = dw.attrs.get("site") or {}
+        lat = lat if lat is not None else site.get("latitude")
+        lon = lon if lon is not None else site.get("longitude")
+        irr = "measured" if {"ghi", "dhi", "dni"} & set(dw.columns) else None
+        findings.append(f"weather: {wfmt} file, {len(dw)} rows, columns {list(dw.columns)}")
+        if lon is not None and "ghi" in dw:
+            findings.append(
+                f"weather: clock check (the reader's UTC): {_clock.solar_clock_offset(dw.index, dw['ghi'], lon).describe()}"
+            )
+
+    # -- the logger's clock (after the weather's) -----------------------------------------------
+    izone = _logger_clock(lay, din, timezone or lay.timezone, lon, findings, "logger")
+    if izone.startswith(MARK):
+        questions.append(f"data.measurements.timezone: {izone[len(MARK) :].strip()}")
+    ti_utc = _to_utc(din["Ti"], izone)
+
+    # -- site, periods, models ------------------------------------------------------------------
+    if lat is None or lon is None:
+        site_value = _q(
+            "the site: {latitude: DEG north, longitude: DEG east}; give --latitude, --longitude"
+        )
+        questions.append("site: the site's latitude and longitude (the sun on the facades)")
+    else:
+        site_value = {
+            "latitude": round(float(lat), 4),
+            "longitude": round(float(lon), 4),
+            "altitude": 0,
+        }
+    s, e, gap_notes = _stretch(ti_utc, te_utc)
+    findings.append(
+        f"overlap: longest stretch without a gap over {MAX_GAP_H} h: {s:%Y-%m-%d %H:%M} to {e:%Y-%m-%d %H:%M} UTC"
+    )
+    findings += [f"overlap: {g}" for g in gap_notes]
+    cs, ce, vs, ve, why = _periods(s, e)
+    findings.append(f"periods: {why}")
+    hygric = "RHi" in icols and ("RHe" in dw.columns)
+    name = name or (output.parent.name if output.stem == "config" else output.stem) or "room"
+
+    lines = [
+        f"# Written by `hbayes init` on {_dt.date.today():%Y-%m-%d} from",
+        f"#   logger:  {rel(indoor)}",
+        f"#   weather: {rel(weather)}",
+        "# What init found, and why (check each):",
+        *[f"#   - {f}" for f in findings],
+        "# Values starting with '??' are open questions: `hbayes calibrate` refuses this file",
+        "# until each is answered. Dates are UTC; paths are relative to this file.",
+        "",
+        f"name: {_yaml_value(name)}",
+        'building: ""',
+        'room: ""',
+        "seed: 1",
+        "",
+        f"site: {_yaml_value(site_value)}",
+        "",
+        "data:",
+    ]
+    if wlay is not None:
+        lines += _source_lines("weather", wlay, rel(weather), wzone, wcols, wunits, wlabel)
+    else:
+        lines += ["  weather:", f"    format: {wfmt}", f"    path: {_yaml_value(rel(weather))}"]
+    lines += _source_lines("measurements", lay, rel(indoor), izone, icols, iunits, "end")
+    if irr == "measured":
+        lines += [
+            "  irradiance: measured",
+            "  # The sun on the four vertical facades (tilt, azimuth from north) [°]; for a",
+            "  # roof or a building turned off north, edit (e.g. roof_E: [30, 90]).",
+        ]
+    elif lat is not None:
+        lines += ["  irradiance: clear_sky   # no measured irradiance: a clear-sky proxy (pvlib)"]
+    else:
+        lines += ["  irradiance: none"]
+    lines += ["  step: 1h", f"  max_gap: {MAX_GAP_H}h", "", "periods:", f"  # {why}"]
+    lines += [
+        f"  calibration: {{start: {cs}, end: {ce}}}",
+        f"  validation: {{start: {vs}, end: {ve}}}",
+        "",
+        "# The smallest model of each ladder; the report's ladder fits the larger ones",
+        "# (thermal_2c, thermal_4a; hygric_2c, hygric_2c_fixed) and shows whether they pay.",
+        "thermal:",
+        "  model: thermal_1c",
+    ]
+    if hygric:
+        lines += ["", "hygric:", "  model: hygric_1c"]
+    lines += ["", "sampler:", "  max_time: 30min   # wall-time budget per model", ""]
+    text = "\n".join(lines)
+    if not questions:  # the same schema as every config: it must load
+        from heritage_bayes.config import parse_config
+
+        parse_config(yaml.safe_load(text), source=str(output), base_dir=str(base), name=name)
+    output.parent.mkdir(parents=True, exist_ok=True)
+    atomic_write_text(output, text)
+    return InitResult(output, text, findings, questions)
+
+
+def _clock_step(index: pd.DatetimeIndex) -> str:
+    from heritage_bayes.io._common import format_timedelta, modal_step
+
+    st = modal_step(index)
+    return format_timedelta(st) if st is not None else "?"
+
+
+def _to_utc(series: pd.Series, zone: str | None) -> pd.Series:
+    """A series read on its file's clock (stamps as if UTC) moved to UTC by ``zone``
+    (unchanged when the zone is an open question)."""
+    from heritage_bayes.io import parse_timezone
+    from heritage_bayes.io._common import localize
+
+    if zone is None or str(zone).startswith(MARK):
+        return series
+    loc = localize(series.index.tz_localize(None), parse_timezone(zone))
+    return pd.Series(series.to_numpy()[loc.keep], index=loc.utc)

@@ -367,6 +367,10 @@ def _calibrate_into(
     t0 = time.perf_counter()
     prep = prepare(cfg)
     t_prep = time.perf_counter() - t0
+    from heritage_bayes.prepare import clock_warnings
+
+    for w in clock_warnings(prep):  # a declared timezone the data contradict
+        say.warn(w)
     say.say(
         f"data: {prep.n_rows} steps of {prep.dt / 3600:g} h from "
         f"{prep.frame.index[0]} to {prep.frame.index[-1]} "

@@ -144,9 +144,7 @@ def _build_parser() -> argparse.ArgumentParser:
         metavar="TZ",
         help="the logger's clock when its header does not name it (UTC+1, Europe/Paris)",
     )
-    ini.add_argument(
-        "--weather-timezone", metavar="TZ", help="the weather file's clock, likewise"
-    )
+    ini.add_argument("--weather-timezone", metavar="TZ", help="the weather file's clock, likewise")
     ini.add_argument(
         "-o", "--output", metavar="PATH", default="config.yaml", help="default: config.yaml"
     )

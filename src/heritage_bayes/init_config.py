@@ -269,13 +269,20 @@ def _periods(s: pd.Timestamp, e: pd.Timestamp) -> tuple[str, str, str, str, str]
     """Calibration [s, m) and validation [m, end) in whole days (UTC), and why."""
     day = pd.Timedelta(days=1)
     s0 = s.ceil("D")
+    e0 = e.floor("D")
+    jan = pd.Timestamp(year=s0.year + int((s0.month, s0.day) > (1, 1)), month=1, day=1, tz=s0.tz)
     if s0.day != 1 and (e - s0).days >= YEAR_DAYS + 31:
         s0 = (s0 + pd.offsets.MonthBegin(1)).normalize()
-    e0 = e.floor("D")
+    if e0 >= jan + pd.DateOffset(years=1):  # a whole calendar year: the reporting year
+        s0 = jan
     if (e0 - s0).days >= YEAR_DAYS:
         end = s0 + pd.DateOffset(months=12)
         mid = s0 + pd.DateOffset(months=8)
-        why = "the first whole year of the longest stretch: 8 months to calibrate, 4 to validate"
+        what = "calendar year" if (s0.month, s0.day) == (1, 1) else "year"
+        why = (
+            f"the first whole {what} of the longest stretch (all seasons): 8 months to "
+            "calibrate, 4 to validate"
+        )
     else:
         end = e0
         mid = s0 + day * round((e0 - s0).days * 2 / 3)
@@ -423,14 +430,15 @@ def init_config(
         ``output`` exists (without ``force``), a file cannot be read as a table, no
         indoor temperature column, no overlap of the two files.
     """
-    from heritage_bayes.inference.results import atomic_write_text
+    from heritage_bayes.rundir.policy import resolve_output, write_new_file
 
-    output = Path(output)
-    if output.exists() and not force:
-        raise InputError(f"{output}: exists; pass --force to replace it")
-    if output.is_dir():
-        raise InputError(f"{output}: is a folder; give the configuration file's name")
     indoor, weather = Path(indoor), Path(weather)
+    for p, opt in ((indoor, "INDOOR_FILE"), (weather, "--weather")):
+        if not p.is_file():
+            raise DataError(f"{opt}: {p}: " + ("is a folder" if p.is_dir() else "file not found"))
+    output = resolve_output(output, what="--output", kind="file", protect=(indoor, weather))
+    if output.exists() and not force:  # before the inspection: fail at once
+        raise InputError(f"--output: {output} exists; choose another name or add --force")
     findings: list[str] = []
     questions: list[str] = []
     base = output.resolve().parent
@@ -455,12 +463,12 @@ def init_config(
     din = _read_naive(lay, icols, iunits)
     step = _clock_step(din.index)
     findings.append(
-        f"logger: {len(din)} rows, step {step}, {din.index[0]:%Y-%m-%d} to {din.index[-1]:%Y-%m-%d} (file clock)"
+        f"logger: {len(din)} rows, step {step}, {din.index[0]:%Y-%m-%d} to "
+        f"{din.index[-1]:%Y-%m-%d} (file clock)"
     )
 
     # -- the weather -------------------------------------------------------------------------
     wfmt = _weather_format(weather, weather_format)
-    site_lines: list[str]
     lat, lon = latitude, longitude
     wlay = None
     wlabel = "end"
@@ -502,9 +510,8 @@ def init_config(
         irr = "measured" if {"ghi", "dhi", "dni"} & set(dw.columns) else None
         findings.append(f"weather: {wfmt} file, {len(dw)} rows, columns {list(dw.columns)}")
         if lon is not None and "ghi" in dw:
-            findings.append(
-                f"weather: clock check (the reader's UTC): {_clock.solar_clock_offset(dw.index, dw['ghi'], lon).describe()}"
-            )
+            est = _clock.solar_clock_offset(dw.index, dw["ghi"], lon)
+            findings.append(f"weather: clock check (the reader's UTC): {est.describe()}")
 
     # -- the logger's clock (after the weather's) -----------------------------------------------
     izone = _logger_clock(lay, din, timezone or lay.timezone, lon, findings, "logger")
@@ -526,7 +533,8 @@ def init_config(
         }
     s, e, gap_notes = _stretch(ti_utc, te_utc)
     findings.append(
-        f"overlap: longest stretch without a gap over {MAX_GAP_H} h: {s:%Y-%m-%d %H:%M} to {e:%Y-%m-%d %H:%M} UTC"
+        f"overlap: longest stretch without a gap over {MAX_GAP_H} h: "
+        f"{s:%Y-%m-%d %H:%M} to {e:%Y-%m-%d %H:%M} UTC"
     )
     findings += [f"overlap: {g}" for g in gap_notes]
     cs, ce, vs, ve, why = _periods(s, e)
@@ -560,11 +568,18 @@ def init_config(
     if irr == "measured":
         lines += [
             "  irradiance: measured",
-            "  # The sun on the four vertical facades (tilt, azimuth from north) [°]; for a",
-            "  # roof or a building turned off north, edit (e.g. roof_E: [30, 90]).",
+            "  # One solar aperture on the horizontal (tilt, azimuth from north) [°]: the",
+            "  # sun on the building as a whole, which the data can pin. Name the facades",
+            "  # or roof planes that matter when you know them (e.g. S: [90, 180], roof_E:",
+            "  # [30, 90]); each adds an aperture to estimate. (Measured on the TRH-1 attic,",
+            "  # MAP validation FIT of Ti: 78.0 % with H, 76.7 % with the four facades.)",
+            "  surfaces: {H: [0, 0]}",
         ]
     elif lat is not None:
-        lines += ["  irradiance: clear_sky   # no measured irradiance: a clear-sky proxy (pvlib)"]
+        lines += [
+            "  irradiance: clear_sky   # no measured irradiance: a clear-sky proxy (pvlib)",
+            "  surfaces: {H: [0, 0]}   # one aperture on the horizontal (see above)",
+        ]
     else:
         lines += ["  irradiance: none"]
     lines += ["  step: 1h", f"  max_gap: {MAX_GAP_H}h", "", "periods:", f"  # {why}"]
@@ -585,8 +600,7 @@ def init_config(
         from heritage_bayes.config import parse_config
 
         parse_config(yaml.safe_load(text), source=str(output), base_dir=str(base), name=name)
-    output.parent.mkdir(parents=True, exist_ok=True)
-    atomic_write_text(output, text)
+    write_new_file(output, text, force=force, what="--output")
     return InitResult(output, text, findings, questions)
 
 

@@ -68,7 +68,7 @@ def solar_noon_utc(dates: pd.DatetimeIndex, longitude: float) -> np.ndarray:
     """
     from pvlib.solarposition import equation_of_time_spencer71
 
-    eot = np.asarray(equation_of_time_spencer71(np.asarray(dates.dayofyear)), dtype=float)
+    eot = np.asarray(equation_of_time_spencer71(np.asarray(dates.day_of_year)), dtype=float)
     return 12.0 - longitude / 15.0 - eot / 60.0
 
 
@@ -372,3 +372,105 @@ def _transitions(tz, year: int) -> list[tuple[pd.Timestamp, pd.Timedelta]]:
             prev = off
         t = nxt
     return found
+
+
+#: A residual clock error below this [h] is not reported: hourly irradiance means leave
+#: the stamp's place in the hour (start, middle, end) uncertain by half a step.
+TOLERANCE_H = 0.75
+
+
+def check_declared_clock(df: pd.DataFrame, longitude: float | None, where: str) -> dict:
+    """Check the clock a table was read with (its UTC index) against its own data.
+
+    Parameters
+    ----------
+    df : pandas.DataFrame
+        A reader's output: UTC index, standard columns, ``attrs`` (``timezone``,
+        ``averaged``, ``interval``, ``dropped``).
+    longitude : float or None
+        Site longitude [° east] (None: only the DST evidence of the reader is used).
+    where : str
+        The config key of the table, for the messages (``data.weather``).
+
+    Returns
+    -------
+    dict
+        ``{"sun": ClockEstimate.to_dict() or None, "warnings": [str, ...]}``. A warning
+        states the measured offset: the residual between the declared clock and the
+        sun beyond :data:`TOLERANCE_H` (for the stamp label that fits best), a summer and
+        winter that differ by an hour (a DST clock declared fixed, or the reverse), or
+        rows the reader dropped inside a skipped spring hour (a fixed clock declared
+        with DST).
+    """
+    attrs = df.attrs
+    zone = attrs.get("timezone")
+    warnings: list[str] = []
+    dropped = attrs.get("dropped") or {}
+    if dropped.get("nonexistent_dst"):
+        warnings.append(
+            f"{where}: {dropped['nonexistent_dst']} row(s) stamped inside the hour that "
+            f"{zone} skips in spring (dropped): the file keeps a fixed clock, not {zone}; "
+            f"declare its standard offset (e.g. UTC+1) as timezone"
+        )
+    irr = next((c for c in ("ghi", "dhi") if c in df.columns), None)
+    if longitude is None or irr is None:
+        return {"sun": None, "warnings": warnings}
+    averaged = irr in (attrs.get("averaged") or ())
+    labels = ("end", "instant", "start") if averaged else ("instant", "end", "start")
+    est = {
+        lab: solar_clock_offset(
+            df.index, df[irr], longitude, interval=attrs.get("interval"), label=lab
+        )
+        for lab in labels
+    }
+    first = est[labels[0]]
+    if first.offset_h is None:
+        return {"sun": None, "warnings": warnings}
+    best = min(labels, key=lambda k: abs(est[k].offset_h))
+    # the offset reported: the reading that puts the clock on a whole hour (clocks are
+    # whole hours from UTC; the stamp's place in the interval is half a step uncertain)
+    whole = min(labels, key=lambda k: abs(est[k].offset_h % 1 - 0.5) * -1 + 0.01 * (k != labels[0]))
+    res = est[whole].offset_h
+    as_read = "interval means ending at the stamp" if averaged else "values at the stamp"
+    reading = {
+        "end": "means ending at the stamp",
+        "instant": "values at the stamp",
+        "start": "means starting at the stamp",
+    }
+    if abs(est[best].offset_h) > TOLERANCE_H:
+        alt = "" if whole == labels[0] else f"; {first.offset_h:+.1f} h as read: {as_read}"
+        warnings.append(
+            f"{where}: the sun in {irr} puts the file's clock {res:+.1f} h from the "
+            f"declared timezone {zone} (irradiance as {reading[whole]}{alt}; "
+            f"{est[whole].describe()}): the file's clock is "
+            f"UTC{_fmt_offset(_zone_offset(df.index, zone) + res)}, not the declared "
+            "one; correct timezone"
+        )
+    elif (
+        first.summer_h is not None
+        and first.winter_h is not None
+        and abs(first.summer_h - first.winter_h) > 0.75
+    ):
+        warnings.append(
+            f"{where}: the sun puts April-September {first.summer_h - first.winter_h:+.1f} h "
+            f"from November-February on the declared timezone {zone} "
+            f"({first.describe()}): the file's clock "
+            + (
+                "follows daylight-saving time; declare its zone (e.g. Europe/Paris)"
+                if first.summer_h > first.winter_h
+                else "is fixed; declare its standard offset (e.g. UTC+1)"
+            )
+        )
+    return {"sun": first.to_dict() | {"best_label": best}, "warnings": warnings}
+
+
+def _zone_offset(index: pd.DatetimeIndex, zone) -> float:
+    """Winter UTC offset [h] of a declared zone (0 when unknown)."""
+    from heritage_bayes.io._common import parse_timezone
+
+    try:
+        tz = parse_timezone(zone)
+    except (ValueError, TypeError):
+        return 0.0
+    t = pd.Timestamp(year=int(index[0].year), month=1, day=15, tz="UTC").tz_convert(tz)
+    return t.utcoffset().total_seconds() / 3600.0

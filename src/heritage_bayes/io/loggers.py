@@ -387,7 +387,7 @@ def _classify(name: str, label: str, stats, preamble: list[str], layout: str) ->
             kind = k
             break
     lo, med, hi = stats
-    rng = f"values {lo:g} to {hi:g} (median {med:g})"
+    rng = f"values {lo:g} to {hi:g} (median {med:g}; first {_SAMPLE_LINES} lines)"
     if kind == "skip" or kind is None:
         return ColumnGuess(
             name, None, why=f"name {label!r} not temperature, RH or irradiance; {rng}", stats=stats

@@ -151,96 +151,103 @@ def _declared_offsets(zone: str, index: pd.DatetimeIndex) -> tuple[float, float 
     return off[0], (off[1] if off[1] != off[0] else None)
 
 
+_READING = {
+    "end": "means ending at the stamp",
+    "instant": "values at the stamp",
+    "start": "means starting at the stamp",
+}
+
+
+def _whole_hour_label(est: dict) -> str:
+    """The stamp reading that puts the clock on a whole hour from UTC (ties: 'end')."""
+    return min(
+        est, key=lambda k: abs(est[k].offset_h - round(est[k].offset_h)) + 0.01 * (k != "end")
+    )
+
+
 def _weather_clock(df, lon, declared, findings, where):
-    """The weather file's clock: (timezone, irradiance label, question or None)."""
-    irr = next((c for c in ("ghi", "dhi") if c in df.columns), None)
+    """The weather file's clock: (timezone, irradiance reading, question or None).
+
+    With irradiance and a longitude: the sun (:func:`~heritage_bayes.io.clock.solar_clock_offset`)
+    under the three readings of the stamps (interval end, instant, interval start);
+    otherwise the outdoor daily cycle (coarser)."""
     if lon is None:
         if declared:
             findings.append(f"{where}: clock {declared} (from the file); not checked (no site)")
             return declared, "end", None
-        return (
-            None,
-            "end",
-            "the weather file's clock (e.g. UTC, UTC+2); give --longitude to measure it",
-        )
+        return None, "end", "the weather file's clock (e.g. UTC, UTC+2); give --longitude"
+    irr = next((c for c in ("ghi", "dhi") if c in df.columns), None)
+    est = {}
     if irr is not None:
         est = {
             lab: _clock.solar_clock_offset(df.index, df[irr], lon, label=lab)
             for lab in ("end", "instant", "start")
         }
-        if est["end"].offset_h is None:
-            irr = None
-    if irr is None:
+    if not est or est["end"].offset_h is None:
         e = _clock.outdoor_cycle_offset(df.index, df["Te"], lon)
-        findings.append(f"{where}: clock measured from the outdoor daily cycle ({e.describe()})")
+        findings.append(f"{where}: clock from the outdoor daily cycle ({e.describe()})")
         if e.offset_h is None:
             return declared, "end", None if declared else "the weather file's clock"
-        if declared:
-            w, s = _declared_offsets(declared, df.index)
-            if abs(e.offset_h - w) <= 1.5:
-                return declared, "end", None
+        if not declared:
             return (
-                declared,
+                None,
                 "end",
-                (
-                    f"declared {declared} but the outdoor daily cycle says {_fmt_h(e.offset_h)} "
-                    f"({e.describe()}); which clock does the file keep?"
-                ),
+                f"the weather file's clock: the daily cycle says {_fmt_h(e.offset_h)}",
             )
-        return (
-            None,
-            "end",
-            f"the weather file's clock: the daily cycle says about {_fmt_h(e.offset_h)}",
-        )
-    for lab, e in est.items():
-        findings.append(f"{where}: the sun in {irr} read as '{lab}' values: {e.describe()}")
-    if declared:
-        w, s = _declared_offsets(declared, df.index)
-        e = est["end"]
-        if s is not None and e.follows_dst is False:
-            return (
-                declared,
-                "end",
-                (
-                    f"declared {declared} (UTC{w:+g}, UTC{s:+g} in summer) but the file keeps a "
-                    f"fixed clock: the sun gives {e.describe()}; use a fixed offset such as "
-                    f"{_fmt_h(round(est['instant'].offset_h))}"
-                ),
-            )
-        for lab in ("end", "instant", "start"):
-            if abs(est[lab].offset_h - w) < 0.34:
-                findings.append(
-                    f"{where}: clock {declared} confirmed by the sun, irradiance as "
-                    + {
-                        "end": "means of the interval ending at the stamp",
-                        "instant": "values at the stamp (or centred means)",
-                        "start": "means of the interval starting at the stamp",
-                    }[lab]
-                )
-                return declared, lab, None
+        w, _ = _declared_offsets(declared, df.index)
+        if abs(e.offset_h - w) <= 1.5:
+            return declared, "end", None
         return (
             declared,
             "end",
             (
-                f"declared {declared} but the sun says {_fmt_h(est['end'].offset_h)} (irradiance "
-                f"as means ending at the stamp; {_fmt_h(est['instant'].offset_h)} as values at "
-                f"the stamp): {est['end'].describe()}; which clock does the file keep?"
+                f"declared {declared} but the outdoor daily cycle says {_fmt_h(e.offset_h)} "
+                f"({e.describe()}); which clock does the file keep?"
             ),
         )
-    if est["end"].follows_dst:
+    for lab, e in est.items():
+        findings.append(f"{where}: the sun in {irr} read as {_READING[lab]}: {e.describe()}")
+    lab = _whole_hour_label(est)
+    if declared:
+        w, summer = _declared_offsets(declared, df.index)
+        if summer is not None and est[lab].follows_dst is False:
+            return (
+                declared,
+                lab,
+                (
+                    f"declared {declared} (UTC{w:+g}, UTC{summer:+g} in summer) but the file keeps "
+                    f"a fixed clock: the sun gives {est['end'].describe()} reading "
+                    f"{_READING['end']}; "
+                    f"use a fixed offset such as {_fmt_h(round(est[lab].offset_h))}"
+                ),
+            )
+        ok = [k for k in ("end", "instant", "start") if abs(est[k].offset_h - w) < 0.34]
+        if ok:
+            findings.append(
+                f"{where}: clock {declared} confirmed by the sun, irradiance as {_READING[ok[0]]}"
+            )
+            return declared, ok[0], None
+        other = "end" if lab != "end" else "instant"
+        return (
+            declared,
+            lab,
+            (
+                f"declared {declared} but the sun says {_fmt_h(est[lab].offset_h)} (irradiance "
+                f"as {_READING[lab]}; {_fmt_h(est[other].offset_h)} as {_READING[other]}): "
+                f"{est[lab].describe()}; which clock does the file keep?"
+            ),
+        )
+    if est[lab].follows_dst:
         return (
             None,
-            "end",
+            lab,
             (
-                f"the weather file keeps a daylight-saving clock ({est['end'].describe()}): "
+                f"the weather file keeps a daylight-saving clock ({est[lab].describe()}): "
                 "name its zone, e.g. Europe/Helsinki"
             ),
         )
-    lab = min(
-        est, key=lambda k: abs(est[k].offset_h - round(est[k].offset_h)) + 0.01 * (k != "end")
-    )
     zone = _fmt_h(round(est[lab].offset_h))
-    findings.append(f"{where}: no clock named in the file; the sun says {zone} ('{lab}' values)")
+    findings.append(f"{where}: no clock named in the file; the sun says {zone} ({_READING[lab]})")
     return zone, lab, None
 
 

@@ -162,17 +162,22 @@ def _split(line: str, sep: str) -> list[str]:
 
 
 def _sep_for(lines: list[str]) -> str:
-    """The separator giving the most consistent multi-field rows over the last lines."""
+    """The separator giving the most consistent multi-field rows over the last lines;
+    among equals, the one whose table starts earliest (its header line has the same
+    width: ``;`` over ``,`` in a file with decimal commas)."""
     body = [ln for ln in lines[-200:] if ln.strip()]
-    best, score = ",", -1.0
+    best, best_key = ",", None
     for sep in (",", ";", "\t"):
         counts = [len(_split(ln, sep)) for ln in body]
         if not counts:
             continue
         mode = max(set(counts), key=counts.count)
-        s = counts.count(mode) / len(counts) if mode > 1 else 0.0
-        if s > score + 1e-9:
-            best, score = sep, s
+        score = counts.count(mode) / len(counts) if mode > 1 else 0.0
+        widths = [len(_split(ln, sep)) for ln in lines[:200]]
+        start = next((k for k, w in enumerate(widths) if w == mode), len(widths))
+        key = (round(score, 2), -start, mode)
+        if best_key is None or key > best_key:
+            best, best_key = sep, key
     return best
 
 

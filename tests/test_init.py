@@ -228,3 +228,31 @@ def test_init_trh1_fit_matches_the_shipped_config(shared_data, tmp_path):
         assert fit_init[sec] > fit_shipped[sec] - 2.0, (sec, fit_init, fit_shipped)
     raw = yaml.safe_load(out.read_text(encoding="utf-8"))
     assert raw["sampler"] == {"max_time": "30min"}
+
+
+def test_init_xlsx_logger_with_declared_clock(tmp_path):
+    from openpyxl import Workbook
+
+    lp, wp = _synthetic(tmp_path, days=40)
+    hobo = pd.read_csv(lp, skiprows=1)
+    wb = Workbook()
+    ws = wb.active
+    ws.append(["Datum", "Temperatuur", "RV"])
+    for t, a, b in zip(hobo["Date Time, GMT+01:00"], hobo["Temp, °C"], hobo["RH, %"], strict=True):
+        ws.append([pd.Timestamp(t).to_pydatetime(), float(a), float(b)])
+    xlsx = tmp_path / "logger.xlsx"
+    wb.save(xlsx)
+    out = tmp_path / "x.yaml"
+    # no clock in the workbook: without --timezone a question, with it a config that loads
+    res = init_config(xlsx, wp, output=out, latitude=52.0, longitude=5.0)
+    assert [q.split(":")[0] for q in res.questions] == ["data.measurements.timezone"]
+    res = init_config(
+        xlsx, wp, output=out, latitude=52.0, longitude=5.0, timezone="UTC+1", force=True
+    )
+    assert res.questions == []
+    from heritage_bayes.sources import read_source
+
+    cfg = load_config(out)
+    df = read_source(cfg, cfg.data.measurements[0], "data.measurements", ("Ti", "RHi", "Pi"))
+    assert df.index[0] == pd.Timestamp("2021-03-01 00:00", tz="UTC")
+    np.testing.assert_allclose(df["Ti"].to_numpy()[:5], hobo["Temp, °C"].to_numpy()[:5])

@@ -218,9 +218,13 @@ def test_day_first_told_from_month_first(tmp_path):
 
 
 def test_inspect_errors_name_the_file(tmp_path):
+    p = tmp_path / "x.xls"
+    p.write_bytes(b"\xd0\xcf\x11\xe0\x00\x00binary")  # an old binary .xls
+    with pytest.raises(DataError, match=r"x\.xls: a binary file, not a text table"):
+        inspect_table(p)
     p = tmp_path / "x.xlsx"
-    p.write_bytes(b"PK\x03\x04\x00\x00binary")
-    with pytest.raises(DataError, match=r"x\.xlsx: a binary file"):
+    p.write_bytes(b"PK\x03\x04\x00\x00damaged")
+    with pytest.raises(DataError, match=r"x\.xlsx: cannot read the workbook"):
         inspect_table(p)
     q = tmp_path / "notime.csv"
     q.write_text("a,b\n1,2\n3,4\n5,6\n", encoding="utf-8")
@@ -244,3 +248,21 @@ def test_read_csv_units_and_errors(tmp_path):
         read_csv(p, time_column="t", columns={"Ti": "T"}, timezone="UTC", units={"Ti": "F"})
     with pytest.raises(InputError, match=r"units\.ghi: only temperatures"):
         read_csv(p, time_column="t", columns={"ghi": "T"}, timezone="UTC", units={"ghi": "K"})
+
+
+def test_xlsx_workbook(tmp_path):
+    # a logger export saved as .xlsx: real date cells, a title row, °C and %RH columns
+    from openpyxl import Workbook
+
+    wb = Workbook()
+    ws = wb.active
+    ws.append(["Store 3, exported 2021-03-04"])
+    ws.append(["Date/time", "Temperature (°C)", "RH (%)"])
+    for t, a, b in zip(TIMES, T_C, RH, strict=True):
+        ws.append([t.to_pydatetime(), float(a), float(b)])
+    p = tmp_path / "store.xlsx"
+    wb.save(p)
+    lay = inspect_table(p)
+    assert (lay.layout, lay.sep, lay.skiprows) == ("generic", ",", 1)
+    assert (lay.time_column, lay.time_format) == ("Date/time", "%Y-%m-%d %H:%M:%S")
+    _check(_read(lay))

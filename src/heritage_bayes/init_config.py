@@ -344,11 +344,13 @@ def _logger_clock(layout, df_naive, declared, lon, findings, where):
 def _raw_times(layout: TableLayout) -> pd.DatetimeIndex:
     """The stamps as written, in file order (for the DST structure)."""
     names = [layout.time_column] if isinstance(layout.time_column, str) else layout.time_column
+    from heritage_bayes.io.readers.workbook import is_workbook, table_source
+
     raw = pd.read_csv(
-        layout.path,
+        table_source(layout.path)(),
         sep=layout.sep,
         skiprows=layout.skiprows,
-        encoding=layout.encoding,
+        encoding=None if is_workbook(layout.path) else layout.encoding,
         dtype=str,
         usecols=lambda c: str(c).strip() in names,
     )

@@ -33,11 +33,17 @@ def _quote(names) -> str:
 
 def _csv_header(path: Path, src, where: str) -> list[str]:
     from heritage_bayes.io._common import READ_ERRORS, damaged, sniff_text
+    from heritage_bayes.io.readers.workbook import is_workbook, table_source
 
     try:
-        sniff_text(path, path.name)  # binary, damaged or truncated: say so at once
+        if not is_workbook(path):
+            sniff_text(path, path.name)  # binary, damaged or truncated: say so at once
         header = pd.read_csv(
-            path, nrows=0, sep=src.sep, encoding=src.encoding, skiprows=src.skiprows
+            table_source(path)(),
+            nrows=0,
+            sep=src.sep,
+            encoding=None if is_workbook(path) else src.encoding,
+            skiprows=src.skiprows,
         )
     except DataError as exc:
         raise DataError(f"{where}: {exc}") from None

@@ -144,9 +144,16 @@ class TableLayout:
 
 
 def _decode(path: Path) -> tuple[str, str]:
+    from heritage_bayes.io.readers.workbook import is_workbook, workbook_text
+
+    if is_workbook(path):
+        return workbook_text(path), "utf-8"
     data = path.read_bytes()[: 1 << 22]
     if b"\x00" in data[:4096]:
-        raise DataError(f"{path.name}: a binary file, not a text table (an .xlsx? save it as CSV)")
+        raise DataError(
+            f"{path.name}: a binary file, not a text table (workbooks are read when named "
+            ".xlsx or .xlsm; save others as CSV)"
+        )
     if data.startswith(b"\xef\xbb\xbf"):
         return data[3:].decode("utf-8", errors="replace"), "utf-8-sig"
     try:
@@ -283,8 +290,13 @@ def inspect_table(path, *, what: str = "file") -> TableLayout:
         counts = [len(_split(ln, sep)) for ln in lines]
         width = max(set(counts[-200:]), key=counts[-200:].count)
         # the header: the first line from which every line has the table's width
-        h = next(
-            (k for k in range(len(lines)) if all(c == width for c in counts[k : k + 20])),
+        filled = [sum(bool(c.strip()) for c in _split(ln, sep)) for ln in lines]
+        h = next(  # (a title line padded to the table's width is not the header)
+            (
+                k
+                for k in range(len(lines))
+                if all(c == width for c in counts[k : k + 20]) and filled[k] >= min(2, width)
+            ),
             None,
         )
         if h is None or width < 2:

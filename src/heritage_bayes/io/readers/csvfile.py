@@ -65,8 +65,10 @@ def read_csv(
     Parameters
     ----------
     path : str or path-like
-        The file. Header names are compared after stripping surrounding whitespace
-        (logger exports often pad them); CRLF line ends are fine.
+        The file: delimited text, or an Excel workbook (``.xlsx``, ``.xlsm``: its first
+        sheet, see :mod:`heritage_bayes.io.readers.workbook`). Header names are compared
+        after stripping surrounding whitespace (logger exports often pad them); CRLF line
+        ends are fine.
     time_column : str or sequence of str
         Column holding the timestamp, or several columns whose values are joined with a
         single space before parsing (e.g. ``("Year", "Month", "Day", "Hour (UTC)")`` with
@@ -191,9 +193,17 @@ def read_csv(
     read_kw = {"sep": sep, "skiprows": skiprows, "encoding": encoding}
 
     # -- header --------------------------------------------------------------------------
-    sniff_text(path, name)
+    from heritage_bayes.io.readers.workbook import is_workbook, table_source
+
+    if is_workbook(path):  # the first sheet as CSV text (see .workbook)
+        if (sep, decimal) != (",", "."):
+            raise InputError(f"{name}: a workbook is read as sep ',' and decimal '.'")
+        read_kw["encoding"] = None
+    else:
+        sniff_text(path, name)
+    table = table_source(path)
     try:
-        header = pd.read_csv(path, nrows=0, **read_kw)
+        header = pd.read_csv(table(), nrows=0, **read_kw)
     except pd.errors.EmptyDataError as exc:
         raise DataError(f"{name}: file is empty, expected a header line") from exc
     except (pd.errors.ParserError, UnicodeDecodeError) as exc:
@@ -237,7 +247,7 @@ def read_csv(
     # -- body ------------------------------------------------------------------------------
     try:
         raw = pd.read_csv(
-            path,
+            table(),
             header=0,
             index_col=False,
             dtype=str,

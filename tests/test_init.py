@@ -256,3 +256,17 @@ def test_init_xlsx_logger_with_declared_clock(tmp_path):
     df = read_source(cfg, cfg.data.measurements[0], "data.measurements", ("Ti", "RHi", "Pi"))
     assert df.index[0] == pd.Timestamp("2021-03-01 00:00", tz="UTC")
     np.testing.assert_allclose(df["Ti"].to_numpy()[:5], hobo["Temp, °C"].to_numpy()[:5])
+
+
+@pytest.mark.shared_data
+def test_init_flags_a_heated_room(shared_data, tmp_path):
+    # TRH-1's heated house below the attic: a thermostat's floor, not free-running
+    d = shared_data / "trh1-espoo-attic"
+    res = init_config(d / "indoor1.csv", d / "fmi.csv", output=tmp_path / "h.yaml", **SITE)
+    assert len(res.questions) == 1
+    assert res.questions[0].startswith("questions: the room looks heated to about 20 °C on 206")
+    with pytest.raises(ConfigError, match=r"questions: the room looks heated"):
+        load_config(tmp_path / "h.yaml")
+    # the attic above it: free-running
+    res = init_config(*_trh1(shared_data), output=tmp_path / "a.yaml", **SITE)
+    assert any("on 0 of 581 days" in f and "free-running" in f for f in res.findings)

@@ -272,6 +272,25 @@ def _stretch(ti: pd.Series, te: pd.Series) -> tuple[pd.Timestamp, pd.Timestamp, 
     return both[starts[k]], both[ends[k]] + pd.Timedelta(hours=1), notes
 
 
+def _heating_floor(ti: pd.Series, te: pd.Series) -> tuple[float, int, int]:
+    """A thermostat's signature: (floor [°C], days held at it, days with both series).
+
+    The floor is the 5th percentile of the daily indoor minima; a day is *held* when its
+    indoor minimum is within 0.5 K of the floor while the outdoor air averaged more than
+    5 K below it. Measured: the TRH-1 attic 0 of 581 days (free-running), the heated house
+    below it 206 of 581 (floor 20.4 °C), Ørholm 426 of 4 414 (10.2 °C), Annisse church
+    114 of 1 536 (16.0 °C).
+    """
+    dti = ti.resample("1D").min().rename("ti")
+    dte = te.resample("1D").mean().rename("te")
+    both = pd.concat([dti, dte], axis=1, sort=True).dropna()
+    if len(both) < 10:
+        return float("nan"), 0, len(both)
+    floor = float(np.percentile(both["ti"], 5))
+    held = (both["ti"] - floor).abs().le(0.5) & both["te"].lt(floor - 5)
+    return floor, int(held.sum()), len(both)
+
+
 def _periods(s: pd.Timestamp, e: pd.Timestamp) -> tuple[str, str, str, str, str]:
     """Calibration [s, m) and validation [m, end) in whole days (UTC), and why."""
     day = pd.Timedelta(days=1)
@@ -546,6 +565,19 @@ def init_config(
         f"{s:%Y-%m-%d %H:%M} to {e:%Y-%m-%d %H:%M} UTC"
     )
     findings += [f"overlap: {g}" for g in gap_notes]
+    floor, held, ndays = _heating_floor(ti_utc, te_utc)
+    heated = held >= max(20, 0.05 * ndays)
+    findings.append(
+        f"control: the indoor daily minimum sat at {floor:.1f} °C (within 0.5 K) on {held} of "
+        f"{ndays} days while the outdoor air averaged 5 K colder"
+        + (": heated (a thermostat's floor)" if heated else ": free-running")
+    )
+    if heated:
+        questions.append(
+            f"questions: the room looks heated to about {floor:.0f} °C on {held} of {ndays} "
+            "days; if so, model the heating (thermal.options: {thermostat: true}) or choose "
+            "periods outside the heating season; then delete this question"
+        )
     cs, ce, vs, ve, why = _periods(s, e)
     findings.append(f"periods: {why}")
     hygric = "RHi" in icols and ("RHe" in dw.columns)
@@ -598,12 +630,19 @@ def init_config(
         "",
         "# The smallest model of each ladder; the report's ladder fits the larger ones",
         "# (thermal_2c, thermal_4a; hygric_2c, hygric_2c_fixed) and shows whether they pay.",
+        "# Tf, the fixed node, is the annual mean outdoor temperature (the ground under the",
+        "# floor). A room without a floor on the ground (an attic, an upper storey): set",
+        "# options: {ground: false}, or give the neighbouring space's measured temperature",
+        "# (data.ground_temperature: {mode: column, column: ..., source: {...}}).",
         "thermal:",
         "  model: thermal_1c",
     ]
     if hygric:
         lines += ["", "hygric:", "  model: hygric_1c"]
     lines += ["", "sampler:", "  max_time: 30min   # wall-time budget per model", ""]
+    extra = [q.split(": ", 1)[1] for q in questions if q.startswith("questions: ")]
+    if extra:
+        lines += ["questions:", *[f"  - {_yaml_value(MARK + ' ' + q)}" for q in extra], ""]
     text = "\n".join(lines)
     if not questions:  # the same schema as every config: it must load
         from heritage_bayes.config import parse_config

@@ -270,3 +270,28 @@ def test_init_flags_a_heated_room(shared_data, tmp_path):
     # the attic above it: free-running
     res = init_config(*_trh1(shared_data), output=tmp_path / "a.yaml", **SITE)
     assert any("on 0 of 581 days" in f and "free-running" in f for f in res.findings)
+
+
+@pytest.mark.shared_data
+def test_init_with_a_knmi_weather_file(shared_data, tmp_path):
+    from heritage_bayes.io import read_knmi_hourly
+
+    knmi = shared_data / "knmi-debilt" / "uurgeg_260_2011-2020.txt.gz"
+    te = read_knmi_hourly(knmi)["Te"].loc["2019-01-01":"2019-12-31"]
+    ti = te.ewm(halflife=12).mean() + 2  # a room following the outdoor air
+    lines = ["t;Temp C;RH"] + [
+        f"{t:%d-%m-%Y %H:%M};{a:.2f};55".replace(".", ",")
+        for t, a in zip((te.index + pd.Timedelta(hours=1)).tz_localize(None), ti, strict=True)
+    ]
+    logger = tmp_path / "kerk.csv"
+    logger.write_text("\n".join(lines), encoding="utf-8")
+    out = tmp_path / "kerk.yaml"
+    res = init_config(logger, knmi, output=out, latitude=52.1, longitude=5.18, timezone="UTC+1")
+    assert res.questions == []
+    cfg = load_config(out)
+    assert cfg.data.weather.format == "knmi"
+    assert (cfg.data.measurements[0].sep, cfg.data.measurements[0].decimal) == (";", ",")
+    assert cfg.periods.calibration.start == "2019-01-01"
+    # the calendar year 2019: 8 months to calibrate, 4 to validate
+    assert (cfg.periods.calibration.end, cfg.periods.validation.end) == ("2019-09-01", "2020-01-01")
+    assert any("clock check (the reader's UTC): sun: UTC-0:0" in f for f in res.findings)

@@ -21,7 +21,7 @@ from heritage_bayes.io.clock import (
     solar_clock_offset,
     solar_noon_utc,
 )
-from heritage_bayes.prepare import clock_warnings, prepare
+from heritage_bayes.prepare import prepare
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
 ESPOO_LON = 24.66  # configs/trh1_attic.yaml
@@ -99,6 +99,10 @@ def test_dst_structure_dst_clock():
     assert st.verdict == "dst"
     assert (st.spring_gap, st.autumn_repeat) == (2, 2)
     assert dst_structure(utc.tz_localize(None), "Europe/Helsinki").verdict == "fixed"
+
+
+def clock_warnings(prep) -> list[str]:
+    return prep.sources["clock"]["warnings"]
 
 
 def _trh1(shared_data, tmp_path, weather_path=None, weather_tz=None):

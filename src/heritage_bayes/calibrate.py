@@ -354,7 +354,6 @@ def _calibrate_into(
 ) -> None:
     """Calibrate and write every output into ``out`` (the staging folder of ``final``)."""
     t_start = time.perf_counter()
-    chash = config_hash(cfg)
     say = _Progress(quiet)
     # the heavy imports (arviz, scipy.optimize, emcee) only once the config is valid
     from heritage_bayes.inference.idata import CONVERGENCE
@@ -367,9 +366,7 @@ def _calibrate_into(
     t0 = time.perf_counter()
     prep = prepare(cfg)
     t_prep = time.perf_counter() - t0
-    from heritage_bayes.prepare import clock_warnings
-
-    for w in clock_warnings(prep):  # a declared timezone the data contradict
+    for w in prep.sources.get("clock", {}).get("warnings", []):  # see sources.check_clocks
         say.warn(w)
     say.say(
         f"data: {prep.n_rows} steps of {prep.dt / 3600:g} h from "
@@ -483,7 +480,7 @@ def _calibrate_into(
     t0 = time.perf_counter()
     from heritage_bayes.inference.idata import build_run_outputs
 
-    idata, summary = build_run_outputs(cfg, prep, sections, chash=chash, seed=cfg.seed)
+    idata, summary = build_run_outputs(cfg, prep, sections, chash=config_hash(cfg), seed=cfg.seed)
     t_out = time.perf_counter() - t0
     summary["ladder"] = ladder or None
     summary["timings"] = {

@@ -334,8 +334,6 @@ def prepare(cfg) -> Prepared:
     raw = read_sources(cfg)
     weather, meas_tables, site, monument = raw.weather, raw.measurements, raw.site, raw.monument
     sources = dict(raw.notes)
-    if monument is None:  # the declared clocks against the data (sun, DST changes)
-        sources["clock"] = _check_clocks(cfg, weather, meas_tables, site)
 
     # -- inputs ----------------------------------------------------------------------------
     tables, note = weather_inputs(
@@ -533,25 +531,6 @@ def prepare(cfg) -> Prepared:
         truth=truth,
         sources=to_jsonable(sources),
     )
-
-
-def _check_clocks(cfg, weather, meas_tables, site) -> dict:
-    """:func:`heritage_bayes.io.clock.check_declared_clock` on each table read: the
-    measured offsets, and warnings (``["warnings"]``) when a declared clock disagrees."""
-    from heritage_bayes.io.clock import check_declared_clock
-
-    lon = (site or {}).get("longitude")
-    out = {"data.weather": check_declared_clock(weather, lon, "data.weather")}
-    many = len(meas_tables) > 1
-    for i, m in enumerate(meas_tables):
-        key = "data.measurements" + (f"[{i}]" if many else "")
-        out[key] = check_declared_clock(m, lon, key)
-    return out
-
-
-def clock_warnings(prep: Prepared) -> list[str]:
-    """The clock warnings :func:`prepare` found (see :func:`_check_clocks`)."""
-    return [w for v in (prep.sources.get("clock") or {}).values() for w in v.get("warnings", [])]
 
 
 def _check_observations(frame, cal, val, warmup_steps, thermal, hygric, step) -> None:

@@ -18,7 +18,14 @@ import pandas as pd
 
 from heritage_bayes.errors import ConfigError, DataError, InputError
 
-__all__ = ["INPUT_COLUMNS", "OUTPUT_COLUMNS", "RawData", "read_source", "read_sources"]
+__all__ = [
+    "INPUT_COLUMNS",
+    "OUTPUT_COLUMNS",
+    "RawData",
+    "check_clocks",
+    "read_source",
+    "read_sources",
+]
 
 #: Standard columns that weather files may provide (model inputs and what they derive from).
 #: ("Ph": a known heat input [W], e.g. measured heating power of a test cell.)
@@ -272,11 +279,30 @@ def read_sources(cfg) -> RawData:
             site = weather.attrs.get("site")
             if site is not None:
                 sources["site"] = dict(site) | {"from": "weather file"}
+        sources["clock"] = check_clocks(weather, meas_tables, site)
         sources["weather"] = _source_note(weather, data.weather.format)
         sources["measurements"] = [
             _source_note(m, s.format) for m, s in zip(meas_tables, data.measurements, strict=True)
         ]
     return RawData(weather, meas_tables, site, sources, monument)
+
+
+def check_clocks(weather: pd.DataFrame, measurements: list, site: dict | None) -> dict:
+    """The declared clock of each table against its data
+    (:func:`heritage_bayes.io.clock.check_declared_clock`: the sun, DST changes).
+
+    Returns ``{key: {"sun": ..., "warnings": [...]}, "warnings": [all of them]}``; a
+    warning names the config key and states the measured offset.
+    """
+    from heritage_bayes.io.clock import check_declared_clock
+
+    lon = (site or {}).get("longitude")
+    out = {"data.weather": check_declared_clock(weather, lon, "data.weather")}
+    for i, m in enumerate(measurements):
+        key = "data.measurements" + (f"[{i}]" if len(measurements) > 1 else "")
+        out[key] = check_declared_clock(m, lon, key)
+    out["warnings"] = [w for v in out.values() for w in v["warnings"]]
+    return out
 
 
 def _source_note(df: pd.DataFrame, fmt: str) -> dict:

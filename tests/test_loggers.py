@@ -43,17 +43,22 @@ def _check(df, t_expected=T_C, rh_expected=RH, offset_h=0):
     assert (df.index == want).all()
 
 
+def _hobo(path, title, header, temps, tail, encoding="utf-8"):
+    """A HOBOware CSV: title line, header, numbered rows (US 12-hour time stamps)."""
+    lines = [f'"Plot Title: {title}"', header]
+    for i, (t, a, b) in enumerate(zip(TIMES, temps, RH, strict=True)):
+        lines.append(f"{i + 1},{t:%m/%d/%y %I:%M:%S %p},{a:.3f},{b:.3f}{tail}")
+    path.write_bytes(("\r\n".join(lines) + "\r\n").encode(encoding))
+    return path
+
+
 def test_hobo_hoboware_csv(tmp_path):
     # HOBOware CSV as in building-energy/hoboreader tests/sample_hobo_u12_data.csv
-    lines = [
-        '"Plot Title: 01_10_13 "',
+    header = (
         '"#","Time, GMT+01:00","Temp, °C()","RH, %()","Intensity, Lux()","Bad Battery()",'
-        '"Host Connected()","Stopped()","End Of File()"',
-    ]
-    for i, (t, a, b) in enumerate(zip(TIMES, T_C, RH, strict=True)):
-        lines.append(f"{i + 1},{t:%m/%d/%y %I:%M:%S %p},{a:.3f},{b:.3f},11.8,,,,")
-    p = tmp_path / "hobo.csv"
-    p.write_text("\n".join(lines) + "\n", encoding="utf-8")
+        '"Host Connected()","Stopped()","End Of File()"'
+    )
+    p = _hobo(tmp_path / "hobo.csv", "01_10_13 ", header, T_C, ",11.8,,,,")
     lay = inspect_table(p)
     assert lay.layout == "hobo"
     assert lay.time_column == "Time, GMT+01:00"
@@ -68,15 +73,11 @@ def test_hobo_pendant_fahrenheit_cp1252(tmp_path):
     # HOBO pendant export in °F (hoboreader tests/sample_hobo_pendant_data.csv), saved
     # by an older Windows HOBOware: cp1252 degree sign
     t_f = np.round(T_C * 1.8 + 32, 3)
-    lines = [
-        '"Plot Title: P12_4"',
+    header = (
         '"#","Date Time, GMT+01:00","Temp, °F (LGR S/N: 10469238, SEN S/N: 10469238)",'
-        '"RH, % (LGR S/N: 10469238)","Stopped (LGR S/N: 10469238)"',
-    ]
-    for i, (t, a, b) in enumerate(zip(TIMES, t_f, RH, strict=True)):
-        lines.append(f"{i + 1},{t:%m/%d/%y %I:%M:%S %p},{a:.3f},{b:.2f},")
-    p = tmp_path / "pendant.csv"
-    p.write_bytes(("\r\n".join(lines) + "\r\n").encode("cp1252"))
+        '"RH, % (LGR S/N: 10469238)","Stopped (LGR S/N: 10469238)"'
+    )
+    p = _hobo(tmp_path / "pendant.csv", "P12_4", header, t_f, ",", encoding="cp1252")
     lay = inspect_table(p)
     assert (lay.layout, lay.encoding) == ("hobo", "cp1252")
     assert lay.first("T").unit == "°F"

@@ -195,17 +195,13 @@ def _cmd_calibrate(args) -> int:
 def _cmd_init(args) -> int:
     from heritage_bayes.init_config import init_config
 
+    opts = ("weather_format", "latitude", "longitude", "name", "timezone", "weather_timezone")
     res = init_config(
         args.indoor,
         args.weather,
         output=args.output,
-        weather_format=args.weather_format,
-        latitude=args.latitude,
-        longitude=args.longitude,
-        name=args.name,
-        timezone=args.timezone,
-        weather_timezone=args.weather_timezone,
         force=args.force,
+        **{k: getattr(args, k) for k in opts},
     )
     for f in res.findings:
         print(f"hbayes init: {f}", file=sys.stderr)

@@ -134,3 +134,17 @@ def test_prepare_warns_with_the_measured_offset(shared_data, tmp_path):
     assert len(warn) == 1
     assert "+3.0 h from the declared timezone UTC+2" in warn[0]
     assert re.search(r"the file's clock is UTC\+(4:5\d|5:0\d), not the declared", warn[0])
+
+
+@pytest.mark.shared_data
+def test_prepare_warns_from_the_outdoor_cycle_without_irradiance(shared_data):
+    # Ørholm: DMI weather (UTC, no irradiance): the daily cycle of Te is checked
+    raw = yaml.safe_load((CONFIGS / "orholm.yaml").read_text(encoding="utf-8"))
+    prep = prepare(parse_config(raw, base_dir=str(CONFIGS), name="orholm"))
+    assert prep.sources["clock"]["warnings"] == []
+    assert abs(prep.sources["clock"]["data.weather"]["outdoor_cycle"]["offset_h"]) < 0.6
+    raw["data"]["weather"]["timezone"] = "UTC+3"  # the UTC file declared three hours east
+    prep = prepare(parse_config(raw, base_dir=str(CONFIGS), name="orholm"))
+    (w,) = prep.sources["clock"]["warnings"]
+    assert "daily cycle of Te puts the file's clock -2.6 h from the declared timezone UTC+3" in w
+    assert "the file's clock is about UTC+0:00" in w

@@ -379,6 +379,11 @@ def _transitions(tz, year: int) -> list[tuple[pd.Timestamp, pd.Timedelta]]:
 TOLERANCE_H = 0.75
 
 
+#: The same for the outdoor daily cycle [h]: clouds, fronts and sea breezes move the
+#: peak (the monthly medians of De Bilt 2011-2020 spread over ±0.5 h).
+TE_TOLERANCE_H = 1.5
+
+
 def check_declared_clock(df: pd.DataFrame, longitude: float | None, where: str) -> dict:
     """Check the clock a table was read with (its UTC index) against its own data.
 
@@ -413,8 +418,21 @@ def check_declared_clock(df: pd.DataFrame, longitude: float | None, where: str) 
             f"declare its standard offset (e.g. UTC+1) as timezone"
         )
     irr = next((c for c in ("ghi", "dhi") if c in df.columns), None)
-    if longitude is None or irr is None:
+    if longitude is None:
         return {"sun": None, "warnings": warnings}
+    if irr is None:  # no irradiance: the outdoor daily cycle, coarser
+        if "Te" not in df.columns:
+            return {"sun": None, "warnings": warnings}
+        e = outdoor_cycle_offset(df.index, df["Te"], longitude)
+        if e.offset_h is not None and abs(e.offset_h) > TE_TOLERANCE_H:
+            warnings.append(
+                f"{where}: the daily cycle of Te puts the file's clock {e.offset_h:+.1f} h "
+                f"from the declared timezone {zone} ({e.describe()}; outdoor air peaks "
+                f"{TE_PEAK_LAG_H:g} h after solar noon): the file's clock is about "
+                f"UTC{_fmt_offset(_zone_offset(df.index, zone) + round(e.offset_h))}; "
+                "correct timezone"
+            )
+        return {"sun": None, "outdoor_cycle": e.to_dict(), "warnings": warnings}
     averaged = irr in (attrs.get("averaged") or ())
     labels = ("end", "instant", "start") if averaged else ("instant", "end", "start")
     est = {

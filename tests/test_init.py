@@ -295,3 +295,25 @@ def test_init_with_a_knmi_weather_file(shared_data, tmp_path):
     # the calendar year 2019: 8 months to calibrate, 4 to validate
     assert (cfg.periods.calibration.end, cfg.periods.validation.end) == ("2019-09-01", "2020-01-01")
     assert any("clock check (the reader's UTC): sun: UTC-0:0" in f for f in res.findings)
+
+
+def test_init_iso_stamps_and_plain_names(tmp_path):
+    lp, wp = _synthetic(tmp_path, days=30)
+    hobo = pd.read_csv(lp, skiprows=1)
+    t = pd.to_datetime(hobo["Date Time, GMT+01:00"], format="%m/%d/%y %I:%M:%S %p")
+    iso = pd.DataFrame(
+        {
+            "time": t.dt.strftime("%Y-%m-%dT%H:%M:%S+01:00"),
+            "temperature": hobo["Temp, °C"],
+            "humidity": hobo["RH, %"],
+        }
+    )
+    logger = tmp_path / "iso.csv"
+    iso.to_csv(logger, index=False)
+    out = tmp_path / "iso.yaml"
+    res = init_config(logger, wp, output=out, latitude=52.0, longitude=5.0)
+    assert res.questions == []
+    m = load_config(out).data.measurements[0]
+    assert (m.time_format, m.timezone) == (None, None)  # the stamps carry their offset
+    with pytest.raises(InputError, match=r"--name: 'a/b' is not a plain name"):
+        init_config(logger, wp, output=tmp_path / "n.yaml", name="a/b", longitude=5.0)

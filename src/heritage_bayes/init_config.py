@@ -207,7 +207,9 @@ def init_config(
         ``output`` exists (without ``force``), a file cannot be read as a table, no
         indoor temperature column, no overlap of the two files.
     """
-    from heritage_bayes.rundir.policy import resolve_output, write_new_file
+    from heritage_bayes.rundir.policy import check_name, resolve_output, write_new_file
+
+    name_given = name is not None
 
     indoor, weather = Path(indoor), Path(weather)
     for p, opt in ((indoor, "INDOOR_FILE"), (weather, "--weather")):
@@ -269,7 +271,11 @@ def init_config(
             )
         dw = _read_naive(wlay, wcols, wunits)
         declared = weather_timezone or wlay.timezone
-        wzone, wlabel, wq = weather_clock(dw, lon, declared, findings, "weather")
+        if wlay.time_format == "ISO8601":  # stamps with their UTC offset: the clock is known
+            wzone, wq = None, None
+            findings.append("weather: time stamps carry their UTC offset")
+        else:
+            wzone, wlabel, wq = weather_clock(dw, lon, declared, findings, "weather")
         if wq:
             wzone = marked(wq)
             questions.append(f"data.weather.timezone: {wq}")
@@ -291,8 +297,12 @@ def init_config(
             findings.append(f"weather: clock check (the reader's UTC): {est.describe()}")
 
     # -- the logger's clock (after the weather's) -----------------------------------------------
-    izone = logger_clock(lay, din, timezone or lay.timezone, lon, findings, "logger")
-    if izone.startswith(MARK):
+    if lay.time_format == "ISO8601":  # stamps with their UTC offset: the clock is known
+        izone = None
+        findings.append("logger: time stamps carry their UTC offset")
+    else:
+        izone = logger_clock(lay, din, timezone or lay.timezone, lon, findings, "logger")
+    if izone and izone.startswith(MARK):
         questions.append(f"data.measurements.timezone: {izone[len(MARK) :].strip()}")
     ti_utc = to_utc(din["Ti"], izone)
 
@@ -331,6 +341,7 @@ def init_config(
     findings.append(f"periods: {why}")
     hygric = "RHi" in icols and ("RHe" in dw.columns)
     name = name or (output.parent.name if output.stem == "config" else output.stem) or "room"
+    check_name(name, what="--name" if name_given else "name (from --output)")
 
     lines = [
         f"# Written by `hbayes init` on {_dt.date.today():%Y-%m-%d} from",

@@ -148,3 +148,22 @@ def test_prepare_warns_from_the_outdoor_cycle_without_irradiance(shared_data):
     (w,) = prep.sources["clock"]["warnings"]
     assert "daily cycle of Te puts the file's clock -2.6 h from the declared timezone UTC+3" in w
     assert "the file's clock is about UTC+0:00" in w
+
+
+def test_dst_clock_declared_fixed_is_reported(tmp_path):
+    from heritage_bayes.io import read_csv
+    from heritage_bayes.io.clock import check_declared_clock
+
+    utc = pd.date_range("2010-01-01", "2011-12-31", freq="1h", tz="UTC")
+    wall = utc.tz_convert("Europe/Copenhagen").tz_localize(None)  # a DST logger
+    p = tmp_path / "dst.csv"
+    pd.DataFrame(
+        {"t": wall.strftime("%Y-%m-%d %H:%M"), "T": 15.0 + np.arange(wall.size) % 7}
+    ).to_csv(p, index=False)
+    df = read_csv(p, time_column="t", columns={"Ti": "T"}, timezone="UTC+1", duplicates="first")
+    (w,) = check_declared_clock(df, None, "data.measurements")["warnings"]
+    assert "declared the fixed clock UTC+1, but the stamps jump at the DST changes" in w
+    assert "0 spring change(s) with stamps inside the skipped hour, 2 with a one-hour jump" in w
+    # the same file read with its zone: no warning; a fixed clock read as fixed: none
+    df = read_csv(p, time_column="t", columns={"Ti": "T"}, timezone="Europe/Copenhagen")
+    assert check_declared_clock(df, None, "data.measurements")["warnings"] == []

@@ -417,6 +417,13 @@ def check_declared_clock(df: pd.DataFrame, longitude: float | None, where: str) 
             f"{zone} skips in spring (dropped): the file keeps a fixed clock, not {zone}; "
             f"declare its standard offset (e.g. UTC+1) as timezone"
         )
+    dst = _dst_of_fixed(df.index, zone)
+    if dst is not None and dst.verdict == "dst":
+        warnings.append(
+            f"{where}: declared the fixed clock {zone}, but the stamps jump at the DST "
+            f"changes of {dst.zone} ({dst.describe()}): the file's clock follows "
+            f"daylight-saving time; declare its zone (e.g. {dst.zone})"
+        )
     irr = next((c for c in ("ghi", "dhi") if c in df.columns), None)
     if longitude is None:
         return {"sun": None, "warnings": warnings}
@@ -492,3 +499,34 @@ def _zone_offset(index: pd.DatetimeIndex, zone) -> float:
         return 0.0
     t = pd.Timestamp(year=int(index[0].year), month=1, day=15, tz="UTC").tz_convert(tz)
     return t.utcoffset().total_seconds() / 3600.0
+
+
+#: The DST zone checked for each fixed offset [h] (EU and US rules).
+_DST_ZONES = {
+    0: "Europe/London",
+    1: "Europe/Paris",
+    2: "Europe/Helsinki",
+    -5: "America/New_York",
+    -6: "America/Chicago",
+    -7: "America/Denver",
+    -8: "America/Los_Angeles",
+}
+
+
+def _dst_of_fixed(index: pd.DatetimeIndex, zone) -> DSTStructure | None:
+    """For a table read with a fixed offset: its wall-clock stamps against the DST zone
+    of that offset (a DST clock declared fixed shows a one-hour jump every spring)."""
+    from heritage_bayes.io._common import parse_timezone
+
+    try:
+        tz = parse_timezone(zone)
+    except (ValueError, TypeError):
+        return None
+    if not isinstance(tz, _dt.timezone) or len(index) < 3:
+        return None
+    off = tz.utcoffset(None).total_seconds() / 3600.0
+    name = _DST_ZONES.get(int(off)) if off == int(off) else None
+    if name is None:
+        return None
+    wall = index.tz_convert("UTC").tz_localize(None) + pd.Timedelta(hours=off)
+    return dst_structure(wall, name)

@@ -196,8 +196,7 @@ def test_the_reference_gives_defaults_as_written_in_yaml():
     assert keys["room_volume"].unit == "m³"
     assert keys["data.measurements"].section and keys["data.measurements.timezone"].unit is None
     assert describe_key("data.step") == (
-        "data.step [duration] (default 1h): the model's time step: every table is put on "
-        "this grid"
+        "data.step [duration] (default 1h): the model's time step: every table is put on this grid"
     )
     with pytest.raises(KeyError):
         describe_key("data.nope")

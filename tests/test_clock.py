@@ -132,7 +132,7 @@ def test_prepare_warns_with_the_measured_offset(shared_data, tmp_path):
     d.to_csv(shifted, index=False)
     warn = clock_warnings(prepare(_trh1(shared_data, tmp_path, weather_path=shifted)))
     assert len(warn) == 1
-    assert "+3.0 h from the declared timezone UTC+2" in warn[0]
+    assert "+3.0 h from the declared timezone UTC+02:00" in warn[0]
     assert re.search(r"the file's clock is UTC\+(4:5\d|5:0\d), not the declared", warn[0])
 
 
@@ -146,7 +146,7 @@ def test_prepare_warns_from_the_outdoor_cycle_without_irradiance(shared_data):
     raw["data"]["weather"]["timezone"] = "UTC+3"  # the UTC file declared three hours east
     prep = prepare(parse_config(raw, base_dir=str(CONFIGS), name="orholm"))
     (w,) = prep.sources["clock"]["warnings"]
-    assert "daily cycle of Te puts the file's clock -2.6 h from the declared timezone UTC+3" in w
+    assert "daily cycle of Te puts the file's clock -2.6 h from the declared timezone UTC+03:00" in w
     assert "the file's clock is about UTC+0:00" in w
 
 

@@ -14,6 +14,7 @@ import yaml
 
 from heritage_bayes.cli import main
 from heritage_bayes.config import load_config, parse_config
+from heritage_bayes.convert import timezone_text
 from heritage_bayes.errors import ConfigError, InputError
 from heritage_bayes.init_config import init_config
 from heritage_bayes.io.clock import solar_noon_utc
@@ -69,10 +70,10 @@ def test_init_synthetic_measures_an_undeclared_weather_clock(tmp_path):
     cfg = load_config(out)
     # the weather file names no clock: the sun gives UTC+1 (end-of-hour reading is
     # the convention; the synthetic values are instantaneous: 'instant' fits a whole hour)
-    assert cfg.data.weather.timezone == "UTC+1"
+    assert timezone_text(cfg.data.weather.timezone) == "UTC+01:00"
     assert cfg.data.weather.sep == ";" and cfg.data.weather.decimal == ","
     assert cfg.data.weather.columns == {"Te": "T_out", "RHe": "RH_out", "ghi": "global_rad"}
-    assert cfg.data.measurements[0].timezone == "UTC+1"  # HOBO's header clock
+    assert timezone_text(cfg.data.measurements[0].timezone) == "UTC+01:00"  # HOBO's header
     assert cfg.data.measurements[0].time_format == "%m/%d/%y %I:%M:%S %p"
     assert cfg.name == "room" and cfg.thermal.model == "thermal_1c"
     assert cfg.data.surfaces == {"H": (0.0, 0.0)}
@@ -95,7 +96,7 @@ def test_init_never_overwrites_without_force(tmp_path, capsys):
     assert main([*args, "-o", str(out)]) == 2
     assert "exists" in capsys.readouterr().err
     assert main([*args, "-o", str(out), "--force"]) == 0
-    assert load_config(out).data.weather.timezone == "UTC+1"
+    assert timezone_text(load_config(out).data.weather.timezone) == "UTC+01:00"
     assert main(["init", str(tmp_path / "none.csv"), "--weather", str(wp)]) == 2
     assert "none.csv: file not found" in capsys.readouterr().err
 
@@ -141,7 +142,8 @@ def test_init_trh1(shared_data, tmp_path):
     cfg = load_config(out)
     assert Path(cfg.path(cfg.data.weather.path)).resolve() == weather.resolve()
     assert os.path.isabs(cfg.data.weather.path) is False
-    assert cfg.data.weather.timezone == cfg.data.measurements[0].timezone == "UTC+2"
+    zones = {timezone_text(s.timezone) for s in (cfg.data.weather, *cfg.data.measurements)}
+    assert zones == {"UTC+02:00"}
     # the sun says FMI's irradiance is instantaneous (UTC+2:00), not hour-ending (+1:30)
     assert cfg.data.weather.averaged == []
     assert any("clock UTC+2 confirmed by the sun" in f for f in res.findings)

@@ -24,12 +24,7 @@ import numpy as np
 import yaml
 
 from heritage_bayes._version import __version__
-from heritage_bayes.config import (
-    MAX_SEED,
-    CalibrationConfig,
-    chain_tag,
-    config_hash,
-)
+from heritage_bayes.config import MAX_SEED, CalibrationConfig, chain_tag, config_hash
 from heritage_bayes.convert import format_timedelta
 from heritage_bayes.errors import InputError
 from heritage_bayes.inference.posterior import LogPosterior

@@ -12,6 +12,22 @@ see :mod:`heritage_bayes.questions`) that ``hbayes calibrate`` refuses until ans
 The written file is validated by the same schema as any config
 (:func:`heritage_bayes.config.parse_config`).
 
+Choices, with the measurements behind them (TRH-1 attic, ``benchmarks/bench_init.py``
+and ``tests/test_init.py``):
+
+* **One solar aperture on the horizontal** (``surfaces: {H: [0, 0]}``), not the four
+  facades: the data pin one aperture; with four, thermal_1c put fI_E on its bound and
+  left fI_N unidentified, and its MAP validation FIT of Ti was 76.7 % against 78.0 % with
+  H (calibration Dec 2010-Aug 2011, validation Aug-Dec 2011; 4 facades also sampled
+  slowly: τmax 141 after 13 000 steps, stopped).
+* **Periods**: the first whole calendar year of the longest stretch without a gap over
+  6 h (all seasons; 8 months to calibrate, 4 to validate), else its first whole 12
+  months, else 2/3 and 1/3 of it.
+* **Models**: thermal_1c and hygric_1c, the smallest of each ladder; the report's
+  ladder fits the larger ones.
+* **Irradiance stamps**: the reading of the stamps (interval end, instant, interval
+  start) under which the sun confirms the declared clock (FMI: values at the stamp).
+
 Example
 -------
 ::
@@ -70,6 +86,14 @@ class InitResult:
 def _yaml_value(v) -> str:
     text = yaml.safe_dump(v, default_flow_style=True, allow_unicode=True, width=10_000).strip()
     return text[:-4].strip() if text.endswith("\n...") else text.removesuffix("...").strip()
+
+
+def _doc(path: str) -> str:
+    """A comment line for a key from the schema (:func:`describe_key`), indented as the key."""
+    from heritage_bayes.config.reference import describe_key
+
+    depth = path.count(".")
+    return "  " * depth + "# " + describe_key(path).split(" ", 1)[1]
 
 
 def _weather_format(path: Path, given: str | None) -> str:
@@ -372,8 +396,7 @@ def init_config(
             "  # One solar aperture on the horizontal (tilt, azimuth from north) [°]: the",
             "  # sun on the building as a whole, which the data can pin. Name the facades",
             "  # or roof planes that matter when you know them (e.g. S: [90, 180], roof_E:",
-            "  # [30, 90]); each adds an aperture to estimate. (Measured on the TRH-1 attic,",
-            "  # MAP validation FIT of Ti: 78.0 % with H, 76.7 % with the four facades.)",
+            "  # [30, 90]); each adds an aperture to estimate.",
             "  surfaces: {H: [0, 0]}",
         ]
     elif lat is not None:
@@ -383,7 +406,8 @@ def init_config(
         ]
     else:
         lines += ["  irradiance: none"]
-    lines += ["  step: 1h", f"  max_gap: {MAX_GAP_H}h", "", "periods:", f"  # {why}"]
+    lines += [_doc("data.step"), "  step: 1h", _doc("data.max_gap"), f"  max_gap: {MAX_GAP_H}h"]
+    lines += ["", "periods:", f"  # {why}"]
     lines += [
         f"  calibration: {{start: {cs}, end: {ce}}}",
         f"  validation: {{start: {vs}, end: {ve}}}",
@@ -399,7 +423,7 @@ def init_config(
     ]
     if hygric:
         lines += ["", "hygric:", "  model: hygric_1c"]
-    lines += ["", "sampler:", "  max_time: 30min   # wall-time budget per model", ""]
+    lines += ["", "sampler:", _doc("sampler.max_time"), "  max_time: 30min", ""]
     extra = [q.split(": ", 1)[1] for q in questions if q.startswith("questions: ")]
     if extra:
         lines += ["questions:", *[f"  - {_yaml_value(MARK + ' ' + q)}" for q in extra], ""]

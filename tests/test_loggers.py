@@ -267,3 +267,17 @@ def test_xlsx_workbook(tmp_path):
     assert (lay.layout, lay.sep, lay.skiprows) == ("generic", ",", 1)
     assert (lay.time_column, lay.time_format) == ("Date/time", "%Y-%m-%d %H:%M:%S")
     _check(_read(lay))
+
+
+def test_weather_service_date_parts(tmp_path):
+    # DMI's layout (Station;Year;Month;Day;Hour (UTC);TEMP C;%RH): time over four columns
+    lines = ["Station;Year;Month;Day;Hour (UTC);TEMP C;%RH"] + [
+        f"618100;{t.year};{t.month};{t.day};{t.hour};{a:.1f};{b:.0f}"
+        for t, a, b in zip(TIMES, T_C, RH, strict=True)
+    ]
+    p = tmp_path / "dmi.csv"
+    p.write_text("\n".join(lines), encoding="utf-8")
+    lay = inspect_table(p)
+    assert lay.time_column == ["Year", "Month", "Day", "Hour (UTC)"]
+    assert (lay.time_format, lay.timezone, lay.sep) == ("%Y %m %d %H", "UTC", ";")
+    assert lay.first("T").name == "TEMP C" and lay.first("RH").name == "%RH"

@@ -238,11 +238,22 @@ def logger_clock(layout, df_naive, declared, lon, findings, where):
                 f"declared {declared}, but the file keeps a fixed clock ({st.describe()}); "
                 f"the winter offset would be UTC{w:+g}"
             )
+    else:  # a fixed offset: does the file jump at the DST changes of its region?
+        off = tz.utcoffset(None).total_seconds() / 3600
+        zone = _clock.DST_ZONES.get(int(off)) if off == int(off) else None
+        st = _clock.dst_structure(_raw_times(layout), zone) if zone else None
+        if st is not None and st.changes:
+            findings.append(f"{where}: {st.describe()}")
+        if st is not None and st.verdict == "dst":
+            question = marked(
+                f"declared the fixed clock {declared}, but the stamps jump at the DST "
+                f"changes of {zone} ({st.describe()}): declare that zone"
+            )
     if lon is not None and "Ti" in df_naive:
         from heritage_bayes.io._common import localize
 
-        utc = localize(df_naive.index.tz_localize(None), tz).utc
-        peak = _clock.daily_cycle_phase(utc, df_naive["Ti"].to_numpy()[: len(utc)], min_range=1.0)
+        loc = localize(df_naive.index.tz_localize(None), tz)
+        peak = _clock.daily_cycle_phase(loc.utc, df_naive["Ti"].to_numpy()[loc.keep], min_range=1.0)
         lag = _clock._wrap(peak - _clock.solar_noon_utc(pd.DatetimeIndex(peak.index), lon))
         if np.isfinite(lag).sum() >= 5:
             med = float(np.nanmedian(lag))

@@ -38,6 +38,7 @@ import numpy as np
 import pandas as pd
 
 __all__ = [
+    "DST_ZONES",
     "TE_PEAK_LAG_H",
     "ClockEstimate",
     "DSTStructure",
@@ -502,7 +503,7 @@ def _zone_offset(index: pd.DatetimeIndex, zone) -> float:
 
 
 #: The DST zone checked for each fixed offset [h] (EU and US rules).
-_DST_ZONES = {
+DST_ZONES = {
     0: "Europe/London",
     1: "Europe/Paris",
     2: "Europe/Helsinki",
@@ -525,7 +526,7 @@ def _dst_of_fixed(index: pd.DatetimeIndex, zone) -> DSTStructure | None:
     if not isinstance(tz, _dt.timezone) or len(index) < 3:
         return None
     off = tz.utcoffset(None).total_seconds() / 3600.0
-    name = _DST_ZONES.get(int(off)) if off == int(off) else None
+    name = DST_ZONES.get(int(off)) if off == int(off) else None
     if name is None:
         return None
     wall = index.tz_convert("UTC").tz_localize(None) + pd.Timedelta(hours=off)

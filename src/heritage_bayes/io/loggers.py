@@ -335,6 +335,8 @@ def inspect_table(path, *, what: str = "file") -> TableLayout:
             if f is not None:
                 time_column, fmt = [a, b], f
                 break
+    if time_column is None:  # weather services: Year, Month, Day, Hour [, Minute]
+        time_column, fmt = _split_date_columns(cols)
     if time_column is None:
         raise DataError(
             f"{path.name}: no column holds time stamps in a known format; columns are "
@@ -385,6 +387,34 @@ def inspect_table(path, *, what: str = "file") -> TableLayout:
         columns=guesses,
         notes=notes,
     )
+
+
+_PARTS = (("year", "%Y"), ("month", "%m"), ("day", "%d"), ("hour", "%H"), ("minute", "%M"))
+
+
+def _split_date_columns(cols: dict) -> tuple[list[str] | None, str | None]:
+    """Time split over columns named Year, Month, Day, Hour (and Minute), as DMI and
+    other weather services export it: the columns and the strptime format of their
+    values joined by spaces, or (None, None)."""
+    names, fmts = [], []
+    for part, f in _PARTS:
+        hit = next((n for n in cols if re.match(rf"^{part}\b", n.strip().lower())), None)
+        if hit is None:
+            if part in ("year", "month", "day", "hour"):
+                return None, None
+            break
+        names.append(hit)
+        fmts.append(f)
+    fmt = " ".join(fmts)
+    sample = [
+        " ".join(cols[n][i].strip() for n in names) for i in range(min(300, len(cols[names[0]])))
+    ]
+    try:
+        for v in sample:
+            datetime.strptime(v, fmt)
+    except ValueError:
+        return None, None
+    return names, fmt
 
 
 def _first_comma(cols, names) -> str:

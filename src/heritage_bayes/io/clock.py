@@ -279,8 +279,9 @@ def outdoor_cycle_offset(times, te, longitude: float) -> ClockEstimate:
 class DSTStructure:
     """Wall-clock stamps against the changes of a DST zone (see :func:`dst_structure`).
 
-    ``in_skipped_hour``: spring changes whose skipped hour holds stamps (a fixed clock);
-    ``spring_gap``: spring changes where the stamps jump an hour (a DST clock);
+    ``in_skipped_hour``: spring changes whose skipped hour holds stamps and no jump (a
+    fixed clock); ``spring_gap``: spring changes where the stamps jump an hour within
+    three steps of the change (a DST clock, also one that switches an hour early or late);
     ``autumn_repeat``: autumn changes whose repeated hour is stamped twice (a DST clock);
     ``autumn_single``: autumn changes stamped once (a fixed clock, or a logger that
     overwrote the repeat). ``changes``: changes inside the file's span with data around.
@@ -344,11 +345,12 @@ def dst_structure(naive_times, zone: str) -> DSTStructure:
                 continue
             out.changes += 1
             if delta > pd.Timedelta(0):  # spring: [wall, wall + 1 h) does not exist
-                inside = ((near >= start) & (near < end)).sum()
-                if inside:
-                    out.in_skipped_hour += 1
-                elif np.diff(near.asi8).max() >= (delta + step).value:
+                # a jump of an hour near the change is a DST clock even when it jumped an
+                # hour early or late (Ørholm's logger skipped 01:00, not 02:00, 2009-2011)
+                if np.diff(near.asi8).max() >= (delta + step).value:
                     out.spring_gap += 1
+                elif ((near >= start) & (near < end)).any():
+                    out.in_skipped_hour += 1
             else:  # autumn: [wall - 1 h, wall) happens twice
                 rep = near[(near >= end) & (near < start)]
                 if rep.has_duplicates or (np.diff(near.asi8) < 0).any():

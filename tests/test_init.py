@@ -319,3 +319,25 @@ def test_init_iso_stamps_and_plain_names(tmp_path):
     assert (m.time_format, m.timezone) == (None, None)  # the stamps carry their offset
     with pytest.raises(InputError, match=r"--name: 'a/b' is not a plain name"):
         init_config(logger, wp, output=tmp_path / "n.yaml", name="a/b", longitude=5.0)
+
+
+def test_init_keeps_the_reading_it_inspected(tmp_path):
+    # a logger with a repeated stamp (other values) and an unreadable value: init says so
+    # and writes the policies that let the calibration read the file as init did
+    lp, wp = _synthetic(tmp_path, days=30)
+    lines = lp.read_text(encoding="utf-8").splitlines()
+    lines.insert(10, lines[9].replace(lines[9].split(",")[2], "25.000"))  # same stamp
+    lines[20] = ",".join([*lines[20].split(",")[:2], "ERR", lines[20].split(",")[3]])
+    lp.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    out = tmp_path / "p.yaml"
+    res = init_config(lp, wp, output=out, latitude=52.0, longitude=5.0)
+    assert res.questions == []
+    assert any("logger: the reader dropped or changed" in f for f in res.findings)
+    text = out.read_text(encoding="utf-8")
+    assert "duplicates: first   # 1 stamps repeated with other values" in text
+    assert "invalid: nan   # 1 unreadable values: left out" in text
+    from heritage_bayes.sources import read_source
+
+    cfg = load_config(out)
+    df = read_source(cfg, cfg.data.measurements[0], "data.measurements", ("Ti", "RHi", "Pi"))
+    assert df.attrs["dropped"] == {"unparseable_values": 1, "duplicates": 1}

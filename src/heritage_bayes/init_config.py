@@ -155,7 +155,7 @@ def _pick(layout: TableLayout, kinds: dict[str, str], findings: list[str], what:
 
 
 def _source_lines(
-    key: str, layout: TableLayout, rel: str, zone, columns, units, label
+    key: str, layout: TableLayout, rel: str, zone, columns, units, label, dropped
 ) -> list[str]:
     out = [f"  {key}:", "    format: csv", f"    path: {_yaml_value(rel)}"]
     tc = layout.time_column
@@ -178,7 +178,39 @@ def _source_lines(
         out.append("    averaged: []   # irradiance values at the stamp (see the clock check)")
     elif label == "start":
         out.append("    label: start   # irradiance means of the hour starting at the stamp")
+    out += _policy_lines(dropped)
     return out
+
+
+#: What the reader dropped while init inspected a file, and the key that lets the
+#: calibration read the file the same way (its default would refuse it).
+_POLICIES = {
+    "duplicates": ("duplicates: first", "stamps repeated with other values: the first kept"),
+    "bad_timestamps": ("invalid: nan", "unreadable time stamps: those rows dropped"),
+    "unparseable_values": ("invalid: nan", "unreadable values: left out"),
+    "out_of_range": ("invalid: nan", "values outside the physical range: left out"),
+}
+
+
+def _policy_lines(dropped: dict) -> list[str]:
+    lines: dict[str, list[str]] = {}
+    for what, n in (dropped or {}).items():
+        if what in _POLICIES and n:
+            setting, why = _POLICIES[what]
+            lines.setdefault(setting, []).append(f"{n} {why}")
+    return [f"    {k}   # {'; '.join(v)}" for k, v in lines.items()]
+
+
+def _dropped_findings(df: pd.DataFrame, where: str, findings: list[str], questions: list[str]):
+    dropped = dict(df.attrs.get("dropped") or {})
+    if dropped:
+        findings.append(f"{where}: the reader dropped or changed {dropped}")
+    if dropped.get("sorted"):
+        questions.append(
+            f"questions: the {where} file's time stamps go backwards {dropped['sorted']} "
+            "time(s) (a clock reset? two files joined?); fix the file, then delete this question"
+        )
+    return dropped
 
 
 def init_config(
@@ -264,6 +296,7 @@ def init_config(
             + "; ".join(f"{c.name!r} ({c.why})" for c in lay.columns)
         )
     din = _read_naive(lay, icols, iunits)
+    idropped = _dropped_findings(din, "logger", findings, questions)
     step = clock_step(din.index)
     findings.append(
         f"logger: {len(din)} rows, step {step}, {din.index[0]:%Y-%m-%d} to "
@@ -294,6 +327,7 @@ def init_config(
                 f"{weather.name}: no outdoor temperature column found (columns {wlay.header})"
             )
         dw = _read_naive(wlay, wcols, wunits)
+        wdropped = _dropped_findings(dw, "weather", findings, questions)
         declared = weather_timezone or wlay.timezone
         if wlay.time_format == "ISO8601":  # stamps with their UTC offset: the clock is known
             wzone, wq = None, None
@@ -386,10 +420,12 @@ def init_config(
         "data:",
     ]
     if wlay is not None:
-        lines += _source_lines("weather", wlay, rel(weather), wzone, wcols, wunits, wlabel)
+        lines += _source_lines(
+            "weather", wlay, rel(weather), wzone, wcols, wunits, wlabel, wdropped
+        )
     else:
         lines += ["  weather:", f"    format: {wfmt}", f"    path: {_yaml_value(rel(weather))}"]
-    lines += _source_lines("measurements", lay, rel(indoor), izone, icols, iunits, "end")
+    lines += _source_lines("measurements", lay, rel(indoor), izone, icols, iunits, "end", idropped)
     if irr == "measured":
         lines += [
             "  irradiance: measured",

@@ -15,7 +15,7 @@ import yaml
 from heritage_bayes.cli import main
 from heritage_bayes.config import load_config, parse_config
 from heritage_bayes.convert import timezone_text
-from heritage_bayes.errors import ConfigError, InputError
+from heritage_bayes.errors import ConfigError, DataError, InputError
 from heritage_bayes.init_config import init_config
 from heritage_bayes.io.clock import solar_noon_utc
 from heritage_bayes.questions import open_questions
@@ -341,3 +341,66 @@ def test_init_keeps_the_reading_it_inspected(tmp_path):
     cfg = load_config(out)
     df = read_source(cfg, cfg.data.measurements[0], "data.measurements", ("Ti", "RHi", "Pi"))
     assert df.attrs["dropped"] == {"unparseable_values": 1, "duplicates": 1}
+
+
+@pytest.mark.parametrize("layout", ["tinytag", "rotronic", "hanwell"])
+def test_init_logger_layouts_end_to_end(tmp_path, layout):
+    # init writes the layout's reading (skiprows lists, split date and time) into the
+    # config, and the calibration's reader gets the logger's values back
+    lp, wp = _synthetic(tmp_path, days=20)
+    hobo = pd.read_csv(lp, skiprows=1)
+    t = pd.to_datetime(hobo["Date Time, GMT+01:00"], format="%m/%d/%y %I:%M:%S %p")
+    rows = list(zip(t, hobo["Temp, °C"], hobo["RH, %"], strict=True))
+    if layout == "tinytag":
+        lines = [
+            ",Time,1,2",
+            "S/N,,1,1",
+            "Type,,TGU-4500,TGU-4500",
+            "Description,,Nave,Nave",
+            "Property,,Temperature,Humidity",
+        ]
+        lines += [f"{i + 1},{x:%Y-%m-%d %H:%M:%S},{a},{b}" for i, (x, a, b) in enumerate(rows)]
+    elif layout == "rotronic":
+        lines = [
+            "[#I]Device Description,,,",
+            "Nave,,,",
+            "[#1],,,",
+            "Humidity = %rh,,,",
+            "[#2],,,",
+            "Temperature = °C,,,",
+            "[#H],,,",
+            "Date,Time,Humidity,Temperature",
+            ",,,",
+            "[#D],,,",
+        ]
+        lines += [f"{x:%d/%m/%Y},{x:%H:%M:%S},{b},{a}" for x, a, b in rows]
+    else:
+        lines = [
+            "",
+            "Database Valid",
+            "  Sensor:,Thermistor/RH",
+            "",
+            "Time, Temperature (C),Humidity (RH(%)),",
+        ]
+        lines += [f"{x:%H:%M:%S %d/%b/%Y},{a},{b}," for x, a, b in rows]
+    logger = tmp_path / f"{layout}.csv"
+    logger.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    out = tmp_path / f"{layout}.yaml"
+    res = init_config(logger, wp, output=out, latitude=52.0, longitude=5.0, timezone="UTC+1")
+    assert res.questions == []
+    assert f"logger: {layout} layout" in res.findings[0]
+    from heritage_bayes.sources import read_source
+
+    cfg = load_config(out)
+    df = read_source(cfg, cfg.data.measurements[0], "data.measurements", ("Ti", "RHi", "Pi"))
+    np.testing.assert_allclose(df["Ti"].to_numpy(), hobo["Temp, °C"].to_numpy())
+    assert df.index[0] == pd.Timestamp("2021-03-01 00:00", tz="UTC")
+
+
+@pytest.mark.shared_data
+def test_init_typical_year_weather_is_refused_with_a_reason(shared_data, tmp_path):
+    lp, _ = _synthetic(tmp_path, days=20)
+    epw = shared_data / "epw" / "BEL_VLG_Uccle.064470_TMYx.2007-2021.epw"
+    with pytest.raises(DataError, match=r"a typical year cannot calibrate a room"):
+        init_config(lp, epw, output=tmp_path / "e.yaml", timezone="UTC+1")
+    assert not (tmp_path / "e.yaml").exists()

@@ -376,7 +376,16 @@ def init_config(
             "longitude": round(float(lon), 4),
             "altitude": 0,
         }
-    s, e, gap_notes = longest_stretch(ti_utc, te_utc)
+    try:
+        s, e, gap_notes = longest_stretch(ti_utc, te_utc)
+    except DataError as exc:
+        typical = (
+            " (a typical year cannot calibrate a room: use the weather measured over "
+            "the logger's period)"
+            if wfmt in ("epw", "tmy3")
+            else ""
+        )
+        raise DataError(f"{indoor.name}, {weather.name}: {exc}{typical}") from None
     findings.append(
         f"overlap: longest stretch without a gap over {MAX_GAP_H} h: "
         f"{s:%Y-%m-%d %H:%M} to {e:%Y-%m-%d %H:%M} UTC"

@@ -17,6 +17,19 @@ from heritage_bayes.io import clock as _clock
 from heritage_bayes.io.loggers import TableLayout
 from heritage_bayes.questions import MARK
 
+__all__ = [
+    "MAX_GAP_H",
+    "YEAR_DAYS",
+    "choose_periods",
+    "clock_step",
+    "heating_floor",
+    "logger_clock",
+    "longest_stretch",
+    "marked",
+    "to_utc",
+    "weather_clock",
+]
+
 #: Longest gap [h] bridged inside a period (the config's ``data.max_gap``).
 MAX_GAP_H = 6
 #: A stretch this long [days] or longer is split 8 months / 4 months (a year); shorter
@@ -25,6 +38,7 @@ YEAR_DAYS = 365
 
 
 def marked(text: str) -> str:
+    """``text`` as an open question: the value ``?? text`` the schema refuses."""
     return f"{MARK} {text}"
 
 
@@ -65,11 +79,36 @@ def _whole_hour_label(est: dict) -> str:
 
 
 def weather_clock(df, lon, declared, findings, where):
-    """The weather file's clock: (timezone, irradiance reading, question or None).
+    """The weather file's clock, measured and checked against the declared one.
 
-    With irradiance and a longitude: the sun (:func:`~heritage_bayes.io.clock.solar_clock_offset`)
-    under the three readings of the stamps (interval end, instant, interval start);
-    otherwise the outdoor daily cycle (coarser)."""
+    Parameters
+    ----------
+    df : pandas.DataFrame
+        The weather table on its file's clock (stamps read as if UTC): ``Te`` [°C] and,
+        when measured, ``ghi``/``dhi`` [W/m²].
+    lon : float or None
+        Site longitude [° east].
+    declared : str or None
+        The clock the header or ``--weather-timezone`` names.
+    findings : list of str
+        Appended to: what was measured.
+    where : str
+        Label for the findings.
+
+    Returns
+    -------
+    (timezone, reading, question)
+        ``timezone``: text for the config or None; ``reading``: ``"end"``,
+        ``"instant"`` or ``"start"`` (how the irradiance stamps are read); ``question``:
+        None, or the text of the open question.
+
+    Notes
+    -----
+    With irradiance: the sun (:func:`~heritage_bayes.io.clock.solar_clock_offset`) under
+    the three readings of the stamps; the reading that confirms the declared clock, or
+    puts an undeclared one on a whole hour, is kept. Without: the outdoor daily cycle
+    (:func:`~heritage_bayes.io.clock.outdoor_cycle_offset`, ±1.5 h).
+    """
     if lon is None:
         if declared:
             findings.append(f"{where}: clock {declared} (from the file); not checked (no site)")
@@ -151,7 +190,14 @@ def weather_clock(df, lon, declared, findings, where):
 
 
 def longest_stretch(ti: pd.Series, te: pd.Series) -> tuple[pd.Timestamp, pd.Timestamp, list[str]]:
-    """Longest run of hours with both Ti and Te, gaps up to MAX_GAP_H bridged [UTC]."""
+    """The longest run of hours with both ``Ti`` and ``Te`` [°C], gaps of up to
+    :data:`MAX_GAP_H` hours bridged: (start, end) [UTC] and notes on the gaps found.
+
+    Raises
+    ------
+    DataError
+        The files overlap in fewer than 48 hours (the message gives both spans).
+    """
     a = ti.dropna().index.floor("h").unique()
     b = te.dropna().index.floor("h").unique()
     both = a.intersection(b).sort_values()
@@ -191,7 +237,10 @@ def heating_floor(ti: pd.Series, te: pd.Series) -> tuple[float, int, int]:
 
 
 def choose_periods(s: pd.Timestamp, e: pd.Timestamp) -> tuple[str, str, str, str, str]:
-    """Calibration [s, m) and validation [m, end) in whole days (UTC), and why."""
+    """Calibration ``[start, mid)`` and validation ``[mid, end)`` in whole UTC days
+    within the stretch ``[s, e)``, and why: the first whole calendar year (8 months to
+    calibrate, 4 to validate: all seasons), else the first 12 whole months, else the
+    stretch's first 2/3 and the rest. Returns ``(start, mid, mid, end, why)`` as text."""
     day = pd.Timedelta(days=1)
     s0 = s.ceil("D")
     e0 = e.floor("D")
@@ -217,7 +266,16 @@ def choose_periods(s: pd.Timestamp, e: pd.Timestamp) -> tuple[str, str, str, str
 
 
 def logger_clock(layout, df_naive, declared, lon, findings, where):
-    """Check a logger's declared clock: DST structure and the daily peak vs the sun."""
+    """Check a logger's declared clock; return the zone text or an open question.
+
+    A DST zone: its changes against the stamps as written
+    (:func:`~heritage_bayes.io.clock.dst_structure`; a fixed clock is a question). A
+    fixed offset: the same against the DST zone of that offset
+    (:data:`~heritage_bayes.io.clock.DST_ZONES`; a DST clock is a question). With a
+    longitude: the indoor temperature's daily peak against solar noon [h], a finding
+    (a question when it comes more than half an hour before noon: no free-running room
+    warms before the sun does). No declared clock: a question.
+    """
     question = None
     if declared is None:
         return marked(
@@ -292,6 +350,7 @@ def _raw_times(layout: TableLayout) -> pd.DatetimeIndex:
 
 
 def clock_step(index: pd.DatetimeIndex) -> str:
+    """The most frequent step of ``index`` as text (``'1h'``, ``'10min'``)."""
     from heritage_bayes.io._common import format_timedelta, modal_step
 
     st = modal_step(index)

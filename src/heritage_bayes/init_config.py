@@ -88,12 +88,19 @@ def _yaml_value(v) -> str:
     return text[:-4].strip() if text.endswith("\n...") else text.removesuffix("...").strip()
 
 
-def _doc(path: str) -> str:
-    """A comment line for a key from the schema (:func:`describe_key`), indented as the key."""
+def _wrap(text: str, first: str, rest: str, width: int = 92) -> list[str]:
+    """Comment lines of at most ``width`` characters."""
+    import textwrap
+
+    return textwrap.wrap(text, width, initial_indent=first, subsequent_indent=rest) or [first]
+
+
+def _doc(path: str) -> list[str]:
+    """Comment lines for a key from the schema (:func:`describe_key`), indented as the key."""
     from heritage_bayes.config.reference import describe_key
 
-    depth = path.count(".")
-    return "  " * depth + "# " + describe_key(path).split(" ", 1)[1]
+    pad = "  " * path.count(".") + "# "
+    return _wrap(describe_key(path).split(" ", 1)[1], pad, pad)
 
 
 def _weather_format(path: Path, given: str | None) -> str:
@@ -415,7 +422,7 @@ def init_config(
         f"#   logger:  {rel(indoor)}",
         f"#   weather: {rel(weather)}",
         "# What init found, and why (check each):",
-        *[f"#   - {f}" for f in findings],
+        *[line for f in findings for line in _wrap(f, "#   - ", "#     ")],
         "# Values starting with '??' are open questions: `hbayes calibrate` refuses this file",
         "# until each is answered. Dates are UTC; paths are relative to this file.",
         "",
@@ -451,8 +458,8 @@ def init_config(
         ]
     else:
         lines += ["  irradiance: none"]
-    lines += [_doc("data.step"), "  step: 1h", _doc("data.max_gap"), f"  max_gap: {MAX_GAP_H}h"]
-    lines += ["", "periods:", f"  # {why}"]
+    lines += [*_doc("data.step"), "  step: 1h", *_doc("data.max_gap"), f"  max_gap: {MAX_GAP_H}h"]
+    lines += ["", "periods:", *_wrap(why, "  # ", "  # ")]
     lines += [
         f"  calibration: {{start: {cs}, end: {ce}}}",
         f"  validation: {{start: {vs}, end: {ve}}}",
@@ -468,7 +475,7 @@ def init_config(
     ]
     if hygric:
         lines += ["", "hygric:", "  model: hygric_1c"]
-    lines += ["", "sampler:", _doc("sampler.max_time"), "  max_time: 30min", ""]
+    lines += ["", "sampler:", *_doc("sampler.max_time"), "  max_time: 30min", ""]
     extra = [q.split(": ", 1)[1] for q in questions if q.startswith("questions: ")]
     if extra:
         lines += ["questions:", *[f"  - {_yaml_value(MARK + ' ' + q)}" for q in extra], ""]

@@ -186,6 +186,7 @@ def measured_risk(run_dir: str | Path) -> dict:
     """
     from heritage_bayes._arviz import az
     from heritage_bayes.climate import risk
+    from heritage_bayes.climate.risk._inputs import MIN_YEAR_HOURS
 
     path = Path(run_dir) / "posterior.nc"
     try:
@@ -200,9 +201,9 @@ def measured_risk(run_dir: str | Path) -> dict:
     if ok.sum() < 24:
         return {}
     T, RH = T[ok], np.clip(RH[ok], 0.0, 100.0)
-    groups = ["chemical", "mechanical"]
-    if ok.sum() >= 8760:
-        groups += ["mould", "ashrae", "en15757"]
+    groups = ["mechanical"]  # the others depend on the season covered: a year or more
+    if ok.sum() >= MIN_YEAR_HOURS:
+        groups += ["chemical", "mould", "ashrae", "en15757"]
     table = risk.assess(T, RH, indicators=groups, nan_policy="omit")
     by = table.set_index("indicator")
     out: dict[str, Any] = {"risk_hours": int(ok.sum())}

@@ -613,7 +613,7 @@ def test_registry_covers_every_column():
         assert info.definition and info.source and info.period
     assert indicator_info("ashrae_AA").name == "Hours within ASHRAE class AA"
     assert indicator_info("lifetime_multiplier[paper]").worse == -1
-    with pytest.raises(InputError, match="known: .*twpi"):
+    with pytest.raises(InputError, match=r"known: .*twpi"):
         indicator_info("metal_corrosion")
     with pytest.raises(InputError, match=r"thresholds\[1\].indicator.*'twpix'.*'twpi'"):
         check_indicator_names(["twpi", "twpix"], batch.columns, "thresholds")

@@ -111,8 +111,7 @@ def _entries() -> dict[str, Indicator]:
             "years",
             "Harmonic mean over the hours of the preservation index PI(T, RH) of "
             "cellulose-acetate/paper (IPI); < 45 years rated 'risk', ≥ 75 'good'.",
-            "Sebera (1994) Isoperms; Reilly, Nishimura & Zinn (1995) New Tools for "
-            "Preservation",
+            "Sebera (1994) Isoperms; Reilly, Nishimura & Zinn (1995) New Tools for Preservation",
             _YEARS,
             -1,
             "chemical",
@@ -214,8 +213,7 @@ def _entries() -> dict[str, Indicator]:
             "ashrae_best_class",
             "Best ASHRAE class reached",
             "class",
-            "The strictest class whose share of hours reaches the threshold ('none' if "
-            "none does).",
+            "The strictest class whose share of hours reaches the threshold ('none' if none does).",
             "ASHRAE Handbook — HVAC Applications, ch. 24 (museums)",
             _YEARS,
             0,

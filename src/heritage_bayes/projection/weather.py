@@ -18,6 +18,7 @@ import numpy as np
 import pandas as pd
 
 from heritage_bayes.climate.risk._inputs import MIN_YEAR_HOURS
+from heritage_bayes.climate.risk.registry import complete_year_hours
 from heritage_bayes.config import parse_duration
 from heritage_bayes.errors import ConfigError, DataError, InputError
 
@@ -152,7 +153,9 @@ def model_inputs(run, pcfg, weather: pd.DataFrame, site: dict | None, where: str
     """Model inputs on the run's grid from a weather table (as for the calibration).
 
     Returns a frame with every input column of the run's models (``Te``, ``I_<surface>``,
-    ``Tf``, ``Pe``, ...), regular UTC index.
+    ``Tf``, ``Pe``, ...), regular UTC index, cut to the complete years of the weather
+    (:func:`~heritage_bayes.climate.risk.registry.complete_year_hours`;
+    ``frame.attrs["hours_dropped"]`` counts the hours after the last complete year).
     """
     from heritage_bayes.inputs import annual_mean_temperature, calendar_inputs, weather_inputs
     from heritage_bayes.io import align
@@ -207,4 +210,8 @@ def model_inputs(run, pcfg, weather: pd.DataFrame, site: dict | None, where: str
             f"{where}: {len(frame)} rows on the grid; a projection needs at least "
             f"{MIN_YEAR_HOURS} h"
         )
-    return frame
+    # the yearly indicators depend on the season covered: complete years only
+    n = complete_year_hours(len(frame))
+    out = frame.iloc[:n].copy()
+    out.attrs["hours_dropped"] = len(frame) - n
+    return out

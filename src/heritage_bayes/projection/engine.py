@@ -200,7 +200,8 @@ def simulate_cases(
         In the order of ``inputs``, with the per-complete-year values of
         :data:`heritage_bayes.projection._stream.ANNUAL` (``annual_*``) and, when the
         EN 15757 group is computed and ``baseline``, the column
-        ``en15757_outside_baseline`` (mean over the years). ``seconds``: ``simulate`` (modal forms, and
+        ``en15757_outside_baseline`` (mean over the years). ``seconds``: ``simulate``
+        (modal forms, and
         ``model.forward`` of controlled models), ``noise`` (the noise draws, shared
         equally by the cases that use them) and ``risk`` (the compiled pass: simulation
         of free-running models, RH, indicators, monthly means).
@@ -242,9 +243,7 @@ def simulate_cases(
         plan = fused_plan(len(inp), func="assess_batch", **plan_opts)  # checks options
         Ut = {s: np.ascontiguousarray(u.T) for s, u in U.items()}
         mode = (1 if not cases else 2) if baseline else 0
-        cases.append(
-            _Case(U, Ut, starts, months, plan, len(inp), hour_of_year(inp.index), mode)
-        )
+        cases.append(_Case(U, Ut, starts, months, plan, len(inp), hour_of_year(inp.index), mode))
     K = draws.index.size
     out = [_CaseOut.empty(c, K) for c in cases]
     slots = max(1, min(numba.get_num_threads(), chunk, K))

@@ -191,6 +191,15 @@ def _cmd_project(args) -> int:
         print(proj.probability_table().to_string(float_format=lambda v: f"{v:.2f}"))
         for p in proj.paths.values():
             print(p)
+    if not proj.summary["converged"]:
+        from heritage_bayes.projection import EXIT_UNCONVERGED_RUN, UNCONVERGED_TEXT
+
+        print(
+            f"hbayes project: written, but {UNCONVERGED_TEXT} (exit code "
+            f"{EXIT_UNCONVERGED_RUN}); continue the calibration with --resume",
+            file=sys.stderr,
+        )
+        return EXIT_UNCONVERGED_RUN
     return 0
 
 

@@ -106,13 +106,15 @@ class Threshold(_Strict):
         return self
 
 
-#: Default probability statements (IPI-style risk limits of heritage_bayes.climate.risk).
+#: Default probability statements (IPI-style risk limits of heritage_bayes.climate.risk;
+#: EN 15757: more hours outside the baseline band than the baseline climate itself can
+#: spend outside it, 14 % = below the 7th plus above the 93rd percentile).
 DEFAULT_THRESHOLDS = (
     Threshold(indicator="vtt_mould_index_max", above=1.0),
     Threshold(indicator="twpi", below=45.0),
     Threshold(indicator="emc_max", above=12.5),
     Threshold(indicator="emc_min", below=5.0),
-    Threshold(indicator="en15757_outside", above=10.0),
+    Threshold(indicator="en15757_outside_baseline", above=14.0),
 )
 
 
@@ -122,6 +124,11 @@ class ProjectionConfig(_Strict):
     name: str | None = None
     baseline: Source | None = None
     baseline_label: str = "baseline"
+    allow_other_site: bool = Field(
+        default=False,
+        description="accept baseline or future weather from a site more than 50 km from "
+        "the calibration's (heritage_bayes.projection.weather.MAX_SITE_DISTANCE_KM)",
+    )
     humidity: Humidity = "constant_rh"
     ground_temperature: GroundTemperature | None = None
     knmi14: Knmi14 | None = None

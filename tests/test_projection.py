@@ -271,6 +271,9 @@ _LAYOUT_JS = """(() => {
   for (const d of document.querySelectorAll('div.scroll'))
     out.scrolls.push({sw: d.scrollWidth, cw: d.clientWidth});
   out.text = document.body.innerText;
+  out.docw = document.documentElement.scrollWidth;
+  out.right = Math.max(...[...document.querySelectorAll('nav.toc a, h1, h2, p, figure img')]
+                           .map(e => e.getBoundingClientRect().right));
   return out;
 })()"""
 
@@ -309,6 +312,7 @@ def test_projection_page_in_headless_chromium(proj, size):
         assert t["w"] <= t["cw"] + 0.5 and t["right"] <= lay["width"], t
     for d in lay["scrolls"]:
         assert d["sw"] <= d["cw"], d
+    assert lay["docw"] <= lay["width"] and lay["right"] <= lay["width"], lay["right"]
     _no_percentage_above_100(lay["text"])
 
 

@@ -60,7 +60,7 @@ _COLUMNS = [
     ("proj.twpi.p_worse", "P(TWPI worse)", "{:.2f}"),
     ("proj.vtt_mould_index_max.change", "Δ mould index max", "{:+.2f}"),
     ("proj.vtt_mould_index_max.p_worse", "P(mould worse)", "{:.2f}"),
-    ("proj.en15757_outside.change", "Δ outside EN 15757 [% h]", "{:+.1f}"),
+    ("proj.en15757_outside_baseline.change", "Δ outside baseline EN 15757 band [% h]", "{:+.1f}"),
     ("proj.probability", "P(statement)", "{:.2f}"),
     ("proj.statement", "statement", "{}"),
     ("message", "message", "{}"),

@@ -76,7 +76,7 @@ def _peak_rss_mb() -> float:
 
 
 #: Indicators whose projected change the portfolio table carries (median and P(worse)).
-PROJECTED = ("twpi", "vtt_mould_index_max", "en15757_outside", "emc_range")
+PROJECTED = ("twpi", "vtt_mould_index_max", "en15757_outside_baseline", "emc_range")
 
 
 def _project_room(run_dir: Path, projection: Path, resume: bool) -> dict:

@@ -21,12 +21,13 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit, prange
 
 from heritage_bayes.climate import _vecmath
-from heritage_bayes.climate._vecmath import psat_water, stamp_cache
+from heritage_bayes.climate._vecmath import psat_water, stamp_cache, vcosh, vexp
 from heritage_bayes.climate.risk import _fused
-from heritage_bayes.climate.risk._fused import BLOCK, pairwise_sum, series_indicators
+from heritage_bayes.climate.risk._fused import BLOCK, _bsum, pairwise_sum, series_indicators
 
 
 @njit(cache=True, error_model="numpy")
@@ -173,24 +174,41 @@ def annual_values(T, RH, N, hoy, mode, en, band, out, ma, cnt):  # pragma: no co
                 band[jj] = last
         band[HOY] = en[3]
         band[HOY + 1] = en[4]
+    has_lim = limc == limc
+    lo_off = band[HOY] if mode != 0 else 0.0
+    hi_off = band[HOY + 1] if mode != 0 else 0.0
+    w = np.empty(BLOCK)
     for y in range(ny):
         inv_pi = 0.0
         wet = 0
         lim = 0
         out_band = 0
-        for t in range(y * L, (y + 1) * L):
-            x = T[t]
-            r = RH[t]
-            a = (95220.0 - 134.9 * r) / (8.314 * (x + 273.15)) + 0.0284 * r - 28.023
-            inv_pi += 365.0 * math.exp(-a)
-            wet += 1 if (r > 80.0) and (x > 0.0) else 0
-            lim += 1 if r > 100.0 * (0.02633 * math.cosh(0.10083 * (x - 30.0)) + limc) else 0
+        for b0 in range(y * L, (y + 1) * L, BLOCK):  # blocks: the loops vectorise
+            m = min(BLOCK, (y + 1) * L - b0)
+            Tb = T[b0 : b0 + m]
+            RHb = RH[b0 : b0 + m]
+            for t in range(m):  # 1 / PI (chemical._pi), as in the fused pass
+                x = Tb[t]
+                r = RHb[t]
+                w[t] = 365.0 * vexp(
+                    -((95220.0 - 134.9 * r) * (1.0 / (x + 273.15) / 8.314) + 0.0284 * r - 28.023)
+                )
+            inv_pi += _bsum(w, m)
+            for t in range(m):  # ISO 9223 time of wetness
+                wet += 1 if (RHb[t] > 80.0) and (Tb[t] > 0.0) else 0
+            if has_lim:
+                for t in range(m):  # lowest isopleth for mould (biological._lim)
+                    lim_t = 100.0 * (0.02633 * vcosh(0.10083 * (Tb[t] - 30.0)) + limc)
+                    lim += 1 if RHb[t] > lim_t else 0
             if mode != 0:
-                c = band[hoy[t]]
-                out_band += 1 if (r < c + band[HOY]) or (r > c + band[HOY + 1]) else 0
+                hb = hoy[b0 : b0 + m]
+                for t in range(m):
+                    c = band[hb[t]]
+                    r = RHb[t]
+                    out_band += 1 if (r < c + lo_off) or (r > c + hi_off) else 0
         out[y, 0] = L / inv_pi
         out[y, 1] = wet / L * 8760.0
-        out[y, 2] = lim / L * 8760.0 if limc == limc else math.nan
+        out[y, 2] = lim / L * 8760.0 if has_lim else math.nan
         out[y, 3] = 100.0 * out_band / L if mode != 0 else math.nan
 
 

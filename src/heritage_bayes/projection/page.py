@@ -73,6 +73,10 @@ def _fig_seasonal(proj) -> str:
     with matplotlib.rc_context(RC_PARAMS):
         fig = _figure(9.0, 5.6)
         axes = fig.subplots(2, 1, sharex=True)
+        # bands for the baseline and the warmest future (overlapping bands of every
+        # case would hide each other); medians for all
+        te = [c["mean_Te"] for c in proj.summary["cases"]]
+        banded = {0, int(np.argmax(te))}
         handles = []
         for ax, name, label in (
             (axes[0], "Ti", "indoor temperature [°C]"),
@@ -83,13 +87,18 @@ def _fig_seasonal(proj) -> str:
             for i, _lab in enumerate(proj.labels):
                 q = np.nanquantile(arr[i], [0.05, 0.5, 0.95], axis=0)
                 c = _colour(i)
-                ax.fill_between(months, q[0], q[2], color=c, alpha=0.12, lw=0)
+                if i in banded:
+                    ax.fill_between(months, q[0], q[2], color=c, alpha=0.15, lw=0)
                 (h,) = ax.plot(months, q[1], color=c, lw=1.6 if i == 0 else 1.2)
                 handles.append(h)
             ax.set_ylabel(label)
         axes[1].set_xticks(months, ["J", "F", "M", "A", "M", "J", "J", "A", "S", "O", "N", "D"])
         axes[1].set_xlabel("calendar month (mean over the case's years)")
-        axes[0].set_title("Seasonal cycle: median and 5–95 % predictive band of the draws")
+        warm = proj.labels[max(banded)]
+        axes[0].set_title(
+            "Seasonal cycle: median of the draws; 5–95 % predictive band for the baseline"
+            + (f" and {warm}" if len(banded) > 1 else "")
+        )
         _legend_below(fig, handles, proj.labels, ncol=min(5, len(proj.labels)))
         return to_png_uri(fig)
 

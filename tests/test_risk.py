@@ -617,3 +617,13 @@ def test_registry_covers_every_column():
         indicator_info("metal_corrosion")
     with pytest.raises(InputError, match=r"thresholds\[1\].indicator.*'twpix'.*'twpi'"):
         check_indicator_names(["twpi", "twpix"], batch.columns, "thresholds")
+
+
+def test_registry_markdown_for_the_docs():
+    from heritage_bayes.climate.risk.registry import INDICATORS, as_markdown
+
+    md = as_markdown()
+    rows = [r for r in md.splitlines() if r.startswith("| `")]
+    assert len(rows) == len(INDICATORS)
+    assert all(r.count(" | ") == 6 for r in rows)
+    assert "`en15757_outside_baseline`" in md and "ISO 9223" in md

@@ -30,8 +30,17 @@ User-supplied future weather::
       - {scenario: rcp85, horizon: 2080, weather: {format: epw, path: future.epw}}
 
 ``baseline``: the weather the transformations start from (a ``Source`` as in the
-calibration config); default the calibration's own weather. Relative paths are relative
-to the projection file.
+calibration config); default the calibration's own weather. A baseline or future file
+whose site lies more than 50 km from the calibration's is refused unless
+``allow_other_site: true``. Relative paths are relative to the projection file.
+
+Probability statements (``thresholds``), on any indicator the projection computes
+(:mod:`heritage_bayes.climate.risk.registry`; an unknown name is refused with the list)::
+
+    thresholds:
+      - {indicator: twpi, below: 45}                       # [years]
+      - {indicator: en15757_outside_baseline, above: 14}   # [% of hours]
+      - {indicator: time_of_wetness, above: 2500}          # [h/year], ISO 9223 τ4
 """
 
 from __future__ import annotations

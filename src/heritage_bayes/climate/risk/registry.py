@@ -26,7 +26,7 @@ unit the scale of a difference.
 from __future__ import annotations
 
 import re
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 
 from heritage_bayes.climate.risk._inputs import HOURS_PER_YEAR, MIN_YEAR_HOURS
 from heritage_bayes.errors import InputError
@@ -34,6 +34,7 @@ from heritage_bayes.errors import InputError
 __all__ = [
     "INDICATORS",
     "Indicator",
+    "as_markdown",
     "check_indicator_names",
     "complete_year_hours",
     "indicator_info",
@@ -304,18 +305,7 @@ def indicator_info(key: str) -> Indicator:
         m = pat.match(key)
         if m:
             base = INDICATORS[fam]
-            p = m.group(1)
-            return Indicator(
-                key=key,
-                name=base.name.format(p),
-                unit=base.unit,
-                definition=base.definition,
-                source=base.source,
-                period=base.period,
-                worse=base.worse,
-                group=base.group,
-                annual=base.annual,
-            )
+            return replace(base, key=key, name=base.name.format(m.group(1)))
     raise InputError(f"unknown indicator {key!r}; known: {', '.join(INDICATORS)}")
 
 
@@ -356,3 +346,24 @@ def years_of(n: int) -> int:
     """Number of complete years in ``n`` hours (0 below 8736 h)."""
     n = int(n)
     return 0 if n < MIN_YEAR_HOURS else max(1, n // HOURS_PER_YEAR)
+
+
+def as_markdown() -> str:
+    """The registry as a Markdown table (for the documentation: one source of truth).
+
+    Parameterised families keep their ``{}`` placeholder (e.g. ``ashrae_{}``: one
+    column per ASHRAE class).
+    """
+
+    def cell(text: str) -> str:
+        return str(text).replace("|", "\\|").replace("\n", " ")
+
+    lines = [
+        "| key | indicator | unit | definition | source | period | worse when |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    worse = {1: "higher", -1: "lower", 0: "—"}
+    for i in INDICATORS.values():
+        row = (f"`{i.key}`", i.name, i.unit, i.definition, i.source, i.period, worse[i.worse])
+        lines.append("| " + " | ".join(cell(c) for c in row) + " |")
+    return "\n".join(lines) + "\n"

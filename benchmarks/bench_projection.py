@@ -1,8 +1,8 @@
 """Projection benchmark (issue 12): posterior draws × 30 years hourly × 4 scenarios ×
 2 models (thermal_2c, hygric_2c), noise draws and every risk indicator included.
 
-Target of the issue: 1000 draws × 30 years × 4 scenarios × 2 models in ≤ 60 s and
-≤ 2 GB peak on this 2-core machine.
+Target (issues 12 and 26): 1000 draws × 30 years × 4 scenarios × 2 models in ≤ 60 s
+and ≤ 1 GB peak on this 2-core machine (figures in ``benchmarks/README.md``).
 
 Measured in one run:
 

@@ -55,6 +55,7 @@ _COLUMNS = [
     ("emc_range_pct", "EMC range [% MC]", "{:.1f}"),
     ("mould_index_max", "mould index max", "{:.2f}"),
     ("en15757_outside_pct", "outside EN 15757 band [% h]", "{:.1f}"),
+    ("risk_note", "measured-risk note", "{}"),
     ("proj.case", "projection: most severe case", "{}"),
     ("proj.twpi.change", "Δ TWPI [years]", "{:+.1f}"),
     ("proj.twpi.p_worse", "P(TWPI worse)", "{:.2f}"),

@@ -469,3 +469,36 @@ def test_projection_of_a_run_with_a_weekly_calendar(tmp_path):
     use = U["hours_of_use"].to_numpy()
     sunday_morning = (U.index.day_of_week == 6) & (U.index.hour >= 8) & (U.index.hour < 12)
     assert np.array_equal(use, sunday_morning.astype(float))
+
+
+def test_several_baseline_years_give_a_weather_year_share(run_dir, tmp_path):
+    """A two-year baseline (the demo's year twice, the second 1 K warmer): the per-year
+    indicators get a weather-year share, the shares still sum to 1, and the baseline's
+    own EN 15757 baseline-band share is the one a future equal to it gets."""
+    import pandas as pd
+
+    from heritage_bayes.run import load_run
+    from heritage_bayes.sources import read_sources
+
+    w = read_sources(load_run(run_dir).config).weather
+    # two years and two days (the grid may lose an hour at either end)
+    two = pd.concat([w, w, w], ignore_index=True).iloc[: 2 * 8760 + 48]
+    two.index = pd.date_range(w.index[0], periods=len(two), freq="h")
+    two.iloc[8760:, two.columns.get_loc("Te")] += 1.0
+    csv = tmp_path / "two_years.csv"
+    cols = [c for c in ("Te", "RHe", "ghi", "dni", "dhi") if c in two.columns]
+    two[cols].rename_axis("time").to_csv(csv)
+    cfg = {
+        **PROJ,
+        "draws": 8,
+        "baseline": {"format": "csv", "path": str(csv), "time_column": "time"},
+        "morphing": [_morph("same", 2050, 0.0), _morph("warm", 2050, SHIFT)],
+    }
+    p = project(run_dir, cfg, write=False)
+    assert [c["years"] for c in p.summary["cases"]] == [2, 2, 2]
+    e = p.summary["uncertainty_split"]["baseline"]["indicators"]["twpi"]
+    assert e["variance"]["weather_year"] > 0 and e["basis"].startswith("one year's value")
+    assert sum(e["share"].values()) == pytest.approx(1.0, abs=1e-9)
+    col = "en15757_outside_baseline"
+    same = p.results[1].predictive[col].to_numpy()
+    np.testing.assert_array_equal(same, p.results[0].predictive[col].to_numpy())

@@ -181,8 +181,8 @@ def measured_risk(run_dir: str | Path) -> dict:
     mechanical indicators (EMC range [% MC]) need no minimum length; the chemical ones
     (TWPI [years]), the mould index (VTT), ASHRAE classes and the EN 15757 band depend on
     the season covered, need a year of data and are left out (NaN) for shorter logs,
-    with ``risk_note`` saying so (over a year: computed on the complete years). ``risk_flags`` counts the indicators
-    rated "risk" by their published thresholds (see ``assess``); the overview sorts by
+    with ``risk_note`` saying so (over a year: computed on the complete years).
+    ``risk_flags`` counts the indicators rated "risk" by their published thresholds (see ``assess``); the overview sorts by
     it. Both temperature and RH must have been logged; otherwise the columns are absent.
     """
     from heritage_bayes._arviz import az

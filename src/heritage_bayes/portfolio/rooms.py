@@ -182,8 +182,8 @@ def measured_risk(run_dir: str | Path) -> dict:
     (TWPI [years]), the mould index (VTT), ASHRAE classes and the EN 15757 band depend on
     the season covered, need a year of data and are left out (NaN) for shorter logs,
     with ``risk_note`` saying so (over a year: computed on the complete years).
-    ``risk_flags`` counts the indicators rated "risk" by their published thresholds (see ``assess``); the overview sorts by
-    it. Both temperature and RH must have been logged; otherwise the columns are absent.
+    ``risk_flags`` counts the indicators rated "risk" by their published thresholds
+    (see ``assess``); the overview sorts by it. Both temperature and RH must have been logged; otherwise the columns are absent.
     """
     from heritage_bayes._arviz import az
     from heritage_bayes.climate import risk

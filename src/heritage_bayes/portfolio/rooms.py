@@ -183,7 +183,8 @@ def measured_risk(run_dir: str | Path) -> dict:
     the season covered, need a year of data and are left out (NaN) for shorter logs,
     with ``risk_note`` saying so (over a year: computed on the complete years).
     ``risk_flags`` counts the indicators rated "risk" by their published thresholds
-    (see ``assess``); the overview sorts by it. Both temperature and RH must have been logged; otherwise the columns are absent.
+    (see ``assess``); the overview sorts by it. Both temperature and RH must have been
+    logged; otherwise the columns are absent.
     """
     from heritage_bayes._arviz import az
     from heritage_bayes.climate import risk

@@ -587,7 +587,9 @@ def test_annual_indicators_use_complete_years_only():
     (the half year after it is left out, and counted), and do not depend on the
     month the year starts in: the same year rotated (June-May) gives the same values."""
     T, RH = synthetic_year(n=8760 + 4380, seed=3)
+    RH = np.clip(RH + 12.0, 0.0, 100.0)  # damp: a time of wetness of hundreds of hours
     full = risk.assess(T, RH).set_index("indicator")
+    assert full.loc["time_of_wetness", "value"] > 500
     first = risk.assess(T[:8760], RH[:8760]).set_index("indicator")
     assert risk.assess(T, RH).attrs["hours_dropped"] == 4380
     for name in ("twpi", "time_of_wetness", "hours_above_LIM0", "lifetime_multiplier[paper]"):
@@ -627,3 +629,14 @@ def test_registry_markdown_for_the_docs():
     assert len(rows) == len(INDICATORS)
     assert all(r.count(" | ") == 6 for r in rows)
     assert "`en15757_outside_baseline`" in md and "ISO 9223" in md
+
+
+def test_time_of_wetness_needs_wet_and_above_freezing():
+    """ISO 9223: hours with RH > 80 % and T > 0 °C; frozen or dry hours do not count."""
+    n = 8760
+    wet_warm = risk.assess(np.full(n, 5.0), np.full(n, 95.0), indicators=["chemical"])
+    frozen = risk.assess(np.full(n, -5.0), np.full(n, 95.0), indicators=["chemical"])
+    dry = risk.assess(np.full(n, 5.0), np.full(n, 80.0), indicators=["chemical"])
+    tow = [t.set_index("indicator").loc["time_of_wetness"] for t in (wet_warm, frozen, dry)]
+    assert [v["value"] for v in tow] == [8760.0, 0.0, 0.0]
+    assert [v["rating"] for v in tow] == ["τ5", "τ1", "τ1"]

@@ -187,8 +187,9 @@ def _banner(proj) -> str:
     reasons = "".join(f"<li>{escape(str(r))}</li>" for r in s.get("unconverged_reasons") or [])
     return (
         "<div class='note red' id='unconverged'><strong>Calibration not converged</strong>"
-        f"<p>{escape(UNCONVERGED_TEXT)}. Continue it (<code>hbayes calibrate … --resume</code>)"
-        " and project again before acting on these numbers.</p>"
+        f"<p>{escape(UNCONVERGED_TEXT[:1].upper() + UNCONVERGED_TEXT[1:])}. Continue it "
+        "(<code>hbayes calibrate … --resume</code>) and project again before acting on "
+        "these numbers.</p>"
         + (f"<ul>{reasons}</ul>" if reasons else "")
         + "</div>"
     )

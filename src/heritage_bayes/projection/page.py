@@ -189,9 +189,7 @@ def _banner(proj) -> str:
         "<div class='note red' id='unconverged'><strong>Calibration not converged</strong>"
         f"<p>{escape(UNCONVERGED_TEXT[:1].upper() + UNCONVERGED_TEXT[1:])}. Continue it "
         "(<code>hbayes calibrate … --resume</code>) and project again before acting on "
-        "these numbers.</p>"
-        + (f"<ul>{reasons}</ul>" if reasons else "")
-        + "</div>"
+        "these numbers.</p>" + (f"<ul>{reasons}</ul>" if reasons else "") + "</div>"
     )
 
 

@@ -8,7 +8,6 @@ typed settings below the boundary are timedeltas and tz objects.
 from __future__ import annotations
 
 import datetime as dt
-import json
 import zoneinfo
 from pathlib import Path
 
@@ -29,22 +28,7 @@ from heritage_bayes.config import (
 )
 from heritage_bayes.config.loader import MAX_ALIASES
 from heritage_bayes.errors import ConfigError
-
-CONFIGS = Path(__file__).resolve().parents[1] / "configs"
-DEMO = {"data": {"demo": {}}, "thermal": {"model": "thermal_2c"}}
-
-
-def _error(raw) -> str:
-    with pytest.raises(ConfigError) as exc:
-        parse_config(raw)
-    return str(exc.value)
-
-
-def _with(**sections) -> dict:
-    raw = json.loads(json.dumps(DEMO))
-    raw.update(sections)
-    return raw
-
+from test_config import CONFIGS, _error, _with
 
 # -- durations need a unit -----------------------------------------------------------------
 

@@ -30,6 +30,7 @@ from heritage_bayes.config import (
     chain_tag,
     config_hash,
 )
+from heritage_bayes.convergence import unconverged_reasons
 from heritage_bayes.convert import format_timedelta
 from heritage_bayes.errors import InputError
 from heritage_bayes.inference.posterior import LogPosterior
@@ -61,10 +62,8 @@ __all__ = [
 ]
 
 
-def _parameters(cfg, section: str, model: RCModel, priors: Mapping):
-    """Noise model and parameter set (priors validated) of a config section
-    (:func:`heritage_bayes.run.section_parameters`)."""
-    return section_parameters(cfg, section, model, priors)
+#: Noise model and parameter set (priors validated) of a config section.
+_parameters = section_parameters
 
 
 def check_models(cfg: CalibrationConfig) -> None:
@@ -133,7 +132,8 @@ def _say_findings(say: _Progress, s: _Section) -> None:
     """
     s.map_at_bound = s.logpost.params.at_bound(s.map.x)
     capped = [n for n, side in s.map_at_bound if n.startswith("phi_") and side == "upper"]
-    if capped and s.logpost.noise.name == "ar1_white":
+    told = {(n, "upper") for n in capped} if s.logpost.noise.name == "ar1_white" else set()
+    if told:
         ph = s.logpost.params.parameters[s.logpost.params.names.index(capped[0])].prior.upper
         hours = -s.logpost.dt / 3600.0 / np.log(ph)
         say.warn(
@@ -170,8 +170,9 @@ def _say_findings(say: _Progress, s: _Section) -> None:
             )
             + ", or model the fixed node (thermal: options.ground; hygric: hygric_2c_fixed)"
         )
-    if s.map_at_bound:
-        what = ", ".join(f"{n} ({side})" for n, side in s.map_at_bound)
+    unexplained = [(n, side) for n, side in s.map_at_bound if (n, side) not in told]
+    if unexplained:  # a capped phi is explained above, not flagged twice
+        what = ", ".join(f"{n} ({side})" for n, side in unexplained)
         say.warn(
             f"[{s.name}] the MAP lies on a prior bound for {what}: the data push "
             "these parameters to the edge of the allowed range. Check the prior (is the "
@@ -358,7 +359,7 @@ def _calibrate_into(
     chash = config_hash(cfg)
     say = _Progress(quiet)
     # the heavy imports (arviz, scipy.optimize, emcee) only once the config is valid
-    from heritage_bayes.inference.idata import CONVERGENCE
+    from heritage_bayes.inference.idata import CONVERGENCE, build_run_outputs
     from heritage_bayes.inference.optimize import find_map, laplace
     from heritage_bayes.inference.sampler import run_sampler
     from heritage_bayes.prepare import prepare
@@ -478,9 +479,8 @@ def _calibrate_into(
             ladder[s.name] = model_ladder(cfg, prep, s, seed=cfg.seed + 101 * i)
             s.timings["ladder_seconds"] = time.perf_counter() - t0
     t0 = time.perf_counter()
-    from heritage_bayes.inference.idata import build_run_outputs
-
     idata, summary = build_run_outputs(cfg, prep, sections, chash=chash, seed=cfg.seed)
+    summary["unconverged_reasons"] = unconverged_reasons(summary)  # [] when converged
     t_out = time.perf_counter() - t0
     summary["ladder"] = ladder or None
     summary["timings"] = {

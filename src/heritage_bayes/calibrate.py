@@ -124,11 +124,12 @@ class _Section:
     timings: dict = field(default_factory=dict)
 
 
-def _say_findings(say: _Progress, s: _Section) -> None:
+def _say_findings(say: _Progress, s: _Section, priors: Mapping | tuple = ()) -> None:
     """Before sampling: a MAP on a prior bound, and parameters the data do not pin.
 
     Both are findings about the prior or the model, shown as warnings (and kept in
-    the summary); the sampler starts inside the support regardless.
+    the summary); the sampler starts inside the support regardless. A phi at its cap
+    whose prior the config sets (``priors``) is a decision taken: said, not warned.
     """
     s.map_at_bound = s.logpost.params.at_bound(s.map.x)
     capped = [n for n, side in s.map_at_bound if n.startswith("phi_") and side == "upper"]
@@ -136,7 +137,7 @@ def _say_findings(say: _Progress, s: _Section) -> None:
     if told:
         ph = s.logpost.params.parameters[s.logpost.params.names.index(capped[0])].prior.upper
         hours = -s.logpost.dt / 3600.0 / np.log(ph)
-        say.warn(
+        (say.say if capped[0] in priors else say.warn)(
             f"[{s.name}] {', '.join(capped)} at its cap {ph:g}: the misfit stays correlated "
             f"for longer than the noise model allows (about {hours:.0f} h), so the model "
             "misses a slow process (a missing input such as solar gains, a heat or "
@@ -170,8 +171,7 @@ def _say_findings(say: _Progress, s: _Section) -> None:
             )
             + ", or model the fixed node (thermal: options.ground; hygric: hygric_2c_fixed)"
         )
-    unexplained = [(n, side) for n, side in s.map_at_bound if (n, side) not in told]
-    if unexplained:  # a capped phi is explained above, not flagged twice
+    if unexplained := [b for b in s.map_at_bound if b not in told]:  # not flagged twice
         what = ", ".join(f"{n} ({side})" for n, side in unexplained)
         say.warn(
             f"[{s.name}] the MAP lies on a prior bound for {what}: the data push "
@@ -419,7 +419,7 @@ def _calibrate_into(
         ref = s.identifiability.scale_reference
         s.laplace = laplace(s.logpost, s.map.x, given=(ref,) if ref else ())
         s.timings["identifiability_seconds"] = time.perf_counter() - t0
-        _say_findings(say, s)
+        _say_findings(say, s, getattr(cfg, s.name).priors)
         t0 = time.perf_counter()
         update = say.sampler(s.name, cfg.sampler.max_steps)
         try:

@@ -54,7 +54,7 @@ def build_model(cfg: CalibrationConfig, section: str) -> RCModel:
     where = f"{section}.model"
     try:
         if isinstance(sec.model, Mapping):
-            m = Network.from_dict(sec.model, where=where).compile()
+            m = RCModel(Network.from_dict(sec.model, where=where))
             _check_names(m, where)
         else:
             if sec.model not in CATALOG:

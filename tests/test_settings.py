@@ -283,3 +283,20 @@ def test_a_phi_at_its_cap_is_warned_once_and_not_when_the_config_sets_it(monkeyp
     # with a single AR(1) the cap is not explained: the bound is flagged
     cal._say_findings(cal._Progress(quiet=False), _section_at_cap("ar1"))
     assert "the MAP lies on a prior bound for phi_Ti (upper)" in capsys.readouterr().err
+
+
+def test_a_parameter_the_config_pins_is_not_flagged_as_unidentified(monkeypatch, capsys):
+    """demo.yaml closes hygric_2c's Cw-Gw direction with a lognormal prior on Gw: the
+    advice 'add an informative prior' is already taken, so no warning for it."""
+    import heritage_bayes.calibrate as cal
+
+    monkeypatch.setattr(cal, "frozen_time_constant", lambda *a: None)
+    s = _section_at_cap("ar1")
+    s.logpost.params.at_bound = lambda x: []
+    s.identifiability.identifiable = {"Ci": True, "Gw": False}
+    cal._say_findings(cal._Progress(quiet=True), s)
+    assert "over-parameterised for these data (structurally not identifiable: Gw)" in (
+        capsys.readouterr().err
+    )
+    cal._say_findings(cal._Progress(quiet=True), s, {"Gw": {"dist": "lognormal"}})
+    assert capsys.readouterr().err == ""

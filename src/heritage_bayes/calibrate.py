@@ -127,9 +127,9 @@ class _Section:
 def _say_findings(say: _Progress, s: _Section, priors: Mapping | tuple = ()) -> None:
     """Before sampling: a MAP on a prior bound, and parameters the data do not pin.
 
-    Both are findings about the prior or the model, shown as warnings (and kept in
-    the summary); the sampler starts inside the support regardless. A phi at its cap
-    whose prior the config sets (``priors``) is a decision taken: said, not warned.
+    Findings about the prior or the model, warned (and kept in the summary); a parameter
+    whose prior the config sets (``priors``) is a decision taken: a capped phi is said,
+    not warned, and one the data do not pin is not flagged (its prior closes it).
     """
     s.map_at_bound = s.logpost.params.at_bound(s.map.x)
     capped = [n for n, side in s.map_at_bound if n.startswith("phi_") and side == "upper"]
@@ -183,9 +183,9 @@ def _say_findings(say: _Progress, s: _Section, priors: Mapping | tuple = ()) -> 
     # the overall scale of C and G (no known heat input) is a null direction only a
     # prior closes: reported in the identifiability section, not flagged here
     ok = ident.identifiable_given_scale if ident.has_scale_direction else ident.identifiable
-    structural = [p for p, good in ok.items() if not good]
+    structural = [p for p, good in ok.items() if not good and p not in priors]
     practical = list(s.laplace.unidentified) if s.laplace is not None else []
-    poor = [p for p in practical if p in s.model.parameter_names]
+    poor = [p for p in practical if p in s.model.parameter_names and p not in priors]
     if structural or poor:
         parts = []
         if structural:

@@ -6,7 +6,8 @@ Thin: parse arguments, call the library, map outcomes to exit codes:
 - 3: finished but **not converged** (``calibrate``: the run directory is complete, but a
   chain stopped at ``sampler.max_time`` or ``sampler.max_steps`` before the criteria
   held: ``summary.json`` has ``converged: false`` and ``unconverged_reasons``; continue
-  with ``--resume`` or a larger budget. ``batch``: every room finished, some unconverged);
+  with ``--resume`` or a larger budget. ``batch``: every room finished, some unconverged.
+  ``project``: written, but from an unconverged calibration);
 - 2: a user error (config, data, arguments; a message, no traceback);
 - 1: an internal error (a bug: the traceback is shown);
 - 130: interrupted by SIGINT or SIGTERM at any stage.

@@ -37,6 +37,7 @@ from heritage_bayes.inference.results import (
     atomic_write_text,
     dump_json,
     ensure_free_space,
+    write_inference_data,
 )
 from heritage_bayes.models import SECTIONS, _catalog_options, build_model, initial_state_of
 from heritage_bayes.rc.catalog import model as catalog_model
@@ -122,6 +123,7 @@ class _Section:
     frozen_node: dict | None = None  # the MAP's slowest mode, when many records long
     lp: np.ndarray | None = None
     timings: dict = field(default_factory=dict)
+    chain_tag: str = ""  # what the chain checkpoint must match (config, data, section)
 
 
 def _say_findings(say: _Progress, s: _Section) -> None:
@@ -359,7 +361,7 @@ def _calibrate_into(
     # the heavy imports (arviz, scipy.optimize, emcee) only once the config is valid
     from heritage_bayes.inference.idata import CONVERGENCE
     from heritage_bayes.inference.optimize import find_map, laplace
-    from heritage_bayes.inference.sampler import run_sampler
+    from heritage_bayes.inference.sampler import compact_checkpoint, run_sampler
     from heritage_bayes.prepare import prepare
     from heritage_bayes.rc.identify import structural_identifiability
 
@@ -420,6 +422,7 @@ def _calibrate_into(
         _say_findings(say, s)
         t0 = time.perf_counter()
         update = say.sampler(s.name, cfg.sampler.max_steps)
+        s.chain_tag = f"{chain_tag(cfg)}:{_data_hash(s.logpost)}:{s.name}"
         try:
             s.chain = run_sampler(
                 s.logpost,
@@ -435,7 +438,7 @@ def _calibrate_into(
                 tau_rtol=cfg.sampler.tau_rtol,
                 init_ball=cfg.sampler.init_ball,
                 checkpoint=out / f"chain_{s.name}.h5",
-                tag=f"{chain_tag(cfg)}:{_data_hash(s.logpost)}:{s.name}",
+                tag=s.chain_tag,
                 resume=resume,
                 progress=update,
                 notice=say.warn,
@@ -489,8 +492,10 @@ def _calibrate_into(
     }
     summary["wall_seconds"] = time.perf_counter() - t_start
     ensure_free_space(out / "posterior.nc", sum(int(idata[g].nbytes) for g in idata.groups()))
-    atomic_write(out / "posterior.nc", lambda p: idata.to_netcdf(str(p), engine="h5netcdf"))
+    atomic_write(out / "posterior.nc", lambda p: write_inference_data(idata, p))
     dump_json(out / "summary.json", summary)
+    for s in sections:  # a converged chain keeps only its retained draws (issue 28)
+        compact_checkpoint(out / f"chain_{s.name}.h5", s.chain_tag, s.chain, cfg.sampler.max_draws)
     say.say(
         f"summary: converged={summary['converged']}, max R-hat "
         f"{summary['max_rhat']:.3f}, min bulk ESS {summary['min_ess_bulk']:.0f}, "

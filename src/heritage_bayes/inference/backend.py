@@ -259,3 +259,67 @@ def _read_prefix(chain_ds, lp_ds, n: int, block: int = 64):
 
 def _cat(parts, ds):
     return np.concatenate(parts) if parts else np.zeros((0, *ds.shape[1:]))
+
+
+#: ``format`` attribute of a compacted checkpoint (see :func:`write_compact`).
+COMPACT_FORMAT = "compact-1"
+
+
+def write_compact(path: Path, tag: str, draws, log_prob, info: dict) -> None:
+    """Replace a converged chain's checkpoint by the draws its outputs use.
+
+    ``draws`` (kept steps, walkers, d) and ``log_prob`` (kept steps, walkers) are the
+    post-burn-in, thinned steps (float64: at most ``sampler.max_draws`` × d values, a
+    few hundred kB); ``info`` (JSON) records the chain they came from (steps, burn,
+    thin, τ, τ history, acceptance counts). The full chain is what ``--resume`` needs
+    while a chain is unconverged; once converged, these draws are all a resumed run
+    needs to rebuild its outputs. Datasets gzip-compressed with Fletcher-32 checksums;
+    written atomically.
+    """
+    from heritage_bayes.inference.results import atomic_write
+
+    def write(tmp: Path) -> None:
+        with h5py.File(tmp, "w") as f:
+            f.attrs["tag"] = tag
+            f.attrs["format"] = COMPACT_FORMAT
+            f.attrs["compact"] = json.dumps(info)
+            for name, a in (("draws", draws), ("draws_log_prob", log_prob)):
+                f.create_dataset(
+                    name,
+                    data=np.asarray(a, dtype="f8"),
+                    compression="gzip",
+                    shuffle=True,
+                    fletcher32=True,
+                )
+
+    atomic_write(Path(path), write)
+
+
+def read_compact(path: Path, tag: str) -> tuple[np.ndarray, np.ndarray, dict] | None:
+    """(draws, log_prob, info) of a compacted checkpoint (:func:`write_compact`), or
+    None for a full one (or none at all).
+
+    Raises
+    ------
+    InputError
+        A compacted checkpoint of another configuration, or an unreadable one.
+    """
+    path = Path(path)
+    if not path.is_file():
+        return None
+    try:
+        with h5py.File(path, "r") as f:
+            if f.attrs.get("format") != COMPACT_FORMAT:
+                return None
+            if f.attrs.get("tag") != tag:
+                raise InputError(
+                    f"{path}: this checkpoint belongs to a different configuration, "
+                    "model or data; run without --resume (it will be replaced) or restore "
+                    "the config and data it was made with"
+                )
+            return f["draws"][...], f["draws_log_prob"][...], json.loads(f.attrs["compact"])
+    except (OSError, KeyError, ValueError) as exc:
+        raise InputError(
+            f"{path}: the compacted chain checkpoint is damaged ({_first_line(exc)}); run "
+            "without --resume to sample afresh (the file is then replaced)"
+        ) from None

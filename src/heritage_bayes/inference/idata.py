@@ -34,6 +34,13 @@ CONVERGENCE = {"max_rhat": 1.01, "min_ess_bulk": 400.0}
 
 _OUT_UNITS = {"Ti": "°C", "Pi": "Pa", "RHi": "%"}
 
+#: About this many posterior-predictive draws are stored per variable (the
+#: ``posterior_predictive`` group); the bands are computed over all saved draws first.
+PREDICTIVE_DRAWS = 200
+#: Quantile levels of ``predictive_bands`` [-] (the report's 50 % and 90 % bands and
+#: the median).
+BAND_LEVELS = (0.05, 0.25, 0.5, 0.75, 0.95)
+
 
 def _times(prep) -> np.ndarray:
     idx = pd.DatetimeIndex(prep.frame.index)
@@ -54,6 +61,35 @@ def _saved_index(n_chain: int, n_draw: int, n_total: int) -> np.ndarray:
     """Draws per chain kept in ``posterior.nc``: evenly spaced, about ``n_total`` in all."""
     m = max(1, min(n_draw, math.ceil(n_total / n_chain)))
     return np.unique(np.linspace(0, n_draw - 1, m).round().astype(int))
+
+
+def predictive_bands(pp: dict[str, xr.DataArray]) -> dict[str, xr.DataArray]:
+    """Quantiles :data:`BAND_LEVELS` over (chain, draw) of each predictive variable:
+    (quantile, time) arrays in the variable's unit, exact over every draw given."""
+    out = {}
+    for k, da in pp.items():
+        v = np.asarray(da.values, dtype=float).reshape(-1, da.shape[-1])
+        q = np.quantile(v, BAND_LEVELS, axis=0)
+        out[k] = xr.DataArray(
+            q.astype(np.float32),
+            dims=("quantile", "time"),
+            coords={"quantile": np.asarray(BAND_LEVELS), "time": da["time"].values},
+            attrs=dict(da.attrs),
+        )
+    return out
+
+
+def bounded_predictive(
+    pp: dict[str, xr.DataArray], n_draws: int = PREDICTIVE_DRAWS
+) -> dict[str, xr.DataArray]:
+    """The predictive variables on about ``n_draws`` of their draws: the same evenly
+    spaced draws of every chain (so the pairing of thermal and hygric draws, and with
+    the posterior's ``draw`` labels, is kept)."""
+    if not pp:
+        return pp
+    da = next(iter(pp.values()))
+    keep = _saved_index(da.sizes["chain"], da.sizes["draw"], n_draws)
+    return {k: v.isel(draw=keep) for k, v in pp.items()}
 
 
 def _pointwise(s, pw: np.ndarray, times: np.ndarray, shape) -> dict[str, xr.DataArray]:
@@ -421,7 +457,10 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
         "posterior": xr.Dataset(post, coords=coords, attrs=attrs),
         "sample_stats": xr.Dataset(stats, coords=coords, attrs=attrs),
         "log_likelihood": xr.Dataset(loglik, coords=coords, attrs=attrs),
-        "posterior_predictive": xr.Dataset(pp, attrs=attrs),
+        # a bounded number of draws, the bands over all of them (issue 28: the
+        # predictive was 75 % of a 130 MB demo run directory)
+        "posterior_predictive": xr.Dataset(bounded_predictive(pp), attrs=attrs),
+        "predictive_bands": xr.Dataset(predictive_bands(pp), attrs=attrs),
         "observed_data": xr.Dataset(observed, attrs=attrs),
         "constant_data": xr.Dataset(const, attrs=attrs),
     }

@@ -18,7 +18,6 @@ import yaml
 from _report_browser import find_chromium, open_page
 from heritage_bayes._arviz import az
 from heritage_bayes.cli import main
-from heritage_bayes.inference.idata import PREDICTIVE_DRAWS
 from heritage_bayes.compare import (
     _block_se,
     _practical_rank,
@@ -27,6 +26,7 @@ from heritage_bayes.compare import (
     elpd_validation,
     load_inference,
 )
+from heritage_bayes.inference.idata import PREDICTIVE_DRAWS
 
 TINY = {
     "name": "tiny",

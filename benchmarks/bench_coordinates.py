@@ -30,18 +30,16 @@ os.environ.setdefault("MKL_NUM_THREADS", "1")
 
 import argparse
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
+import bench_sampling
 from _common import config_map
-from heritage_bayes._arviz import az
 from heritage_bayes.config import load_config
 from heritage_bayes.inference.coordinates import node_time_constants
-from heritage_bayes.inference.sampler import run_sampler
 
 ROOT = Path(__file__).resolve().parents[1]
 #: name -> (config, section, model (None: the config's own))
@@ -63,30 +61,19 @@ def _config(path: Path, section: str, model_name: str | None):
 
 
 def _run(label, lp, mp, coords, cfg, args):
-    c0, t0 = time.process_time(), time.perf_counter()
-    res = run_sampler(
+    return bench_sampling._run(
+        label,
         lp,
         mp.x,
-        seed=cfg.seed,
+        lambda x: x,  # the chain is stored in the log coordinates either way
+        lp.params.bounds,
+        cfg,
+        args.max_time,
         moves=cfg.sampler.moves,
-        bounds=lp.params.bounds,
         max_steps=args.max_steps,
-        max_seconds=args.max_time,
-        check_every=cfg.sampler.check_every,
-        tau_factor=cfg.sampler.tau_factor,
         max_draws=cfg.sampler.max_draws,
         coordinates=coords,
     )
-    cpu, wall = time.process_time() - c0, time.perf_counter() - t0
-    X, _ = res.draws(cfg.sampler.max_draws)
-    ess = float(az.ess(az.convert_to_dataset({"x": X}), method="bulk")["x"].min())
-    print(
-        f"  {label:<8s} steps {res.steps:7d}  τmax {np.nanmax(res.tau):7.0f}  converged "
-        f"{res.converged!s:5s}  wall {wall:7.1f} s  CPU {cpu:7.1f} s  min ESS {ess:6.0f}  "
-        f"ESS/CPU-s {ess / cpu:7.2f}",
-        flush=True,
-    )
-    return res, cpu, ess / cpu
 
 
 def main() -> None:

@@ -263,19 +263,24 @@ def _cat(parts, ds):
 
 #: ``format`` attribute of a compacted checkpoint (see :func:`write_compact`).
 COMPACT_FORMAT = "compact-1"
+#: Steps per walker of the trace a compacted checkpoint keeps (the report's plots).
+TRACE_STEPS = 400
 
 
-def write_compact(path: Path, tag: str, draws, log_prob, info: dict) -> None:
+def write_compact(path: Path, tag: str, draws, log_prob, info: dict, chain, chain_lp) -> None:
     """Replace a converged chain's checkpoint by the draws its outputs use.
 
     ``draws`` (kept steps, walkers, d) and ``log_prob`` (kept steps, walkers) are the
     post-burn-in, thinned steps (float64: at most ``sampler.max_draws`` × d values, a
     few hundred kB); ``info`` (JSON) records the chain they came from (steps, burn,
-    thin, τ, τ history, acceptance counts). The full chain is what ``--resume`` needs
-    while a chain is unconverged; once converged, these draws are all a resumed run
-    needs to rebuild its outputs. Datasets gzip-compressed with Fletcher-32 checksums;
-    written atomically.
+    thin, τ, τ history, acceptance counts). ``chain``/``log_prob`` hold a trace of
+    the whole chain for plots, burn-in included: every ``trace_stride``-th step
+    (attribute), at most :data:`TRACE_STEPS` per walker, float32. The full chain is
+    what ``--resume`` needs while a chain is unconverged; once converged, these draws
+    are all a resumed run needs to rebuild its outputs. Datasets gzip-compressed with
+    Fletcher-32 checksums; written atomically.
     """
+    stride = max(1, -(-int(chain.shape[0]) // TRACE_STEPS))
     from heritage_bayes.inference.results import atomic_write
 
     def write(tmp: Path) -> None:
@@ -283,10 +288,16 @@ def write_compact(path: Path, tag: str, draws, log_prob, info: dict) -> None:
             f.attrs["tag"] = tag
             f.attrs["format"] = COMPACT_FORMAT
             f.attrs["compact"] = json.dumps(info)
-            for name, a in (("draws", draws), ("draws_log_prob", log_prob)):
+            f.attrs["trace_stride"] = stride
+            for name, a, dtype in (
+                ("draws", draws, "f8"),
+                ("draws_log_prob", log_prob, "f8"),
+                ("chain", chain[::stride], "f4"),
+                ("log_prob", chain_lp[::stride], "f4"),
+            ):
                 f.create_dataset(
                     name,
-                    data=np.asarray(a, dtype="f8"),
+                    data=np.asarray(a, dtype=dtype),
                     compression="gzip",
                     shuffle=True,
                     fletcher32=True,

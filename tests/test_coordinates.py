@@ -149,3 +149,17 @@ def test_a_converged_chain_is_compacted_and_a_resume_rebuilds_from_its_draws(tmp
     before = (tmp_path / "c.h5").read_bytes()
     compact_checkpoint(tmp_path / "c.h5", "t", c, max_draws=400)
     assert not c.converged and (tmp_path / "c.h5").read_bytes() == before
+
+
+def test_default_coordinates_re_coordinate_three_node_networks_only():
+    from heritage_bayes.inference.coordinates import default_coordinates
+
+    lp2, _ = _logpost("thermal_2c")
+    assert default_coordinates(lp2) is None
+    m = hb.model("thermal_4a", surfaces=("S",))
+    noise = get_noise_model("ar1")
+    U = np.ones((48, len(m.input_names)))
+    lp4 = LogPosterior(m, parameters_for(m, noise), noise, U, np.ones((48, 1)), warmup=0)
+    c = default_coordinates(lp4)
+    names = lp4.params.free_names
+    assert sorted(names[k] for k, _ in c.nodes) == ["Ci", "Cint", "Cw"]

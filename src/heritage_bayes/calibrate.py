@@ -124,6 +124,7 @@ class _Section:
     lp: np.ndarray | None = None
     timings: dict = field(default_factory=dict)
     chain_tag: str = ""  # what the chain checkpoint must match (config, data, section)
+    coordinates: str = "log"  # what emcee moved in: "log" or "node_tau" (node time constants)
 
 
 def _say_findings(say: _Progress, s: _Section) -> None:
@@ -359,6 +360,7 @@ def _calibrate_into(
     chash = config_hash(cfg)
     say = _Progress(quiet)
     # the heavy imports (arviz, scipy.optimize, emcee) only once the config is valid
+    from heritage_bayes.inference.coordinates import default_coordinates
     from heritage_bayes.inference.idata import CONVERGENCE
     from heritage_bayes.inference.optimize import find_map, laplace
     from heritage_bayes.inference.sampler import compact_checkpoint, run_sampler
@@ -423,6 +425,8 @@ def _calibrate_into(
         t0 = time.perf_counter()
         update = say.sampler(s.name, cfg.sampler.max_steps)
         s.chain_tag = f"{chain_tag(cfg)}:{_data_hash(s.logpost)}:{s.name}"
+        coords = default_coordinates(s.logpost)
+        s.coordinates = "log" if coords is None else "node_tau"
         try:
             s.chain = run_sampler(
                 s.logpost,
@@ -445,6 +449,7 @@ def _calibrate_into(
                 max_rhat=CONVERGENCE["max_rhat"],
                 min_ess=CONVERGENCE["min_ess_bulk"],
                 max_draws=cfg.sampler.max_draws,
+                coordinates=coords,
             )
         finally:
             say.close()

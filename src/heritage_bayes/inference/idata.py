@@ -373,6 +373,7 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
             "map": s.map.to_dict(names),
             "identifiability": s.identifiability.to_dict(),
             "chain": {
+                "coordinates": getattr(s, "coordinates", "log"),
                 "walkers": int(W),
                 "steps": int(s.chain.steps),
                 "burn": int(s.chain.burn),

@@ -26,7 +26,7 @@ from heritage_bayes.compare import (
     elpd_validation,
     load_inference,
 )
-from heritage_bayes.inference.idata import PREDICTIVE_DRAWS
+from heritage_bayes.inference.predictive import PREDICTIVE_DRAWS
 
 TINY = {
     "name": "tiny",

@@ -9,7 +9,7 @@ import pytest
 import xarray as xr
 
 from heritage_bayes._arviz import az
-from heritage_bayes.inference.idata import (
+from heritage_bayes.inference.predictive import (
     BAND_LEVELS,
     PREDICTIVE_DRAWS,
     bounded_predictive,

@@ -13,7 +13,6 @@ for climate-change projections).
 
 from __future__ import annotations
 
-import hashlib
 import sys
 import time
 from collections.abc import Mapping
@@ -123,8 +122,6 @@ class _Section:
     frozen_node: dict | None = None  # the MAP's slowest mode, when many records long
     lp: np.ndarray | None = None
     timings: dict = field(default_factory=dict)
-    chain_tag: str = ""  # what the chain checkpoint must match (config, data, section)
-    coordinates: str = "log"  # what emcee moved in: "log" or "node_tau" (node time constants)
 
 
 def _say_findings(say: _Progress, s: _Section) -> None:
@@ -336,16 +333,6 @@ def _run_calibration(
     return out
 
 
-def _data_hash(lp: LogPosterior) -> str:
-    """SHA-256 (16 hex digits) of the prepared inputs and observations of a section."""
-    h = hashlib.sha256()
-    for a in (lp.inputs, lp.observed):
-        a = np.ascontiguousarray(a, dtype=float)
-        h.update(str(a.shape).encode())
-        h.update(a.tobytes())
-    return h.hexdigest()[:16]
-
-
 def _calibrate_into(
     out: Path,
     cfg: CalibrationConfig,
@@ -363,7 +350,7 @@ def _calibrate_into(
     from heritage_bayes.inference.coordinates import default_coordinates
     from heritage_bayes.inference.idata import CONVERGENCE
     from heritage_bayes.inference.optimize import find_map, laplace
-    from heritage_bayes.inference.sampler import compact_checkpoint, run_sampler
+    from heritage_bayes.inference.sampler import run_sampler
     from heritage_bayes.prepare import prepare
     from heritage_bayes.rc.identify import structural_identifiability
 
@@ -424,9 +411,6 @@ def _calibrate_into(
         _say_findings(say, s)
         t0 = time.perf_counter()
         update = say.sampler(s.name, cfg.sampler.max_steps)
-        s.chain_tag = f"{chain_tag(cfg)}:{_data_hash(s.logpost)}:{s.name}"
-        coords = default_coordinates(s.logpost)
-        s.coordinates = "log" if coords is None else "node_tau"
         try:
             s.chain = run_sampler(
                 s.logpost,
@@ -442,14 +426,15 @@ def _calibrate_into(
                 tau_rtol=cfg.sampler.tau_rtol,
                 init_ball=cfg.sampler.init_ball,
                 checkpoint=out / f"chain_{s.name}.h5",
-                tag=s.chain_tag,
+                tag=f"{chain_tag(cfg)}:{s.logpost.data_hash()}:{s.name}",
                 resume=resume,
                 progress=update,
                 notice=say.warn,
                 max_rhat=CONVERGENCE["max_rhat"],
                 min_ess=CONVERGENCE["min_ess_bulk"],
                 max_draws=cfg.sampler.max_draws,
-                coordinates=coords,
+                coordinates=default_coordinates(s.logpost),
+                compact=True,
             )
         finally:
             say.close()
@@ -499,8 +484,6 @@ def _calibrate_into(
     ensure_free_space(out / "posterior.nc", sum(int(idata[g].nbytes) for g in idata.groups()))
     atomic_write(out / "posterior.nc", lambda p: write_inference_data(idata, p))
     dump_json(out / "summary.json", summary)
-    for s in sections:  # a converged chain keeps only its retained draws (issue 28)
-        compact_checkpoint(out / f"chain_{s.name}.h5", s.chain_tag, s.chain, cfg.sampler.max_draws)
     say.say(
         f"summary: converged={summary['converged']}, max R-hat "
         f"{summary['max_rhat']:.3f}, min bulk ESS {summary['min_ess_bulk']:.0f}, "

@@ -57,6 +57,8 @@ class NodeTimeConstants:
         conductance, (free index or None when fixed, fixed value, log-scale?).
     """
 
+    name = "node_tau"
+
     def __init__(self, logpost):
         self.logpost = logpost
         params, model = logpost.params, logpost.model

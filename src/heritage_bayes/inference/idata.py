@@ -19,8 +19,11 @@ from heritage_bayes._arviz import az
 from heritage_bayes._version import __version__
 from heritage_bayes.climate.psychro import saturation_vapour_pressure
 from heritage_bayes.inference.predictive import (
+    _saved_index,
+    bounded_predictive,
     condensation_cap,
     initial_state_text,
+    predictive_bands,
     predictive_noise,
 )
 from heritage_bayes.inference.results import coverage, fit_metrics
@@ -33,13 +36,6 @@ __all__ = ["CONVERGENCE", "build_run_outputs"]
 CONVERGENCE = {"max_rhat": 1.01, "min_ess_bulk": 400.0}
 
 _OUT_UNITS = {"Ti": "°C", "Pi": "Pa", "RHi": "%"}
-
-#: About this many posterior-predictive draws are stored per variable (the
-#: ``posterior_predictive`` group); the bands are computed over all saved draws first.
-PREDICTIVE_DRAWS = 200
-#: Quantile levels of ``predictive_bands`` [-] (the report's 50 % and 90 % bands and
-#: the median).
-BAND_LEVELS = (0.05, 0.25, 0.5, 0.75, 0.95)
 
 
 def _times(prep) -> np.ndarray:
@@ -55,41 +51,6 @@ def _period_codes(prep) -> np.ndarray:
         code[prep.validation] = 2
     code[cal.start : cal.start + prep.warmup_steps] = 0
     return code
-
-
-def _saved_index(n_chain: int, n_draw: int, n_total: int) -> np.ndarray:
-    """Draws per chain kept in ``posterior.nc``: evenly spaced, about ``n_total`` in all."""
-    m = max(1, min(n_draw, math.ceil(n_total / n_chain)))
-    return np.unique(np.linspace(0, n_draw - 1, m).round().astype(int))
-
-
-def predictive_bands(pp: dict[str, xr.DataArray]) -> dict[str, xr.DataArray]:
-    """Quantiles :data:`BAND_LEVELS` over (chain, draw) of each predictive variable:
-    (quantile, time) arrays in the variable's unit, exact over every draw given."""
-    out = {}
-    for k, da in pp.items():
-        v = np.asarray(da.values, dtype=float).reshape(-1, da.shape[-1])
-        q = np.quantile(v, BAND_LEVELS, axis=0)
-        out[k] = xr.DataArray(
-            q.astype(np.float32),
-            dims=("quantile", "time"),
-            coords={"quantile": np.asarray(BAND_LEVELS), "time": da["time"].values},
-            attrs=dict(da.attrs),
-        )
-    return out
-
-
-def bounded_predictive(
-    pp: dict[str, xr.DataArray], n_draws: int = PREDICTIVE_DRAWS
-) -> dict[str, xr.DataArray]:
-    """The predictive variables on about ``n_draws`` of their draws: the same evenly
-    spaced draws of every chain (so the pairing of thermal and hygric draws, and with
-    the posterior's ``draw`` labels, is kept)."""
-    if not pp:
-        return pp
-    da = next(iter(pp.values()))
-    keep = _saved_index(da.sizes["chain"], da.sizes["draw"], n_draws)
-    return {k: v.isel(draw=keep) for k, v in pp.items()}
 
 
 def _pointwise(s, pw: np.ndarray, times: np.ndarray, shape) -> dict[str, xr.DataArray]:
@@ -373,7 +334,7 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
             "map": s.map.to_dict(names),
             "identifiability": s.identifiability.to_dict(),
             "chain": {
-                "coordinates": getattr(s, "coordinates", "log"),
+                "coordinates": getattr(s.chain, "coordinates", "log"),
                 "walkers": int(W),
                 "steps": int(s.chain.steps),
                 "burn": int(s.chain.burn),

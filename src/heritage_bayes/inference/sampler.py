@@ -97,6 +97,9 @@ class ChainResult:
         ``chain`` holds only the retained draws (read back from a compacted
         checkpoint, :func:`compact_checkpoint`); ``burn``/``thin`` describe the chain
         they came from, ``n_steps`` its length.
+    coordinates : str
+        What emcee moved in: ``"log"`` (the log-posterior's own coordinates) or the
+        ``name`` of the change of variables (``"node_tau"``).
     """
 
     chain: np.ndarray
@@ -113,6 +116,7 @@ class ChainResult:
     stopped_by: str = ""  # "converged", "max_steps", "max_seconds"
     thinned: bool = False
     n_steps: int | None = None
+    coordinates: str = "log"
 
     @property
     def steps(self) -> int:
@@ -361,6 +365,7 @@ def _run_sampler(
     min_ess: float | None = 400.0,
     max_draws: int = 4000,
     coordinates=None,
+    compact: bool = False,
 ) -> ChainResult:
     """Sample the posterior with emcee until converged (see module docstring).
 
@@ -550,7 +555,7 @@ def _run_sampler(
     chain = np.concatenate(chunks_x)
     log_prob = np.concatenate(chunks_lp)
     burn, thin = _burn_thin(tau, chain.shape[0])
-    return ChainResult(
+    result = ChainResult(
         chain=chain,
         log_prob=log_prob,
         accepted=accepted,
@@ -563,4 +568,8 @@ def _run_sampler(
         resumed_from=resumed_from,
         cpu_seconds=time.process_time() - c0,
         stopped_by="converged" if converged else "max_seconds" if out_of_time else "max_steps",
+        coordinates="log" if coordinates is None else getattr(coordinates, "name", "custom"),
     )
+    if compact and ck is not None:
+        compact_checkpoint(ck.path, tag, result, max_draws)
+    return result

@@ -53,7 +53,7 @@ from pathlib import Path
 
 import numpy as np
 
-from heritage_bayes.io._common import to_jsonable
+from heritage_bayes.convert import to_jsonable
 
 __all__ = [
     "PREDICTIVE_QUANTUM",

@@ -139,7 +139,11 @@ def default_coordinates(logpost) -> NodeTimeConstants | None:
     the two-node models it changed nothing beyond the noise of the τ estimate and
     never helped (demo thermal_2c τmax 133 → 149, hygric_2c 47 → 50, ESS per CPU
     second × 1.05 and × 0.87): their node time constants are nearly their modes'
-    already, and the log coordinates are kept there.
+    already, and the log coordinates are kept there. TRH-1's thermal_2c (a loose
+    envelope node, 30 000 steps) gained most (τmax 2 889 → 855, ESS per CPU second
+    × 6.3): pass ``node_time_constants(logpost)`` to ``run_sampler`` for such rooms;
+    the default for two-node networks stays until the statistical tests that pin
+    their chains have been re-run with it.
     """
     if logpost.model.n_states < MIN_NODES:
         return None

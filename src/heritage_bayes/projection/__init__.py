@@ -92,6 +92,8 @@ class Projection:
     summary: dict
     dataset: object = None
     paths: dict = field(default_factory=dict)
+    #: measure name -> per-case results with the measure (paired with ``results``)
+    interventions: dict = field(default_factory=dict)
 
     def probability_table(self):
         """pandas.DataFrame: probability statements (rows) × cases (columns)."""
@@ -154,6 +156,7 @@ def project(
     """
     from heritage_bayes.climate.risk.registry import indicator_info, years_of
     from heritage_bayes.projection.engine import select_draws, simulate_cases
+    from heritage_bayes.projection.interventions import compare_measures, measures_from_config
     from heritage_bayes.projection.summary import summarize
     from heritage_bayes.projection.weather import Case, baseline_weather, futures, model_inputs
     from heritage_bayes.run import Run, load_run
@@ -194,6 +197,27 @@ def project(
     horizons = [c.horizon for c in cases]
     units = dict(results[0].predictive.attrs.get("units", {}))
     summary = summarize(labels, horizons, results, labels[0], pcfg.thresholds, units)
+    measures = measures_from_config(pcfg)
+    for m in measures:  # refused before the long part
+        m.check(r)
+    per_measure = {}
+    for m in measures:
+        if progress is not None:
+            progress(f"intervention {m.name!r}")
+        per_measure[m.name] = simulate_cases(
+            r,
+            sel,
+            [c.inputs for c in cases],
+            seed=pcfg.seed,
+            noise=pcfg.noise,
+            chunk=pcfg.risk.chunk_draws,
+            risk_options=risk_opts,
+            progress=progress,
+            measure=m,
+        )
+    summary["interventions"] = compare_measures(
+        labels, results, per_measure, pcfg.thresholds, units, {m.name: m.notes(r) for m in measures}
+    )
     summary["cases"] = [
         {
             "label": c.label,
@@ -220,8 +244,15 @@ def project(
     summary["seconds"] = {
         "total": time.perf_counter() - t_start,
         **{k: float(sum(res.seconds[k] for res in results)) for k in ("simulate", "noise", "risk")},
+        "interventions": float(
+            sum(
+                res.seconds["simulate"] + res.seconds["risk"]
+                for rs in per_measure.values()
+                for res in rs
+            )
+        ),
     }
-    proj = Projection(pcfg, labels, horizons, results, summary)
+    proj = Projection(pcfg, labels, horizons, results, summary, interventions=per_measure)
     from heritage_bayes.projection.output import to_dataset, write_outputs
 
     proj.dataset = to_dataset(proj, r)

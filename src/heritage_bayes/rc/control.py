@@ -97,6 +97,8 @@ class Control:
         The weekly calendar that generates the schedule column :data:`HOURS_OF_USE`.
     conservation : bool
         Conservation heating: the set-point also keeps RH <= ``RH_ch`` (input ``Pi``).
+    t_max : float
+        Upper limit [°C] of the conservation-heating set-point (default none).
     humidistat : str or None
         One of ``band``, ``dehumidifier``, ``humidifier``, ``setpoint``.
     capacity : bool
@@ -116,6 +118,10 @@ class Control:
     capacity: bool = False
     source: bool = False
     enabled: frozenset = frozenset(COMPONENTS)
+    #: Conservation heating never raises the air above this temperature [°C] (the
+    #: upper limit of an intervention: a conservation-heating set-point is capped at
+    #: it, the RH limit then yields); not a parameter, so calibrated draws still apply.
+    t_max: float = math.inf
 
     @property
     def active(self) -> bool:
@@ -379,7 +385,16 @@ class ControlledModel(RCModel):
 
     # ------------------------------------------------------------------ simulation
     def forward(
-        self, P, U, dt, *, u_init=None, x0=None, effort: bool = False, max_block: int = 2**22
+        self,
+        P,
+        U,
+        dt,
+        *,
+        u_init=None,
+        x0=None,
+        effort: bool = False,
+        max_block: int = 2**22,
+        spin_up: int = 0,
     ):
         """Controlled simulation of a batch: outputs (K, N, n_out) and validity (K,).
 
@@ -399,6 +414,15 @@ class ControlledModel(RCModel):
             dehumidification < 0; the constant source not included).
         max_block : int
             Forcing values held in memory at once (doubles).
+        spin_up : int
+            Instead of the mean-flow correction of ``u_init``'s steady state, run the
+            controller over the first ``spin_up`` steps from the free-running steady
+            state and add the state difference it made (controlled minus free-running
+            at the end) to that steady state (periodic spin-up: with a year of hourly
+            weather, its end is the start of the next; a controller that never acts
+            starts exactly where the free-running model does). For
+            capacity-limited controllers that have not reached their bound within the
+            720 steps of the mean-flow correction (slow rooms, small capacities).
         """
         from heritage_bayes.rc.discretize import modal_form
 
@@ -430,12 +454,21 @@ class ControlledModel(RCModel):
         ad = np.ascontiguousarray(mf.ad)
         rows = max(256, max_block // max(ecat.size, 1))
 
-        def run(Uin, z, Y, Q):
+        def run(Uin, z, Y, Q, control=True):
+            kw = _rows(c) if control else {**_rows(c), "mode": 0}
             for k0 in range(0, Uin.shape[0], rows):
                 W = Uin[k0 : k0 + rows] @ Bcat + ecat
-                _control_run(ad, W, bd, Cz, z, Y, Q, k0, **_rows(c))
+                _control_run(ad, W, bd, Cz, z, Y, Q, k0, **kw)
 
-        if x0 is None and c["on"]:
+        if x0 is None and c["on"] and spin_up > 0:
+            # the state the control has moved the room by, added to the steady state
+            n0 = min(N, int(spin_up))
+            zc, zf = z0.copy(), z0.copy()
+            yb, q = np.empty((K, n0, Cz.shape[1])), np.zeros((K, n0))
+            run(Un[:n0], zc, yb, q)
+            run(Un[:n0], zf, yb, q, control=False)
+            z0 = np.ascontiguousarray(z0 + (zc - zf))
+        elif x0 is None and c["on"]:
             # one controller pass over the start to put the mean control flow in the
             # initial steady state (the heating floor reaches the slow envelope modes)
             n0 = min(N, 720)
@@ -463,6 +496,7 @@ class ControlledModel(RCModel):
         zero = np.zeros(K)
         out = {
             "mode": 0,
+            "t_max": float(c.t_max),
             "lo0": zero,
             "lo1": zero,
             "hi1": zero,
@@ -514,6 +548,7 @@ def _rows(c: dict) -> dict:
         "qadd": c["qadd"],
         "qrem": c["qrem"],
         "rh_ch": c["rh_ch"],
+        "t_max": c["t_max"],
         "sig": c["s"],
         "pv": c["pv"],
     }
@@ -531,7 +566,7 @@ def _t_at_rh(pv, rh):  # pragma: no cover - compiled
 
 @numba.njit(cache=True, nogil=True)
 def _control_run(
-    ad, W, bd, Cz, z, Y, Q, k0, mode, lo0, lo1, hi1, qadd, qrem, rh_ch, sig, pv
+    ad, W, bd, Cz, z, Y, Q, k0, mode, lo0, lo1, hi1, qadd, qrem, rh_ch, t_max, sig, pv
 ):  # pragma: no cover - compiled
     """Controlled modal recursion (see the module docstring) over the rows of W, in place.
 
@@ -569,6 +604,8 @@ def _control_run(
                 lo = lo0[p] + lo1[p] * sig[k]
                 if mode == 3:
                     tc = _t_at_rh(pv[k], rh_ch[p])
+                    if tc > t_max:
+                        tc = t_max
                     if tc > lo:
                         lo = tc
                 if yf < lo:

@@ -166,14 +166,14 @@ def test_project_compares_measures_and_draws_the_page(run, tmp_path):
     assert list(iv) == ["conservation heating", "dehumidifier", "half ventilation"]
     for e in iv.values():
         assert set(e["cases"]) == set(p.labels)
-        for d in e["cases"]["warm"]["indicators"].values():
+        for d in e["cases"]["warm 2050"]["indicators"].values():
             assert d["p_better"] is None or 0 <= d["p_better"] <= 1
             assert d["q05"] is None or d["q05"] <= d["q50"] <= d["q95"]
-    ch = iv["conservation heating"]["cases"]["warm"]
+    ch = iv["conservation heating"]["cases"]["warm 2050"]
     assert ch["costs"]["heating_energy"]["q50"] > 0
     assert ch["costs"]["heating_peak"]["q95"] <= 2.0 + 1e-9
     assert iv["half ventilation"]["notes"]  # thermal_1c has no separate Gfast
     html = Path(p.paths["html"]).read_text(encoding="utf-8")
-    assert "id='interventions'" in html
+    assert 'id="interventions"' in html
     assert "id='fig-tradeoff'" in html
     assert "priors" in html  # the absolute scale is said to come from the priors

@@ -177,3 +177,14 @@ def test_project_compares_measures_and_draws_the_page(run, tmp_path):
     assert 'id="interventions"' in html
     assert "id='fig-tradeoff'" in html
     assert "priors" in html  # the absolute scale is said to come from the priors
+
+
+def test_shipped_interventions_config_validates():
+    from heritage_bayes.projection import load_projection_config
+
+    cfg = load_projection_config(
+        Path(__file__).resolve().parents[1] / "configs" / "projection_interventions.yaml"
+    )
+    ms = measures_from_config(cfg)
+    assert [m.name for m in ms] == ["conservation heating", "dehumidifier", "half the ventilation"]
+    assert ms[0].heating == (0.65, -273.15, 22.0, 5000.0) and ms[2].ventilation == 0.5

@@ -183,28 +183,12 @@ def project(
     converged = bool(r.summary.get("converged", True))
     if not converged and progress is not None:
         progress(f"WARNING: {UNCONVERGED_TEXT} ({r.path})")
-    results = simulate_cases(
-        r,
-        sel,
-        [c.inputs for c in cases],
-        seed=pcfg.seed,
-        noise=pcfg.noise,
-        chunk=pcfg.risk.chunk_draws,
-        risk_options=risk_opts,
-        progress=progress,
-    )
-    labels = [c.label for c in cases]
-    horizons = [c.horizon for c in cases]
-    units = dict(results[0].predictive.attrs.get("units", {}))
-    summary = summarize(labels, horizons, results, labels[0], pcfg.thresholds, units)
     measures = measures_from_config(pcfg)
     for m in measures:  # refused before the long part
         m.check(r)
-    per_measure = {}
-    for m in measures:
-        if progress is not None:
-            progress(f"intervention {m.name!r}")
-        per_measure[m.name] = simulate_cases(
+
+    def run_cases(measure=None):
+        return simulate_cases(
             r,
             sel,
             [c.inputs for c in cases],
@@ -213,8 +197,19 @@ def project(
             chunk=pcfg.risk.chunk_draws,
             risk_options=risk_opts,
             progress=progress,
-            measure=m,
+            measure=measure,
         )
+
+    results = run_cases()
+    labels = [c.label for c in cases]
+    horizons = [c.horizon for c in cases]
+    units = dict(results[0].predictive.attrs.get("units", {}))
+    summary = summarize(labels, horizons, results, labels[0], pcfg.thresholds, units)
+    per_measure = {}
+    for m in measures:  # paired with doing nothing: same draws, noise seed and weather
+        if progress is not None:
+            progress(f"intervention {m.name!r}")
+        per_measure[m.name] = run_cases(m)
     summary["interventions"] = compare_measures(
         labels, results, per_measure, pcfg.thresholds, units, {m.name: m.notes(r) for m in measures}
     )

@@ -182,14 +182,8 @@ class Measure:
                 Control(thermostat=True, conservation=True, power_limit=limited, t_max=t_max),
             )
             extra = {"Tset": t_min, "Pmax": pmax, "RH_ch": rh}
-            Q = np.empty((k, N))
-            for p in range(k):
-                P = _extended(ctl, model["thermal"][p : p + 1], extra)
-                Uc = np.column_stack([U["thermal"], Y["hygric"][p]])
-                u = np.r_[u0["thermal"], Y["hygric"][p, :1]]
-                y, ok, Q[p] = ctl.forward(P, Uc, dt, u_init=u, effort=True, spin_up=spin)
-                _check_valid(ok, self.name, P)
-                Y["thermal"][p] = y[0, :, 0]
+            Y["thermal"], Q = self._per_draw(ctl, model["thermal"], U["thermal"], Y["hygric"],
+                                             u0["thermal"], extra, dt, spin)  # fmt: skip
             e = np.clip(Q, 0.0, None)  # [W]
             costs["heating_energy"] = e.sum(axis=1) * dt / 3.6e6 / years
             costs["heating_peak"] = e.max(axis=1) / 1e3
@@ -198,20 +192,29 @@ class Measure:
             m = run.models["hygric"]
             ctl = ControlledModel(m.network, Control(humidistat="dehumidifier", capacity=True))
             extra = {"RH_hi": rh, "M_dehum": cap}
-            Q = np.empty((k, N))
-            for p in range(k):
-                P = _extended(ctl, model["hygric"][p : p + 1], extra)
-                Uc = np.column_stack([U["hygric"], Y["thermal"][p]])
-                u = np.r_[u0["hygric"], Y["thermal"][p, :1]]
-                y, ok, Q[p] = ctl.forward(P, Uc, dt, u_init=u, effort=True, spin_up=spin)
-                _check_valid(ok, self.name, P)
-                Y["hygric"][p] = y[0, :, 0]
+            Y["hygric"], Q = self._per_draw(ctl, model["hygric"], U["hygric"], Y["thermal"],
+                                            u0["hygric"], extra, dt, spin)  # fmt: skip
             w = np.clip(-Q, 0.0, None)  # [kg/s]
             costs["water_removed"] = w.sum(axis=1) * dt / years
             costs["dehumidifier_peak"] = w.max(axis=1) * 3600.0
             if e_kg is not None:
                 costs["dehumidifier_energy"] = costs["water_removed"] * e_kg
         return Y, costs
+
+    def _per_draw(self, ctl, P, U, other, u0, extra, dt, spin) -> tuple:
+        """Controlled outputs (k, N) and control flows (k, N) of ``ctl``, draw by draw:
+        each draw's control input (``Pi`` for conservation heating, ``Ti`` for the
+        humidistat) is its own simulated series ``other[p]``."""
+        k, N = other.shape
+        Y, Q = np.empty((k, N)), np.empty((k, N))
+        for p in range(k):
+            Pp = _extended(ctl, P[p : p + 1], extra)
+            Uc = np.column_stack([U, other[p]])
+            u = np.r_[u0, other[p, :1]]
+            y, ok, Q[p] = ctl.forward(Pp, Uc, dt, u_init=u, effort=True, spin_up=spin)
+            _check_valid(ok, self.name, Pp)
+            Y[p] = y[0, :, 0]
+        return Y, Q
 
 
 def _check_valid(ok: np.ndarray, name: str, P: np.ndarray) -> None:

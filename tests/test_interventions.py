@@ -173,6 +173,12 @@ def test_project_compares_measures_and_draws_the_page(run, tmp_path):
     assert ch["costs"]["heating_energy"]["q50"] > 0
     assert ch["costs"]["heating_peak"]["q95"] <= 2.0 + 1e-9
     assert iv["half ventilation"]["notes"]  # thermal_1c has no separate Gfast
+    ds = p.dataset
+    assert list(ds["measure"].values) == list(iv)
+    e = ds["cost_heating_energy"].sel(measure="conservation heating", case="warm 2050")
+    assert float(e.median()) == pytest.approx(ch["costs"]["heating_energy"]["q50"], rel=1e-5)
+    assert np.isnan(ds["cost_heating_energy"].sel(measure="dehumidifier")).all()
+    assert ds["twpi_measure"].dims == ("measure", "case", "draw")
     html = Path(p.paths["html"]).read_text(encoding="utf-8")
     assert 'id="interventions"' in html
     assert "id='fig-tradeoff'" in html

@@ -24,6 +24,14 @@ change relative to the baseline, probability statements, the uncertainty
 decomposition, the indicator registry, the weather transformations, timings),
 ``projection.csv`` (one row per indicator and case, with name, unit, period and source)
 and ``projection.html`` (self-contained decision page).
+
+Measures (``interventions:``, :mod:`heritage_bayes.projection.interventions`):
+conservation heating, a dehumidifier, less ventilation — each simulated draw by draw
+with the same parameters, noise and weather as doing nothing, in every case. Their
+indicators (``<indicator>_measure``) and running costs (``cost_<name>``) per measure,
+case and draw are in ``projection.nc``; the paired comparison (change with interval,
+P(better), probability statements with and without, costs with intervals) in
+``projection.json`` (``interventions``) and on the page.
 """
 
 from __future__ import annotations

@@ -207,9 +207,11 @@ class Measure:
         humidistat) is its own simulated series ``other[p]``."""
         k, N = other.shape
         Y, Q = np.empty((k, N)), np.empty((k, N))
+        Uc = np.empty((N, U.shape[1] + 1))
+        Uc[:, :-1] = U
         for p in range(k):
             Pp = _extended(ctl, P[p : p + 1], extra)
-            Uc = np.column_stack([U, other[p]])
+            Uc[:, -1] = other[p]
             u = np.r_[u0, other[p, :1]]
             y, ok, Q[p] = ctl.forward(Pp, Uc, dt, u_init=u, effort=True, spin_up=spin)
             _check_valid(ok, self.name, Pp)

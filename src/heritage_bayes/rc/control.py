@@ -432,7 +432,8 @@ class ControlledModel(RCModel):
         N = U.shape[0]
         mf = modal_form(self, P, dt)
         valid = mf.valid & self._control_ok(P)
-        Un, Uc = U[:, : self._m_net], U[:, self._m_net :]
+        # contiguous: the forcing product below is 10x slower on a strided view
+        Un, Uc = np.ascontiguousarray(U[:, : self._m_net]), U[:, self._m_net :]
         air = int(self._ix["out"][0])
         # modal response to a unit flow into the air node: continuous and one-step ZOH
         bz = mf.s[:, air, None] * mf.V[:, air, :]  # (K, n)

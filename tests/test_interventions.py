@@ -107,6 +107,21 @@ def test_power_limit_bounds_the_peak(run, case):
     assert np.all(heat.costs["heating_peak"] <= 0.2 + 1e-12)  # [kW]
 
 
+def test_heating_schedule(run, case):
+    """A thermostat at 10 °C raises the mean T and lowers the mean RH in every draw;
+    16 °C on Sunday mornings (UTC+1) costs more energy in every draw."""
+    from heritage_bayes.rc.calendar import parse_weekly
+
+    _, _, nothing = case
+    base = _with(run, case, Measure("t", thermostat=(10.0, None, None, np.inf)))
+    assert np.all(base.Ti_month.mean(axis=1) > nothing.Ti_month.mean(axis=1))
+    assert np.all(base.RHi_month.mean(axis=1) < nothing.RHi_month.mean(axis=1))
+    cal = parse_weekly({"weekly": ["Sun 08-12"], "timezone": "UTC+1"})
+    use = _with(run, case, Measure("s", thermostat=(10.0, 16.0, cal, np.inf)))
+    assert np.all(use.costs["heating_energy"] > base.costs["heating_energy"])
+    assert np.all(base.costs["heating_energy"] > 0)
+
+
 def test_dehumidifier_lowers_rh_and_removes_water(run, case):
     _, _, nothing = case
     dry = _with(run, case, Measure("dh", dehumidifier=(0.45, 5.0 / 3600, 0.7)))
@@ -126,12 +141,19 @@ def test_schema():
             {"name": "ch", "conservation_heating": {"rh_max": 65, "t_max": 20, "t_min": 5}},
             {"name": "dh", "dehumidification": {"rh_max": 60, "capacity": 0.5}},
             {"name": "less air", "ventilation": {"factor": 0.5}},
+            {
+                "name": "services",
+                "heating": {"t_set": 8, "t_use": 16, "weekly": ["Sun 08-12"], "timezone": "UTC+1"},
+                "dehumidification": {"rh_max": 60, "capacity": 0.5},
+            },
         ],
     }
     ms = measures_from_config(parse_projection_config(ok))
     assert ms[0].heating == (0.65, 5.0, 20.0, np.inf)
     assert ms[1].dehumidifier == (0.6, 0.5 / 3600, None)
     assert ms[2].ventilation == 0.5
+    assert ms[3].thermostat[:2] == (8.0, 16.0) and ms[3].thermostat[2].hours_per_week == 4
+    assert ms[3].dehumidifier is not None
     bad = [
         ({"name": "x", "conservation_heating": {"rh_max": 65, "t_max": 20, "power": 1}},
          "power"),
@@ -142,6 +164,11 @@ def test_schema():
         ({"name": "x", "conservation_heating": {"rh_max": 65, "t_min": 20, "t_max": 10}},
          "t_min"),
         ({"name": "x", "ventilation": {"factor": -1}}, "factor"),
+        ({"name": "x", "heating": {"t_set": 8, "t_use": 16}}, "together"),
+        ({"name": "x", "heating": {"t_set": 8, "t_use": 16, "weekly": ["Sun 25-26"]}},
+         "heating"),
+        ({"name": "x", "heating": {"t_set": 8},
+          "conservation_heating": {"rh_max": 65, "t_max": 20}}, "give one"),
     ]  # fmt: skip
     for item, needle in bad:
         with pytest.raises(ConfigError, match=needle):

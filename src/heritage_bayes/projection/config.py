@@ -45,8 +45,10 @@ parameters, noise and weather as doing nothing, on the baseline and every future
         dehumidification: {rh_max: 60, capacity: 0.5, energy_per_kg: 0.7}
       - name: half the ventilation
         ventilation: {factor: 0.5}
+      - name: heating for services
+        heating: {t_set: 8, t_use: 16, weekly: ["Sun 08-12"], timezone: UTC+1}
 
-(``ventilation`` combines with either of the others in one measure.)
+(``ventilation`` combines with any other; ``heating`` with ``dehumidification``.)
 
 Probability statements (``thresholds``), on any indicator the projection computes
 (:mod:`heritage_bayes.climate.risk.registry`; an unknown name is refused with the list)::
@@ -162,6 +164,35 @@ class ConservationHeating(_Strict):
         return self
 
 
+class Heating(_Strict):
+    """A thermostat: the air heated to ``t_set`` and, in the hours of use of a weekly
+    calendar, to ``t_use`` (intermittent heating of a church), up to ``power_max``."""
+
+    t_set: float = key(unit="°C", description="set-point outside the hours of use")
+    t_use: float | None = key(
+        None, unit="°C", description="set-point in the hours of use (needs weekly)"
+    )
+    weekly: list[str] | None = key(
+        None,
+        unit=None,
+        description="hours of use, e.g. ['Sun 08-12', 'Sat 18-20'] (heritage_bayes.rc.calendar)",
+    )
+    timezone: str = key("UTC", unit=None, description="time zone of the weekly hours")
+    power_max: float | None = key(
+        None, unit="W", gt=0, description="heating power available (default unlimited)"
+    )
+
+    @model_validator(mode="after")
+    def _use(self):
+        if (self.t_use is None) != (self.weekly is None):
+            raise ValueError("give t_use and weekly together (or neither)")
+        if self.weekly is not None:
+            from heritage_bayes.rc.calendar import parse_weekly
+
+            parse_weekly({"weekly": self.weekly, "timezone": self.timezone}, "heating")
+        return self
+
+
 class Dehumidification(_Strict):
     """A humidistat-controlled dehumidifier: RH at or below ``rh_max``, at most
     ``capacity`` of water removed."""
@@ -189,12 +220,15 @@ class Ventilation(_Strict):
 
 
 class Intervention(_Strict):
-    """A named measure: one change to the calibrated room (``ventilation`` may be
-    combined with one of the controls)."""
+    """A named measure: a change to the calibrated room (``ventilation`` combines with
+    any other, ``heating`` with ``dehumidification``)."""
 
     name: str = key(unit=None, min_length=1, description="name on the page and in outputs")
     conservation_heating: ConservationHeating | None = key(
         None, unit=None, description="heat to keep the RH down"
+    )
+    heating: Heating | None = key(
+        None, unit=None, description="a thermostat with an optional weekly schedule"
     )
     dehumidification: Dehumidification | None = key(
         None, unit=None, description="a dehumidifier with a humidistat"
@@ -203,11 +237,19 @@ class Intervention(_Strict):
 
     @model_validator(mode="after")
     def _one(self):
-        if self.conservation_heating is None and self.dehumidification is None:
-            if self.ventilation is None:
-                raise ValueError(
-                    "give a change: conservation_heating, dehumidification or ventilation"
-                )
+        if all(
+            x is None
+            for x in (self.conservation_heating, self.heating, self.dehumidification,
+                      self.ventilation)
+        ):  # fmt: skip
+            raise ValueError(
+                "give a change: conservation_heating, heating, dehumidification or ventilation"
+            )
+        if self.conservation_heating is not None and self.heating is not None:
+            raise ValueError(
+                "conservation_heating and heating are both thermostats; give one (the "
+                "conservation heating's t_min is a heating floor)"
+            )
         if self.conservation_heating is not None and self.dehumidification is not None:
             raise ValueError(
                 "conservation_heating and dehumidification in one measure are not "

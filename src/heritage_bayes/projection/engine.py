@@ -252,7 +252,8 @@ def simulate_cases(
         plan = fused_plan(len(inp), func="assess_batch", **plan_opts)  # checks options
         Ut = {s: np.ascontiguousarray(u.T) for s, u in U.items()}
         mode = (1 if not cases else 2) if baseline else 0
-        cases.append(_Case(U, Ut, starts, months, plan, len(inp), hour_of_year(inp.index), mode))
+        hoy = hour_of_year(inp.index)
+        cases.append(_Case(U, Ut, starts, months, plan, len(inp), hoy, mode, inp.index))
     K = draws.index.size
     out = [_CaseOut.empty(c, K) for c in cases]
     slots = max(1, min(numba.get_num_threads(), chunk, K))
@@ -315,6 +316,7 @@ class _Case:
     N: int
     hoy: np.ndarray  # (N,) hour of the year of each hour
     mode: int  # 1: the baseline (builds each draw's EN 15757 band), 2: judged by it, 0: none
+    index: pd.DatetimeIndex | None = None  # time of each hour (an intervention's calendar)
 
     def en_params(self) -> tuple[np.ndarray, int]:
         """(en, en_col) of :func:`heritage_bayes.projection._stream.chunk_kernel`."""
@@ -451,7 +453,7 @@ def _controlled(run, draws, c: _Case, o: _CaseOut | None, rows, dt, w, measure) 
     measure's controllers; their running costs stored in ``o``."""
     u0 = {s: c.U[s][: max(1, w)].mean(axis=0) for s in run.models}
     P = {s: draws.model[s][rows] for s in run.models}
-    Y, costs = measure.simulate(run, P, c.U, u0, dt)
+    Y, costs = measure.simulate(run, P, c.U, u0, dt, index=c.index)
     if o is not None:
         K = o.par.shape[0]
         for name, v in costs.items():

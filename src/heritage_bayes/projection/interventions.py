@@ -11,6 +11,8 @@ draw (:class:`Measure`):
 - **dehumidification**: a humidistat on the hygric model (``mode: dehumidifier``) that
   keeps the RH at the draw's simulated indoor temperature at or below ``rh_max``,
   removing at most ``capacity`` [kg/h];
+- **heating** to a set-point ``t_set`` and, in the hours of use of a weekly calendar,
+  ``t_use`` (intermittent heating of a church for services), up to ``power_max``;
 - **ventilation** scaled by a factor: ``Gfast`` of both models (the thermal one lumps
   ventilation and glazing) multiplied, every other parameter as calibrated.
 
@@ -87,17 +89,21 @@ class Measure:
         ``(rh_max [-], capacity [kg/s], energy_per_kg [kWh/kg] or None)``.
     ventilation : float
         Factor on ``Gfast`` of both models [-].
+    thermostat : tuple or None
+        ``(t_set [°C], t_use [°C] or None, WeeklyCalendar or None, power_max [W] or
+        inf)``: heating to a set-point, ``t_use`` in the calendar's hours of use.
     """
 
     name: str
     heating: tuple | None = None
     dehumidifier: tuple | None = None
     ventilation: float = 1.0
+    thermostat: tuple | None = None
 
     @property
     def controlled(self) -> bool:
         """Simulated through a controller (the per-draw path), not the modal pass."""
-        return self.heating is not None or self.dehumidifier is not None
+        return any(x is not None for x in (self.heating, self.dehumidifier, self.thermostat))
 
     def check(self, run) -> None:
         """Refuse a measure the run's models cannot take (names the measure)."""
@@ -111,7 +117,8 @@ class Measure:
                 f"interventions: {self.name!r}: ventilation scales the conductance Gfast "
                 f"(air exchange), which none of the run's models {names} has"
             )
-        for s, on in (("thermal", self.heating), ("hygric", self.dehumidifier)):
+        heat = self.heating or self.thermostat
+        for s, on in (("thermal", heat), ("hygric", self.dehumidifier)):
             if on is not None and isinstance(run.models[s], ControlledModel):
                 raise ConfigError(
                     f"interventions: {self.name!r}: the calibrated {s} model is already "
@@ -141,7 +148,7 @@ class Measure:
             out[s] = P
         return out
 
-    def simulate(self, run, model: dict, U: dict, u0: dict, dt: float):
+    def simulate(self, run, model: dict, U: dict, u0: dict, dt: float, index=None):
         """Noise-free outputs of a chunk of draws with the controllers.
 
         Parameters
@@ -155,6 +162,8 @@ class Measure:
             Section -> inputs of the initial steady state.
         dt : float
             Step [s].
+        index : pandas.DatetimeIndex, optional
+            Time of each step (for a thermostat's weekly hours of use).
 
         Returns
         -------
@@ -184,9 +193,11 @@ class Measure:
             extra = {"Tset": t_min, "Pmax": pmax, "RH_ch": rh}
             Y["thermal"], Q = self._per_draw(ctl, model["thermal"], U["thermal"], Y["hygric"],
                                              u0["thermal"], extra, dt, spin)  # fmt: skip
-            e = np.clip(Q, 0.0, None)  # [W]
-            costs["heating_energy"] = e.sum(axis=1) * dt / 3.6e6 / years
-            costs["heating_peak"] = e.max(axis=1) / 1e3
+            costs.update(_heating_costs(Q, dt, years))
+        if self.thermostat is not None:
+            Y["thermal"], Q = self._thermostat(run, model["thermal"], U["thermal"],
+                                               u0["thermal"], dt, spin, index)  # fmt: skip
+            costs.update(_heating_costs(Q, dt, years))
         if self.dehumidifier is not None:
             rh, cap, e_kg = self.dehumidifier
             m = run.models["hygric"]
@@ -200,6 +211,31 @@ class Measure:
             if e_kg is not None:
                 costs["dehumidifier_energy"] = costs["water_removed"] * e_kg
         return Y, costs
+
+    def _thermostat(self, run, P, U, u0, dt, spin, index) -> tuple:
+        """Thermostat outputs and heating flows (k, N), all draws at once (the
+        controller needs no other model's series)."""
+        from heritage_bayes.rc.control import HOURS_OF_USE, Control, ControlledModel
+
+        t_set, t_use, cal, pmax = self.thermostat
+        limited = bool(np.isfinite(pmax))
+        ctl = ControlledModel(
+            run.models["thermal"].network,
+            Control(thermostat=True, power_limit=limited,
+                    schedule=HOURS_OF_USE if cal is not None else None, calendar=cal),
+        )  # fmt: skip
+        extra = {"Tset": t_set, "Tset_use": t_use, "Pmax": pmax}
+        Pc = _extended(ctl, P, extra)
+        if cal is not None:
+            if index is None:
+                raise ConfigError(
+                    f"interventions: {self.name!r}: a weekly schedule needs the time of each step"
+                )
+            use = cal.fraction(index, dt)
+            U, u0 = np.column_stack([U, use]), np.r_[u0, use[:1]]
+        y, ok, Q = ctl.forward(Pc, U, dt, u_init=u0, effort=True, spin_up=spin)
+        _check_valid(ok, self.name, Pc)
+        return np.ascontiguousarray(y[..., 0]), Q
 
     def _per_draw(self, ctl, P, U, other, u0, extra, dt, spin) -> tuple:
         """Controlled outputs (k, N) and control flows (k, N) of ``ctl``, draw by draw:
@@ -217,6 +253,13 @@ class Measure:
             _check_valid(ok, self.name, Pp)
             Y[p] = y[0, :, 0]
         return Y, Q
+
+
+def _heating_costs(Q: np.ndarray, dt: float, years: float) -> dict:
+    """Heating energy [kWh/a] and peak power [kW] from heating flows (k, N) [W]."""
+    e = np.clip(Q, 0.0, None)
+    return {"heating_energy": e.sum(axis=1) * dt / 3.6e6 / years,
+            "heating_peak": e.max(axis=1) / 1e3}  # fmt: skip
 
 
 def _check_valid(ok: np.ndarray, name: str, P: np.ndarray) -> None:
@@ -256,9 +299,20 @@ def measures_from_config(pcfg) -> list[Measure]:
                 if d is None
                 else (d.rh_max / 100.0, d.capacity / 3600.0, d.energy_per_kg),
                 ventilation=1.0 if it.ventilation is None else it.ventilation.factor,
+                thermostat=None if it.heating is None else _thermostat_spec(it.heating),
             )
         )
     return out
+
+
+def _thermostat_spec(h) -> tuple:
+    from heritage_bayes.rc.calendar import parse_weekly
+
+    cal = None
+    if h.weekly is not None:
+        cal = parse_weekly({"weekly": h.weekly, "timezone": h.timezone}, "heating")
+    pmax = np.inf if h.power_max is None else h.power_max
+    return (h.t_set, h.t_use, cal, pmax)
 
 
 def _q(x: np.ndarray) -> dict:

@@ -177,7 +177,8 @@ def test_schema():
         parse_projection_config({**PROJ, "interventions": [ok["interventions"][2]] * 2})
 
 
-def test_project_compares_measures_and_draws_the_page(run, tmp_path):
+@pytest.fixture(scope="module")
+def projected(run, tmp_path_factory):
     cfg = {
         **PROJ,
         "interventions": [
@@ -188,7 +189,11 @@ def test_project_compares_measures_and_draws_the_page(run, tmp_path):
             {"name": "half ventilation", "ventilation": {"factor": 0.5}},
         ],
     }  # fmt: skip
-    p = project(run, cfg, out=tmp_path / "p")
+    return project(run, cfg, out=tmp_path_factory.mktemp("interv_p") / "p")
+
+
+def test_project_compares_measures_and_draws_the_page(projected):
+    p = projected
     iv = p.summary["interventions"]
     assert list(iv) == ["conservation heating", "dehumidifier", "half ventilation"]
     for e in iv.values():
@@ -221,3 +226,32 @@ def test_shipped_interventions_config_validates():
     ms = measures_from_config(cfg)
     assert [m.name for m in ms] == ["conservation heating", "dehumidifier", "half the ventilation"]
     assert ms[0].heating == (0.65, -273.15, 22.0, 5000.0) and ms[2].ventilation == 0.5
+
+
+@pytest.mark.browser
+@pytest.mark.parametrize("size", [(1280, 800), (1920, 1080)])
+def test_measures_section_in_headless_chromium(projected, size):
+    """The measures section and its figure sit in the page; no table wider than its
+    container at 1280 and 1920 px."""
+    from _report_browser import find_chromium, open_page
+    from test_projection import _LAYOUT_JS
+
+    chromium = find_chromium()
+    if chromium is None:
+        pytest.skip("chromium not installed: the page was not opened in a real browser")
+    res = open_page(
+        Path(projected.paths["html"]),
+        chromium=chromium,
+        width=size[0],
+        height=size[1],
+        extra_js=_LAYOUT_JS,
+    )
+    assert res.errors == [], res.errors
+    assert "interventions" in res.dom["sections"]
+    assert "fig-tradeoff" in res.dom["figures"]
+    lay = res.dom["extra"]
+    for t in lay["tables"]:
+        assert t["w"] <= t["cw"] + 0.5 and t["right"] <= lay["width"], t
+    for d in lay["scrolls"]:
+        assert d["sw"] <= d["cw"], d
+    assert lay["docw"] <= lay["width"] and lay["right"] <= lay["width"]

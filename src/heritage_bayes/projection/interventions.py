@@ -191,7 +191,7 @@ class Measure:
                 Control(thermostat=True, conservation=True, power_limit=limited, t_max=t_max),
             )
             extra = {"Tset": t_min, "Pmax": pmax, "RH_ch": rh}
-            Y["thermal"], Q = self._per_draw(ctl, model["thermal"], U["thermal"], Y["hygric"],
+            Y["thermal"], Q = self._coupled(ctl, model["thermal"], U["thermal"], Y["hygric"],
                                              u0["thermal"], extra, dt, spin)  # fmt: skip
             costs.update(_heating_costs(Q, dt, years))
         if self.thermostat is not None:
@@ -203,7 +203,7 @@ class Measure:
             m = run.models["hygric"]
             ctl = ControlledModel(m.network, Control(humidistat="dehumidifier", capacity=True))
             extra = {"RH_hi": rh, "M_dehum": cap}
-            Y["hygric"], Q = self._per_draw(ctl, model["hygric"], U["hygric"], Y["thermal"],
+            Y["hygric"], Q = self._coupled(ctl, model["hygric"], U["hygric"], Y["thermal"],
                                             u0["hygric"], extra, dt, spin)  # fmt: skip
             w = np.clip(-Q, 0.0, None)  # [kg/s]
             costs["water_removed"] = w.sum(axis=1) * dt / years
@@ -237,21 +237,17 @@ class Measure:
         _check_valid(ok, self.name, Pc)
         return np.ascontiguousarray(y[..., 0]), Q
 
-    def _per_draw(self, ctl, P, U, other, u0, extra, dt, spin) -> tuple:
-        """Controlled outputs (k, N) and control flows (k, N) of ``ctl``, draw by draw:
-        each draw's control input (``Pi`` for conservation heating, ``Ti`` for the
-        humidistat) is its own simulated series ``other[p]``."""
-        k, N = other.shape
-        Y, Q = np.empty((k, N)), np.empty((k, N))
-        Uc = np.empty((N, U.shape[1] + 1))
-        Uc[:, :-1] = U
-        for p in range(k):
-            Pp = _extended(ctl, P[p : p + 1], extra)
-            Uc[:, -1] = other[p]
-            u = np.r_[u0, other[p, :1]]
-            y, ok, Q[p] = ctl.forward(Pp, Uc, dt, u_init=u, effort=True, spin_up=spin)
-            _check_valid(ok, self.name, Pp)
-            Y[p] = y[0, :, 0]
+    def _coupled(self, ctl, P, U, other, u0, extra, dt, spin) -> tuple:
+        """Controlled outputs (k, N) and control flows (k, N) of ``ctl``, all draws at
+        once: each draw's control input (``Pi`` for conservation heating, ``Ti`` for
+        the humidistat) is its own simulated series ``other[p]``."""
+        Pc = _extended(ctl, P, extra)
+        u = np.r_[u0, np.mean(other[:, :1])]  # only the network's part is used
+        y, ok, Q = ctl.forward(
+            Pc, U, dt, u_init=u, effort=True, spin_up=spin, control_inputs=other[:, :, None]
+        )
+        _check_valid(ok, self.name, Pc)
+        Y = np.ascontiguousarray(y[..., 0])
         return Y, Q
 
 

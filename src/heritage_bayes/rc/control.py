@@ -395,6 +395,7 @@ class ControlledModel(RCModel):
         effort: bool = False,
         max_block: int = 2**22,
         spin_up: int = 0,
+        control_inputs=None,
     ):
         """Controlled simulation of a batch: outputs (K, N, n_out) and validity (K,).
 
@@ -423,6 +424,11 @@ class ControlledModel(RCModel):
             starts exactly where the free-running model does). For
             capacity-limited controllers that have not reached their bound within the
             720 steps of the mean-flow correction (slow rooms, small capacities).
+        control_inputs : (K, N, c) array, optional
+            The control inputs (``Ti``, ``Pi``, the schedule: the last ``c`` of
+            :attr:`input_names`) of each parameter set, instead of ``U``'s columns
+            (a projection's simulated ``Ti`` per draw); ``U`` may then hold the
+            network's inputs only.
         """
         from heritage_bayes.rc.discretize import modal_form
 
@@ -433,7 +439,16 @@ class ControlledModel(RCModel):
         mf = modal_form(self, P, dt)
         valid = mf.valid & self._control_ok(P)
         # contiguous: the forcing product below is 10x slower on a strided view
-        Un, Uc = np.ascontiguousarray(U[:, : self._m_net]), U[:, self._m_net :]
+        Un = np.ascontiguousarray(U[:, : self._m_net])
+        if control_inputs is None:
+            Uc = U[None, :, self._m_net :]  # one control signal for every walker
+        else:
+            Uc = np.asarray(control_inputs, dtype=float)
+            if Uc.shape != (K, N, len(self._control_inputs)):
+                raise ValueError(
+                    f"control_inputs: expected shape {(K, N, len(self._control_inputs))} "
+                    f"({list(self._control_inputs)} per parameter set), got {Uc.shape}"
+                )
         air = int(self._ix["out"][0])
         # modal response to a unit flow into the air node: continuous and one-step ZOH
         bz = mf.s[:, air, None] * mf.V[:, air, :]  # (K, n)
@@ -487,12 +502,13 @@ class ControlledModel(RCModel):
         return (Y, valid, Q) if effort else (Y, valid)
 
     def _controller_arrays(self, P: np.ndarray, Uc: np.ndarray) -> dict:
-        """Per-walker controller parameters and per-step signals for the kernel."""
+        """Per-walker controller parameters and per-step signals for the kernel
+        (``Uc``: (1 or K, N, c); the signals (1 or K, N))."""
         from heritage_bayes.climate.psychro import saturation_vapour_pressure
 
         c, on = self.control, self.control.enabled
-        K, N = P.shape[0], Uc.shape[0]
-        cols = {u: Uc[:, i] for i, u in enumerate(self._control_inputs)}
+        K, N = P.shape[0], Uc.shape[1]
+        cols = {u: Uc[:, :, i] for i, u in enumerate(self._control_inputs)}
         inf = np.full(K, np.inf)
         zero = np.zeros(K)
         out = {
@@ -504,8 +520,8 @@ class ControlledModel(RCModel):
             "qadd": zero,
             "qrem": zero,
             "rh_ch": zero,
-            "s": np.zeros(N),
-            "pv": np.zeros(N),
+            "s": np.zeros((1, N)),
+            "pv": np.zeros((1, N)),
             "on": False,
             "src": self._cp(P, "Qs") if "Qs" in self.parameter_names else self._cp(P, "Ms"),
         }
@@ -577,9 +593,12 @@ def _control_run(
     the air node at the end of step k: thermostat ``lo = lo0 + lo1 sig[k]`` (and the
     temperature at RH ``rh_ch`` of ``pv[k]``), no upper bound; humidistat
     ``lo = lo1 sig[k]``, ``hi = hi1 sig[k]`` (``sig`` = saturation pressure at the
-    indoor temperature).
+    indoor temperature). ``sig``, ``pv``: (1, N) one signal for every walker, or
+    (K, N) one per walker.
     """
     K, n = ad.shape
+    s_each = sig.shape[0] > 1
+    p_each = pv.shape[0] > 1
     Nb = W.shape[0]
     n_out = Cz.shape[1]
     zf = np.empty(n)
@@ -591,6 +610,8 @@ def _control_run(
         k = k0 + kb
         for p in range(K):
             base = p * n
+            ps = p if s_each else 0
+            pp = p if p_each else 0
             for o in range(n_out):
                 acc = 0.0
                 for j in range(n):
@@ -602,9 +623,9 @@ def _control_run(
                 yf += Cz[p, 0, j] * zf[j]
             q = 0.0
             if mode == 1 or mode == 3:
-                lo = lo0[p] + lo1[p] * sig[k]
+                lo = lo0[p] + lo1[p] * sig[ps, k]
                 if mode == 3:
-                    tc = _t_at_rh(pv[k], rh_ch[p])
+                    tc = _t_at_rh(pv[pp, k], rh_ch[p])
                     if tc > t_max:
                         tc = t_max
                     if tc > lo:
@@ -614,8 +635,8 @@ def _control_run(
                     if q > qadd[p]:
                         q = qadd[p]
             elif mode == 2:
-                lo = lo1[p] * sig[k]
-                hi = hi1[p] * sig[k]
+                lo = lo1[p] * sig[ps, k]
+                hi = hi1[p] * sig[ps, k]
                 if yf > hi:
                     q = (hi - yf) / g[p]
                     if q < -qrem[p]:

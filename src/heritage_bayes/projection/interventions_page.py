@@ -66,10 +66,12 @@ def _energy(costs: dict) -> dict | None:
     return costs[cols[0]] if len(cols) == 1 else None
 
 
-def fig_tradeoff(proj, page_key: tuple) -> str:
+def fig_tradeoff(proj, page_key: tuple, colour, legend) -> str:
     """Risk reduction vs annual energy: the first mould indicator and the chemical one
     computed (:data:`_TRADEOFF`), the improvement (change in the registry's better
-    direction) against the measure's energy [kWh/a] (0 for a measure without one)."""
+    direction) against the measure's energy [kWh/a] (0 for a measure without one).
+    ``colour(i)``: the page's colour of case ``i``; ``legend(fig, handles, labels,
+    ncol)``: the page's legend below the axes."""
     import matplotlib
 
     iv = proj.summary.get("interventions") or {}
@@ -79,8 +81,6 @@ def fig_tradeoff(proj, page_key: tuple) -> str:
     names = list(dict.fromkeys(names))
     if not iv or not names:
         return ""
-    from heritage_bayes.projection.page import _colour, _legend_below
-
     with matplotlib.rc_context(RC_PARAMS):
         fig = _figure(9.5, 4.2)
         axes = np.atleast_1d(fig.subplots(1, len(names)))
@@ -103,7 +103,7 @@ def fig_tradeoff(proj, page_key: tuple) -> str:
                         xerr=[[x["q50"] - x["q05"]], [x["q95"] - x["q50"]]],
                         yerr=[[y[1] - min(y[0], y[2])], [max(y[0], y[2]) - y[1]]],
                         fmt=_MARKERS[j % len(_MARKERS)],
-                        color=_colour(i),
+                        color=colour(i),
                         capsize=2,
                         alpha=0.85,
                     )
@@ -118,12 +118,13 @@ def fig_tradeoff(proj, page_key: tuple) -> str:
             "Improvement against doing nothing vs running cost (median and 5–95 % of the "
             "draws; above 0: better)"
         )
-        _legend_below(fig, handles, labels, ncol=min(3, max(1, len(labels))))
+        legend(fig, handles, labels, ncol=min(3, max(1, len(labels))))
         return to_png_uri(fig)
 
 
-def interventions_html(proj, run, page_key: tuple) -> str:
-    """The section body (empty string when the projection has no interventions)."""
+def interventions_html(proj, run, page_key: tuple, colour, legend) -> str:
+    """The section body (empty string when the projection has no interventions);
+    ``colour``, ``legend``: the page's (see :func:`fig_tradeoff`)."""
     iv = proj.summary.get("interventions") or {}
     if not iv:
         return ""
@@ -178,7 +179,7 @@ def interventions_html(proj, run, page_key: tuple) -> str:
             f"<th class='num'>with the measure</th></tr></thead><tbody>{''.join(probs)}"
             "</tbody></table></div>"
         )
-    fig = fig_tradeoff(proj, page_key)
+    fig = fig_tradeoff(proj, page_key, colour, legend)
     if fig:
         parts.append(
             f"<figure id='fig-tradeoff'><img src='{fig}' alt='risk reduction against "

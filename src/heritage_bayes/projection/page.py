@@ -372,7 +372,7 @@ def render_projection_page(proj, run) -> str:
     risk = _fig_risk(proj)
     from heritage_bayes.projection.interventions_page import interventions_html
 
-    measures = interventions_html(proj, run, KEY_INDICATORS)
+    measures = interventions_html(proj, run, KEY_INDICATORS, _colour, _legend_below)
     sections = [
         Section(
             "What the projection assumes", f"<ul>{assumptions}</ul>", id="assumptions", lead=lead

@@ -255,3 +255,24 @@ def test_measures_section_in_headless_chromium(projected, size):
     for d in lay["scrolls"]:
         assert d["sw"] <= d["cw"], d
     assert lay["docw"] <= lay["width"] and lay["right"] <= lay["width"]
+
+
+def test_measures_the_run_cannot_take_are_refused():
+    """A controller on an already controlled model, ventilation without any Gfast:
+    ConfigError naming the measure (hbayes project exits 2 before simulating)."""
+    from types import SimpleNamespace
+
+    import heritage_bayes as hb
+
+    heated = SimpleNamespace(
+        models={
+            "thermal": hb.model("thermal_1c", thermostat=True),
+            "hygric": hb.model("hygric_1c"),
+        }
+    )
+    with pytest.raises(ConfigError, match=r"'ch'.*already controlled"):
+        Measure("ch", heating=(0.6, -273.15, 20.0, np.inf)).check(heated)
+    Measure("dh", dehumidifier=(0.6, 1e-4, None)).check(heated)  # the hygric one is free
+    no_gfast = SimpleNamespace(models={"thermal": hb.model("thermal_1c")})
+    with pytest.raises(ConfigError, match=r"'air'.*Gfast"):
+        Measure("air", ventilation=0.5).check(no_gfast)

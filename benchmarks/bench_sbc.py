@@ -161,12 +161,6 @@ def simulate_reference(model, params, U: np.ndarray) -> np.ndarray:
 def replicate(args) -> dict:
     """One room: generate, calibrate, and rank the truth of each quantity."""
     import heritage_bayes as hb
-    from heritage_bayes.config import ModelSection
-    from heritage_bayes.inference.likelihoods import get_noise_model
-    from heritage_bayes.inference.optimize import find_map
-    from heritage_bayes.inference.parameters import parameters_for
-    from heritage_bayes.inference.posterior import LogPosterior
-    from heritage_bayes.inference.sampler import run_sampler
     from heritage_bayes.rc.derived import derived_quantities
 
     name, rep, variants, seed, max_steps = args[:5]
@@ -210,7 +204,33 @@ def replicate(args) -> dict:
     if "gap" not in without:
         y[g0 : g0 + 7 * 24] = np.nan
     dq_true = {k: float(np.ravel(v)[0]) for k, v in derived_quantities(model, p).items()}
-    result = {"model": name, "rep": rep, "truth": dq_true, "truth_parameters": p, "variants": {}}
+    result = {"model": name, "rep": rep, "truth": dq_true, "truth_parameters": p}
+    result["variants"] = fit_and_rank(
+        model, U[rows], y, dq_true, variants, rep, max_steps, priors, floor, envelope
+    )
+    return result
+
+
+def fit_and_rank(
+    model, U, y, dq_true, variants, rep, max_steps, priors, floor, envelope, extra=None
+) -> dict:
+    """Calibrate one replicate with ``hbayes calibrate``'s defaults and rank the truths.
+
+    ``U`` (N, m) inputs and ``y`` (N,) observations (NaN = missing) of the calibration
+    period; ``dq_true`` the true derived quantities; ``extra`` an optional function
+    ``(dq, theta) -> {name: draws}`` of further quantities (their truths in
+    ``dq_true``). Returns ``{variant: {ranks, converged, map, steps, cpu}}``.
+    """
+    from heritage_bayes.config import ModelSection
+    from heritage_bayes.inference.likelihoods import get_noise_model
+    from heritage_bayes.inference.optimize import find_map
+    from heritage_bayes.inference.parameters import parameters_for
+    from heritage_bayes.inference.posterior import LogPosterior
+    from heritage_bayes.inference.sampler import run_sampler
+    from heritage_bayes.rc.derived import derived_quantities
+
+    name = model.name
+    out = {}
     for variant in variants:
         noise_name, init = variant.split(":")
         t0 = time.process_time()
@@ -229,7 +249,7 @@ def replicate(args) -> dict:
             model,
             ps,
             noise,
-            U[rows],
+            U,
             y[:, None],
             warmup=336 if init == "steady" else 0,
             init_window=720,
@@ -249,8 +269,12 @@ def replicate(args) -> dict:
         Xd, _ = chain.draws(4000)
         theta = ps.values(Xd.reshape(-1, Xd.shape[-1]))
         dq = derived_quantities(model, theta[:, : lp.n_model])
+        if extra is not None:
+            dq = {**dq, **extra(dq, theta)}
         ranks = {}
         for k, t in dq_true.items():
+            if k not in dq:
+                continue
             d = np.asarray(dq[k], dtype=float).reshape(-1)
             if not np.all(np.isfinite(d)) or np.ptp(d) == 0:
                 continue
@@ -262,24 +286,27 @@ def replicate(args) -> dict:
                 "median": float(np.median(d)),
                 "sd": float(np.std(d)),
             }
-        result["variants"][variant] = {
+        out[variant] = {
             "ranks": ranks,
             "converged": bool(chain.converged),
             "map": dict(zip(ps.names, map(float, mp.theta), strict=True)),
             "steps": int(chain.steps),
             "cpu": time.process_time() - t0,
         }
-    return result
+    return out
 
 
 QUANTITIES = {
     "thermal_2c": ("tau_1_h", "gain_Ti_Te", "gain_Ti_I_S", "gain_Ti_Tf"),
     "hygric_2c": ("tau_1_h", "tau_2_h"),
-    "hygric_2c_fixed": ("tau_1_h", "gain_Pi_Pe", "offset_Pi_h"),
+    "hygric_2c_fixed": ("tau_1_h", "gain_Pi_Pe", "offset_Pi_Pf"),
 }
 
 
-def table(results: list[dict], variant: str) -> list[str]:
+def table(results: list[dict], variant: str, quantities: dict | None = None) -> list[str]:
+    """Coverage and rank-uniformity lines of ``variant`` for each model's quantities
+    (``quantities``: model -> names; default :data:`QUANTITIES`)."""
+    quantities = QUANTITIES if quantities is None else quantities
     lines = []
     for name in sorted({r["model"] for r in results}):
         rs = [r for r in results if r["model"] == name and variant in r["variants"]]
@@ -290,7 +317,7 @@ def table(results: list[dict], variant: str) -> list[str]:
         )
         keys = [
             k
-            for k in QUANTITIES.get(name, ())
+            for k in quantities.get(name, ())
             if any(k in r["variants"][variant]["ranks"] for r in rs)
         ]
         for k in keys:

@@ -57,7 +57,7 @@ from scipy.linalg import expm
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from bench_sbc import (  # noqa: E402  (the benchmark directory is not a package)
+from bench_sbc import (  # the benchmark directory is not a package
     CAL_DAYS,
     ENVELOPE,
     FLOOR,
@@ -205,9 +205,7 @@ def replicate(args) -> dict:
     gw = generator_weather(int(rng.integers(2**31)))
     fine = gw["fine"]
     nf = fine["Te"].size
-    Uf = np.column_stack(
-        [fine[c] if c in fine else np.full(nf, 10.0) for c in model.input_names]
-    )
+    Uf = np.column_stack([fine[c] if c in fine else np.full(nf, 10.0) for c in model.input_names])
     if "Tf" in model.input_names:  # ground: the mean outdoor temperature, constant
         Uf[:, model.input_names.index("Tf")] = fine["Te"].mean()
     A, B, _, _ = model.state_space(p)

@@ -77,6 +77,72 @@ def _pointwise(s, pw: np.ndarray, times: np.ndarray, shape) -> dict[str, xr.Data
     return out
 
 
+#: Name of the combined pointwise log-likelihood of a run with several outputs.
+JOINT_LOGLIK = "all_outputs"
+
+
+def loglik_groups(loglik: dict[str, xr.DataArray], coords: dict, attrs: dict) -> dict:
+    """The ``log_likelihood`` group arviz reads by default, and the per-output terms.
+
+    ``az.loo(idata)`` and ``az.waic(idata)`` take the group's only variable when no
+    ``var_name`` is given. With one output that is the output's own variable
+    (``thermal.Ti``). With several (thermal and hygric), ``log_likelihood`` holds one
+    variable :data:`JOINT_LOGLIK`: every output's terms on one ``observation`` axis
+    (each an hour of one output; the noise of different outputs is independent, so the
+    terms still sum to the log-likelihood the sampler used), with the coordinates
+    ``observation_variable`` and ``observation_time`` saying which hour of which output
+    each is; the per-output variables go to ``log_likelihood_outputs`` (not an arviz
+    group: ``az.loo(idata, var_name=...)`` does not see it; read it with
+    :func:`heritage_bayes.compare.scores.pointwise_terms`).
+    """
+    if len(loglik) <= 1:
+        return {"log_likelihood": xr.Dataset(loglik, coords=coords, attrs=attrs)}
+    names = list(loglik)
+    vals = np.concatenate([loglik[v].values for v in names], axis=-1)
+    var = np.concatenate([np.full(loglik[v].shape[-1], v, dtype=object) for v in names])
+    when = np.concatenate([loglik[v][loglik[v].dims[-1]].values for v in names])
+    joint = xr.DataArray(
+        vals,
+        dims=("chain", "draw", "observation"),
+        coords={
+            "observation": np.arange(vals.shape[-1]),
+            "observation_variable": ("observation", var.astype(str)),
+            "observation_time": ("observation", when),
+        },
+        attrs={"description": f"pointwise terms of {', '.join(names)} on one axis"},
+    )
+    return {
+        "log_likelihood": xr.Dataset({JOINT_LOGLIK: joint}, coords=coords, attrs=attrs),
+        "log_likelihood_outputs": xr.Dataset(loglik, coords=coords, attrs=attrs),
+    }
+
+
+def convergence_stats(post: dict[str, xr.DataArray], names: list[str]):
+    """Rank-normalised split R-hat, bulk and tail ESS of the saved draws ``names``.
+
+    The estimators of ``az.summary`` (Vehtari et al. 2021 [1]_) on the very arrays
+    ``posterior.nc`` stores (walkers as chains), so that the report's figures are
+    reproduced by ``az.summary(az.from_netcdf("posterior.nc"))``. The sampler's stopping
+    rule checks all its retained draws (:func:`heritage_bayes.inference.sampler.run_sampler`);
+    the saved draws are an evenly thinned subset, nearly independent, so their bulk
+    ESS is close to their number when the chain has converged.
+
+    Returns
+    -------
+    (r_hat, ess_bulk, ess_tail) : three ``xarray.Dataset``
+        Indexed by the names.
+
+    References
+    ----------
+    .. [1] A. Vehtari, A. Gelman, D. Simpson, B. Carpenter, P.-C. Bürkner, "Rank-
+       normalization, folding, and localization: an improved R-hat for assessing
+       convergence of MCMC", *Bayesian Analysis* 16 (2021) 667-718.
+       doi:10.1214/20-BA1221
+    """
+    ds = xr.Dataset({v: post[v] for v in names})
+    return az.rhat(ds), az.ess(ds, method="bulk"), az.ess(ds, method="tail")
+
+
 def _validation_pointwise(s, prep, Ysim, tn, th=None) -> np.ndarray:
     """(K, N, n_out) one-step predictive log densities of the validation observations.
 
@@ -248,16 +314,11 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
         loglik.update(_pointwise(s, pw, times[prep.calibration], (W, n_sel)))
         pw = _validation_pointwise(s, prep, Ysim, tn_sel, th_sel)
         loglik_val.update(_pointwise(s, pw, times, (W, n_sel)))
-        # parameter summaries
-        # statistics on all draws the sampler checked; R-hat and ESS in the sampler's
-        # coordinates, exactly as its stopping rule computed them (folded R-hat is not
-        # invariant under the log/logit transforms)
+        # parameter summaries: quantiles on all draws the sampler kept; R-hat and ESS
+        # on the draws posterior.nc holds, so that az.summary reproduces them
         kept = s.theta_kept
         free_vars = [f"{s.name}.{n}" for n in ps.free_names]
-        ds = xr.Dataset({v: (cdims, s.X_kept[..., i]) for i, v in enumerate(free_vars)})
-        rhat = az.rhat(ds[free_vars])
-        ess_b = az.ess(ds[free_vars], method="bulk")
-        ess_t = az.ess(ds[free_vars], method="tail")
+        rhat, ess_b, ess_t = convergence_stats(post, free_vars)
         tau = dict(zip(ps.free_names, s.chain.tau, strict=True))
         truth, truth_dq = _truth_for(cfg, prep, s)
         mapv = dict(zip(names, s.map.theta, strict=True))
@@ -299,8 +360,9 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
             x = dq_all[k].reshape(-1)
             summary_derived[key] = {"unit": units.get(k, ""), **_summ(x), "truth": truth_dq.get(k)}
             if np.all(np.isfinite(x)) and np.ptp(x) > 0:
-                summary_derived[key]["r_hat"] = float(az.rhat(dq_all[k]))
-                summary_derived[key]["ess_bulk"] = float(az.ess(dq_all[k], method="bulk"))
+                r, e, _ = convergence_stats(post, [key])
+                summary_derived[key]["r_hat"] = float(r[key])
+                summary_derived[key]["ess_bulk"] = float(e[key])
         # posterior correlations of the free parameters (log scale where the prior is)
         Y = []
         for j, p in enumerate(ps.parameters):
@@ -420,7 +482,7 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
     groups = {
         "posterior": xr.Dataset(post, coords=coords, attrs=attrs),
         "sample_stats": xr.Dataset(stats, coords=coords, attrs=attrs),
-        "log_likelihood": xr.Dataset(loglik, coords=coords, attrs=attrs),
+        **loglik_groups(loglik, coords, attrs),
         "posterior_predictive": xr.Dataset(pp, attrs=attrs),
         "observed_data": xr.Dataset(observed, attrs=attrs),
         "constant_data": xr.Dataset(const, attrs=attrs),

@@ -121,13 +121,17 @@ def fit_metrics(measured: np.ndarray, simulated: np.ndarray) -> dict[str, float]
     dict
         ``MSE`` = :math:`\\frac1N\\sum(y'-y)^2` [unit²], ``MAE`` = :math:`\\frac1N\\sum|y'-y|`
         [unit], ``FIT`` = :math:`100\\,(1 - \\|y'-y\\| / \\|y'-\\bar{y}'\\|)` [%]
-        (Kramer, van Schijndel & Schellen; Ljung's goodness of fit), and ``n``.
+        (Kramer, van Schijndel & Schellen; Ljung's goodness of fit), ``SD`` the
+        standard deviation of the measured signal [unit] (FIT's yardstick: on a nearly
+        constant series, e.g. a humidistat-held RH, FIT is strongly negative whatever
+        the accuracy; read MAE there), and ``n``.
     """
     m = np.asarray(measured, dtype=float)
     s = np.asarray(simulated, dtype=float)
     ok = np.isfinite(m) & np.isfinite(s)
     if ok.sum() < 2:
-        return {"MSE": float("nan"), "MAE": float("nan"), "FIT": float("nan"), "n": int(ok.sum())}
+        nan = float("nan")
+        return {"MSE": nan, "MAE": nan, "FIT": nan, "SD": nan, "n": int(ok.sum())}
     e = m[ok] - s[ok]
     denom = np.linalg.norm(m[ok] - m[ok].mean())
     fit = 100.0 * (1.0 - np.linalg.norm(e) / denom) if denom > 0 else float("nan")
@@ -135,6 +139,7 @@ def fit_metrics(measured: np.ndarray, simulated: np.ndarray) -> dict[str, float]
         "MSE": float(np.mean(e**2)),
         "MAE": float(np.mean(np.abs(e))),
         "FIT": float(fit),
+        "SD": float(denom / np.sqrt(ok.sum())),
         "n": int(ok.sum()),
     }
 

@@ -25,15 +25,15 @@ them and just as closed-form per mode (:func:`foh_weights`, :func:`discretize_fo
 .. math::
 
     z_j[k+1] = a_j z_j[k] + w^-_j (\tilde B u[k])_j + w^+_j (\tilde B u[k+1])_j
-               + \phi_j \tilde e_j,\qquad
-    w^-_j = \frac{1 - a_j(1 + \lambda_j\Delta t)}{\lambda_j^2\Delta t},\quad
-    w^+_j = \phi_j - w^-_j,
+               + \\phi_j \tilde e_j,\\qquad
+    w^-_j = \frac{1 - a_j(1 + \\lambda_j\\Delta t)}{\\lambda_j^2\\Delta t},\\quad
+    w^+_j = \\phi_j - w^-_j,
 
-with :math:`a_j = e^{-\lambda_j\Delta t}` and :math:`\phi_j = (1 - a_j)/\lambda_j`.
+with :math:`a_j = e^{-\\lambda_j\\Delta t}` and :math:`\\phi_j = (1 - a_j)/\\lambda_j`.
 Written with the interval mean :math:`\bar u_k = (u[k] + u[k+1])/2` that
 :func:`heritage_bayes.io.align` puts on row ``k`` for an instantaneous column, the
-forcing is :math:`\phi_j \tilde B \bar u_k + c_j \tilde B (u[k+1] - u[k])` with the
-slope gain :math:`c_j = (w^+_j - w^-_j)/2 \approx \lambda_j\Delta t^2/12` for slow
+forcing is :math:`\\phi_j \tilde B \bar u_k + c_j \tilde B (u[k+1] - u[k])` with the
+slope gain :math:`c_j = (w^+_j - w^-_j)/2 \approx \\lambda_j\\Delta t^2/12` for slow
 modes: the zero-order hold of the interval mean is exact for modes much slower than
 the step, and the slope term corrects the fast (air) modes.
 
@@ -220,28 +220,28 @@ def foh_weights(lam, dt: float) -> tuple[np.ndarray, np.ndarray]:
     """Exact first-order-hold weights of a mode with decay rate ``lam`` [1/s].
 
     For an input linear between the samples ``u[k]`` and ``u[k+1]`` over a step ``dt``
-    [s], the mode :math:`\dot z = -\lambda z + b\,u(t)` gives
-    :math:`z[k+1] = e^{-\lambda\Delta t} z[k] + b\,(w^- u[k] + w^+ u[k+1])`.
+    [s], the mode :math:`\\dot z = -\\lambda z + b\\,u(t)` gives
+    :math:`z[k+1] = e^{-\\lambda\\Delta t} z[k] + b\\,(w^- u[k] + w^+ u[k+1])`.
 
     Parameters
     ----------
     lam : array_like
-        Decay rates :math:`\lambda \ge 0` [1/s].
+        Decay rates :math:`\\lambda \\ge 0` [1/s].
     dt : float
         Time step [s].
 
     Returns
     -------
     w_prev, w_next : arrays like ``lam`` [s]
-        :math:`w^- = (1 - e^{-x}(1 + x)) / (\lambda x)` and
-        :math:`w^+ = (1 - e^{-x})/\lambda - w^-` with :math:`x = \lambda\Delta t`;
-        both :math:`\Delta t/2` for :math:`\lambda \to 0` (the trapezoid), and
-        :math:`w^- \to 0`, :math:`w^+ \to 1/\lambda` for very fast modes (the mode
+        :math:`w^- = (1 - e^{-x}(1 + x)) / (\\lambda x)` and
+        :math:`w^+ = (1 - e^{-x})/\\lambda - w^-` with :math:`x = \\lambda\\Delta t`;
+        both :math:`\\Delta t/2` for :math:`\\lambda \to 0` (the trapezoid), and
+        :math:`w^- \to 0`, :math:`w^+ \to 1/\\lambda` for very fast modes (the mode
         follows the input). A series is used for :math:`x < 10^{-2}` (no cancellation).
 
     Notes
     -----
-    :math:`w^- = \int_0^{\Delta t} e^{-\lambda s}\,s/\Delta t\,ds` weights the sample at
+    :math:`w^- = \\int_0^{\\Delta t} e^{-\\lambda s}\\,s/\\Delta t\\,ds` weights the sample at
     the start of the step, :math:`w^+` the one at its end [1]_.
     """
     dt = _check_dt(dt)

@@ -140,21 +140,23 @@ def truth(model, rng, floor_area: float | None = None) -> dict[str, float]:
     return {k: float(p[k]) for k in model.parameter_names}
 
 
-def simulate_reference(model, params, U: np.ndarray) -> np.ndarray:
-    """Exact ZOH simulation with scipy.linalg.expm (block-matrix form), from the steady
-    state of the first day's mean inputs: all node potentials (N, n)."""
+def simulate_reference(model, params, U: np.ndarray, dt: float = DT, x0=None) -> np.ndarray:
+    """Exact ZOH simulation with scipy.linalg.expm (block-matrix form), steps of ``dt``
+    [s], from ``x0`` or else the steady state of the first 24 rows' mean inputs: all
+    node potentials at the start of every step (N, n)."""
     A, B, _, _ = model.state_space(params)
     e = model.offset(params)
     n, m = B.shape
     Mx = np.zeros((n + m + 1, n + m + 1))
     Mx[:n, :n], Mx[:n, n : n + m], Mx[:n, -1] = A, B, e
-    E = expm(Mx * DT)
+    E = expm(Mx * dt)
     Ad, Bd, ed = E[:n, :n], E[:n, n : n + m], E[:n, -1]
-    x = np.linalg.solve(-A, B @ U[:24].mean(axis=0) + e)
+    x = np.linalg.solve(-A, B @ U[:24].mean(axis=0) + e) if x0 is None else x0
+    W = U @ Bd.T + ed
     X = np.empty((U.shape[0], n))
     for k in range(U.shape[0]):
         X[k] = x
-        x = Ad @ x + Bd @ U[k] + ed
+        x = Ad @ x + W[k]
     return X
 
 
@@ -383,6 +385,38 @@ def repeat_room(results: list[dict], variant: str) -> list[str]:
     return lines
 
 
+def print_study(results, variants, header: str, quantities: dict | None = None) -> None:
+    """Print a study's header line and its coverage table for each variant."""
+    print(header)
+    print("coverage of central 50 % / 90 % intervals (target 0.50 / 0.90; 90 %: 0.85-0.95)")
+    for v in variants:
+        for line in table(results, v, quantities):
+            print(line)
+
+
+def run_tasks(fn, tasks: list, jobs: int, log: str | None) -> list[dict]:
+    """Run ``fn`` on every task (``jobs`` processes), appending each result to ``log``
+    as one JSON line as soon as it is done (a study cut short can be tabulated)."""
+    results = []
+
+    def done(r):
+        results.append(r)
+        if log:
+            with open(log, "a") as f:
+                f.write(json.dumps(r) + "\n")
+        conv = ", ".join(f"{v}: {x['steps']} steps" for v, x in r["variants"].items())
+        print(f"  {r['model']} replicate {r['rep']} done ({conv})", flush=True)
+
+    if jobs > 1:
+        with ProcessPoolExecutor(jobs) as ex:
+            for r in ex.map(fn, tasks):
+                done(r)
+    else:
+        for t in tasks:
+            done(fn(t))
+    return results
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--reps", type=int, default=50)
@@ -499,31 +533,13 @@ def main() -> None:
         for m in args.models.split(",")
     ]  # models interleaved: a study cut short still covers every model
     t0 = time.perf_counter()
-    results = []
-
-    def done(r):
-        results.append(r)
-        if args.log:  # one JSON line per replicate: a partial study can be tabulated
-            with open(args.log, "a") as f:
-                f.write(json.dumps(r) + "\n")
-        conv = ", ".join(f"{v}: {x['steps']} steps" for v, x in r["variants"].items())
-        print(f"  {r['model']} replicate {r['rep']} done ({conv})", flush=True)
-
-    if args.jobs > 1:
-        with ProcessPoolExecutor(args.jobs) as ex:
-            for r in ex.map(replicate, tasks):
-                done(r)
-    else:
-        for t in tasks:
-            done(replicate(t))
-    print(
+    results = run_tasks(replicate, tasks, args.jobs, args.log)
+    print_study(
+        results,
+        variants,
         f"SBC: {args.reps} replicates per model, 3 months hourly De Bilt weather, "
-        f"{time.perf_counter() - t0:.0f} s wall"
+        f"{time.perf_counter() - t0:.0f} s wall",
     )
-    print("coverage of central 50 % / 90 % intervals (target 0.50 / 0.90; 90 %: 0.85-0.95)")
-    for v in variants:
-        for line in table(results, v):
-            print(line)
 
 
 if __name__ == "__main__":

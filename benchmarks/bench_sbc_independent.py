@@ -45,7 +45,6 @@ import json
 import os
 import sys
 import time
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
@@ -53,7 +52,6 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 
 import numpy as np
 import pandas as pd
-from scipy.linalg import expm
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
@@ -65,6 +63,9 @@ from bench_sbc import (  # the benchmark directory is not a package
     MAX_SPIN_DAYS,
     _knmi_cache,
     fit_and_rank,
+    print_study,
+    run_tasks,
+    simulate_reference,
     table,
     truth,
 )
@@ -170,25 +171,6 @@ def fit_inputs(hourly: pd.DataFrame) -> pd.DataFrame:
     return align([met, irr], step="1h", max_gap="0h").frame
 
 
-def simulate_fine(model, params, U: np.ndarray, x0: np.ndarray) -> np.ndarray:
-    """Exact steps of ``DT_SUB`` with inputs held over each sub-step: node potentials at
-    the start of every sub-step (N, n)."""
-    A, B, _, _ = model.state_space(params)
-    e = model.offset(params)
-    n, m = B.shape
-    Mx = np.zeros((n + m + 1, n + m + 1))
-    Mx[:n, :n], Mx[:n, n : n + m], Mx[:n, -1] = A, B, e
-    E = expm(Mx * DT_SUB)
-    Ad, Bd, ed = E[:n, :n], E[:n, n : n + m], E[:n, -1]
-    W = U @ Bd.T + ed
-    X = np.empty((U.shape[0], n))
-    x = x0
-    for k in range(U.shape[0]):
-        X[k] = x
-        x = Ad @ x + W[k]
-    return X
-
-
 def replicate(args) -> dict:
     """One room: generate on the 10-minute grid, fit on the hourly record, rank truths."""
     import heritage_bayes as hb
@@ -210,7 +192,7 @@ def replicate(args) -> dict:
         Uf[:, model.input_names.index("Tf")] = fine["Te"].mean()
     A, B, _, _ = model.state_space(p)
     x0 = np.linalg.solve(-A, B @ Uf[: 24 * SUB].mean(axis=0) + model.offset(p))
-    X = simulate_fine(model, p, Uf, x0)
+    X = simulate_reference(model, p, Uf, DT_SUB, x0)  # exact 10-minute steps
     out = model.output_names[0]
     y_hour = X[::SUB, model.state_names.index(out)]  # the node at every full hour
     frame = fit_inputs(gw["hourly"])
@@ -287,31 +269,14 @@ def main(argv=None) -> int:
         for m in args.models.split(",")
     ]
     t0 = time.perf_counter()
-    results = []
-
-    def done(r):
-        results.append(r)
-        if args.log:
-            with open(args.log, "a") as f:
-                f.write(json.dumps(r) + "\n")
-        conv = ", ".join(f"{v}: {x['steps']} steps" for v, x in r["variants"].items())
-        print(f"  {r['model']} replicate {r['rep']} done ({conv})", flush=True)
-
-    if args.jobs > 1:
-        with ProcessPoolExecutor(args.jobs) as ex:
-            for r in ex.map(replicate, tasks):
-                done(r)
-    else:
-        for t in tasks:
-            done(replicate(t))
-    print(
+    results = run_tasks(replicate, tasks, args.jobs, args.log)
+    print_study(
+        results,
+        variants,
         f"SBC (independent generator): {args.reps} replicates per model, "
-        f"{time.perf_counter() - t0:.0f} s wall"
+        f"{time.perf_counter() - t0:.0f} s wall",
+        QUANTITIES,
     )
-    print("coverage of central 50 % / 90 % intervals (target 0.50 / 0.90; 90 %: 0.85-0.95)")
-    for v in variants:
-        for line in table(results, v, QUANTITIES):
-            print(line)
     return 0
 
 

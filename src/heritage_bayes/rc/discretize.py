@@ -192,18 +192,25 @@ def discretize(model, params, dt: float = 3600.0):
     ed : (n,) or (K, n)
         Discrete constant forcing (zero unless the network has constant boundaries).
     """
-    dt = _check_dt(dt)
-    P, batch = model.param_array(params)
-    model.check_values(P)
-    mf = modal_form(model, P, dt)
-    Ad = (mf.T * mf.ad[:, None, :]) @ mf.Tinv
+    mf, batch, Ad, ed = _physical(model, params, dt)
     Bd = mf.T @ mf.Bdz
-    ed = np.einsum("kij,kj->ki", mf.T, mf.edz)
     Cm = model.output_matrix()
     D = np.zeros((model.n_outputs, model.n_inputs))
     if not batch:
         Ad, Bd, ed = Ad[0], Bd[0], ed[0]
     return Ad, Bd, Cm, D, ed
+
+
+def _physical(model, params, dt):
+    """(modal form, batch?, Ad, ed) in physical coordinates for :func:`discretize` and
+    :func:`discretize_foh`."""
+    dt = _check_dt(dt)
+    P, batch = model.param_array(params)
+    model.check_values(P)
+    mf = modal_form(model, P, dt)
+    Ad = (mf.T * mf.ad[:, None, :]) @ mf.Tinv
+    ed = np.einsum("kij,kj->ki", mf.T, mf.edz)
+    return mf, batch, Ad, ed
 
 
 def _check_dt(dt) -> float:
@@ -267,13 +274,7 @@ def discretize_foh(model, params, dt: float = 3600.0):
     readings, e.g. outdoor temperature at the hour), as :func:`discretize` is for
     inputs held over each step (interval means). Use one or the other per input
     column: an interval mean's column of ``B0 + B1`` is the ZOH column ``Bd``.
-
-    Parameters
-    ----------
-    model : RCModel
-    params : mapping name -> float, or name -> (K,) arrays for a batch [SI units]
-    dt : float
-        Time step [s].
+    Parameters as :func:`discretize` (``dt`` [s]).
 
     Returns
     -------
@@ -283,15 +284,10 @@ def discretize_foh(model, params, dt: float = 3600.0):
     ed : (n,) or (K, n)
         Discrete constant forcing (as :func:`discretize`).
     """
-    dt = _check_dt(dt)
-    P, batch = model.param_array(params)
-    model.check_values(P)
-    mf = modal_form(model, P, dt)
-    w0, w1 = foh_weights(mf.lam, dt)
-    Ad = (mf.T * mf.ad[:, None, :]) @ mf.Tinv
+    mf, batch, Ad, ed = _physical(model, params, dt)
+    w0, w1 = foh_weights(mf.lam, mf.dt)
     B0 = mf.T @ (w0[:, :, None] * mf.Bz)
     B1 = mf.T @ (w1[:, :, None] * mf.Bz)
-    ed = np.einsum("kij,kj->ki", mf.T, mf.edz)
     if not batch:
         Ad, B0, B1, ed = Ad[0], B0[0], B1[0], ed[0]
     return Ad, B0, B1, ed

@@ -91,13 +91,16 @@ def _fluctuation(rng, n: int, sd: float, tau_steps: float) -> np.ndarray:
     return e
 
 
-def generator_weather(seed: int) -> dict:
+def generator_weather(seed: int, without: tuple = ()) -> dict:
     """A random De Bilt stretch on the 10-minute grid and as a station logs it hourly.
 
     Returns ``fine`` (10-minute Te [°C], Pe [Pa], I_S [W/m²], each the value over the
     sub-step starting at its time), ``hourly`` (a DataFrame of the readings Te, RHe at
     the hour and the hour-ending ghi, UTC, as :func:`read_knmi_hourly` returns them) and
-    ``t0`` the first hour.
+    ``t0`` the first hour. ``without``: parts of the generator left out, to find which
+    one costs coverage: ``"within_hour"`` (no fluctuation within the hour: the
+    readings describe the hour exactly), ``"sky"`` (the generator's facade irradiance
+    is the fit's own, held over each hour).
     """
     import pvlib
 
@@ -116,9 +119,10 @@ def generator_weather(seed: int) -> dict:
     nf = fine_t.size
     # within-hour weather: linear between the hours + a fluctuation the hourly readings
     # sample only at the full hour
-    te_f = np.interp(fine_t, th, part["Te"].to_numpy()) + _fluctuation(rng, nf, 0.3, 3.0)
+    wiggle = 0.0 if "within_hour" in without else 1.0
+    te_f = np.interp(fine_t, th, part["Te"].to_numpy()) + wiggle * _fluctuation(rng, nf, 0.3, 3.0)
     rh_f = np.clip(np.interp(fine_t, th, part["RHe"].to_numpy()), 1.0, 100.0)
-    pe_f = vapour_pressure(te_f, rh_f) + _fluctuation(rng, nf, 10.0, 3.0)
+    pe_f = vapour_pressure(te_f, rh_f) + wiggle * _fluctuation(rng, nf, 10.0, 3.0)
     # the station's hourly record of those series
     on_hour = slice(0, nf, SUB)
     hourly = pd.DataFrame(
@@ -154,6 +158,8 @@ def generator_weather(seed: int) -> dict:
     )
     i_s = np.clip(np.nan_to_num(np.asarray(poa["poa_global"], float)), 0.0, None)
     i_s[ghi_f <= 0] = 0.0
+    if "sky" in without:  # the fit's facade irradiance, held over its hour
+        i_s = np.repeat(fit_inputs(hourly)["I_S"].to_numpy(), SUB)
     return {"fine": {"Te": te_f, "Pe": pe_f, "I_S": i_s}, "hourly": hourly, "t0": hours[0]}
 
 
@@ -180,11 +186,12 @@ def replicate(args) -> dict:
     cal_days = args[5] if len(args) > 5 else CAL_DAYS
     floor = args[6] if len(args) > 6 else FLOOR
     envelope = args[7] if len(args) > 7 else ENVELOPE
+    without = args[8] if len(args) > 8 else ()
     rng = np.random.default_rng([seed, rep])
     opts = {"surfaces": ("S",)} if name.startswith("thermal") else {}
     model = hb.model(name, **opts)
     p = truth(model, rng, floor)
-    gw = generator_weather(int(rng.integers(2**31)))
+    gw = generator_weather(int(rng.integers(2**31)), without)
     fine = gw["fine"]
     nf = fine["Te"].size
     Uf = np.column_stack([fine[c] if c in fine else np.full(nf, 10.0) for c in model.input_names])
@@ -253,9 +260,17 @@ def main(argv=None) -> int:
     ap.add_argument("--seed", type=int, default=2031)
     ap.add_argument("--max-steps", type=int, default=12000)
     ap.add_argument("--log", help="append each replicate's result as a JSON line")
+    ap.add_argument(
+        "--without",
+        default="",
+        help="comma-separated parts of the generator left out: within_hour, sky",
+    )
     ap.add_argument("--table", help="only tabulate a --log file of an earlier study")
     args = ap.parse_args(argv)
     variants = args.noise or ["ar1_white:estimate"]
+    without = tuple(w for w in args.without.split(",") if w)
+    if set(without) - {"within_hour", "sky"}:
+        ap.error(f"--without: unknown {sorted(set(without) - {'within_hour', 'sky'})}")
     if args.table:
         results = [json.loads(line) for line in open(args.table)]
         print(f"SBC (independent generator) table of {args.table}: {len(results)} replicates")
@@ -264,7 +279,7 @@ def main(argv=None) -> int:
                 print(line)
         return 0
     tasks = [
-        (m, r, variants, args.seed, args.max_steps)
+        (m, r, variants, args.seed, args.max_steps, CAL_DAYS, FLOOR, ENVELOPE, without)
         for r in range(args.first_rep, args.first_rep + args.reps)
         for m in args.models.split(",")
     ]

@@ -11,10 +11,15 @@ Run directory (``hbayes calibrate``):
   - ``posterior``: parameters (fixed ones included as constants) and derived
     identifiable quantities (time constants [h], static gains);
   - ``sample_stats``: ``<model>.lp`` (log-posterior), ``<model>.acceptance_rate``;
-  - ``log_likelihood``: ``<model>.<output>``, the pointwise terms of the calibration
-    likelihood, only the hours that enter it (axis ``time.<model>.<output>``: no warm-up,
-    no gap), so ``az.loo``/``az.compare`` work on the InferenceData as it is; with AR(1)
-    noise each term is the density of the hour given the previous residual;
+  - ``log_likelihood``: the pointwise terms of the calibration likelihood, only the
+    hours that enter it (no warm-up, no gap), so ``az.loo(idata)``, ``az.waic(idata)``
+    and ``az.compare`` work on the InferenceData as it is, without ``var_name``: with one
+    output the variable ``<model>.<output>`` (axis ``time.<model>.<output>``), with
+    several one variable ``all_outputs`` holding all of them on an ``observation`` axis
+    (coordinates ``observation_variable``, ``observation_time``); with AR(1) noise each
+    term is the density of the hour given the previous residual;
+  - ``log_likelihood_outputs`` (not an arviz group; runs with several outputs): the
+    per-output terms ``<model>.<output>``;
   - ``log_likelihood_validation`` (not an arviz group): the same over the validation
     period, from the simulation continued past calibration (expected log predictive
     density of new data);
@@ -26,7 +31,8 @@ Run directory (``hbayes calibrate``):
     subset of draws (and ``RHi`` combining thermal and hygric draws);
   - attributes: package version, seed, config hash, creation time.
 
-- ``summary.json``: per parameter median, 5 %, 95 %, r_hat, ess_bulk, ess_tail, τ; fit
+- ``summary.json``: per parameter median, 5 %, 95 %, r_hat, ess_bulk, ess_tail (those
+  of the saved draws: ``az.summary`` of ``posterior.nc`` gives the same), τ; fit
   metrics; convergence verdict; MAP; identifiability.
 - ``config.yaml``: the resolved config.
 

@@ -768,3 +768,24 @@ def test_verdict_is_not_green_while_a_truth_marker_misses():
         "thermal.gain_Ti_Te: the true value 0.9 lies outside the 90 % interval "
         "[0.75, 0.85], 3.3 σ from the median"
     ]
+
+
+def test_fit_is_flagged_on_a_nearly_constant_series():
+    """A humidistat-held RH (Ørholm: MAE 2.1 %RH, FIT −98 %): the measured series varies
+    less than the error, FIT says nothing and the table says so; a varying series with
+    a good fit is not flagged."""
+    from heritage_bayes.report.sections.metrics import _nearly_constant
+
+    mae, fit = 2.1, -98.0
+    rmse = 1.25 * mae  # Gaussian errors: RMSE ≈ 1.25 MAE
+    words = _nearly_constant({"MAE": mae, "MSE": rmse**2, "FIT": fit})  # no SD: derived
+    assert "nearly constant" in words and "MAE 2.1" in words
+    sd = rmse / (1 - fit / 100)
+    assert f"standard deviation {fmt(sd)}" in words
+    assert _nearly_constant({"MAE": 0.2, "MSE": 0.0625, "FIT": 80.0, "SD": 1.25}) == ""
+    # the SD stored by fit_metrics is the population standard deviation of the measured
+    from heritage_bayes.inference.results import fit_metrics
+
+    y = np.array([50.0, 51.0, np.nan, 49.0, 50.5])
+    m = fit_metrics(y, np.full(5, 50.0))
+    assert m["SD"] == pytest.approx(np.nanstd(y))

@@ -253,6 +253,26 @@ def replicate(args) -> dict:
     return result
 
 
+def zscore_lines(results: list[dict], variant: str) -> list[str]:
+    """Per model and quantity the rms of z = (posterior median - truth) / posterior sd
+    over the replicates: about 1 for calibrated intervals, the factor by which they are
+    too narrow otherwise (with n replicates its standard error is about 1/sqrt(2n))."""
+    lines = []
+    for name in sorted({r["model"] for r in results}):
+        rs = [r for r in results if r["model"] == name and variant in r["variants"]]
+        parts = []
+        for k in QUANTITIES.get(name, ()):
+            z = [
+                (x["median"] - r["truth"][k]) / x["sd"]
+                for r in rs
+                if (x := r["variants"][variant]["ranks"].get(k)) and x["sd"] > 0
+            ]
+            if z:
+                parts.append(f"{k} {np.sqrt(np.mean(np.square(z))):.2f}")
+        lines.append(f"  {name} [{variant}] z rms ({len(rs)} rooms): " + ", ".join(parts))
+    return lines
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--reps", type=int, default=50)
@@ -280,7 +300,7 @@ def main(argv=None) -> int:
         results = [json.loads(line) for line in open(args.table)]
         print(f"SBC (independent generator) table of {args.table}: {len(results)} replicates")
         for v in sorted({v for r in results for v in r["variants"]}):
-            for line in table(results, v, QUANTITIES):
+            for line in table(results, v, QUANTITIES) + zscore_lines(results, v):
                 print(line)
         return 0
     tasks = [

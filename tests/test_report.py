@@ -789,3 +789,23 @@ def test_fit_is_flagged_on_a_nearly_constant_series():
     y = np.array([50.0, 51.0, np.nan, 49.0, 50.5])
     m = fit_metrics(y, np.full(5, 50.0))
     assert m["SD"] == pytest.approx(np.nanstd(y))
+
+
+def test_weakly_separated_pairs_are_named_in_words():
+    """Gain and offset of a fixed node that the data trade against each other (r ≈ −1)
+    are named; an independent time constant is not."""
+    from heritage_bayes.report.identifiable import Coord
+    from heritage_bayes.report.sections.identifiability import tradeoff_words
+
+    rng = np.random.default_rng(5)
+    a = rng.normal(size=(8, 50))
+    coords = [
+        Coord("tau_1_h", "log10 τ1 [h]", True, rng.normal(size=(8, 50)), None, None),
+        Coord("gain_Pi_Pe", "gain_Pi_Pe [-]", False, a, None, None),
+        Coord("offset_Pi_Pf", "offset_Pi_Pf [Pa]", False, -a, None, None),
+    ]
+    coords[2].draws = -a + 0.1 * rng.normal(size=a.shape)
+    words = tradeoff_words(coords)
+    assert len(words) == 1
+    assert words[0].startswith("gain_Pi_Pe [-] and offset_Pi_Pf [Pa] trade off")
+    assert "one rises as the other falls" in words[0]

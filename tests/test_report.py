@@ -802,9 +802,15 @@ def test_weakly_separated_pairs_are_named_in_words():
     coords = [
         Coord("tau_1_h", "log10 τ1 [h]", True, rng.normal(size=(8, 50)), None, None),
         Coord("gain_Pi_Pe", "gain_Pi_Pe [-]", False, a, None, None),
-        Coord("offset_Pi_Pf", "offset_Pi_Pf [Pa]", False, -a, None, None),
+        Coord(
+            "offset_Pi_Pf",
+            "offset_Pi_Pf [Pa]",
+            False,
+            -a + 0.1 * rng.normal(size=a.shape),
+            None,
+            None,
+        ),
     ]
-    coords[2].draws = -a + 0.1 * rng.normal(size=a.shape)
     words = tradeoff_words(coords)
     assert len(words) == 1
     assert words[0].startswith("gain_Pi_Pe [-] and offset_Pi_Pf [Pa] trade off")

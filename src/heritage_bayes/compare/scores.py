@@ -52,7 +52,7 @@ def pointwise_terms(idata, var_name: str | None = None) -> xr.Dataset:
 
     A run with one output keeps them in ``log_likelihood``; a run with several keeps
     their combination there (the default of ``az.loo``) and the per-output terms in
-    ``log_likelihood_outputs`` (see :func:`heritage_bayes.inference.idata.loglik_groups`).
+    ``log_likelihood_outputs`` (see :func:`heritage_bayes.inference.interop.loglik_groups`).
     """
     if "log_likelihood_outputs" in idata.groups() and (
         var_name is None or var_name not in idata.log_likelihood

@@ -1,0 +1,334 @@
+"""Generated references: the configuration keys from the schema, the CLI from its parser.
+
+The documentation's configuration and command-line references are produced by these
+functions at build time (``docs/reference/*.md`` call them in executed blocks), never
+written by hand: a key added to a pydantic model, a description or unit given to a field,
+an option or a subcommand added to :func:`heritage_bayes.cli._build_parser` appears in
+the next build with no edit of the docs.
+
+The walk is generic: :func:`schema_reference` follows any pydantic model through its
+``model_fields`` (nested models, optional models, lists and mappings of models), and
+:func:`parser_reference` any :class:`argparse.ArgumentParser` through its actions and
+sub-parsers. What a field states is what the reference prints: its type, its default
+(or *required*), its bounds (``ge``/``gt``/``le``/``lt``, lengths), its description, and
+a unit or examples when the field carries them (``json_schema_extra={"unit": "m³"}``,
+``examples=[...]``).
+
+Layer: documentation tooling beside the CLI; it reads the config schema, the projection
+schema and the parser, and nothing reads it.
+"""
+
+from __future__ import annotations
+
+import argparse
+import enum
+import re
+import types
+import typing
+from collections.abc import Iterator
+
+from pydantic import BaseModel
+from pydantic.fields import FieldInfo
+from pydantic_core import PydanticUndefined
+
+__all__ = [
+    "cli_reference",
+    "config_reference",
+    "parser_reference",
+    "schema_reference",
+]
+
+#: a Sphinx cross-reference role in a docstring, ``:func:`~a.b``` -> ``a.b``
+_ROLE = re.compile(r":[a-z]+:`~?([^`]+)`")
+_BOUNDS = (("ge", "≥"), ("gt", ">"), ("le", "≤"), ("lt", "<"))
+_LENGTHS = (("min_length", "at least {} items"), ("max_length", "at most {} items"))
+
+
+# --------------------------------------------------------------------------- schema
+def _type_text(tp, root: type[BaseModel]) -> str:
+    """A readable type: ``str | None``, ``"estimate" | "steady"``, ``list[float]``; a
+    nested model as a link to its table in the reference of ``root``."""
+    origin = typing.get_origin(tp)
+    args = typing.get_args(tp)
+    if tp is type(None):
+        return "none"
+    if origin is typing.Literal:
+        return " | ".join(f'"{a}"' if isinstance(a, str) else repr(a) for a in args)
+    if origin in (typing.Union, types.UnionType):
+        return " | ".join(_type_text(a, root) for a in args)
+    if origin is typing.Annotated:
+        return _type_text(args[0], root)
+    if origin in (list, tuple, set, frozenset):
+        inner = ", ".join("…" if a is Ellipsis else _type_text(a, root) for a in args)
+        return f"{origin.__name__}[{inner}]" if inner else origin.__name__
+    if origin is dict:
+        if not args:
+            return "mapping"
+        return f"mapping[{_type_text(args[0], root)}, {_type_text(args[1], root)}]"
+    if isinstance(tp, type) and issubclass(tp, BaseModel):
+        return f"[{tp.__name__}](#{_anchor(tp, root)})"
+    if isinstance(tp, type) and issubclass(tp, enum.Enum):
+        return " | ".join(f'"{m.value}"' for m in tp)
+    if tp is typing.Any:
+        return "any"
+    return getattr(tp, "__name__", str(tp)).replace("NoneType", "none")
+
+
+def _cell(text: str) -> str:
+    """Text safe inside a markdown table cell."""
+    return text.replace("|", "\\|")
+
+
+def _anchor(model: type[BaseModel], root: type[BaseModel]) -> str:
+    """Anchor of a model's table, unique per reference (two roots may share a model)."""
+    return f"{root.__name__.lower()}-{model.__name__.lower()}"
+
+
+def _nested_models(tp) -> Iterator[tuple[str, type[BaseModel]]]:
+    """(key suffix, model) for every pydantic model inside a type annotation.
+
+    The suffix says how the nested keys are reached: ``""`` (the value is the model),
+    ``"[]"`` (a list of them), ``".<key>"`` (a mapping of them).
+    """
+    origin = typing.get_origin(tp)
+    args = typing.get_args(tp)
+    if isinstance(tp, type) and issubclass(tp, BaseModel):
+        yield "", tp
+    elif origin in (typing.Union, types.UnionType, typing.Annotated):
+        for a in args if origin is not typing.Annotated else args[:1]:
+            yield from _nested_models(a)
+    elif origin in (list, tuple, set, frozenset):
+        for a in args:
+            for suffix, m in _nested_models(a):
+                yield "[]" + suffix, m
+    elif origin is dict and args:
+        for suffix, m in _nested_models(args[1]):
+            yield ".<key>" + suffix, m
+
+
+def _default_text(field: FieldInfo) -> str:
+    if field.default_factory is not None:
+        try:
+            value = field.default_factory()
+        except TypeError:  # a factory that takes the validated data
+            return "computed"
+        if isinstance(value, BaseModel):
+            return "its defaults"
+        return _value_text(value)
+    if field.default is PydanticUndefined:
+        return "**required**"
+    return _value_text(field.default)
+
+
+def _value_text(value) -> str:
+    if value is None:
+        return "none"
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, enum.Enum):
+        value = value.value
+    if value in ({}, [], ""):
+        return "empty"
+    return _cell(f"`{value}`")
+
+
+def _bounds_text(field: FieldInfo) -> str:
+    parts = []
+    for meta in field.metadata:
+        for attr, sign in _BOUNDS:
+            v = getattr(meta, attr, None)
+            if v is not None:
+                parts.append(f"{sign} {v:g}" if isinstance(v, float) else f"{sign} {v}")
+        for attr, text in _LENGTHS:
+            v = getattr(meta, attr, None)
+            if v is not None:
+                parts.append(text.format(v))
+    return ", ".join(parts)
+
+
+def _extra(field: FieldInfo, key: str):
+    extra = field.json_schema_extra
+    return extra.get(key) if isinstance(extra, dict) else None
+
+
+def _description_text(field: FieldInfo) -> str:
+    text = " ".join((field.description or "").split())
+    unit = _extra(field, "unit")
+    if unit and f"[{unit}]" not in text:
+        text = f"[{unit}] {text}".strip()
+    examples = field.examples or _extra(field, "examples")
+    if examples:
+        text += (" " if text else "") + "Example: " + ", ".join(f"`{e}`" for e in examples)
+    return _cell(text)
+
+
+def _doc_text(model: type[BaseModel]) -> str:
+    """The first paragraph of a model's own docstring (not pydantic's BaseModel's)."""
+    doc = model.__dict__.get("__doc__") or ""
+    first = " ".join(doc.strip().split("\n\n")[0].split())
+    return _ROLE.sub(r"`\1`", first)
+
+
+def schema_reference(
+    model: type[BaseModel], *, title: str | None = None, prefix: str = "", level: int = 2
+) -> str:
+    """The keys of a pydantic model as markdown: one table per (nested) model.
+
+    Parameters
+    ----------
+    model : type[pydantic.BaseModel]
+        The root of the schema, e.g. :class:`heritage_bayes.config.CalibrationConfig`.
+    title : str, optional
+        Heading of the root table (default: the model's name).
+    prefix : str
+        Key path of the root (``""`` for a top-level file).
+    level : int
+        Markdown heading level of each table.
+
+    Returns
+    -------
+    str
+        Markdown: for every model reached from the root, a heading naming its key path,
+        the model's docstring and a table *key | type | default | allowed | description*.
+        Each model appears once, at the first key path that reaches it; later paths link
+        to it.
+    """
+    seen: dict[type[BaseModel], str] = {}
+    order: list[tuple[type[BaseModel], str]] = []
+
+    def visit(m: type[BaseModel], path: str) -> None:
+        if m in seen:
+            return
+        seen[m] = path
+        order.append((m, path))
+        for name, field in m.model_fields.items():
+            key = field.alias or name
+            for suffix, sub in _nested_models(field.annotation):
+                visit(sub, f"{path}.{key}{suffix}" if path else f"{key}{suffix}")
+
+    visit(model, prefix)
+    out = []
+    hashes = "#" * level
+    for i, (m, path) in enumerate(order):
+        heading = (title or m.__name__) if i == 0 else f"`{path}`"
+        out.append(f"{hashes} {heading} {{ #{_anchor(m, model)} }}\n")
+        doc = _doc_text(m)
+        if doc:
+            out.append(doc + "\n")
+        out.append("| key | type | default | allowed | description |")
+        out.append("|---|---|---|---|---|")
+        for name, field in m.model_fields.items():
+            key = field.alias or name
+            full = f"{path}.{key}" if path else key
+            type_text = _cell(_type_text(field.annotation, model))
+            out.append(
+                f"| `{full}` | {type_text} | {_default_text(field)} "
+                f"| {_bounds_text(field)} | {_description_text(field)} |"
+            )
+        out.append("")
+    return "\n".join(out)
+
+
+def config_reference() -> str:
+    """The reference of the calibration config and of the projection file (markdown)."""
+    from heritage_bayes.config import CalibrationConfig
+    from heritage_bayes.projection.config import ProjectionConfig
+
+    return "\n".join(
+        [
+            schema_reference(CalibrationConfig, title="Calibration config (`hbayes calibrate`)"),
+            schema_reference(ProjectionConfig, title="Projection file (`hbayes project`)"),
+        ]
+    )
+
+
+# --------------------------------------------------------------------------- parser
+def _subcommands(parser: argparse.ArgumentParser):
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            helps = {a.dest: a.help for a in action._choices_actions}
+            for name, sub in action.choices.items():
+                yield name, sub, helps.get(name)
+
+
+def _action_help(parser: argparse.ArgumentParser, action: argparse.Action) -> str:
+    if not action.help or action.help == argparse.SUPPRESS:
+        return ""
+    text = parser._get_formatter()._expand_help(action)
+    if action.choices and not isinstance(action, argparse._SubParsersAction):
+        choices = ", ".join(f"`{c}`" for c in action.choices)
+        if choices not in text:
+            text += f" (one of {choices})"
+    default = action.default
+    if (
+        action.option_strings
+        and action.nargs != 0
+        and default not in (None, False, argparse.SUPPRESS)
+        and str(default) not in text
+    ):
+        text += f" (default `{default}`)"
+    return _cell(" ".join(text.split()))
+
+
+def _action_rows(parser: argparse.ArgumentParser) -> list[str]:
+    rows = []
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction) or action.help == argparse.SUPPRESS:
+            continue
+        if action.option_strings:
+            names = ", ".join(f"`{s}`" for s in action.option_strings)
+            takes = action.nargs != 0
+            metavar = action.metavar or action.dest.upper()
+            arg = f"`{metavar}`" if takes else ""
+        else:
+            names = f"`{action.metavar or action.dest.upper()}`"
+            arg = "optional" if action.nargs in ("?", "*") else "required"
+        rows.append(f"| {names} | {arg} | {_action_help(parser, action)} |")
+    return rows
+
+
+def parser_reference(parser: argparse.ArgumentParser, *, level: int = 2) -> str:
+    """Every command of an argparse parser as markdown.
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        The program's parser, sub-parsers included (e.g. ``hbayes``'s).
+    level : int
+        Markdown heading level of each command.
+
+    Returns
+    -------
+    str
+        Markdown: the program's usage and options, then for every subcommand (recursively)
+        a heading ``prog command``, its description, its usage line and a table
+        *argument | value | help* with the defaults and choices argparse knows.
+    """
+    out = []
+
+    def visit(p: argparse.ArgumentParser, lvl: int, summary: str | None) -> None:
+        hashes = "#" * lvl
+        out.append(f"{hashes} `{p.prog}`\n")
+        text = p.description or summary
+        if text:
+            out.append(" ".join(text.split()) + "\n")
+        usage = " ".join(p.format_usage().removeprefix("usage: ").split())
+        out.append(f"```text\n{usage}\n```\n")
+        rows = _action_rows(p)
+        if rows:
+            out.append("| argument | value | help |")
+            out.append("|---|---|---|")
+            out.extend(rows)
+            out.append("")
+        for _name, sub, help_ in _subcommands(p):
+            visit(sub, min(lvl + 1, 6), help_)
+
+    visit(parser, level, None)
+    return "\n".join(out)
+
+
+def cli_reference() -> str:
+    """The reference of the ``hbayes`` command line (markdown), from its parser."""
+    from heritage_bayes.cli import _build_parser
+
+    return parser_reference(_build_parser())

@@ -215,3 +215,45 @@ def test_a_dangling_api_reference_fails_the_build(tmp_path, _mkdocs):
     res = _build(cfg)
     assert res.returncode != 0
     assert "no_such_function" in res.stderr
+
+
+# ------------------------------------------------------- the report's "From Python"
+TINY = {
+    "name": "tiny",
+    "seed": 3,
+    "data": {"demo": {"seed": 7}},
+    "periods": {
+        "calibration": {"start": "2019-02-01", "end": "2019-02-11"},
+        "validation": {"start": "2019-02-11", "end": "2019-02-16"},
+    },
+    "thermal": {"model": "thermal_1c"},
+    "hygric": {"model": "hygric_1c"},
+    "sampler": {"max_steps": 600, "check_every": 200},
+    "optimizer": {"maxiter": 20, "starts": 1, "popsize": 4},
+    "ladder": False,
+}
+
+
+def test_the_reports_from_python_lines_run_as_printed(tmp_path):
+    """The report prints Python that opens its own run; it runs in a fresh interpreter
+    exactly as the page shows it (HTML entities undone, nothing else)."""
+    import html
+    import re
+
+    from heritage_bayes.calibrate import run_calibration
+    from heritage_bayes.config import parse_config
+    from heritage_bayes.report import write_report
+
+    run_dir = tmp_path / "a run's folder"  # a quote and a space: the path is a literal
+    run_calibration(parse_config(TINY), out_dir=run_dir, report=False, quiet=True)
+    page = write_report(run_dir).read_text(encoding="utf-8")
+    m = re.search(r'<pre class="config" id="from-python">(.*?)</pre>', page, re.S)
+    assert m, "the report has no From Python block"
+    code = html.unescape(m.group(1))
+    assert repr(str(run_dir.resolve())) in code
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path)
+    assert res.returncode == 0, res.stderr
+    assert res.stdout.startswith("converged: False")  # 600 steps: not converged
+    for name in ("thermal.tau_1_h", "thermal.gain_Ti_Te", "hygric.tau_1_h"):
+        assert name in res.stdout
+    assert re.search(r"^thermal \{'Ci': [0-9.e+]+, ", res.stdout, re.M)

@@ -32,6 +32,8 @@ from pydantic.fields import FieldInfo
 from pydantic_core import PydanticUndefined
 
 __all__ = [
+    "check_config_snippet",
+    "check_projection_snippet",
     "cli_reference",
     "config_reference",
     "parser_reference",
@@ -332,3 +334,71 @@ def cli_reference() -> str:
     from heritage_bayes.cli import _build_parser
 
     return parser_reference(_build_parser())
+
+
+# --------------------------------------------------------------------------- snippets
+def _merge(base: dict, extra: dict) -> dict:
+    out = dict(base)
+    for k, v in extra.items():
+        out[k] = _merge(out[k], v) if isinstance(v, dict) and isinstance(out.get(k), dict) else v
+    return out
+
+
+def check_config_snippet(snippet: str, base: str = "configs/demo.yaml") -> str:
+    """Validate a piece of a calibration config as the docs show it; return it as given.
+
+    The snippet (YAML text) is merged key by key into the config ``base`` and the result
+    goes through the same checks as ``hbayes calibrate`` before it reads any data: the
+    schema (:func:`heritage_bayes.config.parse_config`) and the models with their
+    options and priors (:func:`heritage_bayes.calibrate.check_models`). The manual's
+    how-to pages print their config examples through this function, so an example with
+    a misspelt key or an option a model does not take fails the docs build.
+
+    Parameters
+    ----------
+    snippet : str
+        YAML text: keys of a calibration config, nested as in a file.
+    base : str
+        A complete config the snippet is merged into (its paths are not read).
+
+    Returns
+    -------
+    str
+        ``snippet`` as a fenced YAML block, ready to print into a page.
+
+    Raises
+    ------
+    heritage_bayes.ConfigError
+        The merged config is not valid; the message names the key path.
+    """
+    import yaml
+
+    from heritage_bayes.calibrate import check_models
+    from heritage_bayes.config import parse_config, read_yaml
+
+    raw, _ = read_yaml(base)
+    extra = yaml.safe_load(snippet)
+    if not isinstance(extra, dict):
+        raise ValueError(f"a config snippet is a YAML mapping, got {type(extra).__name__}")
+    check_models(parse_config(_merge(raw, extra), source=f"snippet merged into {base}"))
+    return f"```yaml\n{snippet.strip()}\n```"
+
+
+def check_projection_snippet(snippet: str) -> str:
+    """Validate a projection file as the docs show it; return it as a fenced YAML block.
+
+    The snippet is a complete projection file (:class:`ProjectionConfig`), validated by
+    :func:`heritage_bayes.projection.config.parse_projection_config` as ``hbayes
+    project`` does before it runs anything.
+
+    Raises
+    ------
+    heritage_bayes.ConfigError
+        The file is not valid; the message names the key path.
+    """
+    import yaml
+
+    from heritage_bayes.projection.config import parse_projection_config
+
+    parse_projection_config(yaml.safe_load(snippet), source="projection snippet")
+    return f"```yaml\n{snippet.strip()}\n```"

@@ -23,6 +23,7 @@ from pydantic import BaseModel, Field, create_model
 from heritage_bayes.cli import _build_parser
 from heritage_bayes.config import CalibrationConfig
 from heritage_bayes.reference import cli_reference, parser_reference, schema_reference
+from test_report import TINY as REPORT_TINY
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -218,20 +219,8 @@ def test_a_dangling_api_reference_fails_the_build(tmp_path, _mkdocs):
 
 
 # ------------------------------------------------------- the report's "From Python"
-TINY = {
-    "name": "tiny",
-    "seed": 3,
-    "data": {"demo": {"seed": 7}},
-    "periods": {
-        "calibration": {"start": "2019-02-01", "end": "2019-02-11"},
-        "validation": {"start": "2019-02-11", "end": "2019-02-16"},
-    },
-    "thermal": {"model": "thermal_1c"},
-    "hygric": {"model": "hygric_1c"},
-    "sampler": {"max_steps": 600, "check_every": 200},
-    "optimizer": {"maxiter": 20, "starts": 1, "popsize": 4},
-    "ladder": False,
-}
+# the report tests' tiny run (10 + 5 days of the demo, 600 steps), without the ladder
+TINY = {**REPORT_TINY, "ladder": False}
 
 
 def test_the_reports_from_python_lines_run_as_printed(tmp_path):

@@ -30,6 +30,7 @@ from heritage_bayes.config import (
     chain_tag,
     config_hash,
 )
+from heritage_bayes.convert import format_timedelta
 from heritage_bayes.errors import InputError
 from heritage_bayes.inference.posterior import LogPosterior
 from heritage_bayes.inference.results import (
@@ -448,10 +449,10 @@ def _calibrate_into(
         s.timings["sampling_seconds"] = time.perf_counter() - t0
         s.timings["sampling_cpu_seconds"] = s.chain.cpu_seconds
         verdict = "converged" if s.chain.converged else "NOT converged"
-        if s.chain.stopped_by == "max_seconds":
+        if (budget := cfg.sampler.max_time) is not None and s.chain.stopped_by == "max_seconds":
             say.warn(
-                f"[{s.name}] the time budget sampler.max_time = {cfg.sampler.max_time} ran "
-                f"out after {s.chain.steps} steps (τmax {np.nanmax(s.chain.tau):.0f}, "
+                f"[{s.name}] the time budget sampler.max_time = {format_timedelta(budget)} "
+                f"ran out after {s.chain.steps} steps (τmax {np.nanmax(s.chain.tau):.0f}, "
                 f"about {cfg.sampler.tau_factor * np.nanmax(s.chain.tau):.0f} steps needed): "
                 "raise it, or run again with --resume to continue the chain"
             )

@@ -43,7 +43,7 @@ from pathlib import Path
 
 import numpy as np
 
-from heritage_bayes.io._common import to_jsonable
+from heritage_bayes.convert import to_jsonable
 
 __all__ = [
     "atomic_write",

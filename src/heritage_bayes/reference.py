@@ -25,11 +25,9 @@ import enum
 import re
 import types
 import typing
-from collections.abc import Iterator
 
 from pydantic import BaseModel
 from pydantic.fields import FieldInfo
-from pydantic_core import PydanticUndefined
 
 __all__ = [
     "check_config_snippet",
@@ -47,9 +45,8 @@ _LENGTHS = (("min_length", "at least {} items"), ("max_length", "at most {} item
 
 
 # --------------------------------------------------------------------------- schema
-def _type_text(tp, root: type[BaseModel]) -> str:
-    """A readable type: ``str | None``, ``"estimate" | "steady"``, ``list[float]``; a
-    nested model as a link to its table in the reference of ``root``."""
+def _type_text(tp) -> str:
+    """A readable type: ``str | none``, ``"estimate" | "steady"``, ``list[float]``."""
     origin = typing.get_origin(tp)
     args = typing.get_args(tp)
     if tp is type(None):
@@ -57,69 +54,35 @@ def _type_text(tp, root: type[BaseModel]) -> str:
     if origin is typing.Literal:
         return " | ".join(f'"{a}"' if isinstance(a, str) else repr(a) for a in args)
     if origin in (typing.Union, types.UnionType):
-        return " | ".join(_type_text(a, root) for a in args)
+        return " | ".join(_type_text(a) for a in args)
     if origin is typing.Annotated:
-        return _type_text(args[0], root)
+        return _type_text(args[0])
     if origin in (list, tuple, set, frozenset):
-        inner = ", ".join("…" if a is Ellipsis else _type_text(a, root) for a in args)
+        inner = ", ".join("…" if a is Ellipsis else _type_text(a) for a in args)
         return f"{origin.__name__}[{inner}]" if inner else origin.__name__
     if origin is dict:
         if not args:
             return "mapping"
-        return f"mapping[{_type_text(args[0], root)}, {_type_text(args[1], root)}]"
+        return f"mapping[{_type_text(args[0])}, {_type_text(args[1])}]"
     if isinstance(tp, type) and issubclass(tp, BaseModel):
-        return f"[{tp.__name__}](#{_anchor(tp, root)})"
+        return "section"
     if isinstance(tp, type) and issubclass(tp, enum.Enum):
         return " | ".join(f'"{m.value}"' for m in tp)
     if tp is typing.Any:
         return "any"
-    return getattr(tp, "__name__", str(tp)).replace("NoneType", "none")
+    name = getattr(tp, "__name__", None) or str(tp).replace("typing.", "")
+    return {"Timedelta": "duration", "NoneType": "none"}.get(name, name)
 
 
 def _cell(text: str) -> str:
     """Text safe inside a markdown table cell."""
-    return text.replace("|", "\\|")
+    return " ".join(str(text).split()).replace("|", "\\|")
 
 
-def _anchor(model: type[BaseModel], root: type[BaseModel]) -> str:
-    """Anchor of a model's table, unique per reference (two roots may share a model)."""
-    return f"{root.__name__.lower()}-{model.__name__.lower()}"
-
-
-def _nested_models(tp) -> Iterator[tuple[str, type[BaseModel]]]:
-    """(key suffix, model) for every pydantic model inside a type annotation.
-
-    The suffix says how the nested keys are reached: ``""`` (the value is the model),
-    ``"[]"`` (a list of them), ``".<key>"`` (a mapping of them).
-    """
-    origin = typing.get_origin(tp)
-    args = typing.get_args(tp)
-    if isinstance(tp, type) and issubclass(tp, BaseModel):
-        yield "", tp
-    elif origin in (typing.Union, types.UnionType, typing.Annotated):
-        for a in args if origin is not typing.Annotated else args[:1]:
-            yield from _nested_models(a)
-    elif origin in (list, tuple, set, frozenset):
-        for a in args:
-            for suffix, m in _nested_models(a):
-                yield "[]" + suffix, m
-    elif origin is dict and args:
-        for suffix, m in _nested_models(args[1]):
-            yield ".<key>" + suffix, m
-
-
-def _default_text(field: FieldInfo) -> str:
-    if field.default_factory is not None:
-        try:
-            value = field.default_factory()
-        except TypeError:  # a factory that takes the validated data
-            return "computed"
-        if isinstance(value, BaseModel):
-            return "its defaults"
-        return _value_text(value)
-    if field.default is PydanticUndefined:
-        return "**required**"
-    return _value_text(field.default)
+def _anchor(root: type[BaseModel], path: str) -> str:
+    """Anchor of a section's table, unique per page (two roots may share key names)."""
+    slug = re.sub(r"[^a-z0-9]+", "-", path.lower()).strip("-")
+    return f"{root.__name__.lower()}-{slug}" if slug else root.__name__.lower()
 
 
 def _value_text(value) -> str:
@@ -148,33 +111,29 @@ def _bounds_text(field: FieldInfo) -> str:
     return ", ".join(parts)
 
 
-def _extra(field: FieldInfo, key: str):
-    extra = field.json_schema_extra
-    return extra.get(key) if isinstance(extra, dict) else None
-
-
-def _description_text(field: FieldInfo) -> str:
+def _description_text(field: FieldInfo, unit: str | None) -> str:
     text = " ".join((field.description or "").split())
-    unit = _extra(field, "unit")
-    if unit and f"[{unit}]" not in text:
+    if unit and unit != "-" and f"[{unit}]" not in text:
         text = f"[{unit}] {text}".strip()
-    examples = field.examples or _extra(field, "examples")
+    examples = field.examples
     if examples:
         text += (" " if text else "") + "Example: " + ", ".join(f"`{e}`" for e in examples)
-    return _cell(text)
+    return _cell(_ROLE.sub(r"`\1`", text))
 
 
-def _doc_text(model: type[BaseModel]) -> str:
+def _doc_text(model: type[BaseModel] | None) -> str:
     """The first paragraph of a model's own docstring (not pydantic's BaseModel's)."""
-    doc = model.__dict__.get("__doc__") or ""
+    doc = (model.__dict__.get("__doc__") if model is not None else None) or ""
     first = " ".join(doc.strip().split("\n\n")[0].split())
     return _ROLE.sub(r"`\1`", first)
 
 
-def schema_reference(
-    model: type[BaseModel], *, title: str | None = None, prefix: str = "", level: int = 2
-) -> str:
-    """The keys of a pydantic model as markdown: one table per (nested) model.
+def schema_reference(model: type[BaseModel], *, title: str | None = None, level: int = 2) -> str:
+    """The keys of a config schema as markdown: one table per section.
+
+    The keys come from :func:`heritage_bayes.config.config_keys` (the schema's one
+    walk: key paths, defaults as written in YAML, units, descriptions); the types and
+    bounds (``ge``/``gt``/``le``/``lt``, lengths) from the pydantic fields themselves.
 
     Parameters
     ----------
@@ -182,50 +141,49 @@ def schema_reference(
         The root of the schema, e.g. :class:`heritage_bayes.config.CalibrationConfig`.
     title : str, optional
         Heading of the root table (default: the model's name).
-    prefix : str
-        Key path of the root (``""`` for a top-level file).
     level : int
         Markdown heading level of each table.
 
     Returns
     -------
     str
-        Markdown: for every model reached from the root, a heading naming its key path,
-        the model's docstring and a table *key | type | default | allowed | description*.
-        Each model appears once, at the first key path that reaches it; later paths link
-        to it.
+        Markdown: the root's keys, then for every section (a key that holds further
+        keys) a heading with its key path, the section's docstring and a table
+        *key | type | default | allowed | description*; a section's row in its parent's
+        table links to its own table.
     """
-    seen: dict[type[BaseModel], str] = {}
-    order: list[tuple[type[BaseModel], str]] = []
+    from heritage_bayes.config import config_keys
+    from heritage_bayes.config._messages import section_model
 
-    def visit(m: type[BaseModel], path: str) -> None:
-        if m in seen:
-            return
-        seen[m] = path
-        order.append((m, path))
-        for name, field in m.model_fields.items():
-            key = field.alias or name
-            for suffix, sub in _nested_models(field.annotation):
-                visit(sub, f"{path}.{key}{suffix}" if path else f"{key}{suffix}")
-
-    visit(model, prefix)
-    out = []
+    keys = config_keys(model)
+    tables: dict[str, list] = {"": []}
+    for k in keys:
+        parent = k.path.rpartition(".")[0]
+        tables.setdefault(parent, []).append(k)
+        if k.section:
+            tables.setdefault(k.path, [])
     hashes = "#" * level
-    for i, (m, path) in enumerate(order):
-        heading = (title or m.__name__) if i == 0 else f"`{path}`"
-        out.append(f"{hashes} {heading} {{ #{_anchor(m, model)} }}\n")
-        doc = _doc_text(m)
+    out = []
+    for path, rows in tables.items():
+        sec = model if not path else section_model(path.split("."), model)
+        heading = (title or model.__name__) if not path else f"`{path}`"
+        out.append(f"{hashes} {heading} {{ #{_anchor(model, path)} }}\n")
+        doc = _doc_text(sec)
         if doc:
             out.append(doc + "\n")
         out.append("| key | type | default | allowed | description |")
         out.append("|---|---|---|---|---|")
-        for name, field in m.model_fields.items():
-            key = field.alias or name
-            full = f"{path}.{key}" if path else key
-            type_text = _cell(_type_text(field.annotation, model))
+        for k in rows:
+            field = sec.model_fields[k.path.rpartition(".")[2]]
+            if k.section:
+                type_text = f"[section](#{_anchor(model, k.path)})"
+                default = "see section" if not k.required else "**required**"
+            else:
+                type_text = _cell(_type_text(field.annotation))
+                default = "**required**" if k.required else _value_text(k.default)
             out.append(
-                f"| `{full}` | {type_text} | {_default_text(field)} "
-                f"| {_bounds_text(field)} | {_description_text(field)} |"
+                f"| `{k.path}` | {type_text} | {default} | {_bounds_text(field)} "
+                f"| {_description_text(field, k.unit)} |"
             )
         out.append("")
     return "\n".join(out)

@@ -135,6 +135,23 @@ def test_an_option_added_to_the_parser_appears_in_the_reference():
     assert "| `--fmt` | `FMT` | file layout (one of `hobo`, `meaco`) |" in text
 
 
+# ------------------------------------------------------------- config examples
+def test_config_examples_of_the_manual_are_checked_like_a_config():
+    from heritage_bayes.errors import ConfigError
+    from heritage_bayes.reference import check_config_snippet, check_projection_snippet
+
+    ok = "thermal:\n  model: thermal_2c\n  options: {thermostat: true}\n"
+    assert check_config_snippet(ok) == f"```yaml\n{ok.strip()}\n```"
+    with pytest.raises(ConfigError, match=r"thermal\.modle"):
+        check_config_snippet("thermal: {modle: thermal_2c}")
+    with pytest.raises(ConfigError, match="thermostat"):  # a model option, not the schema
+        check_config_snippet("hygric: {model: hygric_2c, options: {thermostat: true}}")
+    with pytest.raises(ConfigError, match=r"sampler\.max_time"):
+        check_config_snippet("sampler: {max_time: 10}")
+    with pytest.raises(ConfigError, match="draws"):
+        check_projection_snippet("draws: -1\nmorphing: []\n")
+
+
 # --------------------------------------------------------------------- the build
 def _mkdocs_site(tmp_path: Path, pages: dict[str, str]) -> Path:
     """A small site built with the repository's mkdocs.yml (only docs and nav replaced)."""

@@ -234,26 +234,49 @@ def test_a_dangling_api_reference_fails_the_build(tmp_path, _mkdocs):
 TINY = {**REPORT_TINY, "ladder": False}
 
 
-def test_the_reports_from_python_lines_run_as_printed(tmp_path):
+@pytest.fixture(scope="module")
+def tiny_run(tmp_path_factory) -> Path:
+    from heritage_bayes.calibrate import run_calibration
+    from heritage_bayes.config import parse_config
+
+    run_dir = tmp_path_factory.mktemp("docs") / "a run's folder"  # a quote, a space
+    run_calibration(parse_config(TINY), out_dir=run_dir, report=False, quiet=True)
+    return run_dir
+
+
+def test_the_reports_from_python_lines_run_as_printed(tiny_run):
     """The report prints Python that opens its own run; it runs in a fresh interpreter
     exactly as the page shows it (HTML entities undone, nothing else)."""
     import html
     import re
 
-    from heritage_bayes.calibrate import run_calibration
-    from heritage_bayes.config import parse_config
     from heritage_bayes.report import write_report
 
-    run_dir = tmp_path / "a run's folder"  # a quote and a space: the path is a literal
-    run_calibration(parse_config(TINY), out_dir=run_dir, report=False, quiet=True)
-    page = write_report(run_dir).read_text(encoding="utf-8")
+    page = write_report(tiny_run).read_text(encoding="utf-8")
     m = re.search(r'<pre class="config" id="from-python">(.*?)</pre>', page, re.S)
     assert m, "the report has no From Python block"
     code = html.unescape(m.group(1))
-    assert repr(str(run_dir.resolve())) in code
-    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path)
+    assert repr(str(tiny_run.resolve())) in code  # the path is a Python literal
+    res = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, cwd=tiny_run.parent
+    )
     assert res.returncode == 0, res.stderr
     assert res.stdout.startswith("converged: False")  # 600 steps: not converged
     for name in ("thermal.tau_1_h", "thermal.gain_Ti_Te", "hygric.tau_1_h"):
         assert name in res.stdout
     assert re.search(r"^thermal \{'Ci': [0-9.e+]+, ", res.stdout, re.M)
+
+
+def test_the_readmes_python_block_runs(tiny_run):
+    """The README's "From Python" block, on a run in place of ``reports/demo``."""
+    import re
+
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    blocks = re.findall(r"```python\n(.*?)```", readme, re.S)
+    assert len(blocks) == 1
+    assert '"reports/demo"' in blocks[0]
+    code = blocks[0].replace('"reports/demo"', repr(str(tiny_run)))
+    code += "\nprint(sorted(draws), run.summary['converged'])\n"
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert res.returncode == 0, res.stderr
+    assert res.stdout.strip() == "['Ci', 'Ge', 'Gf', 'fI_E', 'fI_N', 'fI_S', 'fI_W'] False"

@@ -30,6 +30,7 @@ from heritage_bayes.config import (
     chain_tag,
     config_hash,
 )
+from heritage_bayes.convergence import unconverged_reasons
 from heritage_bayes.convert import format_timedelta
 from heritage_bayes.errors import InputError
 from heritage_bayes.inference.posterior import LogPosterior
@@ -61,10 +62,8 @@ __all__ = [
 ]
 
 
-def _parameters(cfg, section: str, model: RCModel, priors: Mapping):
-    """Noise model and parameter set (priors validated) of a config section
-    (:func:`heritage_bayes.run.section_parameters`)."""
-    return section_parameters(cfg, section, model, priors)
+#: Noise model and parameter set (priors validated) of a config section.
+_parameters = section_parameters
 
 
 def check_models(cfg: CalibrationConfig) -> None:
@@ -125,18 +124,20 @@ class _Section:
     timings: dict = field(default_factory=dict)
 
 
-def _say_findings(say: _Progress, s: _Section) -> None:
+def _say_findings(say: _Progress, s: _Section, priors: Mapping | tuple = ()) -> None:
     """Before sampling: a MAP on a prior bound, and parameters the data do not pin.
 
-    Both are findings about the prior or the model, shown as warnings (and kept in
-    the summary); the sampler starts inside the support regardless.
+    Findings about the prior or the model, warned (and kept in the summary); a parameter
+    whose prior the config sets (``priors``) is a decision taken: a capped phi is said,
+    not warned, and one the data do not pin is not flagged (its prior closes it).
     """
     s.map_at_bound = s.logpost.params.at_bound(s.map.x)
     capped = [n for n, side in s.map_at_bound if n.startswith("phi_") and side == "upper"]
-    if capped and s.logpost.noise.name == "ar1_white":
+    told = {(n, "upper") for n in capped} if s.logpost.noise.name == "ar1_white" else set()
+    if told:
         ph = s.logpost.params.parameters[s.logpost.params.names.index(capped[0])].prior.upper
         hours = -s.logpost.dt / 3600.0 / np.log(ph)
-        say.warn(
+        (say.say if capped[0] in priors else say.warn)(
             f"[{s.name}] {', '.join(capped)} at its cap {ph:g}: the misfit stays correlated "
             f"for longer than the noise model allows (about {hours:.0f} h), so the model "
             "misses a slow process (a missing input such as solar gains, a heat or "
@@ -170,8 +171,8 @@ def _say_findings(say: _Progress, s: _Section) -> None:
             )
             + ", or model the fixed node (thermal: options.ground; hygric: hygric_2c_fixed)"
         )
-    if s.map_at_bound:
-        what = ", ".join(f"{n} ({side})" for n, side in s.map_at_bound)
+    if unexplained := [b for b in s.map_at_bound if b not in told]:  # not flagged twice
+        what = ", ".join(f"{n} ({side})" for n, side in unexplained)
         say.warn(
             f"[{s.name}] the MAP lies on a prior bound for {what}: the data push "
             "these parameters to the edge of the allowed range. Check the prior (is the "
@@ -182,9 +183,9 @@ def _say_findings(say: _Progress, s: _Section) -> None:
     # the overall scale of C and G (no known heat input) is a null direction only a
     # prior closes: reported in the identifiability section, not flagged here
     ok = ident.identifiable_given_scale if ident.has_scale_direction else ident.identifiable
-    structural = [p for p, good in ok.items() if not good]
+    structural = [p for p, good in ok.items() if not good and p not in priors]
     practical = list(s.laplace.unidentified) if s.laplace is not None else []
-    poor = [p for p in practical if p in s.model.parameter_names]
+    poor = [p for p in practical if p in s.model.parameter_names and p not in priors]
     if structural or poor:
         parts = []
         if structural:
@@ -358,7 +359,7 @@ def _calibrate_into(
     chash = config_hash(cfg)
     say = _Progress(quiet)
     # the heavy imports (arviz, scipy.optimize, emcee) only once the config is valid
-    from heritage_bayes.inference.idata import CONVERGENCE
+    from heritage_bayes.inference.idata import CONVERGENCE, build_run_outputs
     from heritage_bayes.inference.optimize import find_map, laplace
     from heritage_bayes.inference.sampler import run_sampler
     from heritage_bayes.prepare import prepare
@@ -418,7 +419,7 @@ def _calibrate_into(
         ref = s.identifiability.scale_reference
         s.laplace = laplace(s.logpost, s.map.x, given=(ref,) if ref else ())
         s.timings["identifiability_seconds"] = time.perf_counter() - t0
-        _say_findings(say, s)
+        _say_findings(say, s, getattr(cfg, s.name).priors)
         t0 = time.perf_counter()
         update = say.sampler(s.name, cfg.sampler.max_steps)
         try:
@@ -478,9 +479,8 @@ def _calibrate_into(
             ladder[s.name] = model_ladder(cfg, prep, s, seed=cfg.seed + 101 * i)
             s.timings["ladder_seconds"] = time.perf_counter() - t0
     t0 = time.perf_counter()
-    from heritage_bayes.inference.idata import build_run_outputs
-
     idata, summary = build_run_outputs(cfg, prep, sections, chash=chash, seed=cfg.seed)
+    summary["unconverged_reasons"] = unconverged_reasons(summary)  # [] when converged
     t_out = time.perf_counter() - t0
     summary["ladder"] = ladder or None
     summary["timings"] = {

@@ -13,7 +13,6 @@ for climate-change projections).
 
 from __future__ import annotations
 
-import hashlib
 import sys
 import time
 from collections.abc import Mapping
@@ -39,6 +38,7 @@ from heritage_bayes.inference.results import (
     atomic_write_text,
     dump_json,
     ensure_free_space,
+    write_inference_data,
 )
 from heritage_bayes.models import SECTIONS, _catalog_options, build_model, initial_state_of
 from heritage_bayes.rc.catalog import model as catalog_model
@@ -335,16 +335,6 @@ def _run_calibration(
     return out
 
 
-def _data_hash(lp: LogPosterior) -> str:
-    """SHA-256 (16 hex digits) of the prepared inputs and observations of a section."""
-    h = hashlib.sha256()
-    for a in (lp.inputs, lp.observed):
-        a = np.ascontiguousarray(a, dtype=float)
-        h.update(str(a.shape).encode())
-        h.update(a.tobytes())
-    return h.hexdigest()[:16]
-
-
 def _calibrate_into(
     out: Path,
     cfg: CalibrationConfig,
@@ -359,6 +349,7 @@ def _calibrate_into(
     chash = config_hash(cfg)
     say = _Progress(quiet)
     # the heavy imports (arviz, scipy.optimize, emcee) only once the config is valid
+    from heritage_bayes.inference.coordinates import default_coordinates
     from heritage_bayes.inference.idata import CONVERGENCE, build_run_outputs
     from heritage_bayes.inference.optimize import find_map, laplace
     from heritage_bayes.inference.sampler import run_sampler
@@ -437,13 +428,15 @@ def _calibrate_into(
                 tau_rtol=cfg.sampler.tau_rtol,
                 init_ball=cfg.sampler.init_ball,
                 checkpoint=out / f"chain_{s.name}.h5",
-                tag=f"{chain_tag(cfg)}:{_data_hash(s.logpost)}:{s.name}",
+                tag=f"{chain_tag(cfg)}:{s.logpost.data_hash()}:{s.name}",
                 resume=resume,
                 progress=update,
                 notice=say.warn,
                 max_rhat=CONVERGENCE["max_rhat"],
                 min_ess=CONVERGENCE["min_ess_bulk"],
                 max_draws=cfg.sampler.max_draws,
+                coordinates=default_coordinates(s.logpost),
+                compact=True,
             )
         finally:
             say.close()
@@ -490,7 +483,7 @@ def _calibrate_into(
     }
     summary["wall_seconds"] = time.perf_counter() - t_start
     ensure_free_space(out / "posterior.nc", sum(int(idata[g].nbytes) for g in idata.groups()))
-    atomic_write(out / "posterior.nc", lambda p: idata.to_netcdf(str(p), engine="h5netcdf"))
+    atomic_write(out / "posterior.nc", lambda p: write_inference_data(idata, p))
     dump_json(out / "summary.json", summary)
     say.say(
         f"summary: converged={summary['converged']}, max R-hat "

@@ -129,6 +129,13 @@ def _build_parser() -> argparse.ArgumentParser:
     )
     cmp_.add_argument("--quiet", action="store_true", help="no progress output")
     cmp_.add_argument("--no-report", action="store_true", help="no report.html per model")
+    cmp_.add_argument(
+        "--workers",
+        type=int,
+        metavar="N",
+        help="candidates calibrated at once, each in its own process (default: one per "
+        "core, at most one per model; 1: one after the other)",
+    )
     cmp_.set_defaults(func=_cmd_compare)
 
     bat = sub.add_parser(
@@ -268,6 +275,7 @@ def _cmd_compare(args) -> int:
         report=False if args.no_report else None,
         resume=args.resume,
         force=args.force,
+        workers=args.workers,
     )
     if not args.quiet:
         import json

@@ -7,6 +7,7 @@ from heritage_bayes.report.format import fmt, fmt_time
 from heritage_bayes.report.page import Section
 from heritage_bayes.report.rundata import RunData
 from heritage_bayes.report.sections._fragment import render_fragment
+from heritage_bayes.report.snippet import from_python
 
 ID, TITLE = "reproducibility", "8. Reproducibility"
 
@@ -54,10 +55,12 @@ def timings(s: dict) -> list[dict]:
 
 
 def reproducibility_context(rd: RunData) -> dict:
-    """Seed, config hash, run date, timings, run-directory files and library versions."""
+    """Seed, config hash, run date, timings, run-directory files, library versions and
+    the Python lines that open this run (:func:`heritage_bayes.report.snippet.from_python`)."""
     versions, when = library_versions(rd.summary)
     return {
         "config": rd.config_text,
+        "from_python": from_python(rd.path, rd.run.sections, rd.idata.posterior.data_vars),
         "versions": versions,
         "versions_from": when,
         "seed": rd.summary.get("seed"),

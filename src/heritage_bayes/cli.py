@@ -132,7 +132,17 @@ def _build_parser() -> argparse.ArgumentParser:
     bat.add_argument(
         "--scheduler", metavar="ADDRESS", help="a running Dask scheduler, e.g. tcp://host:8786"
     )
-    bat.add_argument("--workers", type=int, metavar="N", help="local workers (default: cores)")
+    bat.add_argument(
+        "--workers",
+        type=int,
+        metavar="N",
+        help="local workers (default and maximum: the CPUs available)",
+    )
+    bat.add_argument(
+        "--workers-unbounded",
+        action="store_true",
+        help="allow --workers above the CPUs available",
+    )
     bat.add_argument(
         "--resume", action="store_true", help="skip finished rooms, continue interrupted chains"
     )
@@ -264,8 +274,9 @@ Options (YAML: <section>.options), any catalogue model:
 
 
 def _cmd_batch(args) -> int:
-    from heritage_bayes.portfolio import load_portfolio, run
+    from heritage_bayes.portfolio import check_workers, load_portfolio, run
 
+    check_workers(args.workers, unbounded=args.workers_unbounded)  # before any work
     pf = load_portfolio(args.portfolio)  # every room validated before any work starts
     df = run(
         pf,
@@ -274,6 +285,7 @@ def _cmd_batch(args) -> int:
         workers=args.workers,
         resume=args.resume,
         quiet=args.quiet,
+        workers_unbounded=args.workers_unbounded,
     )
     bad = df[~df["status"].isin(["done", "skipped"])]
     for _, r in bad.iterrows():

@@ -105,8 +105,9 @@ def run_compare(
         ``comparison.html``.
     seed, quiet, report, resume, force
         As for :func:`heritage_bayes.calibrate.run_calibration` (applied to every
-        candidate; ``force`` lets a candidate's run replace an existing folder
-        ``<out_dir>/<model>/`` that is not a run directory).
+        candidate; with ``force`` a candidate's run and the comparison are written
+        beside the files of folders hbayes did not make, replacing none of them: see
+        :class:`~heritage_bayes.rundir.folder.OutputFolder`).
 
     Raises
     ------
@@ -114,21 +115,31 @@ def run_compare(
         Unknown model, models of different sections, or a section the config lacks.
     """
     from heritage_bayes.calibrate import run_calibration
+    from heritage_bayes.rundir import check_name
+    from heritage_bayes.rundir.folder import OutputFolder
+    from heritage_bayes.rundir.writer import is_run_directory
+    from heritage_bayes.sources import input_paths
 
     section, names = _section_of(cfg, models)
     cands = {n: _candidate_config(cfg, section, n) for n in names}
-    out = Path(out_dir) if out_dir is not None else Path("reports") / f"{cfg.name or 'run'}-compare"
-    out.mkdir(parents=True, exist_ok=True)
-    dirs = {}
-    for n, c in cands.items():
-        if not quiet:
-            import sys
+    if out_dir is None:
+        out_dir = Path("reports") / check_name(f"{cfg.name or 'run'}-compare", what="name")
+    folder = OutputFolder(out_dir, kind="comparison", protect=input_paths(cfg), force=force)
+    with folder:
+        out = folder.path
+        # a candidate's folder: new, its own run, or (--force) one the run writes beside
+        folder.claim(*names, folders_from=lambda q: force or is_run_directory(q))
+        folder.claim("comparison.json", "comparison.html")
+        dirs = {}
+        for n, c in cands.items():
+            if not quiet:
+                import sys
 
-            print(f"hbayes compare: calibrating {n}", file=sys.stderr, flush=True)
-        dirs[n] = run_calibration(
-            c, out / n, seed=seed, quiet=quiet, report=report, resume=resume, force=force
-        )
-    result = compare_runs(dirs, section, seed=cfg.seed if seed is None else int(seed))
-    result["config"] = {"name": cfg.name, "building": cfg.building, "room": cfg.room}
-    write_comparison(result, out)
+                print(f"hbayes compare: calibrating {n}", file=sys.stderr, flush=True)
+            dirs[n] = run_calibration(
+                c, out / n, seed=seed, quiet=quiet, report=report, resume=resume, force=force
+            )
+        result = compare_runs(dirs, section, seed=cfg.seed if seed is None else int(seed))
+        result["config"] = {"name": cfg.name, "building": cfg.building, "room": cfg.room}
+        write_comparison(result, out)
     return out

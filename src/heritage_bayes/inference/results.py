@@ -37,13 +37,12 @@ from __future__ import annotations
 
 import json
 import os
-import tempfile
-from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 
 from heritage_bayes.io._common import to_jsonable
+from heritage_bayes.rundir.atomic import atomic_write, atomic_write_text
 
 __all__ = [
     "atomic_write",
@@ -52,29 +51,6 @@ __all__ = [
     "ensure_free_space",
     "fit_metrics",
 ]
-
-
-def atomic_write(path: str | Path, write: Callable[[Path], None]) -> Path:
-    """Call ``write(tmp_path)``, then rename ``tmp_path`` to ``path`` (same folder).
-
-    An interrupted write leaves at most a ``.tmp`` file, never a half-written ``path``.
-    """
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    os.close(fd)
-    tmp_path = Path(tmp)
-    try:
-        write(tmp_path)
-        # mkstemp creates 0600; give the file the permissions a normal write would
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp_path, 0o666 & ~umask)
-        os.replace(tmp_path, path)
-    except BaseException:
-        tmp_path.unlink(missing_ok=True)
-        raise
-    return path
 
 
 def ensure_free_space(path: str | Path, nbytes: int, margin: int = 4 << 20) -> None:
@@ -99,11 +75,6 @@ def ensure_free_space(path: str | Path, nbytes: int, margin: int = 4 << 20) -> N
             f"({free / 2**20:.1f} MiB free, about {need / 2**20:.1f} MiB needed); free some "
             "space or choose another --out"
         )
-
-
-def atomic_write_text(path: str | Path, text: str) -> Path:
-    """Write text atomically (UTF-8)."""
-    return atomic_write(path, lambda p: p.write_text(text, encoding="utf-8"))
 
 
 def fit_metrics(measured: np.ndarray, simulated: np.ndarray) -> dict[str, float]:

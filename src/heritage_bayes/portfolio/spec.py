@@ -9,8 +9,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import yaml
-
 from heritage_bayes.errors import ConfigError
 
 __all__ = ["Portfolio", "RoomSpec", "load_portfolio"]
@@ -52,18 +50,15 @@ def _deep_merge(base: dict, extra: Mapping) -> dict:
 
 
 def _read_yaml(path: Path, where: str) -> Any:
-    if not path.is_file():
-        raise ConfigError(f"{where}: file not found: {path}")
+    """The strict loader of every config (:func:`heritage_bayes.config.read_yaml`:
+    duplicate keys refused, anchors and nesting bounded, no tags), errors prefixed
+    with the key that named the file."""
+    from heritage_bayes.config import read_yaml
+
     try:
-        return yaml.safe_load(path.read_text(encoding="utf-8"))
-    except UnicodeDecodeError:
-        raise ConfigError(f"{where}: {path} is not a UTF-8 text file") from None
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        at = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
-        raise ConfigError(
-            f"{where}: {path} is not valid YAML{at}: {getattr(exc, 'problem', exc)}"
-        ) from None
+        return read_yaml(path, what="portfolio file" if where == "portfolio" else "config file")[0]
+    except ConfigError as exc:
+        raise ConfigError(f"{where}: {exc}") from None
 
 
 def load_portfolio(path: str | Path) -> Portfolio:

@@ -263,7 +263,8 @@ def _run_calibration(
         if not 0 <= int(seed) <= MAX_SEED:
             raise InputError(f"--seed: must be within 0..{MAX_SEED} (got {seed})")
         cfg = cfg.model_copy(update={"seed": int(seed)})
-    out_dir = Path("reports") / check_name(cfg.name or "run") if out_dir is None else out_dir
+    name = check_name(cfg.name or "run")  # a plain name, even where --out is given
+    out_dir = Path("reports") / name if out_dir is None else out_dir
     writer = RunWriter(out_dir, force=force, resume=resume, protect=input_paths(cfg))
     writer.check()  # before reading any data: a bad --out fails at once
     out = writer.out

@@ -67,7 +67,7 @@ from pydantic import (
     model_validator,
 )
 
-from heritage_bayes.errors import ConfigError
+from heritage_bayes.errors import ConfigError, check_known_keys
 
 __all__ = [
     "CalibrationConfig",
@@ -763,6 +763,7 @@ def parse_config(
         raise ConfigError(
             f"{source}: expected a YAML mapping at the top level (got {type(raw).__name__})"
         )
+    check_known_keys(raw, _allowed_keys(()), source=source, what="calibration config")
     try:
         cfg = CalibrationConfig.model_validate(raw)
     except ValidationError as exc:

@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from heritage_bayes.errors import ConfigError
+from heritage_bayes.errors import ConfigError, check_known_keys
 
 __all__ = ["Portfolio", "RoomSpec", "load_portfolio"]
 
@@ -55,8 +55,10 @@ def _read_yaml(path: Path, where: str) -> Any:
     with the key that named the file."""
     from heritage_bayes.config import read_yaml
 
+    if where == "portfolio":
+        return read_yaml(path, what="portfolio file")[0]
     try:
-        return read_yaml(path, what="portfolio file" if where == "portfolio" else "config file")[0]
+        return read_yaml(path, what="config file")[0]
     except ConfigError as exc:
         raise ConfigError(f"{where}: {exc}") from None
 
@@ -77,6 +79,7 @@ def load_portfolio(path: str | Path) -> Portfolio:
     raw = _read_yaml(p, "portfolio")
     if not isinstance(raw, dict):
         raise ConfigError(f"{p}: expected a YAML mapping with 'rooms' (got {type(raw).__name__})")
+    check_known_keys(raw, _TOP_KEYS, source=str(p), what="portfolio file")
     unknown = sorted(set(raw) - _TOP_KEYS)
     if unknown:
         raise ConfigError(f"{p}: unknown key(s) {unknown}; expected some of {sorted(_TOP_KEYS)}")

@@ -133,17 +133,18 @@ def project(
 
             raise ConfigError(f"--draws: expected a positive number (got {draws})")
         pcfg = pcfg.model_copy(update=upd)
-    r = run if isinstance(run, Run) else load_run(run)
     dest = None
-    if write:  # the output path checked before the long part
+    if write:  # the output path checked before anything is read
         from heritage_bayes.rundir.folder import OutputFolder
 
+        run_dir = Path(run.path if isinstance(run, Run) else run)
         dest = OutputFolder(
-            Path(out) if out is not None else Path(r.path) / "projection",
+            Path(out) if out is not None else run_dir / "projection",
             kind="projection",
-            protect=_input_files(pcfg),
+            protect=[*_input_files(pcfg), run_dir / "posterior.nc"],
         )
         dest.check()
+    r = run if isinstance(run, Run) else load_run(run)
     sel = select_draws(r, pcfg.draws, pcfg.seed)
     base, site, base_note = baseline_weather(r, pcfg)
     cases = [Case(pcfg.baseline_label, None, base, base_note)]

@@ -378,7 +378,7 @@ USER_ERRORS = {
     "out-force-never-replaces": (_case_paths("force-clash"), "named like the run's files"),
     "map-search-time-budget": (
         _case_config(_tiny(**{"sampler.max_time": "3s", "optimizer.popsize": 10_000})),
-        "sampler.max_time = 3s ran out during the MAP search",
+        "sampler.max_time = 3s (1 section(s) left",
     ),
     # -- batch, project, compare configs through the same strict loader
     "batch-duplicate-key": (_case_portfolio("name: a\nname: b\n" + _ROOMS), "duplicate key 'name'"),

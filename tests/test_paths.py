@@ -526,24 +526,9 @@ def _tiny_run(root: Path) -> Path:
 
     from heritage_bayes.calibrate import run_calibration
     from heritage_bayes.config import load_config
+    from test_faults import _tiny
 
-    cfg = {
-        "name": "tiny",
-        "seed": 3,
-        "data": {"demo": {}},
-        "room_volume": 400,
-        "periods": {
-            "calibration": {"start": "2019-01-02", "end": "2019-01-09"},
-            "validation": {"start": "2019-01-09", "end": "2019-01-12"},
-            "warmup": "2D",
-            "init_window": "2D",
-        },
-        "thermal": {"model": "thermal_1c", "noise": "ar1"},
-        "sampler": {"max_steps": 100, "check_every": 50, "max_draws": 100, "n_predictive": 10},
-        "optimizer": {"maxiter": 10, "starts": 1},
-        "ladder": False,
-        "report": False,
-    }
+    cfg = _tiny(name="tiny", **{"sampler.max_steps": 100})
     (root / "tiny.yaml").write_text(yaml.safe_dump(cfg))
     return run_calibration(load_config(root / "tiny.yaml"), root / "run", quiet=True)
 

@@ -346,7 +346,8 @@ def _calibrate_into(
             maxiter=cfg.optimizer.maxiter,
             starts=cfg.optimizer.starts,
             deadline=deadline,
-            budget=f"the time budget sampler.max_time = {cfg.sampler.max_time}",
+            budget=f"the time budget sampler.max_time = {cfg.sampler.max_time} "
+            f"({len(sections) - i} section(s) left: {(deadline or t0) - t0:.0f} s for this one)",
         )
         s.timings["map_seconds"] = time.perf_counter() - t0
         say.say(

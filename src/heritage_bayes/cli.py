@@ -46,8 +46,8 @@ def _build_parser() -> argparse.ArgumentParser:
     cal.add_argument(
         "--force",
         action="store_true",
-        help="write into an existing folder that is not a run directory (files named like "
-        "the run's outputs are replaced, others kept)",
+        help="write the run beside the files of a folder hbayes did not make (none of them "
+        "is replaced; one named like a run's file is refused)",
     )
     cal.set_defaults(func=_cmd_calibrate)
 
@@ -114,7 +114,8 @@ def _build_parser() -> argparse.ArgumentParser:
     cmp_.add_argument(
         "--force",
         action="store_true",
-        help="let a candidate's run replace a folder <out>/<model>/ that is not a run directory",
+        help="write beside the files of folders hbayes did not make (<out>, <out>/<model>/); "
+        "none of them is replaced",
     )
     cmp_.add_argument("--quiet", action="store_true", help="no progress output")
     cmp_.add_argument("--no-report", action="store_true", help="no report.html per model")

@@ -57,10 +57,16 @@ def proj(run_dir, tmp_path_factory):
 def test_outputs_written(proj):
     p, out = proj
     assert sorted(x.name for x in out.iterdir()) == [
+        ".hbayes-run.json",  # the marker: the folder and the three files are the package's
         "projection.html",
         "projection.json",
         "projection.nc",
     ]
+    from heritage_bayes.rundir.marker import read_marker
+
+    marker = read_marker(out)
+    assert marker.kind == "projection"
+    assert marker.files == ("projection.html", "projection.json", "projection.nc")
     import xarray as xr
 
     ds = xr.open_dataset(out / "projection.nc", engine="h5netcdf")

@@ -141,6 +141,27 @@ def test_no_import_cycle_in_the_package():
     assert cycle is None, "import cycle: " + " -> ".join(cycle)
 
 
+def test_rc_network_is_a_description_the_model_compiles():
+    """``rc.network`` imports nothing of the package (not even lazily or for typing);
+    ``rc.model`` imports it and its numerics at module level: the cycle the two once
+    hid behind a lazy import and a ``TYPE_CHECKING`` block is gone (issue 28)."""
+    modules = _modules()
+    net_tree = ast.parse(modules["heritage_bayes.rc.network"].read_text(encoding="utf-8"))
+    assert not [
+        n
+        for n in ast.walk(net_tree)
+        if isinstance(n, ast.Import | ast.ImportFrom)
+        and PKG in (getattr(n, "module", None) or "") + "".join(a.name for a in n.names)
+    ]
+    model_tree = ast.parse(modules["heritage_bayes.rc.model"].read_text(encoding="utf-8"))
+    top = set(map(id, model_tree.body))
+    lazy = [
+        n.module for n in ast.walk(model_tree) if isinstance(n, ast.ImportFrom) and id(n) not in top
+    ]
+    assert lazy == []
+    assert "heritage_bayes.rc.network" in import_graph()["heritage_bayes.rc.model"]
+
+
 def test_lower_layers_do_not_import_higher_ones():
     graph = import_graph()
     layers = {  # lower number = lower layer

@@ -6,6 +6,7 @@ import json
 import os
 from pathlib import Path
 
+import pandas as pd
 import pytest
 import yaml
 
@@ -140,7 +141,10 @@ def test_unknown_nested_key_names_its_path():
     raw = {"data": _csv_data(), "thermal": {"model": "thermal_4a"}}
     raw["data"]["weather"]["colums"] = {"Te": "T"}
     msg = _error(raw)
-    assert "data.weather.colums: unknown key; allowed keys: format, path, time_column" in msg
+    assert (
+        "data.weather.colums: unknown key; did you mean 'columns'? Allowed keys: format, path, "
+        "time_column" in msg
+    )
 
 
 def test_unknown_key_in_second_measurement_table_has_index():
@@ -161,8 +165,14 @@ def test_wrong_type_says_what_was_found():
 
 def test_durations_are_normalised_for_pandas():
     cfg = parse_config(_with(periods={"warmup": "3d", "init_window": "36H"}))
-    assert (cfg.periods.warmup, cfg.periods.init_window) == ("3D", "36h")
-    assert cfg.periods.init_window == Periods().init_window.replace("30D", "36h")
+    assert (cfg.periods.warmup, cfg.periods.init_window) == (
+        pd.Timedelta(days=3),
+        pd.Timedelta(hours=36),
+    )
+    assert Periods().init_window == pd.Timedelta(days=30)
+    # written back as text that reads the same
+    assert cfg.resolved()["periods"]["warmup"] == "3D"
+    assert cfg.resolved()["periods"]["init_window"] == "1D12h"
     # no warm-up unless asked for or a model starts from the steady state
     assert Periods().warmup is None
 

@@ -15,7 +15,7 @@ import pytest
 from scipy.optimize import least_squares
 
 import heritage_bayes as hb
-from heritage_bayes.rc import Link, Network, Node, Source
+from heritage_bayes.rc import Link, Network, Node, RCModel, Source
 from heritage_bayes.rc import identify as ident
 from heritage_bayes.rc.identify import (
     constant_contributions,
@@ -423,7 +423,7 @@ def test_parallel_links_and_disconnected_nodes_are_described():
         outputs=("Ti",),
         sources=(Source("I_S", "Ti", "a"),),
     )
-    m = net.compile()
+    m = RCModel(net)
     p = dict(Ci=1e6, Cx=1e7, G1=30.0, G2=70.0, Gx=5.0, a=2.0)
     r = structural_identifiability(m, p)
     # Ci, G1 + G2, a: two ratios identifiable; Cx, Gx: no influence at all

@@ -14,6 +14,7 @@ import math
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pytest
 from scipy.stats import multivariate_normal
 
@@ -149,7 +150,7 @@ def test_initial_state_config_errors():
     }
     cfg = parse_config(base)
     assert initial_state_of(cfg, "thermal") == "estimate"
-    assert default_warmup(cfg) == "0h"
+    assert default_warmup(cfg) == pd.Timedelta(0)
     bad = parse_config({**base, "thermal": {"model": "thermal_2c", "initial_state": {"Tx": 3}}})
     with pytest.raises(ConfigError, match=r"thermal.initial_state: unknown node.*Tx"):
         initial_state_of(bad, "thermal")
@@ -159,7 +160,7 @@ def test_initial_state_config_errors():
     ctl.pop("initial_state")
     cfg = parse_config({**base, "thermal": ctl})
     assert initial_state_of(cfg, "thermal") == "steady"
-    assert default_warmup(cfg) == "14D"
+    assert default_warmup(cfg) == pd.Timedelta(days=14)
 
 
 def test_free_run_error_fit_recovers_a_slow_error():

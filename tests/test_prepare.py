@@ -303,7 +303,7 @@ def test_csv_sources(files):
     assert prep.irradiance_source == "measured"
     assert prep.sources["irradiance"]["label"].startswith("measured; dni/dhi from ghi by Erbs")
     assert prep.sources["site"]["from"] == "config"
-    assert prep.sources["measurements"][0]["timezone"] == "UTC+1"
+    assert prep.sources["measurements"][0]["timezone"] == "UTC+01:00"
     assert prep.sources["ground_temperature"]["mode"] == "annual_mean"
     # UTC+1 logger: the reading stamped 02-01-2020 01:00 is the row 2020-01-02 00:00 UTC
     logger = pd.read_csv(files / "logger.csv", sep=";")
@@ -373,9 +373,9 @@ def test_reader_errors_are_wrapped_with_the_key(files):
         prepare(_load(files, raw))
     assert str(exc.value).startswith("data.measurements: logger.csv: cannot parse timestamp")
     raw = _csv_config(files)
-    raw["data"]["measurements"]["timezone"] = "Mars/Olympus"
-    with pytest.raises(ConfigError, match=r"^data\.measurements: unknown timezone"):
-        prepare(_load(files, raw))
+    raw["data"]["measurements"]["timezone"] = "Mars/Olympus"  # refused at load, not read
+    with pytest.raises(ConfigError, match=r"data\.measurements\.timezone: unknown timezone"):
+        _load(files, raw)
 
 
 def test_input_gap_too_long(tmp_path):

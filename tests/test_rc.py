@@ -7,7 +7,7 @@ from scipy import signal
 from scipy.linalg import expm
 
 import heritage_bayes as hb
-from heritage_bayes.rc import Link, Network, Node, Source, iter_simulate, modal_form
+from heritage_bayes.rc import Link, Network, Node, RCModel, Source, iter_simulate, modal_form
 
 P4A = dict(
     Cw=5e8,
@@ -270,7 +270,7 @@ def test_custom_network_two_rooms_from_dict():
         "outputs": ["T1", "T2"],
         "sources": [{"input": "I_S", "node": "T1", "gain": "fI_S"}],
     }
-    m = Network.from_dict(spec).compile()
+    m = RCModel(Network.from_dict(spec))
     assert m.parameter_names == ("C1", "C2", "G1", "G12", "G2", "fI_S")
     assert [i.unit for i in m.parameters] == ["J/K", "J/K", "W/K", "W/K", "W/K", "m²"]
     p = dict(C1=1e6, C2=2e6, G1=50.0, G12=30.0, G2=40.0, fI_S=2.0)

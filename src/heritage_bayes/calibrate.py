@@ -24,6 +24,7 @@ import numpy as np
 from heritage_bayes._progress import Progress as _Progress
 from heritage_bayes._version import __version__
 from heritage_bayes.config import MAX_SEED, CalibrationConfig, chain_tag, config_hash
+from heritage_bayes.convert import format_timedelta
 from heritage_bayes.errors import InputError
 from heritage_bayes.inference.posterior import LogPosterior
 from heritage_bayes.inference.results import (
@@ -346,8 +347,9 @@ def _calibrate_into(
             maxiter=cfg.optimizer.maxiter,
             starts=cfg.optimizer.starts,
             deadline=deadline,
-            budget=f"the time budget sampler.max_time = {cfg.sampler.max_time} "
-            f"({len(sections) - i} section(s) left: {(deadline or t0) - t0:.0f} s for this one)",
+            budget=f"the time budget sampler.max_time = "
+            f"{format_timedelta(cfg.sampler.max_time or 0)} ({len(sections) - i} section(s) "
+            f"left: {(deadline or t0) - t0:.0f} s for this one)",
         )
         s.timings["map_seconds"] = time.perf_counter() - t0
         say.say(
@@ -396,10 +398,10 @@ def _calibrate_into(
         s.timings["sampling_seconds"] = time.perf_counter() - t0
         s.timings["sampling_cpu_seconds"] = s.chain.cpu_seconds
         verdict = "converged" if s.chain.converged else "NOT converged"
-        if s.chain.stopped_by == "max_seconds":
+        if (budget := cfg.sampler.max_time) is not None and s.chain.stopped_by == "max_seconds":
             say.warn(
-                f"[{s.name}] the time budget sampler.max_time = {cfg.sampler.max_time} ran "
-                f"out after {s.chain.steps} steps (τmax {np.nanmax(s.chain.tau):.0f}, "
+                f"[{s.name}] the time budget sampler.max_time = {format_timedelta(budget)} "
+                f"ran out after {s.chain.steps} steps (τmax {np.nanmax(s.chain.tau):.0f}, "
                 f"about {cfg.sampler.tau_factor * np.nanmax(s.chain.tau):.0f} steps needed): "
                 "raise it, or run again with --resume to continue the chain"
             )

@@ -9,6 +9,8 @@ from __future__ import annotations
 import re
 from collections.abc import Mapping
 
+import pandas as pd
+
 from heritage_bayes.config import CalibrationConfig
 from heritage_bayes.errors import ConfigError
 from heritage_bayes.rc.catalog import CATALOG
@@ -52,7 +54,7 @@ def build_model(cfg: CalibrationConfig, section: str) -> RCModel:
     where = f"{section}.model"
     try:
         if isinstance(sec.model, Mapping):
-            m = Network.from_dict(sec.model, where=where).compile()
+            m = RCModel(Network.from_dict(sec.model, where=where))
             _check_names(m, where)
         else:
             if sec.model not in CATALOG:
@@ -98,13 +100,13 @@ def initial_state_of(cfg: CalibrationConfig, section: str, model: RCModel | None
     return mode
 
 
-def default_warmup(cfg: CalibrationConfig) -> str:
+def default_warmup(cfg: CalibrationConfig) -> pd.Timedelta:
     """``periods.warmup`` when not configured: none when every model estimates its
     initial state, 14 days when one starts from the steady state."""
     steady = any(
         initial_state_of(cfg, s) == "steady" for s in SECTIONS if getattr(cfg, s) is not None
     )
-    return "14D" if steady else "0h"
+    return pd.Timedelta(days=14) if steady else pd.Timedelta(0)
 
 
 def _catalog_options(cfg: CalibrationConfig, section: str, name: str) -> dict:

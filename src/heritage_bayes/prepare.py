@@ -50,7 +50,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from heritage_bayes.config import parse_duration
+from heritage_bayes.convert import format_timedelta, to_jsonable
 from heritage_bayes.errors import ConfigError, DataError, InputError
 from heritage_bayes.inputs import (
     _with_vapour_pressure,
@@ -59,7 +59,6 @@ from heritage_bayes.inputs import (
     solar_inputs,
     weather_inputs,
 )
-from heritage_bayes.io._common import to_jsonable
 from heritage_bayes.sources import (
     INPUT_COLUMNS,
     OUTPUT_COLUMNS,
@@ -326,7 +325,7 @@ def prepare(cfg) -> Prepared:
         raise ConfigError("give at least one of 'thermal' and 'hygric'")
     _check_models_vs_irradiance(cfg)
     data = cfg.data
-    step = parse_duration(data.step)
+    step = data.step
     surfaces = {k: tuple(v) for k, v in data.surfaces.items()}
     truth = None
 
@@ -382,7 +381,7 @@ def prepare(cfg) -> Prepared:
             tables,
             meas_tables,
             step=step,
-            max_gap=parse_duration(data.max_gap),
+            max_gap=data.max_gap,
             start=start,
             end=end,
         )
@@ -394,7 +393,8 @@ def prepare(cfg) -> Prepared:
         )
         raise DataError(
             f"data.weather/data.measurements: aligning on {what} with data.step="
-            f"{data.step}, data.max_gap={data.max_gap}: {exc}"
+            f"{format_timedelta(data.step)}, data.max_gap={format_timedelta(data.max_gap)}: "
+            f"{exc}"
         ) from None
     except InputError as exc:
         raise ConfigError(f"data: {exc}") from None
@@ -469,7 +469,7 @@ def prepare(cfg) -> Prepared:
         if k < 1 or k >= n:
             raise DataError(
                 f"periods: the common period of all data has only {n} rows of "
-                f"{data.step}; too short to split into calibration and validation"
+                f"{format_timedelta(data.step)}; too short to split into calibration and validation"
             )
         cal, val = slice(0, k), slice(k, n)
         period_note = "default: first 2/3 of the common period of all data, then the rest"
@@ -477,13 +477,13 @@ def prepare(cfg) -> Prepared:
     from heritage_bayes.models import default_warmup
 
     warmup = per.warmup if per.warmup is not None else default_warmup(cfg)
-    warmup_steps = math.ceil(parse_duration(warmup) / step - 1e-9)
-    init_steps = math.ceil(parse_duration(per.init_window) / step - 1e-9)
+    warmup_steps = math.ceil(warmup / step - 1e-9)
+    init_steps = math.ceil(per.init_window / step - 1e-9)
     cal_rows = cal.stop - cal.start
     if warmup_steps >= cal_rows:
         raise ConfigError(
-            f"periods.warmup: {warmup} ({warmup_steps} rows) is not shorter than the "
-            f"calibration period ({cal_rows} rows, {_iso(frame.index[cal.start])} to "
+            f"periods.warmup: {format_timedelta(warmup)} ({warmup_steps} rows) is not shorter "
+            f"than the calibration period ({cal_rows} rows, {_iso(frame.index[cal.start])} to "
             f"{_iso(frame.index[cal.stop - 1] + step)})"
         )
     _check_observations(frame, cal, val, warmup_steps, thermal, hygric, step)
@@ -502,9 +502,9 @@ def prepare(cfg) -> Prepared:
         "from": period_note,
         "calibration": _span(cal),
         "validation": _span(val),
-        "warmup": warmup,
+        "warmup": format_timedelta(warmup),
         "warmup_steps": warmup_steps,
-        "init_window": per.init_window,
+        "init_window": format_timedelta(per.init_window),
         "init_steps": init_steps,
     }
 

@@ -66,7 +66,6 @@ def section_parameters(cfg: CalibrationConfig, section: str, model: RCModel, pri
     -------
     (NoiseModel, ParameterSet)
     """
-    from heritage_bayes.config import parse_duration
     from heritage_bayes.inference.likelihoods import get_noise_model
     from heritage_bayes.inference.parameters import parameters_for
 
@@ -82,7 +81,7 @@ def section_parameters(cfg: CalibrationConfig, section: str, model: RCModel, pri
         floor_area=cfg.floor_area,
         envelope_area=cfg.envelope_area,
         where=f"{section}.priors",
-        dt=parse_duration(cfg.data.step).total_seconds(),
+        dt=cfg.data.step.total_seconds(),
     )
     return noise, params
 

@@ -41,7 +41,7 @@ from pathlib import Path
 
 import numpy as np
 
-from heritage_bayes.io._common import to_jsonable
+from heritage_bayes.convert import to_jsonable
 from heritage_bayes.rundir.atomic import atomic_write, atomic_write_text
 
 __all__ = [

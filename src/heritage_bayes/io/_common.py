@@ -1,4 +1,7 @@
-"""Shared machinery of the readers: standard columns, time zones, validation, finalising.
+"""Shared machinery of the readers: standard columns, validation, finalising.
+
+Time zones, durations and JSON conversion live in :mod:`heritage_bayes.convert` (layer 0,
+also used by ``rc/`` and ``inference/``); they are re-exported here for the readers.
 
 Private module: the public API is re-exported by :mod:`heritage_bayes.io`.
 """
@@ -6,9 +9,7 @@ Private module: the public API is re-exported by :mod:`heritage_bayes.io`.
 from __future__ import annotations
 
 import datetime as _dt
-import re
 import zlib
-import zoneinfo
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -16,6 +17,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from heritage_bayes.convert import format_timedelta, parse_timezone, to_jsonable
 from heritage_bayes.errors import DataError, InputError
 
 __all__ = [
@@ -24,6 +26,7 @@ __all__ = [
     "STANDARD_COLUMNS",
     "format_timedelta",
     "parse_timezone",
+    "to_jsonable",
 ]
 
 #: Standard column names: name -> (unit, description, (lower, upper) physical range).
@@ -54,58 +57,6 @@ IRRADIANCE = ("ghi", "dni", "dhi", "Isol")
 #: Negative irradiance down to this value [W/m²] is sensor noise (thermopile night
 #: offset) and is set to 0; below it the value is invalid.
 IRRADIANCE_NOISE = 10.0
-
-_FIXED_OFFSET = re.compile(r"^(?:UTC|GMT)?\s*([+-])\s*(\d{1,2})(?::?(\d{2}))?$")
-
-
-def parse_timezone(timezone) -> _dt.tzinfo:
-    """Turn ``'UTC'``, ``'UTC+2'``, ``'UTC-03:30'``, ``'+02:00'`` or an IANA name into a tzinfo.
-
-    Fixed offsets have no daylight-saving time; IANA names (``'Europe/Copenhagen'``)
-    follow the local clock, with its DST changes.
-    """
-    if isinstance(timezone, _dt.tzinfo):
-        return timezone
-    if not isinstance(timezone, str) or not timezone.strip():
-        raise InputError(
-            f"timezone must be a string such as 'UTC', 'UTC+2' or 'Europe/Copenhagen' "
-            f"(got {timezone!r})"
-        )
-    text = timezone.strip()
-    if text.upper() in ("UTC", "Z", "GMT"):
-        return _dt.UTC
-    match = _FIXED_OFFSET.match(text.upper())
-    if match:
-        sign, hours, minutes = match.groups()
-        delta = _dt.timedelta(hours=int(hours), minutes=int(minutes or 0))
-        if delta > _dt.timedelta(hours=14):
-            raise InputError(f"timezone {timezone!r}: offset beyond ±14 h")
-        return _dt.timezone(-delta if sign == "-" else delta)
-    try:
-        return zoneinfo.ZoneInfo(text)
-    except (zoneinfo.ZoneInfoNotFoundError, ValueError) as exc:
-        raise InputError(
-            f"unknown timezone {timezone!r}; use 'UTC', a fixed offset such as 'UTC+2' or "
-            f"'UTC-03:30', or an IANA name such as 'Europe/Copenhagen'"
-        ) from exc
-
-
-def format_timedelta(td) -> str:
-    """Compact string of a duration, e.g. ``'1h'``, ``'10min'``, ``'1h30min'``, ``'2D'``."""
-    td = pd.Timedelta(td)
-    total = int(td.total_seconds())
-    if td.total_seconds() != total:
-        return str(td)
-    if total == 0:
-        return "0s"
-    sign = "-" if total < 0 else ""
-    total = abs(total)
-    days, rest = divmod(total, 86400)
-    hours, rest = divmod(rest, 3600)
-    minutes, seconds = divmod(rest, 60)
-    parts = [f"{days}D" if days else "", f"{hours}h" if hours else ""]
-    parts += [f"{minutes}min" if minutes else "", f"{seconds}s" if seconds else ""]
-    return sign + "".join(parts)
 
 
 def modal_step(index: pd.DatetimeIndex) -> pd.Timedelta | None:
@@ -357,36 +308,6 @@ def finalize(
         attrs.update(extra)
     frame.attrs = attrs
     return frame
-
-
-def to_jsonable(obj):
-    """Recursively convert to strict-JSON types: numpy scalars and arrays to Python,
-    non-finite floats to None, timestamps to ISO 8601, durations as ``format_timedelta``,
-    paths and anything else to text."""
-    from collections.abc import Mapping
-    from pathlib import PurePath
-
-    if isinstance(obj, Mapping):
-        return {str(k): to_jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, list | tuple):
-        return [to_jsonable(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return to_jsonable(obj.tolist())
-    if isinstance(obj, bool | np.bool_):
-        return bool(obj)
-    if isinstance(obj, int | np.integer):
-        return int(obj)
-    if isinstance(obj, float | np.floating):
-        return float(obj) if np.isfinite(obj) else None
-    if isinstance(obj, pd.Timestamp):
-        return obj.isoformat()
-    if isinstance(obj, pd.Timedelta):
-        return format_timedelta(obj)
-    if obj is None or isinstance(obj, str):
-        return obj
-    if isinstance(obj, PurePath):
-        return str(obj)
-    return str(obj)
 
 
 def _quote_list(names: Iterable[str], limit: int = 30) -> str:

@@ -270,8 +270,8 @@ def _table(rows: list[dict], pf: Portfolio) -> pd.DataFrame:
 
 
 def _write_outputs(pf: Portfolio, out: Path, rows: list[dict], seconds: float) -> pd.DataFrame:
+    from heritage_bayes.convert import to_jsonable
     from heritage_bayes.inference.results import atomic_write, atomic_write_text
-    from heritage_bayes.io._common import to_jsonable
 
     df = _table(rows, pf)
     atomic_write(out / "portfolio.csv", lambda p: df.to_csv(p, index=False))

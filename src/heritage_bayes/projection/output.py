@@ -81,7 +81,7 @@ def to_dataset(proj, run):
 
 def write_outputs(proj, run, dest: Path) -> dict:
     """Render everything, then write the three files atomically into ``dest``."""
-    from heritage_bayes.io._common import to_jsonable
+    from heritage_bayes.convert import to_jsonable
     from heritage_bayes.projection.page import render_projection_page
 
     dest = Path(dest)

@@ -18,7 +18,6 @@ import numpy as np
 import pandas as pd
 
 from heritage_bayes.climate.risk._inputs import MIN_YEAR_HOURS
-from heritage_bayes.config import parse_duration
 from heritage_bayes.errors import ConfigError, DataError, InputError
 
 #: Largest distance between the calibration site and a future file's site. [°]
@@ -161,7 +160,7 @@ def model_inputs(run, pcfg, weather: pd.DataFrame, site: dict | None, where: str
     cfg = run.config
     data = cfg.data
     thermal, hygric = "thermal" in run.models, "hygric" in run.models
-    step = parse_duration(data.step)
+    step = data.step
     tables, _ = weather_inputs(
         weather[[c for c in weather.columns if c in _WEATHER_COLUMNS]],
         thermal=thermal,
@@ -173,7 +172,7 @@ def model_inputs(run, pcfg, weather: pd.DataFrame, site: dict | None, where: str
         extra=_extra_inputs(cfg),
     )
     try:
-        aligned = align(tables, None, step=step, max_gap=parse_duration(data.max_gap))
+        aligned = align(tables, None, step=step, max_gap=data.max_gap)
     except (DataError, InputError) as exc:
         raise DataError(f"{where}: putting the weather on the run's grid: {exc}") from None
     frame = aligned.frame.copy()

@@ -97,7 +97,7 @@ class WeeklyCalendar:
         -------
         (N,) float array in [0, 1].
         """
-        from heritage_bayes.io._common import parse_timezone
+        from heritage_bayes.convert import parse_timezone
 
         if index.tz is None:
             raise ValueError("WeeklyCalendar.fraction: the time index must be timezone-aware")
@@ -150,7 +150,7 @@ def parse_weekly(spec, where: str = "schedule") -> WeeklyCalendar:
             f"{where}.weekly: expected a list of entries such as ['Sun 08-12'] (got {entries!r})"
         )
     tz = spec.get("timezone", "UTC")
-    from heritage_bayes.io._common import parse_timezone
+    from heritage_bayes.convert import parse_timezone
 
     try:
         parse_timezone(tz)

@@ -98,6 +98,7 @@ from heritage_bayes.rc.identify_result import (
     _describe,
     _scale_reference,
 )
+from heritage_bayes.rc.model import RCModel
 
 __all__ = [
     "DEFAULT_LONGEST_PERIOD",
@@ -220,7 +221,6 @@ def structural_identifiability(
     if model.control is not None:
         # a controlled room: the network's check, and the control's parameters described
         from heritage_bayes.rc.control import control_identifiability
-        from heritage_bayes.rc.model import RCModel
 
         net = RCModel(model.network)
         n_net = len(net.parameter_names)

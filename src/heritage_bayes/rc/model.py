@@ -1,14 +1,19 @@
-"""A compiled RC network: names, units and batched state-space assembly."""
+"""A compiled RC network: names, units and batched state-space assembly.
+
+Import direction: :mod:`heritage_bayes.rc.network` is the declarative description and
+imports nothing of the package; this module compiles it (``RCModel(network)``) and
+imports the network, the discretisation and the simulator at module level.
+"""
 
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import TYPE_CHECKING
 
 import numpy as np
 
-if TYPE_CHECKING:  # the network is a description; this module compiles it
-    from heritage_bayes.rc.network import Network, ParameterInfo
+from heritage_bayes.rc.discretize import modal_form
+from heritage_bayes.rc.network import Network, ParameterInfo
+from heritage_bayes.rc.simulate import modal_simulate
 
 __all__ = ["RCModel"]
 
@@ -253,9 +258,6 @@ class RCModel:
         x0 : (n,) or (K, n) array, optional
             Initial state [°C] or [Pa] instead.
         """
-        from heritage_bayes.rc.discretize import modal_form
-        from heritage_bayes.rc.simulate import modal_simulate
-
         P = np.atleast_2d(np.asarray(P, dtype=float))
         mf = modal_form(self, P, dt)
         with np.errstate(divide="ignore", invalid="ignore"):

@@ -356,12 +356,6 @@ class Network:
             input_units=dict(spec.get("input_units", {}) or {}),
         )
 
-    def compile(self):
-        """Compile to an :class:`~heritage_bayes.rc.model.RCModel`."""
-        from heritage_bayes.rc.model import RCModel
-
-        return RCModel(self)
-
 
 def _no_duplicates(items: Sequence[str], what: str) -> None:
     seen, dup = set(), []

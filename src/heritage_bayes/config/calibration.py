@@ -1,0 +1,227 @@
+"""The calibration config: the top level of the schema (the building, the scale priors,
+the outputs) and the one entry from YAML to typed settings, :func:`load_config`.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from pathlib import Path
+from typing import Any
+
+from pydantic import PrivateAttr, ValidationError, model_validator
+
+from heritage_bayes.config._base import MAX_SEED, _Strict, key
+from heritage_bayes.config._messages import join_errors
+from heritage_bayes.config.loader import read_yaml
+from heritage_bayes.config.models import ModelSection
+from heritage_bayes.config.periods import Periods
+from heritage_bayes.config.sampler import OptimizerSettings, SamplerSettings
+from heritage_bayes.config.sources import Data, Site
+from heritage_bayes.errors import ConfigError, check_known_keys
+
+__all__ = ["CalibrationConfig", "chain_tag", "config_hash", "load_config", "parse_config"]
+
+
+class CalibrationConfig(_Strict):
+    """What ``hbayes calibrate`` reads: one room, its data, periods, models, sampler and
+    outputs (see ``configs/demo.yaml`` for a complete, commented example)."""
+
+    name: str | None = key(
+        None, unit=None, description="run name (default: the config file's stem)"
+    )
+    building: str = key("", unit=None, description="free text, shown in the report")
+    room: str = key("", unit=None, description="free text, shown in the report")
+    notes: str = key("", unit=None, description="free text, shown in the report")
+    seed: int = key(
+        1,
+        unit=None,
+        description="seed of the MAP search and the sampler: the same seed gives the same "
+        "posterior",
+        ge=0,
+        le=MAX_SEED,
+    )
+    site: Site | None = key(
+        None,
+        unit=None,
+        description="latitude, longitude, altitude: needed for solar input unless the "
+        "weather file (epw, tmy3) carries them",
+    )
+    room_volume: float | None = key(
+        None, unit="m³", description="air volume: log-normal prior on each model's Ci", gt=0
+    )
+    air_change_rate: float | None = key(
+        None,
+        unit="1/h",
+        description="ventilation rate: log-normal prior on Gfast of both models",
+        gt=0,
+    )
+    air_change_sigma: float = key(
+        1.0, unit="-", description="sd of log(air change rate)", gt=0, le=5
+    )
+    floor_area: float | None = key(
+        None,
+        unit="m²",
+        description="floor on the ground: log-normal prior on the thermal Gf",
+        gt=0,
+    )
+    envelope_area: float | None = key(
+        None,
+        unit="m²",
+        description="exterior area of walls and roof: upper bounds on thermal Gw and Cw",
+        gt=0,
+    )
+    data: Data = key(unit=None, description="weather and logger files (or the demo)")
+    periods: Periods = key(
+        unit=None,
+        description="calibration and validation periods, warm-up",
+        default_factory=Periods,
+    )
+    thermal: ModelSection | None = key(
+        None, unit=None, description="the thermal model (indoor temperature)"
+    )
+    hygric: ModelSection | None = key(
+        None, unit=None, description="the hygric model (indoor vapour pressure)"
+    )
+    sampler: SamplerSettings = key(
+        unit=None, description="emcee and its budget", default_factory=SamplerSettings
+    )
+    optimizer: OptimizerSettings = key(
+        unit=None, description="the MAP search", default_factory=OptimizerSettings
+    )
+    report: bool = key(True, unit=None, description="write report.html")
+    ladder: bool = key(
+        True,
+        unit=None,
+        description="MAP fits of the neighbouring model orders for the "
+        "accuracy-vs-identifiability comparison",
+    )
+    base_dir: str | None = key(
+        None, unit=None, description="the config file's folder (set by load_config)"
+    )
+    _source_text: str | None = PrivateAttr(default=None)
+
+    @property
+    def source_text(self) -> str | None:
+        """The YAML text the config was read from (set by :func:`load_config`)."""
+        return self._source_text
+
+    @model_validator(mode="after")
+    def _needs_models(self):
+        if self.thermal is None and self.hygric is None:
+            raise ValueError("give at least one of 'thermal' and 'hygric'")
+        if self.data.demo is not None and self.site is not None:
+            raise ValueError(
+                "site: the demo uses the site of its weather file (Greensboro, NC; De Bilt "
+                "for debilt_knmi); remove 'site'"
+            )
+        site_in_file = self.data.weather is not None and self.data.weather.format in (
+            "epw",
+            "tmy3",
+        )
+        needs_sun = self.data.irradiance != "none" and self.data.demo is None
+        if needs_sun and self.site is None and not site_in_file:
+            raise ValueError(
+                "site: required (latitude, longitude) to compute solar "
+                "irradiance on the surfaces; or set data.irradiance: none"
+            )
+        return self
+
+    def resolved(self) -> dict:
+        """The config with defaults filled in (what ``config.yaml`` in a run holds)."""
+        return self.model_dump(mode="json", exclude={"base_dir"})
+
+    def portable(self) -> dict:
+        """:meth:`resolved` with absolute data paths: re-runs from any folder."""
+        d = self.resolved()
+        data = d["data"]
+        sources = [data.get("weather"), *(data.get("measurements") or [])]
+        sources.append((data.get("ground_temperature") or {}).get("source"))
+        demo = data.get("demo") or {}
+        for holder, k in [(s, "path") for s in sources if s] + [(demo, "weather_path")]:
+            p = holder.get(k)
+            if p is not None:
+                absolute = [
+                    str(self.path(q).absolute()) for q in ([p] if isinstance(p, str) else p)
+                ]
+                holder[k] = absolute[0] if isinstance(p, str) else absolute
+        return d
+
+    def path(self, p: str) -> Path:
+        """A data path resolved against the config file's folder."""
+        q = Path(p).expanduser()
+        return q if q.is_absolute() or self.base_dir is None else Path(self.base_dir) / q
+
+
+def parse_config(
+    raw: Any, *, source: str = "config", base_dir: str | None = None, name: str | None = None
+) -> CalibrationConfig:
+    """Validate a parsed YAML mapping into typed settings.
+
+    Parameters
+    ----------
+    raw : mapping
+        The YAML content (:func:`~heritage_bayes.config.loader.read_yaml`).
+    source : str
+        The file, for messages.
+    base_dir : str, optional
+        The folder relative data paths start from.
+    name : str, optional
+        The run name when the config gives none.
+
+    Raises
+    ------
+    ConfigError
+        One line per wrong key, each naming its key path, what was expected and what was
+        found (an unknown key with the nearest known one).
+    """
+    if not isinstance(raw, dict):
+        raise ConfigError(
+            f"{source}: expected a YAML mapping at the top level (got {type(raw).__name__})"
+        )
+    known = [k for k in CalibrationConfig.model_fields if k != "base_dir"]
+    check_known_keys(raw, known, source=source, what="calibration config")
+    try:
+        cfg = CalibrationConfig.model_validate(raw)
+    except ValidationError as exc:
+        lines = join_errors(exc.errors(), raw, CalibrationConfig)
+        raise ConfigError(f"{source}: invalid configuration:\n  " + "\n  ".join(lines)) from None
+    cfg.base_dir = base_dir
+    if cfg.name is None:
+        cfg.name = name or "run"
+    return cfg
+
+
+def load_config(path) -> CalibrationConfig:
+    """Read and validate a YAML config file (see :func:`read_yaml` for the limits).
+
+    Raises
+    ------
+    ConfigError
+        Missing file, invalid YAML (with line and column), or invalid content (with
+        key paths).
+    """
+    p = Path(path)
+    raw, text = read_yaml(p)
+    cfg = parse_config(raw, source=str(p), base_dir=str(p.parent.resolve()), name=p.stem)
+    cfg._source_text = text
+    return cfg
+
+
+def chain_tag(cfg: CalibrationConfig) -> str:
+    """Hash of what determines the Markov chains (data, models, priors, seed, walkers,
+    moves, optimiser), leaving out run-length settings (``max_steps``, ``check_every``,
+    ``tau_factor``, ...) and outputs, so that ``--resume`` may extend a run."""
+    d = cfg.resolved()
+    keep = {k: d["sampler"][k] for k in ("walkers", "moves", "init_ball")}
+    d = {**d, "sampler": keep}
+    for k in ("report", "ladder", "name", "building", "room", "notes"):
+        d.pop(k, None)
+    blob = json.dumps(d, sort_keys=True, default=str).encode()
+    return hashlib.sha256(blob).hexdigest()[:16]
+
+
+def config_hash(cfg: CalibrationConfig) -> str:
+    """SHA-256 (first 16 hex digits) of the resolved config."""
+    blob = json.dumps(cfg.resolved(), sort_keys=True, default=str).encode()
+    return hashlib.sha256(blob).hexdigest()[:16]

@@ -1,0 +1,110 @@
+"""Settings of one calibrated model (``thermal:``, ``hygric:``): the catalogue model and
+its options, the noise model, the initial state and the priors.
+
+The model names, options and prior keys are checked where the catalogue is known
+(:func:`heritage_bayes.models.build_model`,
+:func:`heritage_bayes.inference.parameters.parameters_for`), before any data are read.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated, Any, Literal
+
+import pandas as pd
+from pydantic import PlainSerializer, PlainValidator, WithJsonSchema
+
+from heritage_bayes.config._base import DURATION_UNIT, _duration, _Strict, key
+from heritage_bayes.convert import format_timedelta
+
+__all__ = ["DurationOrNone", "ModelSection"]
+
+
+def _duration_or_none(v: Any) -> pd.Timedelta | str | None:
+    if v is None:
+        return None
+    if isinstance(v, str) and v.strip().lower() == "none":
+        return "none"
+    return _duration(v, positive=True)
+
+
+#: A positive duration with its unit, or ``'none'`` (no limit); null: the default.
+DurationOrNone = Annotated[
+    pd.Timedelta | Literal["none"] | None,
+    PlainValidator(_duration_or_none),
+    PlainSerializer(
+        lambda v: v if v is None or v == "none" else format_timedelta(v), return_type=str | None
+    ),
+    WithJsonSchema({"type": "string", "format": "duration-with-unit or none"}),
+]
+
+
+def _seconds(v: pd.Timedelta | str) -> float:
+    return math.inf if isinstance(v, str) else v.total_seconds()
+
+
+class ModelSection(_Strict):
+    """One calibrated model (thermal or hygric)."""
+
+    model: str | dict[str, Any] = key(
+        unit=None,
+        description="a catalogue model (hbayes models lists them, e.g. thermal_2c, "
+        "hygric_2c) or an RC network given as a mapping",
+    )
+    options: dict[str, Any] = key(
+        unit=None,
+        description="the model's options: surfaces, ground, heating, thermostat, "
+        "humidistat, source (hbayes models)",
+        default_factory=dict,
+    )
+    noise: Literal["ar1_white", "ar1", "iid", "kalman"] = key(
+        "ar1_white",
+        unit=None,
+        description="noise model: AR(1) model error + white sensor noise, a single AR(1), "
+        "iid, or a Kalman filter on the stochastic RC model",
+    )
+    initial_state: Literal["estimate", "steady"] | dict[str, float] | None = key(
+        None,
+        unit="°C or Pa",
+        description="'estimate' (integrated out exactly; default for linear models), "
+        "'steady' (default for controlled rooms) or {node: value}",
+    )
+    initial_state_sd: float | None = key(
+        None, unit="K or Pa", description="prior sd of the estimated initial state", gt=0
+    )
+    initial_state_horizon: DurationOrNone = key(
+        None,
+        unit=DURATION_UNIT,
+        description="modes slower than this have their estimated start pulled to the "
+        "steady state; 'none': no pull (default: the calibration record)",
+    )
+    time_constant_cap: DurationOrNone = key(
+        None,
+        unit=DURATION_UNIT,
+        description="soft prior 1/(1 + (τ/cap)²) on every time constant; 'none': no cap "
+        "(default: 365d for thermal models, none for hygric ones)",
+    )
+    priors: dict[str, dict[str, Any]] = key(
+        unit="SI",
+        description="per parameter: {dist, lower, upper, mu, sigma, fixed} (hbayes models "
+        "NAME lists the names, units and default priors)",
+        default_factory=dict,
+    )
+    room_volume: float | None = key(
+        None, unit="m³", description="this model's air volume (default: the top-level one)", gt=0
+    )
+
+    def cap_seconds(self, domain: str) -> float:
+        """``time_constant_cap`` in seconds (``inf`` for none); the default by domain:
+        a year for thermal models (no building node relaxes slower), none for hygric
+        ones (deep moisture buffers can take years)."""
+        if self.time_constant_cap is None:
+            return 365 * 86400.0 if domain == "thermal" else math.inf
+        return _seconds(self.time_constant_cap)
+
+    @property
+    def horizon_seconds(self) -> float | None:
+        """``initial_state_horizon`` in seconds: None for the calibration record's
+        length, ``inf`` for ``none`` (no slow-mode shrinkage)."""
+        h = self.initial_state_horizon
+        return None if h is None else _seconds(h)

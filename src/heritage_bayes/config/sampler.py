@@ -1,0 +1,103 @@
+"""Settings of the sampler (emcee) and of the MAP search that starts it."""
+
+from __future__ import annotations
+
+from typing import Annotated, Any, Literal
+
+import pandas as pd
+from pydantic import PlainSerializer, PlainValidator, WithJsonSchema
+
+from heritage_bayes.config._base import DURATION_UNIT, _duration, _Strict, key
+from heritage_bayes.convert import format_timedelta
+
+__all__ = ["Budget", "OptimizerSettings", "SamplerSettings"]
+
+
+def _budget(v: Any) -> pd.Timedelta | None:
+    if v is None or (isinstance(v, str) and v.strip().lower() == "none"):
+        return None
+    return _duration(v, positive=True)
+
+
+#: A wall-time budget: a positive duration with its unit, or ``none`` (no budget).
+Budget = Annotated[
+    pd.Timedelta | None,
+    PlainValidator(_budget),
+    PlainSerializer(lambda v: "none" if v is None else format_timedelta(v), return_type=str),
+    WithJsonSchema({"type": "string", "format": "duration-with-unit or none"}),
+]
+
+
+class SamplerSettings(_Strict):
+    """emcee settings. Run length comes from the chain (τ, R-hat, ESS); ``max_time`` is
+    the wall-time budget per model (a duration, e.g. ``10min``, or ``none``) and
+    ``max_steps`` a safety cap on memory. A run that stops at either before converging
+    exits with code 3 (see :mod:`heritage_bayes.cli`)."""
+
+    walkers: int | None = key(
+        None, unit=None, description="ensemble size (default max(32, 2 d + 2))", ge=4, le=4096
+    )
+    max_steps: int = key(
+        200_000, unit="steps", description="safety cap on the chain length", ge=100
+    )
+    max_time: Budget = key(
+        "30min",
+        unit=DURATION_UNIT,
+        description="wall-time budget per model (e.g. 10min, 2h) or none; the chain stops "
+        "earlier once converged",
+        validate_default=True,
+    )
+    check_every: int = key(500, unit="steps", description="steps between convergence checks", ge=50)
+    tau_factor: float = key(
+        50.0,
+        unit="τ",
+        description="converged when the chain is this many autocorrelation times long",
+        ge=10,
+    )
+    tau_rtol: float = key(
+        0.05,
+        unit="-",
+        description="and the estimate of τ changed by less than this fraction",
+        gt=0,
+        le=1,
+    )
+    moves: Literal["de_snooker", "stretch", "de"] = key(
+        "de_snooker", unit=None, description="emcee's proposal moves"
+    )
+    init_ball: float = key(
+        1e-3,
+        unit="-",
+        description="walkers start in a ball of this radius around the MAP (unconstrained)",
+        gt=0,
+        le=1,
+    )
+    max_draws: int = key(
+        4000, unit="draws", description="posterior draws kept (all walkers)", ge=100
+    )
+    n_predictive: int = key(
+        1000,
+        unit="draws",
+        description="draws (all walkers) saved in posterior.nc, the same in every group "
+        "(posterior, predictive, log-likelihood); PSIS-LOO needs about 1000",
+        ge=10,
+    )
+
+    @property
+    def max_seconds(self) -> float | None:
+        """``max_time`` in seconds (None: no budget)."""
+        return None if self.max_time is None else self.max_time.total_seconds()
+
+
+class OptimizerSettings(_Strict):
+    """The MAP search (global, then local) that starts the chains."""
+
+    method: Literal["differential_evolution", "multistart"] = key(
+        "differential_evolution", unit=None, description="global search of the MAP"
+    )
+    popsize: int = key(
+        10, unit="-", description="differential evolution: population per parameter", ge=4
+    )
+    maxiter: int = key(
+        300, unit="generations", description="differential evolution: generations", ge=10
+    )
+    starts: int = key(4, unit="starts", description="local searches from the best points", ge=1)

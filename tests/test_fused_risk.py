@@ -165,7 +165,7 @@ def test_fused_indicator_groups(groups):
 
 def test_fused_short_series_and_shared_temperature():
     T, RH = series(3, 2000, seed=4)
-    short = ["chemical", "mechanical"]
+    short = ["mechanical"]
     assert_same(risk.assess_batch(T, RH, indicators=short), assess_fused(T, RH, indicators=short))
     with pytest.raises(InputError, match="at least one year"):
         assess_fused(T, RH)

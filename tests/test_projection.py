@@ -57,7 +57,8 @@ def proj(run_dir, tmp_path_factory):
 def test_outputs_written(proj):
     p, out = proj
     assert sorted(x.name for x in out.iterdir()) == [
-        ".hbayes-run.json",  # the marker: the folder and the three files are the package's
+        ".hbayes-run.json",  # the marker: the folder and the four files are the package's
+        "projection.csv",
         "projection.html",
         "projection.json",
         "projection.nc",
@@ -66,7 +67,7 @@ def test_outputs_written(proj):
 
     marker = read_marker(out)
     assert marker.kind == "projection"
-    assert marker.files == ("projection.html", "projection.json", "projection.nc")
+    assert marker.files == tuple(f"projection.{x}" for x in ("csv", "html", "json", "nc"))
     import xarray as xr
 
     ds = xr.open_dataset(out / "projection.nc", engine="h5netcdf")
@@ -74,7 +75,8 @@ def test_outputs_written(proj):
     assert ds.sizes["draw"] == DRAWS and ds.sizes["month"] == 12
     for v in ("twpi", "vtt_mould_index_max", "emc_range", "en15757_outside", "Ti_monthly"):
         assert v in ds
-    assert "twpi_parametric" in ds
+    assert "twpi_parametric" in ds and "en15757_outside_baseline" in ds
+    assert ds["twpi_per_year"].dims == ("case", "draw", "year")
     s = json.loads((out / "projection.json").read_text())
     assert s["draws"] == DRAWS and len(s["cases"]) == 3
     assert s["cases"][0]["hours"] == 8759  # a TMY year on the UTC grid: not refused
@@ -83,7 +85,15 @@ def test_outputs_written(proj):
     for r in s["probabilities"]:
         for c in r["cases"].values():
             assert 0.0 <= c["p"] <= 1.0
-    assert set(s["uncertainty_split"]) == {"2050"}
+    assert set(s["uncertainty_split"]) == {"baseline", "2050"}
+    assert s["indicator_registry"]["time_of_wetness"]["source"].startswith("ISO 9223")
+    import pandas as pd
+
+    csv = pd.read_csv(out / "projection.csv")
+    assert set(csv["case"]) == {"baseline", "warm 2050", "mild 2050"}
+    row = csv[(csv.indicator == "twpi") & (csv.case == "baseline")].iloc[0]
+    assert row["name"] == "Time-weighted preservation index" and row["unit"] == "years"
+    assert row["q50"] == pytest.approx(s["indicators"]["twpi"]["cases"]["baseline"]["q50"])
 
 
 def test_warming_reaches_the_room(proj):
@@ -108,10 +118,11 @@ def test_noise_draw_widens_the_bands(proj):
     ds = p.dataset
     rh = ds["RHi_monthly"].values
     assert np.nanmax(rh) <= 100.0 and np.nanmin(rh) >= 0.0
-    split = p.summary["uncertainty_split"]["2050"]["twpi"]
-    assert split["variance"]["model_error"] > 0
+    split = p.summary["uncertainty_split"]["2050"]["indicators"]["twpi"]
+    assert split["variance"]["noise"] > 0
     assert split["variance"]["scenario"] > 0
-    assert abs(sum(split["share"].values()) - 1) < 1e-9
+    assert split["variance"]["weather_year"] is None  # one year of weather: none
+    assert abs(sum(v for v in split["share"].values() if v is not None) - 1) < 1e-9
 
 
 def test_noise_free_projection_is_parametric(run_dir):
@@ -125,16 +136,20 @@ def test_probability_table(proj):
     p, _ = proj
     t = p.probability_table()
     assert list(t.columns) == p.labels
-    assert any(i.startswith("P(vtt_mould_index_max > 1") for i in t.index)
+    assert any(i.startswith("P(Highest VTT mould index > 1") for i in t.index)
 
 
 def test_cli_project(run_dir, tmp_path, capsys):
     cfg = tmp_path / "p.yaml"
     cfg.write_text(yaml.safe_dump(PROJ))
     out = tmp_path / "out"
-    assert main(["project", str(run_dir), str(cfg), "--out", str(out), "--draws", "8"]) == 0
-    stdout = capsys.readouterr().out
-    assert "P(twpi < 45 years)" in stdout and "warm 2050" in stdout
+    # the tiny run is not converged: written, with a warning and exit status 3
+    assert main(["project", str(run_dir), str(cfg), "--out", str(out), "--draws", "8"]) == 3
+    cap = capsys.readouterr()
+    assert "P(Time-weighted preservation index < 45 years)" in cap.out and "warm 2050" in cap.out
+    assert "calibration did not converge" in cap.err and "exit code 3" in cap.err
+    html = (out / "projection.html").read_text()
+    assert "id='unconverged'" in html and "Calibration not converged" in html
     assert json.loads((out / "projection.json").read_text())["draws"] == 8
 
 
@@ -211,9 +226,33 @@ def test_future_file_on_another_site(run_dir, tmp_path, shared_data):
             {"scenario": "x", "horizon": 2080, "weather": {"format": "epw", "path": str(path)}}
         ],
     }
-    with pytest.raises(InputError, match=r"files\[0\]\.weather: the file is for another site"):
+    with pytest.raises(
+        InputError,
+        match=r"files\[0\]\.weather: the file is for another site.* km from.*"
+        r"within 50 km.*allow_other_site: true",
+    ):
         project(run_dir, bad, out=tmp_path / "o")
     assert not (tmp_path / "o").exists()
+    # the baseline too
+    bad = {**PROJ, "baseline": {"format": "epw", "path": str(path)}}
+    with pytest.raises(InputError, match=r"^baseline: the file is for another site"):
+        project(run_dir, bad, out=tmp_path / "o")
+    assert not (tmp_path / "o").exists()
+    # said explicitly: accepted
+    ok = project(run_dir, {**bad, "allow_other_site": True, "draws": 4}, write=False)
+    assert ok.summary["cases"][0]["weather"]["from"] == "projection file (baseline)"
+
+
+def test_unknown_threshold_indicator_is_refused(run_dir, tmp_path, capsys):
+    cfg = tmp_path / "p.yaml"
+    cfg.write_text(yaml.safe_dump({**PROJ, "thresholds": [{"indicator": "twpi", "below": 4},
+                                                         {"indicator": "metal_corrosion",
+                                                          "above": 9}]}))  # fmt: skip
+    out = tmp_path / "out"
+    _fails(["project", str(run_dir), str(cfg), "--out", str(out)], capsys,
+           "thresholds[1].indicator: unknown indicator 'metal_corrosion'", "time_of_wetness",
+           "en15757_outside_baseline")  # fmt: skip
+    assert not out.exists()
 
 
 def test_schema_errors_name_keys():
@@ -228,29 +267,151 @@ def test_schema_errors_name_keys():
 
 
 # ------------------------------------------------------------------------ browser
+_LAYOUT_JS = """(() => {
+  const out = {tables: [], scrolls: [], width: window.innerWidth};
+  for (const t of document.querySelectorAll('table')) {
+    const c = t.parentElement;
+    out.tables.push({w: t.getBoundingClientRect().width, cw: c.clientWidth,
+                     right: t.getBoundingClientRect().right});
+  }
+  for (const d of document.querySelectorAll('div.scroll'))
+    out.scrolls.push({sw: d.scrollWidth, cw: d.clientWidth});
+  out.text = document.body.innerText;
+  out.docw = document.documentElement.scrollWidth;
+  out.right = Math.max(...[...document.querySelectorAll('nav.toc a, h1, h2, p, figure img')]
+                           .map(e => e.getBoundingClientRect().right));
+  return out;
+})()"""
+
+
 @pytest.mark.browser
-def test_projection_page_in_headless_chromium(proj):
+@pytest.mark.parametrize("size", [(1280, 800), (1920, 1080)])
+def test_projection_page_in_headless_chromium(proj, size):
+    """At 1280 × 800 and 1920 × 1080: no table wider than its container (nothing cut
+    or scrolled sideways), the three figures, no percentage above 100 %."""
     chromium = find_chromium()
     if chromium is None:
         pytest.skip("chromium not installed: the page was not opened in a real browser")
     _, out = proj
     path = out / "projection.html"
-    res = open_page(path, chromium=chromium, width=1280, height=1600)
+    res = open_page(path, chromium=chromium, width=size[0], height=size[1], extra_js=_LAYOUT_JS)
     assert res.errors == [], res.errors
     external = [u for u in res.requests[1:] if not u.startswith("data:")]
     assert external == [], external
     dom = res.dom
     assert dom["sections"] == [
         "assumptions",
+        "decision",
         "probabilities",
         "climate",
         "risk",
         "uncertainty",
+        "indicators",
         "weather",
     ]
-    assert dom["figures"] == ["fig-fans", "fig-risk"]
+    assert dom["figures"] == ["fig-seasonal", "fig-risk", "fig-split"]
     assert dom["scripts"] == 0
     assert all(i["complete"] and i["w"] > 400 and i["h"] > 200 for i in dom["images"])
+    lay = dom["extra"]
+    assert len(lay["tables"]) >= 5
+    for t in lay["tables"]:
+        assert t["w"] <= t["cw"] + 0.5 and t["right"] <= lay["width"], t
+    for d in lay["scrolls"]:
+        assert d["sw"] <= d["cw"], d
+    assert lay["docw"] <= lay["width"] and lay["right"] <= lay["width"], lay["right"]
+    _no_percentage_above_100(lay["text"])
+
+
+def _no_percentage_above_100(text: str) -> None:
+    import re
+
+    found = [float(m) for m in re.findall(r"(-?\d+(?:\.\d+)?)\s?%", text)]
+    assert found, "no percentage on the page"
+    assert max(found) <= 100.0, sorted(found)[-5:]
+
+
+def test_page_and_outputs_have_no_share_above_100(proj):
+    import html as html_mod
+    import re
+
+    p, out = proj
+    text = html_mod.unescape(re.sub(r"<[^>]+>", " ", (out / "projection.html").read_text()))
+    text = re.sub(r"data:image/png;base64,\S+", "", text)
+    _no_percentage_above_100(text)
+    s = json.loads((out / "projection.json").read_text())
+    for r in s["probabilities"]:
+        assert all(0 <= c["p"] <= 1 for c in r["cases"].values())
+    for cls in s["ashrae_best_class"].values():
+        assert abs(sum(cls.values()) - 1) < 1e-9
+    for n, e in s["indicators"].items():
+        if e["unit"] == "% of hours":
+            for c in e["cases"].values():
+                assert c["q95"] is None or 0 <= c["q95"] <= 100, n
+
+
+def test_decomposition_sums_to_100(proj):
+    """Shares of the decomposition sum to 100 % ± 0.1 for every indicator and group."""
+    p, _ = proj
+    checked = 0
+    for block in p.summary["uncertainty_split"].values():
+        for n, e in block["indicators"].items():
+            if e["total"]:
+                total = sum(v for v in e["share"].values() if v is not None)
+                assert abs(100 * total - 100) <= 0.1, (n, e)
+                checked += 1
+    assert checked > 10
+
+
+def test_decompose_components_by_construction():
+    """decompose() on data built from known parts: the scenario, parameter, noise and
+    weather-year variances come back (large samples), and the shares add up to 1."""
+    from heritage_bayes.projection.summary import decompose
+
+    rng = np.random.default_rng(3)
+    S, K, Y = 4, 4000, 30
+    scen = np.array([0.0, 1.0, 2.0, 3.0])[:, None, None]  # variance 1.25
+    par = rng.normal(0, 2.0, (1, K, 1))  # parameter variance 4
+    year = rng.normal(0, 1.5, (1, 1, Y))  # weather-year variance 2.25
+    noise = rng.normal(0, 0.5, (S, K, 1))  # noise variance 0.25 (draw level)
+    x = scen + par + year + 0 * noise
+    y = x + noise
+    d = decompose(y, x)
+    v = d["variance"]
+    # tolerances: 4 standard errors of each sample variance. Scenario: the noise means
+    # per scenario (SE 0.5/√K) move Var_s by 2 Cov_s, SE 2·0.5/√K·√5/4 = 0.0088;
+    # parameter: 4·√(2/K) = 9 % relative; noise (S·K values): 4·0.25·√(2/(S K)) = 0.011
+    assert v["scenario"] == pytest.approx(1.25, abs=0.035)
+    assert v["parameter"] == pytest.approx(4.0, rel=0.09)
+    assert v["weather_year"] == pytest.approx(year.var(), rel=1e-9)  # exact: no noise
+    assert v["noise"] == pytest.approx(0.25, abs=0.012)
+    assert d["total"] == pytest.approx(y.var(), rel=1e-12)
+    assert sum(d["share"].values()) == pytest.approx(1.0, abs=1e-12)
+    # one scenario, no years: scenario 0, no weather-year share
+    d1 = decompose(y[:1, :, 0], x[:1, :, 0])
+    assert d1["variance"]["scenario"] == 0 and d1["share"]["weather_year"] is None
+    assert sum(v for v in d1["share"].values() if v is not None) == pytest.approx(1.0)
+
+
+def test_figure_legends_do_not_cover_the_data(proj, monkeypatch):
+    """Every legend of the page's figures lies outside every axes."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    from heritage_bayes.projection import page
+
+    p, _ = proj
+    figs = []
+    monkeypatch.setattr(page, "to_png_uri", lambda fig: figs.append(fig) or "data:,")
+    page._fig_seasonal(p), page._fig_risk(p), page._fig_split(p)
+    assert len(figs) == 3
+    for fig in figs:
+        FigureCanvasAgg(fig).draw()
+        r = fig.canvas.get_renderer()
+        legends = list(fig.legends) + [a.get_legend() for a in fig.axes if a.get_legend()]
+        for leg in legends:
+            lb = leg.get_window_extent(r)
+            for ax in fig.axes:
+                if ax.get_visible():
+                    assert not lb.overlaps(ax.get_window_extent(r)), fig
 
 
 # ------------------------------------------------------------------ shipped configs
@@ -314,3 +475,36 @@ def test_projection_of_a_run_with_a_weekly_calendar(tmp_path):
     use = U["hours_of_use"].to_numpy()
     sunday_morning = (U.index.day_of_week == 6) & (U.index.hour >= 8) & (U.index.hour < 12)
     assert np.array_equal(use, sunday_morning.astype(float))
+
+
+def test_several_baseline_years_give_a_weather_year_share(run_dir, tmp_path):
+    """A two-year baseline (the demo's year twice, the second 1 K warmer): the per-year
+    indicators get a weather-year share, the shares still sum to 1, and the baseline's
+    own EN 15757 baseline-band share is the one a future equal to it gets."""
+    import pandas as pd
+
+    from heritage_bayes.run import load_run
+    from heritage_bayes.sources import read_sources
+
+    w = read_sources(load_run(run_dir).config).weather
+    # two years and two days (the grid may lose an hour at either end)
+    two = pd.concat([w, w, w], ignore_index=True).iloc[: 2 * 8760 + 48]
+    two.index = pd.date_range(w.index[0], periods=len(two), freq="h")
+    two.iloc[8760:, two.columns.get_loc("Te")] += 1.0
+    csv = tmp_path / "two_years.csv"
+    cols = [c for c in ("Te", "RHe", "ghi", "dni", "dhi") if c in two.columns]
+    two[cols].rename_axis("time").to_csv(csv)
+    cfg = {
+        **PROJ,
+        "draws": 8,
+        "baseline": {"format": "csv", "path": str(csv), "time_column": "time"},
+        "morphing": [_morph("same", 2050, 0.0), _morph("warm", 2050, SHIFT)],
+    }
+    p = project(run_dir, cfg, write=False)
+    assert [c["years"] for c in p.summary["cases"]] == [2, 2, 2]
+    e = p.summary["uncertainty_split"]["baseline"]["indicators"]["twpi"]
+    assert e["variance"]["weather_year"] > 0 and e["basis"].startswith("one year's value")
+    assert sum(e["share"].values()) == pytest.approx(1.0, abs=1e-9)
+    col = "en15757_outside_baseline"
+    same = p.results[1].predictive[col].to_numpy()
+    np.testing.assert_array_equal(same, p.results[0].predictive[col].to_numpy())

@@ -40,7 +40,8 @@ def setup():
     models = {"thermal": hb.model("thermal_2c"), "hygric": hb.model("hygric_2c")}
     run = SimpleNamespace(models=models, summary={"dt": 3600.0, "init_steps": 720}, path="t")
     _, inp, _, _, _ = _inputs("greensboro_tmy3")  # 8759 h: a TMY on the UTC grid
-    two = pd.concat([inp, inp], ignore_index=True)  # 17 518 h, months cut mid-way
+    # two complete years (17 520 h, the third copy cut: months cut mid-way)
+    two = pd.concat([inp, inp, inp], ignore_index=True).iloc[:17_520]
     two.index = pd.date_range(inp.index[0], periods=len(two), freq="h")
     warm = two.copy()
     warm[["Te", "Tf"]] += 3.0
@@ -89,8 +90,8 @@ def assert_close(ref: pd.DataFrame, got: pd.DataFrame):
     past the start-up the noise-free climate is periodic and the band edges (order
     statistics) are tied by one hour per year; whether those hours lie outside is decided
     by the last bit of the series (two edges × two years)."""
-    assert list(got.columns) == list(ref.columns)
-    n = 17_518
+    assert [c for c in got.columns if c != "en15757_outside_baseline"] == list(ref.columns)
+    n = 17_520
     for c in ref.columns:
         if c == "en15757_outside":
             np.testing.assert_allclose(got[c], ref[c], rtol=0, atol=4 * 100 / n, err_msg=c)
@@ -125,11 +126,16 @@ def test_cases_equal_the_numpy_path(setup):
         assert_close(pred, g.predictive)
         np.testing.assert_allclose(g.Ti_month, tm, rtol=6e-8)
         np.testing.assert_allclose(g.RHi_month, rm, rtol=6e-8)
-        assert g.predictive.attrs["units"] == pred.attrs["units"]
+        units = dict(g.predictive.attrs["units"])
+        assert units.pop("en15757_outside_baseline") == "% of hours"
+        assert units == pred.attrs["units"]
         assert set(g.seconds) == {"simulate", "noise", "risk"}
     # paired: the same noise in every case of the same length; one case alone is the same
+    # (alone, the warm case is its own baseline: the baseline-band share differs)
     one = engine.simulate_case(run, draws, cases[1], seed=SEED, chunk=CHUNK)
-    pd.testing.assert_frame_equal(one.predictive, got[1].predictive)
+    col = "en15757_outside_baseline"
+    pd.testing.assert_frame_equal(one.predictive.drop(columns=col),
+                                  got[1].predictive.drop(columns=col))  # fmt: skip
 
 
 def test_noise_free(setup):
@@ -178,6 +184,77 @@ def test_risk_options_reach_the_plan(setup):
         "lifetime_multiplier[paper]",
         "lifetime_multiplier[varnish]",
         "twpi",
+        "time_of_wetness",
     ]
     with pytest.raises(InputError, match="indicators must be"):
         engine.simulate_case(run, draws, two, seed=SEED, risk_options={"indicators": ["x"]})
+
+
+def _numpy_annual(T, RH, hoy, base_RH=None):
+    """Per-year TWPI, time of wetness and baseline-band share with numpy (reference of
+    the compiled pass): the band from ``base_RH`` (default ``RH``) as EN 15757 defines
+    it, its seasonal cycle averaged by hour of the year."""
+    from heritage_bayes.climate.risk._inputs import centred_mean
+
+    base = RH if base_RH is None else base_RH
+    ma = centred_mean(base, 360, "shrink", "propagate")
+    band = np.array([np.bincount(hoy, m, 8760) / np.bincount(hoy, None, 8760) for m in ma])
+    res = risk.en15757_band(base)
+    lo = np.atleast_1d(res.lower_offset)[:, None]
+    hi = np.atleast_1d(res.upper_offset)[:, None]
+    out = (RH < band[:, hoy] + lo) | (RH > band[:, hoy] + hi)
+    years = T.shape[1] // 8760
+    rows = []
+    for y in range(years):
+        sl = slice(y * 8760, (y + 1) * 8760)
+        rows.append(
+            [
+                risk.twpi(T[:, sl], RH[:, sl]),
+                8760 * np.mean((RH[:, sl] > 80) & (T[:, sl] > 0), axis=1),
+                100 * out[:, sl].mean(axis=1),
+            ]
+        )
+    return np.array(rows).transpose(2, 0, 1)  # draws, years, 3
+
+
+def test_annual_values_and_the_baseline_band(setup):
+    """The per-year values equal numpy's; a future equal to the baseline is outside the
+    baseline band exactly as often as the baseline; a warmer room (lower RH) and a
+    wetter one (higher vapour pressure outside) leave it more often."""
+    run, draws, (two, warm) = setup
+    wet = two.copy()
+    wet["Pe"] *= 1.25
+    got = engine.simulate_cases(run, draws, [two, two.copy(), warm, wet], seed=SEED,
+                                chunk=CHUNK, noise=False)  # fmt: skip
+    base, same, hot, damp = got
+    assert base.annual_names[:2] == ("twpi", "time_of_wetness")
+    assert base.annual_names[2].startswith("hours_above_LIM")
+    hoy = engine.hour_of_year(two.index)
+    _, _, _, _, series = reference(run, draws, two, noise=False)
+    Ts = np.concatenate([t for t, _ in series])
+    RHs = _relative_humidity(Ts, np.concatenate([p for _, p in series]))
+    ref = _numpy_annual(Ts, RHs, hoy)
+    a = base.annual_parametric
+    np.testing.assert_allclose(a[..., 0], ref[..., 0], rtol=1e-9)  # TWPI per year
+    np.testing.assert_allclose(a[..., 1], ref[..., 1], rtol=1e-12)  # time of wetness
+    # the band share: the moving averages are summed in another order (ties at the edges)
+    np.testing.assert_allclose(a[..., 3], ref[..., 2], atol=2 * 100 / 8760)
+    # the whole-period TWPI is the harmonic mean of the years'
+    np.testing.assert_allclose(base.parametric["twpi"], 1 / np.mean(1 / a[..., 0], axis=1),
+                               rtol=1e-9)  # fmt: skip
+    col = "en15757_outside_baseline"
+    np.testing.assert_array_equal(same.parametric[col], base.parametric[col])
+    assert (hot.parametric[col] > base.parametric[col] + 5).all()
+    assert (damp.parametric[col] > base.parametric[col] + 5).all()
+    # the self-referenced share cannot see the change: at most 7 % + 7 % of the hours
+    # by construction (less where the minimum band widens it), whatever the climate
+    for g in (base, hot, damp):
+        assert (g.parametric["en15757_outside"] <= 14.0 + 2 * 100 / 17_520).all()
+
+
+def test_no_baseline_no_band(setup):
+    run, draws, (two, warm) = setup
+    got = engine.simulate_cases(run, draws, [two, warm], seed=SEED, chunk=CHUNK,
+                                noise=False, baseline=False)  # fmt: skip
+    assert "en15757_outside_baseline" not in got[1].parametric.columns
+    assert np.isnan(got[1].annual_parametric[..., 3]).all()

@@ -339,7 +339,8 @@ def test_series_in_series_out():
 def test_assess_table():
     T, RH = synthetic_year()
     table = risk.assess(T, RH)
-    assert list(table.columns) == ["indicator", "value", "unit", "rating"]
+    assert list(table.columns) == ["indicator", "value", "unit", "rating", "hours"]
+    assert set(table["hours"]) == {len(T)} and table.attrs["hours_dropped"] == 0
     t = table.set_index("indicator")
     assert t.loc["twpi", "value"] == pytest.approx(risk.twpi(T, RH))
     assert t.loc["twpi", "unit"] == "years"
@@ -353,7 +354,11 @@ def test_assess_table():
         assert t.loc[f"ashrae_{c}", "value"] == pytest.approx(ash.share[c])
     assert t.loc["ashrae_best_class", "rating"] == (ash.best or "none")
     assert t.loc["en15757_outside", "value"] == pytest.approx(risk.en15757_band(RH).share_outside)
-    assert set(t["rating"]) <= {"", "good", "OK", "risk", "AA", "As", "A", "B", "C", "D", "none"}
+    tow = 8760 * np.mean((RH > 80) & (T > 0))
+    assert t.loc["time_of_wetness", "value"] == pytest.approx(tow, rel=1e-12)
+    assert t.loc["time_of_wetness", "unit"] == "h/year"
+    grades = {"", "good", "OK", "risk", "AA", "As", "A", "B", "C", "D", "none"}
+    assert set(t["rating"]) <= grades | {f"τ{i}" for i in range(1, 6)}
     # options reach the functions; unknown options are rejected
     t2 = risk.assess(T, RH, vtt={"sensitivity": "R"}, lm={"Ea": {"film": 90e3}})
     assert "lifetime_multiplier[film]" in set(t2["indicator"])
@@ -367,8 +372,11 @@ def test_assess_short_series_and_groups():
     T, RH = synthetic_year(n=2000)
     with pytest.raises(InputError, match=r"at least one year.*got 2000 h"):
         risk.assess(T, RH)
-    t = risk.assess(T, RH, indicators=["chemical", "mechanical"])
-    assert "twpi" in set(t["indicator"]) and "ashrae_AA" not in set(t["indicator"])
+    # TWPI and time of wetness depend on the season covered: a year or more only
+    with pytest.raises(InputError, match=r"\['chemical'\].*indicators=\['mechanical'\]"):
+        risk.assess(T, RH, indicators=["chemical", "mechanical"])
+    t = risk.assess(T, RH, indicators=["mechanical"])
+    assert "emc_range" in set(t["indicator"]) and "twpi" not in set(t["indicator"])
     with pytest.raises(InputError, match="indicators"):
         risk.assess(T, RH, indicators=["chemistry"])
 
@@ -438,7 +446,11 @@ def test_nan_policies():
     assert risk.ashrae_classes(T, RHn).share.isna().all()
     table = risk.assess(T, RHn, nan_policy="omit")
     assert table["value"].notna().all()
-    assert risk.assess(T, RHn)["value"].isna().all()  # propagate: every indicator NaN
+    assert set(table["hours"]) == {len(T) - 3}  # computed on the valid hours, stated
+    with pytest.raises(InputError, match="3 NaN"):  # the default refuses a gap
+        risk.assess(T, RHn)
+    # propagate (asked for): every indicator NaN
+    assert risk.assess(T, RHn, nan_policy="propagate")["value"].isna().all()
     with pytest.raises(InputError, match="nan_policy"):
         risk.twpi(T, RH, nan_policy="skip")
 
@@ -568,3 +580,63 @@ def test_yearly_indicators_accept_a_typical_year_on_a_grid():
     assert np.isfinite(t.loc["en15757_outside", "value"])
     with pytest.raises(InputError, match=r"at least one year.*8736 h.*got 8735 h"):
         risk.assess(T[:8735], RH[:8735])
+
+
+def test_annual_indicators_use_complete_years_only():
+    """TWPI and the annual counts of a year and a half equal those of its first year
+    (the half year after it is left out, and counted), and do not depend on the
+    month the year starts in: the same year rotated (June-May) gives the same values."""
+    T, RH = synthetic_year(n=8760 + 4380, seed=3)
+    RH = np.clip(RH + 12.0, 0.0, 100.0)  # damp: a time of wetness of hundreds of hours
+    full = risk.assess(T, RH).set_index("indicator")
+    assert full.loc["time_of_wetness", "value"] > 500
+    first = risk.assess(T[:8760], RH[:8760]).set_index("indicator")
+    assert risk.assess(T, RH).attrs["hours_dropped"] == 4380
+    for name in ("twpi", "time_of_wetness", "hours_above_LIM0", "lifetime_multiplier[paper]"):
+        assert full.loc[name, "value"] == pytest.approx(first.loc[name, "value"], rel=1e-12)
+        assert full.loc[name, "hours"] == 8760
+    rolled = risk.assess(np.roll(T[:8760], -3624), np.roll(RH[:8760], -3624))
+    rolled = rolled.set_index("indicator")
+    for name in ("twpi", "time_of_wetness", "hours_above_LIM0", "lifetime_multiplier[paper]"):
+        assert rolled.loc[name, "value"] == pytest.approx(first.loc[name, "value"], rel=1e-9)
+    # a January-May record is refused for them (it would give a far longer TWPI)
+    with pytest.raises(InputError, match="at least one year"):
+        risk.assess(T[:3624], RH[:3624], indicators=["chemical"])
+
+
+def test_registry_covers_every_column():
+    from heritage_bayes.climate.risk.registry import check_indicator_names, indicator_info
+
+    T, RH = synthetic_year()
+    batch = risk.assess_batch(T[None], RH[None])
+    for c in batch.columns:
+        info = indicator_info(c)
+        assert info.unit == batch.attrs["units"][c]
+        assert info.definition and info.source and info.period
+    assert indicator_info("ashrae_AA").name == "Hours within ASHRAE class AA"
+    assert indicator_info("lifetime_multiplier[paper]").worse == -1
+    with pytest.raises(InputError, match=r"known: .*twpi"):
+        indicator_info("metal_corrosion")
+    with pytest.raises(InputError, match=r"thresholds\[1\].indicator.*'twpix'.*'twpi'"):
+        check_indicator_names(["twpi", "twpix"], batch.columns, "thresholds")
+
+
+def test_registry_markdown_for_the_docs():
+    from heritage_bayes.climate.risk.registry import INDICATORS, as_markdown
+
+    md = as_markdown()
+    rows = [r for r in md.splitlines() if r.startswith("| `")]
+    assert len(rows) == len(INDICATORS)
+    assert all(r.count(" | ") == 6 for r in rows)
+    assert "`en15757_outside_baseline`" in md and "ISO 9223" in md
+
+
+def test_time_of_wetness_needs_wet_and_above_freezing():
+    """ISO 9223: hours with RH > 80 % and T > 0 °C; frozen or dry hours do not count."""
+    n = 8760
+    wet_warm = risk.assess(np.full(n, 5.0), np.full(n, 95.0), indicators=["chemical"])
+    frozen = risk.assess(np.full(n, -5.0), np.full(n, 95.0), indicators=["chemical"])
+    dry = risk.assess(np.full(n, 5.0), np.full(n, 80.0), indicators=["chemical"])
+    tow = [t.set_index("indicator").loc["time_of_wetness"] for t in (wet_warm, frozen, dry)]
+    assert [v["value"] for v in tow] == [8760.0, 0.0, 0.0]
+    assert [v["rating"] for v in tow] == ["τ5", "τ1", "τ1"]

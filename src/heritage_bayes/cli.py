@@ -65,7 +65,9 @@ def _build_parser() -> argparse.ArgumentParser:
         help="project a calibrated room's climate and risk onto future weather",
         description="Run the posterior draws of a calibrated room on future weather "
         "(KNMI'14 scenarios, morphing, or future files) and turn the indoor climate into "
-        "conservation risk; write projection.nc, projection.json and projection.html.",
+        "conservation risk; write projection.nc, projection.json, projection.csv and "
+        "projection.html. Exit status 3 (written, with a warning) when the calibration "
+        "did not converge.",
     )
     prj.add_argument("run_dir", help="a run directory written by `hbayes calibrate`")
     prj.add_argument("projection", help="projection YAML file (e.g. configs/projection_demo.yaml)")
@@ -202,6 +204,15 @@ def _cmd_project(args) -> int:
         print(proj.probability_table().to_string(float_format=lambda v: f"{v:.2f}"))
         for p in proj.paths.values():
             print(p)
+    if not proj.summary["converged"]:
+        from heritage_bayes.projection import EXIT_UNCONVERGED_RUN, UNCONVERGED_TEXT
+
+        print(
+            f"hbayes project: written, but {UNCONVERGED_TEXT} (exit code "
+            f"{EXIT_UNCONVERGED_RUN}); continue the calibration with --resume",
+            file=sys.stderr,
+        )
+        return EXIT_UNCONVERGED_RUN
     return 0
 
 

@@ -81,7 +81,7 @@ def _peak_rss_mb() -> float:
 
 
 #: Indicators whose projected change the portfolio table carries (median and P(worse)).
-PROJECTED = ("twpi", "vtt_mould_index_max", "en15757_outside", "emc_range")
+PROJECTED = ("twpi", "vtt_mould_index_max", "en15757_outside_baseline", "emc_range")
 
 
 def _project_room(run_dir: Path, projection: Path, resume: bool) -> dict:
@@ -183,14 +183,17 @@ def measured_risk(run_dir: str | Path) -> dict:
 
     Uses the logged ``Ti`` [°C] and ``RHi`` [%] of the run's data period (calibration
     and validation, gaps omitted) with :func:`heritage_bayes.climate.risk.assess`. The
-    chemical (TWPI [years]) and mechanical (EMC range [% MC]) indicators need no minimum
-    length; the mould index (VTT), ASHRAE classes and the EN 15757 band need a year of
-    data and are left out (NaN) for shorter logs. ``risk_flags`` counts the indicators
-    rated "risk" by their published thresholds (see ``assess``); the overview sorts by
-    it. Both temperature and RH must have been logged; otherwise the columns are absent.
+    mechanical indicators (EMC range [% MC]) need no minimum length; the chemical ones
+    (TWPI [years]), the mould index (VTT), ASHRAE classes and the EN 15757 band depend on
+    the season covered, need a year of data and are left out (NaN) for shorter logs,
+    with ``risk_note`` saying so (over a year: computed on the complete years).
+    ``risk_flags`` counts the indicators rated "risk" by their published thresholds
+    (see ``assess``); the overview sorts by it. Both temperature and RH must have been
+    logged; otherwise the columns are absent.
     """
     from heritage_bayes._arviz import az
     from heritage_bayes.climate import risk
+    from heritage_bayes.climate.risk._inputs import MIN_YEAR_HOURS
 
     path = Path(run_dir) / "posterior.nc"
     try:
@@ -205,12 +208,22 @@ def measured_risk(run_dir: str | Path) -> dict:
     if ok.sum() < 24:
         return {}
     T, RH = T[ok], np.clip(RH[ok], 0.0, 100.0)
-    groups = ["chemical", "mechanical"]
-    if ok.sum() >= 8760:
-        groups += ["mould", "ashrae", "en15757"]
+    groups = ["mechanical"]  # the others depend on the season covered: a year or more
+    if ok.sum() >= MIN_YEAR_HOURS:
+        groups += ["chemical", "mould", "ashrae", "en15757"]
     table = risk.assess(T, RH, indicators=groups, nan_policy="omit")
     by = table.set_index("indicator")
     out: dict[str, Any] = {"risk_hours": int(ok.sum())}
+    if ok.sum() < MIN_YEAR_HOURS:
+        out["risk_note"] = (
+            f"{int(ok.sum())} h measured, less than a year: TWPI, mould, ASHRAE and EN 15757 "
+            "not computed (they depend on the season covered)"
+        )
+    elif table.attrs.get("hours_dropped"):
+        out["risk_note"] = (
+            f"over the complete years: the last {table.attrs['hours_dropped']} h measured "
+            "are not used"
+        )
     for ind, col in (
         ("twpi", "twpi_years"),
         ("emc_range", "emc_range_pct"),

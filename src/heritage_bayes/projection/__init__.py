@@ -19,9 +19,11 @@ that of the baseline.
 Outputs (``--out``, default ``RUN_DIR/projection``): ``projection.nc`` (xarray: per
 case — the baseline and each scenario × horizon — and draw, every risk indicator, and
 the monthly means of ``Ti`` and ``RHi`` by calendar month; the hourly draws are not
-stored), ``projection.json`` (quantiles, change relative to the baseline, probability
-statements, the uncertainty split, the weather transformations, timings) and
-``projection.html`` (self-contained page).
+stored; the per-year indicators per complete year), ``projection.json`` (quantiles,
+change relative to the baseline, probability statements, the uncertainty
+decomposition, the indicator registry, the weather transformations, timings),
+``projection.csv`` (one row per indicator and case, with name, unit, period and source)
+and ``projection.html`` (self-contained decision page).
 """
 
 from __future__ import annotations
@@ -54,6 +56,29 @@ ASSUMPTIONS = (
     "The indoor RH is formed from the simulated Ti and Pi and capped at saturation "
     "(100 %): vapour above saturation condenses.",
 )
+
+
+#: Exit status of ``hbayes project`` on a run whose sampler did not converge (the same
+#: code as ``hbayes calibrate`` for an unconverged run): the projection is written, with
+#: a banner on its page.
+EXIT_UNCONVERGED_RUN = 3
+UNCONVERGED_TEXT = (
+    "the calibration did not converge: the posterior draws may not represent the room, "
+    "and the projected intervals and probabilities can be wrong"
+)
+
+
+def _check_thresholds(pcfg, n_hours: int, risk_opts: dict) -> None:
+    """Refuse a probability statement on an indicator the projection does not compute
+    (the message lists those it does)."""
+    from heritage_bayes.climate.risk.fused import fused_plan
+    from heritage_bayes.climate.risk.registry import check_indicator_names
+
+    plan = fused_plan(n_hours, func="assess_batch", **risk_opts)
+    cols = [c for c in plan.columns if c != "ashrae_best_class"]
+    if "en15757_upper_offset" in cols:
+        cols.insert(cols.index("en15757_upper_offset") + 1, "en15757_outside_baseline")
+    check_indicator_names([t.indicator for t in pcfg.thresholds], cols, "thresholds")
 
 
 @dataclass
@@ -117,8 +142,17 @@ def project(
     Raises
     ------
     heritage_bayes.errors.InputError
-        (and its subclasses ConfigError, DataError) for bad input: nothing is written.
+        (and its subclasses ConfigError, DataError) for bad input: nothing is written;
+        among it a threshold on an unknown indicator, or baseline/future weather from
+        another site (see ``allow_other_site``).
+
+    Notes
+    -----
+    A run whose sampler did not converge is projected, with ``summary["converged"]``
+    False, a banner on the page and a warning through ``progress``; ``hbayes project``
+    then exits with :data:`EXIT_UNCONVERGED_RUN`.
     """
+    from heritage_bayes.climate.risk.registry import indicator_info, years_of
     from heritage_bayes.projection.engine import select_draws, simulate_cases
     from heritage_bayes.projection.summary import summarize
     from heritage_bayes.projection.weather import Case, baseline_weather, futures, model_inputs
@@ -153,6 +187,10 @@ def project(
         where = "baseline" if c.horizon is None else f"scenario {c.label}"
         c.inputs = model_inputs(r, pcfg, c.weather, site, where)
     risk_opts = {"indicators": pcfg.risk.indicators} if pcfg.risk.indicators else {}
+    _check_thresholds(pcfg, len(cases[0].inputs), risk_opts)
+    converged = bool(r.summary.get("converged", True))
+    if not converged and progress is not None:
+        progress(f"WARNING: {UNCONVERGED_TEXT} ({r.path})")
     results = simulate_cases(
         r,
         sel,
@@ -175,10 +213,17 @@ def project(
             "weather": c.note,
             "mean_Te": float(c.weather["Te"].mean()),
             "hours": len(c.inputs),
+            "years": years_of(len(c.inputs)),
+            "hours_dropped": int(c.inputs.attrs.get("hours_dropped", 0)),
         }
         for c in cases
     ]
     summary["assumptions"] = list(ASSUMPTIONS)
+    summary["converged"] = converged
+    summary["unconverged_reasons"] = list(r.summary.get("unconverged_reasons") or [])
+    summary["indicator_registry"] = {
+        n: indicator_info(n).as_dict() | {"key": n} for n in summary["indicators"]
+    }
     summary["humidity"] = pcfg.humidity
     summary["run"] = str(r.path)
     summary["seed"] = pcfg.seed
@@ -193,7 +238,7 @@ def project(
     proj.dataset = to_dataset(proj, r)
     if dest is not None:
         with dest:
-            dest.claim("projection.nc", "projection.json", "projection.html")
+            dest.claim(*(f"projection.{x}" for x in ("nc", "json", "csv", "html")))
             proj.paths = write_outputs(proj, r, dest.path)
     return proj
 

@@ -19,12 +19,15 @@ from the noise draws, which the caller shares between cases.
 
 from __future__ import annotations
 
+import math
+
+import numpy as np
 from numba import njit, prange
 
 from heritage_bayes.climate import _vecmath
-from heritage_bayes.climate._vecmath import psat_water, stamp_cache
+from heritage_bayes.climate._vecmath import psat_water, stamp_cache, vcosh, vexp
 from heritage_bayes.climate.risk import _fused
-from heritage_bayes.climate.risk._fused import BLOCK, pairwise_sum, series_indicators
+from heritage_bayes.climate.risk._fused import BLOCK, _bsum, pairwise_sum, series_indicators
 
 
 @njit(cache=True, error_model="numpy")
@@ -92,11 +95,140 @@ def _monthly(x, starts, out):  # pragma: no cover - compiled
         out[j] = (x[a] + pairwise_sum(x, a + 1, b - a - 1)) / (b - a)
 
 
+#: Per-year columns of :func:`annual_values` (index in its ``out`` rows).
+ANNUAL = ("twpi", "time_of_wetness", "hours_above_LIM", "en15757_outside_baseline")
+#: Hour-of-year bins of the baseline seasonal cycle (365 days × 24 h; 29 February is
+#: read as 28 February).
+HOY = 8760
+
+
+@njit(cache=True, error_model="numpy")
+def annual_values(T, RH, N, hoy, mode, en, band, out, ma, cnt):  # pragma: no cover
+    """Per complete year: TWPI [years], time of wetness [h/year], hours above the
+    lowest isopleth [h/year] and the share of hours outside the baseline EN 15757
+    band [% of hours] of the series ``T[:N]`` [°C], ``RH[:N]`` [%].
+
+    Years are consecutive blocks of 8760 h from the start (one block of ``N`` hours
+    when ``8736 <= N < 8760``); ``out`` is (years, 4).
+
+    ``en`` = (mode flag, half window [h], wrap, lower offset, upper offset, LIM
+    constant ``c``): with ``mode == 1`` (the baseline of this draw) the seasonal cycle
+    (centred moving average of ``RH``, ``2 half + 1`` hours, periodic when ``wrap``,
+    else truncated at the ends as :func:`~heritage_bayes.climate.risk.en15757_band`)
+    is averaged by hour of the year (``hoy``) into ``band[:8760]``, and the offsets
+    are stored in ``band[8760:8762]``; with ``mode == 2`` (a future of the same draw)
+    ``band`` is read. Hours outside ``band[hoy] + [lower, upper]`` are counted.
+    ``mode == 0``: no band (NaN). ``ma`` (N,) and ``cnt`` (8760,) are work arrays.
+    """
+    L = 8760 if N >= 8760 else N
+    ny = N // L
+    half = int(en[1])
+    wrap = en[2] != 0.0
+    limc = en[5]
+    if mode == 1:
+        run = 0.0  # centred moving average from a running sum (np.cumsum order)
+        w = 2 * half + 1
+        for t in range(N):
+            a = t - half
+            b = t + half + 1
+            if wrap:
+                s = 0.0
+                if t == 0:
+                    for j in range(a, b):
+                        s += RH[j % N]
+                    run = s
+                else:
+                    run += RH[(b - 1) % N] - RH[(a - 1) % N]
+                ma[t] = run / w
+            else:
+                lo = a if a > 0 else 0
+                hi = b if b < N else N
+                if t == 0:
+                    run = 0.0
+                    for j in range(lo, hi):
+                        run += RH[j]
+                else:
+                    if b <= N:
+                        run += RH[b - 1]
+                    if a - 1 >= 0:
+                        run -= RH[a - 1]
+                ma[t] = run / (hi - lo)
+        for j in range(HOY):
+            band[j] = 0.0
+            cnt[j] = 0.0
+        for t in range(N):
+            band[hoy[t]] += ma[t]
+            cnt[hoy[t]] += 1.0
+        first = -1
+        for j in range(HOY):
+            if cnt[j] > 0:
+                band[j] /= cnt[j]
+                if first < 0:
+                    first = j
+        last = band[first]  # bins the baseline never saw: the previous bin (cyclic)
+        for j in range(HOY):
+            jj = (first + j) % HOY
+            if cnt[jj] > 0:
+                last = band[jj]
+            else:
+                band[jj] = last
+        band[HOY] = en[3]
+        band[HOY + 1] = en[4]
+    has_lim = limc == limc
+    lo_off = band[HOY] if mode != 0 else 0.0
+    hi_off = band[HOY + 1] if mode != 0 else 0.0
+    w = np.empty(BLOCK)
+    for y in range(ny):
+        inv_pi = 0.0
+        wet = 0
+        lim = 0
+        out_band = 0
+        for b0 in range(y * L, (y + 1) * L, BLOCK):  # blocks: the loops vectorise
+            m = min(BLOCK, (y + 1) * L - b0)
+            Tb = T[b0 : b0 + m]
+            RHb = RH[b0 : b0 + m]
+            for t in range(m):  # 1 / PI (chemical._pi), as in the fused pass
+                x = Tb[t]
+                r = RHb[t]
+                w[t] = 365.0 * vexp(
+                    -((95220.0 - 134.9 * r) * (1.0 / (x + 273.15) / 8.314) + 0.0284 * r - 28.023)
+                )
+            inv_pi += _bsum(w, m)
+            for t in range(m):  # ISO 9223 time of wetness
+                wet += 1 if (RHb[t] > 80.0) and (Tb[t] > 0.0) else 0
+            if has_lim:
+                for t in range(m):  # lowest isopleth for mould (biological._lim)
+                    lim_t = 100.0 * (0.02633 * vcosh(0.10083 * (Tb[t] - 30.0)) + limc)
+                    lim += 1 if RHb[t] > lim_t else 0
+            if mode != 0:
+                hb = hoy[b0 : b0 + m]
+                for t in range(m):
+                    c = band[hb[t]]
+                    r = RHb[t]
+                    out_band += 1 if (r < c + lo_off) or (r > c + hi_off) else 0
+        out[y, 0] = L / inv_pi
+        out[y, 1] = wet / L * 8760.0
+        out[y, 2] = lim / L * 8760.0 if has_lim else math.nan
+        out[y, 3] = 100.0 * out_band / L if mode != 0 else math.nan
+
+
+@njit(cache=True, error_model="numpy")
+def _annual_row(T, RH, N, hoy, mode, en, en_col, row, band, out, ma, cnt):  # pragma: no cover
+    """:func:`annual_values` of one series, the band offsets taken from its indicator
+    ``row`` (columns ``en_col``, ``en_col + 1``) when it is the baseline."""
+    e = en.copy()
+    if mode == 1:
+        e[3] = row[en_col]
+        e[4] = row[en_col + 1]
+    annual_values(T, RH, N, hoy, mode if en_col >= 0 else 0, e, band, out, ma, cnt)
+
+
 @njit(parallel=True, cache=True, error_model="numpy")
 def chunk_kernel(
     YT, YP, mT, mP, UT, UP, eT, eP, noise, starts,
     ea_r, fpar, ipar, kinds, cls, ws, tmp, btmp, hist, sbuf, zbuf, wbuf,
     par, pred, spar, spred, Tm, RHm,
+    hoy, mode, en, en_col, bpar, bpred, apar, apred, mabuf, cbuf,
 ):  # fmt: skip  # pragma: no cover - compiled
     """Indicators (noise-free → ``par``, predictive → ``pred``; status 0/1 in ``spar``,
     ``spred``) and monthly means (``Tm``, ``RHm``) of every draw of the chunk.
@@ -104,6 +236,13 @@ def chunk_kernel(
     ``YT``/``YP``: (draws, hours) outputs of ``model.forward``, or (0, 0) to simulate
     here from the modal arrays ``mT``/``mP`` = (ad, Bdz, edz, Cz, z0) with inputs
     ``UT``/``UP`` (inputs × hours); ``eT``/``eP``: (draws, hours) noise (used when ``noise``).
+
+    Per complete year (:func:`annual_values`, noise-free → ``apar``, predictive →
+    ``apred``, (draws, years, 4)): with ``mode`` 1 (the baseline) the draw's EN 15757
+    band is built into ``bpar``/``bpred`` (draws, 8762) from the offsets in the columns
+    ``en_col``, ``en_col + 1`` of its indicators; with ``mode`` 2 (a future) it is read.
+    ``en`` = (mode, half window, wrap, -, -, LIM constant), ``hoy`` (hours,) the hour of
+    the year of each hour; ``mabuf`` (slots, hours) and ``cbuf`` (slots, 8760) work.
     """
     c = par.shape[0]
     N = sbuf.shape[2]
@@ -127,6 +266,8 @@ def chunk_kernel(
                 Ts, RHx, N, ea_r, fpar, ipar, kinds, cls, ws[s], tmp[s], btmp[s], hist[s],
                 par[i],
             )  # fmt: skip
+            _annual_row(Ts, RHx, N, hoy, mode, en, en_col, par[i], bpar[i], apar[i],
+                        mabuf[s], cbuf[s])  # fmt: skip
             if noise:
                 ei = eT[i]
                 pi = eP[i]
@@ -138,10 +279,14 @@ def chunk_kernel(
                     Tx, RHx, N, ea_r, fpar, ipar, kinds, cls, ws[s], tmp[s], btmp[s],
                     hist[s], pred[i],
                 )  # fmt: skip
+                _annual_row(Tx, RHx, N, hoy, mode, en, en_col, pred[i], bpred[i], apred[i],
+                            mabuf[s], cbuf[s])  # fmt: skip
                 _monthly(Tx, starts, Tm[i])
             else:
                 spred[i] = spar[i]
                 pred[i, :] = par[i, :]
+                bpred[i, :] = bpar[i, :]
+                apred[i, :, :] = apar[i, :, :]
                 _monthly(Ts, starts, Tm[i])
             _monthly(RHx, starts, RHm[i])
 

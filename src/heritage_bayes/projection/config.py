@@ -30,8 +30,17 @@ User-supplied future weather::
       - {scenario: rcp85, horizon: 2080, weather: {format: epw, path: future.epw}}
 
 ``baseline``: the weather the transformations start from (a ``Source`` as in the
-calibration config); default the calibration's own weather. Relative paths are relative
-to the projection file.
+calibration config); default the calibration's own weather. A baseline or future file
+whose site lies more than 50 km from the calibration's is refused unless
+``allow_other_site: true``. Relative paths are relative to the projection file.
+
+Probability statements (``thresholds``), on any indicator the projection computes
+(:mod:`heritage_bayes.climate.risk.registry`; an unknown name is refused with the list)::
+
+    thresholds:
+      - {indicator: twpi, below: 45}                       # [years]
+      - {indicator: en15757_outside_baseline, above: 14}   # [% of hours]
+      - {indicator: time_of_wetness, above: 2500}          # [h/year], ISO 9223 τ4
 """
 
 from __future__ import annotations
@@ -106,13 +115,15 @@ class Threshold(_Strict):
         return self
 
 
-#: Default probability statements (IPI-style risk limits of heritage_bayes.climate.risk).
+#: Default probability statements (IPI-style risk limits of heritage_bayes.climate.risk;
+#: EN 15757: more hours outside the baseline band than the baseline climate itself can
+#: spend outside it, 14 % = below the 7th plus above the 93rd percentile).
 DEFAULT_THRESHOLDS = (
     Threshold(indicator="vtt_mould_index_max", above=1.0),
     Threshold(indicator="twpi", below=45.0),
     Threshold(indicator="emc_max", above=12.5),
     Threshold(indicator="emc_min", below=5.0),
-    Threshold(indicator="en15757_outside", above=10.0),
+    Threshold(indicator="en15757_outside_baseline", above=14.0),
 )
 
 
@@ -122,6 +133,11 @@ class ProjectionConfig(_Strict):
     name: str | None = None
     baseline: Source | None = None
     baseline_label: str = "baseline"
+    allow_other_site: bool = Field(
+        default=False,
+        description="accept baseline or future weather from a site more than 50 km from "
+        "the calibration's (heritage_bayes.projection.weather.MAX_SITE_DISTANCE_KM)",
+    )
     humidity: Humidity = "constant_rh"
     ground_temperature: GroundTemperature | None = None
     knmi14: Knmi14 | None = None

@@ -56,6 +56,10 @@ class CaseResult:
     Ti_month: np.ndarray  # (K, n_months) [°C]
     RHi_month: np.ndarray  # (K, n_months) [%]
     seconds: dict
+    #: (K, years, len(annual_names)) per-complete-year values, predictive and noise-free
+    annual_predictive: np.ndarray | None = None
+    annual_parametric: np.ndarray | None = None
+    annual_names: tuple = ()
 
 
 def select_draws(run, n: int | None, seed: int) -> Draws:
@@ -158,6 +162,7 @@ def simulate_cases(
     init_steps: int | None = None,
     risk_options: dict | None = None,
     progress=None,
+    baseline: bool = True,
 ) -> list[CaseResult]:
     """Predictive simulation and risk of every draw on each weather (streamed by chunks).
 
@@ -167,7 +172,8 @@ def simulate_cases(
     draws : Draws
     inputs : list of pandas.DataFrame
         Model inputs of each case on an hourly grid
-        (:func:`heritage_bayes.projection.weather.model_inputs`).
+        (:func:`heritage_bayes.projection.weather.model_inputs`); only their complete
+        years are simulated (:func:`~heritage_bayes.climate.risk.registry.complete_year_hours`).
     seed : int
         Seed of the noise draws: chunk ``i`` uses ``(seed, i)``, for every case (cases
         of the same length share the very same draws: paired differences).
@@ -183,11 +189,19 @@ def simulate_cases(
         Keywords of :func:`heritage_bayes.climate.risk.assess_batch`.
     progress : callable, optional
         Called with one line of text per chunk.
+    baseline : bool
+        ``inputs[0]`` is the baseline: each draw's EN 15757 band is taken from its
+        baseline simulation and every case is judged against it
+        (``en15757_outside_baseline``, :func:`heritage_bayes.projection._stream.annual_values`).
 
     Returns
     -------
     list of CaseResult
-        In the order of ``inputs``. ``seconds``: ``simulate`` (modal forms, and
+        In the order of ``inputs``, with the per-complete-year values of
+        :data:`heritage_bayes.projection._stream.ANNUAL` (``annual_*``) and, when the
+        EN 15757 group is computed and ``baseline``, the column
+        ``en15757_outside_baseline`` (mean over the years). ``seconds``: ``simulate``
+        (modal forms, and
         ``model.forward`` of controlled models), ``noise`` (the noise draws, shared
         equally by the cases that use them) and ``risk`` (the compiled pass: simulation
         of free-running models, RH, indicators, monthly means).
@@ -216,8 +230,11 @@ def simulate_cases(
     w = int(init_steps or run.summary.get("init_steps", 720))
     opts = dict(risk_options or {})
     plan_opts = {k: v for k, v in opts.items() if k not in ("nan_policy", "chunk_size")}
+    from heritage_bayes.climate.risk.registry import complete_year_hours
+
     cases = []
     for inp in inputs:
+        inp = inp.iloc[: complete_year_hours(len(inp))]  # the indicators' complete years
         U = {
             s: np.ascontiguousarray(inp[list(m.input_names)].to_numpy(dtype=float))
             for s, m in run.models.items()
@@ -225,10 +242,16 @@ def simulate_cases(
         starts, months = _month_starts(inp.index)
         plan = fused_plan(len(inp), func="assess_batch", **plan_opts)  # checks options
         Ut = {s: np.ascontiguousarray(u.T) for s, u in U.items()}
-        cases.append(_Case(U, Ut, starts, months, plan, len(inp)))
+        mode = (1 if not cases else 2) if baseline else 0
+        cases.append(_Case(U, Ut, starts, months, plan, len(inp), hour_of_year(inp.index), mode))
     K = draws.index.size
     out = [_CaseOut.empty(c, K) for c in cases]
     slots = max(1, min(numba.get_num_threads(), chunk, K))
+    from heritage_bayes.projection._stream import HOY
+
+    n_max = max(c.N for c in cases)
+    bands = (np.empty((min(chunk, K), HOY + 2)), np.empty((min(chunk, K), HOY + 2)))
+    annual_work = (np.empty((slots, n_max)), np.empty((slots, HOY)))
     work: dict = {}
     lengths = sorted({c.N for c in cases})
     chunks = [slice(s0, min(s0 + chunk, K)) for s0 in range(0, K, chunk)]
@@ -256,7 +279,8 @@ def simulate_cases(
                 if key not in work:
                     work[key] = _work(c.plan, slots, c.N)
                 e = e_all.get(c.N) if noise else None
-                _run_chunk(run, draws, c, o, sl, modal, e, dt, w, work[key], t_modal, opts)
+                aw = (bands, annual_work)
+                _run_chunk(run, draws, c, o, sl, modal, e, dt, w, work[key], aw, t_modal, opts)
             del e_all
             if progress is not None:
                 progress(
@@ -274,6 +298,31 @@ class _Case:
     months: pd.DatetimeIndex
     plan: object
     N: int
+    hoy: np.ndarray  # (N,) hour of the year of each hour
+    mode: int  # 1: the baseline (builds each draw's EN 15757 band), 2: judged by it, 0: none
+
+    def en_params(self) -> tuple[np.ndarray, int]:
+        """(en, en_col) of :func:`heritage_bayes.projection._stream.chunk_kernel`."""
+        from heritage_bayes.climate.risk import _fused as k
+
+        _, fpar, ipar, _, _ = self.plan.arrays
+        cols = self.plan.columns
+        en_col = cols.index("en15757_lower_offset") if "en15757_lower_offset" in cols else -1
+        shared = ipar[k.I_SHARED] != 0
+        half = ipar[k.I_HALF_A] if shared else ipar[k.I_HALF_E]
+        wrap = ipar[k.I_WRAP_A] if shared else ipar[k.I_WRAP_E]
+        limc = fpar[k.F_LIMC] if ipar[k.I_MOULD] else np.nan
+        return np.array([self.mode, half, wrap, 0.0, 0.0, limc], float), en_col
+
+
+def hour_of_year(index: pd.DatetimeIndex) -> np.ndarray:
+    """Hour of the year (0-8759) of each time stamp [UTC]; 29 February counts as
+    28 February (a 365-day year of hours, so that every year maps onto one cycle)."""
+    idx = index.tz_convert("UTC") if index.tz is not None else index
+    doy = np.asarray(idx.day_of_year) - 1
+    leap = np.asarray(idx.is_leap_year) & (doy >= 59)  # 29 Feb and later
+    doy = np.where(leap, doy - 1, doy)
+    return np.ascontiguousarray(doy * 24 + np.asarray(idx.hour), dtype=np.int64)
 
 
 @dataclass
@@ -283,26 +332,51 @@ class _CaseOut:
     Tm: np.ndarray
     RHm: np.ndarray
     seconds: dict
+    apar: np.ndarray
+    apred: np.ndarray
 
     @classmethod
     def empty(cls, c: _Case, K: int) -> _CaseOut:
+        from heritage_bayes.climate.risk.registry import years_of
+        from heritage_bayes.projection._stream import ANNUAL
+
         nm = c.starts.size
+        ny = years_of(c.N)
         return cls(
             par=np.empty((K, c.plan.width)),
             pred=np.empty((K, c.plan.width)),
             Tm=np.empty((K, nm), np.float32),
             RHm=np.empty((K, nm), np.float32),
             seconds={"simulate": 0.0, "noise": 0.0, "risk": 0.0},
+            apar=np.empty((K, ny, len(ANNUAL))),
+            apred=np.empty((K, ny, len(ANNUAL))),
         )
 
     def result(self, c: _Case) -> CaseResult:
+        from heritage_bayes.projection._stream import ANNUAL
+
+        names = tuple(ANNUAL)
+        if "hours_above_LIM" in names:  # the isopleth's own column name
+            lim = [n for n in c.plan.columns if n.startswith("hours_above_LIM")]
+            names = tuple(lim[0] if n == "hours_above_LIM" and lim else n for n in names)
+        frames = []
+        for vals, ann in ((self.pred, self.apred), (self.par, self.apar)):
+            df = c.plan.frame(vals)
+            if c.mode and "en15757_lower_offset" in df.columns:
+                pos = list(df.columns).index("en15757_upper_offset") + 1
+                df.insert(pos, "en15757_outside_baseline", ann[:, :, 3].mean(axis=1))
+                df.attrs["units"]["en15757_outside_baseline"] = "% of hours"
+            frames.append(df)
         return CaseResult(
-            predictive=c.plan.frame(self.pred),
-            parametric=c.plan.frame(self.par),
+            predictive=frames[0],
+            parametric=frames[1],
             months=c.months,
             Ti_month=self.Tm,
             RHi_month=self.RHm,
             seconds=self.seconds,
+            annual_predictive=self.apred,
+            annual_parametric=self.apar,
+            annual_names=names,
         )
 
 
@@ -354,7 +428,7 @@ def _work(plan, slots: int, N: int) -> tuple:
     )
 
 
-def _run_chunk(run, draws, c: _Case, o: _CaseOut, sl, modal, e, dt, w, work, t_modal, opts):
+def _run_chunk(run, draws, c: _Case, o: _CaseOut, sl, modal, e, dt, w, work, aw, t_modal, opts):
     from heritage_bayes.projection._stream import chunk_kernel
 
     t0 = time.perf_counter()
@@ -377,18 +451,21 @@ def _run_chunk(run, draws, c: _Case, o: _CaseOut, sl, modal, e, dt, w, work, t_m
     eT = e["thermal"] if e is not None else dummy
     eP = e["hygric"] if e is not None else dummy
     ws, tmp, btmp, hist, sbuf, zbuf, wbuf = work
+    (bpar, bpred), (mabuf, cbuf) = aw
+    en, en_col = c.en_params()
     chunk_kernel(
         Y["thermal"], Y["hygric"], M["thermal"], M["hygric"], U["thermal"], U["hygric"],
         eT, eP, e is not None, c.starts, *c.plan.arrays, ws, tmp, btmp, hist, sbuf, zbuf, wbuf,
         o.par[sl], o.pred[sl], spar, spred, o.Tm[sl], o.RHm[sl],
+        c.hoy, c.mode, en, en_col, bpar[:k], bpred[:k], o.apar[sl], o.apred[sl], mabuf, cbuf,
     )  # fmt: skip
     bad = np.flatnonzero((spar != 0) | (spred != 0))
     if bad.size:
-        _recompute(run, draws, c, o, sl, bad, e, dt, w, opts)
+        _recompute(run, draws, c, o, sl, bad, e, dt, w, opts, aw)
     o.seconds["risk"] += time.perf_counter() - t0
 
 
-def _recompute(run, draws, c: _Case, o: _CaseOut, sl, bad, e, dt, w, opts):
+def _recompute(run, draws, c: _Case, o: _CaseOut, sl, bad, e, dt, w, opts, aw):
     """Draws the compiled pass handed back (a missing hour, or a series that
     :func:`assess_batch` rejects): the numpy path, with its NaN policy and its errors."""
     from heritage_bayes.climate.risk import assess_batch
@@ -398,14 +475,34 @@ def _recompute(run, draws, c: _Case, o: _CaseOut, sl, bad, e, dt, w, opts):
     for s, m in run.models.items():
         u0 = c.U[s][: max(1, w)].mean(axis=0)
         ys[s] = m.forward(draws.model[s][rows], c.U[s], dt, u_init=u0)[0][..., 0]
+    from heritage_bayes.projection._stream import _annual_row
+
+    (bpar, bpred), (mabuf, cbuf) = aw
+    en, en_col = c.en_params()
+
+    def annual(T, RH, vals, band, ann):
+        for j, i in enumerate(bad):
+            Tj, RHj = np.ascontiguousarray(T[j]), np.ascontiguousarray(RH[j])
+            args = (c.hoy, c.mode, en, en_col, vals[j], band[i], ann[j], mabuf[0], cbuf[0])
+            _annual_row(Tj, RHj, c.N, *args)
+
     Ts, Ps = ys["thermal"], ys["hygric"]
-    o.par[rows] = c.plan.values(assess_batch(Ts, _relative_humidity(Ts, Ps), **opts))
+    RHs = _relative_humidity(Ts, Ps)
+    o.par[rows] = c.plan.values(assess_batch(Ts, RHs, **opts))
+    apar = o.apar[rows]
+    annual(Ts, RHs, o.par[rows], bpar, apar)
+    o.apar[rows] = apar
     if e is None:
         o.pred[rows] = o.par[rows]
+        o.apred[rows] = o.apar[rows]
+        bpred[bad] = bpar[bad]
         return
     T = Ts + e["thermal"][bad]
     RH = _relative_humidity(T, Ps + e["hygric"][bad])
     o.pred[rows] = c.plan.values(assess_batch(T, RH, **opts))
+    apred = o.apred[rows]
+    annual(T, RH, o.pred[rows], bpred, apred)
+    o.apred[rows] = apred
     o.Tm[rows] = _monthly(T, c.starts)
     o.RHm[rows] = _monthly(RH, c.starts)
 

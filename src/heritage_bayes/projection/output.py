@@ -1,4 +1,5 @@
-"""Writing a projection: ``projection.nc``, ``projection.json``, ``projection.html``.
+"""Writing a projection: ``projection.nc``, ``projection.json``, ``projection.csv``,
+``projection.html``.
 
 All three are rendered in memory first and written atomically
 (:func:`heritage_bayes.inference.results.atomic_write`) into the output folder, which
@@ -11,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from heritage_bayes.climate.risk.registry import indicator_info
 from heritage_bayes.inference.results import atomic_write, atomic_write_text
 
 
@@ -56,6 +58,22 @@ def to_dataset(proj, run):
     if "ashrae_best_class" in res[0].predictive.columns:
         arr = np.stack([r.predictive["ashrae_best_class"].astype(str).to_numpy() for r in res])
         data["ashrae_best_class"] = (("case", "draw"), arr.astype("U8"), {"unit": "class"})
+    if res[0].annual_predictive is not None and res[0].annual_names:
+        ny = max(r.annual_predictive.shape[1] for r in res)
+        coords["year"] = np.arange(ny)
+        units_a = {n: indicator_info(n).unit for n in res[0].annual_names}
+        for j, n in enumerate(res[0].annual_names):
+            for suffix, attr in (("", "annual_predictive"), ("_parametric", "annual_parametric")):
+                arr = np.full((len(res), K, ny), np.nan, np.float32)
+                for i, r in enumerate(res):
+                    a = getattr(r, attr)
+                    arr[i, :, : a.shape[1]] = a[:, :, j]
+                data[f"{n}_per_year{suffix}"] = (
+                    ("case", "draw", "year"),
+                    arr,
+                    {"unit": units_a[n], "description": f"{indicator_info(n).name}, per "
+                     "complete year of the weather (blocks of 8760 h from its start)"},
+                )  # fmt: skip
     for name, unit in (("Ti", "°C"), ("RHi", "%")):
         arr = np.stack([_climatology(getattr(r, f"{name}_month"), r.months) for r in res])
         data[f"{name}_monthly"] = (
@@ -79,8 +97,34 @@ def to_dataset(proj, run):
     return ds
 
 
+def indicator_table(proj):
+    """pandas.DataFrame: one row per indicator and case — the registry's name, unit,
+    period and source, the quantiles over the draws, the paired change against the
+    baseline and P(worse) (``projection.csv``)."""
+    import pandas as pd
+
+    rows = []
+    for n, e in proj.summary["indicators"].items():
+        info = indicator_info(n)
+        for c in proj.summary["cases"]:
+            lab = c["label"]
+            v = e["cases"][lab]
+            ch = e["change"].get(lab) or {}
+            rows.append(
+                {
+                    "indicator": n, "name": info.name, "unit": e["unit"], "case": lab,
+                    "scenario": c["scenario"], "horizon": c["horizon"],
+                    "q05": v["q05"], "q50": v["q50"], "q95": v["q95"], "mean": v["mean"],
+                    "change_q05": ch.get("q05"), "change_q50": ch.get("q50"),
+                    "change_q95": ch.get("q95"), "p_worse": ch.get("p_worse"),
+                    "period": info.period, "source": info.source,
+                }
+            )  # fmt: skip
+    return pd.DataFrame(rows)
+
+
 def write_outputs(proj, run, dest: Path) -> dict:
-    """Render everything, then write the three files atomically into ``dest``."""
+    """Render everything, then write the four files atomically into ``dest``."""
     from heritage_bayes.convert import to_jsonable
     from heritage_bayes.projection.page import render_projection_page
 
@@ -93,12 +137,15 @@ def write_outputs(proj, run, dest: Path) -> dict:
     import json
 
     text = json.dumps(to_jsonable(proj.summary), indent=1, ensure_ascii=False, allow_nan=False)
+    csv = indicator_table(proj).to_csv(index=False, float_format="%.6g")
     paths = {
         "nc": dest / "projection.nc",
         "json": dest / "projection.json",
+        "csv": dest / "projection.csv",
         "html": dest / "projection.html",
     }
     atomic_write(paths["nc"], lambda p: proj.dataset.to_netcdf(p, engine="h5netcdf"))
     atomic_write_text(paths["json"], text)
+    atomic_write_text(paths["csv"], csv)
     atomic_write_text(paths["html"], html)
     return paths

@@ -1,6 +1,20 @@
-"""``projection.html``: the projection on one self-contained page in the house style
+"""``projection.html``: the projection as a decision page in the house style
 (:func:`heritage_bayes.report.page.render_page`, figures through
-:mod:`heritage_bayes.report.figures.style`)."""
+:mod:`heritage_bayes.report.figures.style`).
+
+What a conservator reads, in order: a banner when the calibration did not converge;
+per indicator (human name and unit from :mod:`heritage_bayes.climate.risk.registry`)
+the baseline and each scenario with its interval, the change against the baseline and
+the probability that it is worse; the probability of crossing each named threshold;
+the seasonal cycle of the indoor T and RH (baseline vs scenarios, with bands); the
+distributions of the key indicators per scenario; where the uncertainty comes from
+(figure and table of the decomposition of :mod:`heritage_bayes.projection.summary`);
+what every indicator means (definition, source, period); the weather used.
+
+Layout: every table has a fixed, small number of columns (or one column per case with
+short numbers), text cells wrap, legends sit outside the axes: nothing is cut at
+1280 px (checked in headless Chromium by ``tests/test_projection.py``).
+"""
 
 from __future__ import annotations
 
@@ -8,38 +22,84 @@ from html import escape
 
 import numpy as np
 
+from heritage_bayes.climate.risk.registry import indicator_info
 from heritage_bayes.report.figures.style import RC_PARAMS, _figure, to_png_uri
 from heritage_bayes.report.format import fmt, fmt_pct
 
-#: Indicators drawn as distributions (when computed).
-_DIST = ("twpi", "emc_range", "vtt_mould_index_max", "en15757_outside")
-_CASE_COLOURS = ("#222222", "#1f5fa8", "#2e8b57", "#e08a00", "#c0392b", "#7b3fa0", "#8c564b")
+#: Indicators drawn in the figures (when computed), in this order.
+KEY_INDICATORS = (
+    "twpi",
+    "time_of_wetness",
+    "vtt_mould_index_max",
+    "hours_above_LIM0",
+    "emc_range",
+    "en15757_outside_baseline",
+)
+_CASE_COLOURS = ("#222222", "#1f5fa8", "#2e8b57", "#e08a00", "#c0392b", "#7b3fa0", "#8c564b",
+                 "#17becf", "#bcbd22", "#e377c2")  # fmt: skip
+_COMPONENT_COLOURS = {"parameter": "#1f5fa8", "noise": "#9aa5b1", "weather_year": "#2e8b57",
+                      "scenario": "#e08a00"}  # fmt: skip
+_COMPONENT_NAMES = {
+    "parameter": "parameters of the room",
+    "noise": "model error (noise)",
+    "weather_year": "weather year",
+    "scenario": "scenario",
+}
+_CSS = (
+    "<style>table.decision, table.split, table.registry {width: 100%; table-layout: auto;}"
+    " table.decision td, table.registry td {overflow-wrap: anywhere;}"
+    " table.decision td.num {white-space: normal;}</style>"
+)
 
 
 def _colour(i: int) -> str:
     return _CASE_COLOURS[i % len(_CASE_COLOURS)]
 
 
-def _fig_fans(proj) -> str:
+def _key_names(proj) -> list[str]:
+    return [n for n in KEY_INDICATORS if n in proj.summary["indicators"]]
+
+
+def _legend_below(fig, handles, labels, ncol: int) -> None:
+    """A figure legend under the axes (never over the data)."""
+    fig.legend(handles, labels, loc="outside lower center", ncol=ncol, frameon=False)
+
+
+def _fig_seasonal(proj) -> str:
     import matplotlib
 
     ds = proj.dataset
+    months = np.arange(1, 13)
     with matplotlib.rc_context(RC_PARAMS):
-        fig = _figure(9.0, 5.2)
+        fig = _figure(9.0, 5.6)
         axes = fig.subplots(2, 1, sharex=True)
-        months = np.arange(1, 13)
-        for ax, name, unit in ((axes[0], "Ti", "°C"), (axes[1], "RHi", "%")):
+        # bands for the baseline and the warmest future (overlapping bands of every
+        # case would hide each other); medians for all
+        te = [c["mean_Te"] for c in proj.summary["cases"]]
+        banded = {0, int(np.argmax(te))}
+        handles = []
+        for ax, name, label in (
+            (axes[0], "Ti", "indoor temperature [°C]"),
+            (axes[1], "RHi", "indoor relative humidity [%]"),
+        ):
             arr = ds[f"{name}_monthly"].values  # (case, draw, 12)
-            for i, lab in enumerate(proj.labels):
+            handles = []
+            for i, _lab in enumerate(proj.labels):
                 q = np.nanquantile(arr[i], [0.05, 0.5, 0.95], axis=0)
                 c = _colour(i)
-                ax.fill_between(months, q[0], q[2], color=c, alpha=0.15, lw=0)
-                ax.plot(months, q[1], color=c, lw=1.4, label=lab)
-            ax.set_ylabel(f"indoor {name} [{unit}]")
+                if i in banded:
+                    ax.fill_between(months, q[0], q[2], color=c, alpha=0.15, lw=0)
+                (h,) = ax.plot(months, q[1], color=c, lw=1.6 if i == 0 else 1.2)
+                handles.append(h)
+            ax.set_ylabel(label)
         axes[1].set_xticks(months, ["J", "F", "M", "A", "M", "J", "J", "A", "S", "O", "N", "D"])
         axes[1].set_xlabel("calendar month (mean over the case's years)")
-        axes[0].legend(ncol=min(4, len(proj.labels)), loc="best")
-        axes[0].set_title("Monthly indoor climate: median and 5–95 % predictive band of the draws")
+        warm = proj.labels[max(banded)]
+        axes[0].set_title(
+            "Seasonal cycle: median of the draws; 5–95 % predictive band for the baseline"
+            + (f" and {warm}" if len(banded) > 1 else "")
+        )
+        _legend_below(fig, handles, proj.labels, ncol=min(5, len(proj.labels)))
         return to_png_uri(fig)
 
 
@@ -47,13 +107,15 @@ def _fig_risk(proj) -> str:
     import matplotlib
 
     ds = proj.dataset
-    names = [n for n in _DIST if n in ds]
+    names = _key_names(proj)
     if not names:
         return ""
+    ncol = 2 if len(names) > 1 else 1
+    nrow = -(-len(names) // ncol)
     with matplotlib.rc_context(RC_PARAMS):
-        fig = _figure(9.0, 1.9 * len(names) + 0.6)
-        axes = np.atleast_1d(fig.subplots(len(names), 1))
-        for ax, n in zip(axes, names, strict=True):
+        fig = _figure(9.5, 0.35 * len(proj.labels) * nrow + 0.9 * nrow + 0.6)
+        axes = np.atleast_1d(fig.subplots(nrow, ncol)).ravel()
+        for ax, n in zip(axes, names, strict=False):
             data = [v[np.isfinite(v)] for v in ds[n].values]
             ok = [i for i, v in enumerate(data) if v.size]
             if ok:
@@ -69,8 +131,44 @@ def _fig_risk(proj) -> str:
                     patch.set_facecolor(_colour(ok[j]))
                     patch.set_alpha(0.35)
             ax.set_yticks(range(len(proj.labels)), proj.labels)
-            ax.set_xlabel(f"{n} [{ds[n].attrs.get('unit', '')}]")
-        fig.suptitle("Risk indicators over the draws (box: 25–75 %, whiskers: 5–95 %)")
+            ax.invert_yaxis()
+            ax.set_title(indicator_info(n).label(), fontsize=9)
+        for ax in axes[len(names) :]:
+            ax.set_visible(False)
+        fig.suptitle("Indicators over the draws per scenario (box: 25–75 %, whiskers: 5–95 %)")
+        return to_png_uri(fig)
+
+
+def _fig_split(proj) -> str:
+    import matplotlib
+
+    split = proj.summary["uncertainty_split"]
+    names = _key_names(proj)
+    if not names or not split:
+        return ""
+    groups = list(split)
+    with matplotlib.rc_context(RC_PARAMS):
+        fig = _figure(9.0, 0.9 + 0.32 * len(names) * len(groups) + 0.25 * len(groups))
+        axes = np.atleast_1d(fig.subplots(len(groups), 1, sharex=True))
+        handles = {}
+        for ax, g in zip(axes, groups, strict=True):
+            per = split[g]["indicators"]
+            for row, n in enumerate(names):
+                left = 0.0
+                for comp, col in _COMPONENT_COLOURS.items():
+                    share = (per[n]["share"] or {}).get(comp)
+                    if share is None or share <= 0:
+                        continue
+                    handles[comp] = ax.barh(row, 100 * share, left=left, color=col, height=0.7)
+                    left += 100 * share
+            ax.set_yticks(range(len(names)), [indicator_info(n).name for n in names])
+            ax.invert_yaxis()
+            title = "baseline" if g == "baseline" else f"horizon {g}"
+            ax.set_title(f"{title} ({', '.join(split[g]['cases'])})", fontsize=9)
+            ax.set_xlim(0, 100)
+        axes[-1].set_xlabel("share of the variance [%]")
+        comps = [c for c in _COMPONENT_COLOURS if c in handles]
+        _legend_below(fig, [handles[c] for c in comps], [_COMPONENT_NAMES[c] for c in comps], 4)
         return to_png_uri(fig)
 
 
@@ -80,14 +178,74 @@ def _q_text(d: dict | None) -> str:
     return f"{fmt(d['q50'])} [{fmt(d['q05'])}, {fmt(d['q95'])}]"
 
 
+def _banner(proj) -> str:
+    s = proj.summary
+    if s.get("converged", True):
+        return ""
+    from heritage_bayes.projection import UNCONVERGED_TEXT
+
+    reasons = "".join(f"<li>{escape(str(r))}</li>" for r in s.get("unconverged_reasons") or [])
+    return (
+        "<div class='note red' id='unconverged'><strong>Calibration not converged</strong>"
+        f"<p>{escape(UNCONVERGED_TEXT[:1].upper() + UNCONVERGED_TEXT[1:])}. Continue it "
+        "(<code>hbayes calibrate … --resume</code>) and project again before acting on "
+        "these numbers.</p>" + (f"<ul>{reasons}</ul>" if reasons else "") + "</div>"
+    )
+
+
+def _decision_html(proj) -> str:
+    s = proj.summary
+    rows = []
+    for n, e in s["indicators"].items():
+        info = indicator_info(n)
+        span = len(proj.labels)
+        for j, lab in enumerate(proj.labels):
+            ch = e["change"].get(lab)
+            pw = ch.get("p_worse") if ch else None
+            head = ""
+            if j == 0:
+                head = (
+                    f"<td rowspan='{span}'><b>{escape(info.name)}</b>"
+                    f"<br><small>[{escape(e['unit'])}]</small></td>"
+                )
+            rows.append(
+                f"<tr>{head}<td>{escape(lab)}</td><td class='num'>{_q_text(e['cases'][lab])}</td>"
+                f"<td class='num'>{'–' if ch is None else _q_text(ch)}</td>"
+                f"<td class='num'>{'–' if pw is None else fmt_pct(pw)}</td></tr>"
+            )
+    cls = s.get("ashrae_best_class") or {}
+    extra = ""
+    if cls:
+        items = "".join(
+            f"<li>{escape(lab)}: "
+            + ", ".join(f"{escape(k)} {fmt_pct(v)}" for k, v in sorted(cls[lab].items()))
+            + "</li>"
+            for lab in proj.labels
+        )
+        extra = (
+            "<p>Best ASHRAE class reached (share of the draws; 'none': no class is met for "
+            f"the required share of the hours):</p><ul>{items}</ul>"
+        )
+    return (
+        "<p>Median [5 %, 95 %] over the posterior draws, each with a draw of the model "
+        "error. <b>Change</b>: against the baseline, paired draw by draw (same room "
+        "parameters, same noise realisation). <b>P(worse)</b>: share of the draws in "
+        "which the indicator gets worse for the collection. Definitions and periods: "
+        "<a href='#indicators'>Indicators</a>.</p>"
+        "<div class='scroll'><table class='decision'><thead><tr><th>indicator</th>"
+        "<th>case</th><th>value</th><th>change vs baseline</th><th>P(worse)</th>"
+        f"</tr></thead><tbody>{''.join(rows)}</tbody></table></div>{extra}"
+    )
+
+
 def _probability_html(proj) -> str:
     s = proj.summary
-    head = "".join(f"<th>{escape(lab)}</th>" for lab in proj.labels)
+    head = "".join(f"<th class='num'>{escape(lab)}</th>" for lab in proj.labels)
     rows = []
     for p in s["probabilities"]:
-        stmt = f"P({p['indicator']} {p['op']} {p['value']:g} {p['unit']})"
+        stmt = f"P({p['name']} {p['op']} {p['value']:g} {p['unit']})"
         cells = "".join(
-            f"<td class='num'>{fmt(p['cases'][lab]['p'], 2)}</td>" for lab in proj.labels
+            f"<td class='num'>{fmt_pct(p['cases'][lab]['p'])}</td>" for lab in proj.labels
         )
         rows.append(f"<tr><td>{escape(stmt)}</td>{cells}</tr>")
     K = s["draws"]
@@ -95,72 +253,68 @@ def _probability_html(proj) -> str:
     return (
         f"<div class='scroll'><table><thead><tr><th>statement</th>{head}</tr></thead>"
         f"<tbody>{''.join(rows)}</tbody></table></div>"
-        f"<p>Proportions of {K} posterior draws, each simulated with a draw of its noise "
-        f"model (predictive). Monte-Carlo standard error at most {fmt(se, 2)}.</p>"
-    )
-
-
-def _indicator_html(proj) -> str:
-    s = proj.summary
-    futures = proj.labels[1:]
-    head = "<th>indicator</th><th>unit</th>" + "".join(
-        f"<th>{escape(lab)}</th>" for lab in proj.labels
-    )
-    head += "".join(f"<th>Δ {escape(lab)}</th><th>P(worse) {escape(lab)}</th>" for lab in futures)
-    rows = []
-    for n, e in s["indicators"].items():
-        cells = "".join(f"<td class='num'>{_q_text(e['cases'][lab])}</td>" for lab in proj.labels)
-        for lab in futures:
-            ch = e["change"].get(lab)
-            pw = ch.get("p_worse") if ch else None
-            cells += f"<td class='num'>{_q_text(ch)}</td>"
-            cells += f"<td class='num'>{'–' if pw is None else fmt(pw, 2)}</td>"
-        rows.append(f"<tr><td>{escape(n)}</td><td>{escape(e['unit'])}</td>{cells}</tr>")
-    cls = s.get("ashrae_best_class") or {}
-    extra = ""
-    if cls:
-        items = "".join(
-            f"<li>{escape(lab)}: "
-            + ", ".join(f"{escape(k)} {fmt_pct(100 * v)}" for k, v in sorted(cls[lab].items()))
-            + "</li>"
-            for lab in proj.labels
-        )
-        extra = f"<p>Best ASHRAE class reached (share of draws):</p><ul>{items}</ul>"
-    return (
-        "<p>Median [5 %, 95 %] over the draws; Δ: change relative to the baseline, paired "
-        "draw by draw (same parameters, same noise realisation); P(worse): share of draws "
-        "in which the indicator gets worse for the collection.</p>"
-        f"<div class='scroll'><table><thead><tr>{head}</tr></thead>"
-        f"<tbody>{''.join(rows)}</tbody></table></div>{extra}"
+        f"<p>Shares of {K} posterior draws, each simulated with a draw of its noise "
+        f"model (predictive). Monte-Carlo standard error at most {fmt_pct(se, 1)}.</p>"
     )
 
 
 def _split_html(proj) -> str:
     split = proj.summary["uncertainty_split"]
-    if not split:
-        return "<p>No future horizon.</p>"
-    out = []
-    for h, per in split.items():
+    fig = _fig_split(proj)
+    out = [f"<figure id='fig-split'><img src='{fig}' alt='variance decomposition'></figure>"]
+    for g, block in split.items():
         rows = []
-        for n, e in per.items():
+        for n, e in block["indicators"].items():
             sh = e["share"]
             cells = "".join(
-                f"<td class='num'>{'–' if sh[k] is None else fmt_pct(100 * sh[k])}</td>"
-                for k in ("parameter", "model_error", "scenario")
+                f"<td class='num'>{'–' if sh.get(k) is None else fmt_pct(sh[k])}</td>"
+                for k in _COMPONENT_NAMES
             )
-            rows.append(f"<tr><td>{escape(n)}</td>{cells}</tr>")
-        n_s = next(iter(per.values()))["scenarios"] if per else 0
+            rows.append(
+                f"<tr><td>{escape(indicator_info(n).name)}</td>{cells}"
+                f"<td>{escape(e['basis'])}</td></tr>"
+            )
+        title = "Baseline" if g == "baseline" else f"Horizon {g}"
+        head = "".join(f"<th class='num'>{escape(v)}</th>" for v in _COMPONENT_NAMES.values())
         out.append(
-            f"<h3>Horizon {escape(h)} ({n_s} scenario{'s' if n_s != 1 else ''})</h3>"
-            "<div class='scroll'><table><thead><tr><th>indicator</th><th>parameter</th>"
-            "<th>model error</th><th>scenario</th></tr></thead>"
-            f"<tbody>{''.join(rows)}</tbody></table></div>"
+            f"<h3>{escape(title)} ({escape(', '.join(block['cases']))})</h3>"
+            f"<div class='scroll'><table class='split'><thead><tr><th>indicator</th>{head}"
+            f"<th>of</th></tr></thead><tbody>{''.join(rows)}</tbody></table></div>"
+        )
+    years = {c["years"] for c in proj.summary["cases"]}
+    note = ""
+    if years == {1}:
+        note = (
+            "<div class='note amber'><p>The weather is one year: its year-to-year "
+            "variability is not in this projection (no weather-year share). A baseline "
+            "of several years (e.g. ten years of station data) puts it in.</p></div>"
         )
     return (
-        "<p>Share of the variance of each indicator: <b>parameter</b> — the spread of the "
-        "noise-free simulations over the posterior draws; <b>model error</b> — what the "
-        "noise draw changes, draw by draw; <b>scenario</b> — the spread of the "
-        "predictive means over the horizon's scenarios.</p>" + "".join(out)
+        "<p>Shares of the variance of each indicator (they add up to 100 %): "
+        "<b>parameters of the room</b> — the spread of the noise-free simulations over "
+        "the posterior draws; <b>model error</b> — what the noise draw adds; <b>weather "
+        "year</b> — the spread between the years of the weather (per-year indicators "
+        "only, for one year's value); <b>scenario</b> — the spread of the scenario means "
+        "at a horizon. The KNMI'14 tables give one change per scenario, so the spread "
+        "between climate models is not separated from the scenario. Where the model "
+        "error is correlated with the parameters, the covariance is shared in proportion "
+        "to the two variances (see heritage_bayes.projection.summary).</p>" + note + "".join(out)
+    )
+
+
+def _registry_html(proj) -> str:
+    rows = []
+    for n in proj.summary["indicators"]:
+        i = indicator_info(n)
+        rows.append(
+            f"<tr><td><b>{escape(i.name)}</b><br><small><code>{escape(n)}</code></small></td>"
+            f"<td>{escape(i.unit)}</td><td>{escape(i.definition)}</td>"
+            f"<td>{escape(i.source)}</td><td>{escape(i.period)}</td></tr>"
+        )
+    return (
+        "<div class='scroll'><table class='registry'><thead><tr><th>indicator</th>"
+        "<th>unit</th><th>definition</th><th>source</th><th>period</th></tr></thead>"
+        f"<tbody>{''.join(rows)}</tbody></table></div>"
     )
 
 
@@ -177,18 +331,21 @@ def _weather_html(proj) -> str:
         rows.append(
             f"<tr><td>{escape(c['label'])}</td><td>{escape(str(method))}</td>"
             f"<td>{escape(detail)}</td><td class='num'>{fmt(c['mean_Te'])}</td>"
-            f"<td class='num'>{c['hours']}</td></tr>"
+            f"<td class='num'>{c['years']}</td><td class='num'>{c['hours_dropped']}</td></tr>"
         )
     return (
         f"<p>Humidity under warming: <b>{escape(proj.summary['humidity'])}</b> (see "
-        "heritage_bayes.climate.morph).</p><div class='scroll'><table><thead><tr><th>case"
-        "</th><th>weather</th><th>details</th><th>mean Te [°C]</th><th>hours</th></tr>"
+        "heritage_bayes.climate.morph). Every indicator is computed over the complete "
+        "years of the weather (blocks of 8760 h from its start); the hours after the "
+        "last complete year are not simulated.</p><div class='scroll'><table><thead><tr>"
+        "<th>case</th><th>weather</th><th>details</th><th class='num'>mean Te [°C]</th>"
+        "<th class='num'>complete years</th><th class='num'>hours left out</th></tr>"
         f"</thead><tbody>{''.join(rows)}</tbody></table></div>"
     )
 
 
 def render_projection_page(proj, run) -> str:
-    """The HTML page of a projection."""
+    """The HTML page of a projection (see the module docstring)."""
     from heritage_bayes._version import __version__
     from heritage_bayes.report.page import Section, render_page
 
@@ -197,9 +354,11 @@ def render_projection_page(proj, run) -> str:
     noise = s.get("noise")
     noise_text = ", ".join(f"{k}: {v}" for k, v in (noise or {}).items())
     lead = (
-        "<div class='note info'><p>"
-        f"{s['draws']} posterior draws of the calibrated room, each simulated on the "
-        f"baseline and on {len(proj.labels) - 1} future weather(s)"
+        _CSS
+        + _banner(proj)
+        + "<div class='note info'><p>"
+        + f"{s['draws']} posterior draws of the calibrated room, each simulated on the "
+        + f"baseline and on {len(proj.labels) - 1} future weather(s)"
         + (
             f", with a draw of its noise model ({escape(noise_text)})"
             if noise
@@ -207,32 +366,29 @@ def render_projection_page(proj, run) -> str:
         )
         + ".</p></div>"
     )
-    fans = _fig_fans(proj)
+    seasonal = _fig_seasonal(proj)
     risk = _fig_risk(proj)
     sections = [
         Section(
-            "What the projection assumes",
-            f"<ul>{assumptions}</ul>",
-            id="assumptions",
-            lead=lead,
+            "What the projection assumes", f"<ul>{assumptions}</ul>", id="assumptions", lead=lead
         ),
+        Section("Baseline and scenarios", _decision_html(proj), id="decision"),
         Section("Probability statements", _probability_html(proj), id="probabilities"),
         Section(
             "Indoor climate",
-            f"<figure id='fig-fans'><img src='{fans}' alt='monthly fan charts'></figure>",
+            f"<figure id='fig-seasonal'><img src='{seasonal}' alt='seasonal cycle of the "
+            "indoor temperature and RH'></figure>",
             id="climate",
         ),
         Section(
             "Risk for the collection",
-            (
-                f"<figure id='fig-risk'><img src='{risk}' alt='risk distributions'></figure>"
-                if risk
-                else ""
-            )
-            + _indicator_html(proj),
+            f"<figure id='fig-risk'><img src='{risk}' alt='indicator distributions'></figure>"
+            if risk
+            else "<p>No key indicator computed.</p>",
             id="risk",
         ),
         Section("Where the uncertainty comes from", _split_html(proj), id="uncertainty"),
+        Section("Indicators", _registry_html(proj), id="indicators"),
         Section("Weather", _weather_html(proj), id="weather"),
     ]
     cfg = run.config

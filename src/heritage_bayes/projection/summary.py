@@ -1,16 +1,35 @@
-"""From per-draw indicators of every case to statements: quantiles, change relative to
-the baseline, probabilities, and the split of the uncertainty.
+r"""From per-draw indicators of every case to statements: quantiles, change relative to
+the baseline, probabilities, and the decomposition of the uncertainty.
 
-Uncertainty split (per horizon, per indicator; variances over draws):
+Decomposition (per horizon, and for the baseline alone; per indicator). With ``y``
+the predictive value (the draw's noise realisation included) and ``x`` the noise-free
+value of the same draw, for scenarios ``s``, posterior draws ``k`` and, for the
+indicators computed per complete year, years ``j`` of the weather — population
+variances, every group the same size, so that the law of total variance holds exactly:
 
-* **parameter**: the variance of the indicator of the noise-free simulations (posterior
-  spread of the building's parameters), averaged over the horizon's scenarios;
-* **model error**: the variance of what the noise draw changes, ``var(predictive −
-  noise-free)`` draw by draw, averaged over the scenarios;
-* **scenario**: the variance over the horizon's scenarios of the predictive mean.
+.. math::
 
-Shares are of the sum of the three. Probabilities are proportions of draws; their
-Monte-Carlo standard error is ``sqrt(p (1 − p) / K)`` for ``K`` draws.
+    \operatorname{Var}(y) = \underbrace{\operatorname{Var}_s \bar y_s}_{\text{scenario}}
+    + \overline{\operatorname{Var}_k \bar y_{sk}}
+    + \overline{\operatorname{Var}_j y_{skj}}
+
+* **scenario**: the variance of the scenario means (0 with one scenario);
+* **parameter** and **noise** (model error): the between-draw variance
+  ``Var_k(ȳ) = Var(x̄) + Var(d̄) + 2 Cov(x̄, d̄)`` with ``d = y − x``, split in
+  proportion to ``Var(x̄)`` (parameter) and ``Var(d̄)`` (noise): the covariance is
+  shared the same way, so both parts are non-negative and add up to ``Var_k(ȳ)``;
+* **weather year**: the within-draw variance over the years, ``Var_j(y)``, split the
+  same way between ``Var_j(x)`` (weather year) and ``Var_j(d)`` (the year-to-year part
+  of the noise, added to **noise**). Only for the per-year indicators
+  (:data:`heritage_bayes.projection._stream.ANNUAL`), and only when the weather has
+  more than one year; there the split is of **one year's value**. Other indicators
+  (extremes over the period, shares over all hours) have no weather-year term.
+
+The shares are the components over ``Var(y)``: non-negative, and they sum to 1 by
+construction. The KNMI'14 tables give one change per
+scenario, so a climate-model range is not separated from the scenario term.
+Probabilities are proportions of draws; their Monte-Carlo standard error is
+``sqrt(p (1 − p) / K)`` for ``K`` draws.
 """
 
 from __future__ import annotations
@@ -20,26 +39,15 @@ import math
 import numpy as np
 import pandas as pd
 
-#: +1: a higher value is worse for the collection; -1: a lower value is worse.
-WORSE = {
-    "twpi": -1,
-    "lifetime_multiplier": -1,
-    "emc_min": -1,
-    "emc_max": 1,
-    "emc_range": 1,
-    "dimensional_change": 1,
-    "metal_corrosion": 1,
-    "vtt_mould_index_max": 1,
-    "hours_above_LIM": 1,
-    "en15757_outside": 1,
-}
+from heritage_bayes.climate.risk.registry import indicator_info
+
+#: Components of the decomposition, in the order of the page.
+COMPONENTS = ("parameter", "noise", "weather_year", "scenario")
 
 
 def worse_sign(name: str) -> int:
-    for k, v in WORSE.items():
-        if name == k or name.startswith(k):
-            return v
-    return 0
+    """+1 if a higher value is worse for the collection, -1 if lower, 0 if neither."""
+    return indicator_info(name).worse
 
 
 def numeric_columns(df: pd.DataFrame) -> list[str]:
@@ -54,36 +62,132 @@ def _q(x: np.ndarray) -> dict:
     return {"q05": float(q[0]), "q50": float(q[1]), "q95": float(q[2]), "mean": float(x.mean())}
 
 
+def _proportional(a: np.ndarray, b: np.ndarray, axis: int) -> tuple[float, float]:
+    """``Var(a + b)`` split into the parts of ``a`` and ``b`` in proportion to
+    ``Var(a)`` and ``Var(b)`` (the covariance shared the same way): both non-negative,
+    their sum ``Var(a + b)`` exactly; averaged over the other axes."""
+    va, vb = a.var(axis=axis), b.var(axis=axis)
+    tot = (a + b).var(axis=axis)
+    den = va + vb
+    with np.errstate(invalid="ignore", divide="ignore"):
+        fa = np.where(den > 0, va / den, 0.5)
+    return float((fa * tot).mean()), float(((1 - fa) * tot).mean())
+
+
+def decompose(y: np.ndarray, x: np.ndarray) -> dict:
+    """The variance decomposition of the module docstring.
+
+    Parameters
+    ----------
+    y, x : numpy.ndarray
+        Predictive and noise-free values, shape (scenarios, draws) or (scenarios,
+        draws, years). Draws with a non-finite value in any scenario or year are left
+        out.
+
+    Returns
+    -------
+    dict
+        ``variance`` (component → variance, ``weather_year`` None without years),
+        ``total`` and ``share`` (component → share of the total, None where the total
+        is 0 or the component is absent), ``draws`` used.
+    """
+    y = np.asarray(y, float)
+    x = np.asarray(x, float)
+    yearly = y.ndim == 3 and y.shape[2] > 1
+    if y.ndim == 2:
+        y, x = y[:, :, None], x[:, :, None]
+    ok = np.isfinite(y).all(axis=(0, 2)) & np.isfinite(x).all(axis=(0, 2))
+    y, x = y[:, ok], x[:, ok]
+    if not ok.any():
+        return {"variance": dict.fromkeys(COMPONENTS), "total": None,
+                "share": dict.fromkeys(COMPONENTS), "draws": 0}  # fmt: skip
+    d = y - x
+    scenario = float(y.mean(axis=(1, 2)).var())
+    xb, db = x.mean(axis=2), d.mean(axis=2)  # (S, K): means over the years
+    parameter, noise = _proportional(xb, db, axis=1)
+    weather, noise_w = _proportional(x, d, axis=2)
+    noise += noise_w
+    total = float(y.var())
+    parts = {"parameter": parameter, "noise": noise,
+             "weather_year": weather if yearly else None, "scenario": scenario}  # fmt: skip
+    if not yearly:
+        parts["noise"] += weather  # 0 without years (one value per draw)
+    share = {k: (v / total if (v is not None and total > 0) else None) for k, v in parts.items()}
+    return {"variance": parts, "total": total, "share": share, "draws": int(ok.sum())}
+
+
+def _annual(r, name: str):
+    """(predictive, noise-free) per-year values of ``name`` in a case, or None."""
+    names = list(getattr(r, "annual_names", ()) or ())
+    if name not in names or r.annual_predictive is None:
+        return None
+    j = names.index(name)
+    return r.annual_predictive[:, :, j], r.annual_parametric[:, :, j]
+
+
+def _split(labels, horizons, results, names) -> dict:
+    groups = {"baseline": [0]}
+    for h in sorted({h for h in horizons if h is not None}):
+        groups[str(h)] = [i for i, hh in enumerate(horizons) if hh == h]
+    out = {}
+    for key, idx in groups.items():
+        rs = [results[i] for i in idx]
+        per = {}
+        for n in names:
+            ann = [_annual(r, n) for r in rs]
+            if all(a is not None for a in ann) and ann[0][0].shape[1] > 1:
+                y = np.stack([a[0] for a in ann])
+                x = np.stack([a[1] for a in ann])
+                basis = f"one year's value ({ann[0][0].shape[1]} years of weather)"
+            else:
+                y = np.stack([r.predictive[n].to_numpy(float) for r in rs])
+                x = np.stack([r.parametric[n].to_numpy(float) for r in rs])
+                basis = "the value over the period"
+            per[n] = decompose(y, x) | {"basis": basis}
+        out[key] = {"cases": [labels[i] for i in idx], "indicators": per}
+    return out
+
+
 def summarize(labels, horizons, results, baseline: str, thresholds, units) -> dict:
     """The JSON-ready summary (see the module docstring).
 
     ``labels``: case labels, the baseline first; ``horizons``: their horizons (None for
     the baseline); ``results``: their :class:`~heritage_bayes.projection.engine.CaseResult`.
+    Every share and probability is a fraction in [0, 1]; units are those of the
+    indicator registry (:mod:`heritage_bayes.climate.risk.registry`).
     """
     base = results[0].predictive
     K = len(base)
     names = numeric_columns(base)
     ind: dict = {}
     for n in names:
+        info = indicator_info(n)
         b = base[n].to_numpy(float)
-        entry = {"unit": units.get(n, ""), "worse": worse_sign(n), "cases": {}, "change": {}}
+        entry = {
+            "name": info.name,
+            "unit": units.get(n, info.unit),
+            "definition": info.definition,
+            "source": info.source,
+            "period": info.period,
+            "worse": info.worse,
+            "cases": {},
+            "change": {},
+        }
         for lab, r in zip(labels, results, strict=True):
             v = r.predictive[n].to_numpy(float)
             entry["cases"][lab] = _q(v) | {"parametric": _q(r.parametric[n].to_numpy(float))}
             if lab != baseline:
                 d = v - b  # paired: same parameter and noise draws
                 entry["change"][lab] = _q(d)
-                s = worse_sign(n)
-                if s:
-                    entry["change"][lab]["p_worse"] = float(np.mean(s * d > 0))
+                if info.worse:
+                    entry["change"][lab]["p_worse"] = float(np.mean(info.worse * d > 0))
         ind[n] = entry
     probs = []
     for t in thresholds:
-        if t.indicator not in base.columns:
-            continue
         op, val = (">", t.above) if t.above is not None else ("<", t.below)
-        row = {"indicator": t.indicator, "op": op, "value": val, "unit": units.get(t.indicator, "")}
-        row["cases"] = {}
+        info = indicator_info(t.indicator)
+        row = {"indicator": t.indicator, "name": info.name, "op": op, "value": val,
+               "unit": units.get(t.indicator, info.unit), "cases": {}}  # fmt: skip
         for lab, r in zip(labels, results, strict=True):
             v = r.predictive[t.indicator].to_numpy(float)
             p = float(np.mean(v > val) if op == ">" else np.mean(v < val))
@@ -94,33 +198,12 @@ def summarize(labels, horizons, results, baseline: str, thresholds, units) -> di
         for lab, r in zip(labels, results, strict=True):
             vc = r.predictive["ashrae_best_class"].astype(str).value_counts(normalize=True)
             classes[lab] = {str(k): float(v) for k, v in vc.items()}
-    split = {}
-    for h in sorted({h for h in horizons if h is not None}):
-        rs = [r for r, hh in zip(results, horizons, strict=True) if hh == h]
-        split[str(h)] = {}
-        for n in names:
-            par = np.array([np.nanvar(r.parametric[n].to_numpy(float)) for r in rs])
-            err = np.array(
-                [
-                    np.nanvar(r.predictive[n].to_numpy(float) - r.parametric[n].to_numpy(float))
-                    for r in rs
-                ]
-            )
-            means = np.array([np.nanmean(r.predictive[n].to_numpy(float)) for r in rs])
-            parts = {
-                "parameter": float(par.mean()),
-                "model_error": float(err.mean()),
-                "scenario": float(means.var()) if len(rs) > 1 else 0.0,
-            }
-            total = sum(parts.values())
-            shares = {k: (v / total if total > 0 else None) for k, v in parts.items()}
-            split[str(h)][n] = {"variance": parts, "share": shares, "scenarios": len(rs)}
     return {
         "draws": K,
         "indicators": ind,
         "probabilities": probs,
         "ashrae_best_class": classes,
-        "uncertainty_split": split,
+        "uncertainty_split": _split(labels, horizons, results, names),
     }
 
 
@@ -128,6 +211,6 @@ def probability_table(summary: dict, labels) -> pd.DataFrame:
     """Rows: statements; columns: cases; values: probabilities."""
     rows = {}
     for p in summary["probabilities"]:
-        key = f"P({p['indicator']} {p['op']} {p['value']:g} {p['unit']})".replace(" )", ")")
+        key = f"P({p['name']} {p['op']} {p['value']:g} {p['unit']})".replace(" )", ")")
         rows[key] = {lab: p["cases"][lab]["p"] for lab in labels}
     return pd.DataFrame.from_dict(rows, orient="index", columns=list(labels))

@@ -18,10 +18,15 @@ import numpy as np
 import pandas as pd
 
 from heritage_bayes.climate.risk._inputs import MIN_YEAR_HOURS
+from heritage_bayes.climate.risk.registry import complete_year_hours
 from heritage_bayes.errors import ConfigError, DataError, InputError
 
-#: Largest distance between the calibration site and a future file's site. [°]
-MAX_SITE_OFFSET_DEG = 0.5
+#: Largest distance between the calibration site and the site of a baseline or future
+#: weather file, unless the projection file says ``allow_other_site: true``. [km]
+#: 50 km: about the spacing of the KNMI synoptic stations and the size of a KNMI'14
+#: region; a station further away has another climate (coast, altitude).
+MAX_SITE_DISTANCE_KM = 50.0
+_EARTH_RADIUS_KM = 6371.0
 
 _WEATHER_COLUMNS = ("Te", "RHe", "Pe", "ghi", "dni", "dhi", "Tdew", "Ph")
 
@@ -55,7 +60,8 @@ def baseline_weather(run, pcfg) -> tuple[pd.DataFrame, dict | None, dict]:
     if pcfg.baseline is not None:
         weather = read_source(pcfg, pcfg.baseline, "baseline", INPUT_COLUMNS)
         note = {"from": "projection file (baseline)", "path": weather.attrs.get("source")}
-        site = _site_of(run, weather)
+        site = _calibration_site(run)
+        check_same_site(weather.attrs.get("site"), site, "baseline", pcfg.allow_other_site)
         if site is None:
             site = weather.attrs.get("site")
     else:  # the calibration's own weather source (a file, or the demo's generator)
@@ -126,24 +132,52 @@ def futures(run, pcfg, base: pd.DataFrame, site: dict | None) -> list[Case]:
         where = f"files[{i}].weather"
         w = read_source(pcfg, f.weather, where, INPUT_COLUMNS)
         _check_year(w, where)
-        _check_same_site(w, site, where)
+        check_same_site(w.attrs.get("site"), site, where, pcfg.allow_other_site)
         note = {"method": "user-supplied future weather file", "path": w.attrs.get("source")}
         cases.append(Case(f.scenario, f.horizon, w, note))
     return cases
 
 
-def _check_same_site(w: pd.DataFrame, site: dict | None, where: str) -> None:
-    other = w.attrs.get("site")
-    if not other or not site:
+def _calibration_site(run) -> dict | None:
+    """The site of the calibration: the config's ``site`` or that of its weather file."""
+    if run.config.site is not None:
+        return run.config.site.model_dump()
+    from heritage_bayes.sources import read_sources
+
+    site = read_sources(run.config).site
+    return dict(site) if site else None
+
+
+def site_distance_km(a: dict, b: dict) -> float:
+    """Great-circle distance between two sites (``latitude``, ``longitude`` [°]). [km]
+
+    Haversine formula on a sphere of radius 6371 km.
+    """
+    p1, p2 = np.radians(float(a["latitude"])), np.radians(float(b["latitude"]))
+    dl = np.radians(float(b["longitude"]) - float(a["longitude"]))
+    h = np.sin((p2 - p1) / 2) ** 2 + np.cos(p1) * np.cos(p2) * np.sin(dl / 2) ** 2
+    return float(2 * _EARTH_RADIUS_KM * np.arcsin(np.sqrt(min(1.0, h))))
+
+
+def check_same_site(other: dict | None, site: dict | None, where: str, allow: bool) -> None:
+    """Refuse weather of a site more than :data:`MAX_SITE_DISTANCE_KM` from the
+    calibration's, unless ``allow`` (``allow_other_site: true``).
+
+    Raises
+    ------
+    heritage_bayes.errors.InputError
+        Naming ``where``, both sites and the distance.
+    """
+    if not other or not site or allow:
         return
-    d_lat = abs(float(other["latitude"]) - float(site["latitude"]))
-    d_lon = abs(float(other["longitude"]) - float(site["longitude"]))
-    if max(d_lat, d_lon) > MAX_SITE_OFFSET_DEG:
+    d = site_distance_km(other, site)
+    if d > MAX_SITE_DISTANCE_KM:
         raise InputError(
-            f"{where}: the file is for another site ({other['latitude']:.2f}°N, "
-            f"{other['longitude']:.2f}°E); the room was calibrated at "
-            f"{site['latitude']:.2f}°N, {site['longitude']:.2f}°E (expected within "
-            f"{MAX_SITE_OFFSET_DEG}°)"
+            f"{where}: the file is for another site ({float(other['latitude']):.2f}°N, "
+            f"{float(other['longitude']):.2f}°E), {d:.0f} km from where the room was "
+            f"calibrated ({float(site['latitude']):.2f}°N, {float(site['longitude']):.2f}°E); "
+            f"expected within {MAX_SITE_DISTANCE_KM:g} km. If this weather does stand for "
+            "the room's climate, say so with 'allow_other_site: true' in the projection file"
         )
 
 
@@ -151,7 +185,9 @@ def model_inputs(run, pcfg, weather: pd.DataFrame, site: dict | None, where: str
     """Model inputs on the run's grid from a weather table (as for the calibration).
 
     Returns a frame with every input column of the run's models (``Te``, ``I_<surface>``,
-    ``Tf``, ``Pe``, ...), regular UTC index.
+    ``Tf``, ``Pe``, ...), regular UTC index, cut to the complete years of the weather
+    (:func:`~heritage_bayes.climate.risk.registry.complete_year_hours`;
+    ``frame.attrs["hours_dropped"]`` counts the hours after the last complete year).
     """
     from heritage_bayes.inputs import annual_mean_temperature, calendar_inputs, weather_inputs
     from heritage_bayes.io import align
@@ -206,4 +242,8 @@ def model_inputs(run, pcfg, weather: pd.DataFrame, site: dict | None, where: str
             f"{where}: {len(frame)} rows on the grid; a projection needs at least "
             f"{MIN_YEAR_HOURS} h"
         )
-    return frame
+    # the yearly indicators depend on the season covered: complete years only
+    n = complete_year_hours(len(frame))
+    out = frame.iloc[:n].copy()
+    out.attrs["hours_dropped"] = len(frame) - n
+    return out

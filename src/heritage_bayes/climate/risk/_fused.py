@@ -178,7 +178,8 @@ def _bad_hours(T, RH, n):  # pragma: no cover - compiled
 def _pointwise(T, RH, b0, m, fpar, ipar, ea_r, tmp, sums):  # pragma: no cover - compiled
     """Chemical and mechanical indicators and the isopleth count of one block.
 
-    ``sums``: [1/LM per activation energy..., 1/PI, EMC min, EMC max, hours above LIM].
+    ``sums``: [1/LM per activation energy..., 1/PI, EMC min, EMC max, hours above LIM,
+    wet hours].
     """
     nea = ipar[I_NEA]
     u = tmp[0]
@@ -200,6 +201,10 @@ def _pointwise(T, RH, b0, m, fpar, ipar, ea_r, tmp, sums):  # pragma: no cover -
             # 1 / PI with PI = exp(a) / 365 (chemical._pi)
             w[t] = 365.0 * vexp(-((95220.0 - 134.9 * r) * (inv_TK / 8.314) + 0.0284 * r - 28.023))
         sums[nea] += _bsum(w, m)
+        wet = 0
+        for t in range(m):  # ISO 9223 time of wetness: RH > 80 % and T > 0 °C
+            wet += 1 if (RHb[t] > 80.0) and (Tb[t] > 0.0) else 0
+        sums[nea + 4] += wet
         for k in range(nea):
             e = ea_r[k]
             for t in range(m):
@@ -552,7 +557,7 @@ def series_indicators(
     arrays.
     """
     nea = ipar[I_NEA]
-    sums = np.zeros(nea + 4)
+    sums = np.zeros(nea + 5)
     sums[nea + 1] = math.inf
     sums[nea + 2] = -math.inf
     mould = ipar[I_MOULD] != 0
@@ -597,14 +602,15 @@ def series_indicators(
         for k in range(nea + 1):  # lifetime multipliers, then TWPI: harmonic means
             out[col] = n / sums[k]
             col += 1
+        out[col] = 100.0 * sums[nea + 4] / n / 100.0 * 8760.0  # time of wetness [h/year]
+        col += 1
     if ipar[I_MECH]:
         lo, hi = sums[nea + 1], sums[nea + 2]
         out[col] = lo
         out[col + 1] = hi
         out[col + 2] = hi - lo
         out[col + 3] = 100.0 * fpar[F_COEF] * (hi - lo)
-        out[col + 4] = hi
-        col += 5
+        col += 4
     if mould:
         out[col] = vtt[2]
         out[col + 1] = 100.0 * sums[nea + 3] / n / 100.0 * 8760.0  # share → h/year

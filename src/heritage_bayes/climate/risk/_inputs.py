@@ -141,6 +141,7 @@ class Hourly:
     RH: np.ndarray | None
     index: pd.Index | None
     ndim: int  # 1 (one series) or 2 (draws × hours)
+    dropped: int = 0  # hours after the last complete year, not used
 
     @property
     def n_hours(self) -> int:

@@ -18,12 +18,14 @@ import numpy as np
 import pandas as pd
 
 from heritage_bayes.climate.risk._inputs import (
+    HOURS_PER_YEAR,
     MIN_YEAR_HOURS,
     Hourly,
     centred_mean,
     check_positive,
     harmonic_mean,
     hourly,
+    share_percent,
 )
 
 # The functions named in _OPTION_TARGETS are imported for _defaults(), which reads their
@@ -61,7 +63,7 @@ from heritage_bayes.errors import InputError
 
 #: Indicator groups of :func:`assess`; those marked True need at least a year of data.
 INDICATOR_GROUPS = {
-    "chemical": False,
+    "chemical": True,
     "mechanical": False,
     "mould": True,
     "ashrae": True,
@@ -155,7 +157,7 @@ def _resolve_groups(func, indicators):
 def _check_year(func, groups, n):
     yearly = [g for g in groups if INDICATOR_GROUPS[g]]
     if yearly and n < MIN_YEAR_HOURS:
-        short = [g for g in groups if not INDICATOR_GROUPS[g]] or ["chemical", "mechanical"]
+        short = [g for g in groups if not INDICATOR_GROUPS[g]] or ["mechanical"]
         raise InputError(
             f"{func}: the indicators {yearly} need at least one year of hourly data "
             f"({MIN_YEAR_HOURS} h); got {n} h. For a shorter series pass "
@@ -176,13 +178,13 @@ def _assess_core(h: Hourly, groups, opts, nan_policy) -> dict[str, np.ndarray]:
                 val = np.exp(Ea / R_GAS * u + rh_term)
                 out[f"lifetime_multiplier[{label}]"] = harmonic_mean(val, nan_policy)
         out["twpi"] = harmonic_mean(_pi(T, RH), nan_policy)
+        out["time_of_wetness"] = time_of_wetness(h, nan_policy)
     if "mechanical" in groups:
         lo, hi = _minmax(_emc(T, RH), nan_policy)
         out["emc_min"] = lo
         out["emc_max"] = hi
         out["emc_range"] = hi - lo
         out["dimensional_change"] = 100.0 * opts["emc"]["coefficient"] * (hi - lo)
-        out["metal_corrosion"] = hi
     if "mould" in groups:
         _, peak = _vtt_run(h, opts["vtt"]["args"], nan_policy, store=False)
         out["vtt_mould_index_max"] = peak
@@ -232,22 +234,9 @@ def _assess_core(h: Hourly, groups, opts, nan_policy) -> dict[str, np.ndarray]:
 
 
 def _unit(name: str) -> str:
-    if name.startswith("lifetime_multiplier") or name == "vtt_mould_index_max":
-        return "-"
-    if name.startswith("hours_above_LIM"):
-        return "h/year"
-    if name.startswith("ashrae_") or name == "en15757_outside":
-        return "% of hours"
-    return {
-        "twpi": "years",
-        "emc_min": "% MC",
-        "emc_max": "% MC",
-        "emc_range": "% MC",
-        "metal_corrosion": "% MC",
-        "dimensional_change": "%",
-        "en15757_lower_offset": "%RH",
-        "en15757_upper_offset": "%RH",
-    }[name]
+    from heritage_bayes.climate.risk.registry import indicator_info
+
+    return indicator_info(name).unit
 
 
 def _rating(name: str, v) -> str:
@@ -260,18 +249,42 @@ def _rating(name: str, v) -> str:
         return "OK" if v >= 5.0 else "risk"
     if name == "emc_max":
         return "OK" if v <= 12.5 else "risk"
-    if name == "metal_corrosion":
-        return "good" if v < 7.0 else ("OK" if v < 10.5 else "risk")
+    if name == "time_of_wetness":  # ISO 9223 categories τ1-τ5
+        return next((f"τ{i}" for i, top in enumerate(_TOW_TOPS, 1) if v <= top), "τ5")
     if name == "vtt_mould_index_max":
         return "good" if v < 1.0 else "risk"
     return ""
 
 
+#: Upper limits of the ISO 9223 time-of-wetness categories τ1-τ4. [h/year]
+_TOW_TOPS = (10.0, 250.0, 2500.0, 5500.0)
+
+
+def time_of_wetness(h: Hourly, nan_policy) -> np.ndarray:
+    """Hours per year with RH > 80 % and T > 0 °C (ISO 9223 time of wetness). [h/year]"""
+    valid = np.isfinite(h.T) & np.isfinite(h.RH)
+    with np.errstate(invalid="ignore"):
+        wet = (h.RH > 80.0) & (h.T > 0.0)
+    return share_percent(wet, valid, nan_policy) / 100.0 * HOURS_PER_YEAR
+
+
 def _prepare_assess(func, T, RH, indicators, nan_policy, options):
+    """Checked series (cut to their complete years), groups and options.
+
+    A series of a year or more is cut to its complete years
+    (:func:`~heritage_bayes.climate.risk.registry.complete_year_hours`): the hours after
+    the last complete year are not used (``Hourly.dropped`` counts them).
+    """
+    from heritage_bayes.climate.risk.registry import complete_year_hours
+
     groups = _resolve_groups(func, indicators)
     opts = _resolve_options(func, options)
     h = hourly(func, T=T, RH=RH, nan_policy=nan_policy)
     _check_year(func, groups, h.n_hours)
+    n = complete_year_hours(h.n_hours)
+    if n < h.n_hours:
+        index = None if h.index is None else h.index[:n]
+        h = Hourly(T=h.T[:, :n], RH=h.RH[:, :n], index=index, ndim=h.ndim, dropped=h.n_hours - n)
     return h, groups, opts
 
 
@@ -280,7 +293,7 @@ def assess(
     RH,
     *,
     indicators=None,
-    nan_policy="propagate",
+    nan_policy="raise",
     lm=None,
     emc=None,
     vtt=None,
@@ -297,13 +310,15 @@ def assess(
     RH : array_like or pandas.Series
         Hourly relative humidity, shape (hours,). [%]
     indicators : iterable of str, optional
-        Groups to compute, any of ``"chemical"`` (lifetime multipliers, TWPI),
-        ``"mechanical"`` (EMC, dimensional change, corrosion), ``"mould"`` (VTT index,
-        hours above LIM), ``"ashrae"``, ``"en15757"``; default all. ``mould``, ``ashrae``
-        and ``en15757`` need at least a year (8736 h: a year less a day, so that an
-        8759-hour typical year counts).
-    nan_policy : {"propagate", "omit", "raise"}, default "propagate"
-        Missing hours, for every indicator (see the module documentation).
+        Groups to compute, any of ``"chemical"`` (lifetime multipliers, TWPI, time of
+        wetness), ``"mechanical"`` (EMC, dimensional change), ``"mould"`` (VTT index,
+        hours above LIM), ``"ashrae"``, ``"en15757"``; default all. All but
+        ``mechanical`` need at least a year (8736 h: a year less a day, so that an
+        8759-hour typical year counts): their values depend on the season covered.
+    nan_policy : {"raise", "omit", "propagate"}, default "raise"
+        Missing hours: an error naming the count (default), the indicators computed
+        on the valid hours (the table's ``hours`` column gives their number), or NaN
+        results.
     lm : dict, optional
         Options of :func:`twlm`; ``Ea`` is a dict label → activation energy [J/mol],
         default ``{"paper": 100e3, "varnish": 70e3}`` (one row each).
@@ -328,8 +343,8 @@ def assess(
         * ``twpi`` — :func:`twpi` [years], rated good (≥ 75) / OK (≥ 45) / risk;
         * ``emc_min``, ``emc_max`` [% MC] — rated OK/risk against 5 and 12.5 %;
           ``emc_range`` [% MC]; ``dimensional_change`` [%] (:func:`dimensional_change`);
-        * ``metal_corrosion`` — maximum EMC [% MC], rated good (< 7) / OK (< 10.5) /
-          risk;
+        * ``time_of_wetness`` — hours with RH > 80 % and T > 0 °C [h/year] (ISO 9223),
+          rated with its category τ1-τ5;
         * ``vtt_mould_index_max`` — maximum of :func:`vtt_mould_index` [-], rated good
           (< 1) / risk;
         * ``hours_above_LIM0`` — :func:`hours_above_isopleth` [h/year];
@@ -339,7 +354,11 @@ def assess(
         * ``en15757_outside`` [% of hours], ``en15757_lower_offset``,
           ``en15757_upper_offset`` [%RH] (:func:`en15757_band`).
 
-        Ratings are empty where the field has no published scale.
+        Ratings are empty where the field has no published scale. ``hours``: the
+        valid hours the value is computed from. A series of a year or more is cut to
+        its complete years (the first ⌊n / 8760⌋ × 8760 hours): ``table.attrs
+        ["hours_dropped"]`` counts the hours left out. Definitions, sources and periods
+        of every indicator: :data:`heritage_bayes.climate.risk.registry.INDICATORS`.
 
     Raises
     ------
@@ -389,16 +408,19 @@ def assess(
             f"{(h.T.shape[0], h.n_hours)}. Use assess_batch for draws × hours"
         )
     res = _assess_core(h, groups, opts, nan_policy)
+    valid = int((np.isfinite(h.T) & np.isfinite(h.RH)).sum())
     rows = []
     for name, v in res.items():
         if name == "ashrae_best_class":
             best = v[0]
             value = float(res[f"ashrae_{best}"][0]) if best != "none" else math.nan
-            rows.append((name, value, _unit(name), best))
+            rows.append((name, value, _unit(name), best, valid))
             continue
         value = float(v[0])
-        rows.append((name, value, _unit(name), _rating(name, value)))
-    return pd.DataFrame(rows, columns=["indicator", "value", "unit", "rating"])
+        rows.append((name, value, _unit(name), _rating(name, value), valid))
+    table = pd.DataFrame(rows, columns=["indicator", "value", "unit", "rating", "hours"])
+    table.attrs["hours_dropped"] = int(h.dropped)
+    return table
 
 
 def assess_batch(
@@ -464,6 +486,7 @@ def assess_batch(
     cols = {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
     df = pd.DataFrame(cols, index=pd.RangeIndex(d, name="draw"))
     df.attrs["units"] = {k: _unit(k) for k in cols}
+    df.attrs["hours_dropped"] = int(h.dropped)
     return df
 
 

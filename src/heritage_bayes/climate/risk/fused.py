@@ -163,11 +163,12 @@ def _plan(func, n, groups, opts) -> FusedPlan:
         fpar[k.F_TREF_INV] = 1.0 / (lm["T_ref"] + k._T0)
         fpar[k.F_RHREF] = lm["RH_ref"]
         fpar[k.F_N] = lm["n"]
-        cols += [f"lifetime_multiplier[{label}]" for label in lm["Ea"]] + ["twpi"]
+        cols += [f"lifetime_multiplier[{label}]" for label in lm["Ea"]]
+        cols += ["twpi", "time_of_wetness"]
     if "mechanical" in groups:
         ipar[k.I_MECH] = 1
         fpar[k.F_COEF] = opts["emc"]["coefficient"]
-        cols += ["emc_min", "emc_max", "emc_range", "dimensional_change", "metal_corrosion"]
+        cols += ["emc_min", "emc_max", "emc_range", "dimensional_change"]
     if "mould" in groups:
         ipar[k.I_MOULD] = 1
         *vals, frozen_decline = opts["vtt"]["args"]

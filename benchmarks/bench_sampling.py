@@ -70,7 +70,9 @@ def _problem(path: Path, model_name: str | None = None):
     return cfg, lp, m
 
 
-def _run(label, target, x_start, to_x, bounds, cfg, max_time):
+def _run(label, target, x_start, to_x, bounds, cfg, max_time, **kw):
+    """Sample once (``kw``: more arguments of ``run_sampler``) and print a line; returns
+    (ChainResult, CPU seconds, min bulk ESS per CPU second)."""
     c0, t0 = time.process_time(), time.perf_counter()
     res = run_sampler(
         target,
@@ -80,6 +82,7 @@ def _run(label, target, x_start, to_x, bounds, cfg, max_time):
         max_seconds=max_time,
         check_every=cfg.sampler.check_every,
         tau_factor=cfg.sampler.tau_factor,
+        **kw,
     )
     cpu, wall = time.process_time() - c0, time.perf_counter() - t0
     X, _ = res.draws(cfg.sampler.max_draws)
@@ -92,7 +95,7 @@ def _run(label, target, x_start, to_x, bounds, cfg, max_time):
         f"min ESS {ess:6.0f}  ESS/CPU-s {ess / cpu:7.2f}",
         flush=True,
     )
-    return cpu, ess / cpu
+    return res, cpu, ess / cpu
 
 
 def main() -> None:
@@ -103,12 +106,12 @@ def main() -> None:
     for name in args.problems:
         cfg, lp, m = _problem(*PROBLEMS[name])
         print(f"{name}: {lp.model.name}, {lp.ndim} free parameters, MAP {m.log_post:.1f}")
-        c_log, r_log = _run("log", lp, m.x, lambda x: x, lp.params.bounds, cfg, args.max_time)
+        _, c_log, r_log = _run("log", lp, m.x, lambda x: x, lp.params.bounds, cfg, args.max_time)
         ref = lp.params.free_names.index("Ci") if "Ci" in lp.params.free_names else None
         lap = laplace(lp, m.x, given=() if ref is None else ("Ci",))
         aff = affine_coordinates(lp, lap)
         try:
-            c_aff, r_aff = _run(
+            _, c_aff, r_aff = _run(
                 "laplace", aff, aff.to_z(m.x)[0], aff.to_x, None, cfg, args.max_time
             )
         except InputError as exc:

@@ -166,6 +166,7 @@ def test_lower_layers_do_not_import_higher_ones():
     graph = import_graph()
     layers = {  # lower number = lower layer
         "rc": 1, "climate": 1, "io": 1, "errors": 0, "_version": 0, "_arviz": 0,
+        "convert": 0, "convergence": 0,
         "config": 1, "inputs": 2, "models": 2, "sources": 2, "demo": 2, "inference": 2,
         "prepare": 3, "run": 3, "report": 4, "calibrate": 5, "projection": 5, "portfolio": 6,
         "compare": 6,
@@ -181,6 +182,28 @@ def test_lower_layers_do_not_import_higher_ones():
             if dtop in layers and layers[dtop] > layers[top]:
                 bad.append(f"{mod} -> {d}")
     assert bad == [], bad
+
+
+def test_rc_and_inference_see_neither_the_settings_nor_the_readers():
+    """Settings are parsed once, at the boundary: the RC and inference layers receive
+    typed values and import nothing from ``config`` or ``io``."""
+    bad = sorted(
+        f"{mod} -> {d}"
+        for mod, deps in import_graph().items()
+        if mod.split(".")[1:2] in (["rc"], ["inference"])
+        for d in deps
+        if d.split(".")[1:2] in (["config"], ["io"])
+    )
+    assert bad == [], bad
+
+
+def test_the_settings_modules_stay_small():
+    """The settings package is split by topic: no module of it above ~400 lines."""
+    sizes = {
+        p.name: len(p.read_text(encoding="utf-8").splitlines())
+        for p in (SRC / "config").glob("*.py")
+    }
+    assert len(sizes) >= 8 and max(sizes.values()) <= 400, sizes
 
 
 MAX_LINES = 600

@@ -145,8 +145,27 @@ def test_internal_errors_exit_1(monkeypatch, tmp_path, capsys):
 def tiny_run(tmp_path_factory):
     d = tmp_path_factory.mktemp("cli")
     cfg = _write(d / "tiny.yaml", TINY)
-    assert main(["calibrate", str(cfg), "--out", str(d / "run"), "--quiet"]) == 0
+    # 400 steps: the run finishes unconverged, exit code 3 (cli: EXIT_UNCONVERGED)
+    assert main(["calibrate", str(cfg), "--out", str(d / "run"), "--quiet"]) == 3
     return d, cfg
+
+
+def test_an_unconverged_run_exits_3_with_its_reasons(tiny_run, tmp_path, capsys):
+    """400 steps is far below 50 τ: the run directory is complete, the exit code is 3,
+    and summary.json names the reason for each chain."""
+    d, cfg = tiny_run
+    s = json.loads((d / "run" / "summary.json").read_text())
+    assert s["converged"] is False
+    reasons = s["unconverged_reasons"]
+    assert any(
+        r.startswith("thermal: the step cap sampler.max_steps was reached after 400 steps; τmax ")
+        for r in reasons
+    ), reasons
+    assert main(["calibrate", str(cfg), "--out", str(tmp_path / "r"), "--no-report"]) == 3
+    err = capsys.readouterr().err
+    assert "hbayes: finished but NOT converged (exit code 3)" in err
+    assert "thermal: the step cap sampler.max_steps was reached after 400 steps" in err
+    assert "Traceback" not in err
 
 
 def test_tiny_run_directory_and_load_run(tiny_run):
@@ -185,14 +204,14 @@ def test_tiny_run_directory_and_load_run(tiny_run):
 
 def test_same_seed_same_posterior_and_resume(tiny_run, tmp_path):
     d, cfg = tiny_run
-    assert main(["calibrate", str(cfg), "--out", str(tmp_path / "again"), "--quiet"]) == 0
+    assert main(["calibrate", str(cfg), "--out", str(tmp_path / "again"), "--quiet"]) == 3
     a = load_run(d / "run").idata.posterior
     b = load_run(tmp_path / "again").idata.posterior
     for v in a.data_vars:
         np.testing.assert_array_equal(a[v].values, b[v].values)
     # resuming a finished run continues from the saved chain and succeeds
     assert (
-        main(["calibrate", str(cfg), "--out", str(tmp_path / "again"), "--resume", "--quiet"]) == 0
+        main(["calibrate", str(cfg), "--out", str(tmp_path / "again"), "--resume", "--quiet"]) == 3
     )
     s = json.loads((tmp_path / "again" / "summary.json").read_text())
     assert s["models"]["thermal"]["chain"]["resumed_from"] >= 400
@@ -206,10 +225,9 @@ def test_resume_may_extend_a_run(tiny_run, tmp_path):
     import shutil
 
     shutil.copytree(d / "run", tmp_path / "run")
-    assert (
-        main(["calibrate", str(path), "--out", str(tmp_path / "run"), "--resume", "--quiet"]) == 0
-    )
+    code = main(["calibrate", str(path), "--out", str(tmp_path / "run"), "--resume", "--quiet"])
     s = json.loads((tmp_path / "run" / "summary.json").read_text())
+    assert code == (0 if s["converged"] else 3)
     chain = s["models"]["thermal"]["chain"]
     assert chain["resumed_from"] == 400
     assert chain["steps"] == 600 or chain["converged_tau"]
@@ -220,7 +238,7 @@ def test_air_change_rate_sets_the_ventilation_prior_of_both_models(tiny_run, tmp
     cfg["air_change_rate"] = 0.5
     cfg["sampler"]["max_steps"] = 200
     path = _write(tmp_path / "ach.yaml", cfg)
-    assert main(["calibrate", str(path), "--out", str(tmp_path / "run"), "--quiet"]) == 0
+    assert main(["calibrate", str(path), "--out", str(tmp_path / "run"), "--quiet"]) == 3
     s = json.loads((tmp_path / "run" / "summary.json").read_text())
     # hygric_1c's single conductance is Gfast; thermal_1c has none (Ge is total)
     assert s["parameters"]["hygric.Gfast"]["prior"].startswith("lognormal")

@@ -26,6 +26,7 @@ from heritage_bayes.compare import (
     elpd_validation,
     load_inference,
 )
+from heritage_bayes.inference.predictive import PREDICTIVE_DRAWS
 
 TINY = {
     "name": "tiny",
@@ -67,10 +68,19 @@ def test_run_groups_share_draws_and_loglik_has_only_observed_hours(compared):
     out, _ = compared
     idata = load_inference([out / "thermal_2c"])["thermal_2c"]
     post = idata.posterior
-    for g in ("posterior_predictive", "log_likelihood", "log_likelihood_validation"):
+    for g in ("log_likelihood", "log_likelihood_validation"):
         ds = idata[g]
         np.testing.assert_array_equal(ds["chain"].values, post["chain"].values)
         np.testing.assert_array_equal(ds["draw"].values, post["draw"].values)
+    # the predictive: about PREDICTIVE_DRAWS of the same draws (labels kept), and bands
+    # over all of them
+    pp = idata.posterior_predictive
+    np.testing.assert_array_equal(pp["chain"].values, post["chain"].values)
+    assert set(pp["draw"].values) <= set(post["draw"].values)
+    n_pp = pp.sizes["chain"] * pp.sizes["draw"]
+    n_post = post.sizes["chain"] * post.sizes["draw"]
+    assert n_pp == n_post or PREDICTIVE_DRAWS <= n_pp < PREDICTIVE_DRAWS + pp.sizes["chain"]
+    assert idata["predictive_bands"]["thermal.Ti"].sizes["quantile"] == 5
     ll = idata.log_likelihood["thermal.Ti"]
     assert np.all(np.isfinite(ll.values))
     # warm-up (2 days) and the one-day gap are not in the likelihood: 10 - 2 - 1 days

@@ -42,6 +42,8 @@ import yaml
 
 SRC = Path(__file__).resolve().parents[1] / "src"
 STEPS = 300
+#: The tiny runs stop at STEPS before converging: a finished, unconverged run (exit 3).
+DONE = 3
 
 TINY = {
     "name": "faults",
@@ -585,7 +587,7 @@ def runs(tmp_path_factory):
         if name == "other-data":
             c = _write(d / "other.yaml", _tiny(**{"data.demo": {"seed": 8}}))
         rc, err = _hbayes("calibrate", c, "--out", d / "run", "--resume")
-        chain = _committed(d / "run" / "chain_thermal.h5") if rc == 0 else None
+        chain = _committed(d / "run" / "chain_thermal.h5") if rc == DONE else None
         res[f"damaged-{name}"] = {"rc": rc, "err": err, "prefix": prefix, "chain": chain, "d": d}
 
     def fresh_resume():
@@ -618,7 +620,7 @@ def runs(tmp_path_factory):
 
 def test_reference_run_and_its_directory(runs):
     rc, err = runs["ref"]
-    assert rc == 0 and _clean(err), err
+    assert rc == DONE and _clean(err), err
     run = runs["root"] / "ref" / "run"
     summary = json.loads((run / "summary.json").read_text(encoding="utf-8"))
     assert summary["versions"]["numpy"] == np.__version__  # the library versions
@@ -636,7 +638,7 @@ def test_reference_run_and_its_directory(runs):
 @pytest.mark.parametrize("case", sorted(INTERRUPTS))
 def test_interrupt_then_resume_loses_nothing(runs, case):
     r = runs[case]
-    assert r["rc"] in (130, 0), r["err"]  # 0: the run ended before the signal came
+    assert r["rc"] in (130, DONE), r["err"]  # DONE: the run ended before the signal came
     assert _clean(r["err"]), r["err"]
     if r["rc"] == 130:
         assert "hbayes: interrupted" in r["err"] or "hbayes: terminated" in r["err"]
@@ -645,7 +647,7 @@ def test_interrupt_then_resume_loses_nothing(runs, case):
         if r["snap"].is_dir() and (r["snap"] / "chain_thermal.h5").exists():
             saved = _committed(r["snap"] / "chain_thermal.h5")[:STEPS]
             np.testing.assert_array_equal(saved, runs["ref_chain"][: len(saved)])
-    assert r["rc_resume"] == 0, r["err_resume"]
+    assert r["rc_resume"] == DONE, r["err_resume"]
     # as if never interrupted (a late signal may have let the chain pass STEPS steps)
     final = _committed(r["out"] / "chain_thermal.h5")
     assert final.shape[0] >= STEPS
@@ -707,13 +709,13 @@ DAMAGE = {
 
 def test_rows_beyond_the_commit_are_ignored(runs):
     r = runs["damaged-extra-rows"]
-    assert r["rc"] == 0 and _clean(r["err"]), r["err"]
+    assert r["rc"] == DONE and _clean(r["err"]), r["err"]
     np.testing.assert_array_equal(r["chain"][:STEPS], runs["ref_chain"])
 
 
 def test_missing_random_state_is_explained_and_the_chain_kept(runs):
     r = runs["damaged-no-random-state"]
-    assert r["rc"] == 0 and _clean(r["err"]), r["err"]
+    assert r["rc"] == DONE and _clean(r["err"]), r["err"]
     assert "no random-number state" in r["err"]
     n = len(r["prefix"])
     np.testing.assert_array_equal(r["chain"][:n], r["prefix"])
@@ -722,7 +724,7 @@ def test_missing_random_state_is_explained_and_the_chain_kept(runs):
 
 def test_corrupt_chunk_keeps_the_valid_prefix(runs):
     r = runs["damaged-corrupt-chunk"]
-    assert r["rc"] == 0 and _clean(r["err"]), r["err"]
+    assert r["rc"] == DONE and _clean(r["err"]), r["err"]
     assert "damaged" in r["err"] and "kept the 64 valid steps" in r["err"], r["err"]
     np.testing.assert_array_equal(r["chain"][:64], r["prefix"][:64])
     assert r["chain"].shape[0] == STEPS  # 64 kept, the rest sampled again
@@ -749,12 +751,12 @@ def test_unusable_checkpoint_is_a_clean_exit_2(runs, case, message):
 
 def test_resume_without_a_checkpoint_says_so(runs):
     rc, err = runs["fresh"]
-    assert rc == 0 and "no checkpoint" in err and _clean(err), err
+    assert rc == DONE and "no checkpoint" in err and _clean(err), err
 
 
 def test_saved_config_reruns_as_it_is(runs):
     rc, err = runs["rerun"]
-    assert rc == 0 and _clean(err), err
+    assert rc == DONE and _clean(err), err
     chain = _committed(runs["root"] / "rerun" / "run" / "chain_thermal.h5")
     np.testing.assert_array_equal(chain, runs["ref_chain"])
 
@@ -769,7 +771,7 @@ def test_failed_rerun_leaves_the_finished_run_intact(runs):
 def test_concurrent_runs_into_one_out(runs):
     rc, err = runs["concurrent"]["second"]
     assert rc == 2 and "another hbayes run is writing it (pid" in err and _clean(err), err
-    assert runs["concurrent"]["first"] == 0
+    assert runs["concurrent"]["first"] == DONE
 
 
 @pytest.fixture

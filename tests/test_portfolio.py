@@ -2,6 +2,7 @@
 others, the overview table and page, --resume."""
 
 import json
+import shutil
 
 import pandas as pd
 import pytest
@@ -137,6 +138,27 @@ def test_resume_skips_finished_rooms(finished):
     assert by.loc["a", "thermal.Ti.FIT_cal"] == pytest.approx(
         pd.read_csv(out / "portfolio.csv").set_index("room").loc["a", "thermal.Ti.FIT_cal"]
     )
+
+
+def test_batch_counts_unconverged_rooms_and_exits_3(finished, capsys):
+    """The tiny rooms stop at their step cap: finished, unconverged. Without the failing
+    room, batch exits 3 (EXIT_UNCONVERGED) and names each; the table says why."""
+    d, _, _ = finished
+    df = pd.read_csv(d / "out" / "portfolio.csv").set_index("room")
+    for room in ("a", "b"):
+        assert not df.loc[room, "converged"]
+        assert "sampler.max_steps was reached" in df.loc[room, "unconverged_reasons"]
+    index = (d / "out" / "index.html").read_text(encoding="utf-8")
+    assert "why not converged" in index and "2 finished unconverged" in index
+    pf = yaml.safe_load((d / "portfolio.yaml").read_text(encoding="utf-8"))
+    pf["rooms"] = pf["rooms"][:2]
+    two = _write(d / "two.yaml", pf)
+    shutil.copytree(d / "out", d / "out_two")  # the other tests read the fixture's out
+    capsys.readouterr()
+    assert main(["batch", str(two), "--out", str(d / "out_two"), "--resume", "--workers", "1"]) == 3
+    err = capsys.readouterr().err
+    assert "hbayes: room 'a' finished NOT converged: thermal: the step cap" in err
+    assert "0 of 2 room(s) converged, 2 finished unconverged, 0 failed" in err
 
 
 def test_every_bad_entry_reported_before_any_work(tmp_path, capsys):

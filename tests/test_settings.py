@@ -8,7 +8,6 @@ typed settings below the boundary are timedeltas and tz objects.
 from __future__ import annotations
 
 import datetime as dt
-import json
 import zoneinfo
 from pathlib import Path
 
@@ -29,22 +28,7 @@ from heritage_bayes.config import (
 )
 from heritage_bayes.config.loader import MAX_ALIASES
 from heritage_bayes.errors import ConfigError
-
-CONFIGS = Path(__file__).resolve().parents[1] / "configs"
-DEMO = {"data": {"demo": {}}, "thermal": {"model": "thermal_2c"}}
-
-
-def _error(raw) -> str:
-    with pytest.raises(ConfigError) as exc:
-        parse_config(raw)
-    return str(exc.value)
-
-
-def _with(**sections) -> dict:
-    raw = json.loads(json.dumps(DEMO))
-    raw.update(sections)
-    return raw
-
+from test_config import CONFIGS, _error, _with
 
 # -- durations need a unit -----------------------------------------------------------------
 
@@ -254,3 +238,65 @@ def test_shipped_configs_have_no_bare_durations_or_tags(path):
     raw, _ = read_yaml(path)
     if "data" in raw:  # a calibration config (others: projection, portfolio)
         load_config(path)
+
+
+# -- findings before sampling: a decision taken in the config is said, not warned ---------
+
+
+def _section_at_cap(noise="ar1_white"):
+    from types import SimpleNamespace as Ns
+
+    import numpy as np
+
+    phi = Ns(name="phi_Ti", prior=Ns(upper=0.96))
+    params = Ns(
+        names=["Ci", "phi_Ti"],
+        parameters=[Ns(name="Ci"), phi],
+        at_bound=lambda x: [("phi_Ti", "upper")],
+    )
+    logpost = Ns(params=params, dt=3600.0, noise=Ns(name=noise), n_model=1, record_seconds=1e7)
+    ident = Ns(has_scale_direction=False, identifiable={"Ci": True})
+    return Ns(
+        name="thermal",
+        model=Ns(name="thermal_1c", domain="thermal", parameter_names=["Ci"]),
+        logpost=logpost,
+        map=Ns(x=np.zeros(2), theta=np.array([1e7, 0.96])),
+        identifiability=ident,
+        laplace=None,
+        map_at_bound=[],
+        frozen_node=None,
+    )
+
+
+def test_a_phi_at_its_cap_is_warned_once_and_not_when_the_config_sets_it(monkeypatch, capsys):
+    import heritage_bayes.calibrate as cal
+
+    monkeypatch.setattr(cal, "frozen_time_constant", lambda *a: None)
+    cal._say_findings(cal._Progress(quiet=False), _section_at_cap())
+    err = capsys.readouterr().err
+    assert err.count("hbayes: warning:") == 1  # the cap, not also "MAP on a prior bound"
+    assert "phi_Ti at its cap 0.96" in err and "about 24 h" in err
+    priors = {"phi_Ti": {"dist": "uniform", "lower": 0, "upper": 0.96}}
+    cal._say_findings(cal._Progress(quiet=False), _section_at_cap(), priors)
+    err = capsys.readouterr().err
+    assert "warning" not in err and "phi_Ti at its cap 0.96" in err  # said, not warned
+    # with a single AR(1) the cap is not explained: the bound is flagged
+    cal._say_findings(cal._Progress(quiet=False), _section_at_cap("ar1"))
+    assert "the MAP lies on a prior bound for phi_Ti (upper)" in capsys.readouterr().err
+
+
+def test_a_parameter_the_config_pins_is_not_flagged_as_unidentified(monkeypatch, capsys):
+    """demo.yaml closes hygric_2c's Cw-Gw direction with a lognormal prior on Gw: the
+    advice 'add an informative prior' is already taken, so no warning for it."""
+    import heritage_bayes.calibrate as cal
+
+    monkeypatch.setattr(cal, "frozen_time_constant", lambda *a: None)
+    s = _section_at_cap("ar1")
+    s.logpost.params.at_bound = lambda x: []
+    s.identifiability.identifiable = {"Ci": True, "Gw": False}
+    cal._say_findings(cal._Progress(quiet=True), s)
+    assert "over-parameterised for these data (structurally not identifiable: Gw)" in (
+        capsys.readouterr().err
+    )
+    cal._say_findings(cal._Progress(quiet=True), s, {"Gw": {"dist": "lognormal"}})
+    assert capsys.readouterr().err == ""

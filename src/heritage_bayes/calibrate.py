@@ -13,7 +13,6 @@ for climate-change projections).
 
 from __future__ import annotations
 
-import hashlib
 import time
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -24,6 +23,7 @@ import numpy as np
 from heritage_bayes._progress import Progress as _Progress
 from heritage_bayes._version import __version__
 from heritage_bayes.config import MAX_SEED, CalibrationConfig, chain_tag, config_hash
+from heritage_bayes.convergence import unconverged_reasons
 from heritage_bayes.convert import format_timedelta
 from heritage_bayes.errors import InputError
 from heritage_bayes.inference.posterior import LogPosterior
@@ -32,6 +32,7 @@ from heritage_bayes.inference.results import (
     atomic_write_text,
     dump_json,
     ensure_free_space,
+    write_inference_data,
 )
 from heritage_bayes.models import SECTIONS, _catalog_options, build_model, initial_state_of
 from heritage_bayes.rc.catalog import model as catalog_model
@@ -59,10 +60,8 @@ __all__ = [
 ]
 
 
-def _parameters(cfg, section: str, model: RCModel, priors: Mapping):
-    """Noise model and parameter set (priors validated) of a config section
-    (:func:`heritage_bayes.run.section_parameters`)."""
-    return section_parameters(cfg, section, model, priors)
+#: Noise model and parameter set (priors validated) of a config section.
+_parameters = section_parameters
 
 
 def check_models(cfg: CalibrationConfig) -> None:
@@ -124,18 +123,20 @@ class _Section:
     deadline: float | None = None  # time.perf_counter() end of the run's time budget
 
 
-def _say_findings(say: _Progress, s: _Section) -> None:
+def _say_findings(say: _Progress, s: _Section, priors: Mapping | tuple = ()) -> None:
     """Before sampling: a MAP on a prior bound, and parameters the data do not pin.
 
-    Both are findings about the prior or the model, shown as warnings (and kept in
-    the summary); the sampler starts inside the support regardless.
+    Findings about the prior or the model, warned (and kept in the summary); a parameter
+    whose prior the config sets (``priors``) is a decision taken: a capped phi is said,
+    not warned, and one the data do not pin is not flagged (its prior closes it).
     """
     s.map_at_bound = s.logpost.params.at_bound(s.map.x)
     capped = [n for n, side in s.map_at_bound if n.startswith("phi_") and side == "upper"]
-    if capped and s.logpost.noise.name == "ar1_white":
+    told = {(n, "upper") for n in capped} if s.logpost.noise.name == "ar1_white" else set()
+    if told:
         ph = s.logpost.params.parameters[s.logpost.params.names.index(capped[0])].prior.upper
         hours = -s.logpost.dt / 3600.0 / np.log(ph)
-        say.warn(
+        (say.say if capped[0] in priors else say.warn)(
             f"[{s.name}] {', '.join(capped)} at its cap {ph:g}: the misfit stays correlated "
             f"for longer than the noise model allows (about {hours:.0f} h), so the model "
             "misses a slow process (a missing input such as solar gains, a heat or "
@@ -169,8 +170,8 @@ def _say_findings(say: _Progress, s: _Section) -> None:
             )
             + ", or model the fixed node (thermal: options.ground; hygric: hygric_2c_fixed)"
         )
-    if s.map_at_bound:
-        what = ", ".join(f"{n} ({side})" for n, side in s.map_at_bound)
+    if unexplained := [b for b in s.map_at_bound if b not in told]:  # not flagged twice
+        what = ", ".join(f"{n} ({side})" for n, side in unexplained)
         say.warn(
             f"[{s.name}] the MAP lies on a prior bound for {what}: the data push "
             "these parameters to the edge of the allowed range. Check the prior (is the "
@@ -181,9 +182,9 @@ def _say_findings(say: _Progress, s: _Section) -> None:
     # the overall scale of C and G (no known heat input) is a null direction only a
     # prior closes: reported in the identifiability section, not flagged here
     ok = ident.identifiable_given_scale if ident.has_scale_direction else ident.identifiable
-    structural = [p for p, good in ok.items() if not good]
+    structural = [p for p, good in ok.items() if not good and p not in priors]
     practical = list(s.laplace.unidentified) if s.laplace is not None else []
-    poor = [p for p in practical if p in s.model.parameter_names]
+    poor = [p for p in practical if p in s.model.parameter_names and p not in priors]
     if structural or poor:
         parts = []
         if structural:
@@ -280,16 +281,6 @@ def _run_calibration(
     return out
 
 
-def _data_hash(lp: LogPosterior) -> str:
-    """SHA-256 (16 hex digits) of the prepared inputs and observations of a section."""
-    h = hashlib.sha256()
-    for a in (lp.inputs, lp.observed):
-        a = np.ascontiguousarray(a, dtype=float)
-        h.update(str(a.shape).encode())
-        h.update(a.tobytes())
-    return h.hexdigest()[:16]
-
-
 def _calibrate_into(
     out: Path,
     cfg: CalibrationConfig,
@@ -304,7 +295,8 @@ def _calibrate_into(
     chash = config_hash(cfg)
     say = _Progress(quiet)
     # the heavy imports (arviz, scipy.optimize, emcee) only once the config is valid
-    from heritage_bayes.inference.idata import CONVERGENCE
+    from heritage_bayes.inference.coordinates import default_coordinates
+    from heritage_bayes.inference.idata import CONVERGENCE, build_run_outputs
     from heritage_bayes.inference.optimize import find_map, laplace, seconds_left, share_deadline
     from heritage_bayes.inference.sampler import run_sampler
     from heritage_bayes.prepare import prepare
@@ -367,7 +359,7 @@ def _calibrate_into(
         ref = s.identifiability.scale_reference
         s.laplace = laplace(s.logpost, s.map.x, given=(ref,) if ref else ())
         s.timings["identifiability_seconds"] = time.perf_counter() - t0
-        _say_findings(say, s)
+        _say_findings(say, s, getattr(cfg, s.name).priors)
         t0 = time.perf_counter()
         update = say.sampler(s.name, cfg.sampler.max_steps)
         try:
@@ -385,13 +377,15 @@ def _calibrate_into(
                 tau_rtol=cfg.sampler.tau_rtol,
                 init_ball=cfg.sampler.init_ball,
                 checkpoint=out / f"chain_{s.name}.h5",
-                tag=f"{chain_tag(cfg)}:{_data_hash(s.logpost)}:{s.name}",
+                tag=f"{chain_tag(cfg)}:{s.logpost.data_hash()}:{s.name}",
                 resume=resume,
                 progress=update,
                 notice=say.warn,
                 max_rhat=CONVERGENCE["max_rhat"],
                 min_ess=CONVERGENCE["min_ess_bulk"],
                 max_draws=cfg.sampler.max_draws,
+                coordinates=default_coordinates(s.logpost),
+                compact=True,
             )
         finally:
             say.close()
@@ -428,9 +422,8 @@ def _calibrate_into(
             ladder[s.name] = model_ladder(cfg, prep, s, seed=cfg.seed + 101 * i)
             s.timings["ladder_seconds"] = time.perf_counter() - t0
     t0 = time.perf_counter()
-    from heritage_bayes.inference.idata import build_run_outputs
-
     idata, summary = build_run_outputs(cfg, prep, sections, chash=chash, seed=cfg.seed)
+    summary["unconverged_reasons"] = unconverged_reasons(summary)  # [] when converged
     t_out = time.perf_counter() - t0
     summary["ladder"] = ladder or None
     summary["timings"] = {
@@ -441,7 +434,7 @@ def _calibrate_into(
     summary["wall_seconds"] = time.perf_counter() - t_start
     stamp_provenance(cfg, idata, summary)
     ensure_free_space(out / "posterior.nc", sum(int(idata[g].nbytes) for g in idata.groups()))
-    atomic_write(out / "posterior.nc", lambda p: idata.to_netcdf(str(p), engine="h5netcdf"))
+    atomic_write(out / "posterior.nc", lambda p: write_inference_data(idata, p))
     dump_json(out / "summary.json", summary)
     say.say(
         f"summary: converged={summary['converged']}, max R-hat "

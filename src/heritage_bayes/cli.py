@@ -1,9 +1,18 @@
 """Command-line interface: ``hbayes``.
 
-Thin: parse arguments, call the library, map errors to exit codes
-(0 success, 2 user error, 1 internal error, 130 interrupted by SIGINT or SIGTERM at any
-stage). Tested by calling :func:`main` directly, and as a subprocess
-(``tests/test_faults.py``).
+Thin: parse arguments, call the library, map outcomes to exit codes:
+
+- 0: success (``calibrate``: every chain converged);
+- 3: finished but **not converged** (``calibrate``: the run directory is complete, but a
+  chain stopped at ``sampler.max_time`` or ``sampler.max_steps`` before the criteria
+  held: ``summary.json`` has ``converged: false`` and ``unconverged_reasons``; continue
+  with ``--resume`` or a larger budget. ``batch``: every room finished, some unconverged.
+  ``project``: written, but from an unconverged calibration);
+- 2: a user error (config, data, arguments; a message, no traceback);
+- 1: an internal error (a bug: the traceback is shown);
+- 130: interrupted by SIGINT or SIGTERM at any stage.
+
+Tested by calling :func:`main` directly, and as a subprocess (``tests/test_faults.py``).
 """
 
 from __future__ import annotations
@@ -121,6 +130,13 @@ def _build_parser() -> argparse.ArgumentParser:
     )
     cmp_.add_argument("--quiet", action="store_true", help="no progress output")
     cmp_.add_argument("--no-report", action="store_true", help="no report.html per model")
+    cmp_.add_argument(
+        "--workers",
+        type=int,
+        metavar="N",
+        help="candidates calibrated at once, each in its own process (default: one per "
+        "core, at most one per model; 1: one after the other)",
+    )
     cmp_.set_defaults(func=_cmd_compare)
 
     bat = sub.add_parser(
@@ -171,7 +187,30 @@ def _cmd_calibrate(args) -> int:
     )
     if not args.quiet:
         print(out)
-    return 0
+    return _converged_or_3(out)
+
+
+def _converged_or_3(run_dir) -> int:
+    """0 when the run's ``summary.json`` says converged; else name the reasons, return 3."""
+    import json
+    from pathlib import Path
+
+    from heritage_bayes.convergence import EXIT_UNCONVERGED
+
+    summary = json.loads((Path(run_dir) / "summary.json").read_text(encoding="utf-8"))
+    if summary.get("converged"):
+        return 0
+    print(
+        f"hbayes: finished but NOT converged (exit code {EXIT_UNCONVERGED}): {run_dir}",
+        file=sys.stderr,
+    )
+    for reason in summary.get("unconverged_reasons") or ["see summary.json"]:
+        print(f"hbayes:   {reason}", file=sys.stderr)
+    print(
+        "hbayes: continue the chains with --resume, or raise sampler.max_time",
+        file=sys.stderr,
+    )
+    return EXIT_UNCONVERGED
 
 
 def _cmd_report(args) -> int:
@@ -247,6 +286,7 @@ def _cmd_compare(args) -> int:
         report=False if args.no_report else None,
         resume=args.resume,
         force=args.force,
+        workers=args.workers,
     )
     if not args.quiet:
         import json
@@ -299,10 +339,27 @@ def _cmd_batch(args) -> int:
         quiet=args.quiet,
         workers_unbounded=args.workers_unbounded,
     )
+    from heritage_bayes.convergence import EXIT_UNCONVERGED
+
     bad = df[~df["status"].isin(["done", "skipped"])]
     for _, r in bad.iterrows():
         print(f"hbayes: room {r['room']!r} {r['status']}: {r['message']}", file=sys.stderr)
-    return 0 if bad.empty else 1 if (bad["status"] == "error").any() else 2
+    finished = df[df["status"].isin(["done", "skipped"])]
+    conv = finished.get("converged")
+    unconverged = finished[~conv.fillna(False).astype(bool)] if conv is not None else finished[:0]
+    for _, r in unconverged.iterrows():
+        why = r.get("unconverged_reasons")
+        why = why if isinstance(why, str) and why else "see its summary.json"
+        print(f"hbayes: room {r['room']!r} finished NOT converged: {why}", file=sys.stderr)
+    if len(unconverged) and not args.quiet:
+        print(
+            f"hbayes: {len(finished) - len(unconverged)} of {len(df)} room(s) converged, "
+            f"{len(unconverged)} finished unconverged, {len(bad)} failed",
+            file=sys.stderr,
+        )
+    if not bad.empty:
+        return 1 if (bad["status"] == "error").any() else 2
+    return EXIT_UNCONVERGED if len(unconverged) else 0
 
 
 class _Terminated(KeyboardInterrupt):

@@ -62,11 +62,13 @@ def compare_runs(
     """
     from heritage_bayes.run import load_run
 
-    runs = {k: load_run(p) for k, p in run_dirs.items()}
     out_models: dict[str, dict] = {}
     val_pw: dict[str, tuple[np.ndarray, np.ndarray]] = {}
     loo_data = {}
-    for label, run in runs.items():
+    # one run in memory at a time: what the comparison keeps of each (block sums of
+    # the log-likelihood, the posterior draws, pointwise validation densities) is small
+    for label, path in run_dirs.items():
+        run = load_run(path)
         if section not in run.models:
             raise InputError(f"{run.path}: the run has no {section!r} model")
         model = run.models[section]
@@ -109,7 +111,7 @@ def compare_runs(
             "identifiability": ident,
         }
     # differences in validation ELPD against the best, SE from daily block sums
-    if len(val_pw) == len(runs) and val_pw:
+    if len(val_pw) == len(run_dirs) and val_pw:
         best = max(val_pw, key=lambda m: out_models[m]["accuracy"]["elpd_validation"]["elpd"])
         pb, tb = val_pw[best]
         for label, (pw, t) in val_pw.items():

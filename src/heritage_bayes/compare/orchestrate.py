@@ -77,6 +77,27 @@ def _candidate_config(cfg, section: str, name: str):
     return cand
 
 
+def _calibrate_candidate(cand, run_dir: str, kwargs: dict) -> tuple[str, float, float]:
+    """One candidate's calibration in a worker process: (run directory, wall [s], CPU
+    [s] of the worker)."""
+    import time
+
+    from heritage_bayes.calibrate import run_calibration
+
+    t0, c0 = time.perf_counter(), time.process_time()
+    out = run_calibration(cand, run_dir, **kwargs)
+    return str(out), time.perf_counter() - t0, time.process_time() - c0
+
+
+def _n_free(cand, section: str) -> int:
+    """Free parameters of a candidate's section (the order in which to start them)."""
+    from heritage_bayes.models import build_model
+    from heritage_bayes.run import section_parameters
+
+    model = build_model(cand, section)
+    return section_parameters(cand, section, model)[1].ndim
+
+
 def run_compare(
     cfg,
     models: Sequence[str] | None = None,
@@ -87,6 +108,7 @@ def run_compare(
     report: bool | None = None,
     resume: bool = False,
     force: bool = False,
+    workers: int | None = None,
 ) -> Path:
     """Calibrate each candidate model and write the comparison; return its folder.
 
@@ -108,13 +130,27 @@ def run_compare(
         candidate; with ``force`` a candidate's run and the comparison are written
         beside the files of folders hbayes did not make, replacing none of them: see
         :class:`~heritage_bayes.rundir.folder.OutputFolder`).
+    workers : int, optional
+        Candidates calibrated at the same time, each in its own process (default: one
+        per core, at most one per candidate; 1: one after the other in this process).
+        The largest model starts first, so the longest chain does not wait. Each
+        worker process calibrates one candidate and exits, so memory holds one
+        model's calibration per worker; the comparison then reads the runs one at a
+        time. Every candidate has its own seed-determined chain, so the results do not
+        depend on ``workers``.
 
     Raises
     ------
     ConfigError
         Unknown model, models of different sections, or a section the config lacks.
+    InputError
+        ``workers`` below 1.
     """
+    import os
+    import sys
+
     from heritage_bayes.calibrate import run_calibration
+    from heritage_bayes.errors import InputError
     from heritage_bayes.rundir import check_name
     from heritage_bayes.rundir.folder import OutputFolder
     from heritage_bayes.rundir.writer import is_run_directory
@@ -124,6 +160,15 @@ def run_compare(
     cands = {n: _candidate_config(cfg, section, n) for n in names}
     if out_dir is None:
         out_dir = Path("reports") / check_name(f"{cfg.name or 'run'}-compare", what="name")
+    if workers is not None and (isinstance(workers, bool) or int(workers) < 1):
+        raise InputError(f"--workers: expected a whole number >= 1 (got {workers})")
+    n_workers = min(len(cands), int(workers) if workers else (os.cpu_count() or 1))
+    kwargs = dict(seed=seed, quiet=quiet, report=report, resume=resume, force=force)
+
+    def tell(msg: str) -> None:
+        if not quiet:
+            print(f"hbayes compare: {msg}", file=sys.stderr, flush=True)
+
     folder = OutputFolder(out_dir, kind="comparison", protect=input_paths(cfg), force=force)
     with folder:
         out = folder.path
@@ -131,14 +176,33 @@ def run_compare(
         folder.claim(*names, folders_from=lambda q: force or is_run_directory(q))
         folder.claim("comparison.json", "comparison.html")
         dirs = {}
-        for n, c in cands.items():
-            if not quiet:
-                import sys
+        if n_workers <= 1:
+            for n, c in cands.items():
+                tell(f"calibrating {n}")
+                dirs[n] = run_calibration(c, out / n, **kwargs)
+        else:
+            import multiprocessing
+            from concurrent.futures import ProcessPoolExecutor, as_completed
 
-                print(f"hbayes compare: calibrating {n}", file=sys.stderr, flush=True)
-            dirs[n] = run_calibration(
-                c, out / n, seed=seed, quiet=quiet, report=report, resume=resume, force=force
-            )
+            from heritage_bayes.run import RunWriter
+
+            for n in names:  # refuse a bad folder before any candidate starts
+                RunWriter(out / n, force=force, resume=resume).check()
+            order = sorted(cands, key=lambda n: -_n_free(cands[n], section))
+            tell(f"calibrating {', '.join(order)} on {n_workers} worker processes")
+            ctx = multiprocessing.get_context("spawn")  # no forked numba/BLAS threads
+            with ProcessPoolExecutor(n_workers, mp_context=ctx, max_tasks_per_child=1) as pool:
+                futs = {
+                    pool.submit(
+                        _calibrate_candidate, cands[n], str(out / n), {**kwargs, "quiet": True}
+                    ): n
+                    for n in order
+                }
+                for f in as_completed(futs):
+                    run_dir, wall, cpu = f.result()
+                    dirs[futs[f]] = Path(run_dir)
+                    tell(f"{futs[f]} done ({wall:.0f} s wall, {cpu:.0f} s CPU)")
+            dirs = {n: dirs[n] for n in names}
         result = compare_runs(dirs, section, seed=cfg.seed if seed is None else int(seed))
         result["config"] = {"name": cfg.name, "building": cfg.building, "room": cfg.room}
         write_comparison(result, out)

@@ -11,7 +11,7 @@ from typing import Any
 
 from pydantic import BaseModel
 
-__all__ = ["format_error", "nearest_key"]
+__all__ = ["format_error", "nearest_key", "validate"]
 
 
 def _model_of(annotation) -> type[BaseModel] | None:
@@ -154,6 +154,32 @@ def _short(value: Any, limit: int = 120) -> str:
     r.maxlevel = 3
     text = r.repr(value)
     return text if len(text) <= limit + 10 else text[:limit] + "..."
+
+
+def validate(cls: type[BaseModel], raw: Any, source: str, what: str = "configuration"):
+    """``cls.model_validate(raw)``, every error turned into one line naming its key path.
+
+    Raises
+    ------
+    ConfigError
+        ``raw`` is not a mapping, or one line per wrong key (:func:`format_error`).
+    """
+    from pydantic import ValidationError
+
+    from heritage_bayes.errors import ConfigError, check_known_keys
+
+    if not isinstance(raw, dict):
+        raise ConfigError(
+            f"{source}: expected a YAML mapping at the top level (got {type(raw).__name__})"
+        )
+    # a mapping with none of the schema's keys is another file: named, never quoted
+    known = [k for k in cls.model_fields if k != "base_dir"]
+    check_known_keys(raw, known, source=source, what=what)
+    try:
+        return cls.model_validate(raw)
+    except ValidationError as exc:
+        lines = join_errors(exc.errors(), raw, cls)
+        raise ConfigError(f"{source}: invalid {what}:\n  " + "\n  ".join(lines)) from None
 
 
 def join_errors(errors: list[dict], raw: Any, root: type[BaseModel]) -> list[str]:

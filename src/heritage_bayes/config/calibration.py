@@ -9,16 +9,15 @@ import json
 from pathlib import Path
 from typing import Any
 
-from pydantic import PrivateAttr, ValidationError, model_validator
+from pydantic import PrivateAttr, model_validator
 
 from heritage_bayes.config._base import MAX_SEED, _Strict, key
-from heritage_bayes.config._messages import join_errors
+from heritage_bayes.config._messages import validate
 from heritage_bayes.config.loader import read_yaml
 from heritage_bayes.config.models import ModelSection
 from heritage_bayes.config.periods import Periods
 from heritage_bayes.config.sampler import OptimizerSettings, SamplerSettings
 from heritage_bayes.config.sources import Data, Site
-from heritage_bayes.errors import ConfigError, check_known_keys
 
 __all__ = ["CalibrationConfig", "chain_tag", "config_hash", "load_config", "parse_config"]
 
@@ -175,17 +174,7 @@ def parse_config(
         One line per wrong key, each naming its key path, what was expected and what was
         found (an unknown key with the nearest known one).
     """
-    if not isinstance(raw, dict):
-        raise ConfigError(
-            f"{source}: expected a YAML mapping at the top level (got {type(raw).__name__})"
-        )
-    known = [k for k in CalibrationConfig.model_fields if k != "base_dir"]
-    check_known_keys(raw, known, source=source, what="calibration config")
-    try:
-        cfg = CalibrationConfig.model_validate(raw)
-    except ValidationError as exc:
-        lines = join_errors(exc.errors(), raw, CalibrationConfig)
-        raise ConfigError(f"{source}: invalid configuration:\n  " + "\n  ".join(lines)) from None
+    cfg = validate(CalibrationConfig, raw, source)
     cfg.base_dir = base_dir
     if cfg.name is None:
         cfg.name = name or "run"

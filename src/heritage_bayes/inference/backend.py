@@ -358,3 +358,78 @@ def _read_prefix(chain_ds, lp_ds, n: int, block: int = 64):
 
 def _cat(parts, ds):
     return np.concatenate(parts) if parts else np.zeros((0, *ds.shape[1:]))
+
+
+#: ``format`` attribute of a compacted checkpoint (see :func:`write_compact`).
+COMPACT_FORMAT = "compact-1"
+#: Steps per walker of the trace a compacted checkpoint keeps (the report's plots).
+TRACE_STEPS = 400
+
+
+def write_compact(path: Path, tag: str, draws, log_prob, info: dict, chain, chain_lp) -> None:
+    """Replace a converged chain's checkpoint by the draws its outputs use.
+
+    ``draws`` (kept steps, walkers, d) and ``log_prob`` (kept steps, walkers) are the
+    post-burn-in, thinned steps (float64: at most ``sampler.max_draws`` × d values, a
+    few hundred kB); ``info`` (JSON) records the chain they came from (steps, burn,
+    thin, τ, τ history, acceptance counts). ``chain``/``log_prob`` hold a trace of
+    the whole chain for plots, burn-in included: every ``trace_stride``-th step
+    (attribute), at most :data:`TRACE_STEPS` per walker, float32. The full chain is
+    what ``--resume`` needs while a chain is unconverged; once converged, these draws
+    are all a resumed run needs to rebuild its outputs. Datasets gzip-compressed with
+    Fletcher-32 checksums; written atomically.
+    """
+    stride = max(1, -(-int(chain.shape[0]) // TRACE_STEPS))
+    from heritage_bayes.inference.results import atomic_write
+
+    def write(tmp: Path) -> None:
+        with h5py.File(tmp, "w") as f:
+            f.attrs["tag"] = tag
+            f.attrs["format"] = COMPACT_FORMAT
+            f.attrs["compact"] = json.dumps(info)
+            f.attrs["trace_stride"] = stride
+            for name, a, dtype in (
+                ("draws", draws, "f8"),
+                ("draws_log_prob", log_prob, "f8"),
+                ("chain", chain[::stride], "f4"),
+                ("log_prob", chain_lp[::stride], "f4"),
+            ):
+                f.create_dataset(
+                    name,
+                    data=np.asarray(a, dtype=dtype),
+                    compression="gzip",
+                    shuffle=True,
+                    fletcher32=True,
+                )
+
+    atomic_write(Path(path), write)
+
+
+def read_compact(path: Path, tag: str) -> tuple[np.ndarray, np.ndarray, dict] | None:
+    """(draws, log_prob, info) of a compacted checkpoint (:func:`write_compact`), or
+    None for a full one (or none at all).
+
+    Raises
+    ------
+    InputError
+        A compacted checkpoint of another configuration, or an unreadable one.
+    """
+    path = Path(path)
+    if not path.is_file():
+        return None
+    try:
+        with h5py.File(path, "r") as f:
+            if f.attrs.get("format") != COMPACT_FORMAT:
+                return None
+            if f.attrs.get("tag") != tag:
+                raise InputError(
+                    f"{path}: this checkpoint belongs to a different configuration, "
+                    "model or data; run without --resume (it will be replaced) or restore "
+                    "the config and data it was made with"
+                )
+            return f["draws"][...], f["draws_log_prob"][...], json.loads(f.attrs["compact"])
+    except (OSError, KeyError, ValueError) as exc:
+        raise InputError(
+            f"{path}: the compacted chain checkpoint is damaged ({_first_line(exc)}); run "
+            "without --resume to sample afresh (the file is then replaced)"
+        ) from None

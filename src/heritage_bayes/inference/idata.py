@@ -19,8 +19,11 @@ from heritage_bayes._arviz import az
 from heritage_bayes._version import __version__
 from heritage_bayes.climate.psychro import saturation_vapour_pressure
 from heritage_bayes.inference.predictive import (
+    _saved_index,
+    bounded_predictive,
     condensation_cap,
     initial_state_text,
+    predictive_bands,
     predictive_noise,
 )
 from heritage_bayes.inference.results import coverage, fit_metrics
@@ -48,12 +51,6 @@ def _period_codes(prep) -> np.ndarray:
         code[prep.validation] = 2
     code[cal.start : cal.start + prep.warmup_steps] = 0
     return code
-
-
-def _saved_index(n_chain: int, n_draw: int, n_total: int) -> np.ndarray:
-    """Draws per chain kept in ``posterior.nc``: evenly spaced, about ``n_total`` in all."""
-    m = max(1, min(n_draw, math.ceil(n_total / n_chain)))
-    return np.unique(np.linspace(0, n_draw - 1, m).round().astype(int))
 
 
 def _pointwise(s, pw: np.ndarray, times: np.ndarray, shape) -> dict[str, xr.DataArray]:
@@ -337,6 +334,7 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
             "map": s.map.to_dict(names),
             "identifiability": s.identifiability.to_dict(),
             "chain": {
+                "coordinates": getattr(s.chain, "coordinates", "log"),
                 "walkers": int(W),
                 "steps": int(s.chain.steps),
                 "burn": int(s.chain.burn),
@@ -421,7 +419,10 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
         "posterior": xr.Dataset(post, coords=coords, attrs=attrs),
         "sample_stats": xr.Dataset(stats, coords=coords, attrs=attrs),
         "log_likelihood": xr.Dataset(loglik, coords=coords, attrs=attrs),
-        "posterior_predictive": xr.Dataset(pp, attrs=attrs),
+        # a bounded number of draws, the bands over all of them (issue 28: the
+        # predictive was 75 % of a 130 MB demo run directory)
+        "posterior_predictive": xr.Dataset(bounded_predictive(pp), attrs=attrs),
+        "predictive_bands": xr.Dataset(predictive_bands(pp), attrs=attrs),
         "observed_data": xr.Dataset(observed, attrs=attrs),
         "constant_data": xr.Dataset(const, attrs=attrs),
     }

@@ -166,7 +166,9 @@ class _Objective:
             ll = self.lp.log_likelihood(theta)
             lprior = lprior + self.lp.time_constant_log_prior(theta[:, : self.lp.n_model])
         val = -(ll + lprior)
-        return np.where(np.isfinite(val), val, 1e300)
+        # not 1e300: differential evolution takes the std of the energies, whose squares
+        # overflowed (a numpy RuntimeWarning on configs/orholm.yaml); 1e100 squares safely
+        return np.where(np.isfinite(val), val, 1e100)
 
     def fun_and_grad(self, s: np.ndarray, h: float = 1e-6):
         d = s.size

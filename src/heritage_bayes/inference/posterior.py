@@ -208,6 +208,18 @@ class LogPosterior:
             out = -np.log1p((1.0 / (lam * cap)) ** 2).sum(axis=1)
         return np.where(np.isfinite(out), out, -np.inf)
 
+    def data_hash(self) -> str:
+        """SHA-256 (16 hex digits) of the inputs and observations (what a chain
+        checkpoint must have been sampled on)."""
+        import hashlib
+
+        h = hashlib.sha256()
+        for a in (self.inputs, self.observed):
+            a = np.ascontiguousarray(a, dtype=float)
+            h.update(str(a.shape).encode())
+            h.update(a.tobytes())
+        return h.hexdigest()[:16]
+
     @property
     def record_seconds(self) -> float:
         """Length of the calibration record [s] (warm-up included)."""

@@ -1,18 +1,72 @@
-"""The predictive side of a calibration: initial states, noise and physical limits.
+"""The predictive side of a calibration: initial states, noise, physical limits, bands.
 
 What :mod:`heritage_bayes.inference.idata` adds to each posterior draw before the bands
 are drawn: how the initial state was obtained (in words), the noise model of the bands
 (the free-run error when the likelihood's noise model sits at its cap) and the limit
-of predicted vapour pressure at saturation.
+of predicted vapour pressure at saturation; then what of the predictive is stored: the
+bands over every saved draw and a bounded subset of the draws (issue 28).
 """
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
+import xarray as xr
 
 from heritage_bayes.climate.psychro import saturation_vapour_pressure
 
-__all__ = ["condensation_cap", "initial_state_text", "predictive_noise"]
+__all__ = [
+    "BAND_LEVELS",
+    "PREDICTIVE_DRAWS",
+    "bounded_predictive",
+    "condensation_cap",
+    "initial_state_text",
+    "predictive_bands",
+    "predictive_noise",
+]
+
+#: About this many posterior-predictive draws are stored per variable (the
+#: ``posterior_predictive`` group); the bands are computed over all saved draws first.
+PREDICTIVE_DRAWS = 200
+#: Quantile levels of ``predictive_bands`` [-] (the report's 50 % and 90 % bands and
+#: the median).
+BAND_LEVELS = (0.05, 0.25, 0.5, 0.75, 0.95)
+
+
+def _saved_index(n_chain: int, n_draw: int, n_total: int) -> np.ndarray:
+    """Draws per chain kept in ``posterior.nc``: evenly spaced, about ``n_total`` in all."""
+    m = max(1, min(n_draw, math.ceil(n_total / n_chain)))
+    return np.unique(np.linspace(0, n_draw - 1, m).round().astype(int))
+
+
+def predictive_bands(pp: dict[str, xr.DataArray]) -> dict[str, xr.DataArray]:
+    """Quantiles :data:`BAND_LEVELS` over (chain, draw) of each predictive variable:
+    (quantile, time) arrays in the variable's unit, exact over every draw given."""
+    out = {}
+    for k, da in pp.items():
+        v = np.asarray(da.values, dtype=float).reshape(-1, da.shape[-1])
+        q = np.quantile(v, BAND_LEVELS, axis=0)
+        out[k] = xr.DataArray(
+            q.astype(np.float32),
+            dims=("quantile", "time"),
+            coords={"quantile": np.asarray(BAND_LEVELS), "time": da["time"].values},
+            attrs=dict(da.attrs),
+        )
+    return out
+
+
+def bounded_predictive(
+    pp: dict[str, xr.DataArray], n_draws: int = PREDICTIVE_DRAWS
+) -> dict[str, xr.DataArray]:
+    """The predictive variables on about ``n_draws`` of their draws: the same evenly
+    spaced draws of every chain (so the pairing of thermal and hygric draws, and with
+    the posterior's ``draw`` labels, is kept)."""
+    if not pp:
+        return pp
+    da = next(iter(pp.values()))
+    keep = _saved_index(da.sizes["chain"], da.sizes["draw"], n_draws)
+    return {k: v.isel(draw=keep) for k, v in pp.items()}
 
 
 def condensation_cap(s, prep, Ysim: np.ndarray, Ypp: np.ndarray, pp_outputs: dict):

@@ -23,8 +23,18 @@ Run directory (``hbayes calibrate``):
     2 validation, -1 outside);
   - ``posterior_predictive``: ``<model>.<output>`` with noise and
     ``<model>.<output>_sim`` without, over calibration and validation periods, for a
-    subset of draws (and ``RHi`` combining thermal and hygric draws);
+    bounded subset of about 200 of those draws (``draw`` labels are the posterior's;
+    and ``RHi`` combining thermal and hygric draws);
+  - ``predictive_bands`` (not an arviz group): the 5, 25, 50, 75 and 95 % quantiles
+    (axis ``quantile``) of every ``posterior_predictive`` variable over *all* saved
+    draws, computed before the subset is taken: the report's bands and medians;
   - attributes: package version, seed, config hash, creation time.
+
+  Written by :func:`write_inference_data`: every variable compressed (gzip level 4 with
+  byte shuffle); predictive series and bands stored as integers of a fixed quantum
+  (0.01 °C, 0.1 Pa, 0.01 %RH: below any logger's resolution), log-likelihood terms as
+  float32 rounded to 12 mantissa bits (relative error at most 1.2e-4, i.e. below 1e-3
+  nats per hour). See :func:`write_inference_data` for the demo's sizes.
 
 - ``summary.json``: per parameter median, 5 %, 95 %, r_hat, ess_bulk, ess_tail, τ; fit
   metrics; convergence verdict; MAP; identifiability.
@@ -45,12 +55,24 @@ from heritage_bayes.convert import to_jsonable
 from heritage_bayes.rundir.atomic import atomic_write, atomic_write_text
 
 __all__ = [
+    "PREDICTIVE_QUANTUM",
     "atomic_write",
     "atomic_write_text",
     "coverage",
     "ensure_free_space",
     "fit_metrics",
+    "write_inference_data",
 ]
+
+#: Storage quantum of predictive series and bands by unit: the value is stored as an
+#: integer multiple of it (CF ``scale_factor`` packing, decoded on reading). Half of it
+#: is the largest rounding error: 0.005 °C, 0.05 Pa, 0.005 %RH, ten times below the
+#: resolution of the loggers the package reads (0.1 °C, 1 %RH).
+PREDICTIVE_QUANTUM = {"°C": 0.01, "Pa": 0.1, "%": 0.01}
+#: Groups whose values are stored packed by :data:`PREDICTIVE_QUANTUM`.
+_PACKED_GROUPS = ("posterior_predictive", "predictive_bands")
+#: Mantissa bits kept of float32 log-likelihood terms (of 23).
+_LOGLIK_BITS = 12
 
 
 def ensure_free_space(path: str | Path, nbytes: int, margin: int = 4 << 20) -> None:
@@ -75,6 +97,61 @@ def ensure_free_space(path: str | Path, nbytes: int, margin: int = 4 << 20) -> N
             f"({free / 2**20:.1f} MiB free, about {need / 2**20:.1f} MiB needed); free some "
             "space or choose another --out"
         )
+
+
+def _round_mantissa(a: np.ndarray, keep: int) -> np.ndarray:
+    """float32 copy of ``a`` rounded to ``keep`` mantissa bits (round half up on the
+    bit pattern: relative error at most 2**-(keep + 1)). The zeroed low bits compress
+    to almost nothing (Klöwer et al., Nat. Comput. Sci. 1 (2021) 713-724,
+    doi:10.1038/s43588-021-00156-2: bit rounding of climate data)."""
+    bits = np.ascontiguousarray(a, dtype=np.float32).view(np.uint32)
+    drop = 23 - keep
+    half = np.uint32(1 << (drop - 1))
+    mask = np.uint32(0xFFFFFFFF ^ ((1 << drop) - 1))
+    finite = np.isfinite(bits.view(np.float32))
+    out = np.where(finite, (bits + half) & mask, bits)
+    return out.view(np.float32)
+
+
+def _encoding(group: str, da) -> dict:
+    """NetCDF encoding of one variable of ``group`` (see :func:`write_inference_data`)."""
+    if not np.issubdtype(da.dtype, np.number):
+        return {}
+    enc = {"zlib": True, "complevel": 4, "shuffle": True}
+    quantum = PREDICTIVE_QUANTUM.get(da.attrs.get("unit", ""))
+    if group in _PACKED_GROUPS and quantum is not None and np.issubdtype(da.dtype, np.floating):
+        enc.update(dtype="int32", scale_factor=quantum, _FillValue=np.iinfo(np.int32).min)
+    return enc
+
+
+def write_inference_data(idata, path: str | Path) -> None:
+    """Write an InferenceData to ``path`` (NetCDF4/HDF5, one HDF5 group per group),
+    compressed; a plain file: ``arviz.from_netcdf`` and ``xarray`` read it.
+
+    Every numeric variable is gzip-compressed (level 4, byte shuffle). The
+    predictive series and bands (groups ``posterior_predictive``,
+    ``predictive_bands``) of a unit in :data:`PREDICTIVE_QUANTUM` are stored as int32
+    multiples of its quantum; log-likelihood terms (groups starting with
+    ``log_likelihood``) as float32 rounded to 12 mantissa bits (on the demo's terms,
+    |ℓ| < 6 nats, at most 4.9e-4 nats each; PSIS-LOO and the validation ELPD move by
+    far less than their Monte Carlo error). Posterior draws and the data keep their
+    precision. Not atomic by itself: call it through :func:`atomic_write`.
+
+    Measured on the demo (``hbayes calibrate configs/demo.yaml``, commit c012fcd vs
+    this writer with the bounded predictive): ``posterior.nc`` 89.7 MB → see the
+    closing note of issue 28 in ``benchmarks/README.md``.
+    """
+    mode = "w"
+    for group in idata.groups():
+        ds = idata[group]
+        if group.startswith("log_likelihood"):
+            ds = ds.copy()
+            for v in ds.data_vars:
+                if np.issubdtype(ds[v].dtype, np.floating):
+                    ds[v].values = _round_mantissa(ds[v].values, _LOGLIK_BITS)
+        enc = {v: _encoding(group, ds[v]) for v in ds.data_vars}
+        ds.to_netcdf(str(path), mode=mode, group=group, engine="h5netcdf", encoding=enc)
+        mode = "a"
 
 
 def fit_metrics(measured: np.ndarray, simulated: np.ndarray) -> dict[str, float]:

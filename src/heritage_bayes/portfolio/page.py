@@ -42,6 +42,7 @@ _COLUMNS = [
     ("room", "room", "{}"),
     ("status", "status", "{}"),
     ("converged", "converged", "{}"),
+    ("unconverged_reasons", "why not converged", "{}"),
     ("max_rhat", "max R-hat", "{:.3f}"),
     ("thermal.Ti.FIT_cal", "FIT Ti cal [%]", "{:.1f}"),
     ("thermal.Ti.FIT_val", "FIT Ti val [%]", "{:.1f}"),
@@ -122,7 +123,9 @@ def render_index(pf: Portfolio, df: pd.DataFrame, out: Path) -> str:
     n_ok = int(df["status"].isin(["done", "skipped"]).sum()) if len(df) else 0
     n_conv = int(df.get("converged", pd.Series(dtype=bool)).fillna(False).astype(bool).sum())
     intro = (
-        f"<p>{n_ok} of {n} room(s) calibrated ({len(df)} finished), {n_conv} converged. "
+        f"<p>{n_ok} of {n} room(s) calibrated ({len(df)} finished), {n_conv} converged, "
+        f"{n_ok - n_conv} finished unconverged (<code>hbayes batch</code> exits with code 3 "
+        "when a room is unconverged and none failed). "
         "Rows are in <strong>attention order</strong>: rooms whose calibration failed or did "
         "not converge first (their figures cannot be trusted yet), then the most "
         "conservation-risk indicators rated <em>risk</em> by their published thresholds, "

@@ -155,6 +155,7 @@ def room_row(run_dir: str | Path) -> dict:
         "building": s.get("building", ""),
         "room_description": s.get("room", ""),
         "converged": bool(s.get("converged", False)),
+        "unconverged_reasons": "; ".join(s.get("unconverged_reasons") or []),
         "max_rhat": s.get("max_rhat", float("nan")),
         "min_ess_bulk": s.get("min_ess_bulk", float("nan")),
         "wall_seconds": s.get("wall_seconds", float("nan")),

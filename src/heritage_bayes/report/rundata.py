@@ -23,6 +23,7 @@ __all__ = [
     "measurement_gaps",
     "model_label",
     "parameter_set",
+    "predictive_quantiles",
     "section_params",
     "time_axis",
     "utc64",
@@ -104,6 +105,21 @@ def flat_draws(da) -> np.ndarray:
     """(chain, draw, time) DataArray -> (chain·draw, time) float array."""
     v = np.asarray(da.values, dtype=float)
     return v.reshape(-1, v.shape[-1])
+
+
+def predictive_quantiles(idata, var: str, levels) -> np.ndarray:
+    """(len(levels), time) quantiles of the predictive variable ``var``: from the
+    ``predictive_bands`` group (computed over every saved draw when the run was
+    written) when it holds them, else from the draws of ``posterior_predictive`` (runs
+    written before the bands existed)."""
+    levels = [float(q) for q in levels]
+    if "predictive_bands" in idata.groups() and var in idata["predictive_bands"]:
+        da = idata["predictive_bands"][var]
+        have = np.asarray(da["quantile"].values, dtype=float)
+        idx = [int(np.argmin(np.abs(have - q))) for q in levels]
+        if np.allclose(have[idx], levels):
+            return np.asarray(da.values, dtype=float)[idx]
+    return np.quantile(flat_draws(idata.posterior_predictive[var]), levels, axis=0)
 
 
 def model_label(summary: dict, m: str) -> str:

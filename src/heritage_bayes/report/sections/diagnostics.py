@@ -37,13 +37,16 @@ def _traces(rd: RunData, m: str, info: dict):
         return None
     try:
         with h5py.File(path, "r") as f:
+            # a converged chain's checkpoint keeps every trace_stride-th step (issue 28)
+            kept = int(f.attrs.get("trace_stride", 1))
             n = f["chain"].shape[0]
             stride = max(1, math.ceil(n / _TRACE_POINTS))
             X = f["chain"][::stride]
             lp = f["log_prob"][::stride]
     except (OSError, KeyError) as exc:
         raise InputError(f"{path}: cannot be read ({exc})") from None
-    steps = np.arange(0, n, stride)[: X.shape[0]]
+    steps = kept * np.arange(0, n, stride)[: X.shape[0]]
+    stride *= kept
     names = list(((rd.summary.get("correlations") or {}).get(m) or {}).get("names") or [])
     params = section_params(rd.summary, m)
     ps = parameter_set(rd, m)

@@ -13,9 +13,9 @@ from heritage_bayes.report.format import OUT_WORDS
 from heritage_bayes.report.page import Section
 from heritage_bayes.report.rundata import (
     RunData,
-    flat_draws,
     measurement_gaps,
     model_label,
+    predictive_quantiles,
     time_axis,
 )
 from heritage_bayes.report.sections._fragment import render_fragment
@@ -71,10 +71,8 @@ def fit_context(rd: RunData, outputs: list[dict]) -> list[dict]:
     items = []
     for o in outputs:
         gaps = measurement_gaps(rd, dt, o["output"])
-        Y = flat_draws(pp[o["pp"]])
-        S = flat_draws(pp[o["sim"]])
-        med = np.median(S, axis=0)
-        q = np.quantile(Y, [0.05, 0.25, 0.75, 0.95], axis=0)
+        med = predictive_quantiles(rd.idata, o["sim"], [0.5])[0]
+        q = predictive_quantiles(rd.idata, o["pp"], [0.05, 0.25, 0.75, 0.95])
         y = np.asarray(obs[o["output"]].reindex(time=times_pp).values, dtype=float)
         fig = fig_fit(
             times_pp,
@@ -143,8 +141,7 @@ def _one_step_item(rd: RunData, o: dict, pp, times, y, codes, gaps, what: str) -
     """The one-step-ahead band of a state-space noise model (``noise: kalman``)."""
     from heritage_bayes.report.figures import fig_fit
 
-    Y1 = flat_draws(pp[f"{o['pp']}_1step"])
-    q = np.quantile(Y1, [0.05, 0.25, 0.5, 0.75, 0.95], axis=0)
+    q = predictive_quantiles(rd.idata, f"{o['pp']}_1step", [0.05, 0.25, 0.5, 0.75, 0.95])
     fig = fig_fit(
         times,
         y,

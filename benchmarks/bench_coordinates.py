@@ -1,0 +1,115 @@
+"""τ per parameter: the log coordinates vs node time-constant coordinates (issue 28).
+
+For each problem the MAP is found once (as ``hbayes calibrate`` does), then emcee runs
+from the same start with the same seed, the package's moves (DE 80 % / snooker 20 %)
+and its convergence rule (≥ 50 τ, τ stable, R-hat ≤ 1.01, bulk ESS ≥ 400), capped by
+``--max-steps`` and ``--max-time``, twice in the same run:
+
+- ``log``: the reference, emcee in the sampler's log θ / θ / logit coordinates;
+- ``node_tau``: emcee in :class:`heritage_bayes.inference.coordinates.NodeTimeConstants`
+  (log C_i replaced by the log of the node time constant C_i / Σ G_ik).
+
+Both chains are measured in the same coordinates (log θ), so the integrated
+autocorrelation time τ [steps] of each parameter is comparable; printed per parameter,
+with steps, whether converged, CPU and wall time of sampling [s] and min bulk ESS per
+CPU second, and the ratio node_tau / log. BLAS single-threaded; on a shared machine
+CPU time is the figure to compare. A τ from a chain shorter than 50 τ is a lower
+bound (emcee's estimate): the converged column says which.
+
+    python benchmarks/bench_coordinates.py demo_2c demo_4a demo_hygric trh1_2c orholm_4a \
+        [--max-steps N] [--max-time SECONDS] [--only log|node_tau]
+"""
+
+from __future__ import annotations
+
+import os
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+os.environ.setdefault("MKL_NUM_THREADS", "1")
+
+import argparse
+import sys
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import bench_sampling
+from _common import config_map
+from heritage_bayes.config import load_config
+from heritage_bayes.inference.coordinates import node_time_constants
+
+ROOT = Path(__file__).resolve().parents[1]
+#: name -> (config, section, model (None: the config's own))
+PROBLEMS = {
+    "demo_2c": (ROOT / "configs" / "demo.yaml", "thermal", None),
+    "demo_4a": (ROOT / "configs" / "demo.yaml", "thermal", "thermal_4a"),
+    "demo_hygric": (ROOT / "configs" / "demo.yaml", "hygric", None),
+    "trh1_2c": (ROOT / "configs" / "trh1_attic.yaml", "thermal", "thermal_2c"),
+    "orholm_4a": (ROOT / "configs" / "orholm.yaml", "thermal", "thermal_4a"),
+}
+
+
+def _config(path: Path, section: str, model_name: str | None):
+    cfg = load_config(path)
+    if model_name is not None:
+        sec = getattr(cfg, section).model_copy(update={"model": model_name})
+        cfg = cfg.model_copy(update={section: sec})
+    return cfg
+
+
+def _run(label, lp, mp, coords, cfg, args):
+    return bench_sampling._run(
+        label,
+        lp,
+        mp.x,
+        lambda x: x,  # the chain is stored in the log coordinates either way
+        lp.params.bounds,
+        cfg,
+        args.max_time,
+        moves=cfg.sampler.moves,
+        max_steps=args.max_steps,
+        max_draws=cfg.sampler.max_draws,
+        coordinates=coords,
+    )
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("problems", nargs="*", default=list(PROBLEMS))
+    ap.add_argument("--max-steps", type=int, default=200_000)
+    ap.add_argument("--max-time", type=float, default=1800.0, help="per chain [s]")
+    ap.add_argument("--only", choices=("log", "node_tau"), default=None)
+    args = ap.parse_args()
+    for name in args.problems:
+        cfg = _config(*PROBLEMS[name])
+        section = PROBLEMS[name][1]
+        _, model, lp, mp = config_map(cfg, section)
+        coords = node_time_constants(lp)
+        print(
+            f"{name}: {model.name}, {lp.ndim} free parameters, MAP {mp.log_post:.1f}; "
+            f"{len(coords.nodes) if coords else 0} node(s) re-coordinated",
+            flush=True,
+        )
+        runs = {}
+        for label, c in (("log", None), ("node_tau", coords)):
+            if args.only not in (None, label) or (label == "node_tau" and c is None):
+                continue
+            runs[label] = _run(label, lp, mp, c, cfg, args)
+        names = lp.params.free_names
+        print("  τ per parameter [steps]: " + "  ".join(f"{n:>8s}" for n in names))
+        for label, (res, _, _) in runs.items():
+            print(f"  {label:<22s}  " + "  ".join(f"{t:8.0f}" for t in res.tau))
+        if len(runs) == 2:
+            (a, ca, ra), (b, cb, rb) = runs["log"], runs["node_tau"]
+            print(
+                f"  node_tau / log: τmax {np.nanmax(b.tau) / np.nanmax(a.tau):.2f}, "
+                f"CPU {cb / ca:.2f}, ESS/CPU-s {rb / ra:.2f}",
+                flush=True,
+            )
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,165 @@
+"""Node time-constant sampling coordinates (issue 28): a bijection with unit Jacobian,
+the same posterior, and chains stored in the sampler's usual coordinates."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import heritage_bayes as hb
+from heritage_bayes.inference.coordinates import NodeTimeConstants, node_time_constants
+from heritage_bayes.inference.likelihoods import get_noise_model
+from heritage_bayes.inference.parameters import parameters_for
+from heritage_bayes.inference.posterior import LogPosterior
+from heritage_bayes.inference.sampler import run_sampler
+
+
+def _logpost(name="thermal_2c", N=24 * 20, priors=None, seed=0):
+    rng = np.random.default_rng(seed)
+    m = hb.model(name, surfaces=("S",))
+    t = np.arange(N)
+    cols = {
+        "Te": 5 + 4 * np.sin(2 * np.pi * (t - 14) / 24) + np.cumsum(rng.normal(0, 0.3, N)),
+        "I_S": np.clip(400 * np.sin(2 * np.pi * (t - 6) / 24), 0, None),
+        "Tf": np.full(N, 10.0),
+    }
+    U = np.column_stack([cols[c] for c in m.input_names])
+    truth = dict(Cw=5e7, Ci=2e6, Gw=150.0, Gi=300.0, Gfast=80.0, Gf=30.0, fI_S=3.0, Ge=230.0)
+    y = hb.simulate(m, {k: truth[k] for k in m.parameter_names}, U)[:, 0]
+    noise = get_noise_model("ar1")
+    ps = parameters_for(m, noise, priors or {}, room_volume=400)
+    y = y + rng.normal(0, 0.1, N)
+    return LogPosterior(m, ps, noise, U, y[:, None], warmup=24, init_window=24), truth
+
+
+def test_node_time_constants_are_capacity_over_attached_conductances():
+    lp, truth = _logpost()
+    c = NodeTimeConstants(lp)
+    names = lp.params.free_names
+    assert {names[k] for k, _ in c.nodes} == {"Cw", "Ci"}
+    theta = np.array([[truth.get(n, 0.1) if n != "phi_Ti" else 0.5 for n in lp.params.names]])
+    X = lp.params.to_unconstrained(theta)
+    Y = c.to_y(X)
+    # Cw: Gw (to Te) + Gi (to the air); Ci: Gi + Gfast (to Te) + Gf (to the ground)
+    assert Y[0, names.index("Cw")] == pytest.approx(np.log(5e7 / (150.0 + 300.0)))
+    assert Y[0, names.index("Ci")] == pytest.approx(np.log(2e6 / (300.0 + 80.0 + 30.0)))
+    # the other coordinates are the sampler's own
+    keep = [k for k in range(len(names)) if names[k] not in ("Cw", "Ci")]
+    np.testing.assert_array_equal(Y[:, keep], X[:, keep])
+
+
+def test_the_change_of_variables_is_a_bijection_with_unit_jacobian():
+    lp, _ = _logpost()
+    c = node_time_constants(lp)
+    rng = np.random.default_rng(1)
+    X = lp.params.to_unconstrained(lp.params.sample_prior(rng, 20))
+    np.testing.assert_allclose(c.to_x(c.to_y(X)), X, rtol=0, atol=1e-12)
+    # unit Jacobian: the log-density is the same at corresponding points
+    np.testing.assert_allclose(c(c.to_y(X)), lp(X), rtol=1e-12)
+    # and the map really has determinant 1 (central differences)
+    y0 = c.to_y(X[:1])[0]
+    d, h = y0.size, 1e-6
+    J = np.empty((d, d))
+    for j in range(d):
+        e = np.zeros(d)
+        e[j] = h
+        J[:, j] = (c.to_x(y0 + e)[0] - c.to_x(y0 - e)[0]) / (2 * h)
+    assert np.linalg.det(J) == pytest.approx(1.0, abs=1e-6)
+    # outside the prior's support (or non-finite) it is -inf, never an exception
+    Y = c.to_y(X[:3])
+    Y[0, 0] = np.nan
+    Y[1, c.nodes[0][0]] = 1e3
+    out = c(Y)
+    assert out[0] == -np.inf and out[1] == -np.inf and np.isfinite(out[2])
+
+
+def test_fixed_capacities_are_left_alone_and_fixed_conductances_count():
+    lp, _ = _logpost(priors={"Ci": {"fixed": 2e6}, "Gf": {"fixed": 30.0}})
+    c = node_time_constants(lp)
+    names = lp.params.free_names
+    assert [names[k] for k, _ in c.nodes] == ["Cw"]
+    lp1, _ = _logpost("thermal_1c", priors={"Ci": {"fixed": 2e6}})
+    assert node_time_constants(lp1) is None
+    lp2, _ = _logpost("thermal_1c", priors={"Gf": {"fixed": 30.0}})
+    c2 = node_time_constants(lp2)
+    ((k, gs),) = c2.nodes
+    assert (None, 30.0, True) in gs
+
+
+def test_sampler_in_time_constant_coordinates_stores_the_usual_coordinates(tmp_path):
+    lp, _ = _logpost(N=24 * 10)
+    c = node_time_constants(lp)
+    x0 = lp.params.to_unconstrained(
+        np.array([[5e7, 2e6, 150.0, 300.0, 80.0, 30.0, 3.0, 0.1, 0.5]])
+    )[0]
+    kw = dict(seed=3, max_steps=200, check_every=100, tau_factor=1000, bounds=lp.params.bounds)
+    a = run_sampler(lp, x0, coordinates=c, checkpoint=tmp_path / "a.h5", tag="t", **kw)
+    b = run_sampler(lp, x0, coordinates=c, **kw)
+    np.testing.assert_array_equal(a.chain, b.chain)  # same seed, same chain
+    # the stored chain is in the log-posterior's coordinates: its log-prob matches
+    np.testing.assert_allclose(lp(a.chain[-1]), a.log_prob[-1], rtol=1e-10)
+    # a resumed chain (from the checkpoint, in x) continues in the same coordinates
+    kw2 = {**kw, "max_steps": 300}
+    r = run_sampler(
+        lp, x0, coordinates=c, checkpoint=tmp_path / "a.h5", tag="t", resume=True, **kw2
+    )
+    full = run_sampler(lp, x0, coordinates=c, **kw2)
+    assert r.resumed_from == 200
+    np.testing.assert_array_equal(r.chain[:200], full.chain[:200])
+    # the last state goes through x and back: equal up to round-off (1e-16 relative),
+    # which the ensemble moves carry on (measured: 6e-9 relative after 100 steps)
+    np.testing.assert_allclose(r.chain, full.chain, rtol=1e-6)
+
+
+def test_a_converged_chain_is_compacted_and_a_resume_rebuilds_from_its_draws(tmp_path):
+    """Lean outputs: the checkpoint of a converged chain keeps only the retained
+    draws; --resume returns them (same draws, nothing sampled); a stricter rule that
+    would need the dropped steps is refused with a message, not silently ignored."""
+    import h5py
+
+    from heritage_bayes.errors import InputError
+    from heritage_bayes.inference.sampler import compact_checkpoint
+
+    lp, truth = _logpost("thermal_1c", N=24 * 10)
+    x0 = lp.params.to_unconstrained(np.array([[2e6, 230.0, 30.0, 3.0, 0.1, 0.5]]))[0]
+    ck = tmp_path / "chain.h5"
+    kw = dict(seed=2, check_every=100, tau_factor=5, min_ess=None, max_rhat=None)
+    a = run_sampler(lp, x0, checkpoint=ck, tag="t", max_steps=5000, **kw)
+    assert a.converged
+    full_size = ck.stat().st_size
+    compact_checkpoint(ck, "t", a, max_draws=400)
+    assert ck.stat().st_size < full_size / 2
+    with h5py.File(ck) as f:
+        assert f["draws"].shape[1:] == (32, lp.ndim)
+        # a trace of the whole chain for the report's plots, burn-in included
+        k = int(f.attrs["trace_stride"])
+        assert f["chain"].shape[0] == len(range(0, a.steps, k)) <= 400
+        np.testing.assert_allclose(f["chain"][-1], a.chain[::k][-1], rtol=1e-6)
+    b = run_sampler(lp, x0, checkpoint=ck, tag="t", max_steps=5000, resume=True, **kw)
+    assert b.thinned and b.converged and b.steps == a.steps and b.resumed_from == a.steps
+    for got, want in zip(b.draws(400), a.draws(400), strict=True):
+        np.testing.assert_array_equal(got, want)
+    assert (b.burn, b.thin) == (a.burn, a.thin)
+    with pytest.raises(InputError, match="run without --resume"):
+        run_sampler(lp, x0, checkpoint=ck, tag="t", resume=True, **{**kw, "tau_factor": 1e6})
+    with pytest.raises(InputError, match="different configuration"):
+        run_sampler(lp, x0, checkpoint=ck, tag="other", resume=True, **kw)
+    # an unconverged chain is left whole: it is what --resume continues
+    c = run_sampler(lp, x0, checkpoint=tmp_path / "c.h5", tag="t", max_steps=100, **kw)
+    before = (tmp_path / "c.h5").read_bytes()
+    compact_checkpoint(tmp_path / "c.h5", "t", c, max_draws=400)
+    assert not c.converged and (tmp_path / "c.h5").read_bytes() == before
+
+
+def test_default_coordinates_re_coordinate_three_node_networks_only():
+    from heritage_bayes.inference.coordinates import default_coordinates
+
+    lp2, _ = _logpost("thermal_2c")
+    assert default_coordinates(lp2) is None
+    m = hb.model("thermal_4a", surfaces=("S",))
+    noise = get_noise_model("ar1")
+    U = np.ones((48, len(m.input_names)))
+    lp4 = LogPosterior(m, parameters_for(m, noise), noise, U, np.ones((48, 1)), warmup=0)
+    c = default_coordinates(lp4)
+    names = lp4.params.free_names
+    assert sorted(names[k] for k, _ in c.nodes) == ["Ci", "Cint", "Cw"]

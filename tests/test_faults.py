@@ -423,7 +423,7 @@ USER_ERRORS = {
     "compare-name-traversal": (_case_compare(_tiny(name="../../etc")), "not a plain name"),
     "compare-out-cwd": (_case_compare(TINY, "--out", "."), "is the current folder"),
     # -- a file that is not a config: named, its lines never echoed
-    "shadow-as-config": (_case_config(_SHADOW), "not a calibration config"),
+    "shadow-as-config": (_case_config(_SHADOW), "not a configuration: none of its 2"),
     "shadow-as-portfolio": (_case_portfolio(_SHADOW), "not a portfolio file"),
     "shadow-as-projection": (_case_projection(_SHADOW), "not a projection file"),
 }

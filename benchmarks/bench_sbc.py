@@ -140,33 +140,29 @@ def truth(model, rng, floor_area: float | None = None) -> dict[str, float]:
     return {k: float(p[k]) for k in model.parameter_names}
 
 
-def simulate_reference(model, params, U: np.ndarray) -> np.ndarray:
-    """Exact ZOH simulation with scipy.linalg.expm (block-matrix form), from the steady
-    state of the first day's mean inputs: all node potentials (N, n)."""
+def simulate_reference(model, params, U: np.ndarray, dt: float = DT, x0=None) -> np.ndarray:
+    """Exact ZOH simulation with scipy.linalg.expm (block-matrix form), steps of ``dt``
+    [s], from ``x0`` or else the steady state of the first 24 rows' mean inputs: all
+    node potentials at the start of every step (N, n)."""
     A, B, _, _ = model.state_space(params)
     e = model.offset(params)
     n, m = B.shape
     Mx = np.zeros((n + m + 1, n + m + 1))
     Mx[:n, :n], Mx[:n, n : n + m], Mx[:n, -1] = A, B, e
-    E = expm(Mx * DT)
+    E = expm(Mx * dt)
     Ad, Bd, ed = E[:n, :n], E[:n, n : n + m], E[:n, -1]
-    x = np.linalg.solve(-A, B @ U[:24].mean(axis=0) + e)
+    x = np.linalg.solve(-A, B @ U[:24].mean(axis=0) + e) if x0 is None else x0
+    W = U @ Bd.T + ed
     X = np.empty((U.shape[0], n))
     for k in range(U.shape[0]):
         X[k] = x
-        x = Ad @ x + Bd @ U[k] + ed
+        x = Ad @ x + W[k]
     return X
 
 
 def replicate(args) -> dict:
     """One room: generate, calibrate, and rank the truth of each quantity."""
     import heritage_bayes as hb
-    from heritage_bayes.config import ModelSection
-    from heritage_bayes.inference.likelihoods import get_noise_model
-    from heritage_bayes.inference.optimize import find_map
-    from heritage_bayes.inference.parameters import parameters_for
-    from heritage_bayes.inference.posterior import LogPosterior
-    from heritage_bayes.inference.sampler import run_sampler
     from heritage_bayes.rc.derived import derived_quantities
 
     name, rep, variants, seed, max_steps = args[:5]
@@ -210,7 +206,33 @@ def replicate(args) -> dict:
     if "gap" not in without:
         y[g0 : g0 + 7 * 24] = np.nan
     dq_true = {k: float(np.ravel(v)[0]) for k, v in derived_quantities(model, p).items()}
-    result = {"model": name, "rep": rep, "truth": dq_true, "truth_parameters": p, "variants": {}}
+    result = {"model": name, "rep": rep, "truth": dq_true, "truth_parameters": p}
+    result["variants"] = fit_and_rank(
+        model, U[rows], y, dq_true, variants, rep, max_steps, priors, floor, envelope
+    )
+    return result
+
+
+def fit_and_rank(
+    model, U, y, dq_true, variants, rep, max_steps, priors, floor, envelope, extra=None
+) -> dict:
+    """Calibrate one replicate with ``hbayes calibrate``'s defaults and rank the truths.
+
+    ``U`` (N, m) inputs and ``y`` (N,) observations (NaN = missing) of the calibration
+    period; ``dq_true`` the true derived quantities; ``extra`` an optional function
+    ``(dq, theta) -> {name: draws}`` of further quantities (their truths in
+    ``dq_true``). Returns ``{variant: {ranks, converged, map, steps, cpu}}``.
+    """
+    from heritage_bayes.config import ModelSection
+    from heritage_bayes.inference.likelihoods import get_noise_model
+    from heritage_bayes.inference.optimize import find_map
+    from heritage_bayes.inference.parameters import parameters_for
+    from heritage_bayes.inference.posterior import LogPosterior
+    from heritage_bayes.inference.sampler import run_sampler
+    from heritage_bayes.rc.derived import derived_quantities
+
+    name = model.name
+    out = {}
     for variant in variants:
         noise_name, init = variant.split(":")
         t0 = time.process_time()
@@ -229,7 +251,7 @@ def replicate(args) -> dict:
             model,
             ps,
             noise,
-            U[rows],
+            U,
             y[:, None],
             warmup=336 if init == "steady" else 0,
             init_window=720,
@@ -249,8 +271,12 @@ def replicate(args) -> dict:
         Xd, _ = chain.draws(4000)
         theta = ps.values(Xd.reshape(-1, Xd.shape[-1]))
         dq = derived_quantities(model, theta[:, : lp.n_model])
+        if extra is not None:
+            dq = {**dq, **extra(dq, theta)}
         ranks = {}
         for k, t in dq_true.items():
+            if k not in dq:
+                continue
             d = np.asarray(dq[k], dtype=float).reshape(-1)
             if not np.all(np.isfinite(d)) or np.ptp(d) == 0:
                 continue
@@ -262,24 +288,27 @@ def replicate(args) -> dict:
                 "median": float(np.median(d)),
                 "sd": float(np.std(d)),
             }
-        result["variants"][variant] = {
+        out[variant] = {
             "ranks": ranks,
             "converged": bool(chain.converged),
             "map": dict(zip(ps.names, map(float, mp.theta), strict=True)),
             "steps": int(chain.steps),
             "cpu": time.process_time() - t0,
         }
-    return result
+    return out
 
 
 QUANTITIES = {
     "thermal_2c": ("tau_1_h", "gain_Ti_Te", "gain_Ti_I_S", "gain_Ti_Tf"),
     "hygric_2c": ("tau_1_h", "tau_2_h"),
-    "hygric_2c_fixed": ("tau_1_h", "gain_Pi_Pe", "offset_Pi_h"),
+    "hygric_2c_fixed": ("tau_1_h", "gain_Pi_Pe", "offset_Pi_Pf"),
 }
 
 
-def table(results: list[dict], variant: str) -> list[str]:
+def table(results: list[dict], variant: str, quantities: dict | None = None) -> list[str]:
+    """Coverage and rank-uniformity lines of ``variant`` for each model's quantities
+    (``quantities``: model -> names; default :data:`QUANTITIES`)."""
+    quantities = QUANTITIES if quantities is None else quantities
     lines = []
     for name in sorted({r["model"] for r in results}):
         rs = [r for r in results if r["model"] == name and variant in r["variants"]]
@@ -290,7 +319,7 @@ def table(results: list[dict], variant: str) -> list[str]:
         )
         keys = [
             k
-            for k in QUANTITIES.get(name, ())
+            for k in quantities.get(name, ())
             if any(k in r["variants"][variant]["ranks"] for r in rs)
         ]
         for k in keys:
@@ -354,6 +383,38 @@ def repeat_room(results: list[dict], variant: str) -> list[str]:
             f" ± {1 / np.sqrt(len(z)):.2f}   90 %: {np.mean([x['in90'] for x in v]):4.2f}"
         )
     return lines
+
+
+def print_study(results, variants, header: str, quantities: dict | None = None) -> None:
+    """Print a study's header line and its coverage table for each variant."""
+    print(header)
+    print("coverage of central 50 % / 90 % intervals (target 0.50 / 0.90; 90 %: 0.85-0.95)")
+    for v in variants:
+        for line in table(results, v, quantities):
+            print(line)
+
+
+def run_tasks(fn, tasks: list, jobs: int, log: str | None) -> list[dict]:
+    """Run ``fn`` on every task (``jobs`` processes), appending each result to ``log``
+    as one JSON line as soon as it is done (a study cut short can be tabulated)."""
+    results = []
+
+    def done(r):
+        results.append(r)
+        if log:
+            with open(log, "a") as f:
+                f.write(json.dumps(r) + "\n")
+        conv = ", ".join(f"{v}: {x['steps']} steps" for v, x in r["variants"].items())
+        print(f"  {r['model']} replicate {r['rep']} done ({conv})", flush=True)
+
+    if jobs > 1:
+        with ProcessPoolExecutor(jobs) as ex:
+            for r in ex.map(fn, tasks):
+                done(r)
+    else:
+        for t in tasks:
+            done(fn(t))
+    return results
 
 
 def main() -> None:
@@ -472,31 +533,13 @@ def main() -> None:
         for m in args.models.split(",")
     ]  # models interleaved: a study cut short still covers every model
     t0 = time.perf_counter()
-    results = []
-
-    def done(r):
-        results.append(r)
-        if args.log:  # one JSON line per replicate: a partial study can be tabulated
-            with open(args.log, "a") as f:
-                f.write(json.dumps(r) + "\n")
-        conv = ", ".join(f"{v}: {x['steps']} steps" for v, x in r["variants"].items())
-        print(f"  {r['model']} replicate {r['rep']} done ({conv})", flush=True)
-
-    if args.jobs > 1:
-        with ProcessPoolExecutor(args.jobs) as ex:
-            for r in ex.map(replicate, tasks):
-                done(r)
-    else:
-        for t in tasks:
-            done(replicate(t))
-    print(
+    results = run_tasks(replicate, tasks, args.jobs, args.log)
+    print_study(
+        results,
+        variants,
         f"SBC: {args.reps} replicates per model, 3 months hourly De Bilt weather, "
-        f"{time.perf_counter() - t0:.0f} s wall"
+        f"{time.perf_counter() - t0:.0f} s wall",
     )
-    print("coverage of central 50 % / 90 % intervals (target 0.50 / 0.90; 90 %: 0.85-0.95)")
-    for v in variants:
-        for line in table(results, v):
-            print(line)
 
 
 if __name__ == "__main__":

@@ -371,3 +371,75 @@ def test_estimated_fixed_temperature_node():
     assert 3.0 < y[-1, 0] < 15.0
     with pytest.raises(ValueError, match="option ground must be"):
         hb.model("thermal_2c", ground="maybe")
+
+
+# ------------------------------------------------ first-order hold (issue 31)
+def _foh_expm(A, B, dt):
+    """Triangle-hold equivalent from one matrix exponential (Franklin, Powell & Workman
+    sec. 6.3.2): expm([[A dt, B dt, 0], [0, 0, I], [0, 0, 0]]) -> Phi, Gamma1, Gamma2."""
+    n, m = B.shape
+    M = np.zeros((n + 2 * m, n + 2 * m))
+    M[:n, :n], M[:n, n : n + m] = A * dt, B * dt
+    M[n : n + m, n + m :] = np.eye(m)
+    E = expm(M)
+    G1, G2 = E[:n, n : n + m], E[:n, n + m :]
+    return E[:n, :n], G1 - G2, G2
+
+
+@pytest.mark.parametrize("params", STIFF)
+@pytest.mark.parametrize("dt", [60.0, 3600.0, 86400.0])
+def test_first_order_hold_matches_expm(params, dt):
+    m = hb.model("thermal_4a")
+    A, B, _, _ = m.state_space(params)
+    Ad, B0, B1, ed = hb.rc.discretize_foh(m, params, dt)
+    Aref, B0ref, B1ref = _foh_expm(A, B, dt)
+    assert np.abs(Ad - Aref).max() <= 1e-9 * np.abs(Aref).max()
+    for got, ref in ((B0, B0ref), (B1, B1ref)):
+        assert np.abs(got - ref).max() <= 1e-9 * np.abs(ref).max()
+    # an input held constant: FOH and ZOH are the same step
+    _, Bd, _, _, _ = hb.discretize(m, params, dt)
+    np.testing.assert_allclose(B0 + B1, Bd, rtol=1e-9, atol=1e-12 * np.abs(Bd).max())
+    np.testing.assert_array_equal(ed, 0.0)
+
+
+def test_foh_weights_limits_and_series_branch():
+    from heritage_bayes.rc import foh_weights
+
+    dt = 3600.0
+    # both dt/2 for a mode much slower than the step (the trapezoid rule)
+    w0, w1 = foh_weights(np.array([0.0, 1e-15]), dt)
+    np.testing.assert_allclose([w0, w1], dt / 2, rtol=1e-9)
+    # the series (x < 1e-2) and the closed form agree where they meet, to rounding
+    lam = np.array([0.99999e-2, 1.00001e-2]) / dt
+    w0, w1 = foh_weights(lam, dt)
+    np.testing.assert_allclose(w0[0], w0[1], rtol=1e-5)
+    # a mode far faster than the step follows the input: all weight on u[k+1]
+    w0, w1 = foh_weights(np.array([1.0]), dt)
+    np.testing.assert_allclose([w0[0], w1[0]], [1.0 / 3600.0, 1.0 - 1.0 / 3600.0], rtol=1e-9)
+
+
+def test_first_order_hold_is_exact_for_a_linear_input():
+    """A 2-node room driven by inputs linear between hourly samples: FOH equals a
+    2000-substep simulation of the ramp; ZOH of the interval mean (what the aligned frame
+    holds) is off for the air node, by about the FOH slope term c = lambda dt²/12."""
+    m = hb.model("thermal_2c", surfaces=("S",))
+    p = dict(Cw=5e7, Ci=3e5, Gw=200.0, Gi=800.0, Gfast=150.0, Gf=20.0, fI_S=3.0)
+    A, B, _, _ = m.state_space(p)
+    rng = np.random.default_rng(0)
+    N, sub, dt = 48, 2000, 3600.0
+    samples = rng.normal(10.0, 4.0, (N + 1, m.n_inputs))
+    Ad, B0, B1, _ = hb.rc.discretize_foh(m, p, dt)
+    Af, Bf = _zoh_expm(A, B, dt / sub)
+    x_foh = x_fine = np.linalg.solve(-A, B @ samples[0])
+    x_zoh = x_foh.copy()
+    _, Bd, _, _, _ = hb.discretize(m, p, dt)
+    for k in range(N):
+        x_foh = Ad @ x_foh + B0 @ samples[k] + B1 @ samples[k + 1]
+        x_zoh = Ad @ x_zoh + Bd @ (0.5 * (samples[k] + samples[k + 1]))
+        for j in range(sub):  # midpoint of each sub-step of the ramp
+            u = samples[k] + (j + 0.5) / sub * (samples[k + 1] - samples[k])
+            x_fine = Af @ x_fine + Bf @ u
+    scale = np.abs(x_fine).max()
+    # held midpoints of 2000 sub-steps approximate the ramp to O((dt/sub)²)
+    assert np.abs(x_foh - x_fine).max() <= 1e-6 * scale
+    assert np.abs(x_zoh - x_fine).max() > 100 * np.abs(x_foh - x_fine).max()

@@ -27,7 +27,7 @@ from heritage_bayes.errors import InputError
 from heritage_bayes.report import write_report
 from heritage_bayes.report._diag import acf, cumulative_periodogram, innovations
 from heritage_bayes.report.build import SECTIONS
-from heritage_bayes.report.format import fmt, prior_text
+from heritage_bayes.report.format import fmt, fmt_int, prior_text
 from heritage_bayes.report.page import Section, render_page, script_hash
 from heritage_bayes.report.sections.identifiability import ladder_metrics
 from heritage_bayes.report.verdict import convergence_verdict, ess_class, rhat_class, run_notes
@@ -545,7 +545,7 @@ def test_verdict_green_only_when_the_noise_model_checks_pass():
     # 1900 hours at phi 0.9: 100 independent; 0.90 +- 2.58 * 0.3 / 10 = +- 0.077
     s["metrics"]["thermal"]["Ti"]["validation"]["coverage90"] = 0.80
     v = convergence_verdict(s, ok_resid)
-    assert v["level"] == "amber" and "noise model" in v["title"]
+    assert v["level"] == "amber" and "checks below fail" in v["title"]
     assert "covers 80 % of the validation hours (expected 90 ± 8 %" in v["checks"][0]
     s["metrics"]["thermal"]["Ti"]["validation"]["coverage90"] = 0.84
     assert convergence_verdict(s, ok_resid)["level"] == "green"
@@ -689,3 +689,129 @@ def test_rank_counts_flag_a_shifted_group():
     x[24:] += 1.0  # the last 8 walkers sample a shifted distribution
     counts, band, _ = rank_counts(x, groups)
     assert counts[3, -3:].min() > band[1] and counts[3, :3].max() < band[0]
+
+
+# ------------------------------------------------ arviz interoperability (issue 31)
+def test_az_loo_and_waic_run_on_posterior_nc_without_arguments(run_dir):
+    """Thermal and hygric outputs: ``log_likelihood`` holds one combined variable (the
+    default of az.loo/az.waic), the per-output terms sit in ``log_likelihood_outputs``
+    and sum to the same total for every draw."""
+    import warnings
+
+    import arviz as az
+
+    idata = az.from_netcdf(run_dir / "posterior.nc")
+    with warnings.catch_warnings():  # Pareto k / WAIC variance warnings of 600 steps
+        warnings.simplefilter("ignore", UserWarning)
+        loo = az.loo(idata)
+        waic = az.waic(idata)
+    per = idata["log_likelihood_outputs"]
+    assert set(per.data_vars) == {"thermal.Ti", "hygric.Pi"}
+    n = sum(per[v].shape[-1] for v in per.data_vars)
+    assert list(idata.log_likelihood.data_vars) == ["all_outputs"]
+    assert loo.n_data_points == n and waic.n_data_points == n
+    assert np.isfinite(float(loo.elpd_loo)) and np.isfinite(float(waic.elpd_waic))
+    joint = idata.log_likelihood["all_outputs"]
+    total = joint.values.astype(float).sum(axis=-1)
+    parts = sum(per[v].values.astype(float).sum(axis=-1) for v in per.data_vars)
+    np.testing.assert_allclose(total, parts, rtol=1e-6)
+    # which hour of which output each term is
+    names = joint["observation_variable"].values
+    assert (names == "thermal.Ti").sum() == per["thermal.Ti"].shape[-1]
+    np.testing.assert_array_equal(
+        joint["observation_time"].values[names == "hygric.Pi"],
+        per["hygric.Pi"][per["hygric.Pi"].dims[-1]].values,
+    )
+
+
+def test_every_convergence_number_of_the_report_is_az_summary_of_posterior_nc(report, run_dir):
+    """R-hat, bulk and tail ESS in the parameter tables, the derived tables and the
+    verdict line are what ``az.summary`` computes on ``posterior.nc``, to the printed
+    precision."""
+    import arviz as az
+
+    _, html = report
+    summary = json.loads((run_dir / "summary.json").read_text())
+    idata = az.from_netcdf(run_dir / "posterior.nc")
+    free = [k for k, v in summary["parameters"].items() if v.get("fixed") is None]
+    diag = az.summary(idata, var_names=free, kind="diagnostics", round_to="none")
+    for m in ("thermal", "hygric"):
+        table = html[html.index(f'id="table-params-{m}"') :]
+        table = table[: table.index("</table>")]
+        for key in (k for k in free if k.startswith(m + ".")):
+            row = _row(table, f"<strong>{key.split('.', 1)[1]}</strong>")
+            r, eb, et = diag.loc[key, ["r_hat", "ess_bulk", "ess_tail"]]
+            assert f"{r:.3f}" in row, (key, r)
+            assert f">{fmt_int(eb)} / {fmt_int(et)}<" in row, (key, eb, et)
+        # the slowest time constant in the identifiability section
+        key = f"{m}.tau_1_h"
+        d = az.summary(idata, var_names=[key], kind="diagnostics", round_to="none")
+        assert summary["derived"][key]["ess_bulk"] == pytest.approx(d.loc[key, "ess_bulk"])
+        assert summary["derived"][key]["r_hat"] == pytest.approx(d.loc[key, "r_hat"])
+    verdict = html[: html.index('<section id="data">')]
+    assert f"max R-hat {diag['r_hat'].max():.3f}" in verdict
+    assert f"min bulk ESS {fmt_int(diag['ess_bulk'].min())}" in verdict
+
+
+def test_verdict_is_not_green_while_a_truth_marker_misses():
+    s = _summary(1.004, 1200)
+    ok_resid = [{"section": "thermal", "output": "Ti", "adequate": True, "check": {}}]
+    s["derived"] = {
+        "thermal.tau_1_h": {"median": 300.0, "q05": 250.0, "q95": 350.0, "sd": 30.0, "truth": 320},
+        "thermal.gain_Ti_Te": {"median": 0.8, "q05": 0.75, "q95": 0.85, "sd": 0.03, "truth": None},
+    }
+    assert convergence_verdict(s, ok_resid)["level"] == "green"
+    s["derived"]["thermal.gain_Ti_Te"]["truth"] = 0.9
+    v = convergence_verdict(s, ok_resid)
+    assert v["level"] == "amber"
+    assert v["checks"] == [
+        "thermal.gain_Ti_Te: the true value 0.9 lies outside the 90 % interval "
+        "[0.75, 0.85], 3.3 σ from the median"
+    ]
+
+
+def test_fit_is_flagged_on_a_nearly_constant_series():
+    """A humidistat-held RH (Ørholm: MAE 2.1 %RH, FIT −98 %): the measured series varies
+    less than the error, FIT says nothing and the table says so; a varying series with
+    a good fit is not flagged."""
+    from heritage_bayes.report.sections.metrics import _nearly_constant
+
+    mae, fit = 2.1, -98.0
+    rmse = 1.25 * mae  # Gaussian errors: RMSE ≈ 1.25 MAE
+    words = _nearly_constant({"MAE": mae, "MSE": rmse**2, "FIT": fit})  # no SD: derived
+    assert "nearly constant" in words and "MAE 2.1" in words
+    sd = rmse / (1 - fit / 100)
+    assert f"standard deviation {fmt(sd)}" in words
+    assert _nearly_constant({"MAE": 0.2, "MSE": 0.0625, "FIT": 80.0, "SD": 1.25}) == ""
+    # the SD stored by fit_metrics is the population standard deviation of the measured
+    from heritage_bayes.inference.results import fit_metrics
+
+    y = np.array([50.0, 51.0, np.nan, 49.0, 50.5])
+    m = fit_metrics(y, np.full(5, 50.0))
+    assert m["SD"] == pytest.approx(np.nanstd(y))
+
+
+def test_weakly_separated_pairs_are_named_in_words():
+    """Gain and offset of a fixed node that the data trade against each other (r ≈ −1)
+    are named; an independent time constant is not."""
+    from heritage_bayes.report.identifiable import Coord
+    from heritage_bayes.report.sections.identifiability import tradeoff_words
+
+    rng = np.random.default_rng(5)
+    a = rng.normal(size=(8, 50))
+    coords = [
+        Coord("tau_1_h", "log10 τ1 [h]", True, rng.normal(size=(8, 50)), None, None),
+        Coord("gain_Pi_Pe", "gain_Pi_Pe [-]", False, a, None, None),
+        Coord(
+            "offset_Pi_Pf",
+            "offset_Pi_Pf [Pa]",
+            False,
+            -a + 0.1 * rng.normal(size=a.shape),
+            None,
+            None,
+        ),
+    ]
+    words = tradeoff_words(coords)
+    assert len(words) == 1
+    assert words[0].startswith("gain_Pi_Pe [-] and offset_Pi_Pf [Pa] trade off")
+    assert "one rises as the other falls" in words[0]

@@ -46,3 +46,37 @@ def test_small_sbc_thermal_2c_intervals_cover_the_truth():
         below = sum(x["rank"] < 0.5 for x in ranks)
         assert stats.binomtest(below, REPS, 0.5).pvalue > 0.001, f"{q}: ranks one-sided"
     assert np.all([np.isfinite(r["truth"]["tau_1_h"]) for r in results])
+
+
+# ------------------------------------------- the independent generator (issue 31)
+def test_independent_generator_machinery():
+    """One thermal room of ``bench_sbc_independent`` (the full study: 50 replicates per
+    model, its coverage table in the benchmark README): the generator's 10-minute
+    weather is sampled at the hour for the fit, the fit's inputs are the package's
+    (align, Erbs + Perez facade), every listed quantity is ranked, and the mean solar
+    warming's truth uses the generator's own irradiance. The machinery, not the
+    coverage (one replicate cannot say anything about coverage)."""
+    bench = pytest.importorskip("bench_sbc_independent")
+    gw = bench.generator_weather(3)
+    fine, hourly = gw["fine"], gw["hourly"]
+    # the station's hourly readings are the 10-minute series at the full hour
+    np.testing.assert_array_equal(hourly["Te"].to_numpy()[:-1], fine["Te"][:: bench.SUB])
+    frame = bench.fit_inputs(hourly)
+    assert frame.index[0] == gw["t0"] and len(frame) == fine["Te"].size // bench.SUB
+    # align: an instantaneous column's row k is the mean of the readings k and k+1
+    te = hourly["Te"].to_numpy()
+    np.testing.assert_allclose(frame["Te"].to_numpy(), 0.5 * (te[:-1] + te[1:]), atol=1e-9)
+    # another sky model, not another sun: the hourly means agree within 25 %
+    i_gen = fine["I_S"].reshape(-1, bench.SUB).mean(axis=1)
+    ratio = frame["I_S"].sum() / i_gen.sum()
+    assert 0.75 < ratio < 1.25 and abs(ratio - 1) > 1e-3
+    r = bench.replicate(("thermal_2c", 0, ["ar1_white:estimate"], 11, 600, 28))
+    ranks = r["variants"]["ar1_white:estimate"]["ranks"]
+    assert set(bench.QUANTITIES["thermal_2c"]) <= set(ranks)
+    for x in ranks.values():
+        assert 0.0 <= x["rank"] <= 1.0 and x["sd"] > 0
+    t = r["truth"]
+    assert t["solar_warming_K"] == pytest.approx(
+        t["gain_Ti_I_S"] * r["irradiance_mean"]["generator"]
+    )
+    assert t["gain_Ti_Te"] + t["gain_Ti_Tf"] == pytest.approx(1.0)

@@ -292,7 +292,6 @@ def _calibrate_into(
 ) -> None:
     """Calibrate and write every output into ``out`` (the staging folder of ``final``)."""
     t_start = time.perf_counter()
-    chash = config_hash(cfg)
     say = _Progress(quiet)
     # the heavy imports (arviz, scipy.optimize, emcee) only once the config is valid
     from heritage_bayes.inference.coordinates import default_coordinates
@@ -306,6 +305,8 @@ def _calibrate_into(
     t0 = time.perf_counter()
     prep = prepare(cfg)
     t_prep = time.perf_counter() - t0
+    for w in prep.sources.get("clock", {}).get("warnings", []):  # see sources.check_clocks
+        say.warn(w)
     say.say(
         f"data: {prep.n_rows} steps of {prep.dt / 3600:g} h from "
         f"{prep.frame.index[0]} to {prep.frame.index[-1]} "
@@ -422,7 +423,7 @@ def _calibrate_into(
             ladder[s.name] = model_ladder(cfg, prep, s, seed=cfg.seed + 101 * i)
             s.timings["ladder_seconds"] = time.perf_counter() - t0
     t0 = time.perf_counter()
-    idata, summary = build_run_outputs(cfg, prep, sections, chash=chash, seed=cfg.seed)
+    idata, summary = build_run_outputs(cfg, prep, sections, chash=config_hash(cfg), seed=cfg.seed)
     summary["unconverged_reasons"] = unconverged_reasons(summary)  # [] when converged
     t_out = time.perf_counter() - t0
     summary["ladder"] = ladder or None

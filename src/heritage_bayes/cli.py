@@ -139,6 +139,37 @@ def _build_parser() -> argparse.ArgumentParser:
     )
     cmp_.set_defaults(func=_cmd_compare)
 
+    ini = sub.add_parser(
+        "init",
+        help="write a commented config.yaml from a logger file and a weather file",
+        description="Inspect a logger export and a weather file (layout, time column, "
+        "clocks checked against the sun, columns and units, gaps, periods) and write a "
+        "commented configuration. What cannot be decided is left as a '??' question "
+        "that `hbayes calibrate` refuses until answered.",
+    )
+    ini.add_argument("indoor", metavar="INDOOR_FILE", help="logger export (indoor T, RH)")
+    ini.add_argument("--weather", metavar="WEATHER_FILE", required=True, help="weather file")
+    ini.add_argument(
+        "--weather-format",
+        metavar="FMT",
+        choices=["csv", "epw", "knmi", "tmy3"],
+        help="csv, epw, knmi or tmy3 (default: from the file)",
+    )
+    ini.add_argument("--latitude", type=float, metavar="DEG", help="site latitude [° north]")
+    ini.add_argument("--longitude", type=float, metavar="DEG", help="site longitude [° east]")
+    ini.add_argument("--name", help="run name (default: from the output file)")
+    ini.add_argument(
+        "--timezone",
+        metavar="TZ",
+        help="the logger's clock when its header does not name it (UTC+1, Europe/Paris)",
+    )
+    ini.add_argument("--weather-timezone", metavar="TZ", help="the weather file's clock, likewise")
+    ini.add_argument(
+        "-o", "--output", metavar="PATH", default="config.yaml", help="default: config.yaml"
+    )
+    ini.add_argument("--force", action="store_true", help="replace an existing file")
+    ini.set_defaults(func=_cmd_init)
+
     bat = sub.add_parser(
         "batch",
         help="calibrate every room of a portfolio on Dask",
@@ -211,6 +242,27 @@ def _converged_or_3(run_dir) -> int:
         file=sys.stderr,
     )
     return EXIT_UNCONVERGED
+
+
+def _cmd_init(args) -> int:
+    from heritage_bayes.init_config import init_config
+
+    opts = ("weather_format", "latitude", "longitude", "name", "timezone", "weather_timezone")
+    res = init_config(
+        args.indoor,
+        args.weather,
+        output=args.output,
+        force=args.force,
+        **{k: getattr(args, k) for k in opts},
+    )
+    for f in res.findings:
+        print(f"hbayes init: {f}", file=sys.stderr)
+    for q in res.questions:
+        print(f"hbayes init: QUESTION {q}", file=sys.stderr)
+    n = len(res.questions)
+    tail = f"; {n} open question(s) to answer in it before `hbayes calibrate`" if n else ""
+    print(f"{res.path}{tail}")
+    return 0
 
 
 def _cmd_report(args) -> int:

@@ -22,6 +22,7 @@ __all__ = [
     "INPUT_COLUMNS",
     "OUTPUT_COLUMNS",
     "RawData",
+    "check_clocks",
     "input_paths",
     "read_source",
     "read_sources",
@@ -40,10 +41,18 @@ def _quote(names) -> str:
 
 def _csv_header(path: Path, src, where: str) -> list[str]:
     from heritage_bayes.io._common import READ_ERRORS, damaged, sniff_text
+    from heritage_bayes.io.readers.workbook import is_workbook, table_source
 
     try:
-        sniff_text(path, path.name)  # binary, damaged or truncated: say so at once
-        header = pd.read_csv(path, nrows=0, sep=src.sep, encoding="utf-8")
+        if not is_workbook(path):
+            sniff_text(path, path.name)  # binary, damaged or truncated: say so at once
+        header = pd.read_csv(
+            table_source(path)(),
+            nrows=0,
+            sep=src.sep,
+            encoding=None if is_workbook(path) else src.encoding,
+            skiprows=src.skiprows,
+        )
     except DataError as exc:
         raise DataError(f"{where}: {exc}") from None
     except READ_ERRORS as exc:
@@ -96,6 +105,8 @@ def _csv_kwargs(src) -> dict:
         "label": src.label,
         "duplicates": src.duplicates,
         "invalid": src.invalid,
+        "skiprows": src.skiprows,
+        "encoding": src.encoding,
     }
     if src.na_values is not None:
         kw["na_values"] = src.na_values
@@ -121,7 +132,7 @@ def read_source(cfg, src, where: str, allowed: Sequence[str]) -> pd.DataFrame:
     try:
         if src.format == "csv":
             _check_csv_columns(path, src, where, allowed)
-            df = read_csv(path, columns=src.columns, **_csv_kwargs(src))
+            df = read_csv(path, columns=src.columns, units=src.units, **_csv_kwargs(src))
         elif src.format == "epw":
             df = read_epw(path, year=src.year, invalid=src.invalid)
         elif src.format == "tmy3":
@@ -269,11 +280,30 @@ def read_sources(cfg) -> RawData:
             site = weather.attrs.get("site")
             if site is not None:
                 sources["site"] = dict(site) | {"from": "weather file"}
+        sources["clock"] = check_clocks(weather, meas_tables, site)
         sources["weather"] = _source_note(weather, data.weather.format)
         sources["measurements"] = [
             _source_note(m, s.format) for m, s in zip(meas_tables, data.measurements, strict=True)
         ]
     return RawData(weather, meas_tables, site, sources, monument)
+
+
+def check_clocks(weather: pd.DataFrame, measurements: list, site: dict | None) -> dict:
+    """The declared clock of each table against its data
+    (:func:`heritage_bayes.io.clock.check_declared_clock`: the sun, DST changes).
+
+    Returns ``{key: {"sun": ..., "warnings": [...]}, "warnings": [all of them]}``; a
+    warning names the config key and states the measured offset.
+    """
+    from heritage_bayes.io.clock import check_declared_clock
+
+    lon = (site or {}).get("longitude")
+    out = {"data.weather": check_declared_clock(weather, lon, "data.weather")}
+    for i, m in enumerate(measurements):
+        key = "data.measurements" + (f"[{i}]" if len(measurements) > 1 else "")
+        out[key] = check_declared_clock(m, lon, key)
+    out["warnings"] = [w for v in out.values() for w in v["warnings"]]
+    return out
 
 
 def _source_note(df: pd.DataFrame, fmt: str) -> dict:

@@ -47,6 +47,20 @@ def load_inference(run_dirs: Sequence[str | Path] | Mapping[str, str | Path]) ->
     return out
 
 
+def pointwise_terms(idata, var_name: str | None = None) -> xr.Dataset:
+    """The group holding the per-output calibration terms ``var_name`` (``thermal.Ti``).
+
+    A run with one output keeps them in ``log_likelihood``; a run with several keeps
+    their combination there (the default of ``az.loo``) and the per-output terms in
+    ``log_likelihood_outputs`` (see :func:`heritage_bayes.inference.interop.loglik_groups`).
+    """
+    if "log_likelihood_outputs" in idata.groups() and (
+        var_name is None or var_name not in idata.log_likelihood
+    ):
+        return idata["log_likelihood_outputs"]
+    return idata.log_likelihood
+
+
 def _one_var(ds: xr.Dataset, var_name: str | None, where: str) -> str:
     names = list(ds.data_vars)
     if var_name is None:
@@ -86,7 +100,7 @@ def blocked_loo_data(idata, var_name: str | None = None, block_hours: float = 24
     hour); ``az.loo`` on the result leaves out one block at a time, ``az.compare`` ranks
     runs by it. The posterior group is kept for the relative efficiency.
     """
-    ll = idata.log_likelihood
+    ll = pointwise_terms(idata, var_name)
     v = _one_var(ll, var_name, "log_likelihood")
     blocks = _block_sum(ll[v], block_hours)
     return az.InferenceData(

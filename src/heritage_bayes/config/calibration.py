@@ -172,8 +172,12 @@ def parse_config(
     ------
     ConfigError
         One line per wrong key, each naming its key path, what was expected and what was
-        found (an unknown key with the nearest known one).
+        found (an unknown key with the nearest known one); or the open questions ``hbayes
+        init`` left (values starting with ``??``, a ``questions:`` list), each named.
     """
+    from heritage_bayes.questions import check_answered
+
+    check_answered(raw, source)  # `hbayes init`'s '??' values: named before the schema
     cfg = validate(CalibrationConfig, raw, source)
     cfg.base_dir = base_dir
     if cfg.name is None:

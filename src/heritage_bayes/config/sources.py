@@ -111,6 +111,9 @@ _CSV_ONLY = (
     "label",
     "duplicates",
     "na_values",
+    "skiprows",
+    "encoding",
+    "units",
 )
 
 
@@ -178,6 +181,21 @@ class Source(_Strict):
         "raise", unit=None, description="an implausible value: an error, or left out (NaN)"
     )
     year: int | None = key(None, unit=None, description="epw/tmy3: the year a typical year becomes")
+    skiprows: int | list[int] = key(
+        0,
+        unit=None,
+        description="csv: lines before the header, or the 0-based numbers of the lines to "
+        "skip (logger metadata lines: Tinytag, Rotronic; see heritage_bayes.io.loggers)",
+    )
+    encoding: str = key(
+        "utf-8", unit=None, description="csv: text encoding, e.g. utf-8-sig, cp1252"
+    )
+    units: dict[str, str] | None = key(
+        None,
+        unit=None,
+        description="csv: {standard name: unit in the file} for temperatures in °F or K and "
+        "relative humidity as a fraction, converted on reading, e.g. {Ti: °F, RHi: fraction}",
+    )
 
     @model_validator(mode="after")
     def _options_fit_format(self):

@@ -18,6 +18,7 @@ import xarray as xr
 from heritage_bayes._arviz import az
 from heritage_bayes._version import __version__
 from heritage_bayes.climate.psychro import saturation_vapour_pressure
+from heritage_bayes.inference.interop import convergence_stats, loglik_groups
 from heritage_bayes.inference.predictive import (
     _saved_index,
     bounded_predictive,
@@ -245,16 +246,11 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
         loglik.update(_pointwise(s, pw, times[prep.calibration], (W, n_sel)))
         pw = _validation_pointwise(s, prep, Ysim, tn_sel, th_sel)
         loglik_val.update(_pointwise(s, pw, times, (W, n_sel)))
-        # parameter summaries
-        # statistics on all draws the sampler checked; R-hat and ESS in the sampler's
-        # coordinates, exactly as its stopping rule computed them (folded R-hat is not
-        # invariant under the log/logit transforms)
+        # parameter summaries: quantiles on all draws the sampler kept; R-hat and ESS
+        # on the draws posterior.nc holds, so that az.summary reproduces them
         kept = s.theta_kept
         free_vars = [f"{s.name}.{n}" for n in ps.free_names]
-        ds = xr.Dataset({v: (cdims, s.X_kept[..., i]) for i, v in enumerate(free_vars)})
-        rhat = az.rhat(ds[free_vars])
-        ess_b = az.ess(ds[free_vars], method="bulk")
-        ess_t = az.ess(ds[free_vars], method="tail")
+        rhat, ess_b, ess_t = convergence_stats(post, free_vars)
         tau = dict(zip(ps.free_names, s.chain.tau, strict=True))
         truth, truth_dq = _truth_for(cfg, prep, s)
         mapv = dict(zip(names, s.map.theta, strict=True))
@@ -296,8 +292,9 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
             x = dq_all[k].reshape(-1)
             summary_derived[key] = {"unit": units.get(k, ""), **_summ(x), "truth": truth_dq.get(k)}
             if np.all(np.isfinite(x)) and np.ptp(x) > 0:
-                summary_derived[key]["r_hat"] = float(az.rhat(dq_all[k]))
-                summary_derived[key]["ess_bulk"] = float(az.ess(dq_all[k], method="bulk"))
+                r, e, _ = convergence_stats(post, [key])
+                summary_derived[key]["r_hat"] = float(r[key])
+                summary_derived[key]["ess_bulk"] = float(e[key])
         # posterior correlations of the free parameters (log scale where the prior is)
         Y = []
         for j, p in enumerate(ps.parameters):
@@ -418,7 +415,7 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
     groups = {
         "posterior": xr.Dataset(post, coords=coords, attrs=attrs),
         "sample_stats": xr.Dataset(stats, coords=coords, attrs=attrs),
-        "log_likelihood": xr.Dataset(loglik, coords=coords, attrs=attrs),
+        **loglik_groups(loglik, coords, attrs),
         # a bounded number of draws, the bands over all of them (issue 28: the
         # predictive was 75 % of a 130 MB demo run directory)
         "posterior_predictive": xr.Dataset(bounded_predictive(pp), attrs=attrs),

@@ -11,10 +11,15 @@ Run directory (``hbayes calibrate``):
   - ``posterior``: parameters (fixed ones included as constants) and derived
     identifiable quantities (time constants [h], static gains);
   - ``sample_stats``: ``<model>.lp`` (log-posterior), ``<model>.acceptance_rate``;
-  - ``log_likelihood``: ``<model>.<output>``, the pointwise terms of the calibration
-    likelihood, only the hours that enter it (axis ``time.<model>.<output>``: no warm-up,
-    no gap), so ``az.loo``/``az.compare`` work on the InferenceData as it is; with AR(1)
-    noise each term is the density of the hour given the previous residual;
+  - ``log_likelihood``: the pointwise terms of the calibration likelihood, only the
+    hours that enter it (no warm-up, no gap), so ``az.loo(idata)``, ``az.waic(idata)``
+    and ``az.compare`` work on the InferenceData as it is, without ``var_name``: with one
+    output the variable ``<model>.<output>`` (axis ``time.<model>.<output>``), with
+    several one variable ``all_outputs`` holding all of them on an ``observation`` axis
+    (coordinates ``observation_variable``, ``observation_time``); with AR(1) noise each
+    term is the density of the hour given the previous residual;
+  - ``log_likelihood_outputs`` (not an arviz group; runs with several outputs): the
+    per-output terms ``<model>.<output>``;
   - ``log_likelihood_validation`` (not an arviz group): the same over the validation
     period, from the simulation continued past calibration (expected log predictive
     density of new data);
@@ -36,7 +41,8 @@ Run directory (``hbayes calibrate``):
   float32 rounded to 12 mantissa bits (relative error at most 1.2e-4, i.e. below 1e-3
   nats per hour). See :func:`write_inference_data` for the demo's sizes.
 
-- ``summary.json``: per parameter median, 5 %, 95 %, r_hat, ess_bulk, ess_tail, τ; fit
+- ``summary.json``: per parameter median, 5 %, 95 %, r_hat, ess_bulk, ess_tail (those
+  of the saved draws: ``az.summary`` of ``posterior.nc`` gives the same), τ; fit
   metrics; convergence verdict; MAP; identifiability.
 - ``config.yaml``: the resolved config.
 
@@ -169,13 +175,17 @@ def fit_metrics(measured: np.ndarray, simulated: np.ndarray) -> dict[str, float]
     dict
         ``MSE`` = :math:`\\frac1N\\sum(y'-y)^2` [unit²], ``MAE`` = :math:`\\frac1N\\sum|y'-y|`
         [unit], ``FIT`` = :math:`100\\,(1 - \\|y'-y\\| / \\|y'-\\bar{y}'\\|)` [%]
-        (Kramer, van Schijndel & Schellen; Ljung's goodness of fit), and ``n``.
+        (Kramer, van Schijndel & Schellen; Ljung's goodness of fit), ``SD`` the
+        standard deviation of the measured signal [unit] (FIT's yardstick: on a nearly
+        constant series, e.g. a humidistat-held RH, FIT is strongly negative whatever
+        the accuracy; read MAE there), and ``n``.
     """
     m = np.asarray(measured, dtype=float)
     s = np.asarray(simulated, dtype=float)
     ok = np.isfinite(m) & np.isfinite(s)
     if ok.sum() < 2:
-        return {"MSE": float("nan"), "MAE": float("nan"), "FIT": float("nan"), "n": int(ok.sum())}
+        nan = float("nan")
+        return {"MSE": nan, "MAE": nan, "FIT": nan, "SD": nan, "n": int(ok.sum())}
     e = m[ok] - s[ok]
     denom = np.linalg.norm(m[ok] - m[ok].mean())
     fit = 100.0 * (1.0 - np.linalg.norm(e) / denom) if denom > 0 else float("nan")
@@ -183,6 +193,7 @@ def fit_metrics(measured: np.ndarray, simulated: np.ndarray) -> dict[str, float]
         "MSE": float(np.mean(e**2)),
         "MAE": float(np.mean(np.abs(e))),
         "FIT": float(fit),
+        "SD": float(denom / np.sqrt(ok.sum())),
         "n": int(ok.sum()),
     }
 

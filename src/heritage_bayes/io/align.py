@@ -445,13 +445,15 @@ def align(
         outputs=out_names,
         averaged_inputs=tuple(s.name for s in inputs if s.averaged),
         max_gap=max_gap,
+        # distinct time stamps: tables derived from one record (its facade irradiance)
+        # share its rows and are not counted twice
         rows_in={
-            "weather": int(sum(len(df) for df in wframes)),
-            "measurements": int(sum(len(df) for df in mframes)),
+            "weather": int(_stamps(wframes).size),
+            "measurements": int(_stamps(mframes).size),
         },
         rows_dropped={
-            "weather": int(sum(_outside(df.index.asi8, s0, e0) for df in wframes)),
-            "measurements": int(sum(_outside(df.index.asi8, s0, e0) for df in mframes)),
+            "weather": _outside(_stamps(wframes), s0, e0),
+            "measurements": _outside(_stamps(mframes), s0, e0),
         },
         interpolated=interpolated,
         flagged_rows={k: int(flag_cols[k].sum()) for k in in_names},
@@ -465,6 +467,13 @@ def align(
 
 def _fmt(ns: int) -> str:
     return f"{pd.Timestamp(ns, tz='UTC'):%Y-%m-%d %H:%M} UTC"
+
+
+def _stamps(frames: Sequence[pd.DataFrame]) -> np.ndarray:
+    """The distinct time stamps [ns] of a role's tables."""
+    if not frames:
+        return np.empty(0, dtype=np.int64)
+    return np.unique(np.concatenate([df.index.asi8 for df in frames]))
 
 
 def _outside(t: np.ndarray, lo: int, hi: int) -> int:

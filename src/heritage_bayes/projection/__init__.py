@@ -24,6 +24,14 @@ change relative to the baseline, probability statements, the uncertainty
 decomposition, the indicator registry, the weather transformations, timings),
 ``projection.csv`` (one row per indicator and case, with name, unit, period and source)
 and ``projection.html`` (self-contained decision page).
+
+Measures (``interventions:``, :mod:`heritage_bayes.projection.interventions`):
+conservation heating, a dehumidifier, less ventilation — each simulated draw by draw
+with the same parameters, noise and weather as doing nothing, in every case. Their
+indicators (``<indicator>_measure``) and running costs (``cost_<name>``) per measure,
+case and draw are in ``projection.nc``; the paired comparison (change with interval,
+P(better), probability statements with and without, costs with intervals) in
+``projection.json`` (``interventions``) and on the page.
 """
 
 from __future__ import annotations
@@ -92,6 +100,8 @@ class Projection:
     summary: dict
     dataset: object = None
     paths: dict = field(default_factory=dict)
+    #: measure name -> per-case results with the measure (paired with ``results``)
+    interventions: dict = field(default_factory=dict)
 
     def probability_table(self):
         """pandas.DataFrame: probability statements (rows) × cases (columns)."""
@@ -154,6 +164,7 @@ def project(
     """
     from heritage_bayes.climate.risk.registry import indicator_info, years_of
     from heritage_bayes.projection.engine import select_draws, simulate_cases
+    from heritage_bayes.projection.interventions import compare_measures, measures_from_config
     from heritage_bayes.projection.summary import summarize
     from heritage_bayes.projection.weather import Case, baseline_weather, futures, model_inputs
     from heritage_bayes.run import Run, load_run
@@ -191,20 +202,36 @@ def project(
     converged = bool(r.summary.get("converged", True))
     if not converged and progress is not None:
         progress(f"WARNING: {UNCONVERGED_TEXT} ({r.path})")
-    results = simulate_cases(
-        r,
-        sel,
-        [c.inputs for c in cases],
-        seed=pcfg.seed,
-        noise=pcfg.noise,
-        chunk=pcfg.risk.chunk_draws,
-        risk_options=risk_opts,
-        progress=progress,
-    )
+    measures = measures_from_config(pcfg)
+    for m in measures:  # refused before the long part
+        m.check(r)
+
+    def run_cases(measure=None):
+        return simulate_cases(
+            r,
+            sel,
+            [c.inputs for c in cases],
+            seed=pcfg.seed,
+            noise=pcfg.noise,
+            chunk=pcfg.risk.chunk_draws,
+            risk_options=risk_opts,
+            progress=progress,
+            measure=measure,
+        )
+
+    results = run_cases()
     labels = [c.label for c in cases]
     horizons = [c.horizon for c in cases]
     units = dict(results[0].predictive.attrs.get("units", {}))
     summary = summarize(labels, horizons, results, labels[0], pcfg.thresholds, units)
+    per_measure = {}
+    for m in measures:  # paired with doing nothing: same draws, noise seed and weather
+        if progress is not None:
+            progress(f"intervention {m.name!r}")
+        per_measure[m.name] = run_cases(m)
+    summary["interventions"] = compare_measures(
+        labels, results, per_measure, pcfg.thresholds, units, {m.name: m.notes(r) for m in measures}
+    )
     summary["cases"] = [
         {
             "label": c.label,
@@ -231,8 +258,15 @@ def project(
     summary["seconds"] = {
         "total": time.perf_counter() - t_start,
         **{k: float(sum(res.seconds[k] for res in results)) for k in ("simulate", "noise", "risk")},
+        "interventions": float(
+            sum(
+                res.seconds["simulate"] + res.seconds["risk"]
+                for rs in per_measure.values()
+                for res in rs
+            )
+        ),
     }
-    proj = Projection(pcfg, labels, horizons, results, summary)
+    proj = Projection(pcfg, labels, horizons, results, summary, interventions=per_measure)
     from heritage_bayes.projection.output import to_dataset, write_outputs
 
     proj.dataset = to_dataset(proj, r)

@@ -34,6 +34,22 @@ calibration config); default the calibration's own weather. A baseline or future
 whose site lies more than 50 km from the calibration's is refused unless
 ``allow_other_site: true``. Relative paths are relative to the projection file.
 
+Interventions (``interventions``, :mod:`heritage_bayes.projection.interventions`):
+named changes to the calibrated room, each simulated draw by draw with the same
+parameters, noise and weather as doing nothing, on the baseline and every future::
+
+    interventions:
+      - name: conservation heating
+        conservation_heating: {rh_max: 65, t_min: 5, t_max: 20, power_max: 3000}
+      - name: dehumidifier
+        dehumidification: {rh_max: 60, capacity: 0.5, energy_per_kg: 0.7}
+      - name: half the ventilation
+        ventilation: {factor: 0.5}
+      - name: heating for services
+        heating: {t_set: 8, t_use: 16, weekly: ["Sun 08-12"], timezone: UTC+1}
+
+(``ventilation`` combines with any other; ``heating`` with ``dehumidification``.)
+
 Probability statements (``thresholds``), on any indicator the projection computes
 (:mod:`heritage_bayes.climate.risk.registry`; an unknown name is refused with the list)::
 
@@ -51,7 +67,14 @@ from typing import Any, Literal
 from pydantic import Field, ValidationError, field_validator, model_validator
 
 from heritage_bayes.climate.morph import KNMI14_SCENARIOS
-from heritage_bayes.config import GroundTemperature, Source, _format_error, _Strict, read_yaml
+from heritage_bayes.config import (
+    GroundTemperature,
+    Source,
+    _format_error,
+    _Strict,
+    key,
+    read_yaml,
+)
 from heritage_bayes.errors import ConfigError, check_known_keys
 
 __all__ = ["ProjectionConfig", "load_projection_config", "parse_projection_config"]
@@ -115,6 +138,127 @@ class Threshold(_Strict):
         return self
 
 
+class ConservationHeating(_Strict):
+    """Heating so that the indoor RH stays at or below ``rh_max`` (Staniforth 2006),
+    within ``[t_min, t_max]`` and up to ``power_max``."""
+
+    rh_max: float = key(
+        unit="%", gt=0, le=100, description="RH the heating keeps the air at or below"
+    )
+    t_min: float | None = key(
+        None, unit="°C", description="heating floor: the air is never colder (default none)"
+    )
+    t_max: float = key(
+        unit="°C",
+        description="the heating never raises the air above this temperature; the RH "
+        "limit then yields (comfort, collection, energy)",
+    )
+    power_max: float | None = key(
+        None, unit="W", gt=0, description="heating power available (default unlimited)"
+    )
+
+    @model_validator(mode="after")
+    def _limits(self):
+        if self.t_min is not None and self.t_min >= self.t_max:
+            raise ValueError(f"t_min ({self.t_min}) must be below t_max ({self.t_max})")
+        return self
+
+
+class Heating(_Strict):
+    """A thermostat: the air heated to ``t_set`` and, in the hours of use of a weekly
+    calendar, to ``t_use`` (intermittent heating of a church), up to ``power_max``."""
+
+    t_set: float = key(unit="°C", description="set-point outside the hours of use")
+    t_use: float | None = key(
+        None, unit="°C", description="set-point in the hours of use (needs weekly)"
+    )
+    weekly: list[str] | None = key(
+        None,
+        unit=None,
+        description="hours of use, e.g. ['Sun 08-12', 'Sat 18-20'] (heritage_bayes.rc.calendar)",
+    )
+    timezone: str = key("UTC", unit=None, description="time zone of the weekly hours")
+    power_max: float | None = key(
+        None, unit="W", gt=0, description="heating power available (default unlimited)"
+    )
+
+    @model_validator(mode="after")
+    def _use(self):
+        if (self.t_use is None) != (self.weekly is None):
+            raise ValueError("give t_use and weekly together (or neither)")
+        if self.weekly is not None:
+            from heritage_bayes.rc.calendar import parse_weekly
+
+            parse_weekly({"weekly": self.weekly, "timezone": self.timezone}, "heating")
+        return self
+
+
+class Dehumidification(_Strict):
+    """A humidistat-controlled dehumidifier: RH at or below ``rh_max``, at most
+    ``capacity`` of water removed."""
+
+    rh_max: float = key(unit="%", gt=0, le=100, description="RH kept at or below")
+    capacity: float = key(
+        unit="kg/h", ge=0, description="water the dehumidifier can remove per hour"
+    )
+    energy_per_kg: float | None = key(
+        None,
+        unit="kWh/kg",
+        ge=0,
+        description="electric energy per kg of water removed (the unit's data sheet); "
+        "without it, the running cost is the water removed only",
+    )
+
+
+class Ventilation(_Strict):
+    """The air exchange scaled: ``Gfast`` of the hygric model (ventilation) and of the
+    thermal model (ventilation and glazing: the thermal model lumps them)."""
+
+    factor: float = key(
+        unit="-", ge=0, description="factor on the calibrated air exchange (0.5: half)"
+    )
+
+
+class Intervention(_Strict):
+    """A named measure: a change to the calibrated room (``ventilation`` combines with
+    any other, ``heating`` with ``dehumidification``)."""
+
+    name: str = key(unit=None, min_length=1, description="name on the page and in outputs")
+    conservation_heating: ConservationHeating | None = key(
+        None, unit=None, description="heat to keep the RH down"
+    )
+    heating: Heating | None = key(
+        None, unit=None, description="a thermostat with an optional weekly schedule"
+    )
+    dehumidification: Dehumidification | None = key(
+        None, unit=None, description="a dehumidifier with a humidistat"
+    )
+    ventilation: Ventilation | None = key(None, unit=None, description="scale the air exchange")
+
+    @model_validator(mode="after")
+    def _one(self):
+        if all(
+            x is None
+            for x in (self.conservation_heating, self.heating, self.dehumidification,
+                      self.ventilation)
+        ):  # fmt: skip
+            raise ValueError(
+                "give a change: conservation_heating, heating, dehumidification or ventilation"
+            )
+        if self.conservation_heating is not None and self.heating is not None:
+            raise ValueError(
+                "conservation_heating and heating are both thermostats; give one (the "
+                "conservation heating's t_min is a heating floor)"
+            )
+        if self.conservation_heating is not None and self.dehumidification is not None:
+            raise ValueError(
+                "conservation_heating and dehumidification in one measure are not "
+                "supported (each controller needs the other's air state); give them as "
+                "two measures"
+            )
+        return self
+
+
 #: Default probability statements (IPI-style risk limits of heritage_bayes.climate.risk;
 #: EN 15757: more hours outside the baseline band than the baseline climate itself can
 #: spend outside it, 14 % = below the 7th plus above the 93rd percentile).
@@ -148,6 +292,12 @@ class ProjectionConfig(_Strict):
     noise: bool = Field(default=True, description="add a draw of each section's noise model")
     risk: RiskOptions = Field(default_factory=RiskOptions)
     thresholds: list[Threshold] = Field(default_factory=lambda: list(DEFAULT_THRESHOLDS))
+    interventions: list[Intervention] = key(
+        default_factory=list,
+        unit=None,
+        description="measures compared with doing nothing, draw by draw "
+        "(heritage_bayes.projection.interventions)",
+    )
     base_dir: str | None = Field(default=None, description="set by the loader")
 
     @model_validator(mode="after")
@@ -161,6 +311,9 @@ class ProjectionConfig(_Strict):
                 "humidity: 'table' takes the RHe change from morphing tables; KNMI'14 and "
                 "future files have none (use constant_rh or constant_vapour_pressure)"
             )
+        names = [m.name for m in self.interventions]
+        if len(set(names)) != len(names):
+            raise ValueError(f"interventions: repeated names {names}")
         seen = set()
         for s, h in self.cases():
             if (s, h) in seen:

@@ -60,6 +60,9 @@ class CaseResult:
     annual_predictive: np.ndarray | None = None
     annual_parametric: np.ndarray | None = None
     annual_names: tuple = ()
+    #: draws × running costs of an intervention
+    #: (:data:`heritage_bayes.projection.interventions.COSTS`), empty for doing nothing
+    costs: pd.DataFrame | None = None
 
 
 def select_draws(run, n: int | None, seed: int) -> Draws:
@@ -163,6 +166,7 @@ def simulate_cases(
     risk_options: dict | None = None,
     progress=None,
     baseline: bool = True,
+    measure=None,
 ) -> list[CaseResult]:
     """Predictive simulation and risk of every draw on each weather (streamed by chunks).
 
@@ -228,6 +232,11 @@ def simulate_cases(
             f"run {run.path}: data.step is {dt:g} s; the risk indicators need an hourly grid"
         )
     w = int(init_steps or run.summary.get("init_steps", 720))
+    if measure is not None:
+        measure.check(run)
+        draws = Draws(
+            draws.index, measure.params(run, draws.model), draws.noise, draws.noise_models
+        )
     opts = dict(risk_options or {})
     plan_opts = {k: v for k, v in opts.items() if k not in ("nan_policy", "chunk_size")}
     from heritage_bayes.climate.risk.registry import complete_year_hours
@@ -243,7 +252,8 @@ def simulate_cases(
         plan = fused_plan(len(inp), func="assess_batch", **plan_opts)  # checks options
         Ut = {s: np.ascontiguousarray(u.T) for s, u in U.items()}
         mode = (1 if not cases else 2) if baseline else 0
-        cases.append(_Case(U, Ut, starts, months, plan, len(inp), hour_of_year(inp.index), mode))
+        hoy = hour_of_year(inp.index)
+        cases.append(_Case(U, Ut, starts, months, plan, len(inp), hoy, mode, inp.index))
     K = draws.index.size
     out = [_CaseOut.empty(c, K) for c in cases]
     slots = max(1, min(numba.get_num_threads(), chunk, K))
@@ -271,7 +281,11 @@ def simulate_cases(
             if i + 1 < len(chunks):
                 ahead = pool.submit(draw_noise, i + 1)
             t0 = time.perf_counter()
-            modal = {s: _modal_form(m, draws.model[s][sl], dt) for s, m in run.models.items()}
+            modal = {
+                s: None if measure is not None and measure.controlled else
+                _modal_form(m, draws.model[s][sl], dt)
+                for s, m in run.models.items()
+            }  # fmt: skip
             t_modal = (time.perf_counter() - t0) / len(cases)
             for c, o in zip(cases, out, strict=True):
                 o.seconds["noise"] += t_noise / sum(cc.N == c.N for cc in cases)
@@ -280,7 +294,9 @@ def simulate_cases(
                     work[key] = _work(c.plan, slots, c.N)
                 e = e_all.get(c.N) if noise else None
                 aw = (bands, annual_work)
-                _run_chunk(run, draws, c, o, sl, modal, e, dt, w, work[key], aw, t_modal, opts)
+                _run_chunk(
+                    run, draws, c, o, sl, modal, e, dt, w, work[key], aw, t_modal, opts, measure
+                )
             del e_all
             if progress is not None:
                 progress(
@@ -300,6 +316,7 @@ class _Case:
     N: int
     hoy: np.ndarray  # (N,) hour of the year of each hour
     mode: int  # 1: the baseline (builds each draw's EN 15757 band), 2: judged by it, 0: none
+    index: pd.DatetimeIndex | None = None  # time of each hour (an intervention's calendar)
 
     def en_params(self) -> tuple[np.ndarray, int]:
         """(en, en_col) of :func:`heritage_bayes.projection._stream.chunk_kernel`."""
@@ -334,6 +351,7 @@ class _CaseOut:
     seconds: dict
     apar: np.ndarray
     apred: np.ndarray
+    costs: dict
 
     @classmethod
     def empty(cls, c: _Case, K: int) -> _CaseOut:
@@ -350,6 +368,7 @@ class _CaseOut:
             seconds={"simulate": 0.0, "noise": 0.0, "risk": 0.0},
             apar=np.empty((K, ny, len(ANNUAL))),
             apred=np.empty((K, ny, len(ANNUAL))),
+            costs={},
         )
 
     def result(self, c: _Case) -> CaseResult:
@@ -377,6 +396,7 @@ class _CaseOut:
             annual_predictive=self.apred,
             annual_parametric=self.apar,
             annual_names=names,
+            costs=pd.DataFrame(self.costs),
         )
 
 
@@ -428,14 +448,33 @@ def _work(plan, slots: int, N: int) -> tuple:
     )
 
 
-def _run_chunk(run, draws, c: _Case, o: _CaseOut, sl, modal, e, dt, w, work, aw, t_modal, opts):
+def _controlled(run, draws, c: _Case, o: _CaseOut | None, rows, dt, w, measure) -> dict:
+    """Noise-free ``Ti``, ``Pi`` (section -> (k, N)) of draws ``rows`` with the
+    measure's controllers; their running costs stored in ``o``."""
+    u0 = {s: c.U[s][: max(1, w)].mean(axis=0) for s in run.models}
+    P = {s: draws.model[s][rows] for s in run.models}
+    Y, costs = measure.simulate(run, P, c.U, u0, dt, index=c.index)
+    if o is not None:
+        K = o.par.shape[0]
+        for name, v in costs.items():
+            o.costs.setdefault(name, np.full(K, np.nan))[rows] = v
+    return Y
+
+
+def _run_chunk(
+    run, draws, c: _Case, o: _CaseOut, sl, modal, e, dt, w, work, aw, t_modal, opts, measure=None
+):
     from heritage_bayes.projection._stream import chunk_kernel
 
     t0 = time.perf_counter()
     Y, M, U = {}, {}, {}
+    if measure is not None and measure.controlled:
+        Y = _controlled(run, draws, c, o, sl, dt, w, measure)
     for s, m in run.models.items():
         u0 = c.U[s][: max(1, w)].mean(axis=0)  # steady state of the first window
-        if modal[s] is None:
+        if s in Y:
+            M[s], U[s] = _NO_MODAL, np.zeros((1, 1))
+        elif modal[s] is None:
             Y[s] = np.ascontiguousarray(
                 m.forward(draws.model[s][sl], c.U[s], dt, u_init=u0)[0][..., 0]
             )
@@ -461,20 +500,23 @@ def _run_chunk(run, draws, c: _Case, o: _CaseOut, sl, modal, e, dt, w, work, aw,
     )  # fmt: skip
     bad = np.flatnonzero((spar != 0) | (spred != 0))
     if bad.size:
-        _recompute(run, draws, c, o, sl, bad, e, dt, w, opts, aw)
+        _recompute(run, draws, c, o, sl, bad, e, dt, w, opts, aw, measure)
     o.seconds["risk"] += time.perf_counter() - t0
 
 
-def _recompute(run, draws, c: _Case, o: _CaseOut, sl, bad, e, dt, w, opts, aw):
+def _recompute(run, draws, c: _Case, o: _CaseOut, sl, bad, e, dt, w, opts, aw, measure=None):
     """Draws the compiled pass handed back (a missing hour, or a series that
     :func:`assess_batch` rejects): the numpy path, with its NaN policy and its errors."""
     from heritage_bayes.climate.risk import assess_batch
 
     rows = np.arange(sl.start, sl.stop)[bad]
     ys = {}
+    if measure is not None and measure.controlled:
+        ys = _controlled(run, draws, c, None, rows, dt, w, measure)
     for s, m in run.models.items():
         u0 = c.U[s][: max(1, w)].mean(axis=0)
-        ys[s] = m.forward(draws.model[s][rows], c.U[s], dt, u_init=u0)[0][..., 0]
+        if s not in ys:
+            ys[s] = m.forward(draws.model[s][rows], c.U[s], dt, u_init=u0)[0][..., 0]
     from heritage_bayes.projection._stream import _annual_row
 
     (bpar, bpred), (mabuf, cbuf) = aw

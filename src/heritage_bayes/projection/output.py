@@ -81,6 +81,8 @@ def to_dataset(proj, run):
             arr,
             {"unit": unit, "description": f"mean {name} by calendar month over the case's years"},
         )
+    if proj.interventions:
+        _measures(proj, data, coords, units)
     ds = xr.Dataset(
         {k: xr.DataArray(v[1], dims=v[0], attrs=v[2]) for k, v in data.items()}, coords=coords
     )
@@ -95,6 +97,35 @@ def to_dataset(proj, run):
         }
     )
     return ds
+
+
+def _measures(proj, data: dict, coords: dict, units: dict) -> None:
+    """Per measure, case and draw: each indicator with the measure (``<name>_measure``,
+    predictive, paired with ``<name>``) and each running cost (``cost_<name>``, NaN
+    where the measure has none)."""
+    from heritage_bayes.projection.interventions import COSTS
+    from heritage_bayes.projection.summary import numeric_columns
+
+    names = list(proj.interventions)
+    coords["measure"] = np.array(names, dtype=str)
+    runs = [proj.interventions[m] for m in names]
+    K = len(proj.results[0].predictive)
+    for n in numeric_columns(proj.results[0].predictive):
+        arr = np.stack([np.stack([r.predictive[n].to_numpy(float) for r in rs]) for rs in runs])
+        data[f"{n}_measure"] = (
+            ("measure", "case", "draw"),
+            arr.astype(np.float32),
+            {"unit": units.get(n, ""), "kind": "predictive, with the measure"},
+        )
+    for c, (unit, desc) in COSTS.items():
+        arr = np.full((len(names), len(proj.labels), K), np.nan, np.float32)
+        for i, rs in enumerate(runs):
+            for j, r in enumerate(rs):
+                if r.costs is not None and c in r.costs.columns:
+                    arr[i, j] = r.costs[c].to_numpy(float)
+        if np.isfinite(arr).any():
+            data[f"cost_{c}"] = (("measure", "case", "draw"), arr, {"unit": unit,
+                                 "description": desc})  # fmt: skip
 
 
 def indicator_table(proj):

@@ -7,7 +7,9 @@ per indicator (human name and unit from :mod:`heritage_bayes.climate.risk.regist
 the baseline and each scenario with its interval, the change against the baseline and
 the probability that it is worse; the probability of crossing each named threshold;
 the seasonal cycle of the indoor T and RH (baseline vs scenarios, with bands); the
-distributions of the key indicators per scenario; where the uncertainty comes from
+distributions of the key indicators per scenario; the measures (interventions) against
+doing nothing (:mod:`heritage_bayes.projection.interventions_page`); where the
+uncertainty comes from
 (figure and table of the decomposition of :mod:`heritage_bayes.projection.summary`);
 what every indicator means (definition, source, period); the weather used.
 
@@ -368,6 +370,9 @@ def render_projection_page(proj, run) -> str:
     )
     seasonal = _fig_seasonal(proj)
     risk = _fig_risk(proj)
+    from heritage_bayes.projection.interventions_page import interventions_html
+
+    measures = interventions_html(proj, run, KEY_INDICATORS, _colour, _legend_below)
     sections = [
         Section(
             "What the projection assumes", f"<ul>{assumptions}</ul>", id="assumptions", lead=lead
@@ -386,6 +391,11 @@ def render_projection_page(proj, run) -> str:
             if risk
             else "<p>No key indicator computed.</p>",
             id="risk",
+        ),
+        *(
+            [Section("Measures against doing nothing", measures, id="interventions")]
+            if measures
+            else []
         ),
         Section("Where the uncertainty comes from", _split_html(proj), id="uncertainty"),
         Section("Indicators", _registry_html(proj), id="indicators"),

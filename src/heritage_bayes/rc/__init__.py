@@ -11,7 +11,13 @@ from heritage_bayes.rc.derived import (
     static_gains,
     time_constants,
 )
-from heritage_bayes.rc.discretize import ModalForm, discretize, modal_form
+from heritage_bayes.rc.discretize import (
+    ModalForm,
+    discretize,
+    discretize_foh,
+    foh_weights,
+    modal_form,
+)
 from heritage_bayes.rc.identify import structural_identifiability
 from heritage_bayes.rc.identify_result import IdentifiabilityResult, NullDirection
 from heritage_bayes.rc.model import RCModel
@@ -34,6 +40,8 @@ __all__ = [
     "derived_quantities",
     "derived_units",
     "discretize",
+    "discretize_foh",
+    "foh_weights",
     "iter_simulate",
     "modal_form",
     "model",

@@ -97,6 +97,8 @@ class Control:
         The weekly calendar that generates the schedule column :data:`HOURS_OF_USE`.
     conservation : bool
         Conservation heating: the set-point also keeps RH <= ``RH_ch`` (input ``Pi``).
+    t_max : float
+        Upper limit [°C] of the conservation-heating set-point (default none).
     humidistat : str or None
         One of ``band``, ``dehumidifier``, ``humidifier``, ``setpoint``.
     capacity : bool
@@ -116,6 +118,10 @@ class Control:
     capacity: bool = False
     source: bool = False
     enabled: frozenset = frozenset(COMPONENTS)
+    #: Conservation heating never raises the air above this temperature [°C] (the
+    #: upper limit of an intervention: a conservation-heating set-point is capped at
+    #: it, the RH limit then yields); not a parameter, so calibrated draws still apply.
+    t_max: float = math.inf
 
     @property
     def active(self) -> bool:
@@ -379,7 +385,17 @@ class ControlledModel(RCModel):
 
     # ------------------------------------------------------------------ simulation
     def forward(
-        self, P, U, dt, *, u_init=None, x0=None, effort: bool = False, max_block: int = 2**22
+        self,
+        P,
+        U,
+        dt,
+        *,
+        u_init=None,
+        x0=None,
+        effort: bool = False,
+        max_block: int = 2**22,
+        spin_up: int = 0,
+        control_inputs=None,
     ):
         """Controlled simulation of a batch: outputs (K, N, n_out) and validity (K,).
 
@@ -399,6 +415,20 @@ class ControlledModel(RCModel):
             dehumidification < 0; the constant source not included).
         max_block : int
             Forcing values held in memory at once (doubles).
+        spin_up : int
+            Instead of the mean-flow correction of ``u_init``'s steady state, run the
+            controller over the first ``spin_up`` steps from the free-running steady
+            state and add the state difference it made (controlled minus free-running
+            at the end) to that steady state (periodic spin-up: with a year of hourly
+            weather, its end is the start of the next; a controller that never acts
+            starts exactly where the free-running model does). For
+            capacity-limited controllers that have not reached their bound within the
+            720 steps of the mean-flow correction (slow rooms, small capacities).
+        control_inputs : (K, N, c) array, optional
+            The control inputs (``Ti``, ``Pi``, the schedule: the last ``c`` of
+            :attr:`input_names`) of each parameter set, instead of ``U``'s columns
+            (a projection's simulated ``Ti`` per draw); ``U`` may then hold the
+            network's inputs only.
         """
         from heritage_bayes.rc.discretize import modal_form
 
@@ -408,7 +438,17 @@ class ControlledModel(RCModel):
         N = U.shape[0]
         mf = modal_form(self, P, dt)
         valid = mf.valid & self._control_ok(P)
-        Un, Uc = U[:, : self._m_net], U[:, self._m_net :]
+        # contiguous: the forcing product below is 10x slower on a strided view
+        Un = np.ascontiguousarray(U[:, : self._m_net])
+        if control_inputs is None:
+            Uc = U[None, :, self._m_net :]  # one control signal for every walker
+        else:
+            Uc = np.asarray(control_inputs, dtype=float)
+            if Uc.shape != (K, N, len(self._control_inputs)):
+                raise ValueError(
+                    f"control_inputs: expected shape {(K, N, len(self._control_inputs))} "
+                    f"({list(self._control_inputs)} per parameter set), got {Uc.shape}"
+                )
         air = int(self._ix["out"][0])
         # modal response to a unit flow into the air node: continuous and one-step ZOH
         bz = mf.s[:, air, None] * mf.V[:, air, :]  # (K, n)
@@ -430,12 +470,21 @@ class ControlledModel(RCModel):
         ad = np.ascontiguousarray(mf.ad)
         rows = max(256, max_block // max(ecat.size, 1))
 
-        def run(Uin, z, Y, Q):
+        def run(Uin, z, Y, Q, control=True):
+            kw = _rows(c) if control else {**_rows(c), "mode": 0}
             for k0 in range(0, Uin.shape[0], rows):
                 W = Uin[k0 : k0 + rows] @ Bcat + ecat
-                _control_run(ad, W, bd, Cz, z, Y, Q, k0, **_rows(c))
+                _control_run(ad, W, bd, Cz, z, Y, Q, k0, **kw)
 
-        if x0 is None and c["on"]:
+        if x0 is None and c["on"] and spin_up > 0:
+            # the state the control has moved the room by, added to the steady state
+            n0 = min(N, int(spin_up))
+            zc, zf = z0.copy(), z0.copy()
+            yb, q = np.empty((K, n0, Cz.shape[1])), np.zeros((K, n0))
+            run(Un[:n0], zc, yb, q)
+            run(Un[:n0], zf, yb, q, control=False)
+            z0 = np.ascontiguousarray(z0 + (zc - zf))
+        elif x0 is None and c["on"]:
             # one controller pass over the start to put the mean control flow in the
             # initial steady state (the heating floor reaches the slow envelope modes)
             n0 = min(N, 720)
@@ -453,24 +502,26 @@ class ControlledModel(RCModel):
         return (Y, valid, Q) if effort else (Y, valid)
 
     def _controller_arrays(self, P: np.ndarray, Uc: np.ndarray) -> dict:
-        """Per-walker controller parameters and per-step signals for the kernel."""
+        """Per-walker controller parameters and per-step signals for the kernel
+        (``Uc``: (1 or K, N, c); the signals (1 or K, N))."""
         from heritage_bayes.climate.psychro import saturation_vapour_pressure
 
         c, on = self.control, self.control.enabled
-        K, N = P.shape[0], Uc.shape[0]
-        cols = {u: Uc[:, i] for i, u in enumerate(self._control_inputs)}
+        K, N = P.shape[0], Uc.shape[1]
+        cols = {u: Uc[:, :, i] for i, u in enumerate(self._control_inputs)}
         inf = np.full(K, np.inf)
         zero = np.zeros(K)
         out = {
             "mode": 0,
+            "t_max": float(c.t_max),
             "lo0": zero,
             "lo1": zero,
             "hi1": zero,
             "qadd": zero,
             "qrem": zero,
             "rh_ch": zero,
-            "s": np.zeros(N),
-            "pv": np.zeros(N),
+            "s": np.zeros((1, N)),
+            "pv": np.zeros((1, N)),
             "on": False,
             "src": self._cp(P, "Qs") if "Qs" in self.parameter_names else self._cp(P, "Ms"),
         }
@@ -514,6 +565,7 @@ def _rows(c: dict) -> dict:
         "qadd": c["qadd"],
         "qrem": c["qrem"],
         "rh_ch": c["rh_ch"],
+        "t_max": c["t_max"],
         "sig": c["s"],
         "pv": c["pv"],
     }
@@ -531,7 +583,7 @@ def _t_at_rh(pv, rh):  # pragma: no cover - compiled
 
 @numba.njit(cache=True, nogil=True)
 def _control_run(
-    ad, W, bd, Cz, z, Y, Q, k0, mode, lo0, lo1, hi1, qadd, qrem, rh_ch, sig, pv
+    ad, W, bd, Cz, z, Y, Q, k0, mode, lo0, lo1, hi1, qadd, qrem, rh_ch, t_max, sig, pv
 ):  # pragma: no cover - compiled
     """Controlled modal recursion (see the module docstring) over the rows of W, in place.
 
@@ -541,9 +593,12 @@ def _control_run(
     the air node at the end of step k: thermostat ``lo = lo0 + lo1 sig[k]`` (and the
     temperature at RH ``rh_ch`` of ``pv[k]``), no upper bound; humidistat
     ``lo = lo1 sig[k]``, ``hi = hi1 sig[k]`` (``sig`` = saturation pressure at the
-    indoor temperature).
+    indoor temperature). ``sig``, ``pv``: (1, N) one signal for every walker, or
+    (K, N) one per walker.
     """
     K, n = ad.shape
+    s_each = sig.shape[0] > 1
+    p_each = pv.shape[0] > 1
     Nb = W.shape[0]
     n_out = Cz.shape[1]
     zf = np.empty(n)
@@ -555,6 +610,8 @@ def _control_run(
         k = k0 + kb
         for p in range(K):
             base = p * n
+            ps = p if s_each else 0
+            pp = p if p_each else 0
             for o in range(n_out):
                 acc = 0.0
                 for j in range(n):
@@ -566,9 +623,11 @@ def _control_run(
                 yf += Cz[p, 0, j] * zf[j]
             q = 0.0
             if mode == 1 or mode == 3:
-                lo = lo0[p] + lo1[p] * sig[k]
+                lo = lo0[p] + lo1[p] * sig[ps, k]
                 if mode == 3:
-                    tc = _t_at_rh(pv[k], rh_ch[p])
+                    tc = _t_at_rh(pv[pp, k], rh_ch[p])
+                    if tc > t_max:
+                        tc = t_max
                     if tc > lo:
                         lo = tc
                 if yf < lo:
@@ -576,8 +635,8 @@ def _control_run(
                     if q > qadd[p]:
                         q = qadd[p]
             elif mode == 2:
-                lo = lo1[p] * sig[k]
-                hi = hi1[p] * sig[k]
+                lo = lo1[p] * sig[ps, k]
+                hi = hi1[p] * sig[ps, k]
                 if yf > hi:
                     q = (hi - yf) / g[p]
                     if q < -qrem[p]:

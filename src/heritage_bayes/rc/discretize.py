@@ -18,10 +18,30 @@ which is the exact zero-order-hold solution (``u[k]`` held over
 :math:`[t_k, t_{k+1})`). ``-expm1`` keeps the gain accurate for slow modes (time constants
 of years) and the decay exact for fast ones (minutes).
 
+Inputs sampled at instants (outdoor temperature read at the hour) are better described
+as linear between the samples: the **first-order hold** (triangle hold) is exact for
+them and just as closed-form per mode (:func:`foh_weights`, :func:`discretize_foh`):
+
+.. math::
+
+    z_j[k+1] = a_j z_j[k] + w^-_j (\tilde B u[k])_j + w^+_j (\tilde B u[k+1])_j
+               + \\phi_j \tilde e_j,\\qquad
+    w^-_j = \frac{1 - a_j(1 + \\lambda_j\\Delta t)}{\\lambda_j^2\\Delta t},\\quad
+    w^+_j = \\phi_j - w^-_j,
+
+with :math:`a_j = e^{-\\lambda_j\\Delta t}` and :math:`\\phi_j = (1 - a_j)/\\lambda_j`.
+Written with the interval mean :math:`\bar u_k = (u[k] + u[k+1])/2` that
+:func:`heritage_bayes.io.align` puts on row ``k`` for an instantaneous column, the
+forcing is :math:`\\phi_j \tilde B \bar u_k + c_j \tilde B (u[k+1] - u[k])` with the
+slope gain :math:`c_j = (w^+_j - w^-_j)/2 \approx \\lambda_j\\Delta t^2/12` for slow
+modes: the zero-order hold of the interval mean is exact for modes much slower than
+the step, and the slope term corrects the fast (air) modes.
+
 References
 ----------
 .. [1] G.F. Franklin, J.D. Powell, M.L. Workman, *Digital Control of Dynamic Systems*,
-   3rd ed., Addison-Wesley, 1998, ch. 4 (zero-order-hold equivalent).
+   3rd ed., Addison-Wesley, 1998, ch. 4 (zero-order-hold equivalent) and sec. 6.3.2
+   (triangle-hold equivalent).
 """
 
 from __future__ import annotations
@@ -30,7 +50,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["ModalForm", "discretize", "modal_form"]
+__all__ = ["ModalForm", "discretize", "discretize_foh", "foh_weights", "modal_form"]
 
 
 @dataclass
@@ -172,18 +192,25 @@ def discretize(model, params, dt: float = 3600.0):
     ed : (n,) or (K, n)
         Discrete constant forcing (zero unless the network has constant boundaries).
     """
-    dt = _check_dt(dt)
-    P, batch = model.param_array(params)
-    model.check_values(P)
-    mf = modal_form(model, P, dt)
-    Ad = (mf.T * mf.ad[:, None, :]) @ mf.Tinv
+    mf, batch, Ad, ed = _physical(model, params, dt)
     Bd = mf.T @ mf.Bdz
-    ed = np.einsum("kij,kj->ki", mf.T, mf.edz)
     Cm = model.output_matrix()
     D = np.zeros((model.n_outputs, model.n_inputs))
     if not batch:
         Ad, Bd, ed = Ad[0], Bd[0], ed[0]
     return Ad, Bd, Cm, D, ed
+
+
+def _physical(model, params, dt):
+    """(modal form, batch?, Ad, ed) in physical coordinates for :func:`discretize` and
+    :func:`discretize_foh`."""
+    dt = _check_dt(dt)
+    P, batch = model.param_array(params)
+    model.check_values(P)
+    mf = modal_form(model, P, dt)
+    Ad = (mf.T * mf.ad[:, None, :]) @ mf.Tinv
+    ed = np.einsum("kij,kj->ki", mf.T, mf.edz)
+    return mf, batch, Ad, ed
 
 
 def _check_dt(dt) -> float:
@@ -194,3 +221,73 @@ def _check_dt(dt) -> float:
     if not np.isfinite(dt) or dt <= 0:
         raise ValueError(f"dt must be a positive number of seconds (got {dt!r})")
     return dt
+
+
+def foh_weights(lam, dt: float) -> tuple[np.ndarray, np.ndarray]:
+    """Exact first-order-hold weights of a mode with decay rate ``lam`` [1/s].
+
+    For an input linear between the samples ``u[k]`` and ``u[k+1]`` over a step ``dt``
+    [s], the mode :math:`\\dot z = -\\lambda z + b\\,u(t)` gives
+    :math:`z[k+1] = e^{-\\lambda\\Delta t} z[k] + b\\,(w^- u[k] + w^+ u[k+1])`.
+
+    Parameters
+    ----------
+    lam : array_like
+        Decay rates :math:`\\lambda \\ge 0` [1/s].
+    dt : float
+        Time step [s].
+
+    Returns
+    -------
+    w_prev, w_next : arrays like ``lam`` [s]
+        :math:`w^- = (1 - e^{-x}(1 + x)) / (\\lambda x)` and
+        :math:`w^+ = (1 - e^{-x})/\\lambda - w^-` with :math:`x = \\lambda\\Delta t`;
+        both :math:`\\Delta t/2` for :math:`\\lambda \to 0` (the trapezoid), and
+        :math:`w^- \to 0`, :math:`w^+ \to 1/\\lambda` for very fast modes (the mode
+        follows the input). A series is used for :math:`x < 10^{-2}` (no cancellation).
+
+    Notes
+    -----
+    :math:`w^- = \\int_0^{\\Delta t} e^{-\\lambda s}\\,s/\\Delta t\\,ds` weights the sample at
+    the start of the step, :math:`w^+` the one at its end [1]_.
+    """
+    dt = _check_dt(dt)
+    lam = np.asarray(lam, dtype=float)
+    x = lam * dt
+    small = x < 1e-2
+    xs = np.where(small, x, 0.0)
+    # (1 - e^-x (1 + x)) / x^2 = 1/2 - x/3 + x^2/8 - x^3/30 + x^4/144 - x^5/840
+    series = 0.5 + xs * (-1 / 3 + xs * (1 / 8 + xs * (-1 / 30 + xs * (1 / 144 - xs / 840))))
+    xl = np.where(small, 1.0, x)
+    big = (-np.expm1(-xl) - xl * np.exp(-xl)) / (xl * xl)
+    w_prev = dt * np.where(small, series, big)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        total = np.where(x > 1e-300, -np.expm1(-x) / np.where(lam > 0, lam, 1.0), dt)
+    return w_prev, total - w_prev
+
+
+def discretize_foh(model, params, dt: float = 3600.0):
+    """Exact first-order-hold discretization of inputs linear between samples.
+
+    ``x[k+1] = Ad x[k] + B0 u[k] + B1 u[k+1] (+ ed)``, ``y = C x``: exact when every
+    input is linear between its samples at ``t_k`` and ``t_{k+1}`` (instantaneous
+    readings, e.g. outdoor temperature at the hour), as :func:`discretize` is for
+    inputs held over each step (interval means). Use one or the other per input
+    column: an interval mean's column of ``B0 + B1`` is the ZOH column ``Bd``.
+    Parameters as :func:`discretize` (``dt`` [s]).
+
+    Returns
+    -------
+    Ad : (n, n) or (K, n, n)
+    B0, B1 : (n, m) or (K, n, m)
+        Weights of the samples at the start and at the end of the step.
+    ed : (n,) or (K, n)
+        Discrete constant forcing (as :func:`discretize`).
+    """
+    mf, batch, Ad, ed = _physical(model, params, dt)
+    w0, w1 = foh_weights(mf.lam, mf.dt)
+    B0 = mf.T @ (w0[:, :, None] * mf.Bz)
+    B1 = mf.T @ (w1[:, :, None] * mf.Bz)
+    if not batch:
+        Ad, B0, B1, ed = Ad[0], B0[0], B1[0], ed[0]
+    return Ad, B0, B1, ed

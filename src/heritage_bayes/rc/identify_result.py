@@ -329,9 +329,11 @@ def _describe(model, names, kinds, p0, v, threshold, is_scale, k, ref) -> NullDi
     if len(big) == 1:
         j = big[0]
         text = (
-            f"{names[j]} has no influence on the input-output behaviour: it is not "
-            "identifiable from these inputs and outputs. Fix it, give it an informative "
-            "prior, or remove it from the model."
+            f"{names[j]} is not identifiable from these inputs and outputs: at these "
+            "parameter values its influence on the output is below what the data "
+            "resolve (to first order). That does not mean the link does nothing in the "
+            "room, only that these data cannot tell its value. Fix it, give it an "
+            "informative prior, or use a model without it."
         )
         return NullDirection(label, vec, text, pinned)
     units = sorted({_TRANSFORM[kinds[j]] for j in big})

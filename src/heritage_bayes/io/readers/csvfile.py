@@ -56,16 +56,19 @@ def read_csv(
     sort: bool = False,
     invalid: str = "raise",
     na_values: Iterable | None = None,
-    skiprows: int = 0,
+    skiprows: int | Sequence[int] = 0,
     encoding: str = "utf-8",
+    units: Mapping[str, str] | None = None,
 ) -> pd.DataFrame:
     """Read a delimited text table (logger export, weather service) into standard columns.
 
     Parameters
     ----------
     path : str or path-like
-        The file. Header names are compared after stripping surrounding whitespace
-        (logger exports often pad them); CRLF line ends are fine.
+        The file: delimited text, or an Excel workbook (``.xlsx``, ``.xlsm``: its first
+        sheet, see :mod:`heritage_bayes.io.readers.workbook`). Header names are compared
+        after stripping surrounding whitespace (logger exports often pad them); CRLF line
+        ends are fine.
     time_column : str or sequence of str
         Column holding the timestamp, or several columns whose values are joined with a
         single space before parsing (e.g. ``("Year", "Month", "Day", "Hour (UTC)")`` with
@@ -115,9 +118,18 @@ def read_csv(
     na_values : iterable, optional
         Extra markers of missing values, e.g. ``[-9999, "ERR"]`` (empty cells, ``NA``,
         ``NaN`` and ``null`` are always missing).
-    skiprows : int, default 0
-        Lines to skip before the header line.
+    skiprows : int or sequence of int, default 0
+        Lines to skip before the header line, or the 0-based numbers of the lines to
+        skip anywhere (logger exports put metadata lines before the header and between
+        it and the data: Tinytag Explorer, Rotronic HW4; see
+        :mod:`heritage_bayes.io.loggers`).
     encoding : str, default "utf-8"
+        ``"utf-8-sig"`` for a file starting with a byte-order mark, ``"cp1252"`` for an
+        export of older Windows software.
+    units : mapping of str to str, optional
+        ``{standard_name: unit in the file}`` for columns not in the standard unit,
+        converted on reading: temperatures ``"°F"`` or ``"K"`` (to °C), relative
+        humidity ``"fraction"`` (0-1, to %); see :data:`UNIT_CONVERSIONS`.
 
     Returns
     -------
@@ -167,17 +179,31 @@ def read_csv(
     time_cols = [time_column] if isinstance(time_column, str) else list(time_column)
     if not time_cols or not all(isinstance(c, str) for c in time_cols):
         raise InputError(f"time_column must be a column name or a list of names ({time_column!r})")
-    if isinstance(skiprows, bool) or not isinstance(skiprows, int) or skiprows < 0:
+    skip_list = None
+    if not isinstance(skiprows, int | bool) and isinstance(skiprows, Sequence):
+        if not all(isinstance(i, int) and not isinstance(i, bool) and i >= 0 for i in skiprows):
+            raise InputError(f"skiprows: line numbers must be non-negative integers ({skiprows!r})")
+        skip_list = sorted(set(skiprows))
+    elif isinstance(skiprows, bool) or not isinstance(skiprows, int) or skiprows < 0:
         raise InputError(f"skiprows must be a non-negative integer (got {skiprows!r})")
+    conversions = _unit_conversions(units)
     tz = parse_timezone(timezone) if timezone is not None else None
     na_list = list(na_values) if na_values is not None else []
     na_numeric = [float(v) for v in na_list if isinstance(v, int | float)]
     read_kw = {"sep": sep, "skiprows": skiprows, "encoding": encoding}
 
     # -- header --------------------------------------------------------------------------
-    sniff_text(path, name)
+    from heritage_bayes.io.readers.workbook import is_workbook, table_source
+
+    if is_workbook(path):  # the first sheet as CSV text (see .workbook)
+        if (sep, decimal) != (",", "."):
+            raise InputError(f"{name}: a workbook is read as sep ',' and decimal '.'")
+        read_kw["encoding"] = None
+    else:
+        sniff_text(path, name)
+    table = table_source(path)
     try:
-        header = pd.read_csv(path, nrows=0, **read_kw)
+        header = pd.read_csv(table(), nrows=0, **read_kw)
     except pd.errors.EmptyDataError as exc:
         raise DataError(f"{name}: file is empty, expected a header line") from exc
     except (pd.errors.ParserError, UnicodeDecodeError) as exc:
@@ -221,7 +247,7 @@ def read_csv(
     # -- body ------------------------------------------------------------------------------
     try:
         raw = pd.read_csv(
-            path,
+            table(),
             header=0,
             index_col=False,
             dtype=str,
@@ -239,7 +265,15 @@ def read_csv(
         raise DataError(f"{name}: malformed table: rows have more fields than the header")
     raw = raw.iloc[:, usecols]
     raw.columns = [stripped[i] for i in usecols]
-    lines = np.arange(len(raw)) + skiprows + 2  # 1-based line numbers, header on skiprows+1
+    if skip_list is None:
+        lines = np.arange(len(raw)) + skiprows + 2  # 1-based line numbers, header on skiprows+1
+    else:  # the lines pandas kept: header first, then the body
+        kept, skip, i = [], set(skip_list), 0
+        while len(kept) < len(raw) + 1:
+            if i not in skip:
+                kept.append(i + 1)
+            i += 1
+        lines = np.asarray(kept[1:], dtype=int)
     counts: dict[str, int] = {}
 
     blank = raw.isna().all(axis=1).to_numpy()
@@ -298,6 +332,8 @@ def read_csv(
         values = num.to_numpy(copy=True)
         if na_numeric:
             values[np.isin(values, na_numeric)] = np.nan
+        if std in conversions:
+            values = conversions[std](values)
         data[std] = values
 
     # -- time zone -------------------------------------------------------------------------
@@ -366,6 +402,40 @@ def read_csv(
         clipped=clipped,
         extra={"timezone": tz_label, "source_columns": dict(wanted)},
     )
+
+
+#: Units a column may be declared in (``units=``) and their conversion to the standard
+#: unit: temperatures to °C, relative humidity to %.
+UNIT_CONVERSIONS = {
+    "temperature": {
+        "°C": lambda v: v,
+        "°F": lambda v: (v - 32.0) / 1.8,
+        "K": lambda v: v - 273.15,
+    },
+    "humidity": {"%": lambda v: v, "fraction": lambda v: 100.0 * v},
+}
+_KIND = {"Te": "temperature", "Ti": "temperature", "Tdew": "temperature", "Tf": "temperature"}
+_KIND |= {"RHe": "humidity", "RHi": "humidity"}
+
+
+def _unit_conversions(units) -> dict:
+    if units is None:
+        return {}
+    if not isinstance(units, Mapping):
+        raise InputError(f"units must be a mapping {{standard_name: unit}} (got {units!r})")
+    out = {}
+    for std, unit in units.items():
+        kind = _KIND.get(std)
+        if kind is None:
+            raise InputError(
+                f"units.{std}: only temperatures (Te, Ti, Tdew, Tf) and relative "
+                f"humidities (RHe, RHi) take a unit"
+            )
+        table = UNIT_CONVERSIONS[kind]
+        if unit not in table:
+            raise InputError(f"units.{std}: one of {', '.join(map(repr, table))} (got {unit!r})")
+        out[std] = table[unit]
+    return out
 
 
 def _as_timedelta(value, what: str) -> pd.Timedelta:

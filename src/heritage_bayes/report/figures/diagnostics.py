@@ -129,10 +129,18 @@ def fig_residuals(
     phi: float | None,
     dt_hours: float,
     max_lag_hours: float = 72.0,
+    innov: np.ndarray | None = None,
+    acf_scale: float = 1.0,
 ):
     """Residuals over the calibration period, their ACF and cumulative periodogram.
 
-    ``phi``: the posterior median AR(1) coefficient (None for iid noise).
+    ``phi``: the posterior median AR(1) coefficient (None for iid noise). ``innov``: the
+    noise model's standardised one-step innovations (white if the noise model is right;
+    default the AR(1) innovations :math:`e_t - \varphi e_{t-1}`), drawn with their own
+    autocorrelation and periodogram. ``acf_scale``: the share of the residual variance
+    that is correlated, so that the noise model expects the residual autocorrelation
+    ``acf_scale * phi**k`` at lags k ≥ 1 (``sigma² / (sigma² + sigma_meas²)`` for AR(1)
+    + white noise, 1 for AR(1)).
     """
     fig = _figure(12, 3.6)
     a0, a1, a2 = fig.subplots(1, 3, width_ratios=[1.3, 1, 1])
@@ -146,16 +154,33 @@ def fig_residuals(
     max_lag = max(1, round(max_lag_hours / dt_hours))
     lags, rho, n = acf(resid, max_lag)
     lag_h = lags * dt_hours
-    w = innovations(resid, phi or 0.0)
+    w = innovations(resid, phi or 0.0) if innov is None else np.asarray(innov, dtype=float)
     _, rho_w, n_w = acf(w, max_lag)
     bound = 1.96 / math.sqrt(max(n, 1))
     a1.axhspan(-bound, bound, color="#cccccc", alpha=0.6, lw=0, label="white-noise 95 % band")
     a1.plot(lag_h, rho, "-", color=C_MEAS, lw=1.2, label="residuals")
     if phi is not None:
+        expected = np.where(lags == 0, 1.0, acf_scale * phi**lags)
         a1.plot(
-            lag_h, phi**lags, "--", color=C_MODEL, lw=1.2, label=f"AR(1) model: φᵏ, φ = {phi:.2f}"
+            lag_h,
+            expected,
+            "--",
+            color=C_MODEL,
+            lw=1.2,
+            label=f"noise model: {acf_scale:.2f}·φᵏ, φ = {phi:.2f}"
+            if acf_scale < 1
+            else f"AR(1) model: φᵏ, φ = {phi:.2f}",
         )
-        a1.plot(lag_h[1:], rho_w[1:], "o", color=C_ALT, ms=2.5, label="innovations e − φ·e₋₁")
+    if phi is not None or innov is not None:
+        lag1 = rho_w[1] if rho_w.size > 1 else float("nan")
+        a1.plot(
+            lag_h[1:],
+            rho_w[1:],
+            "o",
+            color=C_ALT,
+            ms=2.5,
+            label=f"standardised innovations (lag 1: {lag1:.2f})",
+        )
     a1.set_xlabel("lag [h]")
     a1.set_ylabel("autocorrelation [-]")
     a1.set_xlim(0, lag_h[-1] if lag_h.size else 1)
@@ -177,7 +202,7 @@ def fig_residuals(
     )
     a2.plot([0, nyq], [0, 1], "-", color="#888888", lw=0.8)
     a2.plot(fd, c, "-", color=C_MEAS, lw=1.2, label="residuals")
-    if phi is not None:
+    if phi is not None or innov is not None:
         fw, cw, _ = cumulative_periodogram(w)
         a2.plot(fw * per_day, cw, "-", color=C_ALT, lw=1.0, label="innovations")
     a2.set_xlim(0, nyq)

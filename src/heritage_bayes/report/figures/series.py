@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 
 import numpy as np
@@ -67,6 +68,11 @@ def fig_data_overview(
                 )
         ax.set_ylabel(panel["ylabel"])
         handles = ax.get_legend_handles_labels()[0]
+        # headroom for the legend row(s) above the data: a legend drawn over the
+        # highest values (the south facade's winter daily means) would hide them
+        lo, hi = ax.get_ylim()
+        rows = math.ceil(len(handles) / min(4, max(1, len(handles))))
+        ax.set_ylim(lo, hi + (0.12 + 0.12 * rows) * (hi - lo))
         ax.legend(loc="upper left", ncols=min(4, max(1, len(handles))))
         _date_axis(ax, label=i == n - 1)
     axes[0].set_xlim(times[0], times[-1] + _step(times))

@@ -23,6 +23,31 @@ def _input_units(rd: RunData) -> dict:
     return units
 
 
+def _sources(notes: list[dict]) -> list[dict]:
+    """One row per source file and role: the tables derived from one record (its
+    facade irradiance, ``"<file> (irradiance on surfaces)"``) join its row."""
+    rows: dict[tuple, dict] = {}
+    names = {str(src.get("source", "")) for src in notes}
+    for src in notes:
+        name = str(src.get("source", ""))
+        base = name.rsplit(" (", 1)[0] if name.endswith(")") else name
+        base = base if base in names else name
+        key = (src.get("role", ""), base)
+        row = rows.setdefault(
+            key,
+            {"role": key[0], "source": base, "columns": [], "timezone": [], "averaged": []},
+        )
+        for k in ("columns", "averaged"):
+            row[k] += [str(c) for c in src.get(k) or [] if str(c) not in row[k]]
+        tz = str(src.get("timezone", "") or "")
+        if tz and tz not in row["timezone"]:
+            row["timezone"].append(tz)
+    return [
+        {k: v if isinstance(v, str) else ", ".join(v) for k, v in row.items()}
+        for row in rows.values()
+    ]
+
+
 def data_context(rd: RunData) -> dict:
     import pandas as pd
 
@@ -150,17 +175,7 @@ def data_context(rd: RunData) -> dict:
     missing = [
         {"column": c, "n": fmt_int(n)} for c, n in (al.get("measurement_missing") or {}).items()
     ]
-    sources = []
-    for src in al.get("sources") or []:
-        sources.append(
-            {
-                "role": src.get("role", ""),
-                "source": src.get("source", ""),
-                "columns": ", ".join(map(str, src.get("columns") or [])),
-                "timezone": src.get("timezone", ""),
-                "averaged": ", ".join(map(str, src.get("averaged") or [])),
-            }
-        )
+    sources = _sources(al.get("sources") or [])
     n_interp = sum(int(v or 0) for v in (al.get("interpolated") or {}).values())
     n_flag = sum(int(v or 0) for v in (al.get("flagged_rows") or {}).values())
     spans: dict[tuple, list[str]] = {}
@@ -193,12 +208,13 @@ def data_context(rd: RunData) -> dict:
         )
     else:
         words += "The measurements have no gaps. "
-    dropped = sum(int(v or 0) for v in (al.get("rows_dropped") or {}).values())
+    dropped = [
+        f"{fmt_int(n)} {role.removesuffix('s')} rows"
+        for role, n in (al.get("rows_dropped") or {}).items()
+        if int(n or 0)
+    ]
     if dropped:
-        words += (
-            f"{fmt_int(dropped)} rows of the input tables lie outside this period "
-            "and were not used."
-        )
+        words += f"{' and '.join(dropped)} lie outside this period and were not used."
     return {
         "figure": fig,
         "rows": rows,

@@ -148,6 +148,8 @@ def _residual_check(
     worst = int(np.nanargmax(np.abs(rho_w[1:]))) + 1 if rho_w.size > 1 else 0
     return {
         "lag1": lag1,
+        "innovations": w,
+        "lag1_innovations": float(rho_w[1]) if rho_w.size > 1 else float("nan"),
         "worst_lag_h": worst * dt_hours,
         "worst_rho": float(rho_w[worst]) if worst else float("nan"),
         "phi": phi,
@@ -230,6 +232,8 @@ def diagnostics_context(rd: RunData, fits: list[dict]) -> dict:
             unit=OUT_UNITS.get(o, ""),
             phi=phi,
             dt_hours=dt_hours,
+            innov=check.pop("innovations"),
+            acf_scale=white[0] ** 2 / (white[0] ** 2 + white[2] ** 2) if white else 1.0,
         )
         if white is not None:
             words = (
@@ -251,6 +255,8 @@ def diagnostics_context(rd: RunData, fits: list[dict]) -> dict:
             )
             subject = "the residuals"
         share = fmt_pct(check["out_share"])
+        if phi is not None:
+            words += f"Lag-1 autocorrelation of the innovations {check['lag1_innovations']:.2f}. "
         if check["adequate"]:
             words += (
                 f"The noise model looks adequate: {subject} are close to white "

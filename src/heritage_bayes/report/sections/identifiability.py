@@ -103,6 +103,7 @@ def identifiability_context(rd: RunData) -> list[dict]:
                 "corr_raw_fig": fig_raw,
                 **figs,
                 "scale": _scale_words(rd, m, idf, coords),
+                "tradeoffs": tradeoff_words(coords),
                 "derived": _derived_rows(s, m, info, mcse_table(rd, _derived_keys(s, m))),
             }
         )
@@ -149,6 +150,39 @@ def _coordinate_figures(coords: list, title: str) -> dict:
         ],
         title=f"{title}: prior (push-forward, line) and posterior (histogram)",
     )
+    return out
+
+
+#: |posterior correlation| from which two identifiable coordinates are called a
+#: weakly separated pair in words
+TRADEOFF_R = 0.9
+
+
+def tradeoff_words(coords: list) -> list[str]:
+    """Plain words for each pair of identifiable coordinates (time constants, gains,
+    offsets, scale) whose posterior correlation reaches ±:data:`TRADEOFF_R`: the data
+    determine mainly a combination of the two (how the response splits between outdoor
+    air and a slow boundary, a fixed node's gain and its offset, envelope and interior
+    mass), and each interval is as wide as that trade-off leaves it."""
+    from heritage_bayes.report.identifiable import identifiable_correlation
+
+    if len(coords) < 2:
+        return []
+    r = identifiable_correlation(coords)
+    out = []
+    for i in range(len(coords)):
+        for j in range(i + 1, len(coords)):
+            rij = r[i, j]
+            if not (np.isfinite(rij) and abs(rij) >= TRADEOFF_R):
+                continue
+            a, b = coords[i], coords[j]
+            sign = "one rises as the other falls" if rij < 0 else "they rise and fall together"
+            out.append(
+                f"{a.label} and {b.label} trade off (posterior correlation {rij:+.2f}: "
+                f"{sign}). These data determine mainly a combination of the two; each "
+                "one's 90 % interval is as wide as that trade-off leaves it, and knowledge "
+                "of either (a prior) narrows the other."
+            )
     return out
 
 

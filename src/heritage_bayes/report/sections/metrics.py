@@ -29,17 +29,21 @@ def metrics_context(rd: RunData) -> dict:
     periods = [p for p in ("calibration", "validation") if any(p in g["per"] for g in groups)]
     rows = []
     cov_rows = []
+    notes: list[str] = []
     for p in periods:
         cells, cov = [], []
         for g in groups:
             v = g["per"].get(p) or {}
             cells += [
-                fmt(v.get("MSE")),
                 fmt(v.get("MAE")),
+                fmt(v.get("MSE")),
                 fmt(v.get("FIT"), 3)
                 if v.get("FIT") is None
                 else f"{v['FIT']:.1f}".replace("-", "−"),
             ]
+            flat = _nearly_constant(v)
+            if flat:
+                notes.append(f"{g['label']}, {p}: {flat}")
             cov += [
                 fmt_int(v.get("n")),
                 _cov_cell(v.get("coverage50"), 0.5),
@@ -47,7 +51,27 @@ def metrics_context(rd: RunData) -> dict:
             ]
         rows.append({"period": p, "cells": cells})
         cov_rows.append({"period": p, "cells": cov})
-    return {"groups": groups, "rows": rows, "cov_rows": cov_rows}
+    return {"groups": groups, "rows": rows, "cov_rows": cov_rows, "notes": notes}
+
+
+def _nearly_constant(v: dict) -> str:
+    """Words when FIT says nothing: the measured series varies less than twice the
+    model's mean absolute error (standard deviation SD ≤ 2 MAE, i.e. FIT ≲ 40 % for
+    Gaussian errors), e.g. a humidistat-held RH; empty otherwise."""
+    mae, mse, fit = v.get("MAE"), v.get("MSE"), v.get("FIT")
+    sd = v.get("SD")
+    if sd is None and None not in (mse, fit) and fit < 100:
+        sd = math.sqrt(mse) / (1 - fit / 100)  # runs written before SD was stored
+    if sd is None or mae is None or not (math.isfinite(sd) and math.isfinite(mae)):
+        return ""
+    if sd > 2 * mae:
+        return ""
+    return (
+        f"the measurements vary little (standard deviation {fmt(sd)}) against the "
+        f"model's error (MAE {fmt(mae)}): FIT, which divides the error by that "
+        "variation, is no measure of accuracy on such a nearly constant series. "
+        "Read the MAE and the band coverage."
+    )
 
 
 def _cov_cell(v, nominal: float) -> dict:

@@ -47,7 +47,9 @@ def header_context(rd: RunData) -> dict:
         "notes": (s.get("notes") or rd.cfg.notes or "").strip(),
         "models": models,
         "periods": periods,
-        "warmup": f"{warmup_h / 24:g} d" if warmup_h >= 24 else f"{warmup_h:g} h",
+        "warmup": ""
+        if warmup_h <= 0
+        else (f"{warmup_h / 24:g} d" if warmup_h >= 24 else f"{warmup_h:g} h"),
         "created_at": fmt_time(s.get("created_at")),
         "version": s.get("heritage_bayes_version", "?"),
         "seed": s.get("seed"),

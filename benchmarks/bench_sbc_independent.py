@@ -1,0 +1,326 @@
+"""Simulation-based calibration on rooms the package did not generate.
+
+``bench_sbc.py`` simulates its rooms with the very discretisation the fit uses (hourly
+zero-order hold of the same hourly inputs): the easy case. Here the generator shares no
+discretisation and no solar model with the fit:
+
+- **10-minute sub-steps**, each an exact step (``scipy.linalg.expm``) of the continuous
+  state space with its own 10-minute inputs;
+- **weather that varies within the hour**: outdoor temperature and vapour pressure are
+  the KNMI hourly readings (De Bilt, instantaneous at the hour) interpolated linearly,
+  plus a within-hour fluctuation (AR(1), correlation time 30 min, sd 0.3 K and 10 Pa);
+  the fit sees only the hourly readings *of that fluctuating series* (as a station
+  logs it);
+- **a different sky model**: the generator spreads each hour's global irradiance over
+  its six 10-minute intervals in proportion to the cosine of the sun's zenith, splits it
+  with Orgill-Hollands and transposes it to the south facade with the isotropic sky,
+  while the fit gets what ``hbayes calibrate`` computes from the hourly file (Erbs and
+  Perez at mid-hour, :func:`heritage_bayes.climate.surface_irradiance`);
+- the fit's hourly inputs come from :func:`heritage_bayes.io.align` (the package's own
+  sampling semantics: readings as instantaneous, irradiance as hour-ending means);
+- **observation**: the indoor node at the full hour, plus AR(1) model error (phi
+  0.90-0.95, marginal sd 0.15-0.30 K or 15-30 Pa), white sensor noise (0.1 K or 12 Pa),
+  rounding to 0.1 and a one-week gap, as in ``bench_sbc.py``.
+
+Truths are those of the continuous-time room (time constants, static gains, the fixed
+node's gain and offset), independent of any discretisation. The **mean solar warming**
+``solar_warming_K`` [K] is the static solar gain times the mean facade irradiance over
+the calibration period, each in its own irradiance model (the generator's for the
+truth, the fit's input for the draws): the physical effect, which does not depend on
+which sky model scaled the aperture.
+
+    python benchmarks/bench_sbc_independent.py --reps 50 --jobs 2 --log sbc_ind.jsonl
+    python benchmarks/bench_sbc_independent.py --table sbc_ind.jsonl
+    python benchmarks/bench_sbc_independent.py --reps 4 --models thermal_2c
+
+Each replicate's room, weather stretch and noise come from ``(seed, replicate)``; one
+JSON line per replicate is appended to ``--log`` as soon as it is done (a study cut
+short can be tabulated), and ``--first-rep`` extends a study.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import time
+from pathlib import Path
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+
+import numpy as np
+import pandas as pd
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from bench_sbc import (  # the benchmark directory is not a package
+    CAL_DAYS,
+    ENVELOPE,
+    FLOOR,
+    KNMI,
+    MAX_SPIN_DAYS,
+    _knmi_cache,
+    fit_and_rank,
+    print_study,
+    run_tasks,
+    simulate_reference,
+    table,
+    truth,
+)
+
+#: De Bilt, KNMI station 260 [°N, °E, m]
+SITE = {"latitude": 52.10, "longitude": 5.18, "altitude": 1.9}
+SUB = 6  # 10-minute sub-steps per hour
+DT_SUB = 600.0  # [s]
+QUANTITIES = {
+    "thermal_2c": ("tau_1_h", "gain_Ti_Te", "gain_Ti_I_S", "gain_Ti_Tf", "solar_warming_K"),
+    "hygric_2c_fixed": ("tau_1_h", "gain_Pi_Pe", "offset_Pi_Pf"),
+}
+
+
+def _fluctuation(rng, n: int, sd: float, tau_steps: float) -> np.ndarray:
+    """Stationary AR(1) of marginal sd ``sd`` and correlation time ``tau_steps``."""
+    phi = np.exp(-1.0 / tau_steps)
+    z = rng.normal(0.0, sd * np.sqrt(1 - phi**2), n)
+    e = np.empty(n)
+    e[0] = rng.normal(0.0, sd)
+    for k in range(1, n):
+        e[k] = phi * e[k - 1] + z[k]
+    return e
+
+
+def generator_weather(seed: int, without: tuple = ()) -> dict:
+    """A random De Bilt stretch on the 10-minute grid and as a station logs it hourly.
+
+    Returns ``fine`` (10-minute Te [°C], Pe [Pa], I_S [W/m²], each the value over the
+    sub-step starting at its time), ``hourly`` (a DataFrame of the readings Te, RHe at
+    the hour and the hour-ending ghi, UTC, as :func:`read_knmi_hourly` returns them) and
+    ``t0`` the first hour. ``without``: parts of the generator left out, to find which
+    one costs coverage: ``"within_hour"`` (no fluctuation within the hour: the
+    readings describe the hour exactly), ``"sky"`` (the generator's facade irradiance
+    is the fit's own, held over each hour); :func:`replicate` also knows
+    ``"substeps"`` (the room simulated in hourly steps of the fit's own inputs).
+    """
+    import pvlib
+
+    from heritage_bayes.climate.psychro import vapour_pressure
+
+    w = _knmi_cache()
+    n = (CAL_DAYS + MAX_SPIN_DAYS + 2) * 24
+    rng = np.random.default_rng(seed)
+    start = int(rng.integers(0, len(w) - n - 1))
+    part = w.iloc[start : start + n + 1][["Te", "RHe", "ghi"]]
+    part = part.interpolate(limit_direction="both")
+    hours = part.index
+    th = hours.asi8 / 1e9
+    fine_t = th[0] + DT_SUB * np.arange((len(hours) - 1) * SUB)
+    mid = fine_t + DT_SUB / 2
+    nf = fine_t.size
+    # within-hour weather: linear between the hours + a fluctuation the hourly readings
+    # sample only at the full hour
+    wiggle = 0.0 if "within_hour" in without else 1.0
+    te_f = np.interp(fine_t, th, part["Te"].to_numpy()) + wiggle * _fluctuation(rng, nf, 0.3, 3.0)
+    rh_f = np.clip(np.interp(fine_t, th, part["RHe"].to_numpy()), 1.0, 100.0)
+    pe_f = vapour_pressure(te_f, rh_f) + wiggle * _fluctuation(rng, nf, 10.0, 3.0)
+    # the station's hourly record of those series
+    on_hour = slice(0, nf, SUB)
+    hourly = pd.DataFrame(
+        {
+            "Te": np.append(te_f[on_hour], te_f[-1]),
+            "Pe": np.append(pe_f[on_hour], pe_f[-1]),
+            "ghi": part["ghi"].to_numpy(),
+        },
+        index=hours,
+    )
+    hourly.attrs.update(averaged=("ghi",), interval="1h", source="generator")
+    # 10-minute irradiance: hour-ending means spread by cos(zenith) at each mid-sub-step
+    times = pd.DatetimeIndex(pd.to_datetime(mid, unit="s", utc=True))
+    sp = pvlib.solarposition.get_solarposition(
+        times, SITE["latitude"], SITE["longitude"], SITE["altitude"]
+    )
+    cz = np.clip(np.cos(np.radians(sp["apparent_zenith"].to_numpy())), 0.0, None)
+    cz_h = cz.reshape(-1, SUB)
+    mean_cz = cz_h.mean(axis=1, keepdims=True)
+    share = np.where(mean_cz > 1e-3, cz_h / np.where(mean_cz > 1e-3, mean_cz, 1.0), 1.0)
+    ghi_f = (part["ghi"].to_numpy()[1:, None] * share).reshape(-1)  # hour ending at +1h
+    split = pvlib.irradiance.orgill_hollands(ghi_f, sp["zenith"].to_numpy(), times)
+    poa = pvlib.irradiance.get_total_irradiance(
+        90.0,
+        180.0,
+        sp["apparent_zenith"].to_numpy(),
+        sp["azimuth"].to_numpy(),
+        np.nan_to_num(np.asarray(split["dni"], float)),
+        ghi_f,
+        np.nan_to_num(np.asarray(split["dhi"], float)),
+        albedo=0.2,
+        model="isotropic",
+    )
+    i_s = np.clip(np.nan_to_num(np.asarray(poa["poa_global"], float)), 0.0, None)
+    i_s[ghi_f <= 0] = 0.0
+    if "sky" in without:  # the fit's facade irradiance, held over its hour
+        i_s = np.repeat(fit_inputs(hourly)["I_S"].to_numpy(), SUB)
+    return {"fine": {"Te": te_f, "Pe": pe_f, "I_S": i_s}, "hourly": hourly, "t0": hours[0]}
+
+
+def fit_inputs(hourly: pd.DataFrame) -> pd.DataFrame:
+    """The hourly inputs ``hbayes calibrate`` builds from the station record: the south
+    facade by :func:`surface_irradiance` (its defaults) and :func:`align` on 1 h."""
+    from heritage_bayes.climate.solar import surface_irradiance
+    from heritage_bayes.io.align import align
+
+    irr = surface_irradiance(hourly[["ghi"]], SITE, {"S": (90.0, 180.0)})
+    irr = irr.rename(columns={"S": "I_S"})
+    irr.attrs["source"] = "facade"
+    met = hourly[["Te", "Pe"]].copy()
+    met.attrs.update(averaged=(), interval="1h", source="station")
+    return align([met, irr], step="1h", max_gap="0h").frame
+
+
+def replicate(args) -> dict:
+    """One room: generate on the 10-minute grid, fit on the hourly record, rank truths."""
+    import heritage_bayes as hb
+    from heritage_bayes.rc.derived import derived_quantities
+
+    name, rep, variants, seed, max_steps = args[:5]
+    cal_days = args[5] if len(args) > 5 else CAL_DAYS
+    floor = args[6] if len(args) > 6 else FLOOR
+    envelope = args[7] if len(args) > 7 else ENVELOPE
+    without = args[8] if len(args) > 8 else ()
+    rng = np.random.default_rng([seed, rep])
+    opts = {"surfaces": ("S",)} if name.startswith("thermal") else {}
+    model = hb.model(name, **opts)
+    p = truth(model, rng, floor)
+    gw = generator_weather(int(rng.integers(2**31)), without)
+    fine = gw["fine"]
+    nf = fine["Te"].size
+    Uf = np.column_stack([fine[c] if c in fine else np.full(nf, 10.0) for c in model.input_names])
+    if "Tf" in model.input_names:  # ground: the mean outdoor temperature, constant
+        Uf[:, model.input_names.index("Tf")] = fine["Te"].mean()
+    A, B, _, _ = model.state_space(p)
+    x0 = np.linalg.solve(-A, B @ Uf[: 24 * SUB].mean(axis=0) + model.offset(p))
+    X = simulate_reference(model, p, Uf, DT_SUB, x0)  # exact 10-minute steps
+    out = model.output_names[0]
+    y_hour = X[::SUB, model.state_names.index(out)]  # the node at every full hour
+    frame = fit_inputs(gw["hourly"])
+    U = np.column_stack(
+        [
+            frame[c].to_numpy(float) if c in frame else np.full(len(frame), 10.0)
+            for c in model.input_names
+        ]
+    )
+    if "Tf" in model.input_names:
+        U[:, model.input_names.index("Tf")] = fine["Te"].mean()
+    if "substeps" in without:  # the fit's own discretisation: hourly ZOH of its inputs
+        y_hour = simulate_reference(model, p, U, 3600.0, x0)[:, model.state_names.index(out)]
+    n = min(len(U), y_hour.size)
+    spin = int(rng.integers(7, MAX_SPIN_DAYS + 1)) * 24
+    rows = slice(spin, spin + cal_days * 24)
+    assert rows.stop <= n, "weather stretch too short for the spin-up and calibration"
+    thermal = model.domain == "thermal"
+    phi = rng.uniform(0.90, 0.95)
+    sd = rng.uniform(0.15, 0.30) * (1.0 if thermal else 100.0)
+    e = _fluctuation(rng, n, sd, -1.0 / np.log(phi))
+    sensor = 0.1 if thermal else 12.0  # [K]; [Pa] ~ 1 %RH at 10 °C
+    y = np.round(y_hour[:n] + e + rng.normal(0, sensor, n), 1)[rows]
+    g0 = int(rng.integers(7 * 24, cal_days * 24 - 14 * 24))
+    y[g0 : g0 + 7 * 24] = np.nan
+    dq_true = {k: float(np.ravel(v)[0]) for k, v in derived_quantities(model, p).items()}
+    extra = None
+    if "I_S" in model.input_names:
+        j = model.input_names.index("I_S")
+        cal_fine = slice(rows.start * SUB, rows.stop * SUB)
+        mean_true = float(fine["I_S"][cal_fine].mean())
+        mean_fit = float(U[rows, j].mean())
+        dq_true["solar_warming_K"] = dq_true["gain_Ti_I_S"] * mean_true
+
+        def extra(dq, theta, _m=mean_fit):
+            return {"solar_warming_K": np.asarray(dq["gain_Ti_I_S"], float) * _m}
+
+    result = {
+        "model": name,
+        "rep": rep,
+        "truth": dq_true,
+        "truth_parameters": p,
+        "generator": "independent",
+    }
+    if extra is not None:
+        result["irradiance_mean"] = {"generator": mean_true, "fit": mean_fit}
+    result["variants"] = fit_and_rank(
+        model, U[rows], y, dq_true, variants, rep, max_steps, {}, floor, envelope, extra
+    )
+    return result
+
+
+def zscore_lines(results: list[dict], variant: str) -> list[str]:
+    """Per model and quantity the rms of z = (posterior median - truth) / posterior sd
+    over the replicates: about 1 for calibrated intervals, the factor by which they are
+    too narrow otherwise (with n replicates its standard error is about 1/sqrt(2n))."""
+    lines = []
+    for name in sorted({r["model"] for r in results}):
+        rs = [r for r in results if r["model"] == name and variant in r["variants"]]
+        parts = []
+        for k in QUANTITIES.get(name, ()):
+            z = [
+                (x["median"] - r["truth"][k]) / x["sd"]
+                for r in rs
+                if (x := r["variants"][variant]["ranks"].get(k)) and x["sd"] > 0
+            ]
+            if z:
+                parts.append(f"{k} {np.sqrt(np.mean(np.square(z))):.2f}")
+        lines.append(f"  {name} [{variant}] z rms ({len(rs)} rooms): " + ", ".join(parts))
+    return lines
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--reps", type=int, default=50)
+    ap.add_argument("--first-rep", type=int, default=0)
+    ap.add_argument("--models", default="thermal_2c,hygric_2c_fixed")
+    ap.add_argument("--noise", action="append", help="NAME:INIT (repeatable)")
+    ap.add_argument("--jobs", type=int, default=1)
+    ap.add_argument("--seed", type=int, default=2031)
+    ap.add_argument("--max-steps", type=int, default=12000)
+    ap.add_argument("--log", help="append each replicate's result as a JSON line")
+    ap.add_argument(
+        "--without",
+        default="",
+        help="comma-separated parts of the generator left out: within_hour, sky, substeps "
+        "(then the room is simulated with the fit's hourly zero-order hold of its inputs)",
+    )
+    ap.add_argument("--table", help="only tabulate a --log file of an earlier study")
+    args = ap.parse_args(argv)
+    variants = args.noise or ["ar1_white:estimate"]
+    without = tuple(w for w in args.without.split(",") if w)
+    parts = {"within_hour", "sky", "substeps"}
+    if set(without) - parts:
+        ap.error(f"--without: unknown {sorted(set(without) - parts)}; use {sorted(parts)}")
+    if args.table:
+        results = [json.loads(line) for line in open(args.table)]
+        print(f"SBC (independent generator) table of {args.table}: {len(results)} replicates")
+        for v in sorted({v for r in results for v in r["variants"]}):
+            for line in table(results, v, QUANTITIES) + zscore_lines(results, v):
+                print(line)
+        return 0
+    tasks = [
+        (m, r, variants, args.seed, args.max_steps, CAL_DAYS, FLOOR, ENVELOPE, without)
+        for r in range(args.first_rep, args.first_rep + args.reps)
+        for m in args.models.split(",")
+    ]
+    t0 = time.perf_counter()
+    results = run_tasks(replicate, tasks, args.jobs, args.log)
+    print_study(
+        results,
+        variants,
+        f"SBC (independent generator): {args.reps} replicates per model, "
+        f"{time.perf_counter() - t0:.0f} s wall",
+        QUANTITIES,
+    )
+    return 0
+
+
+if __name__ == "__main__":
+    if not KNMI.is_file():
+        sys.exit(f"needs {KNMI}")
+    sys.exit(main())

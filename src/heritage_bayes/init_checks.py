@@ -1,0 +1,369 @@
+"""The checks behind ``hbayes init`` (:mod:`heritage_bayes.init_config`): the clocks of
+the two files, the longest stretch of overlapping data, the periods, a heating floor.
+
+Each returns what it found and, when it cannot decide, a question (text; the writer marks
+it with :data:`heritage_bayes.questions.MARK`).
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+
+import numpy as np
+import pandas as pd
+
+from heritage_bayes.errors import DataError
+from heritage_bayes.io import clock as _clock
+from heritage_bayes.io.loggers import TableLayout
+from heritage_bayes.questions import MARK
+
+__all__ = [
+    "MAX_GAP_H",
+    "YEAR_DAYS",
+    "choose_periods",
+    "clock_step",
+    "heating_floor",
+    "logger_clock",
+    "longest_stretch",
+    "marked",
+    "to_utc",
+    "weather_clock",
+]
+
+#: Longest gap [h] bridged inside a period (the config's ``data.max_gap``).
+MAX_GAP_H = 6
+#: A stretch this long [days] or longer is split 8 months / 4 months (a year); shorter
+#: ones 2/3 / 1/3.
+YEAR_DAYS = 365
+
+
+def marked(text: str) -> str:
+    """``text`` as an open question: the value ``?? text`` the schema refuses."""
+    return f"{MARK} {text}"
+
+
+def _fmt_h(h: float) -> str:
+    sign = "+" if h >= 0 else "-"
+    m = round(abs(h) * 60)
+    return f"UTC{sign}{m // 60}" + (f":{m % 60:02d}" if m % 60 else "")
+
+
+def _declared_offsets(zone: str, index: pd.DatetimeIndex) -> tuple[float, float | None]:
+    """(winter offset, summer offset or None) [h] of a declared zone over ``index``."""
+    from heritage_bayes.io import parse_timezone
+
+    tz = parse_timezone(zone)
+    off = [
+        pd.Timestamp(year=int(index[0].year), month=m, day=15, tz="UTC")
+        .tz_convert(tz)
+        .utcoffset()
+        .total_seconds()
+        / 3600
+        for m in (1, 7)
+    ]
+    return off[0], (off[1] if off[1] != off[0] else None)
+
+
+_READING = {
+    "end": "means ending at the stamp",
+    "instant": "values at the stamp",
+    "start": "means starting at the stamp",
+}
+
+
+def _whole_hour_label(est: dict) -> str:
+    """The stamp reading that puts the clock on a whole hour from UTC (ties: 'end')."""
+    return min(
+        est, key=lambda k: abs(est[k].offset_h - round(est[k].offset_h)) + 0.01 * (k != "end")
+    )
+
+
+def weather_clock(df, lon, declared, findings, where):
+    """The weather file's clock, measured and checked against the declared one.
+
+    Parameters
+    ----------
+    df : pandas.DataFrame
+        The weather table on its file's clock (stamps read as if UTC): ``Te`` [°C] and,
+        when measured, ``ghi``/``dhi`` [W/m²].
+    lon : float or None
+        Site longitude [° east].
+    declared : str or None
+        The clock the header or ``--weather-timezone`` names.
+    findings : list of str
+        Appended to: what was measured.
+    where : str
+        Label for the findings.
+
+    Returns
+    -------
+    (timezone, reading, question)
+        ``timezone``: text for the config or None; ``reading``: ``"end"``,
+        ``"instant"`` or ``"start"`` (how the irradiance stamps are read); ``question``:
+        None, or the text of the open question.
+
+    Notes
+    -----
+    With irradiance: the sun (:func:`~heritage_bayes.io.clock.solar_clock_offset`) under
+    the three readings of the stamps; the reading that confirms the declared clock, or
+    puts an undeclared one on a whole hour, is kept. Without: the outdoor daily cycle
+    (:func:`~heritage_bayes.io.clock.outdoor_cycle_offset`, ±1.5 h).
+    """
+    if lon is None:
+        if declared:
+            findings.append(f"{where}: clock {declared} (from the file); not checked (no site)")
+            return declared, "end", None
+        return None, "end", "the weather file's clock (e.g. UTC, UTC+2); give --longitude"
+    irr = next((c for c in ("ghi", "dhi") if c in df.columns), None)
+    est = {}
+    if irr is not None:
+        est = {
+            lab: _clock.solar_clock_offset(df.index, df[irr], lon, label=lab)
+            for lab in ("end", "instant", "start")
+        }
+    if not est or est["end"].offset_h is None:
+        e = _clock.outdoor_cycle_offset(df.index, df["Te"], lon)
+        findings.append(f"{where}: clock from the outdoor daily cycle ({e.describe()})")
+        if e.offset_h is None:
+            return declared, "end", None if declared else "the weather file's clock"
+        if not declared:
+            return (
+                None,
+                "end",
+                f"the weather file's clock: the daily cycle says {_fmt_h(e.offset_h)}",
+            )
+        w, _ = _declared_offsets(declared, df.index)
+        if abs(e.offset_h - w) <= 1.5:
+            return declared, "end", None
+        return (
+            declared,
+            "end",
+            (
+                f"declared {declared} but the outdoor daily cycle says {_fmt_h(e.offset_h)} "
+                f"({e.describe()}); which clock does the file keep?"
+            ),
+        )
+    for lab, e in est.items():
+        findings.append(f"{where}: the sun in {irr} read as {_READING[lab]}: {e.describe()}")
+    lab = _whole_hour_label(est)
+    if declared:
+        w, summer = _declared_offsets(declared, df.index)
+        if summer is not None and est[lab].follows_dst is False:
+            return (
+                declared,
+                lab,
+                (
+                    f"declared {declared} (UTC{w:+g}, UTC{summer:+g} in summer) but the file keeps "
+                    f"a fixed clock: the sun gives {est['end'].describe()} reading "
+                    f"{_READING['end']}; "
+                    f"use a fixed offset such as {_fmt_h(round(est[lab].offset_h))}"
+                ),
+            )
+        ok = [k for k in ("end", "instant", "start") if abs(est[k].offset_h - w) < 0.34]
+        if ok:
+            findings.append(
+                f"{where}: clock {declared} confirmed by the sun, irradiance as {_READING[ok[0]]}"
+            )
+            return declared, ok[0], None
+        other = "end" if lab != "end" else "instant"
+        return (
+            declared,
+            lab,
+            (
+                f"declared {declared} but the sun says {_fmt_h(est[lab].offset_h)} (irradiance "
+                f"as {_READING[lab]}; {_fmt_h(est[other].offset_h)} as {_READING[other]}): "
+                f"{est[lab].describe()}; which clock does the file keep?"
+            ),
+        )
+    if est[lab].follows_dst:
+        return (
+            None,
+            lab,
+            (
+                f"the weather file keeps a daylight-saving clock ({est[lab].describe()}): "
+                "name its zone, e.g. Europe/Helsinki"
+            ),
+        )
+    zone = _fmt_h(round(est[lab].offset_h))
+    findings.append(f"{where}: no clock named in the file; the sun says {zone} ({_READING[lab]})")
+    return zone, lab, None
+
+
+def longest_stretch(ti: pd.Series, te: pd.Series) -> tuple[pd.Timestamp, pd.Timestamp, list[str]]:
+    """The longest run of hours with both ``Ti`` and ``Te`` [°C], gaps of up to
+    :data:`MAX_GAP_H` hours bridged: (start, end) [UTC] and notes on the gaps found.
+
+    Raises
+    ------
+    DataError
+        The files overlap in fewer than 48 hours (the message gives both spans).
+    """
+    a = ti.dropna().index.floor("h").unique()
+    b = te.dropna().index.floor("h").unique()
+    both = a.intersection(b).sort_values()
+    if len(both) < 48:
+        raise DataError(
+            f"the logger and weather files overlap in {len(both)} hour(s) only "
+            f"(logger {ti.index[0]} to {ti.index[-1]}, weather {te.index[0]} to {te.index[-1]})"
+        )
+    gap_h = np.diff(both) / pd.Timedelta(hours=1)
+    gaps = np.flatnonzero(gap_h > MAX_GAP_H)
+    starts = np.r_[0, gaps + 1]
+    ends = np.r_[gaps, len(both) - 1]
+    k = int(np.argmax(both[ends] - both[starts]))
+    notes = [f"gap of {gap_h[g]:.0f} h from {both[g]:%Y-%m-%d %H:%M} UTC" for g in gaps[:5]] + (
+        [f"... {len(gaps) - 5} more"] if len(gaps) > 5 else []
+    )
+    return both[starts[k]], both[ends[k]] + pd.Timedelta(hours=1), notes
+
+
+def heating_floor(ti: pd.Series, te: pd.Series) -> tuple[float, int, int]:
+    """A thermostat's signature: (floor [°C], days held at it, days with both series).
+
+    The floor is the 5th percentile of the daily indoor minima; a day is *held* when its
+    indoor minimum is within 0.5 K of the floor while the outdoor air averaged more than
+    5 K below it. Measured: the TRH-1 attic 0 of 581 days (free-running), the heated house
+    below it 206 of 581 (floor 20.4 °C), Ørholm 426 of 4 414 (10.2 °C), Annisse church
+    114 of 1 536 (16.0 °C).
+    """
+    dti = ti.resample("1D").min().rename("ti")
+    dte = te.resample("1D").mean().rename("te")
+    both = pd.concat([dti, dte], axis=1, sort=True).dropna()
+    if len(both) < 10:
+        return float("nan"), 0, len(both)
+    floor = float(np.percentile(both["ti"], 5))
+    held = (both["ti"] - floor).abs().le(0.5) & both["te"].lt(floor - 5)
+    return floor, int(held.sum()), len(both)
+
+
+def choose_periods(s: pd.Timestamp, e: pd.Timestamp) -> tuple[str, str, str, str, str]:
+    """Calibration ``[start, mid)`` and validation ``[mid, end)`` in whole UTC days
+    within the stretch ``[s, e)``, and why: the first whole calendar year (8 months to
+    calibrate, 4 to validate: all seasons), else the first 12 whole months, else the
+    stretch's first 2/3 and the rest. Returns ``(start, mid, mid, end, why)`` as text."""
+    day = pd.Timedelta(days=1)
+    s0 = s.ceil("D")
+    e0 = e.floor("D")
+    jan = pd.Timestamp(year=s0.year + int((s0.month, s0.day) > (1, 1)), month=1, day=1, tz=s0.tz)
+    if s0.day != 1 and (e - s0).days >= YEAR_DAYS + 31:
+        s0 = (s0 + pd.offsets.MonthBegin(1)).normalize()
+    if e0 >= jan + pd.DateOffset(years=1):  # a whole calendar year: the reporting year
+        s0 = jan
+    if (e0 - s0).days >= YEAR_DAYS:
+        end = s0 + pd.DateOffset(months=12)
+        mid = s0 + pd.DateOffset(months=8)
+        what = "calendar year" if (s0.month, s0.day) == (1, 1) else "year"
+        why = (
+            f"the first whole {what} of the longest stretch (all seasons): 8 months to "
+            "calibrate, 4 to validate"
+        )
+    else:
+        end = e0
+        mid = s0 + day * round((e0 - s0).days * 2 / 3)
+        why = "the longest stretch: its first 2/3 to calibrate, the rest to validate"
+    f = "%Y-%m-%d"
+    return s0.strftime(f), mid.strftime(f), mid.strftime(f), end.strftime(f), why
+
+
+def logger_clock(layout, df_naive, declared, lon, findings, where):
+    """Check a logger's declared clock; return the zone text or an open question.
+
+    A DST zone: its changes against the stamps as written
+    (:func:`~heritage_bayes.io.clock.dst_structure`; a fixed clock is a question). A
+    fixed offset: the same against the DST zone of that offset
+    (:data:`~heritage_bayes.io.clock.DST_ZONES`; a DST clock is a question). With a
+    longitude: the indoor temperature's daily peak against solar noon [h], a finding
+    (a question when it comes more than half an hour before noon: no free-running room
+    warms before the sun does). No declared clock: a question.
+    """
+    question = None
+    if declared is None:
+        return marked(
+            "the logger's clock: UTC, a fixed offset such as UTC+1, or a zone with "
+            "daylight-saving time such as Europe/Amsterdam (see its settings or the "
+            "software it was read out with)"
+        )
+    from heritage_bayes.io import parse_timezone
+
+    tz = parse_timezone(declared)
+    if not isinstance(tz, _dt.timezone):  # a DST zone: does the file follow its changes?
+        times = _raw_times(layout)
+        st = _clock.dst_structure(times, declared)
+        findings.append(f"{where}: {st.describe()}")
+        if st.verdict == "fixed":
+            w, _ = _declared_offsets(declared, df_naive.index)
+            question = marked(
+                f"declared {declared}, but the file keeps a fixed clock ({st.describe()}); "
+                f"the winter offset would be UTC{w:+g}"
+            )
+    else:  # a fixed offset: does the file jump at the DST changes of its region?
+        off = tz.utcoffset(None).total_seconds() / 3600
+        zone = _clock.DST_ZONES.get(int(off)) if off == int(off) else None
+        st = _clock.dst_structure(_raw_times(layout), zone) if zone else None
+        if st is not None and st.changes:
+            findings.append(f"{where}: {st.describe()}")
+        if st is not None and st.verdict == "dst":
+            question = marked(
+                f"declared the fixed clock {declared}, but the stamps jump at the DST "
+                f"changes of {zone} ({st.describe()}): declare that zone"
+            )
+    if lon is not None and "Ti" in df_naive:
+        from heritage_bayes.io._common import localize
+
+        loc = localize(df_naive.index.tz_localize(None), tz)
+        peak = _clock.daily_cycle_phase(loc.utc, df_naive["Ti"].to_numpy()[loc.keep], min_range=1.0)
+        lag = _clock._wrap(peak - _clock.solar_noon_utc(pd.DatetimeIndex(peak.index), lon))
+        if np.isfinite(lag).sum() >= 5:
+            med = float(np.nanmedian(lag))
+            findings.append(
+                f"{where}: the indoor temperature peaks {med:+.1f} h after solar noon on the "
+                f"declared clock (median of {int(np.isfinite(lag).sum())} days)"
+            )
+            if med < -0.5 and question is None:
+                question = marked(
+                    f"declared {declared}, but the indoor temperature peaks {-med:.1f} h "
+                    "before solar noon on that clock: no room warms before the sun and the "
+                    "outdoor air do; is the logger's clock ahead of the declared one?"
+                )
+    return question or declared
+
+
+def _raw_times(layout: TableLayout) -> pd.DatetimeIndex:
+    """The stamps as written, in file order (for the DST structure)."""
+    names = [layout.time_column] if isinstance(layout.time_column, str) else layout.time_column
+    from heritage_bayes.io.readers.workbook import is_workbook, table_source
+
+    raw = pd.read_csv(
+        table_source(layout.path)(),
+        sep=layout.sep,
+        skiprows=layout.skiprows,
+        encoding=None if is_workbook(layout.path) else layout.encoding,
+        dtype=str,
+        usecols=lambda c: str(c).strip() in names,
+    )
+    raw.columns = [str(c).strip() for c in raw.columns]
+    text = raw[names[0]].str.strip()
+    for n in names[1:]:
+        text = text + " " + raw[n].str.strip()
+    fmt = None if layout.time_format == "ISO8601" else layout.time_format
+    return pd.DatetimeIndex(pd.to_datetime(text, format=fmt, errors="coerce").dropna())
+
+
+def clock_step(index: pd.DatetimeIndex) -> str:
+    """The most frequent step of ``index`` as text (``'1h'``, ``'10min'``)."""
+    from heritage_bayes.io._common import format_timedelta, modal_step
+
+    st = modal_step(index)
+    return format_timedelta(st) if st is not None else "?"
+
+
+def to_utc(series: pd.Series, zone: str | None) -> pd.Series:
+    """A series read on its file's clock (stamps as if UTC) moved to UTC by ``zone``
+    (unchanged when the zone is an open question)."""
+    from heritage_bayes.io import parse_timezone
+    from heritage_bayes.io._common import localize
+
+    if zone is None or str(zone).startswith(MARK):
+        return series
+    loc = localize(series.index.tz_localize(None), parse_timezone(zone))
+    return pd.Series(series.to_numpy()[loc.keep], index=loc.utc)

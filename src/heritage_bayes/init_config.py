@@ -1,0 +1,488 @@
+"""``hbayes init``: a commented configuration from a logger file and a weather file.
+
+:func:`init_config` inspects the files with :mod:`heritage_bayes.io` (the export's layout
+with :func:`~heritage_bayes.io.loggers.inspect_table`, the clocks with
+:mod:`heritage_bayes.io.clock`), decides what it can — time column and format, the clock
+of each file checked against the sun and the outdoor daily cycle, the columns of
+temperature, relative humidity and irradiance and their units, the step, the gaps, the
+longest stretch of overlapping data for the calibration and validation periods, the
+models to start with — and writes a ``config.yaml`` whose comments say what was guessed
+and why. What it cannot decide becomes a marked question (a value starting with ``??``,
+see :mod:`heritage_bayes.questions`) that ``hbayes calibrate`` refuses until answered.
+The written file is validated by the same schema as any config
+(:func:`heritage_bayes.config.parse_config`).
+
+Choices, with the measurements behind them (TRH-1 attic, ``benchmarks/bench_init.py``
+and ``tests/test_init.py``):
+
+* **One solar aperture on the horizontal** (``surfaces: {H: [0, 0]}``), not the four
+  facades: the data pin one aperture; with four, thermal_1c put fI_E on its bound and
+  left fI_N unidentified, and its MAP validation FIT of Ti was 76.7 % against 78.0 % with
+  H (calibration Dec 2010-Aug 2011, validation Aug-Dec 2011; 4 facades also sampled
+  slowly: τmax 141 after 13 000 steps, stopped).
+* **Periods**: the first whole calendar year of the longest stretch without a gap over
+  6 h (all seasons; 8 months to calibrate, 4 to validate), else its first whole 12
+  months, else 2/3 and 1/3 of it.
+* **Models**: thermal_1c and hygric_1c, the smallest of each ladder; the report's
+  ladder fits the larger ones.
+* **Irradiance stamps**: the reading of the stamps (interval end, instant, interval
+  start) under which the sun confirms the declared clock (FMI: values at the stamp).
+
+Example
+-------
+::
+
+    hbayes init logger.csv --weather fmi.csv --latitude 60.21 --longitude 24.66 \\
+        --name attic -o attic/config.yaml
+    hbayes calibrate attic/config.yaml
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import pandas as pd
+import yaml
+
+from heritage_bayes.errors import DataError, InputError
+from heritage_bayes.init_checks import (
+    MAX_GAP_H,
+    choose_periods,
+    clock_step,
+    heating_floor,
+    logger_clock,
+    longest_stretch,
+    marked,
+    to_utc,
+    weather_clock,
+)
+from heritage_bayes.io import clock as _clock
+from heritage_bayes.io.loggers import TableLayout, inspect_table
+from heritage_bayes.questions import MARK
+
+__all__ = ["InitResult", "init_config"]
+
+#: Weather formats ``init`` reads besides CSV (by the readers of :mod:`heritage_bayes.io`).
+WEATHER_FORMATS = ("csv", "epw", "knmi", "tmy3")
+
+
+@dataclass
+class InitResult:
+    """What :func:`init_config` wrote and found.
+
+    ``text``: the YAML written; ``findings``: what was guessed and why (one line each);
+    ``questions``: what is left open (key path: question).
+    """
+
+    path: Path
+    text: str
+    findings: list[str] = field(default_factory=list)
+    questions: list[str] = field(default_factory=list)
+
+
+def _yaml_value(v) -> str:
+    text = yaml.safe_dump(v, default_flow_style=True, allow_unicode=True, width=10_000).strip()
+    return text[:-4].strip() if text.endswith("\n...") else text.removesuffix("...").strip()
+
+
+def _wrap(text: str, first: str, rest: str, width: int = 92) -> list[str]:
+    """Comment lines of at most ``width`` characters."""
+    import textwrap
+
+    return textwrap.wrap(text, width, initial_indent=first, subsequent_indent=rest) or [first]
+
+
+def _doc(path: str) -> list[str]:
+    """Comment lines for a key from the schema (:func:`describe_key`), indented as the key."""
+    from heritage_bayes.config.reference import describe_key
+
+    pad = "  " * path.count(".") + "# "
+    return _wrap(describe_key(path).split(" ", 1)[1], pad, pad)
+
+
+def _weather_format(path: Path, given: str | None) -> str:
+    if given is not None:
+        if given not in WEATHER_FORMATS:
+            raise InputError(
+                f"--weather-format: one of {', '.join(WEATHER_FORMATS)} (got {given!r})"
+            )
+        return given
+    name = path.name.lower()
+    if name.endswith(".epw"):
+        return "epw"
+    if name.startswith("uurgeg") or name.endswith(".txt.gz"):
+        return "knmi"
+    head = path.read_bytes()[:2000].decode("latin-1")
+    if head.startswith("# STN") or "YYYYMMDD" in head[:2000]:
+        return "knmi"
+    return "csv"
+
+
+def _read_naive(layout: TableLayout, columns: dict[str, str], units: dict) -> pd.DataFrame:
+    """The table on the file's own clock (read as if UTC), for inspection only."""
+    from heritage_bayes.io import read_csv
+
+    return read_csv(
+        layout.path,
+        time_column=layout.time_column,
+        columns=columns,
+        time_format=None if layout.time_format == "ISO8601" else layout.time_format,
+        timezone=None if layout.time_format == "ISO8601" else "UTC",
+        sep=layout.sep,
+        decimal=layout.decimal,
+        skiprows=layout.skiprows,
+        encoding=layout.encoding,
+        units=units or None,
+        averaged=(),
+        duplicates="first",
+        sort=True,
+        invalid="nan",
+    )
+
+
+def _pick(layout: TableLayout, kinds: dict[str, str], findings: list[str], what: str):
+    """``{standard: column}`` and ``{standard: unit}`` from the layout's guesses."""
+    columns, units = {}, {}
+    for std, kind in kinds.items():
+        found = layout.all(kind)
+        if not found:
+            continue
+        c = found[0]
+        columns[std] = c.name
+        if c.unit in ("°F", "K", "fraction"):
+            units[std] = c.unit
+        also = (
+            f" (also {', '.join(repr(x.name) for x in found[1:])}: not used)" if found[1:] else ""
+        )
+        findings.append(f"{what}: {std} = column {c.name!r}: {c.why}{also}")
+    return columns, units
+
+
+def _source_lines(
+    key: str, layout: TableLayout, rel: str, zone, columns, units, label, dropped
+) -> list[str]:
+    out = [f"  {key}:", "    format: csv", f"    path: {_yaml_value(rel)}"]
+    tc = layout.time_column
+    out.append(f"    time_column: {_yaml_value(tc)}")
+    if layout.time_format != "ISO8601":
+        out.append(f"    time_format: {_yaml_value(layout.time_format)}")
+        out.append(f"    timezone: {_yaml_value(zone)}")
+    if layout.sep != ",":
+        out.append(f"    sep: {_yaml_value(layout.sep)}")
+    if layout.decimal != ".":
+        out.append(f"    decimal: {_yaml_value(layout.decimal)}")
+    if layout.skiprows:
+        out.append(f"    skiprows: {_yaml_value(layout.skiprows)}   # {layout.layout} layout")
+    if layout.encoding != "utf-8":
+        out.append(f"    encoding: {layout.encoding}")
+    out.append(f"    columns: {_yaml_value(columns)}")
+    if units:
+        out.append(f"    units: {_yaml_value(units)}   # converted on reading")
+    if label == "instant":
+        out.append("    averaged: []   # irradiance values at the stamp (see the clock check)")
+    elif label == "start":
+        out.append("    label: start   # irradiance means of the hour starting at the stamp")
+    out += _policy_lines(dropped)
+    return out
+
+
+#: What the reader dropped while init inspected a file, and the key that lets the
+#: calibration read the file the same way (its default would refuse it).
+_POLICIES = {
+    "duplicates": ("duplicates: first", "stamps repeated with other values: the first kept"),
+    "bad_timestamps": ("invalid: nan", "unreadable time stamps: those rows dropped"),
+    "unparseable_values": ("invalid: nan", "unreadable values: left out"),
+    "out_of_range": ("invalid: nan", "values outside the physical range: left out"),
+}
+
+
+def _policy_lines(dropped: dict) -> list[str]:
+    lines: dict[str, list[str]] = {}
+    for what, n in (dropped or {}).items():
+        if what in _POLICIES and n:
+            setting, why = _POLICIES[what]
+            lines.setdefault(setting, []).append(f"{n} {why}")
+    return [f"    {k}   # {'; '.join(v)}" for k, v in lines.items()]
+
+
+def _dropped_findings(df: pd.DataFrame, where: str, findings: list[str], questions: list[str]):
+    dropped = dict(df.attrs.get("dropped") or {})
+    if dropped:
+        findings.append(f"{where}: the reader dropped or changed {dropped}")
+    if dropped.get("sorted"):
+        questions.append(
+            f"questions: the {where} file's time stamps go backwards {dropped['sorted']} "
+            "time(s) (a clock reset? two files joined?); fix the file, then delete this question"
+        )
+    return dropped
+
+
+def init_config(
+    indoor,
+    weather,
+    *,
+    output,
+    weather_format: str | None = None,
+    latitude: float | None = None,
+    longitude: float | None = None,
+    name: str | None = None,
+    timezone: str | None = None,
+    weather_timezone: str | None = None,
+    force: bool = False,
+) -> InitResult:
+    """Inspect a logger file and a weather file; write a commented configuration.
+
+    Parameters
+    ----------
+    indoor : path-like
+        The logger export (indoor T and RH): generic CSV/TSV (any header, decimal comma)
+        or a HOBO, Hanwell, Meaco, Tinytag or Rotronic export
+        (:mod:`heritage_bayes.io.loggers`).
+    weather : path-like
+        The weather file: CSV (outdoor T, RH, measured irradiance when available), EPW,
+        KNMI hourly or TMY3.
+    output : path-like
+        The configuration to write; paths in it are relative to its folder.
+    weather_format : {"csv", "epw", "knmi", "tmy3"}, optional
+        Default: from the file name and first line.
+    latitude, longitude : float, optional
+        The site [° north, ° east]; needed for the sun (irradiance on the facades) and
+        to measure the files' clocks. EPW and TMY3 files carry their own.
+    name : str, optional
+        Run name (default: the output file's stem, or its folder's name for
+        ``config.yaml``).
+    timezone, weather_timezone : str, optional
+        The clocks of the logger and weather files when their headers do not name them
+        (``UTC+1``, ``Europe/Amsterdam``): checked against the data either way.
+    force : bool
+        Replace an existing ``output``.
+
+    Returns
+    -------
+    InitResult
+
+    Raises
+    ------
+    heritage_bayes.errors.InputError
+        ``output`` exists (without ``force``), a file cannot be read as a table, no
+        indoor temperature column, no overlap of the two files.
+    """
+    from heritage_bayes.rundir.policy import check_name, resolve_output, write_new_file
+
+    name_given = name is not None
+
+    indoor, weather = Path(indoor), Path(weather)
+    for p, opt in ((indoor, "INDOOR_FILE"), (weather, "--weather")):
+        if not p.is_file():
+            raise DataError(f"{opt}: {p}: " + ("is a folder" if p.is_dir() else "file not found"))
+    output = resolve_output(output, what="--output", kind="file", protect=(indoor, weather))
+    if output.exists() and not force:  # before the inspection: fail at once
+        raise InputError(f"--output: {output} exists; choose another name or add --force")
+    findings: list[str] = []
+    questions: list[str] = []
+    base = output.resolve().parent
+
+    def rel(p: Path) -> str:
+        return Path(os.path.relpath(p.resolve(), base)).as_posix()
+
+    # -- the logger --------------------------------------------------------------------------
+    lay = inspect_table(indoor, what="logger file")
+    findings.append(
+        f"logger: {lay.layout} layout, separator {lay.sep!r}, decimal {lay.decimal!r}, time "
+        f"column {lay.time_column!r} as {lay.time_format!r}"
+        + (f", clock {lay.timezone} (named in the header)" if lay.timezone else "")
+    )
+    findings += [f"logger: {n}" for n in lay.notes]
+    icols, iunits = _pick(lay, {"Ti": "T", "RHi": "RH"}, findings, "logger")
+    if "Ti" not in icols:
+        raise DataError(
+            f"{indoor.name}: no indoor temperature column found; columns: "
+            + "; ".join(f"{c.name!r} ({c.why})" for c in lay.columns)
+        )
+    din = _read_naive(lay, icols, iunits)
+    idropped = _dropped_findings(din, "logger", findings, questions)
+    step = clock_step(din.index)
+    findings.append(
+        f"logger: {len(din)} rows, step {step}, {din.index[0]:%Y-%m-%d} to "
+        f"{din.index[-1]:%Y-%m-%d} (file clock)"
+    )
+
+    # -- the weather -------------------------------------------------------------------------
+    wfmt = _weather_format(weather, weather_format)
+    lat, lon = latitude, longitude
+    wlay = None
+    wlabel = "end"
+    wzone = weather_timezone
+    if wfmt == "csv":
+        wlay = inspect_table(weather, what="weather file")
+        findings.append(
+            f"weather: {wlay.layout} layout, time column {wlay.time_column!r} as "
+            f"{wlay.time_format!r}"
+            + (f", clock {wlay.timezone} (named in the header)" if wlay.timezone else "")
+        )
+        wcols, wunits = _pick(
+            wlay,
+            {"Te": "T", "RHe": "RH", "ghi": "ghi", "dhi": "dhi", "dni": "dni"},
+            findings,
+            "weather",
+        )
+        if "Te" not in wcols:
+            raise DataError(
+                f"{weather.name}: no outdoor temperature column found (columns {wlay.header})"
+            )
+        dw = _read_naive(wlay, wcols, wunits)
+        wdropped = _dropped_findings(dw, "weather", findings, questions)
+        declared = weather_timezone or wlay.timezone
+        if wlay.time_format == "ISO8601":  # stamps with their UTC offset: the clock is known
+            wzone, wq = None, None
+            findings.append("weather: time stamps carry their UTC offset")
+        else:
+            wzone, wlabel, wq = weather_clock(dw, lon, declared, findings, "weather")
+        if wq:
+            wzone = marked(wq)
+            questions.append(f"data.weather.timezone: {wq}")
+        te_utc = to_utc(dw["Te"], wzone)
+        irr = "measured" if {"ghi"} <= set(wcols) or {"ghi", "dhi"} & set(wcols) else None
+    else:
+        from heritage_bayes.io import read_epw, read_knmi_hourly, read_tmy3
+
+        reader = {"epw": read_epw, "knmi": read_knmi_hourly, "tmy3": read_tmy3}[wfmt]
+        dw = reader(weather)
+        te_utc = dw["Te"]
+        site = dw.attrs.get("site") or {}
+        lat = lat if lat is not None else site.get("latitude")
+        lon = lon if lon is not None else site.get("longitude")
+        irr = "measured" if {"ghi", "dhi", "dni"} & set(dw.columns) else None
+        findings.append(f"weather: {wfmt} file, {len(dw)} rows, columns {list(dw.columns)}")
+        if lon is not None and "ghi" in dw:
+            est = _clock.solar_clock_offset(dw.index, dw["ghi"], lon)
+            findings.append(f"weather: clock check (the reader's UTC): {est.describe()}")
+
+    # -- the logger's clock (after the weather's) -----------------------------------------------
+    if lay.time_format == "ISO8601":  # stamps with their UTC offset: the clock is known
+        izone = None
+        findings.append("logger: time stamps carry their UTC offset")
+    else:
+        izone = logger_clock(lay, din, timezone or lay.timezone, lon, findings, "logger")
+    if izone and izone.startswith(MARK):
+        questions.append(f"data.measurements.timezone: {izone[len(MARK) :].strip()}")
+    ti_utc = to_utc(din["Ti"], izone)
+
+    # -- site, periods, models ------------------------------------------------------------------
+    if lat is None or lon is None:
+        site_value = marked(
+            "the site: {latitude: DEG north, longitude: DEG east}; give --latitude, --longitude"
+        )
+        questions.append("site: the site's latitude and longitude (the sun on the facades)")
+    else:
+        site_value = {
+            "latitude": round(float(lat), 4),
+            "longitude": round(float(lon), 4),
+            "altitude": 0,
+        }
+    try:
+        s, e, gap_notes = longest_stretch(ti_utc, te_utc)
+    except DataError as exc:
+        typical = (
+            " (a typical year cannot calibrate a room: use the weather measured over "
+            "the logger's period)"
+            if wfmt in ("epw", "tmy3")
+            else ""
+        )
+        raise DataError(f"{indoor.name}, {weather.name}: {exc}{typical}") from None
+    findings.append(
+        f"overlap: longest stretch without a gap over {MAX_GAP_H} h: "
+        f"{s:%Y-%m-%d %H:%M} to {e:%Y-%m-%d %H:%M} UTC"
+    )
+    findings += [f"overlap: {g}" for g in gap_notes]
+    floor, held, ndays = heating_floor(ti_utc, te_utc)
+    heated = held >= max(20, 0.05 * ndays)
+    findings.append(
+        f"control: the indoor daily minimum sat at {floor:.1f} °C (within 0.5 K) on {held} of "
+        f"{ndays} days while the outdoor air averaged 5 K colder"
+        + (": heated (a thermostat's floor)" if heated else ": free-running")
+    )
+    if heated:
+        questions.append(
+            f"questions: the room looks heated to about {floor:.0f} °C on {held} of {ndays} "
+            "days; if so, model the heating (thermal.options: {thermostat: true}) or choose "
+            "periods outside the heating season; then delete this question"
+        )
+    cs, ce, vs, ve, why = choose_periods(s, e)
+    findings.append(f"periods: {why}")
+    hygric = "RHi" in icols and ("RHe" in dw.columns)
+    name = name or (output.parent.name if output.stem == "config" else output.stem) or "room"
+    check_name(name, what="--name" if name_given else "name (from --output)")
+
+    lines = [
+        f"# Written by `hbayes init` on {_dt.date.today():%Y-%m-%d} from",
+        f"#   logger:  {rel(indoor)}",
+        f"#   weather: {rel(weather)}",
+        "# What init found, and why (check each):",
+        *[line for f in findings for line in _wrap(f, "#   - ", "#     ")],
+        "# Values starting with '??' are open questions: `hbayes calibrate` refuses this file",
+        "# until each is answered. Dates are UTC; paths are relative to this file.",
+        "",
+        f"name: {_yaml_value(name)}",
+        'building: ""',
+        'room: ""',
+        "seed: 1",
+        "",
+        f"site: {_yaml_value(site_value)}",
+        "",
+        "data:",
+    ]
+    if wlay is not None:
+        lines += _source_lines(
+            "weather", wlay, rel(weather), wzone, wcols, wunits, wlabel, wdropped
+        )
+    else:
+        lines += ["  weather:", f"    format: {wfmt}", f"    path: {_yaml_value(rel(weather))}"]
+    lines += _source_lines("measurements", lay, rel(indoor), izone, icols, iunits, "end", idropped)
+    if irr == "measured":
+        lines += [
+            "  irradiance: measured",
+            "  # One solar aperture on the horizontal (tilt, azimuth from north) [°]: the",
+            "  # sun on the building as a whole, which the data can pin. Name the facades",
+            "  # or roof planes that matter when you know them (e.g. S: [90, 180], roof_E:",
+            "  # [30, 90]); each adds an aperture to estimate.",
+            "  surfaces: {H: [0, 0]}",
+        ]
+    elif lat is not None:
+        lines += [
+            "  irradiance: clear_sky   # no measured irradiance: a clear-sky proxy (pvlib)",
+            "  surfaces: {H: [0, 0]}   # one aperture on the horizontal (see above)",
+        ]
+    else:
+        lines += ["  irradiance: none"]
+    lines += [*_doc("data.step"), "  step: 1h", *_doc("data.max_gap"), f"  max_gap: {MAX_GAP_H}h"]
+    lines += ["", "periods:", *_wrap(why, "  # ", "  # ")]
+    lines += [
+        f"  calibration: {{start: {cs}, end: {ce}}}",
+        f"  validation: {{start: {vs}, end: {ve}}}",
+        "",
+        "# The smallest model of each ladder; the report's ladder fits the larger ones",
+        "# (thermal_2c, thermal_4a; hygric_2c, hygric_2c_fixed) and shows whether they pay.",
+        "# Tf, the fixed node, is the annual mean outdoor temperature (the ground under the",
+        "# floor). A room without a floor on the ground (an attic, an upper storey): set",
+        "# options: {ground: false}, or give the neighbouring space's measured temperature",
+        "# (data.ground_temperature: {mode: column, column: ..., source: {...}}).",
+        "thermal:",
+        "  model: thermal_1c",
+    ]
+    if hygric:
+        lines += ["", "hygric:", "  model: hygric_1c"]
+    lines += ["", "sampler:", *_doc("sampler.max_time"), "  max_time: 30min", ""]
+    extra = [q.split(": ", 1)[1] for q in questions if q.startswith("questions: ")]
+    if extra:
+        lines += ["questions:", *[f"  - {_yaml_value(MARK + ' ' + q)}" for q in extra], ""]
+    text = "\n".join(lines)
+    if not questions:  # the same schema as every config: it must load
+        from heritage_bayes.config import parse_config
+
+        parse_config(yaml.safe_load(text), source=str(output), base_dir=str(base), name=name)
+    write_new_file(output, text, force=force, what="--output")
+    return InitResult(output, text, findings, questions)

@@ -1,0 +1,278 @@
+"""Interventions in projections (issue 29): pairing by construction, the physics of
+conservation heating and dehumidification, running costs, the schema and the page.
+
+One module-scoped tiny calibration (thermal_1c + hygric_1c as tests/test_projection.py,
+a few seconds, not converged: enough draws) and one baseline year (the demo's TMY,
+8759 h, of which 8760 - 1 complete-year hours: one year is simulated).
+"""
+
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from heritage_bayes.calibrate import run_calibration
+from heritage_bayes.config import parse_config
+from heritage_bayes.errors import ConfigError
+from heritage_bayes.projection import parse_projection_config, project
+from heritage_bayes.projection.engine import select_draws, simulate_cases
+from heritage_bayes.projection.interventions import Measure, measures_from_config
+from heritage_bayes.projection.weather import baseline_weather, model_inputs
+from test_report import TINY
+
+DRAWS = 6
+PROJ = {
+    "draws": DRAWS,
+    "seed": 2,
+    "morphing": [
+        {"scenario": "warm", "horizon": 2050, "method": "shift", "deltas": {"Te": [2.0] * 12}}
+    ],
+    "risk": {"chunk_draws": 4},
+}
+
+
+@pytest.fixture(scope="module")
+def run(tmp_path_factory):
+    from heritage_bayes.run import load_run
+
+    out = tmp_path_factory.mktemp("interv") / "run"
+    run_calibration(parse_config(copy.deepcopy(TINY)), out_dir=out, report=False, quiet=True)
+    return load_run(out)
+
+
+@pytest.fixture(scope="module")
+def case(run):
+    pcfg = parse_projection_config(PROJ)
+    weather, site, _ = baseline_weather(run, pcfg)
+    inputs = model_inputs(run, pcfg, weather, site, "baseline")
+    draws = select_draws(run, DRAWS, 2)
+    nothing = simulate_cases(run, draws, [inputs], seed=2, chunk=4)[0]
+    return draws, inputs, nothing
+
+
+def _with(run, case, measure):
+    draws, inputs, _ = case
+    return simulate_cases(run, draws, [inputs], seed=2, chunk=4, measure=measure)[0]
+
+
+def test_a_measure_that_changes_nothing_is_do_nothing_in_every_draw(run, case):
+    """Ventilation × 1 takes the same path as doing nothing: identical in every draw."""
+    _, _, nothing = case
+    same = _with(run, case, Measure("nothing", ventilation=1.0))
+    cols = [c for c in nothing.predictive.columns if c != "ashrae_best_class"]
+    d = same.predictive[cols].to_numpy(float) - nothing.predictive[cols].to_numpy(float)
+    assert np.all((d == 0) | np.isnan(d))
+    np.testing.assert_array_equal(same.Ti_month, nothing.Ti_month)
+
+
+def test_a_dehumidifier_of_zero_capacity_changes_nothing(run, case):
+    """Through the controller (model.forward) instead of the compiled pass: equal to
+    rounding (1e-9 relative), the same noise draw added; no water removed."""
+    _, _, nothing = case
+    zero = _with(run, case, Measure("off", dehumidifier=(0.4, 0.0, 0.7)))
+    cols = [c for c in nothing.predictive.columns if c != "ashrae_best_class"]
+    np.testing.assert_allclose(
+        zero.predictive[cols].to_numpy(float),
+        nothing.predictive[cols].to_numpy(float),
+        rtol=1e-9,
+        atol=1e-9,
+    )
+    np.testing.assert_allclose(zero.RHi_month, nothing.RHi_month, rtol=1e-5)
+    assert np.all(zero.costs["water_removed"] == 0)
+    assert np.all(zero.costs["dehumidifier_energy"] == 0)
+
+
+def test_conservation_heating_lowers_rh_and_raises_t_in_every_draw(run, case):
+    _, _, nothing = case
+    rh_now = float(np.nanmedian(nothing.RHi_month))
+    target = max(30.0, rh_now - 15.0)  # [%] well below the room's typical RH
+    heat = _with(run, case, Measure("ch", heating=(target / 100, -273.15, 25.0, np.inf)))
+    assert np.all(heat.RHi_month.mean(axis=1) < nothing.RHi_month.mean(axis=1))
+    assert np.all(heat.Ti_month.mean(axis=1) > nothing.Ti_month.mean(axis=1))
+    assert np.all(heat.costs["heating_energy"] > 0)
+    assert np.all(heat.costs["heating_peak"] > 0)
+    # a lower cap t_max: less heat, a cooler and damper room, in every draw
+    capped = _with(run, case, Measure("ch", heating=(target / 100, -273.15, 8.0, np.inf)))
+    e, e8 = heat.costs["heating_energy"], capped.costs["heating_energy"]
+    assert np.all(e8 < e)
+    assert np.all(capped.Ti_month.mean(axis=1) < heat.Ti_month.mean(axis=1))
+    assert np.all(capped.RHi_month.mean(axis=1) > heat.RHi_month.mean(axis=1))
+
+
+def test_power_limit_bounds_the_peak(run, case):
+    heat = _with(run, case, Measure("ch", heating=(0.3, -273.15, 30.0, 200.0)))
+    assert np.all(heat.costs["heating_peak"] <= 0.2 + 1e-12)  # [kW]
+
+
+def test_heating_schedule(run, case):
+    """A thermostat at 10 °C raises the mean T and lowers the mean RH in every draw;
+    16 °C on Sunday mornings (UTC+1) costs more energy in every draw."""
+    from heritage_bayes.rc.calendar import parse_weekly
+
+    _, _, nothing = case
+    base = _with(run, case, Measure("t", thermostat=(10.0, None, None, np.inf)))
+    assert np.all(base.Ti_month.mean(axis=1) > nothing.Ti_month.mean(axis=1))
+    assert np.all(base.RHi_month.mean(axis=1) < nothing.RHi_month.mean(axis=1))
+    cal = parse_weekly({"weekly": ["Sun 08-12"], "timezone": "UTC+1"})
+    use = _with(run, case, Measure("s", thermostat=(10.0, 16.0, cal, np.inf)))
+    assert np.all(use.costs["heating_energy"] > base.costs["heating_energy"])
+    assert np.all(base.costs["heating_energy"] > 0)
+
+
+def test_dehumidifier_lowers_rh_and_removes_water(run, case):
+    _, _, nothing = case
+    dry = _with(run, case, Measure("dh", dehumidifier=(0.45, 5.0 / 3600, 0.7)))
+    assert np.all(dry.RHi_month.mean(axis=1) < nothing.RHi_month.mean(axis=1))
+    w = dry.costs["water_removed"].to_numpy()
+    assert np.all(w > 0)
+    assert np.all(dry.costs["dehumidifier_peak"] <= 5.0 + 1e-9)  # [kg/h] capacity
+    np.testing.assert_allclose(dry.costs["dehumidifier_energy"], 0.7 * w)
+    # the temperature is not touched by a dehumidifier
+    np.testing.assert_allclose(dry.Ti_month, nothing.Ti_month, rtol=1e-5)
+
+
+def test_schema():
+    ok = {
+        **PROJ,
+        "interventions": [
+            {"name": "ch", "conservation_heating": {"rh_max": 65, "t_max": 20, "t_min": 5}},
+            {"name": "dh", "dehumidification": {"rh_max": 60, "capacity": 0.5}},
+            {"name": "less air", "ventilation": {"factor": 0.5}},
+            {
+                "name": "services",
+                "heating": {"t_set": 8, "t_use": 16, "weekly": ["Sun 08-12"], "timezone": "UTC+1"},
+                "dehumidification": {"rh_max": 60, "capacity": 0.5},
+            },
+        ],
+    }
+    ms = measures_from_config(parse_projection_config(ok))
+    assert ms[0].heating == (0.65, 5.0, 20.0, np.inf)
+    assert ms[1].dehumidifier == (0.6, 0.5 / 3600, None)
+    assert ms[2].ventilation == 0.5
+    assert ms[3].thermostat[:2] == (8.0, 16.0) and ms[3].thermostat[2].hours_per_week == 4
+    assert ms[3].dehumidifier is not None
+    bad = [
+        ({"name": "x", "conservation_heating": {"rh_max": 65, "t_max": 20, "power": 1}},
+         "power"),
+        ({"name": "x", "dehumidification": {"rh_max": 60}}, "capacity"),
+        ({"name": "x"}, "give a change"),
+        ({"name": "x", "conservation_heating": {"rh_max": 65, "t_max": 20},
+          "dehumidification": {"rh_max": 60, "capacity": 1}}, "two measures"),
+        ({"name": "x", "conservation_heating": {"rh_max": 65, "t_min": 20, "t_max": 10}},
+         "t_min"),
+        ({"name": "x", "ventilation": {"factor": -1}}, "factor"),
+        ({"name": "x", "heating": {"t_set": 8, "t_use": 16}}, "together"),
+        ({"name": "x", "heating": {"t_set": 8, "t_use": 16, "weekly": ["Sun 25-26"]}},
+         "heating"),
+        ({"name": "x", "heating": {"t_set": 8},
+          "conservation_heating": {"rh_max": 65, "t_max": 20}}, "give one"),
+    ]  # fmt: skip
+    for item, needle in bad:
+        with pytest.raises(ConfigError, match=needle):
+            parse_projection_config({**PROJ, "interventions": [item]})
+    with pytest.raises(ConfigError, match="repeated"):
+        parse_projection_config({**PROJ, "interventions": [ok["interventions"][2]] * 2})
+
+
+@pytest.fixture(scope="module")
+def projected(run, tmp_path_factory):
+    cfg = {
+        **PROJ,
+        "interventions": [
+            {"name": "conservation heating",
+             "conservation_heating": {"rh_max": 50, "t_max": 22, "power_max": 2000}},
+            {"name": "dehumidifier",
+             "dehumidification": {"rh_max": 50, "capacity": 1.0, "energy_per_kg": 0.7}},
+            {"name": "half ventilation", "ventilation": {"factor": 0.5}},
+        ],
+    }  # fmt: skip
+    return project(run, cfg, out=tmp_path_factory.mktemp("interv_p") / "p")
+
+
+def test_project_compares_measures_and_draws_the_page(projected):
+    p = projected
+    iv = p.summary["interventions"]
+    assert list(iv) == ["conservation heating", "dehumidifier", "half ventilation"]
+    for e in iv.values():
+        assert set(e["cases"]) == set(p.labels)
+        for d in e["cases"]["warm 2050"]["indicators"].values():
+            assert d["p_better"] is None or 0 <= d["p_better"] <= 1
+            assert d["q05"] is None or d["q05"] <= d["q50"] <= d["q95"]
+    ch = iv["conservation heating"]["cases"]["warm 2050"]
+    assert ch["costs"]["heating_energy"]["q50"] > 0
+    assert ch["costs"]["heating_peak"]["q95"] <= 2.0 + 1e-9
+    assert iv["half ventilation"]["notes"]  # thermal_1c has no separate Gfast
+    ds = p.dataset
+    assert list(ds["measure"].values) == list(iv)
+    e = ds["cost_heating_energy"].sel(measure="conservation heating", case="warm 2050")
+    assert float(e.median()) == pytest.approx(ch["costs"]["heating_energy"]["q50"], rel=1e-5)
+    assert np.isnan(ds["cost_heating_energy"].sel(measure="dehumidifier")).all()
+    assert ds["twpi_measure"].dims == ("measure", "case", "draw")
+    html = Path(p.paths["html"]).read_text(encoding="utf-8")
+    assert 'id="interventions"' in html
+    assert "id='fig-tradeoff'" in html
+    assert "priors" in html  # the absolute scale is said to come from the priors
+
+
+def test_shipped_interventions_config_validates():
+    from heritage_bayes.projection import load_projection_config
+
+    cfg = load_projection_config(
+        Path(__file__).resolve().parents[1] / "configs" / "projection_interventions.yaml"
+    )
+    ms = measures_from_config(cfg)
+    assert [m.name for m in ms] == ["conservation heating", "dehumidifier", "half the ventilation"]
+    assert ms[0].heating == (0.65, -273.15, 22.0, 5000.0) and ms[2].ventilation == 0.5
+
+
+@pytest.mark.browser
+@pytest.mark.parametrize("size", [(1280, 800), (1920, 1080)])
+def test_measures_section_in_headless_chromium(projected, size):
+    """The measures section and its figure sit in the page; no table wider than its
+    container at 1280 and 1920 px."""
+    from _report_browser import find_chromium, open_page
+    from test_projection import _LAYOUT_JS
+
+    chromium = find_chromium()
+    if chromium is None:
+        pytest.skip("chromium not installed: the page was not opened in a real browser")
+    res = open_page(
+        Path(projected.paths["html"]),
+        chromium=chromium,
+        width=size[0],
+        height=size[1],
+        extra_js=_LAYOUT_JS,
+    )
+    assert res.errors == [], res.errors
+    assert "interventions" in res.dom["sections"]
+    assert "fig-tradeoff" in res.dom["figures"]
+    lay = res.dom["extra"]
+    for t in lay["tables"]:
+        assert t["w"] <= t["cw"] + 0.5 and t["right"] <= lay["width"], t
+    for d in lay["scrolls"]:
+        assert d["sw"] <= d["cw"], d
+    assert lay["docw"] <= lay["width"] and lay["right"] <= lay["width"]
+
+
+def test_measures_the_run_cannot_take_are_refused():
+    """A controller on an already controlled model, ventilation without any Gfast:
+    ConfigError naming the measure (hbayes project exits 2 before simulating)."""
+    from types import SimpleNamespace
+
+    import heritage_bayes as hb
+
+    heated = SimpleNamespace(
+        models={
+            "thermal": hb.model("thermal_1c", thermostat=True),
+            "hygric": hb.model("hygric_1c"),
+        }
+    )
+    with pytest.raises(ConfigError, match=r"'ch'.*already controlled"):
+        Measure("ch", heating=(0.6, -273.15, 20.0, np.inf)).check(heated)
+    Measure("dh", dehumidifier=(0.6, 1e-4, None)).check(heated)  # the hygric one is free
+    no_gfast = SimpleNamespace(models={"thermal": hb.model("thermal_1c")})
+    with pytest.raises(ConfigError, match=r"'air'.*Gfast"):
+        Measure("air", ventilation=0.5).check(no_gfast)

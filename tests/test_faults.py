@@ -4,7 +4,10 @@ Every case runs ``python -m heritage_bayes.cli`` as a subprocess, as a user woul
 checks what the user sees (exit code, one clear message, no traceback) and what is left
 on disk:
 
-- user errors (config, data, ``--out``, run directory): exit 2 naming the key or file;
+- user errors (config, data, ``--out``, run directory; batch, project and compare
+  configs through the same strict loader; names and output paths that would reach
+  outside the output folder; the time budget spent in the MAP search): exit 2 naming
+  the key or file, every file in the case's folder unchanged (symlinks included);
 - SIGINT/SIGTERM at seeded random instants while the data are prepared, during the MAP
   search, during sampling and while the outputs are written: exit 130, then ``--resume``
   gives the chain of an uninterrupted run, bit for bit;
@@ -225,6 +228,71 @@ def _case_seed_arg(d: Path):
     return ["calibrate", _write(d / "c.yaml", TINY), "--out", d / "run", "--seed", "-5"]
 
 
+def _case_portfolio(text, *extra, room_config=None):
+    """``hbayes batch`` on a portfolio file ``text`` (a room config ``c.yaml`` beside)."""
+
+    def setup(d: Path):
+        _write(d / "c.yaml", TINY if room_config is None else room_config)
+        return ["batch", _write(d / "p.yaml", text), "--out", d / "out", *extra]
+
+    return setup
+
+
+_SHADOW = "root:$6$SECRET1:19000:0:99999:7:::\ndaemon:*:SECRET2:0:99999:7:::\n"
+_ROOMS = "rooms:\n  - {name: nave, config: c.yaml}\n"
+_PROJ = (
+    "draws: 5\nmorphing:\n  - {scenario: warm, horizon: 2050, method: shift, "
+    f"deltas: {{Te: {[1.0] * 12}}}}}\n"
+)
+
+
+def _case_projection(text, *extra):
+    """``hbayes project`` with projection file ``text`` (its checks come first)."""
+
+    def setup(d: Path):
+        proj = _write(d / "proj.yaml", text)
+        return ["project", d / "run", proj, *(a.format(d=d) for a in extra)]
+
+    return setup
+
+
+def _case_compare(cfg, *extra):
+    def setup(d: Path):
+        c = _write(d / "c.yaml", cfg)
+        return ["compare", c, "--models", "thermal_1c,thermal_2c", *extra]
+
+    return setup
+
+
+def _case_paths(kind):
+    """Output paths a careless or unlucky user gives (cwd is the case's folder)."""
+
+    def setup(d: Path):
+        cfg = _write(d / "c.yaml", TINY)
+        if kind == "dotdot":
+            return ["calibrate", cfg, "--out", "run/.."]
+        if kind == "root":
+            return ["calibrate", cfg, "--out", "/"]
+        if kind == "config-folder":
+            cfg = _write(d / "cfg" / "c.yaml", TINY)
+            return ["calibrate", cfg, "--out", d / "cfg"]
+        if kind == "symlink-staging":
+            (d / "elsewhere").mkdir()
+            (d / "elsewhere" / "chain_thermal.h5").write_text("someone else's")
+            os.symlink(d / "elsewhere", d / ".run.partial")
+            return ["calibrate", cfg, "--out", d / "run", "--resume"]
+        if kind == "chain-file":
+            (d / "mine").mkdir()
+            (d / "mine" / "chain_old.h5").write_text("a user's file named like a chain")
+            (d / "mine" / "thesis.docx").write_text("the user's thesis")
+            return ["calibrate", cfg, "--out", d / "mine"]
+        (d / "mine").mkdir()  # "force-clash"
+        (d / "mine" / "summary.json").write_text("my own summary")
+        return ["calibrate", cfg, "--out", d / "mine", "--force"]
+
+    return setup
+
+
 _CUSTOM = {
     "name": "custom",
     "domain": "thermal",
@@ -300,7 +368,85 @@ USER_ERRORS = {
     "out-under-a-file": (_case_out("under_file"), "is a file"),
     "out-not-a-run-directory": (_case_out("mine"), "not a run directory"),
     "report-bad-config-yaml": (_case_report_bad_config, "config.yaml"),
+    # -- names and output paths (issue 25): nothing outside the output folder is touched
+    "name-dotdot": (_case_config(_tiny(name="..")), "name: '..' is not a plain name"),
+    "name-traversal": (_case_config(_tiny(name="../../x")), "not a plain name"),
+    "name-absolute": (_case_config(_tiny(name="/tmp/x")), "not a plain name"),
+    "out-dotdot-is-cwd": (_case_paths("dotdot"), "is the current folder"),
+    "out-root": (_case_paths("root"), "is the filesystem root"),
+    "out-holds-the-config": (_case_paths("config-folder"), "holds an input file"),
+    "out-symlinked-staging": (_case_paths("symlink-staging"), "is a symlink"),
+    "out-chain-file-is-not-a-run": (_case_paths("chain-file"), "not a run directory of hbayes"),
+    "out-force-never-replaces": (_case_paths("force-clash"), "named like the run's files"),
+    "map-search-time-budget": (
+        _case_config(_tiny(**{"sampler.max_time": "3s", "optimizer.popsize": 10_000})),
+        "sampler.max_time = 3s (1 section(s) left",
+    ),
+    # -- batch, project, compare configs through the same strict loader
+    "batch-duplicate-key": (_case_portfolio("name: a\nname: b\n" + _ROOMS), "duplicate key 'name'"),
+    "batch-anchor-bomb": (
+        _case_portfolio(_bomb().split("\nnotes: *a6")[0] + "\nnotes: *a6\n" + _ROOMS),
+        "after expanding YAML anchors",
+    ),
+    "batch-python-tag": (
+        _case_portfolio("name: !!python/object/apply:os.system ['true']\n" + _ROOMS),
+        "not valid YAML",
+    ),
+    "batch-wrongly-nested": (
+        _case_portfolio("rooms:\n  nave: {config: c.yaml}\n"),
+        "rooms: expected a non-empty list",
+    ),
+    "batch-room-config-duplicate-key": (
+        _case_portfolio(_ROOMS, room_config=yaml.safe_dump(TINY) + "seed: 4\n"),
+        "rooms[0] (nave).config",
+    ),
+    "batch-room-name-dotdot": (
+        _case_portfolio("rooms:\n  - {name: '..', config: c.yaml}\n"),
+        "rooms[0] (..).name: expected letters",
+    ),
+    "batch-workers-beyond-cpus": (
+        _case_portfolio(_ROOMS, "--workers", "100000"),
+        "--workers-unbounded",
+    ),
+    "batch-out-root": (_case_portfolio(_ROOMS, "--out", "/"), "is the filesystem root"),
+    "project-duplicate-key": (_case_projection("draws: 5\ndraws: 6\n"), "duplicate key 'draws'"),
+    "project-anchor-bomb": (
+        _case_projection(_bomb().split("\nnotes: *a6")[0] + "\nname: *a6\n"),
+        "after expanding YAML anchors",
+    ),
+    "project-out-root": (_case_projection(_PROJ, "--out", "/"), "is the filesystem root"),
+    "project-out-into-the-run": (
+        _case_projection(_PROJ, "--out", "{d}/run"),
+        "holds an input file",
+    ),
+    "compare-duplicate-key": (_case_compare(yaml.safe_dump(TINY) + "seed: 4\n"), "duplicate key"),
+    "compare-name-traversal": (_case_compare(_tiny(name="../../etc")), "not a plain name"),
+    "compare-out-cwd": (_case_compare(TINY, "--out", "."), "is the current folder"),
+    # -- a file that is not a config: named, its lines never echoed
+    "shadow-as-config": (_case_config(_SHADOW), "not a configuration: none of its 2"),
+    "shadow-as-portfolio": (_case_portfolio(_SHADOW), "not a portfolio file"),
+    "shadow-as-projection": (_case_projection(_SHADOW), "not a projection file"),
 }
+
+
+#: Wall time of each user-error case [s] (printed by -s; never asserted: a busy machine)
+SECONDS: dict[str, float] = {}
+
+
+def _tree(d: Path) -> dict:
+    """Every entry under ``d``, symlinks not followed: files by content, links by target."""
+    out = {}
+    for dirpath, dirnames, filenames in os.walk(d):
+        for n in dirnames + filenames:
+            p = Path(dirpath) / n
+            out[p] = (
+                ("link", os.readlink(p))
+                if p.is_symlink()
+                else ("dir",)
+                if p.is_dir()
+                else ("file", p.read_bytes())
+            )
+    return out
 
 
 @pytest.fixture(scope="module")
@@ -313,13 +459,17 @@ def user_errors(tmp_path_factory):
         d = root / name
         d.mkdir()
         argv = setup(d)
-        before = {p: p.read_bytes() for p in d.rglob("*") if p.is_file()}
+        before = _tree(d)
+        t0 = time.perf_counter()
         rc, err = _hbayes(*argv, cwd=d)
-        after = {p: p.read_bytes() for p in d.rglob("*") if p.is_file()}
-        return name, (rc, err, before == after)
+        SECONDS[name] = time.perf_counter() - t0
+        return name, (rc, err, before == _tree(d))
 
     with ThreadPoolExecutor(2) as pool:
-        return dict(pool.map(one, USER_ERRORS.items()))
+        res = dict(pool.map(one, USER_ERRORS.items()))
+    slow = sorted(SECONDS.items(), key=lambda kv: -kv[1])[:5]
+    print("slowest user-error cases [s]:", ", ".join(f"{k} {v:.1f}" for k, v in slow))
+    return res
 
 
 @pytest.mark.parametrize("case", sorted(USER_ERRORS))
@@ -329,6 +479,14 @@ def test_user_error_is_a_clean_exit_2(user_errors, case):
     assert USER_ERRORS[case][1] in err, err
     assert "hbayes: error: " in err and _clean(err), err
     assert untouched, "the user's files were changed"
+
+
+@pytest.mark.parametrize(
+    "case", ["shadow-as-config", "shadow-as-portfolio", "shadow-as-projection"]
+)
+def test_a_file_that_is_not_a_config_is_not_quoted(user_errors, case):
+    rc, err, _ = user_errors[case]
+    assert rc == 2 and "SECRET" not in err, err
 
 
 # ----------------------------------------------------------- interrupts, then --resume
@@ -532,7 +690,14 @@ def _garbage(path: Path) -> None:
     path.write_bytes(np.random.default_rng(0).bytes(20000))
 
 
+def _edit_row(path: Path) -> None:
+    """A hand edit of one committed row (h5py recomputes the Fletcher-32 checksum)."""
+    with h5py.File(path, "a") as f:
+        f["chain"][10, 0, 0] += 0.25
+
+
 DAMAGE = {
+    "edited-row": _edit_row,
     "extra-rows": _extra_rows,
     "no-random-state": _no_rng,
     "corrupt-chunk": _corrupt_chunk,
@@ -572,6 +737,7 @@ def test_corrupt_chunk_keeps_the_valid_prefix(runs):
         ("truncated", "checkpoint is damaged"),
         ("not-hdf5", "checkpoint is damaged"),
         ("other-data", "different configuration, model or data"),
+        ("edited-row", "block 1 (steps 1 to 50) does not match its checksum"),
     ],
 )
 def test_unusable_checkpoint_is_a_clean_exit_2(runs, case, message):

@@ -57,11 +57,17 @@ def proj(run_dir, tmp_path_factory):
 def test_outputs_written(proj):
     p, out = proj
     assert sorted(x.name for x in out.iterdir()) == [
+        ".hbayes-run.json",  # the marker: the folder and the four files are the package's
         "projection.csv",
         "projection.html",
         "projection.json",
         "projection.nc",
     ]
+    from heritage_bayes.rundir.marker import read_marker
+
+    marker = read_marker(out)
+    assert marker.kind == "projection"
+    assert marker.files == tuple(f"projection.{x}" for x in ("csv", "html", "json", "nc"))
     import xarray as xr
 
     ds = xr.open_dataset(out / "projection.nc", engine="h5netcdf")

@@ -13,15 +13,14 @@ for climate-change projections).
 
 from __future__ import annotations
 
-import sys
 import time
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-import yaml
 
+from heritage_bayes._progress import Progress as _Progress
 from heritage_bayes._version import __version__
 from heritage_bayes.config import MAX_SEED, CalibrationConfig, chain_tag, config_hash
 from heritage_bayes.convergence import unconverged_reasons
@@ -42,9 +41,13 @@ from heritage_bayes.rc.model import RCModel
 from heritage_bayes.run import (  # Run, load_run: re-exported
     Run,
     RunWriter,
+    config_yaml,
     load_run,
     section_parameters,
+    stamp_provenance,
 )
+from heritage_bayes.rundir import check_name
+from heritage_bayes.sources import input_paths
 
 __all__ = [
     "LADDERS",
@@ -117,6 +120,7 @@ class _Section:
     frozen_node: dict | None = None  # the MAP's slowest mode, when many records long
     lp: np.ndarray | None = None
     timings: dict = field(default_factory=dict)
+    deadline: float | None = None  # time.perf_counter() end of the run's time budget
 
 
 def _say_findings(say: _Progress, s: _Section, priors: Mapping | tuple = ()) -> None:
@@ -203,60 +207,6 @@ def _say_findings(say: _Progress, s: _Section, priors: Mapping | tuple = ()) -> 
         )
 
 
-class _Progress:
-    def __init__(self, quiet: bool):
-        self.quiet = quiet
-        self.bar = None
-
-    def say(self, msg: str) -> None:
-        if not self.quiet:
-            print(msg, file=sys.stderr, flush=True)
-
-    def warn(self, msg: str) -> None:
-        """Shown even with --quiet."""
-        print(f"hbayes: warning: {msg}", file=sys.stderr, flush=True)
-
-    def sampler(self, label: str, max_steps: int):
-        if self.quiet:
-            return None
-        if not sys.stderr.isatty():  # a log file: one plain line per update
-
-            def line(done, total, info):
-                self.say(
-                    f"[{label}] emcee {done} steps, {info['seconds']:.0f} s: τmax "
-                    f"{info['tau_max']:.0f}, need ~{total} steps, acc {info['acceptance']:.2f}"
-                )
-
-            return line
-        from tqdm.auto import tqdm
-
-        bar = tqdm(
-            total=None,
-            desc=f"[{label}] emcee",
-            unit="step",
-            file=sys.stderr,
-            leave=True,
-            dynamic_ncols=True,
-        )
-
-        def update(done, total, info):
-            bar.total = total  # the chain's own estimate of the length it needs
-            bar.n = done
-            bar.set_postfix_str(
-                f"τmax {info['tau_max']:.0f}, need {info['needed']:.0f} "
-                f"steps, acc {info['acceptance']:.2f}"
-            )
-            bar.refresh()
-
-        self.bar = bar
-        return update
-
-    def close(self):
-        if self.bar is not None:
-            self.bar.close()
-            self.bar = None
-
-
 def run_calibration(
     cfg: CalibrationConfig,
     out_dir: str | Path | None = None,
@@ -273,7 +223,7 @@ def run_calibration(
     ----------
     cfg : CalibrationConfig
     out_dir : path, optional
-        Default ``reports/<config name>/`` relative to the current folder.
+        Default ``reports/<config name>/`` (a plain name) in the current folder.
     seed : int, optional
         Overrides ``cfg.seed``. The same seed gives the same posterior.
     resume : bool
@@ -283,9 +233,8 @@ def run_calibration(
     report : bool, optional
         Write ``report.html`` (default ``cfg.report``).
     force : bool
-        Write into an existing folder that is not a run directory (see
-        :class:`~heritage_bayes.run.RunWriter`: the run is written to a staging folder
-        and replaces ``out_dir`` only when complete; a failed run leaves it unchanged).
+        Write the run beside the files of a folder hbayes did not make, replacing none
+        (:class:`~heritage_bayes.rundir.writer.RunWriter`: output-path policy, marker).
 
     Notes
     -----
@@ -316,9 +265,11 @@ def _run_calibration(
         if not 0 <= int(seed) <= MAX_SEED:
             raise InputError(f"--seed: must be within 0..{MAX_SEED} (got {seed})")
         cfg = cfg.model_copy(update={"seed": int(seed)})
-    out = Path(out_dir) if out_dir is not None else Path("reports") / (cfg.name or "run")
-    writer = RunWriter(out, force=force, resume=resume)
+    name = check_name(cfg.name or "run")  # a plain name, even where --out is given
+    out_dir = Path("reports") / name if out_dir is None else out_dir
+    writer = RunWriter(out_dir, force=force, resume=resume, protect=input_paths(cfg))
     writer.check()  # before reading any data: a bad --out fails at once
+    out = writer.out
     check_models(cfg)
     with writer:
         try:
@@ -345,7 +296,7 @@ def _calibrate_into(
     # the heavy imports (arviz, scipy.optimize, emcee) only once the config is valid
     from heritage_bayes.inference.coordinates import default_coordinates
     from heritage_bayes.inference.idata import CONVERGENCE, build_run_outputs
-    from heritage_bayes.inference.optimize import find_map, laplace
+    from heritage_bayes.inference.optimize import find_map, laplace, seconds_left, share_deadline
     from heritage_bayes.inference.sampler import run_sampler
     from heritage_bayes.prepare import prepare
     from heritage_bayes.rc.identify import structural_identifiability
@@ -361,9 +312,7 @@ def _calibrate_into(
         f"{prep.frame.index[0]} to {prep.frame.index[-1]} "
         f"(irradiance: {prep.irradiance_source})"
     )
-    atomic_write_text(
-        out / "config.yaml", yaml.safe_dump(cfg.portable(), sort_keys=False, allow_unicode=True)
-    )
+    atomic_write_text(out / "config.yaml", config_yaml(cfg))
     if cfg.source_text is not None:  # the user's own file, comments and all
         atomic_write_text(out / "config.original.yaml", cfg.source_text)
     sections: list[_Section] = []
@@ -376,8 +325,9 @@ def _calibrate_into(
         sections.append(_Section(name, model, lp))
     ndims = [s.logpost.ndim for s in sections]
     nwalkers = cfg.sampler.walkers or max(32, 2 * max(ndims) + 2)
-    for i, s in enumerate(sections):
-        t0 = time.perf_counter()
+    end = None if cfg.sampler.max_seconds is None else t_start + cfg.sampler.max_seconds
+    for i, s in enumerate(sections):  # one budget: MAP search and sampling, all sections
+        t0, deadline = time.perf_counter(), share_deadline(end, len(sections) - i)
         say.say(
             f"[{s.name}] {s.model.name}: {s.logpost.ndim} free parameters, MAP search "
             f"({cfg.optimizer.method})"
@@ -389,6 +339,10 @@ def _calibrate_into(
             popsize=cfg.optimizer.popsize,
             maxiter=cfg.optimizer.maxiter,
             starts=cfg.optimizer.starts,
+            deadline=deadline,
+            budget=f"the time budget sampler.max_time = "
+            f"{format_timedelta(cfg.sampler.max_time or 0)} ({len(sections) - i} section(s) "
+            f"left: {(deadline or t0) - t0:.0f} s for this one)",
         )
         s.timings["map_seconds"] = time.perf_counter() - t0
         say.say(
@@ -417,7 +371,7 @@ def _calibrate_into(
                 nwalkers=nwalkers,
                 moves=cfg.sampler.moves,
                 max_steps=cfg.sampler.max_steps,
-                max_seconds=cfg.sampler.max_seconds,
+                max_seconds=seconds_left(deadline),
                 bounds=s.logpost.params.bounds,
                 check_every=cfg.sampler.check_every,
                 tau_factor=cfg.sampler.tau_factor,
@@ -465,6 +419,7 @@ def _calibrate_into(
         for i, s in enumerate(sections):
             t0 = time.perf_counter()
             say.say(f"[{s.name}] model-order ladder (MAP fits)")
+            s.deadline = end  # the ladder stops where the budget does
             ladder[s.name] = model_ladder(cfg, prep, s, seed=cfg.seed + 101 * i)
             s.timings["ladder_seconds"] = time.perf_counter() - t0
     t0 = time.perf_counter()
@@ -478,6 +433,7 @@ def _calibrate_into(
         "outputs_seconds": t_out,
     }
     summary["wall_seconds"] = time.perf_counter() - t_start
+    stamp_provenance(cfg, idata, summary)
     ensure_free_space(out / "posterior.nc", sum(int(idata[g].nbytes) for g in idata.groups()))
     atomic_write(out / "posterior.nc", lambda p: write_inference_data(idata, p))
     dump_json(out / "summary.json", summary)
@@ -507,9 +463,10 @@ def model_ladder(cfg: CalibrationConfig, prep, section: _Section, *, seed: int) 
     model, room volume and those configured priors whose names exist in the model:
     fit criteria over calibration and validation periods (simulation from the MAP),
     log-likelihood, AIC and BIC, and the structural identifiability (rank, null
-    directions, condition number of the identifiable part) at the MAP.
+    directions, condition number of the identifiable part) at the MAP. Models the time
+    budget (``section.deadline``) leaves no time for are left out.
     """
-    from heritage_bayes.inference.optimize import find_map
+    from heritage_bayes.inference.optimize import BudgetError, find_map
     from heritage_bayes.inference.results import fit_metrics
     from heritage_bayes.rc.identify import structural_identifiability
 
@@ -540,14 +497,18 @@ def model_ladder(cfg: CalibrationConfig, prep, section: _Section, *, seed: int) 
                 # fixed nodes belong to the configured model: the others estimate theirs
                 mode = "steady" if model.control is not None else "estimate"
             lp = _log_posterior(cfg, prep, section.name, model, priors, initial_state=mode)
-            mp = find_map(
-                lp,
-                seed=seed,
-                method=cfg.optimizer.method,
-                popsize=cfg.optimizer.popsize,
-                maxiter=max(30, cfg.optimizer.maxiter // 3),
-                starts=max(1, cfg.optimizer.starts // 2),
-            )
+            try:
+                mp = find_map(
+                    lp,
+                    seed=seed,
+                    method=cfg.optimizer.method,
+                    popsize=cfg.optimizer.popsize,
+                    maxiter=max(30, cfg.optimizer.maxiter // 3),
+                    starts=max(1, cfg.optimizer.starts // 2),
+                    deadline=section.deadline,
+                )
+            except BudgetError:  # sampler.max_time is spent: the ladder ends here
+                break
         tm = mp.theta[: lp.n_model]
         fixed = tuple(p.name for p in lp.params.parameters[: lp.n_model] if not p.free)
         ident = structural_identifiability(

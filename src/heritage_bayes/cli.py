@@ -55,8 +55,8 @@ def _build_parser() -> argparse.ArgumentParser:
     cal.add_argument(
         "--force",
         action="store_true",
-        help="write into an existing folder that is not a run directory (files named like "
-        "the run's outputs are replaced, others kept)",
+        help="write the run beside the files of a folder hbayes did not make (none of them "
+        "is replaced; one named like a run's file is refused)",
     )
     cal.set_defaults(func=_cmd_calibrate)
 
@@ -125,7 +125,8 @@ def _build_parser() -> argparse.ArgumentParser:
     cmp_.add_argument(
         "--force",
         action="store_true",
-        help="let a candidate's run replace a folder <out>/<model>/ that is not a run directory",
+        help="write beside the files of folders hbayes did not make (<out>, <out>/<model>/); "
+        "none of them is replaced",
     )
     cmp_.add_argument("--quiet", action="store_true", help="no progress output")
     cmp_.add_argument("--no-report", action="store_true", help="no report.html per model")
@@ -181,7 +182,17 @@ def _build_parser() -> argparse.ArgumentParser:
     bat.add_argument(
         "--scheduler", metavar="ADDRESS", help="a running Dask scheduler, e.g. tcp://host:8786"
     )
-    bat.add_argument("--workers", type=int, metavar="N", help="local workers (default: cores)")
+    bat.add_argument(
+        "--workers",
+        type=int,
+        metavar="N",
+        help="local workers (default and maximum: the CPUs available)",
+    )
+    bat.add_argument(
+        "--workers-unbounded",
+        action="store_true",
+        help="allow --workers above the CPUs available",
+    )
     bat.add_argument(
         "--resume", action="store_true", help="skip finished rooms, continue interrupted chains"
     )
@@ -367,8 +378,9 @@ Options (YAML: <section>.options), any catalogue model:
 
 
 def _cmd_batch(args) -> int:
-    from heritage_bayes.portfolio import load_portfolio, run
+    from heritage_bayes.portfolio import check_workers, load_portfolio, run
 
+    check_workers(args.workers, unbounded=args.workers_unbounded)  # before any work
     pf = load_portfolio(args.portfolio)  # every room validated before any work starts
     df = run(
         pf,
@@ -377,6 +389,7 @@ def _cmd_batch(args) -> int:
         workers=args.workers,
         resume=args.resume,
         quiet=args.quiet,
+        workers_unbounded=args.workers_unbounded,
     )
     from heritage_bayes.convergence import EXIT_UNCONVERGED
 

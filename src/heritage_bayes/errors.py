@@ -7,7 +7,7 @@ without a traceback. Anything else is an internal error (exit code 1).
 
 from __future__ import annotations
 
-__all__ = ["ConfigError", "DataError", "InputError"]
+__all__ = ["ConfigError", "DataError", "InputError", "check_known_keys"]
 
 
 class InputError(ValueError):
@@ -20,3 +20,33 @@ class ConfigError(InputError):
 
 class DataError(InputError):
     """An invalid data file or table: the message names the file, column and row."""
+
+
+def check_known_keys(raw, known, *, source: str, what: str) -> None:
+    """Refuse a mapping none of whose top-level keys is a known one, *without quoting
+    them*: it is not a file of that kind (``/etc/shadow`` given as a config), and its
+    lines are not the user's data to echo. A file with at least one known key is taken
+    for the user's own, and its unknown keys are named as usual.
+
+    Parameters
+    ----------
+    raw : object
+        The parsed YAML.
+    known : iterable of str
+        The keys a file of this kind may have at the top level.
+    source : str
+        The file, for the message.
+    what : str
+        E.g. ``"calibration config"``.
+
+    Raises
+    ------
+    ConfigError
+    """
+    known = sorted(known)
+    if isinstance(raw, dict) and raw and not any(k in known for k in raw):
+        raise ConfigError(
+            f"{source}: not a {what}: none of its {len(raw)} top-level key(s) is one "
+            f"(expected some of {', '.join(known)}); is it the right file? (its content is "
+            "not shown: only files a config declares as data are quoted)"
+        )

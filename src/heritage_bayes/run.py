@@ -14,7 +14,7 @@ projection, comparison, portfolio) and the orchestrator that writes it
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -25,8 +25,26 @@ from heritage_bayes.errors import InputError
 from heritage_bayes.models import SECTIONS, build_model
 from heritage_bayes.rc.model import RCModel
 from heritage_bayes.rc.simulate import check_inputs
+from heritage_bayes.rundir.writer import (  # the writer's side, re-exported
+    RUN_FILES,
+    RunWriter,
+    is_run_directory,
+    saved_chains,
+    staging_path,
+)
 
-__all__ = ["Run", "load_run", "section_parameters"]
+__all__ = [
+    "RUN_FILES",
+    "Run",
+    "RunWriter",
+    "config_yaml",
+    "is_run_directory",
+    "load_run",
+    "saved_chains",
+    "section_parameters",
+    "staging_path",
+    "stamp_provenance",
+]
 
 
 def section_parameters(cfg: CalibrationConfig, section: str, model: RCModel, priors=None):
@@ -82,6 +100,9 @@ class Run:
         ``summary.json``.
     models : dict
         Section name (``thermal``/``hygric``) -> RCModel.
+    notes : list of str
+        On the config: :attr:`config` is the one recorded in the provenance (SHA-256
+        checked), and a note says if the visible ``config.yaml`` differs from it.
     """
 
     path: Path
@@ -89,6 +110,7 @@ class Run:
     idata: object
     summary: dict
     models: dict
+    notes: list = field(default_factory=list)
 
     @property
     def sections(self) -> tuple[str, ...]:
@@ -203,6 +225,61 @@ class Run:
         return np.minimum(100.0 * Pi / saturation_vapour_pressure(Ti), 100.0)
 
 
+def config_yaml(cfg: CalibrationConfig) -> str:
+    """The text of a run's ``config.yaml``: the resolved config, data paths absolute."""
+    import yaml
+
+    return yaml.safe_dump(cfg.portable(), sort_keys=False, allow_unicode=True)
+
+
+def _snapshot_sha256(snapshot: dict) -> str:
+    import hashlib
+    import json
+
+    blob = json.dumps(snapshot, sort_keys=True, ensure_ascii=False, allow_nan=False)
+    return hashlib.sha256(blob.encode("utf-8")).hexdigest()
+
+
+def stamp_provenance(cfg: CalibrationConfig, idata, summary: dict) -> None:
+    """Record the config that produces a posterior: the snapshot (what ``config.yaml``
+    holds, as data) and its SHA-256 in ``summary["provenance"]``, the hash also in the
+    attributes of every InferenceData group, so that an edited ``config.yaml`` or
+    snapshot is detected by :func:`load_run`."""
+    snapshot = cfg.portable()
+    sha = _snapshot_sha256(snapshot)
+    summary["provenance"] = {"config": snapshot, "config_sha256": sha}
+    for g in idata.groups():
+        idata[g].attrs["config_sha256"] = sha
+
+
+def _recorded_config(p: Path, summary: dict, idata) -> tuple[CalibrationConfig | None, list]:
+    """The config recorded in the provenance of run ``p`` (hash checked) and the notes
+    on it: None for a run written before the provenance was recorded."""
+    prov = summary.get("provenance")
+    if not isinstance(prov, dict) or not isinstance(prov.get("config"), dict):
+        return None, ["the run records no config snapshot (an older hbayes): the report "
+                      "shows config.yaml as it is now"]  # fmt: skip
+    sha = _snapshot_sha256(prov["config"])
+    stamped = {idata[g].attrs.get("config_sha256") for g in idata.groups()} - {None}
+    if sha != prov.get("config_sha256") or stamped - {sha}:
+        raise InputError(
+            f"{p / 'summary.json'}: the config snapshot recorded in the provenance does not "
+            f"match its SHA-256 (recorded {prov.get('config_sha256')!s:.16}, posterior.nc "
+            f"{', '.join(sorted(stamped)) or 'none'}, computed {sha:.16}): the run directory "
+            "was edited; run `hbayes calibrate` again"
+        )
+    cfg = parse_config(prov["config"], source=f"{p / 'summary.json'} (provenance)")
+    notes = []
+    seen = (p / "config.yaml").read_text(encoding="utf-8", errors="replace")
+    if seen != config_yaml(cfg):
+        notes.append(
+            f"{p / 'config.yaml'} differs from the config that produced this posterior "
+            "(recorded with its SHA-256 in summary.json); the report uses and shows the "
+            "recorded one"
+        )
+    return cfg, notes
+
+
 def load_run(path: str | Path) -> Run:
     """Load a run directory written by ``hbayes calibrate``.
 
@@ -210,7 +287,7 @@ def load_run(path: str | Path) -> Run:
     ------
     InputError
         The folder or one of ``posterior.nc``, ``summary.json``, ``config.yaml`` is
-        missing.
+        missing, or the recorded config snapshot does not match its SHA-256.
     """
     import json
 
@@ -223,204 +300,13 @@ def load_run(path: str | Path) -> Run:
                 f"{p}: not a complete run directory ({name} is missing); "
                 "run `hbayes calibrate` first"
             )
-    raw, _ = read_yaml(p / "config.yaml", what="run config")
-    cfg = parse_config(raw, source=str(p / "config.yaml"))
     summary = json.loads((p / "summary.json").read_text(encoding="utf-8"))
+    cfg = None
+    if not isinstance(summary.get("provenance"), dict):  # an older run: config.yaml
+        raw, _ = read_yaml(p / "config.yaml", what="run config")
+        cfg = parse_config(raw, source=str(p / "config.yaml"))
     idata = az.from_netcdf(str(p / "posterior.nc"), engine="h5netcdf")
+    recorded, notes = _recorded_config(p, summary, idata)
+    cfg = recorded or cfg
     models = {s: build_model(cfg, s) for s in SECTIONS if getattr(cfg, s) is not None}
-    return Run(path=p, config=cfg, idata=idata, summary=summary, models=models)
-
-
-# ------------------------------------------------------------------ writing a run
-#: What ``hbayes calibrate`` writes into a run directory (besides ``chain_<model>.h5``).
-RUN_FILES = (
-    "config.yaml",
-    "config.original.yaml",
-    "posterior.nc",
-    "summary.json",
-    "report.html",
-)
-
-
-def _ours(name: str) -> bool:
-    return name in RUN_FILES or (name.startswith("chain_") and ".h5" in name)
-
-
-def is_run_directory(path: str | Path) -> bool:
-    """True for a folder ``hbayes calibrate`` wrote (outputs or chain checkpoints)."""
-    p = Path(path)
-    if not p.is_dir():
-        return False
-    done = (p / "summary.json").is_file() and (p / "posterior.nc").is_file()
-    return done or any(p.glob("chain_*.h5"))
-
-
-def saved_chains(out: str | Path) -> list[Path]:
-    """The chain checkpoints ``--resume`` would continue for the run directory ``out``:
-    those of an unfinished run (its staging folder) or else of the finished one."""
-    out = Path(out)
-    staged = sorted(staging_path(out).glob("chain_*.h5"))
-    return staged or sorted(out.glob("chain_*.h5"))
-
-
-def staging_path(out: Path) -> Path:
-    """Where a run into ``out`` is written until it is complete (a hidden sibling)."""
-    return out.parent / f".{out.name}.partial"
-
-
-class RunWriter:
-    """The writer's side of a run directory: lock, staging folder, swap at the end.
-
-    A run writes into ``.<name>.partial`` beside ``out`` (chains included, so that
-    ``--resume`` continues them) and only a complete run replaces ``out``, by renaming:
-    a failed or interrupted re-run leaves the previous run intact. One run at a time:
-    ``.<name>.lock`` beside ``out`` is locked (``flock``, released by the kernel even
-    when the process is killed) and names the holder. ``out`` must be a run directory,
-    empty or new; anything else is refused unless ``force`` (files named like the
-    run's outputs are then replaced, others kept).
-
-    Use as a context manager: ``with RunWriter(out) as w: ... write into w.staging ...;
-    w.commit()``.
-    """
-
-    def __init__(self, out: str | Path, *, force: bool = False, resume: bool = False):
-        self.out = Path(out).absolute()
-        self.force = force
-        self.resume = resume
-        self.staging = staging_path(self.out)
-        self.lock_path = self.out.parent / f".{self.out.name}.lock"
-        self.committed = False
-        self._fd: int | None = None
-        self._made_parent = False
-
-    # -- checks that need no data: called before anything is read
-    def check(self) -> None:
-        """Raise :class:`InputError` if ``out`` cannot or may not be written."""
-        out = self.out
-        if out.exists() and not out.is_dir():
-            raise InputError(f"--out {out}: is a file, not a folder")
-        anc = out.parent
-        while not anc.exists():
-            anc = anc.parent
-        if not anc.is_dir():
-            raise InputError(f"--out {out}: {anc} is a file, not a folder")
-        import os
-
-        if not os.access(anc, os.W_OK | os.X_OK):
-            raise InputError(f"--out {out}: no permission to write in {anc}")
-        if out.is_dir() and not self.force and not is_run_directory(out):
-            entries = sorted(e.name for e in out.iterdir())
-            if entries:
-                shown = ", ".join(entries[:5]) + (", ..." if len(entries) > 5 else "")
-                raise InputError(
-                    f"--out {out}: the folder exists and is not a run directory of hbayes "
-                    f"(it holds {shown}); choose another folder, or add --force to write "
-                    "into it (files named like the run's outputs are then replaced, "
-                    "others kept)"
-                )
-
-    def __enter__(self):
-        import fcntl
-        import os
-        import shutil
-
-        self.check()
-        self._made_parent = not self.out.parent.exists()
-        try:
-            self.out.parent.mkdir(parents=True, exist_ok=True)
-            self._lock(fcntl, os)
-        except PermissionError as exc:
-            raise InputError(f"--out {self.out}: cannot write ({exc.strerror})") from None
-        old = self.out.parent / f".{self.out.name}.old"
-        if old.is_dir() and not self.out.exists():  # a swap was cut short: undo it
-            os.rename(old, self.out)
-        elif old.is_dir():
-            shutil.rmtree(old, ignore_errors=True)
-        if not self.resume and self.staging.exists():
-            shutil.rmtree(self.staging)
-        self.staging.mkdir(exist_ok=True)
-        if self.resume:  # extend a finished run: its chains the staging folder lacks
-            for p in self.out.glob("chain_*.h5"):
-                if not (self.staging / p.name).exists():
-                    shutil.copy2(p, self.staging / p.name)
-        return self
-
-    def _lock(self, fcntl, os) -> None:
-        import datetime
-        import socket
-
-        while True:
-            fd = os.open(self.lock_path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW, 0o644)
-            try:
-                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            except BlockingIOError:
-                holder = os.read(fd, 1000).decode("utf-8", "replace").strip() or "unknown"
-                os.close(fd)
-                raise InputError(
-                    f"--out {self.out}: another hbayes run is writing it ({holder}); "
-                    "wait for it to end or choose another folder"
-                ) from None
-            try:  # the file may have been removed by the holder that just released it
-                same = os.stat(self.lock_path).st_ino == os.fstat(fd).st_ino
-            except FileNotFoundError:
-                same = False
-            if same:
-                break
-            os.close(fd)
-        now = datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds")
-        os.ftruncate(fd, 0)
-        os.write(fd, f"pid {os.getpid()} on {socket.gethostname()}, since {now}".encode())
-        self._fd = fd
-
-    def commit(self) -> None:
-        """Make the staging folder the run directory (keeping the user's other files)."""
-        import os
-        import shutil
-
-        from heritage_bayes.inference.sampler import _DeferSignals
-
-        old = self.out.parent / f".{self.out.name}.old"
-        with _DeferSignals():
-            if self.out.is_dir():
-                for e in self.out.iterdir():
-                    if not _ours(e.name) and not (self.staging / e.name).exists():
-                        os.rename(e, self.staging / e.name)
-                os.rename(self.out, old)
-            os.rename(self.staging, self.out)
-            self.committed = True
-        shutil.rmtree(old, ignore_errors=True)
-
-    def left_behind(self) -> str:
-        """What an unfinished run leaves, for the error message."""
-        chains = sorted(p.name for p in self.staging.glob("chain_*.h5"))
-        prev = (
-            f"{self.out} is unchanged"
-            if self.out.exists()
-            else f"nothing was written to {self.out}"
-        )
-        if chains:
-            return (
-                f"{prev}; the chains so far ({', '.join(chains)}) are kept in "
-                f"{self.staging}, which --resume continues"
-            )
-        return prev
-
-    def __exit__(self, *exc):
-        import os
-        import shutil
-
-        if not self.committed and self.staging.is_dir():
-            if not any(self.staging.glob("chain_*.h5")):
-                shutil.rmtree(self.staging, ignore_errors=True)
-        if self._fd is not None:
-            try:
-                os.unlink(self.lock_path)
-            finally:
-                os.close(self._fd)
-                self._fd = None
-        if self._made_parent and not self.committed:
-            try:  # nothing left: remove the folder this run created
-                self.out.parent.rmdir()
-            except OSError:
-                pass
-        return False
+    return Run(path=p, config=cfg, idata=idata, summary=summary, models=models, notes=notes)

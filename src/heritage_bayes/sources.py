@@ -23,6 +23,7 @@ __all__ = [
     "OUTPUT_COLUMNS",
     "RawData",
     "check_clocks",
+    "input_paths",
     "read_source",
     "read_sources",
 ]
@@ -359,3 +360,18 @@ def _demo(settings, cfg):
 
 def _iso(ts: pd.Timestamp) -> str:
     return ts.tz_convert("UTC").strftime("%Y-%m-%dT%H:%M:%SZ")
+
+
+def input_paths(cfg) -> list[Path]:
+    """The config's folder and every data file it names (absolute): what an output
+    folder may not be nor hold (:func:`heritage_bayes.rundir.resolve_output`)."""
+    d = cfg.portable()["data"]
+    paths = [Path(cfg.base_dir)] if cfg.base_dir else []
+    sources = [d.get("weather"), *(d.get("measurements") or [])]
+    sources.append((d.get("ground_temperature") or {}).get("source"))
+    found = [src.get("path") for src in sources if src]
+    found.append((d.get("demo") or {}).get("weather_path"))
+    for p in found:
+        for q in [p] if isinstance(p, str) else p or []:
+            paths.append(Path(q))
+    return paths

@@ -127,8 +127,9 @@ def run_compare(
         ``comparison.html``.
     seed, quiet, report, resume, force
         As for :func:`heritage_bayes.calibrate.run_calibration` (applied to every
-        candidate; ``force`` lets a candidate's run replace an existing folder
-        ``<out_dir>/<model>/`` that is not a run directory).
+        candidate; with ``force`` a candidate's run and the comparison are written
+        beside the files of folders hbayes did not make, replacing none of them: see
+        :class:`~heritage_bayes.rundir.folder.OutputFolder`).
     workers : int, optional
         Candidates calibrated at the same time, each in its own process (default: one
         per core, at most one per candidate; 1: one after the other in this process).
@@ -150,49 +151,59 @@ def run_compare(
 
     from heritage_bayes.calibrate import run_calibration
     from heritage_bayes.errors import InputError
+    from heritage_bayes.rundir import check_name
+    from heritage_bayes.rundir.folder import OutputFolder
+    from heritage_bayes.rundir.writer import is_run_directory
+    from heritage_bayes.sources import input_paths
 
     section, names = _section_of(cfg, models)
     cands = {n: _candidate_config(cfg, section, n) for n in names}
-    out = Path(out_dir) if out_dir is not None else Path("reports") / f"{cfg.name or 'run'}-compare"
+    if out_dir is None:
+        out_dir = Path("reports") / check_name(f"{cfg.name or 'run'}-compare", what="name")
     if workers is not None and (isinstance(workers, bool) or int(workers) < 1):
         raise InputError(f"--workers: expected a whole number >= 1 (got {workers})")
     n_workers = min(len(cands), int(workers) if workers else (os.cpu_count() or 1))
-    out.mkdir(parents=True, exist_ok=True)
     kwargs = dict(seed=seed, quiet=quiet, report=report, resume=resume, force=force)
 
     def tell(msg: str) -> None:
         if not quiet:
             print(f"hbayes compare: {msg}", file=sys.stderr, flush=True)
 
-    dirs = {}
-    if n_workers <= 1:
-        for n, c in cands.items():
-            tell(f"calibrating {n}")
-            dirs[n] = run_calibration(c, out / n, **kwargs)
-    else:
-        import multiprocessing
-        from concurrent.futures import ProcessPoolExecutor, as_completed
+    folder = OutputFolder(out_dir, kind="comparison", protect=input_paths(cfg), force=force)
+    with folder:
+        out = folder.path
+        # a candidate's folder: new, its own run, or (--force) one the run writes beside
+        folder.claim(*names, folders_from=lambda q: force or is_run_directory(q))
+        folder.claim("comparison.json", "comparison.html")
+        dirs = {}
+        if n_workers <= 1:
+            for n, c in cands.items():
+                tell(f"calibrating {n}")
+                dirs[n] = run_calibration(c, out / n, **kwargs)
+        else:
+            import multiprocessing
+            from concurrent.futures import ProcessPoolExecutor, as_completed
 
-        from heritage_bayes.run import RunWriter
+            from heritage_bayes.run import RunWriter
 
-        for n in names:  # refuse a bad folder before any candidate starts
-            RunWriter(out / n, force=force, resume=resume).check()
-        order = sorted(cands, key=lambda n: -_n_free(cands[n], section))
-        tell(f"calibrating {', '.join(order)} on {n_workers} worker processes")
-        ctx = multiprocessing.get_context("spawn")  # no forked numba/BLAS threads
-        with ProcessPoolExecutor(n_workers, mp_context=ctx, max_tasks_per_child=1) as pool:
-            futs = {
-                pool.submit(
-                    _calibrate_candidate, cands[n], str(out / n), {**kwargs, "quiet": True}
-                ): n
-                for n in order
-            }
-            for f in as_completed(futs):
-                run_dir, wall, cpu = f.result()
-                dirs[futs[f]] = Path(run_dir)
-                tell(f"{futs[f]} done ({wall:.0f} s wall, {cpu:.0f} s CPU)")
-        dirs = {n: dirs[n] for n in names}
-    result = compare_runs(dirs, section, seed=cfg.seed if seed is None else int(seed))
-    result["config"] = {"name": cfg.name, "building": cfg.building, "room": cfg.room}
-    write_comparison(result, out)
+            for n in names:  # refuse a bad folder before any candidate starts
+                RunWriter(out / n, force=force, resume=resume).check()
+            order = sorted(cands, key=lambda n: -_n_free(cands[n], section))
+            tell(f"calibrating {', '.join(order)} on {n_workers} worker processes")
+            ctx = multiprocessing.get_context("spawn")  # no forked numba/BLAS threads
+            with ProcessPoolExecutor(n_workers, mp_context=ctx, max_tasks_per_child=1) as pool:
+                futs = {
+                    pool.submit(
+                        _calibrate_candidate, cands[n], str(out / n), {**kwargs, "quiet": True}
+                    ): n
+                    for n in order
+                }
+                for f in as_completed(futs):
+                    run_dir, wall, cpu = f.result()
+                    dirs[futs[f]] = Path(run_dir)
+                    tell(f"{futs[f]} done ({wall:.0f} s wall, {cpu:.0f} s CPU)")
+            dirs = {n: dirs[n] for n in names}
+        result = compare_runs(dirs, section, seed=cfg.seed if seed is None else int(seed))
+        result["config"] = {"name": cfg.name, "building": cfg.building, "room": cfg.room}
+        write_comparison(result, out)
     return out

@@ -48,7 +48,7 @@ Layout (see ``configs/demo.yaml`` for a complete, commented example)::
       warmup: 14d                  # durations carry a unit: 1h, 30min, 14d
     thermal: {model: thermal_4a, noise: ar1, priors: {Gf: {fixed: 0}}}
     hygric: {model: hygric_2c_fixed, noise: ar1}
-    sampler: {max_time: 30min}     # wall-time budget per model; the chain decides
+    sampler: {max_time: 30min}     # wall-time budget of the run; the chain decides
     optimizer: {method: differential_evolution}
 """
 

@@ -166,12 +166,15 @@ def validate(cls: type[BaseModel], raw: Any, source: str, what: str = "configura
     """
     from pydantic import ValidationError
 
-    from heritage_bayes.errors import ConfigError
+    from heritage_bayes.errors import ConfigError, check_known_keys
 
     if not isinstance(raw, dict):
         raise ConfigError(
             f"{source}: expected a YAML mapping at the top level (got {type(raw).__name__})"
         )
+    # a mapping with none of the schema's keys is another file: named, never quoted
+    known = [k for k in cls.model_fields if k != "base_dir"]
+    check_known_keys(raw, known, source=source, what=what)
     try:
         return cls.model_validate(raw)
     except ValidationError as exc:

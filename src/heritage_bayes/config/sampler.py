@@ -30,7 +30,9 @@ Budget = Annotated[
 
 class SamplerSettings(_Strict):
     """emcee settings. Run length comes from the chain (τ, R-hat, ESS); ``max_time`` is
-    the wall-time budget per model (a duration, e.g. ``10min``, or ``none``) and
+    the wall-time budget of the whole calibration — data, MAP search, sampling, ladder;
+    each model gets an equal share of what is left (a duration, e.g. ``10min``, or
+    ``none``) and
     ``max_steps`` a safety cap on memory. A run that stops at either before converging
     exits with code 3 (see :mod:`heritage_bayes.cli`)."""
 
@@ -43,8 +45,9 @@ class SamplerSettings(_Strict):
     max_time: Budget = key(
         "30min",
         unit=DURATION_UNIT,
-        description="wall-time budget per model (e.g. 10min, 2h) or none; the chain stops "
-        "earlier once converged",
+        description="wall-time budget of the whole calibration, MAP search included, shared "
+        "equally by the models (e.g. 10min, 2h) or none; the chain stops earlier once "
+        "converged",
         validate_default=True,
     )
     check_every: int = key(500, unit="steps", description="steps between convergence checks", ge=50)

@@ -5,10 +5,18 @@ steps of a chain chunk by chunk (rows first, then one ``commit`` attribute that 
 how many rows are valid, with SIGINT/SIGTERM deferred around it), loads the committed
 prefix with the random-number state for ``--resume``, and explains a damaged file while
 keeping its valid steps. Used by :mod:`heritage_bayes.inference.sampler`.
+
+Tamper evidence (format 3): every append is a *block* of rows whose SHA-256 is chained
+to the previous block's (``h_k = sha256(h_{k-1} || chain rows || log_prob rows)``, as
+stored), and the commit record's state (acceptance counts, random state, τ history) is
+hashed onto the last block. ``--resume`` recomputes the chain and refuses a checkpoint
+whose rows or state were edited, naming the first block that differs. (HDF5's
+Fletcher-32 catches storage damage, not an edit: h5py recomputes it on write.)
 """
 
 from __future__ import annotations
 
+import hashlib
 import json
 import signal
 import threading
@@ -100,7 +108,7 @@ class _Checkpoint:
     a symlink) and renamed into place.
     """
 
-    FORMAT = 2
+    FORMAT = 3
 
     def __init__(self, path: Path, tag: str):
         self.path = Path(path)
@@ -154,6 +162,12 @@ class _Checkpoint:
                 ],
                 "tau_history": np.asarray(tau_history, dtype=float).reshape(-1, 2).tolist(),
             }
+            rows = [
+                np.asarray(r, dtype=f[k].dtype)
+                for k, r in (("chain", chain), ("log_prob", log_prob))
+            ]
+            commit["n_blocks"], last = _append_block(f, n0, n0 + n, rows)
+            commit["state_sha256"] = _state_sha(last, commit)
             f.attrs["commit"] = json.dumps(commit)  # the commit point
             f.attrs["iteration"] = n0 + n  # informative
             f.flush()
@@ -163,6 +177,41 @@ class _Checkpoint:
             f"{self.path}: the chain checkpoint is damaged ({why}); it was left as it is. "
             "Run without --resume to start the chain afresh (the file is then replaced), "
             "or restore a good copy"
+        )
+
+    def _verify(self, f, commit: dict, chain, lp, n: int) -> None:
+        """Recompute the block checksums of the rows read (blocks cut short by storage
+        damage are left to the damage report) and of the commit state."""
+        nb = commit.get("n_blocks")
+        if not isinstance(nb, int) or "state_sha256" not in commit or "block_sha" not in f:
+            raise self._damaged("format 3 without its block checksums")
+        try:
+            ends = f["block_end"][:nb].astype(int)
+            shas = [b.decode("ascii") for b in f["block_sha"][:nb]]
+        except (OSError, ValueError, UnicodeDecodeError) as exc:
+            raise self._damaged(f"unreadable block checksums: {_first_line(exc)}") from None
+        if len(shas) != nb:
+            raise self._damaged(f"{len(shas)} block checksums, the commit says {nb}")
+        prev, a = _GENESIS, 0
+        for k, (b, sha) in enumerate(zip(ends, shas, strict=True), start=1):
+            if b > n:
+                raise self._edited(f"the commit record (it says {n} steps, block {k} ends at {b})")
+            if b > chain.shape[0]:  # beyond the readable prefix (damage reported)
+                return
+            if _block_sha(prev, chain[a:b], lp[a:b]) != sha:
+                raise self._edited(f"block {k} (steps {a + 1} to {b})")
+            prev, a = sha, b
+        if a != n:
+            raise self._edited(f"the commit record (it says {n} steps, the blocks {a})")
+        if _state_sha(prev, commit) != commit["state_sha256"]:
+            raise self._edited("the commit record (acceptance counts, random state, τ history)")
+
+    def _edited(self, what: str) -> InputError:
+        return InputError(
+            f"{self.path}: {what} does not match its checksum: the checkpoint was changed "
+            "after hbayes wrote it, so --resume would continue a chain that was not "
+            "sampled. Run without --resume to start the chain afresh (the file is then "
+            "replaced), or restore the original file"
         )
 
     def load(self) -> _Saved:
@@ -223,12 +272,62 @@ class _Checkpoint:
                 raise self._damaged(f"unreadable commit record: {_first_line(exc)}") from None
             n = min(n, f["chain"].shape[0], f["log_prob"].shape[0])
             chain, lp, bad = _read_prefix(f["chain"], f["log_prob"], n)
+            if "commit" in f.attrs and int(f.attrs.get("format", 2)) >= 3:
+                self._verify(f, json.loads(f.attrs["commit"]), chain, lp, n)
         if bad is not None:
             problem = (
                 f"steps {bad} to {n} are damaged; kept the {chain.shape[0]} valid steps before them"
             )
             rs = None  # the saved random state belongs to the end of the damaged part
         return _Saved(chain, lp, accepted, rs, hist[: max(0, len(hist))], problem)
+
+
+#: The checksum before the first block.
+_GENESIS = "0" * 64
+
+
+def _block_sha(prev: str, chain_rows, lp_rows) -> str:
+    """SHA-256 of a block of rows (as stored), chained to the previous block's."""
+    h = hashlib.sha256(prev.encode("ascii"))
+    for rows in (chain_rows, lp_rows):
+        a = np.ascontiguousarray(rows)
+        h.update(str(a.shape).encode("ascii"))
+        h.update(a.tobytes())
+    return h.hexdigest()
+
+
+def _state_sha(last: str, commit: dict) -> str:
+    """SHA-256 of the commit state (everything but its own checksum) onto the last
+    block's."""
+    state = {k: v for k, v in commit.items() if k != "state_sha256"}
+    blob = json.dumps(state, sort_keys=True, allow_nan=True)
+    return hashlib.sha256((last + blob).encode("utf-8")).hexdigest()
+
+
+def _append_block(f, n0: int, n1: int, rows) -> tuple[int, str]:
+    """Write the checksum of rows ``n0:n1`` after the committed blocks (datasets
+    ``block_end``, ``block_sha``: entries beyond the commit are ignored, like rows); a
+    format-2 file continued now gets its rows so far as one block. Returns the number
+    of blocks and the last checksum."""
+    c = json.loads(f.attrs["commit"]) if "commit" in f.attrs else {}
+    if "block_sha" not in f:
+        f.create_dataset("block_end", (0,), maxshape=(None,), dtype="i8", chunks=(256,))
+        f.create_dataset("block_sha", (0,), maxshape=(None,), dtype="S64", chunks=(256,))
+    ends, shas = f["block_end"], f["block_sha"]
+    nb = int(c.get("n_blocks", 0))
+    recs = list(zip(ends[:nb].astype(int).tolist(), shas[:nb], strict=True))
+    prev = recs[-1][1].decode("ascii") if recs else _GENESIS
+    a = recs[-1][0] if recs else 0
+    if a < n0:  # rows without a block (a format-2 file): one block for them
+        prev = _block_sha(prev, f["chain"][a:n0], f["log_prob"][a:n0])
+        recs.append((n0, prev.encode("ascii")))
+    sha = _block_sha(prev, *rows)
+    recs.append((n1, sha.encode("ascii")))
+    for ds in (ends, shas):
+        ds.resize(len(recs), axis=0)
+    ends[nb:] = [r[0] for r in recs[nb:]]
+    shas[nb:] = [r[1] for r in recs[nb:]]
+    return len(recs), sha
 
 
 def _first_line(exc: BaseException) -> str:

@@ -23,21 +23,71 @@ References
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.optimize import differential_evolution, minimize
 
+from heritage_bayes.errors import InputError
+
 __all__ = [
     "AffineCoordinates",
+    "BudgetError",
     "LaplaceResult",
     "MAPResult",
     "affine_coordinates",
     "find_map",
     "laplace",
+    "seconds_left",
+    "share_deadline",
 ]
 
 _EPS = 1e-9
+#: Parameter sets evaluated per call of the likelihood: bounds the memory of a huge
+#: optimiser population and lets a time budget be checked between chunks.
+CHUNK = 2048
+
+
+class BudgetError(InputError):
+    """The wall-time budget ran out during the MAP search (``evaluations`` done)."""
+
+    def __init__(self, message: str, evaluations: int):
+        super().__init__(message)
+        self.evaluations = evaluations
+
+
+class _OutOfTimeError(Exception):
+    """The deadline passed; ``args[0]`` may say why (an estimate made beforehand)."""
+
+
+def _generation_seconds(n: int) -> float:
+    """Measured cost [s] of the mutation step of one generation of scipy's
+    differential evolution for a population of ``n``: for each member it shuffles the
+    whole population index (``DifferentialEvolutionSolver._select_samples``, scipy
+    1.17), so a generation costs ``n`` shuffles of ``n`` — quadratic, and beyond the
+    reach of a deadline checked between likelihood evaluations (a population of
+    130 000 spent 540 s there)."""
+    idx = np.arange(n)
+    rng = np.random.default_rng(0)
+    t0 = time.perf_counter()
+    rng.shuffle(idx)
+    return n * (time.perf_counter() - t0)
+
+
+def share_deadline(end: float | None, parts_left: int) -> float | None:
+    """One wall-time budget for several parts (the sections of a calibration): the next
+    part may use an equal share of what is left before ``end`` (a
+    :func:`time.perf_counter` value; None: no budget), returned as its deadline."""
+    if end is None:
+        return None
+    now = time.perf_counter()
+    return now + max(0.0, end - now) / max(1, parts_left)
+
+
+def seconds_left(deadline: float | None) -> float | None:
+    """Seconds until ``deadline`` (0 once passed; None without one)."""
+    return None if deadline is None else max(0.0, deadline - time.perf_counter())
 
 
 @dataclass
@@ -83,11 +133,12 @@ class MAPResult:
 class _Objective:
     """Negative MAP objective on the unit cube, vectorised, counting evaluations."""
 
-    def __init__(self, logpost):
+    def __init__(self, logpost, deadline: float | None = None):
         self.lp = logpost
         ps = logpost.params
         self.ps = ps
         self.n = 0
+        self.deadline = deadline  # time.perf_counter() value, or None
 
     def values(self, S: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Unit-cube (K, d) -> (theta (K, P), log prior w.r.t. the unit-cube scale)."""
@@ -101,7 +152,15 @@ class _Objective:
 
     def __call__(self, S: np.ndarray) -> np.ndarray:
         S = np.clip(np.atleast_2d(S), _EPS, 1 - _EPS)
-        self.n += S.shape[0]
+        out = np.empty(S.shape[0])
+        for i in range(0, S.shape[0], CHUNK):
+            if self.deadline is not None and time.perf_counter() > self.deadline:
+                raise _OutOfTimeError
+            out[i : i + CHUNK] = self._values(S[i : i + CHUNK])
+            self.n += min(CHUNK, S.shape[0] - i)
+        return out
+
+    def _values(self, S: np.ndarray) -> np.ndarray:
         theta, lprior = self.values(S)
         with np.errstate(all="ignore"):
             ll = self.lp.log_likelihood(theta)
@@ -140,6 +199,16 @@ def find_map(logpost, **kwargs) -> MAPResult:
     starts : int
         Candidates polished with L-BFGS-B (the best distinct DE members, or random
         starts for ``multistart``).
+    deadline : float, optional
+        A :func:`time.perf_counter` value: the search stops when it passes (checked
+        every :data:`CHUNK` evaluations, a population of any size included).
+    budget : str
+        Names the budget in the message, e.g. ``"sampler.max_time = 30s"``.
+
+    Raises
+    ------
+    BudgetError
+        The deadline passed before the search ended (no MAP: the sampler needs one).
 
     BLAS runs single-threaded meanwhile (many small products: threads only spin).
     """
@@ -157,12 +226,37 @@ def _find_map(
     popsize: int = 10,
     maxiter: int = 300,
     starts: int = 4,
+    deadline: float | None = None,
+    budget: str = "the time budget",
 ) -> MAPResult:
     """Implementation of :func:`find_map` (same parameters)."""
-    obj = _Objective(logpost)
+    obj = _Objective(logpost, deadline)
+    try:
+        return _search(logpost, obj, seed, method, popsize, maxiter, starts)
+    except _OutOfTimeError as exc:
+        d = logpost.params.ndim
+        pop = f"a population of {popsize} × {d} = {popsize * d}" if method != "multistart" else ""
+        why = f"; {exc.args[0]}" if exc.args else ""
+        raise BudgetError(
+            f"{budget} ran out during the MAP search ({method}{', ' if pop else ''}{pop}; "
+            f"{obj.n} parameter sets evaluated{why}): nothing was sampled. Raise the budget, "
+            "or lower optimizer.popsize / optimizer.maxiter / optimizer.starts",
+            obj.n,
+        ) from None
+
+
+def _search(logpost, obj, seed, method, popsize, maxiter, starts) -> MAPResult:
     d = logpost.params.ndim
     rng = np.random.default_rng(seed)
     if method == "differential_evolution":
+        if obj.deadline is not None:  # a generation cannot be stopped once started
+            gen = _generation_seconds(popsize * d)
+            left = obj.deadline - time.perf_counter()
+            if gen > left:
+                raise _OutOfTimeError(
+                    f"one generation's mutation step alone takes about {gen:.0f} s (measured; "
+                    f"quadratic in the population), {max(left, 0):.0f} s were left"
+                )
         res = differential_evolution(
             lambda S: obj(S.T),
             bounds=[(0.0, 1.0)] * d,

@@ -53,13 +53,12 @@ from __future__ import annotations
 
 import json
 import os
-import tempfile
-from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 
 from heritage_bayes.convert import to_jsonable
+from heritage_bayes.rundir.atomic import atomic_write, atomic_write_text
 
 __all__ = [
     "PREDICTIVE_QUANTUM",
@@ -80,29 +79,6 @@ PREDICTIVE_QUANTUM = {"°C": 0.01, "Pa": 0.1, "%": 0.01}
 _PACKED_GROUPS = ("posterior_predictive", "predictive_bands")
 #: Mantissa bits kept of float32 log-likelihood terms (of 23).
 _LOGLIK_BITS = 12
-
-
-def atomic_write(path: str | Path, write: Callable[[Path], None]) -> Path:
-    """Call ``write(tmp_path)``, then rename ``tmp_path`` to ``path`` (same folder).
-
-    An interrupted write leaves at most a ``.tmp`` file, never a half-written ``path``.
-    """
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    os.close(fd)
-    tmp_path = Path(tmp)
-    try:
-        write(tmp_path)
-        # mkstemp creates 0600; give the file the permissions a normal write would
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp_path, 0o666 & ~umask)
-        os.replace(tmp_path, path)
-    except BaseException:
-        tmp_path.unlink(missing_ok=True)
-        raise
-    return path
 
 
 def ensure_free_space(path: str | Path, nbytes: int, margin: int = 4 << 20) -> None:
@@ -182,11 +158,6 @@ def write_inference_data(idata, path: str | Path) -> None:
         enc = {v: _encoding(group, ds[v]) for v in ds.data_vars}
         ds.to_netcdf(str(path), mode=mode, group=group, engine="h5netcdf", encoding=enc)
         mode = "a"
-
-
-def atomic_write_text(path: str | Path, text: str) -> Path:
-    """Write text atomically (UTF-8)."""
-    return atomic_write(path, lambda p: p.write_text(text, encoding="utf-8"))
 
 
 def fit_metrics(measured: np.ndarray, simulated: np.ndarray) -> dict[str, float]:

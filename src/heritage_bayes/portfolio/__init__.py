@@ -52,8 +52,20 @@ from heritage_bayes.errors import InputError
 from heritage_bayes.portfolio.page import render_index
 from heritage_bayes.portfolio.rooms import _attention_order, _room_task, measured_risk, room_row
 from heritage_bayes.portfolio.spec import Portfolio, RoomSpec, load_portfolio
+from heritage_bayes.rundir import check_name
+from heritage_bayes.rundir.folder import OutputFolder
+from heritage_bayes.rundir.writer import is_run_directory
 
-__all__ = ["Portfolio", "RoomSpec", "load_portfolio", "measured_risk", "room_row", "run"]
+__all__ = [
+    "Portfolio",
+    "RoomSpec",
+    "available_cpus",
+    "check_workers",
+    "load_portfolio",
+    "measured_risk",
+    "room_row",
+    "run",
+]
 
 
 @contextlib.contextmanager
@@ -78,7 +90,7 @@ def _client(scheduler: str | None, workers: int | None, n_rooms: int):
         finally:
             client.close()
         return
-    n = workers or min(n_rooms, os.cpu_count() or 1)
+    n = workers or min(n_rooms, available_cpus())
     try:
         import bokeh  # noqa: F401  (the dashboard needs it)
 
@@ -108,6 +120,7 @@ def run(
     workers: int | None = None,
     resume: bool = False,
     quiet: bool = False,
+    workers_unbounded: bool = False,
 ) -> pd.DataFrame:
     """Calibrate every room of a portfolio on Dask; return the overview table.
 
@@ -121,12 +134,15 @@ def run(
         Address of a running Dask scheduler (``tcp://host:8786``); default an embedded
         ``LocalCluster`` with one single-threaded worker process per core.
     workers : int, optional
-        Workers of the local cluster (default: one per core, at most one per room).
+        Workers of the local cluster (default: one per available CPU, at most one per
+        room); at most :func:`available_cpus` unless ``workers_unbounded``.
     resume : bool
         Skip rooms whose run directory holds a finished run of the same config, and
         continue rooms with saved chains.
     quiet : bool
         No progress bar.
+    workers_unbounded : bool
+        Allow more workers than CPUs available.
 
     Returns
     -------
@@ -135,15 +151,60 @@ def run(
         ``portfolio.csv`` and ``portfolio.json``.
     """
     pf = portfolio if isinstance(portfolio, Portfolio) else load_portfolio(portfolio)
-    out = Path(out_dir) if out_dir is not None else Path("reports") / pf.name
-    if out.exists() and not out.is_dir():
-        raise InputError(f"--out {out}: exists and is not a directory")
+    check_workers(workers, unbounded=workers_unbounded)
+    folder = OutputFolder(
+        Path(out_dir) if out_dir is not None else Path("reports") / check_name(pf.name),
+        kind="portfolio",
+        protect=_input_files(pf),
+    )
     try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise InputError(f"--out {out}: cannot create the directory ({exc.strerror})") from None
-    if workers is not None and workers < 1:
+        with folder:
+            folder.claim(*(s.name for s in pf.rooms), folders_from=is_run_directory)
+            folder.claim("portfolio.csv", "portfolio.json", "index.html")
+            return _run(pf, folder.path, scheduler, workers, resume, quiet)
+    except PermissionError as exc:
+        raise InputError(f"--out {folder.path}: cannot write ({exc.strerror})") from None
+
+
+def available_cpus() -> int:
+    """CPUs this process may run on (its affinity mask, e.g. a container's or
+    ``taskset``'s share), else ``os.cpu_count()``."""
+    try:
+        return len(os.sched_getaffinity(0)) or 1
+    except (AttributeError, OSError):
+        return os.cpu_count() or 1
+
+
+def check_workers(workers: int | None, *, unbounded: bool = False) -> None:
+    """Raise InputError for ``--workers`` below 1, or above :func:`available_cpus`
+    unless ``unbounded`` (each worker is a process running one calibration: more of
+    them than CPUs only slows every room down and multiplies the memory)."""
+    if workers is None:
+        return
+    if workers < 1:
         raise InputError(f"--workers: expected a whole number >= 1 (got {workers})")
+    n = available_cpus()
+    if workers > n and not unbounded:
+        raise InputError(
+            f"--workers: {workers} is more than the {n} CPU(s) available to this process; "
+            f"give at most {n}, or add --workers-unbounded to start {workers} anyway"
+        )
+
+
+def _input_files(pf: Portfolio) -> list[Path]:
+    """The portfolio file's folder, each room's config folder and data files."""
+    from heritage_bayes.config import parse_config
+    from heritage_bayes.sources import input_paths
+
+    found = [pf.path.resolve().parent]
+    for spec in pf.rooms:
+        cfg = parse_config(spec.raw, source=str(spec.config_path), base_dir=spec.base_dir)
+        found += input_paths(cfg)
+        found += [spec.projection] if spec.projection is not None else []
+    return found
+
+
+def _run(pf: Portfolio, out: Path, scheduler, workers, resume: bool, quiet: bool):
     rows: list[dict] = []
     t0 = time.perf_counter()
     with _client(scheduler, workers, len(pf.rooms)) as client:

@@ -19,7 +19,12 @@ __all__ = ["measured_risk", "room_row"]
 
 
 def _is_done(run_dir: Path, chash: str) -> bool:
-    """A finished run of the same config: summary.json exists with the same config hash."""
+    """A finished run of the same config: a run directory (valid marker) whose
+    summary.json has the same config hash."""
+    from heritage_bayes.rundir.writer import is_run_directory
+
+    if not is_run_directory(run_dir):
+        return False
     try:
         s = json.loads((run_dir / "summary.json").read_text(encoding="utf-8"))
     except (OSError, ValueError):

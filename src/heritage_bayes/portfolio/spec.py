@@ -9,9 +9,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import yaml
-
-from heritage_bayes.errors import ConfigError
+from heritage_bayes.errors import ConfigError, check_known_keys
 
 __all__ = ["Portfolio", "RoomSpec", "load_portfolio"]
 
@@ -52,18 +50,17 @@ def _deep_merge(base: dict, extra: Mapping) -> dict:
 
 
 def _read_yaml(path: Path, where: str) -> Any:
-    if not path.is_file():
-        raise ConfigError(f"{where}: file not found: {path}")
+    """The strict loader of every config (:func:`heritage_bayes.config.read_yaml`:
+    duplicate keys refused, anchors and nesting bounded, no tags), errors prefixed
+    with the key that named the file."""
+    from heritage_bayes.config import read_yaml
+
+    if where == "portfolio":
+        return read_yaml(path, what="portfolio file")[0]
     try:
-        return yaml.safe_load(path.read_text(encoding="utf-8"))
-    except UnicodeDecodeError:
-        raise ConfigError(f"{where}: {path} is not a UTF-8 text file") from None
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        at = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
-        raise ConfigError(
-            f"{where}: {path} is not valid YAML{at}: {getattr(exc, 'problem', exc)}"
-        ) from None
+        return read_yaml(path, what="config file")[0]
+    except ConfigError as exc:
+        raise ConfigError(f"{where}: {exc}") from None
 
 
 def load_portfolio(path: str | Path) -> Portfolio:
@@ -82,6 +79,7 @@ def load_portfolio(path: str | Path) -> Portfolio:
     raw = _read_yaml(p, "portfolio")
     if not isinstance(raw, dict):
         raise ConfigError(f"{p}: expected a YAML mapping with 'rooms' (got {type(raw).__name__})")
+    check_known_keys(raw, _TOP_KEYS, source=str(p), what="portfolio file")
     unknown = sorted(set(raw) - _TOP_KEYS)
     if unknown:
         raise ConfigError(f"{p}: unknown key(s) {unknown}; expected some of {sorted(_TOP_KEYS)}")

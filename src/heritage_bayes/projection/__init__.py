@@ -178,6 +178,17 @@ def project(
 
             raise ConfigError(f"--draws: expected a positive number (got {draws})")
         pcfg = pcfg.model_copy(update=upd)
+    dest = None
+    if write:  # the output path checked before anything is read
+        from heritage_bayes.rundir.folder import OutputFolder
+
+        run_dir = Path(run.path if isinstance(run, Run) else run)
+        dest = OutputFolder(
+            Path(out) if out is not None else run_dir / "projection",
+            kind="projection",
+            protect=[*_input_files(pcfg), run_dir / "posterior.nc"],
+        )
+        dest.check()
     r = run if isinstance(run, Run) else load_run(run)
     sel = select_draws(r, pcfg.draws, pcfg.seed)
     base, site, base_note = baseline_weather(r, pcfg)
@@ -259,7 +270,28 @@ def project(
     from heritage_bayes.projection.output import to_dataset, write_outputs
 
     proj.dataset = to_dataset(proj, r)
-    if write:
-        dest = Path(out) if out is not None else Path(r.path) / "projection"
-        proj.paths = write_outputs(proj, r, dest)
+    if dest is not None:
+        with dest:
+            dest.claim(*(f"projection.{x}" for x in ("nc", "json", "csv", "html")))
+            proj.paths = write_outputs(proj, r, dest.path)
     return proj
+
+
+def _input_files(pcfg) -> list[Path]:
+    """The projection file's folder and every file it names (an output may not hold
+    them)."""
+    found = [Path(pcfg.base_dir)] if pcfg.base_dir else []
+
+    def walk(node) -> None:
+        if isinstance(node, dict):
+            for k, v in node.items():
+                if k == "path" and isinstance(v, str | list):
+                    found.extend(pcfg.path(str(q)) for q in ([v] if isinstance(v, str) else v))
+                else:
+                    walk(v)
+        elif isinstance(node, list):
+            for v in node:
+                walk(v)
+
+    walk(pcfg.model_dump(mode="json"))
+    return found

@@ -75,7 +75,7 @@ from heritage_bayes.config import (
     key,
     read_yaml,
 )
-from heritage_bayes.errors import ConfigError
+from heritage_bayes.errors import ConfigError, check_known_keys
 
 __all__ = ["ProjectionConfig", "load_projection_config", "parse_projection_config"]
 
@@ -346,6 +346,8 @@ def parse_projection_config(
         raise ConfigError(
             f"{source}: expected a YAML mapping at the top level (got {type(raw).__name__})"
         )
+    known = [k for k in ProjectionConfig.model_fields if k != "base_dir"]
+    check_known_keys(raw, known, source=source, what="projection file")
     try:
         cfg = ProjectionConfig.model_validate(raw)
     except ValidationError as exc:

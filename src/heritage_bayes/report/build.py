@@ -96,7 +96,8 @@ def build_context(run_dir) -> dict:
             "verdict": convergence_verdict(rd.summary, diag["residuals"]),
             "warnings": run_notes(
                 rd.summary, diag["missing"], irradiance_setting=rd.cfg.data.irradiance
-            ),
+            )
+            + [{"level": "amber", "title": "The run's config", "text": n} for n in rd.run.notes],
             "data": data.data_context(rd),
             "fits": [{k: f[k] for k in ("id", "title", "figure", "caption")} for f in fits],
             "metrics": metrics.metrics_context(rd),
@@ -149,9 +150,11 @@ def write_report(run_dir) -> Path:
         file) or one of its files cannot be read.
     """
     from heritage_bayes.inference.results import atomic_write
+    from heritage_bayes.rundir.folder import claim_file
 
     t0 = time.perf_counter()
     ctx = build_context(run_dir)
+    target = claim_file(run_dir, "report.html")  # not a file hbayes did not write
     html_text = None
 
     def _write(tmp: Path) -> None:
@@ -161,4 +164,4 @@ def write_report(run_dir) -> Path:
 
     ctx["generated"]["seconds"] = time.perf_counter() - t0
     html_text = render(ctx)
-    return atomic_write(Path(run_dir) / "report.html", _write)
+    return atomic_write(target, _write)

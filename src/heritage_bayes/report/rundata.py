@@ -80,7 +80,11 @@ def load_run_data(run_dir) -> RunData:
             f"{p / 'posterior.nc'}: cannot be read ({exc}); the run "
             "directory is damaged, run `hbayes calibrate` again"
         ) from None
-    text = (p / "config.yaml").read_text(encoding="utf-8")
+    from heritage_bayes.run import config_yaml
+
+    recorded = isinstance(run.summary.get("provenance"), dict)
+    # the config that produced the posterior (hash checked by load_run), not an edit
+    text = config_yaml(run.config) if recorded else (p / "config.yaml").read_text("utf-8")
     return RunData(path=p, run=run, summary=run.summary, config_text=text)
 
 

@@ -153,9 +153,9 @@ def resolve_output(
                     "own: give a new or empty folder, e.g. reports/<name>"
                 )
     for f in protected_paths(*protect):
-        if p == f:
+        if p == f and not f.is_dir():
             raise InputError(f"{what}: {shown} is an input file of this command; choose another")
-        if kind == "dir" and p in f.parents:
+        if kind == "dir" and (p == f or p in f.parents):
             raise InputError(
                 f"{what}: {shown} holds an input file of this command ({f}); choose a "
                 "folder that holds no config or data file"

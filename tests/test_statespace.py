@@ -14,6 +14,7 @@ from scipy.linalg import expm
 from scipy.stats import multivariate_normal
 
 import heritage_bayes as hb
+from heritage_bayes.convergence import EXIT_UNCONVERGED
 from heritage_bayes.inference.likelihoods import get_noise_model
 from heritage_bayes.inference.parameters import parameters_for
 from heritage_bayes.inference.posterior import LogPosterior
@@ -192,7 +193,9 @@ def test_kalman_run_has_one_step_bands(tmp_path):
     p = tmp_path / "k.yaml"
     p.write_text(yaml.safe_dump(cfg))
     out = tmp_path / "run"
-    assert main(["calibrate", str(p), "--out", str(out), "--quiet"]) == 0
+    # 400 steps: the run finishes unconverged (exit code 3, EXIT_UNCONVERGED); the bands
+    # are written all the same
+    assert main(["calibrate", str(p), "--out", str(out), "--quiet"]) == EXIT_UNCONVERGED
     idata = az.from_netcdf(out / "posterior.nc")
     pp = idata.posterior_predictive
     y1 = pp["thermal.Ti_1step"].values.reshape(-1, pp.sizes["time"])

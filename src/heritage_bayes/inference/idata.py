@@ -432,10 +432,11 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
     free_ess = [v["ess_bulk"] for v in summary_params.values() if "ess_bulk" in v]
     max_rhat = float(np.max(free_rhat))
     min_ess = float(np.min(free_ess))
+    # the decision is the sampler's stopping rule: 50 τ with a stable τ, and R-hat/ESS
+    # within CONVERGENCE on every retained draw; max_rhat/min_ess below are those of the
+    # ~1000 saved draws (what az.summary of posterior.nc gives), a noisier diagnostic
     tau_ok = all(s.chain.converged for s in sections)
-    converged = bool(
-        tau_ok and max_rhat <= CONVERGENCE["max_rhat"] and min_ess >= CONVERGENCE["min_ess_bulk"]
-    )
+    converged = bool(tau_ok)
     summary = {
         "name": cfg.name,
         "building": cfg.building,

@@ -37,6 +37,7 @@ from pathlib import Path
 
 import h5py
 import numpy as np
+import pandas as pd
 import pytest
 import yaml
 
@@ -264,6 +265,40 @@ def _case_compare(cfg, *extra):
     return setup
 
 
+def _hourly_csv(path: Path, names: tuple[str, str], mean: float) -> Path:
+    """Twenty days of hourly readings with a daily cycle (a small logger/weather export)."""
+    h = np.arange(24 * 20)
+    t = pd.Timestamp("2020-01-01") + pd.to_timedelta(h, unit="h")
+    day = np.sin(2 * np.pi * h / 24)
+    pd.DataFrame(
+        {"time": t.strftime("%Y-%m-%d %H:%M"), names[0]: mean + 3 * day, names[1]: 70 + 5 * day}
+    ).to_csv(path, index=False, float_format="%.2f")
+    return path
+
+
+def _case_init(kind):
+    """``hbayes init`` on a logger and a weather export (issue 30) given carelessly."""
+
+    def setup(d: Path):
+        logger = _hourly_csv(d / "logger.csv", ("T", "RH"), 15.0)
+        weather = _hourly_csv(d / "weather.csv", ("Te", "RHe"), 5.0)
+        out = d / "room.yaml"
+        if kind == "missing-logger":
+            logger = d / "nope.csv"
+        elif kind == "not-a-logger":
+            logger = d / "shadow.csv"
+            logger.write_text(_SHADOW)
+        elif kind == "output-exists":
+            out.write_text("# my own notes\n")
+        elif kind == "output-root":
+            out = Path("/")
+        elif kind == "output-is-the-logger":
+            out = d / "sub" / ".." / "logger.csv"
+        return ["init", logger, "--weather", weather, "-o", out]
+
+    return setup
+
+
 def _case_paths(kind):
     """Output paths a careless or unlucky user gives (cwd is the case's folder)."""
 
@@ -422,6 +457,12 @@ USER_ERRORS = {
     "compare-duplicate-key": (_case_compare(yaml.safe_dump(TINY) + "seed: 4\n"), "duplicate key"),
     "compare-name-traversal": (_case_compare(_tiny(name="../../etc")), "not a plain name"),
     "compare-out-cwd": (_case_compare(TINY, "--out", "."), "is the current folder"),
+    # -- hbayes init: named errors, nothing written over the user's files
+    "init-missing-logger": (_case_init("missing-logger"), "nope.csv: file not found"),
+    "init-not-a-logger": (_case_init("not-a-logger"), "a logger file needs a header and data"),
+    "init-output-exists": (_case_init("output-exists"), "exists; choose another name"),
+    "init-output-root": (_case_init("output-root"), "is the filesystem root"),
+    "init-output-is-the-logger": (_case_init("output-is-the-logger"), "is an input file"),
     # -- a file that is not a config: named, its lines never echoed
     "shadow-as-config": (_case_config(_SHADOW), "not a configuration: none of its 2"),
     "shadow-as-portfolio": (_case_portfolio(_SHADOW), "not a portfolio file"),
@@ -482,7 +523,8 @@ def test_user_error_is_a_clean_exit_2(user_errors, case):
 
 
 @pytest.mark.parametrize(
-    "case", ["shadow-as-config", "shadow-as-portfolio", "shadow-as-projection"]
+    "case",
+    ["shadow-as-config", "shadow-as-portfolio", "shadow-as-projection", "init-not-a-logger"],
 )
 def test_a_file_that_is_not_a_config_is_not_quoted(user_errors, case):
     rc, err, _ = user_errors[case]

@@ -280,20 +280,24 @@ def _case_init(kind):
     """``hbayes init`` on a logger and a weather export (issue 30) given carelessly."""
 
     def setup(d: Path):
-        logger = _hourly_csv(d / "logger.csv", ("T", "RH"), 15.0)
-        weather = _hourly_csv(d / "weather.csv", ("Te", "RHe"), 5.0)
+        data = d / "data"  # init writes no config among the data it reads
+        data.mkdir()
+        logger = _hourly_csv(data / "logger.csv", ("T", "RH"), 15.0)
+        weather = _hourly_csv(data / "weather.csv", ("Te", "RHe"), 5.0)
         out = d / "room.yaml"
         if kind == "missing-logger":
-            logger = d / "nope.csv"
+            logger = data / "nope.csv"
         elif kind == "not-a-logger":
-            logger = d / "shadow.csv"
+            logger = data / "shadow.csv"
             logger.write_text(_SHADOW)
         elif kind == "output-exists":
             out.write_text("# my own notes\n")
         elif kind == "output-root":
             out = Path("/")
         elif kind == "output-is-the-logger":
-            out = d / "sub" / ".." / "logger.csv"
+            out = data / "sub" / ".." / "logger.csv"
+        elif kind == "output-in-the-data-folder":
+            out = data / "sub" / "room.yaml"
         return ["init", logger, "--weather", weather, "-o", out]
 
     return setup
@@ -463,6 +467,10 @@ USER_ERRORS = {
     "init-output-exists": (_case_init("output-exists"), "exists; choose another name"),
     "init-output-root": (_case_init("output-root"), "is the filesystem root"),
     "init-output-is-the-logger": (_case_init("output-is-the-logger"), "is an input file"),
+    "init-output-in-the-data-folder": (
+        _case_init("output-in-the-data-folder"),
+        "is in the folder of INDOOR_FILE",
+    ),
     # -- a file that is not a config: named, its lines never echoed
     "shadow-as-config": (_case_config(_SHADOW), "not a configuration: none of its 2"),
     "shadow-as-portfolio": (_case_portfolio(_SHADOW), "not a portfolio file"),

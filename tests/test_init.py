@@ -29,6 +29,13 @@ def _trh1(shared_data):
     return d / "roofmiddle_airmiddle.csv", d / "fmi.csv"
 
 
+def _data(tmp_path):
+    """The folder of a test's data files: ``init`` writes no config among them."""
+    d = tmp_path / "data"
+    d.mkdir(exist_ok=True)
+    return d
+
+
 def _synthetic(tmp_path, *, clock_h=1, lon=5.0, days=120, seed=3):
     """A weather CSV (no clock in its header) and a HOBO logger on a UTC+1 clock."""
     rng = np.random.default_rng(seed)
@@ -49,7 +56,7 @@ def _synthetic(tmp_path, *, clock_h=1, lon=5.0, days=120, seed=3):
             "global_rad": ghi,
         }
     )
-    wp = tmp_path / "weather.csv"
+    wp = _data(tmp_path) / "weather.csv"
     w.to_csv(wp, sep=";", index=False, decimal=",")
     lines = ['"Plot Title: nave"', '"#","Date Time, GMT+01:00","Temp, °C","RH, %"']
     stamps = utc.tz_localize(None) + pd.Timedelta(hours=1)
@@ -57,7 +64,7 @@ def _synthetic(tmp_path, *, clock_h=1, lon=5.0, days=120, seed=3):
         f"{i + 1},{t:%m/%d/%y %I:%M:%S %p},{a:.3f},{b:.2f}"
         for i, (t, a, b) in enumerate(zip(stamps, ti, rh, strict=True))
     ]
-    lp = tmp_path / "logger.csv"
+    lp = _data(tmp_path) / "logger.csv"
     lp.write_text("\n".join(lines) + "\n", encoding="utf-8")
     return lp, wp
 
@@ -78,7 +85,7 @@ def test_init_synthetic_measures_an_undeclared_weather_clock(tmp_path):
     assert cfg.name == "room" and cfg.thermal.model == "thermal_1c"
     assert cfg.data.surfaces == {"H": (0.0, 0.0)}
     # paths relative to the config; 120 days: 2/3 to calibrate, the rest to validate
-    assert cfg.data.weather.path == "../weather.csv"
+    assert cfg.data.weather.path == "../data/weather.csv"
     assert cfg.periods.calibration.start == "2021-03-01"
     assert cfg.periods.validation.start == "2021-05-20"
     assert cfg.periods.validation.end == "2021-06-29"
@@ -99,6 +106,28 @@ def test_init_never_overwrites_without_force(tmp_path, capsys):
     assert timezone_text(load_config(out).data.weather.timezone) == "UTC+01:00"
     assert main(["init", str(tmp_path / "none.csv"), "--weather", str(wp)]) == 2
     assert "none.csv: file not found" in capsys.readouterr().err
+
+
+def test_init_writes_no_config_among_its_data(tmp_path):
+    """Beside or below the logger's or the weather file's folder: refused, nothing
+    written, unless asked for (``--in-data-folder``)."""
+    lp, wp = _synthetic(tmp_path, days=30)
+    for out in (lp.parent / "c.yaml", lp.parent / "sub" / "c.yaml"):
+        with pytest.raises(InputError, match=r"is in the folder of INDOOR_FILE .*--in-data-folder"):
+            init_config(lp, wp, output=out, latitude=52.0, longitude=5.0)
+        assert not out.exists() and not out.parent.joinpath("sub").exists()
+    other = tmp_path / "weather"
+    other.mkdir()
+    wp2 = other / "w.csv"
+    wp2.write_bytes(wp.read_bytes())
+    with pytest.raises(InputError, match=r"in the folder of --weather"):
+        init_config(lp, wp2, output=other / "c.yaml", latitude=52.0, longitude=5.0)
+    assert main(["init", str(lp), "--weather", str(wp), "-o", str(lp.parent / "c.yaml")]) == 2
+    assert not (lp.parent / "c.yaml").exists()
+    res = init_config(
+        lp, wp, output=lp.parent / "c.yaml", latitude=52.0, longitude=5.0, in_data_folder=True
+    )
+    assert res.path.is_file()
 
 
 def test_init_without_site_leaves_questions_that_calibrate_refuses(tmp_path, capsys):
@@ -184,7 +213,7 @@ def test_init_reports_mislabelled_clocks(shared_data, tmp_path):
     d["t_UTC+2"] = (pd.to_datetime(d["t_UTC+2"]) + pd.Timedelta(hours=3)).dt.strftime(
         "%Y-%m-%d %H:%M:%S"
     )
-    shifted = tmp_path / "fmi_shifted.csv"
+    shifted = _data(tmp_path) / "fmi_shifted.csv"
     d.to_csv(shifted, index=False)
     res = init_config(logger, shifted, output=tmp_path / "shift.yaml", **SITE)
     q = dict(x.split(": ", 1) for x in res.questions)
@@ -242,7 +271,7 @@ def test_init_xlsx_logger_with_declared_clock(tmp_path):
     ws.append(["Datum", "Temperatuur", "RV"])
     for t, a, b in zip(hobo["Date Time, GMT+01:00"], hobo["Temp, °C"], hobo["RH, %"], strict=True):
         ws.append([pd.Timestamp(t).to_pydatetime(), float(a), float(b)])
-    xlsx = tmp_path / "logger.xlsx"
+    xlsx = _data(tmp_path) / "logger.xlsx"
     wb.save(xlsx)
     out = tmp_path / "x.yaml"
     # no clock in the workbook: without --timezone a question, with it a config that loads
@@ -285,7 +314,7 @@ def test_init_with_a_knmi_weather_file(shared_data, tmp_path):
         f"{t:%d-%m-%Y %H:%M};{a:.2f};55".replace(".", ",")
         for t, a in zip((te.index + pd.Timedelta(hours=1)).tz_localize(None), ti, strict=True)
     ]
-    logger = tmp_path / "kerk.csv"
+    logger = _data(tmp_path) / "kerk.csv"
     logger.write_text("\n".join(lines), encoding="utf-8")
     out = tmp_path / "kerk.yaml"
     res = init_config(logger, knmi, output=out, latitude=52.1, longitude=5.18, timezone="UTC+1")
@@ -310,7 +339,7 @@ def test_init_iso_stamps_and_plain_names(tmp_path):
             "humidity": hobo["RH, %"],
         }
     )
-    logger = tmp_path / "iso.csv"
+    logger = _data(tmp_path) / "iso.csv"
     iso.to_csv(logger, index=False)
     out = tmp_path / "iso.yaml"
     res = init_config(logger, wp, output=out, latitude=52.0, longitude=5.0)
@@ -383,7 +412,7 @@ def test_init_logger_layouts_end_to_end(tmp_path, layout):
             "Time, Temperature (C),Humidity (RH(%)),",
         ]
         lines += [f"{x:%H:%M:%S %d/%b/%Y},{a},{b}," for x, a, b in rows]
-    logger = tmp_path / f"{layout}.csv"
+    logger = _data(tmp_path) / f"{layout}.csv"
     logger.write_text("\n".join(lines) + "\n", encoding="utf-8")
     out = tmp_path / f"{layout}.yaml"
     res = init_config(logger, wp, output=out, latitude=52.0, longitude=5.0, timezone="UTC+1")

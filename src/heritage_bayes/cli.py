@@ -168,6 +168,12 @@ def _build_parser() -> argparse.ArgumentParser:
         "-o", "--output", metavar="PATH", default="config.yaml", help="default: config.yaml"
     )
     ini.add_argument("--force", action="store_true", help="replace an existing file")
+    ini.add_argument(
+        "--in-data-folder",
+        action="store_true",
+        help="allow --output in the folder of INDOOR_FILE or WEATHER_FILE (refused by "
+        "default: data folders are archives of raw measurements)",
+    )
     ini.set_defaults(func=_cmd_init)
 
     bat = sub.add_parser(
@@ -253,6 +259,7 @@ def _cmd_init(args) -> int:
         args.weather,
         output=args.output,
         force=args.force,
+        in_data_folder=args.in_data_folder,
         **{k: getattr(args, k) for k in opts},
     )
     for f in res.findings:

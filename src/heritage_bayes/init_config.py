@@ -220,6 +220,19 @@ def _dropped_findings(df: pd.DataFrame, where: str, findings: list[str], questio
     return dropped
 
 
+def _refuse_data_folder(output: Path, inputs: dict[str, Path]) -> None:
+    """InputError when ``output`` lies in (or below) the folder of an input file."""
+    for opt, p in inputs.items():
+        folder = p.resolve().parent
+        if output.parent == folder or folder in output.parents:
+            raise InputError(
+                f"--output: {output} is in the folder of {opt} ({folder}); init writes no "
+                "file among the data it reads. Give a path in a project folder of its own "
+                "(e.g. --output rooms/<name>/config.yaml; the config refers to the data by "
+                "relative paths), or add --in-data-folder to write it there anyway"
+            )
+
+
 def init_config(
     indoor,
     weather,
@@ -232,6 +245,7 @@ def init_config(
     timezone: str | None = None,
     weather_timezone: str | None = None,
     force: bool = False,
+    in_data_folder: bool = False,
 ) -> InitResult:
     """Inspect a logger file and a weather file; write a commented configuration.
 
@@ -259,6 +273,10 @@ def init_config(
         (``UTC+1``, ``Europe/Amsterdam``): checked against the data either way.
     force : bool
         Replace an existing ``output``.
+    in_data_folder : bool
+        Allow ``output`` in the folder of the logger or the weather file (or below it).
+        Off by default: data folders are often archives of raw measurements, shared or
+        read-only, where a derived file does not belong (and a test once wrote there).
 
     Returns
     -------
@@ -267,7 +285,8 @@ def init_config(
     Raises
     ------
     heritage_bayes.errors.InputError
-        ``output`` exists (without ``force``), a file cannot be read as a table, no
+        ``output`` exists (without ``force``), lies in a data folder (without
+        ``in_data_folder``), a file cannot be read as a table, no
         indoor temperature column, no overlap of the two files.
     """
     from heritage_bayes.rundir.policy import check_name, resolve_output, write_new_file
@@ -279,6 +298,8 @@ def init_config(
         if not p.is_file():
             raise DataError(f"{opt}: {p}: " + ("is a folder" if p.is_dir() else "file not found"))
     output = resolve_output(output, what="--output", kind="file", protect=(indoor, weather))
+    if not in_data_folder:
+        _refuse_data_folder(output, {"INDOOR_FILE": indoor, "--weather": weather})
     if output.exists() and not force:  # before the inspection: fail at once
         raise InputError(f"--output: {output} exists; choose another name or add --force")
     findings: list[str] = []

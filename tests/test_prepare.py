@@ -297,7 +297,14 @@ def files(tmp_path) -> Path:
 def test_csv_sources(files):
     prep = prepare(_load(files, _csv_config(files)))
     f = prep.frame
-    assert list(f.columns) == ["Te", "I_S", "I_roof", "Tf", "Pe", "Ti", "Pi", "RHi"]
+    inputs = ["Te", "I_S", "I_roof", "Tf", "Pe"]
+    # data.input_hold exact (files' default): each input's change over the step after
+    # the inputs (the first-order hold); zero for interval means and the annual-mean Tf
+    slopes = [f"{c}_slope" for c in ("Te", "I_S", "I_roof", "Tf", "Pe")]
+    assert list(f.columns) == [*inputs, *slopes, "Ti", "Pi", "RHi"]
+    assert f.attrs["input_hold"] == "exact" and f.attrs["units"]["Te_slope"] == "°C per step"
+    assert (f[["I_S_slope", "I_roof_slope", "Tf_slope"]].to_numpy() == 0).all()
+    assert f["Te_slope"].abs().max() > 0
     assert f.index[0] == pd.Timestamp("2020-01-02", tz="UTC")
     assert len(f) == 49 * 24
     assert prep.irradiance_source == "measured"
@@ -473,7 +480,19 @@ def test_annual_mean_temperature():
 def test_orholm_config(shared_data):
     prep = prepare(load_config(CONFIGS / "orholm.yaml"))
     f = prep.frame
-    assert list(f.columns) == ["Te", "Tf", "Pe", "Ti", "Pi", "RHi"]
+    assert list(f.columns) == [
+        "Te",
+        "Tf",
+        "Pe",
+        "Te_slope",
+        "Tf_slope",
+        "Pe_slope",
+        "Ti",
+        "Pi",
+        "RHi",
+    ]
+    # DMI's hourly averages are interval means (averaged: [Te, RHe]): held, no slope
+    assert not f[["Te_slope", "Tf_slope", "Pe_slope"]].to_numpy().any()
     assert len(f) == 17544 and f.index[0] == pd.Timestamp("2015-01-01", tz="UTC")
     assert prep.irradiance_source == "none"
     assert 9 < f["Tf"].min() <= f["Tf"].max() < 11.5  # running annual mean of DMI
@@ -507,7 +526,10 @@ def test_trh1_attic_config(shared_data):
     }
     prep = prepare(parse_config(raw, base_dir=str(CONFIGS)))
     f = prep.frame
-    assert list(f.columns) == ["Te", "I_roof_E", "I_roof_W", "Tf", "Pe", "Ti", "Pi", "RHi"]
+    inputs = ["Te", "I_roof_E", "I_roof_W", "Tf", "Pe"]
+    # the models' inputs' slopes (thermal_1c without a ground node has no Tf)
+    slopes = [f"{c}_slope" for c in ("Te", "I_roof_E", "I_roof_W", "Pe")]
+    assert list(f.columns) == [*inputs, *slopes, "Ti", "Pi", "RHi"]
     assert prep.irradiance_source == "measured"
     # Tf is the heated house below (about 21-26 °C)
     assert 18 < f["Tf"].mean() < 27

@@ -181,10 +181,20 @@ def _source_lines(
     out.append(f"    columns: {_yaml_value(columns)}")
     if units:
         out.append(f"    units: {_yaml_value(units)}   # converted on reading")
-    if label == "instant":
-        out.append("    averaged: []   # irradiance values at the stamp (see the clock check)")
-    elif label == "start":
-        out.append("    label: start   # irradiance means of the hour starting at the stamp")
+    irr = [c for c in ("ghi", "dni", "dhi") if c in columns]
+    if label == "instant" or (label is not None and not irr):
+        out.append(
+            "    averaged: []   # every column read at the stamp (irradiance: see the clock "
+            "check): linear between readings"
+        )
+    elif label in ("end", "start"):
+        out.append(
+            f"    averaged: {_yaml_value(irr)}   # means of the hour "
+            f"{'ending' if label == 'end' else 'starting'} at the stamp (the clock check); "
+            "the others read at the stamp"
+        )
+        if label == "start":
+            out.append("    label: start")
     out += _policy_lines(dropped)
     return out
 
@@ -462,7 +472,7 @@ def init_config(
         )
     else:
         lines += ["  weather:", f"    format: {wfmt}", f"    path: {_yaml_value(rel(weather))}"]
-    lines += _source_lines("measurements", lay, rel(indoor), izone, icols, iunits, "end", idropped)
+    lines += _source_lines("measurements", lay, rel(indoor), izone, icols, iunits, None, idropped)
     if irr == "measured":
         lines += [
             "  irradiance: measured",
@@ -480,6 +490,7 @@ def init_config(
     else:
         lines += ["  irradiance: none"]
     lines += [*_doc("data.step"), "  step: 1h", *_doc("data.max_gap"), f"  max_gap: {MAX_GAP_H}h"]
+    lines += [*_doc("data.input_hold"), "  input_hold: exact"]
     lines += ["", "periods:", *_wrap(why, "  # ", "  # ")]
     lines += [
         f"  calibration: {{start: {cs}, end: {ce}}}",

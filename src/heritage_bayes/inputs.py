@@ -14,7 +14,13 @@ import pandas as pd
 
 from heritage_bayes.errors import ConfigError, DataError, InputError
 
-__all__ = ["annual_mean_temperature", "calendar_inputs", "solar_inputs", "weather_inputs"]
+__all__ = [
+    "add_slope_columns",
+    "annual_mean_temperature",
+    "calendar_inputs",
+    "solar_inputs",
+    "weather_inputs",
+]
 
 _IRRADIANCE = ("ghi", "dni", "dhi")
 _YEAR = pd.Timedelta(days=365)
@@ -117,6 +123,43 @@ def calendar_inputs(models, index: pd.DatetimeIndex, dt: float) -> dict[str, np.
     return out
 
 
+def add_slope_columns(
+    frame: pd.DataFrame, models, slopes: pd.DataFrame | None, flags: pd.DataFrame | None = None
+) -> None:
+    """Add the slope columns (``<input>_slope``) the models need to ``frame``, in place.
+
+    An input's change over each step [its unit per step] from
+    :attr:`heritage_bayes.io.Aligned.slopes` (instantaneous readings: the first-order
+    hold, :meth:`heritage_bayes.rc.RCModel.with_slopes`); zeros for interval means and
+    for inputs made on the grid (``Tf`` as an annual mean or a constant, calendars),
+    which are held over the step. ``flags`` (when given) copy the input's flags;
+    ``frame.attrs`` gain the units and ``input_hold`` (``"exact"`` or
+    ``"interval_mean"``).
+    """
+    units = frame.attrs.setdefault("units", {})
+    outputs = [c for c in frame.attrs.get("outputs", ()) if c in frame.columns]
+    for m in models:
+        for u, col in zip(m.slope_inputs, m.slope_columns, strict=True):
+            if col in frame.columns:
+                continue
+            if slopes is not None and u in slopes.columns:
+                values = slopes[u].reindex(frame.index).to_numpy(dtype=float)
+            else:
+                values = np.zeros(len(frame))
+            # before the outputs (the frame's order: inputs, then outputs)
+            at = frame.columns.get_loc(outputs[0]) if outputs else len(frame.columns)
+            frame.insert(at, col, values)
+            if flags is not None:
+                flag = flags[u].to_numpy() if u in flags.columns else np.zeros(len(frame), bool)
+                flags.insert(at, col, flag)
+            units[col] = f"{units.get(u, '')} per step".strip()
+    cols = [c for m in models for c in m.slope_columns]
+    if "inputs" in frame.attrs:
+        frame.attrs["inputs"] = tuple(dict.fromkeys((*frame.attrs["inputs"], *cols)))
+    slope = bool(cols)
+    frame.attrs["input_hold"] = "exact" if slope else "interval_mean"
+
+
 def solar_inputs(
     weather: pd.DataFrame,
     site: Mapping,
@@ -214,6 +257,8 @@ def _with_vapour_pressure(df: pd.DataFrame, target: str, where: str) -> pd.DataF
     res.attrs = dict(df.attrs)
     res.attrs["units"] = {**df.attrs.get("units", {}), target: "Pa"}
     res.attrs["derived"] = {**df.attrs.get("derived", {}), **out.attrs.get("derived", {})}
+    # derived from interval means, the vapour pressure is one too (its timing, not a reading)
+    res.attrs["averaged"] = tuple(out.attrs.get("averaged", ()))
     return res
 
 

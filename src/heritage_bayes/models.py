@@ -18,7 +18,7 @@ from heritage_bayes.rc.catalog import model as catalog_model
 from heritage_bayes.rc.model import RCModel
 from heritage_bayes.rc.network import Network
 
-__all__ = ["SECTIONS", "build_model", "describe_model"]
+__all__ = ["SECTIONS", "build_model", "describe_model", "input_hold_of"]
 
 SECTIONS = ("thermal", "hygric")
 _SOLAR = {"thermal_1c", "thermal_2c", "thermal_4a"}
@@ -71,7 +71,20 @@ def build_model(cfg: CalibrationConfig, section: str) -> RCModel:
         raise ConfigError(msg if msg.startswith(f"{where}") else f"{where}: {msg}") from None
     if m.domain != section:
         raise ConfigError(f"{where}: a {m.domain} model cannot be used in the {section!r} section")
+    if input_hold_of(cfg) == "exact":
+        # every network input gets its slope column: the data layer fills it with the
+        # change over the step for instantaneous readings, zeros for interval means
+        m = m.with_slopes(m.network.inputs)
     return m
+
+
+def input_hold_of(cfg: CalibrationConfig) -> str:
+    """``data.input_hold`` as configured, else ``"exact"`` for files and
+    ``"interval_mean"`` for the demo (whose generator holds each input's interval mean)."""
+    hold = cfg.data.input_hold
+    if hold is None:
+        hold = "interval_mean" if cfg.data.demo is not None else "exact"
+    return hold
 
 
 def initial_state_of(cfg: CalibrationConfig, section: str, model: RCModel | None = None):

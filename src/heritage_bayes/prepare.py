@@ -2,9 +2,8 @@
 
 :func:`prepare` is the bridge between :mod:`heritage_bayes.config` and the calibration
 engine. It reads the weather and measurement files with the readers of
-:mod:`heritage_bayes.io` (or generates the built-in :mod:`~heritage_bayes.demo`; both
-through :func:`heritage_bayes.sources.read_sources`), derives
-vapour pressures, computes the irradiance on the solar surfaces
+:mod:`heritage_bayes.io` (or the demo; both through :func:`heritage_bayes.sources.read_sources`),
+derives vapour pressures, computes the irradiance on the solar surfaces
 (:func:`heritage_bayes.climate.surface_irradiance`), builds the fixed (ground)
 temperature input ``Tf``, and puts everything on one regular UTC grid with
 :func:`heritage_bayes.io.align`. The demo goes through exactly the same path as real data.
@@ -12,14 +11,15 @@ temperature input ``Tf``, and puts everything on one regular UTC grid with
 Conventions (those of :func:`~heritage_bayes.io.align`)
 -------------------------------------------------------
 * Row ``k`` of :attr:`Prepared.frame` is the instant ``t_k`` (UTC). Input columns hold
-  the mean over ``[t_k, t_k + dt)`` (zero-order hold of the simulator), output columns
-  the measured value at ``t_k`` (NaN where missing: the likelihood masks it).
+  the mean over ``[t_k, t_k + dt)``, output columns the measured value at ``t_k`` (NaN
+  where missing: the likelihood masks it). With ``data.input_hold: exact`` (files' default)
+  ``<input>_slope`` columns hold ``u(t_{k+1}) - u(t_k)`` of readings at an instant (the
+  first-order hold), zero for interval means.
 * Input columns: ``Te`` [°C], ``I_<surface>`` [W/m²] (one per key of ``data.surfaces``),
   ``Tf`` [°C] for the thermal models; ``Pe`` [Pa] for the hygric models. Output columns:
   ``Ti`` [°C], ``Pi`` [Pa], and ``RHi`` [%] when measured (for the combined RH check).
-* Vapour pressures come from temperature and relative humidity (over water, IAPWS,
-  :mod:`heritage_bayes.climate.psychro`) row by row at the native resolution, before any
-  averaging.
+* Vapour pressures come from T and RH (over water, IAPWS, :mod:`heritage_bayes.climate.psychro`)
+  row by row at the native resolution, before any averaging.
 
 Periods
 -------
@@ -54,18 +54,13 @@ from heritage_bayes.convert import format_timedelta, to_jsonable
 from heritage_bayes.errors import ConfigError, DataError, InputError
 from heritage_bayes.inputs import (
     _with_vapour_pressure,
+    add_slope_columns,
     annual_mean_temperature,
     calendar_inputs,
     solar_inputs,
     weather_inputs,
 )
-from heritage_bayes.sources import (
-    INPUT_COLUMNS,
-    OUTPUT_COLUMNS,
-    _ground_column,
-    _iso,
-    read_sources,
-)
+from heritage_bayes.sources import INPUT_COLUMNS, OUTPUT_COLUMNS, _ground_column, _iso, read_sources
 
 __all__ = [
     "INPUT_COLUMNS",
@@ -446,10 +441,10 @@ def prepare(cfg) -> Prepared:
     frame.attrs["units"] = {
         **frame.attrs.get("units", {}),
         **{c: "W/m²" for c in order if c.startswith("I_")},
-        **({"Tf": "°C"} if "Tf" in order else {}),
-        **({"Pi": "Pa"} if "Pi" in order else {}),
+        **{c: u for c, u in (("Tf", "°C"), ("Pi", "Pa")) if c in order},
         **{c: "-" for m in models for c in getattr(m, "calendar_inputs", {})},
     }
+    add_slope_columns(frame, models, aligned.slopes, flags)  # the first-order hold
 
     # -- period rows -----------------------------------------------------------------------
     if per.calibration is not None:

@@ -187,9 +187,7 @@ class Source(_Strict):
         description="csv: lines before the header, or the 0-based numbers of the lines to "
         "skip (logger metadata lines: Tinytag, Rotronic; see heritage_bayes.io.loggers)",
     )
-    encoding: str = key(
-        "utf-8", unit=None, description="csv: text encoding, e.g. utf-8-sig, cp1252"
-    )
+    encoding: str = key("utf-8", unit=None, description="csv: text encoding (utf-8-sig, cp1252)")
     units: dict[str, str] | None = key(
         None,
         unit=None,
@@ -355,6 +353,14 @@ class Data(_Strict):
         unit=DURATION_UNIT,
         description="longest input gap filled by interpolation",
         validate_default=True,
+    )
+    input_hold: Literal["exact", "interval_mean"] | None = key(
+        None,
+        unit=None,
+        description="exact: readings at an instant linear between samples (first-order "
+        "hold), interval means (a source's 'averaged' columns) constant over their interval; "
+        "interval_mean: every input held at its mean over the step. Default: exact for "
+        "files, interval_mean for the demo (its generator's hold)",
     )
 
     @model_validator(mode="after")

@@ -362,6 +362,7 @@ def align(
     frame_cols: dict[str, np.ndarray] = {}
     flag_cols: dict[str, np.ndarray] = {}
     interpolated: dict[str, int] = {}
+    slope_cols: dict[str, np.ndarray] = {}
     for s in inputs:
         values = s.values.copy()
         filled = np.zeros(values.size)
@@ -386,6 +387,7 @@ def align(
             filled[a : b + 1] = 1.0
         interpolated[s.name] = int(filled.sum())
         frame_cols[s.name] = _bin_integrals(s, values, edges) / (step_ns / _NS)
+        slope_cols[s.name] = _slopes(s, values, edges)
         flag_cols[s.name] = _bin_integrals(s, filled, edges) > 1e-9
     if too_long:
         listed = "\n  ".join(str(g) for g in too_long[:_MAX_LISTED])
@@ -462,7 +464,20 @@ def align(
         measurement_missing=missing,
         sources=sources,
     )
-    return Aligned(frame, flags, report, in_names, out_names)
+    slopes = pd.DataFrame({k: slope_cols[k] for k in in_names}, index=index)
+    return Aligned(frame, flags, report, in_names, out_names, slopes)
+
+
+def _slopes(series: _Input, values: np.ndarray, edges: np.ndarray) -> np.ndarray:
+    """Change of an instantaneous input over each bin, ``u(edges[k+1]) - u(edges[k])``,
+    on its linear interpolation between samples; zero for an interval mean (constant
+    over its interval: the zero-order hold of its bin mean is exact)."""
+    n = edges.size - 1
+    if series.averaged:
+        return np.zeros(n)
+    ok = ~np.isnan(values)
+    at = np.interp(edges.astype(float), series.times[ok].astype(float), values[ok])
+    return np.diff(at)
 
 
 def _fmt(ns: int) -> str:

@@ -152,6 +152,11 @@ class Aligned:
     report : AlignmentReport
     inputs, outputs : tuple of str
         Column names of the inputs and outputs in ``frame``.
+    slopes : pandas.DataFrame or None
+        Same index, one column per input: its change over the row,
+        :math:`u(t_{k+1}) - u(t_k)` of the linear interpolation between the samples of
+        an instantaneous input, zero for an interval mean (the first-order hold's
+        second input, see :meth:`heritage_bayes.rc.RCModel.with_slopes`).
     """
 
     frame: pd.DataFrame
@@ -159,6 +164,7 @@ class Aligned:
     report: AlignmentReport
     inputs: tuple[str, ...]
     outputs: tuple[str, ...]
+    slopes: pd.DataFrame | None = None
 
     @property
     def step(self) -> pd.Timedelta:

@@ -189,7 +189,12 @@ def model_inputs(run, pcfg, weather: pd.DataFrame, site: dict | None, where: str
     (:func:`~heritage_bayes.climate.risk.registry.complete_year_hours`;
     ``frame.attrs["hours_dropped"]`` counts the hours after the last complete year).
     """
-    from heritage_bayes.inputs import annual_mean_temperature, calendar_inputs, weather_inputs
+    from heritage_bayes.inputs import (
+        add_slope_columns,
+        annual_mean_temperature,
+        calendar_inputs,
+        weather_inputs,
+    )
     from heritage_bayes.io import align
     from heritage_bayes.prepare import _extra_inputs
 
@@ -230,6 +235,9 @@ def model_inputs(run, pcfg, weather: pd.DataFrame, site: dict | None, where: str
         run.models.values(), frame.index, step.total_seconds()
     ).items():
         frame[name] = col
+    # the run's hold: an input's change over the step where its model has the
+    # first-order hold (readings at an instant), zeros for interval means
+    add_slope_columns(frame, run.models.values(), aligned.slopes)
     for section, model in run.models.items():
         missing = [c for c in model.input_names if c not in frame.columns]
         if missing:

@@ -273,7 +273,6 @@ class ControlledModel(RCModel):
         self._control_params = tuple(specs)
         self._control_inputs = tuple(dict.fromkeys(extra_in))
         self._n_net = len(network.parameter_names)
-        self._m_net = len(network.inputs)
 
     # ------------------------------------------------------------------ names
     @property
@@ -290,7 +289,12 @@ class ControlledModel(RCModel):
 
     @property
     def input_names(self) -> tuple[str, ...]:
-        return self.network.inputs + self._control_inputs
+        return self.network.inputs + self.slope_columns + self._control_inputs
+
+    @property
+    def _m_net(self) -> int:
+        """Input columns of the linear network (its inputs and their slope columns)."""
+        return len(self.network.inputs) + len(self.slope_inputs)
 
     @property
     def n_inputs(self) -> int:
@@ -307,6 +311,8 @@ class ControlledModel(RCModel):
         """Unit of input column ``name``."""
         if name in self.network.inputs:
             return self.network.input_unit(name)
+        if name in self.slope_columns:  # an input's change over the step
+            return self.network.input_unit(self.slope_inputs[self.slope_columns.index(name)])
         return {"Ti": "°C", "Pi": "Pa"}.get(name, "-")
 
     def __repr__(self) -> str:
@@ -348,7 +354,8 @@ class ControlledModel(RCModel):
             on = set(self.control.enabled)
             on |= {k for k, v in enabled.items() if v}
             on -= {k for k, v in enabled.items() if not v}
-        return ControlledModel(self.network, replace(self.control, enabled=frozenset(on)))
+        new = ControlledModel(self.network, replace(self.control, enabled=frozenset(on)))
+        return new.with_slopes(self.slope_inputs)
 
     # ------------------------------------------------------------------ values
     def _cp(self, P: np.ndarray, name: str, default: float = 0.0) -> np.ndarray:

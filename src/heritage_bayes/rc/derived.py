@@ -150,7 +150,9 @@ def static_gains(model, params) -> np.ndarray:
     P, batch = _param_matrix(model, params)
     mf = modal_form(model, P, 1.0)
     with np.errstate(divide="ignore", invalid="ignore"):
-        g = np.einsum("kon,knm->kom", mf.Cz, mf.Bz / mf.lam[:, :, None])
+        # the network's inputs: their slope columns (first-order hold) vanish in steady state
+        Bz = mf.Bz[:, :, : len(model.network.inputs)]
+        g = np.einsum("kon,knm->kom", mf.Cz, Bz / mf.lam[:, :, None])
     g[~mf.valid] = np.nan
     return g if batch else g[0]
 

@@ -78,6 +78,13 @@ class ModalForm:
         Parameter sets that are admissible and gave finite, positive decay rates.
     dt : float
         Time step [s].
+    slope : (m,) bool array or None
+        Input columns that are an input's change over the step,
+        :math:`u(t_{k+1}) - u(t_k)` (first-order hold, :meth:`RCModel.with_slopes`);
+        their discrete weight is :attr:`cs` instead of :attr:`phi`. None: no such column
+        (every input held over the step).
+    cs : (K, n) array or None
+        FOH slope gain :math:`c_j = (w^+_j - w^-_j)/2` [s] of :func:`foh_weights`.
     """
 
     lam: np.ndarray
@@ -90,6 +97,8 @@ class ModalForm:
     V: np.ndarray
     valid: np.ndarray
     dt: float
+    slope: np.ndarray | None = None
+    cs: np.ndarray | None = None
 
     @property
     def T(self) -> np.ndarray:
@@ -103,8 +112,21 @@ class ModalForm:
 
     @property
     def Bdz(self) -> np.ndarray:
-        """Discrete modal input matrix (K, n, m)."""
-        return self.phi[:, :, None] * self.Bz
+        r"""Discrete modal input matrix (K, n, m): :math:`\phi_j` times the columns of
+        the inputs' interval means, :math:`c_j` times their slope columns (FOH)."""
+        if self.slope is None:
+            return self.phi[:, :, None] * self.Bz
+        w = np.where(self.slope[None, None, :], self.cs[:, :, None], self.phi[:, :, None])
+        return w * self.Bz
+
+    def _steady_Bz(self, width: int) -> np.ndarray:
+        """Bz for a steady state: slope columns are zero in steady state; ``width``
+        may also be that of the network's inputs without their slope columns."""
+        if self.slope is None:
+            return self.Bz
+        if width == self.slope.size:
+            return np.where(self.slope[None, None, :], 0.0, self.Bz)
+        return self.Bz[:, :, : int((~self.slope).sum())]
 
     @property
     def edz(self) -> np.ndarray:
@@ -113,7 +135,8 @@ class ModalForm:
 
     def steady_state_modal(self, u0: np.ndarray) -> np.ndarray:
         """Modal steady state for constant inputs ``u0`` ((m,) or (K, m)): (K, n)."""
-        forcing = np.einsum("knm,...m->kn", self.Bz, u0) + self.ez
+        u0 = np.asarray(u0, dtype=float)
+        forcing = np.einsum("knm,...m->kn", self._steady_Bz(u0.shape[-1]), u0) + self.ez
         with np.errstate(divide="ignore", invalid="ignore"):
             return forcing / self.lam
 
@@ -157,6 +180,9 @@ def modal_form(model, P: np.ndarray, dt: float) -> ModalForm:
     lam, V = np.linalg.eigh(S)
     Vt = np.swapaxes(V, 1, 2)
     Bz = Vt @ (s[:, :, None] * Gu)
+    slope = getattr(model, "slope_mask", None)
+    if slope is not None:  # FOH: each slope column couples like its input
+        Bz = np.concatenate([Bz, Bz[:, :, list(model.slope_sources)]], axis=2)
     ez = np.einsum("kij,kj->ki", Vt, s * q) if q.any() else np.zeros_like(lam)
     # outputs are node potentials: rows of T = C^-1/2 V for the observed nodes
     out = model._ix["out"]
@@ -170,7 +196,24 @@ def modal_form(model, P: np.ndarray, dt: float) -> ModalForm:
         phi = np.where(x > 1e-300, -np.expm1(-x) / np.where(lam > 0, lam, 1.0), dt)
     ok = valid & np.all(np.isfinite(lam), axis=1) & np.all(lam > 0, axis=1)
     ok &= np.all(np.isfinite(Bz), axis=(1, 2))
-    return ModalForm(lam=lam, ad=ad, Bz=Bz, ez=ez, phi=phi, Cz=Cz, s=s, V=V, valid=ok, dt=float(dt))
+    cs = None
+    if slope is not None:
+        w0, w1 = foh_weights(np.where(lam > 0, lam, 0.0), dt)
+        cs = 0.5 * (w1 - w0)
+    return ModalForm(
+        lam=lam,
+        ad=ad,
+        Bz=Bz,
+        ez=ez,
+        phi=phi,
+        Cz=Cz,
+        s=s,
+        V=V,
+        valid=ok,
+        dt=float(dt),
+        slope=slope,
+        cs=cs,
+    )
 
 
 def discretize(model, params, dt: float = 3600.0):

@@ -7,6 +7,7 @@ imports the network, the discretisation and the simulator at module level.
 
 from __future__ import annotations
 
+import copy
 from collections.abc import Mapping
 
 import numpy as np
@@ -15,7 +16,10 @@ from heritage_bayes.rc.discretize import modal_form
 from heritage_bayes.rc.network import Network, ParameterInfo
 from heritage_bayes.rc.simulate import modal_simulate
 
-__all__ = ["RCModel"]
+__all__ = ["SLOPE_SUFFIX", "RCModel"]
+
+#: Suffix of the input column holding an input's change over the step (first-order hold).
+SLOPE_SUFFIX = "_slope"
 
 
 class RCModel:
@@ -32,6 +36,11 @@ class RCModel:
     #: Control of the air node (:class:`heritage_bayes.rc.control.Control`); None for a
     #: free-running room.
     control = None
+
+    #: Network inputs discretised with the first-order hold (instantaneous readings,
+    #: linear between samples); each adds the input column ``<name>_slope`` (see
+    #: :meth:`with_slopes`).
+    slope_inputs: tuple[str, ...] = ()
 
     def __init__(self, network: Network):
         self.network = network
@@ -52,7 +61,53 @@ class RCModel:
 
     @property
     def input_names(self) -> tuple[str, ...]:
-        return self.network.inputs
+        return self.network.inputs + self.slope_columns
+
+    @property
+    def slope_columns(self) -> tuple[str, ...]:
+        """Input columns ``<name>_slope`` of :attr:`slope_inputs`, after the network's."""
+        return tuple(f"{u}{SLOPE_SUFFIX}" for u in self.slope_inputs)
+
+    @property
+    def slope_mask(self) -> np.ndarray | None:
+        """(m_net,) bool: the slope columns among the network's input columns (None:
+        none), for :func:`heritage_bayes.rc.discretize.modal_form`."""
+        if not self.slope_inputs:
+            return None
+        n = len(self.network.inputs)
+        return np.arange(n + len(self.slope_inputs)) >= n
+
+    @property
+    def slope_sources(self) -> tuple[int, ...]:
+        """Index in ``network.inputs`` of the input behind each slope column."""
+        return tuple(self.network.inputs.index(u) for u in self.slope_inputs)
+
+    def with_slopes(self, inputs) -> RCModel:
+        r"""This model with the first-order hold (FOH) for the network inputs ``inputs``.
+
+        Each input ``u`` in ``inputs`` gains a column ``u_slope``
+        :math:`= u(t_{k+1}) - u(t_k)` [unit of ``u`` per step] beside its column of
+        interval means :math:`\bar u_k`; the step's forcing is then
+        :math:`\phi\tilde B\bar u_k + c\,\tilde B(u(t_{k+1}) - u(t_k))`, exact for an
+        input linear between its samples (:func:`heritage_bayes.rc.discretize.foh_weights`).
+        A slope column of zeros gives the zero-order hold of the interval mean, exact
+        for an interval mean. Parameters, states and outputs are unchanged.
+
+        Parameters
+        ----------
+        inputs : iterable of str
+            Network inputs (e.g. ``("Te", "Tf")``); ``()`` gives the model without slopes.
+        """
+        inputs = tuple(dict.fromkeys(inputs))
+        unknown = [u for u in inputs if u not in self.network.inputs]
+        if unknown:
+            raise ValueError(
+                f"with_slopes: {unknown} are not inputs of the network of model "
+                f"{self.name!r}; its inputs are {list(self.network.inputs)}"
+            )
+        new = copy.copy(self)
+        new.slope_inputs = tuple(u for u in self.network.inputs if u in inputs)
+        return new
 
     @property
     def state_names(self) -> tuple[str, ...]:
@@ -72,7 +127,7 @@ class RCModel:
 
     @property
     def n_inputs(self) -> int:
-        return len(self.network.inputs)
+        return len(self.network.inputs) + len(self.slope_inputs)
 
     @property
     def n_outputs(self) -> int:

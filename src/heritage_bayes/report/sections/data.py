@@ -60,7 +60,11 @@ def data_context(rd: RunData) -> dict:
     codes = np.asarray(const["period"].values)
     dt = np.median(np.diff(times[:1000])) if times.size > 1 else np.timedelta64(3600, "s")
     units = _input_units(rd)
-    inputs = [c for c in const.data_vars if c != "period" and not c.startswith("interpolated.")]
+    inputs = [
+        c
+        for c in const.data_vars
+        if c != "period" and not c.startswith("interpolated.") and not c.endswith("_slope")
+    ]  # an input's change over the step (first-order hold) is not plotted
     flags = {
         c.split(".", 1)[1]: np.asarray(const[c].values).astype(bool)
         for c in const.data_vars

@@ -35,6 +35,10 @@ is chosen (``duplicates=``).
 grid matching the simulator's zero-order hold (``x[k+1] = Ad x[k] + Bd u[k]``, ``u[k]``
 held over ``[t_k, t_k + step)``): an input at row ``t_k`` is the mean over
 ``[t_k, t_k + step)``; a measurement at row ``t_k`` is the instantaneous value at ``t_k``.
+:attr:`Aligned.slopes` adds each instantaneous input's change over the row,
+``u(t_k + step) - u(t_k)`` (zero for interval averages): with it the simulator holds a
+reading linear between samples (first-order hold) and an average constant over its
+interval, each exactly (``data.input_hold: exact``).
 """
 
 from heritage_bayes.io._common import STANDARD_COLUMNS, parse_timezone

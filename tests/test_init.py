@@ -328,6 +328,47 @@ def test_init_with_a_knmi_weather_file(shared_data, tmp_path):
     assert any("clock check (the reader's UTC): sun: UTC-0:0" in f for f in res.findings)
 
 
+def test_init_states_how_the_weather_was_measured(tmp_path):
+    """The timing of each weather column goes into the config (issue 31): a DMI portal
+    export (its documented layout ``Station;Year;Month;Day;Hour (UTC);TEMP C;%RH``,
+    "hourly averages") as means of the hour ending at the stamp; another file without
+    irradiance as readings at the stamp (said on the terminal); the exact hold always."""
+    lp, wp = _synthetic(tmp_path, days=30)
+    w = pd.read_csv(wp, sep=";", decimal=",")
+    utc = pd.to_datetime(w["time"]) - pd.Timedelta(hours=1)  # the synthetic file is UTC+1
+    dmi = pd.DataFrame(
+        {
+            "Station": 618100,
+            "Year": utc.dt.year,
+            "Month": utc.dt.month,
+            "Day": utc.dt.day,
+            "Hour (UTC)": utc.dt.hour,
+            "TEMP C": w["T_out"],
+            "%RH": w["RH_out"],
+        }
+    )
+    dp = _data(tmp_path) / "dmi.csv"
+    dmi.to_csv(dp, sep=";", index=False)
+    res = init_config(lp, dp, output=tmp_path / "dmi.yaml", latitude=52.0, longitude=5.0)
+    cfg = load_config(tmp_path / "dmi.yaml")
+    assert cfg.data.weather.averaged == ["RHe", "Te"] and cfg.data.weather.label == "end"
+    assert cfg.data.input_hold == "exact"
+    assert any("a DMI export" in f for f in res.findings)
+    plain = _data(tmp_path) / "plain.csv"
+    w.drop(columns="global_rad").to_csv(plain, sep=";", index=False, decimal=",")
+    res = init_config(
+        lp,
+        plain,
+        output=tmp_path / "plain.yaml",
+        latitude=52.0,
+        longitude=5.0,
+        weather_timezone="UTC+1",
+    )
+    cfg = load_config(tmp_path / "plain.yaml")
+    assert cfg.data.weather.averaged == []
+    assert any("taken as readings at the stamp" in f for f in res.findings)
+
+
 def test_init_iso_stamps_and_plain_names(tmp_path):
     lp, wp = _synthetic(tmp_path, days=30)
     hobo = pd.read_csv(lp, skiprows=1)

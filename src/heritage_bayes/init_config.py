@@ -161,6 +161,24 @@ def _pick(layout: TableLayout, kinds: dict[str, str], findings: list[str], what:
     return columns, units
 
 
+def _timing_without_sun(layout: TableLayout, findings: list[str]) -> str:
+    """How a weather CSV without irradiance stamps its values (the sun cannot tell):
+    hour-ending means for a DMI portal export (``Station;Year;Month;Day;Hour (UTC)``,
+    "hourly averages" in its description), readings at the stamp otherwise."""
+    tc = layout.time_column if isinstance(layout.time_column, list) else [layout.time_column]
+    if "Station" in layout.header and "Hour (UTC)" in tc:
+        findings.append(
+            "weather: a DMI export (Station, Year, Month, Day, Hour (UTC)): its values are "
+            "hourly averages, taken as means of the hour ending at the stamp"
+        )
+        return "means_end"
+    findings.append(
+        "weather: no irradiance to time the stamps against the sun: Te and RHe taken as "
+        "readings at the stamp; if the file holds interval means, list them under averaged"
+    )
+    return "instant"
+
+
 def _source_lines(
     key: str, layout: TableLayout, rel: str, zone, columns, units, label, dropped
 ) -> list[str]:
@@ -182,7 +200,12 @@ def _source_lines(
     if units:
         out.append(f"    units: {_yaml_value(units)}   # converted on reading")
     irr = [c for c in ("ghi", "dni", "dhi") if c in columns]
-    if label == "instant" or (label is not None and not irr):
+    if label == "means_end":
+        out.append(
+            f"    averaged: {_yaml_value(sorted(columns))}   # means of the hour ending at "
+            "the stamp (the file's documentation): constant over their hour"
+        )
+    elif label == "instant" or (label is not None and not irr):
         out.append(
             "    averaged: []   # every column read at the stamp (irradiance: see the clock "
             "check): linear between readings"
@@ -377,6 +400,8 @@ def init_config(
             questions.append(f"data.weather.timezone: {wq}")
         te_utc = to_utc(dw["Te"], wzone)
         irr = "measured" if {"ghi"} <= set(wcols) or {"ghi", "dhi"} & set(wcols) else None
+        if irr is None:
+            wlabel = _timing_without_sun(wlay, findings)
     else:
         from heritage_bayes.io import read_epw, read_knmi_hourly, read_tmy3
 

@@ -200,20 +200,8 @@ def modal_form(model, P: np.ndarray, dt: float) -> ModalForm:
     if slope is not None:
         w0, w1 = foh_weights(np.where(lam > 0, lam, 0.0), dt)
         cs = 0.5 * (w1 - w0)
-    return ModalForm(
-        lam=lam,
-        ad=ad,
-        Bz=Bz,
-        ez=ez,
-        phi=phi,
-        Cz=Cz,
-        s=s,
-        V=V,
-        valid=ok,
-        dt=float(dt),
-        slope=slope,
-        cs=cs,
-    )
+    # positional, in the field order: lam, ad, Bz, ez, phi, Cz, s, V, valid, dt, slope, cs
+    return ModalForm(lam, ad, Bz, ez, phi, Cz, s, V, ok, float(dt), slope, cs)
 
 
 def discretize(model, params, dt: float = 3600.0):

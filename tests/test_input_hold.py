@@ -173,3 +173,30 @@ def test_config_states_the_hold():
 
     field = Data.model_fields["input_hold"]
     assert "first-order hold" in field.description
+
+
+def test_slope_columns_join_the_inputs_before_the_outputs():
+    """add_slope_columns (prepare and the projection's weather): each slope column after
+    the inputs, before the outputs; the aligned change of a reading, zeros for an input
+    made on the grid (Tf as an annual mean); flags and units follow the input."""
+    from heritage_bayes.inputs import add_slope_columns
+
+    te = 5.0 + np.arange(25.0)
+    al = align(_hourly(te))
+    frame = al.frame.copy()
+    frame["Tf"] = 8.0
+    frame["Ti"] = 10.0
+    frame.attrs = {"units": {"Te": "°C", "Tf": "°C"}, "outputs": ("Ti",), "inputs": ("Te", "Tf")}
+    flags = pd.DataFrame(False, index=frame.index, columns=frame.columns)
+    flags.loc[flags.index[3], "Te"] = True
+    m = hb.model("thermal_1c", surfaces=()).with_slopes(("Te", "Tf"))
+    add_slope_columns(frame, [m], al.slopes, flags)
+    assert list(frame.columns) == ["Te", "Tf", "Te_slope", "Tf_slope", "Ti"]
+    assert list(flags.columns) == list(frame.columns) and flags["Te_slope"].iloc[3]
+    np.testing.assert_array_equal(frame["Te_slope"], 1.0)
+    np.testing.assert_array_equal(frame["Tf_slope"], 0.0)
+    assert frame.attrs["units"]["Te_slope"] == "°C per step"
+    assert frame.attrs["inputs"] == ("Te", "Tf", "Te_slope", "Tf_slope")
+    assert frame.attrs["input_hold"] == "exact"
+    U = frame[list(m.input_names)].to_numpy()
+    assert np.isfinite(hb.simulate(m, {"Ci": 1e7, "Ge": 100.0, "Gf": 10.0}, U)).all()

@@ -133,6 +133,14 @@ def test_sections_in_order(report):
     ]
 
 
+def test_data_section_says_how_the_inputs_were_held(report):
+    """The demo holds every input at its mean over the step (data.input_hold's demo
+    default, its generator's hold); the data section says so."""
+    _, html = report
+    data = html.split('<section id="data">', 1)[1].split("</section>", 1)[0]
+    assert "Every input held at its mean over each step (data.input_hold: interval_mean)" in data
+
+
 def test_every_figure_is_an_embedded_png(report):
     _, html = report
     figs = _figures(html)

@@ -226,12 +226,25 @@ def data_context(rd: RunData) -> dict:
         "gaps": gaps,
         "missing": missing,
         "sources": sources,
+        "hold": _hold_words(rd),
         "words": words.strip(),
         "irradiance": rd.summary.get("irradiance_source", "?"),
         "ground": ((rd.summary.get("sources") or {}).get("ground_temperature") or {}).get(
             "method", ""
         ),
     }
+
+
+def _hold_words(rd: RunData) -> str:
+    """How the inputs were held over each step (``data.input_hold``)."""
+    slopes = sorted({u for m in rd.run.models.values() for u in m.slope_inputs})
+    if slopes:
+        return (
+            "Inputs as they were measured: interval averages constant over the interval "
+            "they describe; readings at an instant linear between readings (the exact "
+            f"first-order hold; data.input_hold: exact; inputs {', '.join(slopes)})."
+        )
+    return "Every input held at its mean over each step (data.input_hold: interval_mean)."
 
 
 def section(ctx: dict) -> Section:

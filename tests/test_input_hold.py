@@ -200,3 +200,17 @@ def test_slope_columns_join_the_inputs_before_the_outputs():
     assert frame.attrs["input_hold"] == "exact"
     U = frame[list(m.input_names)].to_numpy()
     assert np.isfinite(hb.simulate(m, {"Ci": 1e7, "Ge": 100.0, "Gf": 10.0}, U)).all()
+
+
+def test_a_run_made_before_input_hold_keeps_its_hold():
+    """load_run: a run whose summary recorded input names without slope columns (made
+    before data.input_hold existed) is simulated as it was calibrated."""
+    from heritage_bayes.run import hold_as_recorded
+
+    m = build_model(_cfg(), "thermal")
+    assert m.slope_inputs
+    old = {"models": {"thermal": {"input_names": list(m.network.inputs)}}}
+    assert hold_as_recorded({"thermal": m}, old)["thermal"].slope_inputs == ()
+    new = {"models": {"thermal": {"input_names": list(m.input_names)}}}
+    assert hold_as_recorded({"thermal": m}, new)["thermal"].slope_inputs == m.slope_inputs
+    assert hold_as_recorded({"thermal": m}, {})["thermal"] is m

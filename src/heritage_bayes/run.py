@@ -309,9 +309,17 @@ def load_run(path: str | Path) -> Run:
     recorded, notes = _recorded_config(p, summary, idata)
     cfg = recorded or cfg
     models = {s: build_model(cfg, s) for s in SECTIONS if getattr(cfg, s) is not None}
+    models = hold_as_recorded(models, summary)
+    return Run(path=p, config=cfg, idata=idata, summary=summary, models=models, notes=notes)
+
+
+def hold_as_recorded(models: dict[str, RCModel], summary: dict) -> dict[str, RCModel]:
+    """The models with the input hold the run was calibrated with: a run made before
+    ``data.input_hold`` existed recorded input names without slope columns (every input
+    held at its step mean), which its config, read today, would give."""
+    out = dict(models)
     for s, m in models.items():
-        # a run calibrated before data.input_hold existed held every input over the step
         names = (summary.get("models") or {}).get(s, {}).get("input_names")
         if m.slope_inputs and names is not None and not set(m.slope_columns) & set(names):
-            models[s] = m.with_slopes(())
-    return Run(path=p, config=cfg, idata=idata, summary=summary, models=models, notes=notes)
+            out[s] = m.with_slopes(())
+    return out

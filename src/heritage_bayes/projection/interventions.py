@@ -69,6 +69,9 @@ COSTS = {
     "water_removed": ("kg/a", "water removed by the dehumidifier per year"),
     "dehumidifier_peak": ("kg/h", "peak water removal"),
     "dehumidifier_energy": ("kWh/a", "electric energy of the dehumidifier per year"),
+    "water_added": ("kg/a", "water added by the humidifier per year"),
+    "humidifier_peak": ("kg/h", "peak water addition"),
+    "humidifier_energy": ("kWh/a", "electric energy of the humidifier per year"),
 }
 #: Hours per year of the indicators' complete years.
 _HOURS_YEAR = 8760
@@ -92,6 +95,10 @@ class Measure:
     thermostat : tuple or None
         ``(t_set [°C], t_use [°C] or None, WeeklyCalendar or None, power_max [W] or
         inf)``: heating to a set-point, ``t_use`` in the calendar's hours of use.
+    humidistat : tuple or None
+        ``(rh_min [-], rh_max [-], dehumidifier capacity [kg/s], humidifier capacity
+        [kg/s], differential [-], dehumidifier energy_per_kg [kWh/kg] or None,
+        humidifier energy_per_kg [kWh/kg] or None)``: a humidistat band.
     """
 
     name: str
@@ -99,11 +106,87 @@ class Measure:
     dehumidifier: tuple | None = None
     ventilation: float = 1.0
     thermostat: tuple | None = None
+    humidistat: tuple | None = None
 
     @property
     def controlled(self) -> bool:
-        """Simulated through a controller (the per-draw path), not the modal pass."""
-        return any(x is not None for x in (self.heating, self.dehumidifier, self.thermostat))
+        """Simulated with controllers (both models stepped together), not the modal pass."""
+        return any(
+            x is not None
+            for x in (self.heating, self.dehumidifier, self.thermostat, self.humidistat)
+        )
+
+    def controller_arrays(self, k: int, modal: dict, run) -> tuple:
+        """The compiled pass's controllers for ``k`` draws: ``(cp (k, N_CP), bdT (k, nT),
+        bdP (k, nP), spin)`` (:func:`heritage_bayes.rc.control.coupled_draw`; ``modal``:
+        section -> modal form of the draws, after :meth:`params`)."""
+        from heritage_bayes.rc import control as rc
+
+        cp = np.zeros(rc.N_CP)
+        cp[rc.CP_P_MAX] = np.inf
+        cp[rc.CP_T_MAX] = np.inf
+        if self.heating is not None:
+            rh, t_min, t_max, pmax = self.heating
+            cp[[rc.CP_T_MODE, rc.CP_T_SET, rc.CP_RH_CH, rc.CP_T_MAX, rc.CP_P_MAX]] = (
+                3, t_min, rh, t_max, pmax
+            )  # fmt: skip
+        if self.thermostat is not None:
+            t_set, t_use, _, pmax = self.thermostat
+            cp[[rc.CP_T_MODE, rc.CP_T_SET, rc.CP_P_MAX]] = 1, t_set, pmax
+            cp[rc.CP_T_USE] = 0.0 if t_use is None else t_use - t_set
+        if self.dehumidifier is not None:
+            rh, cap, _ = self.dehumidifier
+            cp[[rc.CP_H_ON, rc.CP_RH_LO, rc.CP_RH_HI, rc.CP_M_DEHUM]] = 1, 0.0, rh, cap
+        if self.humidistat is not None:
+            lo, hi, cap_d, cap_h, diff = self.humidistat[:5]
+            cp[[rc.CP_H_ON, rc.CP_RH_LO, rc.CP_RH_HI, rc.CP_M_DEHUM, rc.CP_M_HUM]] = (
+                1, lo, hi, cap_d, cap_h
+            )  # fmt: skip
+            cp[rc.CP_DIFF] = diff
+        bd = {}
+        for s, mf in modal.items():
+            air = int(run.models[s]._ix["out"][0])
+            bd[s] = np.ascontiguousarray(mf.phi * mf.s[:, air, None] * mf.V[:, air, :])
+        cps = np.ascontiguousarray(np.broadcast_to(cp, (k, rc.N_CP)))
+        return cps, bd["thermal"], bd["hygric"], _HOURS_YEAR
+
+    def hours_of_use(self, index, N: int) -> np.ndarray:
+        """Hours of use (N,) of the heating schedule [-] (zeros without one)."""
+        cal = self.thermostat[2] if self.thermostat is not None else None
+        if cal is None:
+            return np.zeros(N)
+        if index is None:
+            raise ConfigError(
+                f"interventions: {self.name!r}: a weekly schedule needs the time of each step"
+            )
+        return np.ascontiguousarray(cal.fraction(index[:N], 3600.0), dtype=float)
+
+    def costs(self, sums: np.ndarray, dt: float, years: float) -> dict:
+        """Running costs (:data:`COSTS` name -> (K,) values) from the compiled pass's
+        sums (:data:`heritage_bayes.rc.control.N_COST` columns) over ``years``."""
+        out: dict = {}
+        if self.heating is not None or self.thermostat is not None:
+            out["heating_energy"] = sums[:, 0] * dt / 3.6e6 / years
+            out["heating_peak"] = sums[:, 1] / 1e3
+        e_d = e_h = None
+        dehum = self.dehumidifier is not None
+        hum = False
+        if self.dehumidifier is not None:
+            e_d = self.dehumidifier[2]
+        if self.humidistat is not None:
+            dehum, hum = self.humidistat[2] > 0, self.humidistat[3] > 0
+            e_d, e_h = self.humidistat[5], self.humidistat[6]
+        if dehum:
+            out["water_removed"] = sums[:, 2] * dt / years
+            out["dehumidifier_peak"] = sums[:, 3] * 3600.0
+            if e_d is not None:
+                out["dehumidifier_energy"] = out["water_removed"] * e_d
+        if hum:
+            out["water_added"] = sums[:, 4] * dt / years
+            out["humidifier_peak"] = sums[:, 5] * 3600.0
+            if e_h is not None:
+                out["humidifier_energy"] = out["water_added"] * e_h
+        return out
 
     def check(self, run) -> None:
         """Refuse a measure the run's models cannot take (names the measure)."""
@@ -118,7 +201,7 @@ class Measure:
                 f"(air exchange), which none of the run's models {names} has"
             )
         heat = self.heating or self.thermostat
-        for s, on in (("thermal", heat), ("hygric", self.dehumidifier)):
+        for s, on in (("thermal", heat), ("hygric", self.dehumidifier or self.humidistat)):
             if on is not None and isinstance(run.models[s], ControlledModel):
                 raise ConfigError(
                     f"interventions: {self.name!r}: the calibrated {s} model is already "
@@ -148,8 +231,24 @@ class Measure:
             out[s] = P
         return out
 
+    def cost_sums(self, costs: dict, dt: float, years: float) -> np.ndarray:
+        """The inverse of :meth:`costs`: (K, N_COST) sums from running costs."""
+        from heritage_bayes.rc.control import N_COST
+
+        k = len(next(iter(costs.values()))) if costs else 0
+        out = np.zeros((k, N_COST))
+        for col, name, f in (
+            (0, "heating_energy", years * 3.6e6 / dt), (1, "heating_peak", 1e3),
+            (2, "water_removed", years / dt), (3, "dehumidifier_peak", 1 / 3600.0),
+        ):  # fmt: skip
+            if name in costs:
+                out[:, col] = np.asarray(costs[name]) * f
+        return out
+
     def simulate(self, run, model: dict, U: dict, u0: dict, dt: float, index=None):
-        """Noise-free outputs of a chunk of draws with the controllers.
+        """Noise-free outputs of a chunk of draws with the controllers, through
+        ``ControlledModel.forward`` (the reference implementation: each controller
+        against the other model's free-running series, no humidistat band).
 
         Parameters
         ----------
@@ -174,6 +273,11 @@ class Measure:
         """
         from heritage_bayes.rc.control import Control, ControlledModel
 
+        if self.humidistat is not None:
+            raise ValueError(
+                f"interventions: {self.name!r}: the reference path has no humidistat band "
+                "(hysteresis); it is simulated by the compiled pass only"
+            )
         Y = {
             s: np.ascontiguousarray(m.forward(model[s], U[s], dt, u_init=u0[s])[0][..., 0])
             for s, m in run.models.items()

@@ -6,15 +6,29 @@ draw (:class:`Measure`):
 - **conservation heating** (Staniforth 2006 [1]_): a thermostat on the thermal model
   whose set-point is the temperature at which the draw's simulated indoor vapour
   pressure has RH ``rh_max`` (at least ``t_min``, at most ``t_max``), up to
-  ``power_max`` [W] (:class:`heritage_bayes.rc.control.ControlledModel`, ``thermostat``
-  with ``conservation``);
-- **dehumidification**: a humidistat on the hygric model (``mode: dehumidifier``) that
-  keeps the RH at the draw's simulated indoor temperature at or below ``rh_max``,
-  removing at most ``capacity`` [kg/h];
+  ``power_max`` [W];
+- **dehumidification**: a humidistat on the hygric model that keeps the RH at the
+  draw's simulated indoor temperature at or below ``rh_max``, removing at most
+  ``capacity`` [kg/h];
+- a **humidistat band**: a dehumidifier above ``rh_max`` and a humidifier below
+  ``rh_min``, on/off with a switching differential (hysteresis, as a wall humidistat
+  works: on at the limit, off once the RH is back by the differential);
 - **heating** to a set-point ``t_set`` and, in the hours of use of a weekly calendar,
   ``t_use`` (intermittent heating of a church for services), up to ``power_max``;
 - **ventilation** scaled by a factor: ``Gfast`` of both models (the thermal one lumps
-  ventilation and glazing) multiplied, every other parameter as calibrated.
+  ventilation and glazing) multiplied, every other parameter as calibrated;
+- a **combination**: a thermostat (heating or conservation heating) with a humidistat
+  (dehumidification or a band), ventilation with any.
+
+The controllers are stepped in the compiled projection pass
+(:func:`heritage_bayes.rc.control.coupled_draw`, the step of
+:class:`~heritage_bayes.rc.control.ControlledModel`): per draw both models advance
+together, each controller reading the air at the start of the step (conservation
+heating the controlled ``Pi``, the humidistat the saturation pressure at the
+controlled ``Ti``), so conservation heating and a dehumidifier act on one room.
+:meth:`Measure.simulate` is the previous, independent implementation
+(``ControlledModel.forward`` against the other model's free-running series), kept as
+the reference the tests compare single controllers with.
 
 Pairing is by construction: a measure is simulated with the same parameter draw, the
 same noise realisation (the noise is model error, added to the controlled outputs as to
@@ -24,16 +38,13 @@ zero capacity) gives the do-nothing indicators in every draw (to rounding, by te
 
 Each controlled draw starts from the do-nothing initial state (the steady state of the
 first weeks' weather) plus the change of state a year of control makes (periodic
-spin-up over the first weather year, ``spin_up`` of
-:meth:`~heritage_bayes.rc.control.ControlledModel.forward`): a dehumidified room of slow
-response would otherwise begin far from its controlled regime, and a controller that
-never acts starts exactly where doing nothing does.
+spin-up over the first weather year): a dehumidified room of slow response would
+otherwise begin far from its controlled regime, and a controller that never acts
+starts exactly where doing nothing does.
 
 The controllers act on the model's state (noise-free): a sensor reading the room. The
 hygric model ("model 3" of Kramer et al. [2]_) is in vapour pressure with the outdoor
-vapour pressure as its input, so heating changes the RH through the temperature only
-(the conservation-heating controller takes the draw's free-running ``Pi``), and the
-dehumidifier acts on ``Pi`` at the draw's free-running ``Ti``.
+vapour pressure as its input, so heating changes the RH through the temperature only.
 
 Running cost (:data:`COSTS`), from the control flow of each draw: heating energy
 [kWh/a] and peak power [kW]; water removed [kg/a], peak removal [kg/h] and, with
@@ -400,9 +411,19 @@ def measures_from_config(pcfg) -> list[Measure]:
                 else (d.rh_max / 100.0, d.capacity / 3600.0, d.energy_per_kg),
                 ventilation=1.0 if it.ventilation is None else it.ventilation.factor,
                 thermostat=None if it.heating is None else _thermostat_spec(it.heating),
+                humidistat=None if it.humidistat_band is None else _band_spec(it.humidistat_band),
             )
         )
     return out
+
+
+def _band_spec(b) -> tuple:
+    """A humidistat band in SI: RH [-], capacities [kg/s], differential [-]."""
+    return (
+        b.rh_min / 100.0, b.rh_max / 100.0, b.dehumidifier_capacity / 3600.0,
+        b.humidifier_capacity / 3600.0, b.differential / 100.0,
+        b.dehumidifier_energy_per_kg, b.humidifier_energy_per_kg,
+    )  # fmt: skip
 
 
 def _thermostat_spec(h) -> tuple:
@@ -444,7 +465,8 @@ def compare_measures(labels, nothing, per_measure: dict, thresholds, units, note
     dict
         Measure name -> ``{"cases": {label: {"indicators": {name: change},
         "probabilities": [...], "costs": {name: quantiles}}}}``. A change is the paired
-        difference measure − nothing (quantiles 5/50/95 % and mean over the draws) with
+        difference measure − nothing (quantiles 5/50/95 % and mean over the draws, the
+        indicator's own quantiles with the measure in ``with_measure``) with
         ``p_better``: the share of draws in which the measure is strictly better (the
         registry's direction of ``worse``; None for an indicator without one).
         Probabilities: P(statement) with the measure and without, per threshold.
@@ -462,6 +484,7 @@ def compare_measures(labels, nothing, per_measure: dict, thresholds, units, note
                 d = r.predictive[n].to_numpy(float) - r0.predictive[n].to_numpy(float)
                 ok = np.isfinite(d)
                 e = _q(d) | {"name": info.name, "unit": units.get(n, info.unit)}
+                e["with_measure"] = _q(r.predictive[n].to_numpy(float))
                 e["p_better"] = float(np.mean(info.worse * d[ok] < 0)) if info.worse else None
                 inds[n] = e
             probs = []

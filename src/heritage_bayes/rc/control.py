@@ -768,23 +768,27 @@ def _coupled_steps(
         m = 0.0
         if h_on:
             ps = psat_water(yT)
-            if not on_d and yf > cp[CP_RH_HI] * ps:
-                on_d = True
-            if not on_h and yf < cp[CP_RH_LO] * ps:
-                on_h = True
-            if on_d:  # runs until the RH is down to RH_hi - diff
+            hi = cp[CP_RH_HI] * ps
+            lo = cp[CP_RH_LO] * ps
+            off_d = (cp[CP_RH_HI] - diff) * ps  # where a running unit switches off
+            off_h = (cp[CP_RH_LO] + diff) * ps
+            if on_d and yf <= off_d:
+                on_d = False
+            if on_h and yf >= off_h:
                 on_h = False
-                target = (cp[CP_RH_HI] - diff) * ps
-                if yf > target:
-                    m = (target - yf) / gP
-                    m = -cp[CP_M_DEHUM] if m < -cp[CP_M_DEHUM] else m
-                on_d = yf + gP * m > target * (1.0 + 1e-12)
+            if not on_d and yf > hi:
+                on_d = True
+                on_h = False
+            if not on_d and not on_h and yf < lo:
+                on_h = True
+            if on_d:  # runs (at most its capacity) until the RH is down to RH_hi - diff
+                m = (off_d - yf) / gP
+                m = -cp[CP_M_DEHUM] if m < -cp[CP_M_DEHUM] else m
+                on_d = yf + gP * m > off_d * (1.0 + 1e-12)
             elif on_h:  # runs until the RH is up to RH_lo + diff
-                target = (cp[CP_RH_LO] + diff) * ps
-                if yf < target:
-                    m = (target - yf) / gP
-                    m = cp[CP_M_HUM] if m > cp[CP_M_HUM] else m
-                on_h = yf + gP * m < target * (1.0 - 1e-12)
+                m = (off_h - yf) / gP
+                m = cp[CP_M_HUM] if m > cp[CP_M_HUM] else m
+                on_h = yf + gP * m < off_h * (1.0 - 1e-12)
         for j in range(nP):
             zP[j] = zfP[j] + bdP[j] * m
         if store and m != 0.0:

@@ -254,8 +254,13 @@ def test_shipped_interventions_config_validates():
         Path(__file__).resolve().parents[1] / "configs" / "projection_interventions.yaml"
     )
     ms = measures_from_config(cfg)
-    assert [m.name for m in ms] == ["conservation heating", "dehumidifier", "half the ventilation"]
+    assert [m.name for m in ms] == [
+        "conservation heating", "dehumidifier", "half the ventilation", "humidistat band",
+        "conservation heating + dehumidifier",
+    ]  # fmt: skip
     assert ms[0].heating == (0.65, -273.15, 22.0, 5000.0) and ms[2].ventilation == 0.5
+    assert ms[3].humidistat[:2] == (0.4, 0.6) and ms[3].humidistat[4] == pytest.approx(0.05)
+    assert ms[4].heating is not None and ms[4].dehumidifier is not None
 
 
 @pytest.mark.browser

@@ -350,10 +350,8 @@ def _simulate(
             for v, Pv, outs, sv in zip(variants, params, out, sigs, strict=True):
                 t0 = time.perf_counter()
                 ctl = v is not None and v.controlled
-                modal = {
-                    s: _modal_form(m, Pv[s][sl], dt, free=ctl and compiled)
-                    for s, m in run.models.items()
-                }
+                free = {"free": True} if ctl and compiled else {}  # the measure's networks
+                modal = {s: _modal_form(m, Pv[s][sl], dt, **free) for s, m in run.models.items()}
                 ctrl = None
                 if ctl and compiled:
                     ctrl = v.controller_arrays(sl.stop - sl.start, modal, run)

@@ -83,7 +83,10 @@ COSTS = {
     "water_added": ("kg/a", "water added by the humidifier per year"),
     "humidifier_peak": ("kg/h", "peak water addition"),
     "humidifier_energy": ("kWh/a", "electric energy of the humidifier per year"),
+    "total_energy": ("kWh/a", "energy per year of all the measure's units (per draw sum)"),
 }
+#: Energy columns of :data:`COSTS` [kWh/a] (their per-draw sum is ``total_energy``).
+ENERGY = ("heating_energy", "dehumidifier_energy", "humidifier_energy")
 #: Hours per year of the indicators' complete years.
 _HOURS_YEAR = 8760
 _NO_FLOOR = -273.15  # [°C] no heating floor
@@ -197,6 +200,9 @@ class Measure:
             out["humidifier_peak"] = sums[:, 5] * 3600.0
             if e_h is not None:
                 out["humidifier_energy"] = out["water_added"] * e_h
+        energy = [out[c] for c in ENERGY if c in out]
+        if len(energy) > 1:  # quantiles of a sum need the sum of each draw
+            out["total_energy"] = np.sum(energy, axis=0)
         return out
 
     def check(self, run) -> None:

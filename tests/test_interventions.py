@@ -355,7 +355,7 @@ def _series(run, case, measure):
     c.N = len(inputs)
     modal = {s: engine._modal_form(m, P[s], 3600.0, free=True) for s, m in run.models.items()}
     k = len(draws.index)
-    ctrl = measure.controller_arrays(k, modal, run)
+    ctrl = measure.controller_arrays(k, modal, run, P)
     cost = np.zeros((k, 6))
     Y = engine._coupled_series(c, modal, ctrl, np.zeros(c.N), range(k), 720, cost)
     return Y["thermal"], Y["hygric"], measure.costs(cost, 3600.0, 1.0)
@@ -417,3 +417,41 @@ def test_conservation_heating_with_a_dehumidifier_is_one_coupled_room(run, case)
     assert np.all(Tb <= Th + 1e-9) and np.any(Tb < Th - 1e-3)
     assert np.all(Tb >= Td - 1e-9)  # Td: free-running (a dehumidifier does not heat)
     assert np.all(Pb >= Pd * (1 - 1e-9)) and np.all(Pb <= Ph * (1 + 1e-9))
+
+
+def test_a_calibrated_constant_source_stays_with_the_measure(run, case):
+    """A thermal model with a constant heat gain (``options.source``, as Ørholm's) is
+    free-running: a measure may add a thermostat. One that never acts (set-point
+    -100 °C) gives doing nothing's indicators (``ControlledModel.forward`` with the
+    source) to 1e-9 in every draw: the source's forcing and steady state are carried
+    into the compiled pass; a set-point of 15 °C heats (the same noise draw added: no
+    month colder, the coldest warmer by more than 1 K)."""
+    from types import SimpleNamespace
+
+    import heritage_bayes as hb
+    from heritage_bayes.projection.engine import Draws
+
+    draws, inputs, _ = case
+    th = hb.model("thermal_1c", source=True)
+    src = SimpleNamespace(
+        models={"thermal": th, "hygric": run.models["hygric"]}, summary=run.summary,
+        path=run.path,
+    )  # fmt: skip
+    P = np.column_stack([draws.model["thermal"], np.full(len(draws.index), 300.0)])  # Qs [W]
+    assert th.parameter_names[-1] == "Qs"
+    d = Draws(draws.index, {**draws.model, "thermal": P}, draws.noise, draws.noise_models)
+    nothing = simulate_cases(src, d, [inputs], seed=2, chunk=4)[0]
+    never = Measure("off", thermostat=(-100.0, None, None, np.inf))
+    off = simulate_cases(src, d, [inputs], seed=2, chunk=4, measure=never)[0]
+    cols = [c for c in nothing.predictive.columns if c != "ashrae_best_class"]
+    np.testing.assert_allclose(
+        off.predictive[cols].to_numpy(float), nothing.predictive[cols].to_numpy(float),
+        rtol=1e-9, atol=1e-9,
+    )  # fmt: skip
+    assert np.all(off.costs["heating_energy"] == 0)
+    heat = Measure("on", thermostat=(15.0, None, None, np.inf))
+    warm = simulate_cases(src, d, [inputs], seed=2, chunk=4, measure=heat)[0]
+    # the same noise draw: a thermostat never cools a month, and warms the cold ones
+    assert np.all(warm.Ti_month >= nothing.Ti_month - 1e-4)
+    assert np.all(warm.Ti_month.min(axis=1) > nothing.Ti_month.min(axis=1) + 1.0)
+    assert np.all(warm.costs["heating_energy"] > 0)

@@ -354,7 +354,8 @@ def _simulate(
                 modal = {s: _modal_form(m, Pv[s][sl], dt, **free) for s, m in run.models.items()}
                 ctrl = None
                 if ctl and compiled:
-                    ctrl = v.controller_arrays(sl.stop - sl.start, modal, run)
+                    P_sl = {s: Pv[s][sl] for s in run.models}
+                    ctrl = v.controller_arrays(sl.stop - sl.start, modal, run, P_sl)
                 t_modal = (time.perf_counter() - t0) / len(cases)
                 for c, o, sig in zip(cases, outs, sv, strict=True):
                     if v is variants[0]:  # drawn once, for every variant
@@ -500,14 +501,19 @@ def _modal_form(m, P: np.ndarray, dt: float, free: bool = False):
     return modal_form(m, P, dt)
 
 
-def _modal_arrays(mf, u0: np.ndarray) -> tuple:
-    """(ad, Bdz, edz, Cz of the first output, z0) as ``RCModel.forward`` sets them up."""
+def _modal_arrays(mf, u0: np.ndarray, source=None) -> tuple:
+    """(ad, Bdz, edz, Cz of the first output, z0) as ``RCModel.forward`` sets them up;
+    ``source``: (forcing, steady-state shift) of a constant source, added to ``edz`` and
+    ``z0`` as ``ControlledModel.forward`` does."""
     with np.errstate(divide="ignore", invalid="ignore"):
         z0 = mf.steady_state_modal(u0)
     z0 = np.where(np.isfinite(z0), z0, 0.0)
     z0 = np.ascontiguousarray(np.broadcast_to(z0, mf.lam.shape))
     c = np.ascontiguousarray
-    return c(mf.ad), c(mf.Bdz), c(mf.edz), c(mf.Cz[:, 0, :]), z0
+    edz = mf.edz
+    if source is not None:
+        edz, z0 = edz + source[0], c(z0 + source[1])
+    return c(mf.ad), c(mf.Bdz), c(edz), c(mf.Cz[:, 0, :]), z0
 
 
 _MAX_MODES = 64
@@ -555,9 +561,11 @@ def _coupled_series(c: _Case, modal: dict, ctrl: tuple, sig, rows, w: int, cost=
     (:func:`heritage_bayes.rc.control.coupled_draw`, the compiled pass's arithmetic)."""
     from heritage_bayes.rc.control import coupled_draw
 
-    ctl, bdT, bdP, spin = ctrl
-    mT = _modal_arrays(modal["thermal"], c.U["thermal"][: max(1, w)].mean(axis=0))
-    mP = _modal_arrays(modal["hygric"], c.U["hygric"][: max(1, w)].mean(axis=0))
+    ctl, bdT, bdP, spin, src = ctrl
+    mT = _modal_arrays(modal["thermal"], c.U["thermal"][: max(1, w)].mean(axis=0),
+                       src.get("thermal"))  # fmt: skip
+    mP = _modal_arrays(modal["hygric"], c.U["hygric"][: max(1, w)].mean(axis=0),
+                       src.get("hygric"))  # fmt: skip
     Y = {"thermal": np.empty((len(rows), c.N)), "hygric": np.empty((len(rows), c.N))}
     for j, i in enumerate(rows):
         nT, nP = mT[0].shape[1], mP[0].shape[1]
@@ -589,7 +597,8 @@ def _run_chunk(
             Y[s] = np.ascontiguousarray(m.forward(P[s][sl], c.U[s], dt, u_init=u0)[0][..., 0])
             M[s], U[s] = _NO_MODAL, np.zeros((1, 1))
         else:
-            Y[s], M[s], U[s] = np.zeros((0, 0)), _modal_arrays(modal[s], u0), c.Ut[s]
+            shift = None if ctrl is None else ctrl[4].get(s)  # a calibrated constant source
+            Y[s], M[s], U[s] = np.zeros((0, 0)), _modal_arrays(modal[s], u0, shift), c.Ut[s]
     o.seconds["simulate"] += time.perf_counter() - t0 + t_modal
     t0 = time.perf_counter()
     k = sl.stop - sl.start
@@ -604,7 +613,7 @@ def _run_chunk(
     if ctrl is None:
         ctl, bdT, bdP, spin, sig = np.zeros((0, N_CP)), dummy, dummy, 0, np.zeros(1)
     else:
-        ctl, bdT, bdP, spin = ctrl
+        ctl, bdT, bdP, spin, _ = ctrl
     cost = o.cost[sl]
     chunk_kernel(
         Y["thermal"], Y["hygric"], M["thermal"], M["hygric"], U["thermal"], U["hygric"],

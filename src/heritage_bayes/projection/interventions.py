@@ -130,10 +130,13 @@ class Measure:
             for x in (self.heating, self.dehumidifier, self.thermostat, self.humidistat)
         )
 
-    def controller_arrays(self, k: int, modal: dict, run) -> tuple:
+    def controller_arrays(self, k: int, modal: dict, run, P: dict) -> tuple:
         """The compiled pass's controllers for ``k`` draws: ``(cp (k, N_CP), bdT (k, nT),
-        bdP (k, nP), spin)`` (:func:`heritage_bayes.rc.control.coupled_draw`; ``modal``:
-        section -> modal form of the draws, after :meth:`params`)."""
+        bdP (k, nP), spin, sources)`` (:func:`heritage_bayes.rc.control.coupled_draw`;
+        ``modal``: section -> modal form of the draws' networks, ``P``: section -> their
+        parameters, after :meth:`params`). ``sources``: section -> (constant forcing
+        (k, n), steady-state shift (k, n)) of a calibrated constant source ``Qs`` [W] or
+        ``Ms`` [kg/s] (``options.source``), added to the modal arrays."""
         from heritage_bayes.rc import control as rc
 
         cp = np.zeros(rc.N_CP)
@@ -157,12 +160,19 @@ class Measure:
                 1, lo, hi, cap_d, cap_h
             )  # fmt: skip
             cp[rc.CP_DIFF] = diff
-        bd = {}
+        bd, sources = {}, {}
         for s, mf in modal.items():
-            air = int(run.models[s]._ix["out"][0])
-            bd[s] = np.ascontiguousarray(mf.phi * mf.s[:, air, None] * mf.V[:, air, :])
+            m = run.models[s]
+            air = int(m._ix["out"][0])
+            bz = mf.s[:, air, None] * mf.V[:, air, :]
+            bd[s] = np.ascontiguousarray(mf.phi * bz)
+            if isinstance(m, rc.ControlledModel) and m.control.source:
+                names = m.parameter_names
+                q = P[s][:, names.index("Qs" if "Qs" in names else "Ms")][:, None]
+                lam = np.where(mf.lam > 0, mf.lam, np.inf)
+                sources[s] = (q * bd[s], q * bz / lam)
         cps = np.ascontiguousarray(np.broadcast_to(cp, (k, rc.N_CP)))
-        return cps, bd["thermal"], bd["hygric"], _HOURS_YEAR
+        return cps, bd["thermal"], bd["hygric"], _HOURS_YEAR, sources
 
     def hours_of_use(self, index, N: int) -> np.ndarray:
         """Hours of use (N,) of the heating schedule [-] (zeros without one)."""
@@ -219,11 +229,14 @@ class Measure:
             )
         heat = self.heating or self.thermostat
         for s, on in (("thermal", heat), ("hygric", self.dehumidifier or self.humidistat)):
-            if on is not None and isinstance(run.models[s], ControlledModel):
+            m = run.models[s]
+            if (
+                on is not None and isinstance(m, ControlledModel) and set(m.components) - {"source"}
+            ):  # a constant source is part of the free-running room
                 raise ConfigError(
                     f"interventions: {self.name!r}: the calibrated {s} model is already "
-                    f"controlled ({list(run.models[s].components)}); a measure adds a "
-                    "controller to a free-running model"
+                    f"controlled ({list(m.components)}); a measure adds a controller to a "
+                    "free-running model"
                 )
 
     def notes(self, run) -> list[str]:
@@ -290,10 +303,13 @@ class Measure:
         """
         from heritage_bayes.rc.control import Control, ControlledModel
 
-        if self.humidistat is not None:
+        if self.humidistat is not None or any(
+            isinstance(m, ControlledModel) for m in run.models.values()
+        ):
             raise ValueError(
                 f"interventions: {self.name!r}: the reference path has no humidistat band "
-                "(hysteresis); it is simulated by the compiled pass only"
+                "(hysteresis) and takes free-running networks only; it is simulated by "
+                "the compiled pass"
             )
         Y = {
             s: np.ascontiguousarray(m.forward(model[s], U[s], dt, u_init=u0[s])[0][..., 0])

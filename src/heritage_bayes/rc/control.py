@@ -706,6 +706,19 @@ N_CP = 12
 N_COST = 6
 
 
+@numba.njit(inline="always", cache=True, nogil=True, error_model="numpy")
+def _free_step(ad, Bdz, edz, Cz, U, k, z, zf):  # pragma: no cover - compiled
+    """The free-running modal step ``zf = ad z + Bdz u[k] + edz``; returns ``Cz·zf``."""
+    y = 0.0
+    for j in range(ad.size):
+        w = edz[j]
+        for q in range(U.shape[0]):
+            w += Bdz[j, q] * U[q, k]
+        zf[j] = ad[j] * z[j] + w
+        y += Cz[j] * zf[j]
+    return y
+
+
 @numba.njit(cache=True, nogil=True, error_model="numpy")
 def _coupled_steps(
     adT, BdzT, edzT, CzT, UT, adP, BdzP, edzP, CzP, UP, bdT, gT, bdP, gP, cp, sig,
@@ -715,8 +728,6 @@ def _coupled_steps(
     place); outputs stored when ``store``, running costs summed into ``cost``."""
     nT = adT.size
     nP = adP.size
-    mT = UT.shape[0]
-    mP = UP.shape[0]
     zfT = np.empty(nT)
     zfP = np.empty(nP)
     t_mode = int(cp[CP_T_MODE]) if control else 0
@@ -735,13 +746,7 @@ def _coupled_steps(
             Ts[k] = yT
             Ps[k] = yP
         # thermal: the free step, then the heating that meets the bound at its end
-        yf = 0.0
-        for j in range(nT):
-            w = edzT[j]
-            for q in range(mT):
-                w += BdzT[j, q] * UT[q, k]
-            zfT[j] = adT[j] * zT[j] + w
-            yf += CzT[j] * zfT[j]
+        yf = _free_step(adT, BdzT, edzT, CzT, UT, k, zT, zfT)
         q = 0.0
         if t_mode != 0:
             lo = cp[CP_T_SET] + cp[CP_T_USE] * sig[k]
@@ -758,13 +763,7 @@ def _coupled_steps(
             cost[0] += q
             cost[1] = q if q > cost[1] else cost[1]
         # hygric: the free step, then the humidistat (RH at the sensed temperature yT)
-        yf = 0.0
-        for j in range(nP):
-            w = edzP[j]
-            for qq in range(mP):
-                w += BdzP[j, qq] * UP[qq, k]
-            zfP[j] = adP[j] * zP[j] + w
-            yf += CzP[j] * zfP[j]
+        yf = _free_step(adP, BdzP, edzP, CzP, UP, k, zP, zfP)
         m = 0.0
         if h_on:
             ps = psat_water(yT)

@@ -371,8 +371,11 @@ def _simulate(
                     )  # fmt: skip
             del e_all
             if progress is not None:
+                n_m = sum(v is not None for v in variants)
+                what = "" if not n_m else f", {n_m} measure(s)"
+                what += ", doing nothing" if n_m and None in variants else ""
                 progress(
-                    f"draws {sl.start + 1}-{sl.stop} of {K}: {len(cases)} case(s) in "
+                    f"draws {sl.start + 1}-{sl.stop} of {K}: {len(cases)} case(s){what} in "
                     f"{time.perf_counter() - t_chunk:.1f} s"
                 )
     years = [c.N / _HOURS_YEAR for c in cases]

@@ -56,8 +56,8 @@ def scale_text(run) -> str:
         if v is not None
     ]
     by = (
-        f"the priors that pin it ({' and '.join(pinned)} given in the calibration file, "
-        "with their spread)"
+        f"the priors that pin that scale ({' and '.join(pinned)} given in the calibration "
+        "file, with their spread)"
         if pinned
         else "the priors of the capacities and conductances alone (no room volume or air "
         "change rate was given: wide priors, wide intervals)"
@@ -67,8 +67,11 @@ def scale_text(run) -> str:
         "data fix its time constants and gains, not its absolute heat and vapour "
         "conductances [W/K, kg/(s·Pa)]. The running costs (heating energy, water "
         f"removed) scale with those, so their intervals come from {by}, not from the "
-        "measurements; the changes of the indicators do not depend on that scale as "
-        "much. Only measured heating power as an input of the calibration fixes the "
+        "measurements. The changes of temperature, RH and the indicators do not depend "
+        "on that scale while a measure works within its capacity (the set-point or RH "
+        "limit is held); a power or capacity limit [W, kg/h] acts against the "
+        "conductances, so where it is reached they do. Only measured heating power as "
+        "an input of the calibration fixes the "
         "scale from data (not available for the shipped rooms: the heated Ørholm store "
         "logged temperature and RH only; see the Ørholm check in the manual)."
     )

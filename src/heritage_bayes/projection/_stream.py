@@ -274,16 +274,17 @@ def chunk_kernel(
                     bdT[i], bdP[i], ctl[i], sig, spin, Ts, Ps, cost[i],
                     wb[0, :nT], wb[1, :nP], wb[2, :nT], wb[3, :nP],
                 )  # fmt: skip
-            elif simT:
-                _modal(mT[0][i], mT[1][i], mT[2][i], mT[3][i], mT[4][i], UT, Ts, zbuf[s], wbuf[s])
             else:
-                Ts[:] = YT[i]
-            if ctl.shape[0] > 0:
-                pass
-            elif simP:
-                _modal(mP[0][i], mP[1][i], mP[2][i], mP[3][i], mP[4][i], UP, Ps, zbuf[s], wbuf[s])
-            else:
-                Ps[:] = YP[i]
+                if simT:
+                    _modal(mT[0][i], mT[1][i], mT[2][i], mT[3][i], mT[4][i], UT, Ts, zbuf[s],
+                           wbuf[s])  # fmt: skip
+                else:
+                    Ts[:] = YT[i]
+                if simP:
+                    _modal(mP[0][i], mP[1][i], mP[2][i], mP[3][i], mP[4][i], UP, Ps, zbuf[s],
+                           wbuf[s])  # fmt: skip
+                else:
+                    Ps[:] = YP[i]
             if par_on or not noise:
                 for t in range(N):
                     RHx[t] = _rh(Ts[t], Ps[t])

@@ -281,8 +281,9 @@ def _simulate(
     run, draws: Draws, inputs: list, variants: list, *, seed, noise, chunk, init_steps,
     risk_options, progress, baseline, compiled=True,
 ) -> list[list[CaseResult]]:  # fmt: skip
-    """:func:`simulate_measures` for ``variants`` (None: doing nothing, or a Measure)."""
-
+    """:func:`simulate_measures` for ``variants`` (None: doing nothing, or a Measure):
+    per variant, the list of CaseResult. Each variant's EN 15757 band is built from its
+    own baseline case (all cases of a variant are reduced before the next variant)."""
     import numba
 
     from heritage_bayes.climate.risk.fused import fused_plan

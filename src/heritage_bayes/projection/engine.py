@@ -238,25 +238,16 @@ def simulate_cases(
 
 
 def simulate_measures(
-    run,
-    draws: Draws,
-    inputs: list[pd.DataFrame],
-    measures: list,
-    *,
-    seed: int,
-    noise: bool = True,
-    chunk: int = 50,
-    init_steps: int | None = None,
-    risk_options: dict | None = None,
-    progress=None,
-    baseline: bool = True,
+    run, draws: Draws, inputs: list[pd.DataFrame], measures: list, *, seed: int, **options
 ) -> tuple[list[CaseResult], dict]:
     """Doing nothing and every measure, in one streamed pass (paired by construction).
 
-    Parameters are those of :func:`simulate_cases`; ``measures`` a list of
-    :class:`~heritage_bayes.projection.interventions.Measure`. Per chunk of draws the
-    noise is drawn once and each case's weather prepared once for doing nothing and
-    every measure; a measure with a controller steps both models together
+    Parameters are those of :func:`simulate_cases` (``options``: its keywords ``noise``,
+    ``chunk``, ``init_steps``, ``risk_options``, ``progress``, ``baseline``);
+    ``measures`` a list of :class:`~heritage_bayes.projection.interventions.Measure`.
+    Per chunk of draws the noise is drawn once and each case's weather prepared once
+    for doing nothing and every measure; a measure with a controller steps both models
+    together
     (:func:`heritage_bayes.rc.control.coupled_draw`) in the compiled pass, draws in
     parallel over the threads, and only its predictive indicators are computed (a
     measure is compared predictive with predictive; its ``parametric`` frame is NaN
@@ -269,17 +260,14 @@ def simulate_measures(
     per_measure : dict
         Measure name -> list of CaseResult (per case), with ``costs``.
     """
-    res = _simulate(
-        run, draws, inputs, [None, *measures], seed=seed, noise=noise, chunk=chunk,
-        init_steps=init_steps, risk_options=risk_options, progress=progress,
-        baseline=baseline,
-    )  # fmt: skip
+    res = _simulate(run, draws, inputs, [None, *measures], seed=seed, **options)
     return res[0], {m.name: r for m, r in zip(measures, res[1:], strict=True)}
 
 
 def _simulate(
-    run, draws: Draws, inputs: list, variants: list, *, seed, noise, chunk, init_steps,
-    risk_options, progress, baseline, compiled=True,
+    run, draws: Draws, inputs: list, variants: list, *, seed: int, noise: bool = True,
+    chunk: int = 50, init_steps: int | None = None, risk_options: dict | None = None,
+    progress=None, baseline: bool = True, compiled: bool = True,
 ) -> list[list[CaseResult]]:  # fmt: skip
     """:func:`simulate_measures` for ``variants`` (None: doing nothing, or a Measure):
     per variant, the list of CaseResult. Each variant's EN 15757 band is built from its

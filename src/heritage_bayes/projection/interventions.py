@@ -47,13 +47,15 @@ hygric model ("model 3" of Kramer et al. [2]_) is in vapour pressure with the ou
 vapour pressure as its input, so heating changes the RH through the temperature only.
 
 Running cost (:data:`COSTS`), from the control flow of each draw: heating energy
-[kWh/a] and peak power [kW]; water removed [kg/a], peak removal [kg/h] and, with
-``energy_per_kg``, the dehumidifier's electric energy [kWh/a]. A free-running room
-calibrated on temperatures and RH only identifies time constants and gains, not the
-absolute conductances [W/K] (the architecture notes): the scale of these figures, and
-so their interval, comes from the priors that pin it (room volume, air change rate) and
-the page says so; where measured heating power was in the calibration the data narrow
-it.
+[kWh/a] and peak power [kW]; water removed or added [kg/a], peaks [kg/h] and, with
+``energy_per_kg``, the units' electric energy [kWh/a] (``total_energy``: their sum per
+draw). A free-running room calibrated on temperatures and RH only identifies time
+constants and gains, not the absolute conductances [W/K] (the architecture notes): the
+scale of these figures, and so their interval, comes from the priors that pin it (room
+volume, air change rate) and the page says so; only measured heating power as an input
+of the calibration would fix it from data (the Ørholm store was heated but logged no
+power: ``benchmarks/bench_orholm_interventions.py`` gives 345 kWh/a with a 90 %
+interval of [0.7, 45 118] kWh/a there).
 
 References
 ----------

@@ -455,3 +455,26 @@ def test_a_calibrated_constant_source_stays_with_the_measure(run, case):
     assert np.all(warm.Ti_month >= nothing.Ti_month - 1e-4)
     assert np.all(warm.Ti_month.min(axis=1) > nothing.Ti_month.min(axis=1) + 1.0)
     assert np.all(warm.costs["heating_energy"] > 0)
+
+
+def test_one_pass_pairs_measures_with_the_same_doing_nothing(run, case):
+    """``simulate_measures`` (what ``hbayes project`` runs): its doing nothing is
+    ``simulate_cases``' to the bit, a measure that changes nothing gives it in every
+    draw, and a controlled measure gives what its own pass gives (the same noise)."""
+    from heritage_bayes.projection.engine import simulate_measures
+
+    draws, inputs, nothing = case
+    same = Measure("same", ventilation=1.0)
+    dry = Measure("dh", dehumidifier=(0.5, 2.0 / 3600, None))
+    got, per = simulate_measures(run, draws, [inputs], [same, dry], seed=2, chunk=4)
+    cols = [c for c in nothing.predictive.columns if c != "ashrae_best_class"]
+    ref = nothing.predictive[cols].to_numpy(float)
+    np.testing.assert_array_equal(got[0].predictive[cols].to_numpy(float), ref)
+    np.testing.assert_array_equal(got[0].parametric[cols].to_numpy(float),
+                                  nothing.parametric[cols].to_numpy(float))  # fmt: skip
+    np.testing.assert_array_equal(per["same"][0].predictive[cols].to_numpy(float), ref)
+    alone = _with(run, case, dry)
+    np.testing.assert_array_equal(
+        per["dh"][0].predictive[cols].to_numpy(float), alone.predictive[cols].to_numpy(float)
+    )
+    np.testing.assert_array_equal(per["dh"][0].costs.to_numpy(), alone.costs.to_numpy())

@@ -72,8 +72,9 @@ def scale_text(run) -> str:
         "limit is held); a power or capacity limit [W, kg/h] acts against the "
         "conductances, so where it is reached they do. Only measured heating power as "
         "an input of the calibration fixes the "
-        "scale from data (not available for the shipped rooms: the heated Ørholm store "
-        "logged temperature and RH only; see the Ørholm check in the manual)."
+        "scale from data (no shipped room with temperature and RH has it: the heated "
+        "Ørholm store logged temperature and RH only, see the Ørholm check in the "
+        "manual; the Armadillo test cell's heating power comes without RH)."
     )
 
 

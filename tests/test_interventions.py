@@ -148,7 +148,16 @@ def test_schema():
             },
         ],
     }
+    ok["interventions"] += [
+        {"name": "ch+dh", "conservation_heating": {"rh_max": 70, "t_max": 18},
+         "dehumidification": {"rh_max": 60, "capacity": 0.5}},
+        {"name": "band", "humidistat_band": {"rh_min": 45, "rh_max": 60,
+         "dehumidifier_capacity": 1.8, "humidifier_capacity": 0.36,
+         "humidifier_energy_per_kg": 0.75}},
+    ]  # fmt: skip
     ms = measures_from_config(parse_projection_config(ok))
+    assert ms[4].heating == (0.7, -273.15, 18.0, np.inf) and ms[4].dehumidifier[0] == 0.6
+    assert ms[5].humidistat == pytest.approx((0.45, 0.6, 0.0005, 0.0001, 0.05, None, 0.75))
     assert ms[0].heating == (0.65, 5.0, 20.0, np.inf)
     assert ms[1].dehumidifier == (0.6, 0.5 / 3600, None)
     assert ms[2].ventilation == 0.5
@@ -159,8 +168,14 @@ def test_schema():
          "power"),
         ({"name": "x", "dehumidification": {"rh_max": 60}}, "capacity"),
         ({"name": "x"}, "give a change"),
-        ({"name": "x", "conservation_heating": {"rh_max": 65, "t_max": 20},
-          "dehumidification": {"rh_max": 60, "capacity": 1}}, "two measures"),
+        ({"name": "x", "dehumidification": {"rh_max": 60, "capacity": 1},
+          "humidistat_band": {"rh_min": 40, "rh_max": 60, "dehumidifier_capacity": 1,
+                              "humidifier_capacity": 1}}, "both humidistats"),
+        ({"name": "x", "humidistat_band": {"rh_min": 60, "rh_max": 50,
+          "dehumidifier_capacity": 1, "humidifier_capacity": 1}}, "rh_min"),
+        ({"name": "x", "humidistat_band": {"rh_min": 50, "rh_max": 60, "differential": 5,
+          "dehumidifier_capacity": 1, "humidifier_capacity": 1}}, "chase each other"),
+        ({"name": "do nothing", "ventilation": {"factor": 0.5}}, "names doing nothing"),
         ({"name": "x", "conservation_heating": {"rh_max": 65, "t_min": 20, "t_max": 10}},
          "t_min"),
         ({"name": "x", "ventilation": {"factor": -1}}, "factor"),
@@ -211,6 +226,21 @@ def test_project_compares_measures_and_draws_the_page(projected):
     assert float(e.median()) == pytest.approx(ch["costs"]["heating_energy"]["q50"], rel=1e-5)
     assert np.isnan(ds["cost_heating_energy"].sel(measure="dehumidifier")).all()
     assert ds["twpi_measure"].dims == ("measure", "case", "draw")
+    import pandas as pd
+
+    csv = pd.read_csv(p.paths["csv"])  # the measures' rows follow doing nothing's
+    assert list(dict.fromkeys(csv["measure"])) == ["do nothing", *iv]
+    row = csv[(csv.measure == "conservation heating") & (csv.indicator == "twpi")
+              & (csv.case == "warm 2050")].iloc[0]  # fmt: skip
+    d = ch["indicators"]["twpi"]
+    assert row["change_vs"] == "do nothing" and row["p_better"] == pytest.approx(d["p_better"])
+    assert row["change_q50"] == pytest.approx(d["q50"])
+    tw = ds["twpi_measure"].sel(measure="conservation heating", case="warm 2050")
+    assert row["q50"] == pytest.approx(float(tw.median()), rel=1e-5)
+    cost = csv[(csv.indicator == "cost_heating_energy") & (csv.case == "warm 2050")]
+    assert list(cost["measure"]) == ["conservation heating"]
+    assert cost["q50"].iloc[0] == pytest.approx(ch["costs"]["heating_energy"]["q50"])
+    assert set(csv[csv.measure == "do nothing"]["change_vs"].dropna()) == {"baseline"}
     html = Path(p.paths["html"]).read_text(encoding="utf-8")
     assert 'id="interventions"' in html
     assert "id='fig-tradeoff'" in html
@@ -224,8 +254,13 @@ def test_shipped_interventions_config_validates():
         Path(__file__).resolve().parents[1] / "configs" / "projection_interventions.yaml"
     )
     ms = measures_from_config(cfg)
-    assert [m.name for m in ms] == ["conservation heating", "dehumidifier", "half the ventilation"]
+    assert [m.name for m in ms] == [
+        "conservation heating", "dehumidifier", "half the ventilation", "humidistat band",
+        "conservation heating + dehumidifier",
+    ]  # fmt: skip
     assert ms[0].heating == (0.65, -273.15, 22.0, 5000.0) and ms[2].ventilation == 0.5
+    assert ms[3].humidistat[:2] == (0.4, 0.6) and ms[3].humidistat[4] == pytest.approx(0.05)
+    assert ms[4].heating is not None and ms[4].dehumidifier is not None
 
 
 @pytest.mark.browser
@@ -276,3 +311,170 @@ def test_measures_the_run_cannot_take_are_refused():
     no_gfast = SimpleNamespace(models={"thermal": hb.model("thermal_1c")})
     with pytest.raises(ConfigError, match=r"'air'.*Gfast"):
         Measure("air", ventilation=0.5).check(no_gfast)
+
+
+REFERENCE_MEASURES = (
+    Measure("ch", heating=(0.5, 5.0, 22.0, 400.0)),
+    Measure("dh", dehumidifier=(0.5, 2.0 / 3600, 0.7)),
+    Measure("t", thermostat=(8.0, None, None, 300.0)),
+)
+
+
+@pytest.mark.parametrize("measure", REFERENCE_MEASURES, ids=lambda m: m.name)
+def test_the_compiled_pass_equals_the_reference_controller(run, case, measure):
+    """One controller at a time, the coupled compiled kernel (both models stepped
+    together, draws over threads) gives what ``ControlledModel.forward`` against the
+    other model's free-running series gives (the previous implementation): the same
+    recursion in another order of summation, so equal to 1e-9 relative in every
+    indicator, monthly mean and running cost of every draw."""
+    draws, inputs, _ = case
+    got = simulate_cases(run, draws, [inputs], seed=2, chunk=4, measure=measure)[0]
+    ref = simulate_cases(run, draws, [inputs], seed=2, chunk=4, measure=measure, compiled=False)[0]
+    cols = [c for c in got.predictive.columns if c != "ashrae_best_class"]
+    np.testing.assert_allclose(
+        got.predictive[cols].to_numpy(float), ref.predictive[cols].to_numpy(float),
+        rtol=1e-9, atol=1e-9,
+    )  # fmt: skip
+    np.testing.assert_allclose(got.RHi_month, ref.RHi_month, rtol=1e-5)
+    np.testing.assert_allclose(got.Ti_month, ref.Ti_month, rtol=1e-5)
+    assert list(got.costs.columns) == list(ref.costs.columns)
+    np.testing.assert_allclose(got.costs.to_numpy(), ref.costs.to_numpy(), rtol=1e-9)
+    assert got.costs.to_numpy().max() > 0  # the controller acted
+
+
+def _series(run, case, measure):
+    """Noise-free hourly ``Ti`` [°C], ``Pi`` [Pa] and the running costs of every draw
+    with ``measure`` (the compiled kernel, as the projection steps it)."""
+    from heritage_bayes.projection import engine
+
+    draws, inputs, _ = case
+    P = measure.params(run, draws.model)
+    c = engine._Case(*[None] * 8)
+    c.U = {s: inputs[list(m.input_names)].to_numpy(float) for s, m in run.models.items()}
+    c.Ut = {s: np.ascontiguousarray(u.T) for s, u in c.U.items()}
+    c.N = len(inputs)
+    modal = {s: engine._modal_form(m, P[s], 3600.0, free=True) for s, m in run.models.items()}
+    k = len(draws.index)
+    ctrl = measure.controller_arrays(k, modal, run, P)
+    cost = np.zeros((k, 6))
+    Y = engine._coupled_series(c, modal, ctrl, np.zeros(c.N), range(k), 720, cost)
+    return Y["thermal"], Y["hygric"], measure.costs(cost, 3600.0, 1.0)
+
+
+def test_humidistat_band_holds_the_band_with_hysteresis(run, case):
+    """A band of unlimited capacity: at the end of every hour the vapour pressure lies
+    within the band at the sensed temperature (to 1e-9); with a 5 % RH differential
+    the dehumidifier runs on to rh_max - 5 % (hours that end exactly there) and, the
+    room kept drier on average, removes more water than a modulating unit (differential
+    0) in every draw."""
+    from heritage_bayes.climate.psychro import saturation_vapour_pressure as ps
+
+    band = (0.40, 0.55, np.inf, np.inf)  # rh_min, rh_max [-], capacities [kg/s]: ideal
+    T, P, c0 = _series(run, case, Measure("b0", humidistat=(*band, 0.0, None, 0.75)))
+    s = ps(T[:, :-1])
+    assert np.all(P[:, 1:] <= 0.55 * s * (1 + 1e-9))
+    assert np.all(P[:, 1:] >= 0.40 * s * (1 - 1e-9))
+    assert np.all(c0["water_removed"] > 0) and np.all(c0["water_added"] > 0)
+    np.testing.assert_allclose(c0["humidifier_energy"], 0.75 * c0["water_added"])
+    assert "dehumidifier_energy" not in c0  # no energy per kg given
+    T5, P5, c5 = _series(run, case, Measure("b5", humidistat=(*band, 0.05, None, None)))
+    np.testing.assert_array_equal(T5, T)  # a humidistat does not touch the temperature
+    at_off = np.isclose(P5[:, 1:], 0.50 * s, rtol=1e-9, atol=0)
+    assert np.all(at_off.sum(axis=1) > 0)
+    assert np.all(P5[:, 1:] <= 0.55 * s * (1 + 1e-9))
+    assert np.all(c5["water_removed"] > c0["water_removed"])
+
+
+def test_humidifier_only_band_raises_a_dry_room(run, case):
+    """A band above the room's RH with a humidifier only: the monthly RH rises in every
+    draw, water is added, none removed, the temperature untouched."""
+    _, _, nothing = case
+    lo = min(95.0, float(np.nanmax(nothing.RHi_month)) + 5.0) / 100
+    wet = _with(run, case, Measure("hum", humidistat=(lo, 0.99, 0.0, 1.0, 0.0, None, None)))
+    assert np.all(wet.RHi_month.mean(axis=1) > nothing.RHi_month.mean(axis=1))
+    assert np.all(wet.costs["water_added"] > 0)
+    assert "water_removed" not in wet.costs.columns
+    np.testing.assert_allclose(wet.Ti_month, nothing.Ti_month, rtol=1e-5)
+
+
+def test_conservation_heating_with_a_dehumidifier_is_one_coupled_room(run, case):
+    """Conservation heating to 60 % with a dehumidifier at 50 %, stepped together: the
+    dehumidifier lowers the vapour pressure the heating reads, so the pair heats less
+    than conservation heating alone in every draw and is never warmer in any hour; the
+    heating's warmer air holds more vapour at the dehumidifier's limit, so the vapour
+    pressure is never below the dehumidifier's alone (to 1e-9: the controllers are
+    monotone in what they read, the RC networks positive systems); the monthly RH below
+    conservation heating alone in every draw."""
+    ch = (0.60, -273.15, 25.0, np.inf)
+    dh = (0.50, 1.0 / 3600, None)
+    both = _with(run, case, Measure("both", heating=ch, dehumidifier=dh))
+    heat = _with(run, case, Measure("ch", heating=ch))
+    assert np.all(both.costs["heating_energy"] < heat.costs["heating_energy"])
+    assert np.all(both.RHi_month.mean(axis=1) < heat.RHi_month.mean(axis=1))
+    Tb, Pb, _ = _series(run, case, Measure("both", heating=ch, dehumidifier=dh))
+    Th, Ph, _ = _series(run, case, Measure("ch", heating=ch))
+    Td, Pd, _ = _series(run, case, Measure("dh", dehumidifier=dh))
+    assert np.all(Tb <= Th + 1e-9) and np.any(Tb < Th - 1e-3)
+    assert np.all(Tb >= Td - 1e-9)  # Td: free-running (a dehumidifier does not heat)
+    assert np.all(Pb >= Pd * (1 - 1e-9)) and np.all(Pb <= Ph * (1 + 1e-9))
+
+
+def test_a_calibrated_constant_source_stays_with_the_measure(run, case):
+    """A thermal model with a constant heat gain (``options.source``, as Ørholm's) is
+    free-running: a measure may add a thermostat. One that never acts (set-point
+    -100 °C) gives doing nothing's indicators (``ControlledModel.forward`` with the
+    source) to 1e-9 in every draw: the source's forcing and steady state are carried
+    into the compiled pass; a set-point of 15 °C heats (the same noise draw added: no
+    month colder, the coldest warmer by more than 1 K)."""
+    from types import SimpleNamespace
+
+    import heritage_bayes as hb
+    from heritage_bayes.projection.engine import Draws
+
+    draws, inputs, _ = case
+    th = hb.model("thermal_1c", source=True)
+    src = SimpleNamespace(
+        models={"thermal": th, "hygric": run.models["hygric"]}, summary=run.summary,
+        path=run.path,
+    )  # fmt: skip
+    P = np.column_stack([draws.model["thermal"], np.full(len(draws.index), 300.0)])  # Qs [W]
+    assert th.parameter_names[-1] == "Qs"
+    d = Draws(draws.index, {**draws.model, "thermal": P}, draws.noise, draws.noise_models)
+    nothing = simulate_cases(src, d, [inputs], seed=2, chunk=4)[0]
+    never = Measure("off", thermostat=(-100.0, None, None, np.inf))
+    off = simulate_cases(src, d, [inputs], seed=2, chunk=4, measure=never)[0]
+    cols = [c for c in nothing.predictive.columns if c != "ashrae_best_class"]
+    np.testing.assert_allclose(
+        off.predictive[cols].to_numpy(float), nothing.predictive[cols].to_numpy(float),
+        rtol=1e-9, atol=1e-9,
+    )  # fmt: skip
+    assert np.all(off.costs["heating_energy"] == 0)
+    heat = Measure("on", thermostat=(15.0, None, None, np.inf))
+    warm = simulate_cases(src, d, [inputs], seed=2, chunk=4, measure=heat)[0]
+    # the same noise draw: a thermostat never cools a month, and warms the cold ones
+    assert np.all(warm.Ti_month >= nothing.Ti_month - 1e-4)
+    assert np.all(warm.Ti_month.min(axis=1) > nothing.Ti_month.min(axis=1) + 1.0)
+    assert np.all(warm.costs["heating_energy"] > 0)
+
+
+def test_one_pass_pairs_measures_with_the_same_doing_nothing(run, case):
+    """``simulate_measures`` (what ``hbayes project`` runs): its doing nothing is
+    ``simulate_cases``' to the bit, a measure that changes nothing gives it in every
+    draw, and a controlled measure gives what its own pass gives (the same noise)."""
+    from heritage_bayes.projection.engine import simulate_measures
+
+    draws, inputs, nothing = case
+    same = Measure("same", ventilation=1.0)
+    dry = Measure("dh", dehumidifier=(0.5, 2.0 / 3600, None))
+    got, per = simulate_measures(run, draws, [inputs], [same, dry], seed=2, chunk=4)
+    cols = [c for c in nothing.predictive.columns if c != "ashrae_best_class"]
+    ref = nothing.predictive[cols].to_numpy(float)
+    np.testing.assert_array_equal(got[0].predictive[cols].to_numpy(float), ref)
+    np.testing.assert_array_equal(got[0].parametric[cols].to_numpy(float),
+                                  nothing.parametric[cols].to_numpy(float))  # fmt: skip
+    np.testing.assert_array_equal(per["same"][0].predictive[cols].to_numpy(float), ref)
+    alone = _with(run, case, dry)
+    np.testing.assert_array_equal(
+        per["dh"][0].predictive[cols].to_numpy(float), alone.predictive[cols].to_numpy(float)
+    )
+    np.testing.assert_array_equal(per["dh"][0].costs.to_numpy(), alone.costs.to_numpy())

@@ -164,7 +164,7 @@ def project(
     then exits with :data:`EXIT_UNCONVERGED_RUN`.
     """
     from heritage_bayes.climate.risk.registry import indicator_info, years_of
-    from heritage_bayes.projection.engine import select_draws, simulate_cases
+    from heritage_bayes.projection.engine import select_draws, simulate_measures
     from heritage_bayes.projection.interventions import compare_measures, measures_from_config
     from heritage_bayes.projection.summary import summarize
     from heritage_bayes.projection.weather import Case, baseline_weather, futures, model_inputs
@@ -207,29 +207,22 @@ def project(
     for m in measures:  # refused before the long part
         m.check(r)
 
-    def run_cases(measure=None):
-        return simulate_cases(
-            r,
-            sel,
-            [c.inputs for c in cases],
-            seed=pcfg.seed,
-            noise=pcfg.noise,
-            chunk=pcfg.risk.chunk_draws,
-            risk_options=risk_opts,
-            progress=progress,
-            measure=measure,
-        )
-
-    results = run_cases()
+    # doing nothing and every measure in one pass: the same draws, noise and weather
+    results, per_measure = simulate_measures(
+        r,
+        sel,
+        [c.inputs for c in cases],
+        measures,
+        seed=pcfg.seed,
+        noise=pcfg.noise,
+        chunk=pcfg.risk.chunk_draws,
+        risk_options=risk_opts,
+        progress=progress,
+    )
     labels = [c.label for c in cases]
     horizons = [c.horizon for c in cases]
     units = dict(results[0].predictive.attrs.get("units", {}))
     summary = summarize(labels, horizons, results, labels[0], pcfg.thresholds, units)
-    per_measure = {}
-    for m in measures:  # paired with doing nothing: same draws, noise seed and weather
-        if progress is not None:
-            progress(f"intervention {m.name!r}")
-        per_measure[m.name] = run_cases(m)
     summary["interventions"] = compare_measures(
         labels, results, per_measure, pcfg.thresholds, units, {m.name: m.notes(r) for m in measures}
     )

@@ -28,6 +28,8 @@ from heritage_bayes.climate import _vecmath
 from heritage_bayes.climate._vecmath import psat_water, stamp_cache, vcosh, vexp
 from heritage_bayes.climate.risk import _fused
 from heritage_bayes.climate.risk._fused import BLOCK, _bsum, pairwise_sum, series_indicators
+from heritage_bayes.rc import control as _control
+from heritage_bayes.rc.control import coupled_draw
 
 
 @njit(cache=True, error_model="numpy")
@@ -229,6 +231,7 @@ def chunk_kernel(
     ea_r, fpar, ipar, kinds, cls, ws, tmp, btmp, hist, sbuf, zbuf, wbuf,
     par, pred, spar, spred, Tm, RHm,
     hoy, mode, en, en_col, bpar, bpred, apar, apred, mabuf, cbuf,
+    ctl, bdT, bdP, sig, spin, cost, par_on,
 ):  # fmt: skip  # pragma: no cover - compiled
     """Indicators (noise-free → ``par``, predictive → ``pred``; status 0/1 in ``spar``,
     ``spred``) and monthly means (``Tm``, ``RHm``) of every draw of the chunk.
@@ -243,6 +246,15 @@ def chunk_kernel(
     ``en_col``, ``en_col + 1`` of its indicators; with ``mode`` 2 (a future) it is read.
     ``en`` = (mode, half window, wrap, -, -, LIM constant), ``hoy`` (hours,) the hour of
     the year of each hour; ``mabuf`` (slots, hours) and ``cbuf`` (slots, 8760) work.
+
+    An intervention (``ctl`` (draws, :data:`~heritage_bayes.rc.control.N_CP`), (0, ·)
+    for none): both models are stepped together with their controllers
+    (:func:`heritage_bayes.rc.control.coupled_draw`, modal arrays as above, unit-flow
+    responses ``bdT``/``bdP`` (draws, n), hours of use ``sig`` (hours,), periodic
+    spin-up over ``spin`` steps), running-cost sums into ``cost`` (draws,
+    :data:`~heritage_bayes.rc.control.N_COST`). ``par_on`` False (with ``noise``): the
+    noise-free indicators are not computed (NaN; a measure is compared predictive
+    with predictive).
     """
     c = par.shape[0]
     N = sbuf.shape[2]
@@ -252,22 +264,40 @@ def chunk_kernel(
     for s in prange(slots):
         Ts, Ps, Tx, RHx = sbuf[s, 0], sbuf[s, 1], sbuf[s, 2], sbuf[s, 3]
         for i in range(s, c, slots):
-            if simT:
-                _modal(mT[0][i], mT[1][i], mT[2][i], mT[3][i], mT[4][i], UT, Ts, zbuf[s], wbuf[s])
+            if ctl.shape[0] > 0:
+                wb = wbuf[s]
+                nT = mT[0].shape[1]
+                nP = mP[0].shape[1]
+                coupled_draw(
+                    mT[0][i], mT[1][i], mT[2][i], mT[3][i], mT[4][i], UT,
+                    mP[0][i], mP[1][i], mP[2][i], mP[3][i], mP[4][i], UP,
+                    bdT[i], bdP[i], ctl[i], sig, spin, Ts, Ps, cost[i],
+                    wb[0, :nT], wb[1, :nP], wb[2, :nT], wb[3, :nP],
+                )  # fmt: skip
             else:
-                Ts[:] = YT[i]
-            if simP:
-                _modal(mP[0][i], mP[1][i], mP[2][i], mP[3][i], mP[4][i], UP, Ps, zbuf[s], wbuf[s])
+                if simT:
+                    _modal(mT[0][i], mT[1][i], mT[2][i], mT[3][i], mT[4][i], UT, Ts, zbuf[s],
+                           wbuf[s])  # fmt: skip
+                else:
+                    Ts[:] = YT[i]
+                if simP:
+                    _modal(mP[0][i], mP[1][i], mP[2][i], mP[3][i], mP[4][i], UP, Ps, zbuf[s],
+                           wbuf[s])  # fmt: skip
+                else:
+                    Ps[:] = YP[i]
+            if par_on or not noise:
+                for t in range(N):
+                    RHx[t] = _rh(Ts[t], Ps[t])
+                spar[i] = series_indicators(
+                    Ts, RHx, N, ea_r, fpar, ipar, kinds, cls, ws[s], tmp[s], btmp[s],
+                    hist[s], par[i],
+                )  # fmt: skip
+                _annual_row(Ts, RHx, N, hoy, mode, en, en_col, par[i], bpar[i], apar[i],
+                            mabuf[s], cbuf[s])  # fmt: skip
             else:
-                Ps[:] = YP[i]
-            for t in range(N):
-                RHx[t] = _rh(Ts[t], Ps[t])
-            spar[i] = series_indicators(
-                Ts, RHx, N, ea_r, fpar, ipar, kinds, cls, ws[s], tmp[s], btmp[s], hist[s],
-                par[i],
-            )  # fmt: skip
-            _annual_row(Ts, RHx, N, hoy, mode, en, en_col, par[i], bpar[i], apar[i],
-                        mabuf[s], cbuf[s])  # fmt: skip
+                spar[i] = 0
+                par[i, :] = math.nan
+                apar[i, :, :] = math.nan
             if noise:
                 ei = eT[i]
                 pi = eP[i]
@@ -291,4 +321,4 @@ def chunk_kernel(
             _monthly(RHx, starts, RHm[i])
 
 
-stamp_cache(globals(), _fused, _vecmath)
+stamp_cache(globals(), _fused, _vecmath, _control)

@@ -48,7 +48,16 @@ parameters, noise and weather as doing nothing, on the baseline and every future
       - name: heating for services
         heating: {t_set: 8, t_use: 16, weekly: ["Sun 08-12"], timezone: UTC+1}
 
-(``ventilation`` combines with any other; ``heating`` with ``dehumidification``.)
+      - name: humidistat band
+        humidistat_band: {rh_min: 45, rh_max: 60, dehumidifier_capacity: 1,
+                          humidifier_capacity: 0.5, differential: 5}
+      - name: conservation heating and a dehumidifier
+        conservation_heating: {rh_max: 70, t_max: 18}
+        dehumidification: {rh_max: 60, capacity: 0.5}
+
+(a thermostat, ``heating`` or ``conservation_heating``, combines with a humidistat,
+``dehumidification`` or ``humidistat_band``: both models are stepped together, each
+controller reading the other's air; ``ventilation`` combines with any.)
 
 Probability statements (``thresholds``), on any indicator the projection computes
 (:mod:`heritage_bayes.climate.risk.registry`; an unknown name is refused with the list)::
@@ -210,6 +219,52 @@ class Dehumidification(_Strict):
     )
 
 
+class HumidistatBand(_Strict):
+    """A humidistat band: a dehumidifier above ``rh_max`` and a humidifier below
+    ``rh_min``, on/off with a switching differential (hysteresis): the dehumidifier
+    switches on when the RH exceeds ``rh_max`` and runs at its capacity until the RH is
+    down to ``rh_max - differential``; the humidifier switches on below ``rh_min`` and
+    runs until ``rh_min + differential``. Heating is no remedy for dry air (it lowers
+    the RH): combine with ``heating`` or ``conservation_heating`` for the temperature."""
+
+    rh_min: float = key(unit="%", ge=0, lt=100, description="the humidifier keeps the RH above")
+    rh_max: float = key(unit="%", gt=0, le=100, description="the dehumidifier keeps the RH below")
+    dehumidifier_capacity: float = key(
+        unit="kg/h", ge=0, description="water the dehumidifier can remove per hour (0: none)"
+    )
+    humidifier_capacity: float = key(
+        unit="kg/h", ge=0, description="water the humidifier can add per hour (0: none)"
+    )
+    differential: float = key(
+        5.0,
+        unit="%",
+        ge=0,
+        description="switching differential of the humidistat (typical units 3-5 % RH; "
+        "0: the RH held at the limit, a modulating unit)",
+    )
+    dehumidifier_energy_per_kg: float | None = key(
+        None, unit="kWh/kg", ge=0, description="electric energy per kg of water removed"
+    )
+    humidifier_energy_per_kg: float | None = key(
+        None,
+        unit="kWh/kg",
+        ge=0,
+        description="electric energy per kg of water added (steam: about 0.75; the data sheet)",
+    )
+
+    @model_validator(mode="after")
+    def _band(self):
+        if self.rh_min >= self.rh_max:
+            raise ValueError(f"rh_min ({self.rh_min}) must be below rh_max ({self.rh_max})")
+        if 2 * self.differential >= self.rh_max - self.rh_min:
+            raise ValueError(
+                f"differential ({self.differential} % RH) must be less than half the band "
+                f"rh_max - rh_min ({self.rh_max - self.rh_min:g} % RH): the humidifier and "
+                "the dehumidifier would chase each other"
+            )
+        return self
+
+
 class Ventilation(_Strict):
     """The air exchange scaled: ``Gfast`` of the hygric model (ventilation) and of the
     thermal model (ventilation and glazing: the thermal model lumps them)."""
@@ -233,6 +288,9 @@ class Intervention(_Strict):
     dehumidification: Dehumidification | None = key(
         None, unit=None, description="a dehumidifier with a humidistat"
     )
+    humidistat_band: HumidistatBand | None = key(
+        None, unit=None, description="a dehumidifier and a humidifier with a band humidistat"
+    )
     ventilation: Ventilation | None = key(None, unit=None, description="scale the air exchange")
 
     @model_validator(mode="after")
@@ -240,23 +298,31 @@ class Intervention(_Strict):
         if all(
             x is None
             for x in (self.conservation_heating, self.heating, self.dehumidification,
-                      self.ventilation)
+                      self.humidistat_band, self.ventilation)
         ):  # fmt: skip
             raise ValueError(
-                "give a change: conservation_heating, heating, dehumidification or ventilation"
+                "give a change: conservation_heating, heating, dehumidification, "
+                "humidistat_band or ventilation"
             )
         if self.conservation_heating is not None and self.heating is not None:
             raise ValueError(
                 "conservation_heating and heating are both thermostats; give one (the "
                 "conservation heating's t_min is a heating floor)"
             )
-        if self.conservation_heating is not None and self.dehumidification is not None:
+        if self.dehumidification is not None and self.humidistat_band is not None:
             raise ValueError(
-                "conservation_heating and dehumidification in one measure are not "
-                "supported (each controller needs the other's air state); give them as "
-                "two measures"
+                "dehumidification and humidistat_band are both humidistats; give one (the "
+                "band has a dehumidifier_capacity)"
+            )
+        if self.name == DO_NOTHING:
+            raise ValueError(
+                f"{DO_NOTHING!r} names doing nothing in the outputs; rename the measure"
             )
         return self
+
+
+#: The name of doing nothing in the outputs (``projection.csv``'s ``measure`` column).
+DO_NOTHING = "do nothing"
 
 
 #: Default probability statements (IPI-style risk limits of heritage_bayes.climate.risk;

@@ -34,6 +34,7 @@ import pandas as pd
 
 from heritage_bayes.climate.psychro import saturation_vapour_pressure
 from heritage_bayes.errors import ConfigError, InputError
+from heritage_bayes.rc.control import N_COST, N_CP
 
 
 @dataclass
@@ -167,6 +168,7 @@ def simulate_cases(
     progress=None,
     baseline: bool = True,
     measure=None,
+    compiled: bool = True,
 ) -> list[CaseResult]:
     """Predictive simulation and risk of every draw on each weather (streamed by chunks).
 
@@ -197,6 +199,17 @@ def simulate_cases(
         ``inputs[0]`` is the baseline: each draw's EN 15757 band is taken from its
         baseline simulation and every case is judged against it
         (``en15757_outside_baseline``, :func:`heritage_bayes.projection._stream.annual_values`).
+    measure : Measure, optional
+        An intervention (:class:`~heritage_bayes.projection.interventions.Measure`)
+        applied to every draw (:func:`simulate_measures` runs doing nothing and several
+        measures in one pass).
+    compiled : bool
+        A measure's controllers stepped in the compiled pass
+        (:func:`heritage_bayes.rc.control.coupled_draw`); False: through
+        :meth:`~heritage_bayes.projection.interventions.Measure.simulate`
+        (``ControlledModel.forward``, each controller against the other model's
+        free-running series; the previous implementation, kept as the reference the
+        tests and ``benchmarks/bench_interventions.py`` compare with).
 
     Returns
     -------
@@ -217,6 +230,48 @@ def simulate_cases(
     (to rounding, see :mod:`heritage_bayes.climate.risk.fused`); a draw whose series
     that function would reject or that has a missing hour is recomputed with it.
     """
+    return _simulate(
+        run, draws, inputs, [measure], seed=seed, noise=noise, chunk=chunk,
+        init_steps=init_steps, risk_options=risk_options, progress=progress,
+        baseline=baseline, compiled=compiled,
+    )[0]  # fmt: skip
+
+
+def simulate_measures(
+    run, draws: Draws, inputs: list[pd.DataFrame], measures: list, *, seed: int, **options
+) -> tuple[list[CaseResult], dict]:
+    """Doing nothing and every measure, in one streamed pass (paired by construction).
+
+    Parameters are those of :func:`simulate_cases` (``options``: its keywords ``noise``,
+    ``chunk``, ``init_steps``, ``risk_options``, ``progress``, ``baseline``);
+    ``measures`` a list of :class:`~heritage_bayes.projection.interventions.Measure`.
+    Per chunk of draws the noise is drawn once and each case's weather prepared once
+    for doing nothing and every measure; a measure with a controller steps both models
+    together
+    (:func:`heritage_bayes.rc.control.coupled_draw`) in the compiled pass, draws in
+    parallel over the threads, and only its predictive indicators are computed (a
+    measure is compared predictive with predictive; its ``parametric`` frame is NaN
+    when ``noise``).
+
+    Returns
+    -------
+    nothing : list of CaseResult
+        Doing nothing, per case (as :func:`simulate_cases`).
+    per_measure : dict
+        Measure name -> list of CaseResult (per case), with ``costs``.
+    """
+    res = _simulate(run, draws, inputs, [None, *measures], seed=seed, **options)
+    return res[0], {m.name: r for m, r in zip(measures, res[1:], strict=True)}
+
+
+def _simulate(
+    run, draws: Draws, inputs: list, variants: list, *, seed: int, noise: bool = True,
+    chunk: int = 50, init_steps: int | None = None, risk_options: dict | None = None,
+    progress=None, baseline: bool = True, compiled: bool = True,
+) -> list[list[CaseResult]]:  # fmt: skip
+    """:func:`simulate_measures` for ``variants`` (None: doing nothing, or a Measure):
+    per variant, the list of CaseResult. Each variant's EN 15757 band is built from its
+    own baseline case (all cases of a variant are reduced before the next variant)."""
     import numba
 
     from heritage_bayes.climate.risk.fused import fused_plan
@@ -232,11 +287,11 @@ def simulate_cases(
             f"run {run.path}: data.step is {dt:g} s; the risk indicators need an hourly grid"
         )
     w = int(init_steps or run.summary.get("init_steps", 720))
-    if measure is not None:
-        measure.check(run)
-        draws = Draws(
-            draws.index, measure.params(run, draws.model), draws.noise, draws.noise_models
-        )
+    params = []  # each variant's parameter draws (a measure's change applied)
+    for v in variants:
+        if v is not None:
+            v.check(run)
+        params.append(draws.model if v is None else v.params(run, draws.model))
     opts = dict(risk_options or {})
     plan_opts = {k: v for k, v in opts.items() if k not in ("nan_policy", "chunk_size")}
     from heritage_bayes.climate.risk.registry import complete_year_hours
@@ -255,7 +310,8 @@ def simulate_cases(
         hoy = hour_of_year(inp.index)
         cases.append(_Case(U, Ut, starts, months, plan, len(inp), hoy, mode, inp.index))
     K = draws.index.size
-    out = [_CaseOut.empty(c, K) for c in cases]
+    out = [[_CaseOut.empty(c, K) for c in cases] for _ in variants]
+    sigs = [[_hours_of_use(v, c) for c in cases] for v in variants]
     slots = max(1, min(numba.get_num_threads(), chunk, K))
     from heritage_bayes.projection._stream import HOY
 
@@ -280,30 +336,52 @@ def simulate_cases(
             e_all, t_noise = ahead.result()
             if i + 1 < len(chunks):
                 ahead = pool.submit(draw_noise, i + 1)
-            t0 = time.perf_counter()
-            modal = {
-                s: None if measure is not None and measure.controlled else
-                _modal_form(m, draws.model[s][sl], dt)
-                for s, m in run.models.items()
-            }  # fmt: skip
-            t_modal = (time.perf_counter() - t0) / len(cases)
-            for c, o in zip(cases, out, strict=True):
-                o.seconds["noise"] += t_noise / sum(cc.N == c.N for cc in cases)
-                key = (c.N, c.plan.pad)
-                if key not in work:
-                    work[key] = _work(c.plan, slots, c.N)
-                e = e_all.get(c.N) if noise else None
-                aw = (bands, annual_work)
-                _run_chunk(
-                    run, draws, c, o, sl, modal, e, dt, w, work[key], aw, t_modal, opts, measure
-                )
+            for v, Pv, outs, sv in zip(variants, params, out, sigs, strict=True):
+                t0 = time.perf_counter()
+                ctl = v is not None and v.controlled
+                free = {"free": True} if ctl and compiled else {}  # the measure's networks
+                modal = {s: _modal_form(m, Pv[s][sl], dt, **free) for s, m in run.models.items()}
+                ctrl = None
+                if ctl and compiled:
+                    P_sl = {s: Pv[s][sl] for s in run.models}
+                    ctrl = v.controller_arrays(sl.stop - sl.start, modal, run, P_sl)
+                t_modal = (time.perf_counter() - t0) / len(cases)
+                for c, o, sig in zip(cases, outs, sv, strict=True):
+                    if v is variants[0]:  # drawn once, for every variant
+                        o.seconds["noise"] += t_noise / sum(cc.N == c.N for cc in cases)
+                    key = (c.N, c.plan.pad)
+                    if key not in work:
+                        work[key] = _work(c.plan, slots, c.N)
+                    e = e_all.get(c.N) if noise else None
+                    aw = (bands, annual_work)
+                    _run_chunk(
+                        run, Pv, c, o, sl, modal, e, dt, w, work[key], aw, t_modal, opts, v,
+                        ctrl, sig,
+                    )  # fmt: skip
             del e_all
             if progress is not None:
+                n_m = sum(v is not None for v in variants)
+                what = "" if not n_m else f", {n_m} measure(s)"
+                what += ", doing nothing" if n_m and None in variants else ""
                 progress(
-                    f"draws {sl.start + 1}-{sl.stop} of {K}: {len(cases)} case(s) in "
+                    f"draws {sl.start + 1}-{sl.stop} of {K}: {len(cases)} case(s){what} in "
                     f"{time.perf_counter() - t_chunk:.1f} s"
                 )
-    return [o.result(c) for c, o in zip(cases, out, strict=True)]
+    years = [c.N / _HOURS_YEAR for c in cases]
+    return [
+        [o.result(c, v, dt, y) for c, o, y in zip(cases, outs, years, strict=True)]
+        for v, outs in zip(variants, out, strict=True)
+    ]
+
+
+_HOURS_YEAR = 8760
+
+
+def _hours_of_use(v, c) -> np.ndarray:
+    """The hours of use (N,) of a measure's heating schedule on case ``c`` [-]."""
+    if v is None or not v.controlled:
+        return np.zeros(1)
+    return v.hours_of_use(c.index, c.N)
 
 
 @dataclass
@@ -351,7 +429,7 @@ class _CaseOut:
     seconds: dict
     apar: np.ndarray
     apred: np.ndarray
-    costs: dict
+    cost: np.ndarray  # (K, N_COST) running-cost sums of a measure's controllers
 
     @classmethod
     def empty(cls, c: _Case, K: int) -> _CaseOut:
@@ -368,10 +446,10 @@ class _CaseOut:
             seconds={"simulate": 0.0, "noise": 0.0, "risk": 0.0},
             apar=np.empty((K, ny, len(ANNUAL))),
             apred=np.empty((K, ny, len(ANNUAL))),
-            costs={},
+            cost=np.zeros((K, N_COST)),
         )
 
-    def result(self, c: _Case) -> CaseResult:
+    def result(self, c: _Case, measure=None, dt: float = 3600.0, years: float = 1.0) -> CaseResult:
         from heritage_bayes.projection._stream import ANNUAL
 
         names = tuple(ANNUAL)
@@ -396,29 +474,38 @@ class _CaseOut:
             annual_predictive=self.apred,
             annual_parametric=self.apar,
             annual_names=names,
-            costs=pd.DataFrame(self.costs),
+            costs=pd.DataFrame(
+                {} if measure is None else measure.costs(self.cost, dt, years),
+                index=pd.RangeIndex(self.par.shape[0]),
+            ),
         )
 
 
-def _modal_form(m, P: np.ndarray, dt: float):
+def _modal_form(m, P: np.ndarray, dt: float, free: bool = False):
     """The modal form of a free-running model (None for a controlled one: it is
-    simulated by its own ``forward``)."""
+    simulated by its own ``forward``); ``free``: of the model's network whatever it is
+    (a measure's controllers are stepped on it)."""
     from heritage_bayes.rc.discretize import modal_form
     from heritage_bayes.rc.model import RCModel
 
-    if type(m).forward is not RCModel.forward or m.n_states > _MAX_MODES:
+    if m.n_states > _MAX_MODES or (type(m).forward is not RCModel.forward and not free):
         return None
     return modal_form(m, P, dt)
 
 
-def _modal_arrays(mf, u0: np.ndarray) -> tuple:
-    """(ad, Bdz, edz, Cz of the first output, z0) as ``RCModel.forward`` sets them up."""
+def _modal_arrays(mf, u0: np.ndarray, source=None) -> tuple:
+    """(ad, Bdz, edz, Cz of the first output, z0) as ``RCModel.forward`` sets them up;
+    ``source``: (forcing, steady-state shift) of a constant source, added to ``edz`` and
+    ``z0`` as ``ControlledModel.forward`` does."""
     with np.errstate(divide="ignore", invalid="ignore"):
         z0 = mf.steady_state_modal(u0)
     z0 = np.where(np.isfinite(z0), z0, 0.0)
     z0 = np.ascontiguousarray(np.broadcast_to(z0, mf.lam.shape))
     c = np.ascontiguousarray
-    return c(mf.ad), c(mf.Bdz), c(mf.edz), c(mf.Cz[:, 0, :]), z0
+    edz = mf.edz
+    if source is not None:
+        edz, z0 = edz + source[0], c(z0 + source[1])
+    return c(mf.ad), c(mf.Bdz), c(edz), c(mf.Cz[:, 0, :]), z0
 
 
 _MAX_MODES = 64
@@ -448,39 +535,62 @@ def _work(plan, slots: int, N: int) -> tuple:
     )
 
 
-def _controlled(run, draws, c: _Case, o: _CaseOut | None, rows, dt, w, measure) -> dict:
-    """Noise-free ``Ti``, ``Pi`` (section -> (k, N)) of draws ``rows`` with the
-    measure's controllers; their running costs stored in ``o``."""
+def _controlled(run, P, c: _Case, o: _CaseOut | None, rows, dt, w, measure) -> dict:
+    """The reference path: noise-free ``Ti``, ``Pi`` (section -> (k, N)) of draws
+    ``rows`` through :meth:`Measure.simulate`; its running costs stored as sums in ``o``
+    (the compiled pass's :data:`~heritage_bayes.rc.control.N_COST` columns)."""
     u0 = {s: c.U[s][: max(1, w)].mean(axis=0) for s in run.models}
-    P = {s: draws.model[s][rows] for s in run.models}
-    Y, costs = measure.simulate(run, P, c.U, u0, dt, index=c.index)
+    Y, costs = measure.simulate(run, {s: P[s][rows] for s in run.models}, c.U, u0, dt,
+                                index=c.index)  # fmt: skip
     if o is not None:
-        K = o.par.shape[0]
-        for name, v in costs.items():
-            o.costs.setdefault(name, np.full(K, np.nan))[rows] = v
+        o.cost[rows] = measure.cost_sums(costs, dt, c.N / _HOURS_YEAR)
+    return Y
+
+
+def _coupled_series(c: _Case, modal: dict, ctrl: tuple, sig, rows, w: int, cost=None):
+    """Noise-free ``Ti``, ``Pi`` (section -> (k, N)) of the chunk's draws ``rows``
+    (positions in the chunk) with a measure's controllers
+    (:func:`heritage_bayes.rc.control.coupled_draw`, the compiled pass's arithmetic)."""
+    from heritage_bayes.rc.control import coupled_draw
+
+    ctl, bdT, bdP, spin, src = ctrl
+    mT = _modal_arrays(modal["thermal"], c.U["thermal"][: max(1, w)].mean(axis=0),
+                       src.get("thermal"))  # fmt: skip
+    mP = _modal_arrays(modal["hygric"], c.U["hygric"][: max(1, w)].mean(axis=0),
+                       src.get("hygric"))  # fmt: skip
+    Y = {"thermal": np.empty((len(rows), c.N)), "hygric": np.empty((len(rows), c.N))}
+    for j, i in enumerate(rows):
+        nT, nP = mT[0].shape[1], mP[0].shape[1]
+        acc = np.zeros(N_COST) if cost is None else cost[i]
+        coupled_draw(
+            *(x[i] for x in mT), c.Ut["thermal"], *(x[i] for x in mP), c.Ut["hygric"],
+            bdT[i], bdP[i], ctl[i], sig, spin, Y["thermal"][j], Y["hygric"][j], acc,
+            np.empty(nT), np.empty(nP), np.empty(nT), np.empty(nP),
+        )  # fmt: skip
     return Y
 
 
 def _run_chunk(
-    run, draws, c: _Case, o: _CaseOut, sl, modal, e, dt, w, work, aw, t_modal, opts, measure=None
-):
+    run, P, c: _Case, o: _CaseOut, sl, modal, e, dt, w, work, aw, t_modal, opts, measure=None,
+    ctrl=None, sig=None,
+):  # fmt: skip
     from heritage_bayes.projection._stream import chunk_kernel
 
     t0 = time.perf_counter()
     Y, M, U = {}, {}, {}
-    if measure is not None and measure.controlled:
-        Y = _controlled(run, draws, c, o, sl, dt, w, measure)
+    if ctrl is None and measure is not None and measure.controlled:  # the reference
+        Y = _controlled(run, P, c, o, sl, dt, w, measure)
     for s, m in run.models.items():
         u0 = c.U[s][: max(1, w)].mean(axis=0)  # steady state of the first window
         if s in Y:
+            Y[s] = np.ascontiguousarray(Y[s])
             M[s], U[s] = _NO_MODAL, np.zeros((1, 1))
         elif modal[s] is None:
-            Y[s] = np.ascontiguousarray(
-                m.forward(draws.model[s][sl], c.U[s], dt, u_init=u0)[0][..., 0]
-            )
+            Y[s] = np.ascontiguousarray(m.forward(P[s][sl], c.U[s], dt, u_init=u0)[0][..., 0])
             M[s], U[s] = _NO_MODAL, np.zeros((1, 1))
         else:
-            Y[s], M[s], U[s] = np.zeros((0, 0)), _modal_arrays(modal[s], u0), c.Ut[s]
+            shift = None if ctrl is None else ctrl[4].get(s)  # a calibrated constant source
+            Y[s], M[s], U[s] = np.zeros((0, 0)), _modal_arrays(modal[s], u0, shift), c.Ut[s]
     o.seconds["simulate"] += time.perf_counter() - t0 + t_modal
     t0 = time.perf_counter()
     k = sl.stop - sl.start
@@ -492,31 +602,40 @@ def _run_chunk(
     ws, tmp, btmp, hist, sbuf, zbuf, wbuf = work
     (bpar, bpred), (mabuf, cbuf) = aw
     en, en_col = c.en_params()
+    if ctrl is None:
+        ctl, bdT, bdP, spin, sig = np.zeros((0, N_CP)), dummy, dummy, 0, np.zeros(1)
+    else:
+        ctl, bdT, bdP, spin, _ = ctrl
+    cost = o.cost[sl]
     chunk_kernel(
         Y["thermal"], Y["hygric"], M["thermal"], M["hygric"], U["thermal"], U["hygric"],
         eT, eP, e is not None, c.starts, *c.plan.arrays, ws, tmp, btmp, hist, sbuf, zbuf, wbuf,
         o.par[sl], o.pred[sl], spar, spred, o.Tm[sl], o.RHm[sl],
         c.hoy, c.mode, en, en_col, bpar[:k], bpred[:k], o.apar[sl], o.apred[sl], mabuf, cbuf,
+        ctl, bdT, bdP, sig, spin, cost, measure is None,
     )  # fmt: skip
+    o.cost[sl] = cost
     bad = np.flatnonzero((spar != 0) | (spred != 0))
     if bad.size:
-        _recompute(run, draws, c, o, sl, bad, e, dt, w, opts, aw, measure)
+        _recompute(run, P, c, o, sl, bad, e, dt, w, opts, aw, modal, ctrl, sig, measure)
     o.seconds["risk"] += time.perf_counter() - t0
 
 
-def _recompute(run, draws, c: _Case, o: _CaseOut, sl, bad, e, dt, w, opts, aw, measure=None):
+def _recompute(
+    run, P, c: _Case, o: _CaseOut, sl, bad, e, dt, w, opts, aw, modal, ctrl, sig, measure
+):  # fmt: skip
     """Draws the compiled pass handed back (a missing hour, or a series that
     :func:`assess_batch` rejects): the numpy path, with its NaN policy and its errors."""
     from heritage_bayes.climate.risk import assess_batch
 
     rows = np.arange(sl.start, sl.stop)[bad]
-    ys = {}
-    if measure is not None and measure.controlled:
-        ys = _controlled(run, draws, c, None, rows, dt, w, measure)
+    ys = {} if ctrl is None else _coupled_series(c, modal, ctrl, sig, bad, w)
+    if ctrl is None and measure is not None and measure.controlled:
+        ys = _controlled(run, P, c, None, rows, dt, w, measure)
     for s, m in run.models.items():
         u0 = c.U[s][: max(1, w)].mean(axis=0)
         if s not in ys:
-            ys[s] = m.forward(draws.model[s][rows], c.U[s], dt, u_init=u0)[0][..., 0]
+            ys[s] = m.forward(P[s][rows], c.U[s], dt, u_init=u0)[0][..., 0]
     from heritage_bayes.projection._stream import _annual_row
 
     (bpar, bpred), (mabuf, cbuf) = aw

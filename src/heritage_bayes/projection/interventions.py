@@ -6,15 +6,29 @@ draw (:class:`Measure`):
 - **conservation heating** (Staniforth 2006 [1]_): a thermostat on the thermal model
   whose set-point is the temperature at which the draw's simulated indoor vapour
   pressure has RH ``rh_max`` (at least ``t_min``, at most ``t_max``), up to
-  ``power_max`` [W] (:class:`heritage_bayes.rc.control.ControlledModel`, ``thermostat``
-  with ``conservation``);
-- **dehumidification**: a humidistat on the hygric model (``mode: dehumidifier``) that
-  keeps the RH at the draw's simulated indoor temperature at or below ``rh_max``,
-  removing at most ``capacity`` [kg/h];
+  ``power_max`` [W];
+- **dehumidification**: a humidistat on the hygric model that keeps the RH at the
+  draw's simulated indoor temperature at or below ``rh_max``, removing at most
+  ``capacity`` [kg/h];
+- a **humidistat band**: a dehumidifier above ``rh_max`` and a humidifier below
+  ``rh_min``, on/off with a switching differential (hysteresis, as a wall humidistat
+  works: on at the limit, off once the RH is back by the differential);
 - **heating** to a set-point ``t_set`` and, in the hours of use of a weekly calendar,
   ``t_use`` (intermittent heating of a church for services), up to ``power_max``;
 - **ventilation** scaled by a factor: ``Gfast`` of both models (the thermal one lumps
-  ventilation and glazing) multiplied, every other parameter as calibrated.
+  ventilation and glazing) multiplied, every other parameter as calibrated;
+- a **combination**: a thermostat (heating or conservation heating) with a humidistat
+  (dehumidification or a band), ventilation with any.
+
+The controllers are stepped in the compiled projection pass
+(:func:`heritage_bayes.rc.control.coupled_draw`, the step of
+:class:`~heritage_bayes.rc.control.ControlledModel`): per draw both models advance
+together, each controller reading the air at the start of the step (conservation
+heating the controlled ``Pi``, the humidistat the saturation pressure at the
+controlled ``Ti``), so conservation heating and a dehumidifier act on one room.
+:meth:`Measure.simulate` is the previous, independent implementation
+(``ControlledModel.forward`` against the other model's free-running series), kept as
+the reference the tests compare single controllers with.
 
 Pairing is by construction: a measure is simulated with the same parameter draw, the
 same noise realisation (the noise is model error, added to the controlled outputs as to
@@ -24,25 +38,24 @@ zero capacity) gives the do-nothing indicators in every draw (to rounding, by te
 
 Each controlled draw starts from the do-nothing initial state (the steady state of the
 first weeks' weather) plus the change of state a year of control makes (periodic
-spin-up over the first weather year, ``spin_up`` of
-:meth:`~heritage_bayes.rc.control.ControlledModel.forward`): a dehumidified room of slow
-response would otherwise begin far from its controlled regime, and a controller that
-never acts starts exactly where doing nothing does.
+spin-up over the first weather year): a dehumidified room of slow response would
+otherwise begin far from its controlled regime, and a controller that never acts
+starts exactly where doing nothing does.
 
 The controllers act on the model's state (noise-free): a sensor reading the room. The
 hygric model ("model 3" of Kramer et al. [2]_) is in vapour pressure with the outdoor
-vapour pressure as its input, so heating changes the RH through the temperature only
-(the conservation-heating controller takes the draw's free-running ``Pi``), and the
-dehumidifier acts on ``Pi`` at the draw's free-running ``Ti``.
+vapour pressure as its input, so heating changes the RH through the temperature only.
 
 Running cost (:data:`COSTS`), from the control flow of each draw: heating energy
-[kWh/a] and peak power [kW]; water removed [kg/a], peak removal [kg/h] and, with
-``energy_per_kg``, the dehumidifier's electric energy [kWh/a]. A free-running room
-calibrated on temperatures and RH only identifies time constants and gains, not the
-absolute conductances [W/K] (the architecture notes): the scale of these figures, and
-so their interval, comes from the priors that pin it (room volume, air change rate) and
-the page says so; where measured heating power was in the calibration the data narrow
-it.
+[kWh/a] and peak power [kW]; water removed or added [kg/a], peaks [kg/h] and, with
+``energy_per_kg``, the units' electric energy [kWh/a] (``total_energy``: their sum per
+draw). A free-running room calibrated on temperatures and RH only identifies time
+constants and gains, not the absolute conductances [W/K] (the architecture notes): the
+scale of these figures, and so their interval, comes from the priors that pin it (room
+volume, air change rate) and the page says so; only measured heating power as an input
+of the calibration would fix it from data (the Ørholm store was heated but logged no
+power: ``benchmarks/bench_orholm_interventions.py`` gives 345 kWh/a with a 90 %
+interval of [0.7, 45 118] kWh/a there).
 
 References
 ----------
@@ -69,7 +82,13 @@ COSTS = {
     "water_removed": ("kg/a", "water removed by the dehumidifier per year"),
     "dehumidifier_peak": ("kg/h", "peak water removal"),
     "dehumidifier_energy": ("kWh/a", "electric energy of the dehumidifier per year"),
+    "water_added": ("kg/a", "water added by the humidifier per year"),
+    "humidifier_peak": ("kg/h", "peak water addition"),
+    "humidifier_energy": ("kWh/a", "electric energy of the humidifier per year"),
+    "total_energy": ("kWh/a", "energy per year of all the measure's units (per draw sum)"),
 }
+#: Energy columns of :data:`COSTS` [kWh/a] (their per-draw sum is ``total_energy``).
+ENERGY = ("heating_energy", "dehumidifier_energy", "humidifier_energy")
 #: Hours per year of the indicators' complete years.
 _HOURS_YEAR = 8760
 _NO_FLOOR = -273.15  # [°C] no heating floor
@@ -92,6 +111,10 @@ class Measure:
     thermostat : tuple or None
         ``(t_set [°C], t_use [°C] or None, WeeklyCalendar or None, power_max [W] or
         inf)``: heating to a set-point, ``t_use`` in the calendar's hours of use.
+    humidistat : tuple or None
+        ``(rh_min [-], rh_max [-], dehumidifier capacity [kg/s], humidifier capacity
+        [kg/s], differential [-], dehumidifier energy_per_kg [kWh/kg] or None,
+        humidifier energy_per_kg [kWh/kg] or None)``: a humidistat band.
     """
 
     name: str
@@ -99,11 +122,100 @@ class Measure:
     dehumidifier: tuple | None = None
     ventilation: float = 1.0
     thermostat: tuple | None = None
+    humidistat: tuple | None = None
 
     @property
     def controlled(self) -> bool:
-        """Simulated through a controller (the per-draw path), not the modal pass."""
-        return any(x is not None for x in (self.heating, self.dehumidifier, self.thermostat))
+        """Simulated with controllers (both models stepped together), not the modal pass."""
+        return any(
+            x is not None
+            for x in (self.heating, self.dehumidifier, self.thermostat, self.humidistat)
+        )
+
+    def controller_arrays(self, k: int, modal: dict, run, P: dict) -> tuple:
+        """The compiled pass's controllers for ``k`` draws: ``(cp (k, N_CP), bdT (k, nT),
+        bdP (k, nP), spin, sources)`` (:func:`heritage_bayes.rc.control.coupled_draw`;
+        ``modal``: section -> modal form of the draws' networks, ``P``: section -> their
+        parameters, after :meth:`params`). ``sources``: section -> (constant forcing
+        (k, n), steady-state shift (k, n)) of a calibrated constant source ``Qs`` [W] or
+        ``Ms`` [kg/s] (``options.source``), added to the modal arrays."""
+        from heritage_bayes.rc import control as rc
+
+        cp = np.zeros(rc.N_CP)
+        cp[rc.CP_P_MAX] = np.inf
+        cp[rc.CP_T_MAX] = np.inf
+        if self.heating is not None:
+            rh, t_min, t_max, pmax = self.heating
+            cp[[rc.CP_T_MODE, rc.CP_T_SET, rc.CP_RH_CH, rc.CP_T_MAX, rc.CP_P_MAX]] = (
+                3, t_min, rh, t_max, pmax
+            )  # fmt: skip
+        if self.thermostat is not None:
+            t_set, t_use, _, pmax = self.thermostat
+            cp[[rc.CP_T_MODE, rc.CP_T_SET, rc.CP_P_MAX]] = 1, t_set, pmax
+            cp[rc.CP_T_USE] = 0.0 if t_use is None else t_use - t_set
+        if self.dehumidifier is not None:
+            rh, cap, _ = self.dehumidifier
+            cp[[rc.CP_H_ON, rc.CP_RH_LO, rc.CP_RH_HI, rc.CP_M_DEHUM]] = 1, 0.0, rh, cap
+        if self.humidistat is not None:
+            lo, hi, cap_d, cap_h, diff = self.humidistat[:5]
+            cp[[rc.CP_H_ON, rc.CP_RH_LO, rc.CP_RH_HI, rc.CP_M_DEHUM, rc.CP_M_HUM]] = (
+                1, lo, hi, cap_d, cap_h
+            )  # fmt: skip
+            cp[rc.CP_DIFF] = diff
+        bd, sources = {}, {}
+        for s, mf in modal.items():
+            m = run.models[s]
+            air = int(m._ix["out"][0])
+            bz = mf.s[:, air, None] * mf.V[:, air, :]
+            bd[s] = np.ascontiguousarray(mf.phi * bz)
+            if isinstance(m, rc.ControlledModel) and m.control.source:
+                names = m.parameter_names
+                q = P[s][:, names.index("Qs" if "Qs" in names else "Ms")][:, None]
+                lam = np.where(mf.lam > 0, mf.lam, np.inf)
+                sources[s] = (q * bd[s], q * bz / lam)
+        cps = np.ascontiguousarray(np.broadcast_to(cp, (k, rc.N_CP)))
+        return cps, bd["thermal"], bd["hygric"], _HOURS_YEAR, sources
+
+    def hours_of_use(self, index, N: int) -> np.ndarray:
+        """Hours of use (N,) of the heating schedule [-] (zeros without one)."""
+        cal = self.thermostat[2] if self.thermostat is not None else None
+        if cal is None:
+            return np.zeros(N)
+        if index is None:
+            raise ConfigError(
+                f"interventions: {self.name!r}: a weekly schedule needs the time of each step"
+            )
+        return np.ascontiguousarray(cal.fraction(index[:N], 3600.0), dtype=float)
+
+    def costs(self, sums: np.ndarray, dt: float, years: float) -> dict:
+        """Running costs (:data:`COSTS` name -> (K,) values) from the compiled pass's
+        sums (:data:`heritage_bayes.rc.control.N_COST` columns) over ``years``."""
+        out: dict = {}
+        if self.heating is not None or self.thermostat is not None:
+            out["heating_energy"] = sums[:, 0] * dt / 3.6e6 / years
+            out["heating_peak"] = sums[:, 1] / 1e3
+        e_d = e_h = None
+        dehum = self.dehumidifier is not None
+        hum = False
+        if self.dehumidifier is not None:
+            e_d = self.dehumidifier[2]
+        if self.humidistat is not None:
+            dehum, hum = self.humidistat[2] > 0, self.humidistat[3] > 0
+            e_d, e_h = self.humidistat[5], self.humidistat[6]
+        if dehum:
+            out["water_removed"] = sums[:, 2] * dt / years
+            out["dehumidifier_peak"] = sums[:, 3] * 3600.0
+            if e_d is not None:
+                out["dehumidifier_energy"] = out["water_removed"] * e_d
+        if hum:
+            out["water_added"] = sums[:, 4] * dt / years
+            out["humidifier_peak"] = sums[:, 5] * 3600.0
+            if e_h is not None:
+                out["humidifier_energy"] = out["water_added"] * e_h
+        energy = [out[c] for c in ENERGY if c in out]
+        if len(energy) > 1:  # quantiles of a sum need the sum of each draw
+            out["total_energy"] = np.sum(energy, axis=0)
+        return out
 
     def check(self, run) -> None:
         """Refuse a measure the run's models cannot take (names the measure)."""
@@ -118,12 +230,15 @@ class Measure:
                 f"(air exchange), which none of the run's models {names} has"
             )
         heat = self.heating or self.thermostat
-        for s, on in (("thermal", heat), ("hygric", self.dehumidifier)):
-            if on is not None and isinstance(run.models[s], ControlledModel):
+        for s, on in (("thermal", heat), ("hygric", self.dehumidifier or self.humidistat)):
+            m = run.models[s]
+            if (
+                on is not None and isinstance(m, ControlledModel) and set(m.components) - {"source"}
+            ):  # a constant source is part of the free-running room
                 raise ConfigError(
                     f"interventions: {self.name!r}: the calibrated {s} model is already "
-                    f"controlled ({list(run.models[s].components)}); a measure adds a "
-                    "controller to a free-running model"
+                    f"controlled ({list(m.components)}); a measure adds a controller to a "
+                    "free-running model"
                 )
 
     def notes(self, run) -> list[str]:
@@ -148,8 +263,24 @@ class Measure:
             out[s] = P
         return out
 
+    def cost_sums(self, costs: dict, dt: float, years: float) -> np.ndarray:
+        """The inverse of :meth:`costs`: (K, N_COST) sums from running costs."""
+        from heritage_bayes.rc.control import N_COST
+
+        k = len(next(iter(costs.values()))) if costs else 0
+        out = np.zeros((k, N_COST))
+        for col, name, f in (
+            (0, "heating_energy", years * 3.6e6 / dt), (1, "heating_peak", 1e3),
+            (2, "water_removed", years / dt), (3, "dehumidifier_peak", 1 / 3600.0),
+        ):  # fmt: skip
+            if name in costs:
+                out[:, col] = np.asarray(costs[name]) * f
+        return out
+
     def simulate(self, run, model: dict, U: dict, u0: dict, dt: float, index=None):
-        """Noise-free outputs of a chunk of draws with the controllers.
+        """Noise-free outputs of a chunk of draws with the controllers, through
+        ``ControlledModel.forward`` (the reference implementation: each controller
+        against the other model's free-running series, no humidistat band).
 
         Parameters
         ----------
@@ -174,6 +305,14 @@ class Measure:
         """
         from heritage_bayes.rc.control import Control, ControlledModel
 
+        if self.humidistat is not None or any(
+            isinstance(m, ControlledModel) for m in run.models.values()
+        ):
+            raise ValueError(
+                f"interventions: {self.name!r}: the reference path has no humidistat band "
+                "(hysteresis) and takes free-running networks only; it is simulated by "
+                "the compiled pass"
+            )
         Y = {
             s: np.ascontiguousarray(m.forward(model[s], U[s], dt, u_init=u0[s])[0][..., 0])
             for s, m in run.models.items()
@@ -296,9 +435,19 @@ def measures_from_config(pcfg) -> list[Measure]:
                 else (d.rh_max / 100.0, d.capacity / 3600.0, d.energy_per_kg),
                 ventilation=1.0 if it.ventilation is None else it.ventilation.factor,
                 thermostat=None if it.heating is None else _thermostat_spec(it.heating),
+                humidistat=None if it.humidistat_band is None else _band_spec(it.humidistat_band),
             )
         )
     return out
+
+
+def _band_spec(b) -> tuple:
+    """A humidistat band in SI: RH [-], capacities [kg/s], differential [-]."""
+    return (
+        b.rh_min / 100.0, b.rh_max / 100.0, b.dehumidifier_capacity / 3600.0,
+        b.humidifier_capacity / 3600.0, b.differential / 100.0,
+        b.dehumidifier_energy_per_kg, b.humidifier_energy_per_kg,
+    )  # fmt: skip
 
 
 def _thermostat_spec(h) -> tuple:
@@ -340,7 +489,8 @@ def compare_measures(labels, nothing, per_measure: dict, thresholds, units, note
     dict
         Measure name -> ``{"cases": {label: {"indicators": {name: change},
         "probabilities": [...], "costs": {name: quantiles}}}}``. A change is the paired
-        difference measure − nothing (quantiles 5/50/95 % and mean over the draws) with
+        difference measure − nothing (quantiles 5/50/95 % and mean over the draws, the
+        indicator's own quantiles with the measure in ``with_measure``) with
         ``p_better``: the share of draws in which the measure is strictly better (the
         registry's direction of ``worse``; None for an indicator without one).
         Probabilities: P(statement) with the measure and without, per threshold.
@@ -358,6 +508,7 @@ def compare_measures(labels, nothing, per_measure: dict, thresholds, units, note
                 d = r.predictive[n].to_numpy(float) - r0.predictive[n].to_numpy(float)
                 ok = np.isfinite(d)
                 e = _q(d) | {"name": info.name, "unit": units.get(n, info.unit)}
+                e["with_measure"] = _q(r.predictive[n].to_numpy(float))
                 e["p_better"] = float(np.mean(info.worse * d[ok] < 0)) if info.worse else None
                 inds[n] = e
             probs = []

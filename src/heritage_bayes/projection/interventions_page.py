@@ -15,11 +15,10 @@ import numpy as np
 
 from heritage_bayes.climate.risk.registry import indicator_info
 from heritage_bayes.projection.interventions import COSTS
+from heritage_bayes.projection.interventions import ENERGY as _ENERGY
 from heritage_bayes.report.figures.style import RC_PARAMS, _figure, to_png_uri
 from heritage_bayes.report.format import fmt, fmt_pct
 
-#: Energy columns added up on the trade-off figure's axis [kWh/a].
-_ENERGY = ("heating_energy", "dehumidifier_energy")
 _MARKERS = ("o", "s", "D", "^", "v", "P", "X", "*")
 #: Indicators of the trade-off figure, first two computed: mould, then chemical decay.
 _TRADEOFF = ("hours_above_LIM0", "vtt_mould_index_max", "twpi", "time_of_wetness")
@@ -47,23 +46,45 @@ def scale_text(run) -> str:
             "absolute heat capacities and conductances [J/K, W/K], so the heating-energy "
             "intervals carry what the data say about them."
         )
+    cfg = getattr(run, "config", None)
+    pinned = [
+        f"{what} {v:g} {unit}"
+        for what, v, unit in (
+            ("the room volume", getattr(cfg, "room_volume", None), "m³"),
+            ("the air change rate", getattr(cfg, "air_change_rate", None), "1/h"),
+        )
+        if v is not None
+    ]
+    by = (
+        f"the priors that pin that scale ({' and '.join(pinned)} given in the calibration "
+        "file, with their spread)"
+        if pinned
+        else "the priors of the capacities and conductances alone (no room volume or air "
+        "change rate was given: wide priors, wide intervals)"
+    )
     return (
-        "This room was calibrated free-running, on temperature and RH only: the data fix "
-        "its time constants and gains, not its absolute heat and vapour conductances "
-        "[W/K, kg/(s·Pa)]. The running costs scale with those, so their intervals come "
-        "from the physical priors that pin the scale (room volume, air change rate, the "
-        "priors of the conductances) rather than from the measurements; the changes of "
-        "the indicators do not depend on that scale as much. A calibration with measured "
-        "heating power narrows the energy intervals."
+        "This room was calibrated without a known heat input, on temperature and RH: the "
+        "data fix its time constants and gains, not its absolute heat and vapour "
+        "conductances [W/K, kg/(s·Pa)]. The running costs (heating energy, water "
+        f"removed) scale with those, so their intervals come from {by}, not from the "
+        "measurements. The changes of temperature, RH and the indicators do not depend "
+        "on that scale while a measure works within its capacity (the set-point or RH "
+        "limit is held); a power or capacity limit [W, kg/h] acts against the "
+        "conductances, so where it is reached they do. Only measured heating power as "
+        "an input of the calibration fixes the "
+        "scale from data (no shipped room with temperature and RH has it: the heated "
+        "Ørholm store logged temperature and RH only, see the Ørholm check in the "
+        "manual; the Armadillo test cell's heating power comes without RH)."
     )
 
 
 def _energy(costs: dict) -> dict | None:
-    """Annual energy quantiles [kWh/a] of a measure (sum of its energy columns: the
-    quantiles of a sum are approximated by the sum of quantiles of the one column a
-    measure has; heating and dehumidification are never in one measure)."""
+    """Annual energy quantiles [kWh/a] of a measure: its ``total_energy`` (per draw
+    sum) when it has several energy columns, else its one column."""
+    if "total_energy" in costs:
+        return costs["total_energy"]
     cols = [c for c in _ENERGY if c in costs]
-    return costs[cols[0]] if len(cols) == 1 else None
+    return costs[cols[0]] if cols else None
 
 
 def fig_tradeoff(proj, page_key: tuple, colour, legend) -> str:

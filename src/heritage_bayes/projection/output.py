@@ -129,28 +129,55 @@ def _measures(proj, data: dict, coords: dict, units: dict) -> None:
 
 
 def indicator_table(proj):
-    """pandas.DataFrame: one row per indicator and case — the registry's name, unit,
-    period and source, the quantiles over the draws, the paired change against the
-    baseline and P(worse) (``projection.csv``)."""
+    """pandas.DataFrame (``projection.csv``): one row per measure (``do nothing``
+    first), indicator and case — the registry's name, unit, period and source, the
+    quantiles over the draws, the paired change and P(worse) / P(better).
+
+    Doing nothing's change is against the baseline (``change_vs: baseline``, P(worse));
+    a measure's against doing nothing in the same case and draw (``change_vs: do
+    nothing``, P(better)). A measure's running costs follow its indicators as rows
+    ``cost_<name>`` (their quantiles, no change)."""
     import pandas as pd
 
+    from heritage_bayes.projection.config import DO_NOTHING
+    from heritage_bayes.projection.interventions import COSTS
+
     rows = []
+    cases = proj.summary["cases"]
+
+    def row(measure, n, name, unit, c, v, ch, vs, p_worse=None, p_better=None, info=None):
+        return {
+            "measure": measure, "indicator": n, "name": name, "unit": unit,
+            "case": c["label"], "scenario": c["scenario"], "horizon": c["horizon"],
+            "q05": v["q05"], "q50": v["q50"], "q95": v["q95"], "mean": v["mean"],
+            "change_vs": vs, "change_q05": ch.get("q05"), "change_q50": ch.get("q50"),
+            "change_q95": ch.get("q95"), "p_worse": p_worse, "p_better": p_better,
+            "period": None if info is None else info.period,
+            "source": None if info is None else info.source,
+        }  # fmt: skip
+
     for n, e in proj.summary["indicators"].items():
         info = indicator_info(n)
-        for c in proj.summary["cases"]:
-            lab = c["label"]
-            v = e["cases"][lab]
-            ch = e["change"].get(lab) or {}
-            rows.append(
-                {
-                    "indicator": n, "name": info.name, "unit": e["unit"], "case": lab,
-                    "scenario": c["scenario"], "horizon": c["horizon"],
-                    "q05": v["q05"], "q50": v["q50"], "q95": v["q95"], "mean": v["mean"],
-                    "change_q05": ch.get("q05"), "change_q50": ch.get("q50"),
-                    "change_q95": ch.get("q95"), "p_worse": ch.get("p_worse"),
-                    "period": info.period, "source": info.source,
-                }
-            )  # fmt: skip
+        for c in cases:
+            ch = e["change"].get(c["label"]) or {}
+            vs = "baseline" if ch else None
+            v = e["cases"][c["label"]]
+            rows.append(row(DO_NOTHING, n, info.name, e["unit"], c, v, ch, vs, ch.get("p_worse"),
+                            info=info))  # fmt: skip
+    for m, me in (proj.summary.get("interventions") or {}).items():
+        for n in proj.summary["indicators"]:
+            info = indicator_info(n)
+            for c in cases:
+                d = me["cases"][c["label"]]["indicators"].get(n)
+                if d is None:
+                    continue
+                rows.append(row(m, n, info.name, d["unit"], c, d["with_measure"], d,
+                                DO_NOTHING, p_better=d["p_better"], info=info))  # fmt: skip
+        for cost, (unit, desc) in COSTS.items():
+            for c in cases:
+                v = me["cases"][c["label"]]["costs"].get(cost)
+                if v is not None:
+                    rows.append(row(m, f"cost_{cost}", desc, unit, c, v, {}, None))
     return pd.DataFrame(rows)
 
 

@@ -99,7 +99,8 @@ class FusedPlan:
         for j, name in enumerate(self.columns):
             if name == "ashrae_best_class":
                 names = np.array([*self.class_names, "none"], dtype=object)
-                idx = values[:, j].astype(np.int64)
+                v = values[:, j]  # NaN: not computed (a measure's noise-free pass)
+                idx = np.where(np.isfinite(v), v, -1.0).astype(np.int64)
                 cols[name] = names[np.where(idx < 0, len(self.class_names), idx)]
             else:
                 cols[name] = values[:, j].copy()

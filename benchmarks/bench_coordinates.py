@@ -60,7 +60,7 @@ def _config(path: Path, section: str, model_name: str | None):
     return cfg
 
 
-def _run(label, lp, mp, coords, cfg, args):
+def _run(label, lp, mp, coords, cfg, args, moves):
     return bench_sampling._run(
         label,
         lp,
@@ -69,7 +69,7 @@ def _run(label, lp, mp, coords, cfg, args):
         lp.params.bounds,
         cfg,
         args.max_time,
-        moves=cfg.sampler.moves,
+        moves=moves,
         max_steps=args.max_steps,
         max_draws=cfg.sampler.max_draws,
         coordinates=coords,
@@ -82,6 +82,12 @@ def main() -> None:
     ap.add_argument("--max-steps", type=int, default=200_000)
     ap.add_argument("--max-time", type=float, default=1800.0, help="per chain [s]")
     ap.add_argument("--only", choices=("log", "node_tau"), default=None)
+    ap.add_argument(
+        "--moves",
+        default=None,
+        help="comma-separated sampler.moves to run in node_tau coordinates (the first is "
+        "the reference of the ratios; default: the config's)",
+    )
     args = ap.parse_args()
     for name in args.problems:
         cfg = _config(*PROBLEMS[name])
@@ -94,18 +100,21 @@ def main() -> None:
             flush=True,
         )
         runs = {}
-        for label, c in (("log", None), ("node_tau", coords)):
-            if args.only not in (None, label) or (label == "node_tau" and c is None):
-                continue
-            runs[label] = _run(label, lp, mp, c, cfg, args)
+        moves = args.moves.split(",") if args.moves else [cfg.sampler.moves]
+        if args.only != "node_tau":
+            runs["log"] = _run("log", lp, mp, None, cfg, args, moves[0])
+        for m in moves if args.only != "log" else ():
+            label = "node_tau" if len(moves) == 1 else f"node_tau/{m}"
+            runs[label] = _run(label, lp, mp, coords, cfg, args, m)
         names = lp.params.free_names
         print("  τ per parameter [steps]: " + "  ".join(f"{n:>8s}" for n in names))
         for label, (res, _, _) in runs.items():
             print(f"  {label:<22s}  " + "  ".join(f"{t:8.0f}" for t in res.tau))
-        if len(runs) == 2:
-            (a, ca, ra), (b, cb, rb) = runs["log"], runs["node_tau"]
+        labels = list(runs)
+        for other in labels[1:]:
+            (a, ca, ra), (b, cb, rb) = runs[labels[0]], runs[other]
             print(
-                f"  node_tau / log: τmax {np.nanmax(b.tau) / np.nanmax(a.tau):.2f}, "
+                f"  {other} / {labels[0]}: τmax {np.nanmax(b.tau) / np.nanmax(a.tau):.2f}, "
                 f"CPU {cb / ca:.2f}, ESS/CPU-s {rb / ra:.2f}",
                 flush=True,
             )

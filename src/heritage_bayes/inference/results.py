@@ -5,7 +5,7 @@ Run directory (``hbayes calibrate``):
 - ``posterior.nc``: arviz InferenceData (NetCDF4/HDF5). Variables are qualified by the
   calibrated model: ``thermal.Cw``, ``hygric.Ci``, ``thermal.tau_1_h``, ...
 
-  Every group holds the same draws: ``sampler.n_predictive`` (default 1000) evenly
+  Every group holds the same draws: ``sampler.n_predictive`` (default 640) evenly
   spaced retained draws over all walkers (``chain``), with the same ``draw`` labels.
 
   - ``posterior``: parameters (fixed ones included as constants) and derived
@@ -18,17 +18,20 @@ Run directory (``hbayes calibrate``):
     several one variable ``all_outputs`` holding all of them on an ``observation`` axis
     (coordinates ``observation_variable``, ``observation_time``); with AR(1) noise each
     term is the density of the hour given the previous residual;
-  - ``log_likelihood_outputs`` (not an arviz group; runs with several outputs): the
-    per-output terms ``<model>.<output>``;
-  - ``log_likelihood_validation`` (not an arviz group): the same over the validation
-    period, from the simulation continued past calibration (expected log predictive
-    density of new data);
+    (the per-output terms are not stored twice: ``inference.interop.split_outputs``
+    rebuilds ``<model>.<output>`` from ``all_outputs``);
+  - ``log_predictive_density_validation`` (not an arviz group): per output, the log of
+    the posterior-mean predictive density of each validation hour [nats] (over the
+    saved draws, from the simulation continued past calibration; their sum is the
+    expected log predictive density of new data). Runs written before issue 28 hold the
+    terms per draw instead (``log_likelihood_validation``); both are read by
+    ``heritage_bayes.compare.scores.elpd_validation``;
   - ``observed_data``: ``Ti``, ``Pi``, ``RHi`` on the ``time`` axis;
   - ``constant_data``: the model inputs and a ``period`` code (0 warm-up, 1 calibration,
     2 validation, -1 outside);
   - ``posterior_predictive``: ``<model>.<output>`` with noise and
     ``<model>.<output>_sim`` without, over calibration and validation periods, for a
-    bounded subset of about 200 of those draws (``draw`` labels are the posterior's;
+    bounded subset of about 100 of those draws (``draw`` labels are the posterior's;
     and ``RHi`` combining thermal and hygric draws);
   - ``predictive_bands`` (not an arviz group): the 5, 25, 50, 75 and 95 % quantiles
     (axis ``quantile``) of every ``posterior_predictive`` variable over *all* saved

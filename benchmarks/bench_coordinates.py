@@ -60,7 +60,7 @@ def _config(path: Path, section: str, model_name: str | None):
     return cfg
 
 
-def _run(label, lp, mp, coords, cfg, args, moves):
+def _run(label, lp, mp, coords, cfg, args, moves, walkers=None):
     return bench_sampling._run(
         label,
         lp,
@@ -70,6 +70,7 @@ def _run(label, lp, mp, coords, cfg, args, moves):
         cfg,
         args.max_time,
         moves=moves,
+        nwalkers=walkers,
         max_steps=args.max_steps,
         max_draws=cfg.sampler.max_draws,
         coordinates=coords,
@@ -88,6 +89,12 @@ def main() -> None:
         help="comma-separated sampler.moves to run in node_tau coordinates (the first is "
         "the reference of the ratios; default: the config's)",
     )
+    ap.add_argument(
+        "--walkers",
+        default=None,
+        help="comma-separated ensemble sizes, each run with every --moves in node_tau "
+        "coordinates (default: the sampler's, max(32, 2 d + 2))",
+    )
     args = ap.parse_args()
     for name in args.problems:
         cfg = _config(*PROBLEMS[name])
@@ -103,9 +110,12 @@ def main() -> None:
         moves = args.moves.split(",") if args.moves else [cfg.sampler.moves]
         if args.only != "node_tau":
             runs["log"] = _run("log", lp, mp, None, cfg, args, moves[0])
-        for m in moves if args.only != "log" else ():
-            label = "node_tau" if len(moves) == 1 else f"node_tau/{m}"
-            runs[label] = _run(label, lp, mp, coords, cfg, args, m)
+        sizes = [int(w) for w in args.walkers.split(",")] if args.walkers else [None]
+        for w in sizes if args.only != "log" else ():
+            for m in moves:
+                label = "node_tau" + (f"/{m}" if len(moves) > 1 else "")
+                label += f"/{w}w" if w is not None else ""
+                runs[label] = _run(label, lp, mp, coords, cfg, args, m, w)
         names = lp.params.free_names
         print("  τ per parameter [steps]: " + "  ".join(f"{n:>8s}" for n in names))
         for label, (res, _, _) in runs.items():

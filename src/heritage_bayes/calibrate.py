@@ -294,7 +294,7 @@ def _calibrate_into(
     t_start = time.perf_counter()
     say = _Progress(quiet)
     # the heavy imports (arviz, scipy.optimize, emcee) only once the config is valid
-    from heritage_bayes.inference.coordinates import default_coordinates
+    from heritage_bayes.inference.coordinates import sampling_coordinates
     from heritage_bayes.inference.idata import CONVERGENCE, build_run_outputs
     from heritage_bayes.inference.optimize import find_map, laplace, seconds_left, share_deadline
     from heritage_bayes.inference.sampler import run_sampler
@@ -385,7 +385,7 @@ def _calibrate_into(
                 max_rhat=CONVERGENCE["max_rhat"],
                 min_ess=CONVERGENCE["min_ess_bulk"],
                 max_draws=cfg.sampler.max_draws,
-                coordinates=default_coordinates(s.logpost),
+                coordinates=sampling_coordinates(s.logpost, cfg.sampler.coordinates),
                 compact=True,
             )
         finally:

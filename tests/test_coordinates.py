@@ -179,7 +179,7 @@ def test_sampler_coordinates_key_chooses_them_and_enters_the_chain_tag():
     assert sampling_coordinates(lp2, "log") is None
     c = sampling_coordinates(lp2, "node_tau")
     assert isinstance(c, NodeTimeConstants) and len(c.nodes) == 2
-    with pytest.raises(ValueError, match="sampler.coordinates"):
+    with pytest.raises(ValueError, match=r"sampler\.coordinates"):
         sampling_coordinates(lp2, "laplace")
     base = {"name": "t", "data": {"demo": {"seed": 7}}, "thermal": {"model": "thermal_2c"}}
     tags = {

@@ -64,6 +64,15 @@ class SamplerSettings(_Strict):
         gt=0,
         le=1,
     )
+    tau_discard: float | None = key(
+        None,
+        unit="-",
+        description="fraction of the chain left out of the estimate of τ (the walkers' "
+        "spread from their start ball inflates it); default 0.5 where the walkers move in "
+        "node time constants, 0 (the whole chain) in log coordinates",
+        ge=0,
+        lt=1,
+    )
     moves: Literal["de_snooker", "stretch", "de"] = key(
         "de_snooker",
         unit=None,

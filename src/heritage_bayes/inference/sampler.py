@@ -35,6 +35,9 @@ References
    doi:10.1007/s11222-008-9104-9
 .. [3] J. Goodman, J. Weare, "Ensemble samplers with affine invariance", Commun. Appl.
    Math. Comput. Sci. 5 (2010) 65-80.
+.. [4] A. Gelman, J.B. Carlin, H.S. Stern, D.B. Dunson, A. Vehtari, D.B. Rubin,
+   *Bayesian Data Analysis*, 3rd ed., CRC Press (2013), section 11.4 (discarding the
+   first half of each chain as warm-up).
 """
 
 from __future__ import annotations
@@ -55,7 +58,14 @@ from heritage_bayes.inference.backend import (
     write_compact,
 )
 
-__all__ = ["ChainResult", "compact_checkpoint", "make_moves", "run_sampler", "start_ensemble"]
+__all__ = [
+    "ChainResult",
+    "compact_checkpoint",
+    "default_tau_discard",
+    "make_moves",
+    "run_sampler",
+    "start_ensemble",
+]
 
 
 def make_moves(name: str):
@@ -200,18 +210,20 @@ def _from_compact(path: Path, kept, nwalkers: int, d: int, tau_factor: float) ->
     )
 
 
-def _burn_thin(tau: np.ndarray, steps: int) -> tuple[int, int]:
+def _burn_thin(tau: np.ndarray, steps: int, discard: float = 0.0) -> tuple[int, int]:
+    """Burn-in and thinning [steps]: 2 τ (at most half the chain), and at least the part
+    of the chain that τ was not estimated on (``discard``); thinning τ_min / 2."""
     tmax = float(np.nanmax(tau)) if np.isfinite(tau).any() else float(steps)
-    burn = min(int(np.ceil(2 * tmax)), steps // 2)
+    burn = max(min(int(np.ceil(2 * tmax)), steps // 2), int(discard * steps))
     thin = max(1, int(0.5 * np.nanmin(tau))) if np.isfinite(tau).any() else 1
     return burn, thin
 
 
-def _mixing_ok(chain, tau, max_rhat, min_ess, max_draws) -> bool:
+def _mixing_ok(chain, tau, max_rhat, min_ess, max_draws, discard: float = 0.0) -> bool:
     """R-hat and bulk ESS of the retained draws (walkers as chains) meet the targets."""
     from heritage_bayes._arviz import az
 
-    burn, thin = _burn_thin(tau, chain.shape[0])
+    burn, thin = _burn_thin(tau, chain.shape[0], discard)
     res = ChainResult(
         chain=chain,
         log_prob=np.zeros(chain.shape[:2]),
@@ -241,8 +253,28 @@ def _next_check(done: int, check_every: int) -> int:
     return b
 
 
-def _tau(chain: np.ndarray) -> np.ndarray:
-    return emcee.autocorr.integrated_time(chain, c=5, tol=0, quiet=True)
+#: ``sampler.tau_discard`` where the walkers move in node time constants (the default).
+TAU_DISCARD_NODE_TAU = 0.5
+
+
+def default_tau_discard(coordinates) -> float:
+    """The fraction of the chain left out of the estimate of τ when ``sampler.tau_discard``
+    is not set: :data:`TAU_DISCARD_NODE_TAU` for chains in node time constants (the
+    three-node networks, or ``sampler.coordinates: node_tau``), 0 (the whole chain) in
+    the log coordinates, whose chains (the two-node models) are pinned by the
+    statistical tests (recovery, SBC, demo) and stay as they were until those are re-run
+    with it. Measured on the demo's thermal_4a (``benchmarks/bench_coordinates.py
+    demo_4a --only node_tau``, 40 000 steps): τmax 1 285 on the whole chain, 775 on its
+    second half, so 50 τ are reached near 40 000 steps instead of 64 000.
+    """
+    return TAU_DISCARD_NODE_TAU if coordinates is not None else 0.0
+
+
+def _tau(chain: np.ndarray, discard: float = 0.0) -> np.ndarray:
+    """Integrated autocorrelation time per parameter [steps] of ``chain`` (steps,
+    walkers, d), estimated on the steps after its first ``discard`` fraction."""
+    start = int(discard * chain.shape[0])
+    return emcee.autocorr.integrated_time(chain[start:], c=5, tol=0, quiet=True)
 
 
 def start_ensemble(
@@ -355,6 +387,7 @@ def _run_sampler(
     check_every: int = 500,
     tau_factor: float = 50.0,
     tau_rtol: float = 0.05,
+    tau_discard: float = 0.0,
     init_ball: float = 1e-3,
     checkpoint: str | Path | None = None,
     tag: str = "",
@@ -396,6 +429,14 @@ def _run_sampler(
     notice : callable, optional
         Called with a message when a resume does not go as asked (no checkpoint, a
         damaged one: see :class:`_Checkpoint`).
+    tau_discard : float
+        Fraction of the chain left out of the estimate of τ, in [0, 1) (0: the whole
+        chain). The walkers start in a small ball around the MAP and spread over the
+        posterior first; that transient makes each walker's series non-stationary and
+        inflates τ estimated on the whole chain (demo thermal_4a, node time constants,
+        40 000 steps: τmax 1 285 on the whole chain, 775 on its second half). Leaving
+        out the first half is the classical burn-in of Gelman et al. [4]_; the retained
+        draws come from the part τ was estimated on (burn-in at least that fraction).
     max_rhat, min_ess : float or None
         Once the chain is long enough for τ, it also runs until the rank-normalised
         R-hat (walkers as chains) is at most ``max_rhat`` and the bulk ESS at least
@@ -404,6 +445,8 @@ def _run_sampler(
         under the monotone transforms of the sampling space.
     """
     d = int(np.size(x_map))
+    if not 0.0 <= tau_discard < 1.0:
+        raise InputError(f"sampler.tau_discard: expected a fraction in [0, 1) (got {tau_discard})")
     if nwalkers is None:
         nwalkers = max(32, 2 * d + 2)
     nwalkers += nwalkers % 2
@@ -491,12 +534,14 @@ def _run_sampler(
     converged = False
     tau = np.full(d, np.nan)
     if done > 0:  # resumed: the saved chain may already be long enough
-        tau = _tau(np.concatenate(chunks_x))
+        tau = _tau(np.concatenate(chunks_x), tau_discard)
         tmax = float(np.max(tau))
         stable = bool(tau_hist) and abs(tmax - tau_hist[-1][1]) / tmax < tau_rtol
         converged = bool(done >= tau_factor * tmax and stable and np.all(np.isfinite(tau)))
         if converged and (max_rhat is not None or min_ess is not None):
-            converged = _mixing_ok(np.concatenate(chunks_x), tau, max_rhat, min_ess, max_draws)
+            converged = _mixing_ok(
+                np.concatenate(chunks_x), tau, max_rhat, min_ess, max_draws, tau_discard
+            )
     # SIGINT/SIGTERM only set a flag while sampling: the chain stops after the current
     # step, the steps done are committed, then KeyboardInterrupt (never an exception
     # inside emcee's likelihood call, which would print the parameter matrix)
@@ -530,7 +575,7 @@ def _run_sampler(
             chunks_x.append(x)
             chunks_lp.append(lp)
             done += n
-            tau = _tau(np.concatenate(chunks_x))
+            tau = _tau(np.concatenate(chunks_x), tau_discard)
             tmax = float(np.max(tau))
             stable = bool(tau_hist) and abs(tmax - tau_hist[-1][1]) / tmax < tau_rtol
             tau_hist.append((float(done), tmax))
@@ -538,7 +583,9 @@ def _run_sampler(
                 ck.append(x, lp, accepted, state.random_state, tau_hist)
             converged = done >= tau_factor * tmax and stable and np.all(np.isfinite(tau))
             if converged and (max_rhat is not None or min_ess is not None):
-                converged = _mixing_ok(np.concatenate(chunks_x), tau, max_rhat, min_ess, max_draws)
+                converged = _mixing_ok(
+                    np.concatenate(chunks_x), tau, max_rhat, min_ess, max_draws, tau_discard
+                )
             if progress is not None:
                 progress(
                     done,
@@ -554,7 +601,7 @@ def _run_sampler(
                 break
     chain = np.concatenate(chunks_x)
     log_prob = np.concatenate(chunks_lp)
-    burn, thin = _burn_thin(tau, chain.shape[0])
+    burn, thin = _burn_thin(tau, chain.shape[0], tau_discard)
     result = ChainResult(
         chain=chain,
         log_prob=log_prob,

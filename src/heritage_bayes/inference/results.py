@@ -5,7 +5,7 @@ Run directory (``hbayes calibrate``):
 - ``posterior.nc``: arviz InferenceData (NetCDF4/HDF5). Variables are qualified by the
   calibrated model: ``thermal.Cw``, ``hygric.Ci``, ``thermal.tau_1_h``, ...
 
-  Every group holds the same draws: ``sampler.n_predictive`` (default 640) evenly
+  Every group holds the same draws: ``sampler.n_predictive`` (default 1000) evenly
   spaced retained draws over all walkers (``chain``), with the same ``draw`` labels.
 
   - ``posterior``: parameters (fixed ones included as constants) and derived
@@ -31,7 +31,7 @@ Run directory (``hbayes calibrate``):
     2 validation, -1 outside);
   - ``posterior_predictive``: ``<model>.<output>`` with noise and
     ``<model>.<output>_sim`` without, over calibration and validation periods, for a
-    bounded subset of about 100 of those draws (``draw`` labels are the posterior's;
+    bounded subset of about 64 of those draws (``draw`` labels are the posterior's;
     and ``RHi`` combining thermal and hygric draws);
   - ``predictive_bands`` (not an arviz group): the 5, 25, 50, 75 and 95 % quantiles
     (axis ``quantile``) of every ``posterior_predictive`` variable over *all* saved

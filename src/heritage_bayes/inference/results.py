@@ -82,6 +82,8 @@ PREDICTIVE_QUANTUM = {"°C": 0.01, "Pa": 0.1, "%": 0.01}
 _PACKED_GROUPS = ("posterior_predictive", "predictive_bands")
 #: Mantissa bits kept of float32 log-likelihood terms (of 23).
 _LOGLIK_BITS = 12
+#: Hours (or observations) per chunk of (chain, draw, hour) arrays.
+_CHUNK_HOURS = 256
 
 
 def ensure_free_space(path: str | Path, nbytes: int, margin: int = 4 << 20) -> None:
@@ -127,6 +129,12 @@ def _encoding(group: str, da) -> dict:
     if not np.issubdtype(da.dtype, np.number):
         return {}
     enc = {"zlib": True, "complevel": 4, "shuffle": True}
+    if da.dims[:2] == ("chain", "draw") and da.ndim == 3 and da.size:
+        # every draw of a few hundred hours in one chunk: the terms (or values) of one
+        # hour over the draws are alike, and after the byte shuffle their leading bytes
+        # compress together (the demo's log_likelihood: 7.43 MB with the library's
+        # default chunks, 6.38 MB so)
+        enc["chunksizes"] = (da.shape[0], da.shape[1], min(_CHUNK_HOURS, da.shape[2]))
     quantum = PREDICTIVE_QUANTUM.get(da.attrs.get("unit", ""))
     if group in _PACKED_GROUPS and quantum is not None and np.issubdtype(da.dtype, np.floating):
         enc.update(dtype="int32", scale_factor=quantum, _FillValue=np.iinfo(np.int32).min)

@@ -275,7 +275,7 @@ def test_tau_without_the_start_transient_stops_sooner_and_samples_the_same():
     (a non-stationary start): τ on the whole chain is inflated by it, τ on the second
     half is not; ``tau_discard=0.5`` estimates τ there (the chain meets 50 τ no later;
     here R-hat/ESS decide) and keeps draws only from there, which sample N(0, 1)."""
-    from heritage_bayes.inference.sampler import _tau, default_tau_discard
+    from heritage_bayes.inference.sampler import _tau
 
     f = _BoxGauss(mu=[0.0, 0.0], sd=[1.0, 1.0], lo=[-np.inf] * 2, hi=[np.inf] * 2)
     kw = dict(seed=5, nwalkers=16, max_steps=20_000, check_every=250, init_ball=1e-3)
@@ -293,7 +293,6 @@ def test_tau_without_the_start_transient_stops_sooner_and_samples_the_same():
     np.testing.assert_allclose(x.std(axis=0), 1.0, atol=4 / np.sqrt(2 * n_eff))
     with pytest.raises(InputError, match="tau_discard"):
         run_sampler(f, np.zeros(2), tau_discard=1.0, **kw)
-    assert default_tau_discard(None) == 0.0 and default_tau_discard(object()) == 0.5
 
 
 def test_every_moves_choice_of_the_config_builds_emcee_moves_and_samples():

@@ -297,7 +297,7 @@ def _calibrate_into(
     from heritage_bayes.inference.coordinates import sampling_coordinates
     from heritage_bayes.inference.idata import CONVERGENCE, build_run_outputs
     from heritage_bayes.inference.optimize import find_map, laplace, seconds_left, share_deadline
-    from heritage_bayes.inference.sampler import default_tau_discard, run_sampler
+    from heritage_bayes.inference.sampler import run_sampler
     from heritage_bayes.prepare import prepare
     from heritage_bayes.rc.identify import structural_identifiability
 
@@ -364,9 +364,6 @@ def _calibrate_into(
         t0 = time.perf_counter()
         update = say.sampler(s.name, cfg.sampler.max_steps)
         coords = sampling_coordinates(s.logpost, cfg.sampler.coordinates)
-        tau_discard = cfg.sampler.tau_discard
-        if tau_discard is None:
-            tau_discard = default_tau_discard(coords)
         try:
             s.chain = run_sampler(
                 s.logpost,
@@ -380,7 +377,7 @@ def _calibrate_into(
                 check_every=cfg.sampler.check_every,
                 tau_factor=cfg.sampler.tau_factor,
                 tau_rtol=cfg.sampler.tau_rtol,
-                tau_discard=tau_discard,
+                tau_discard=cfg.sampler.tau_discard,
                 init_ball=cfg.sampler.init_ball,
                 checkpoint=out / f"chain_{s.name}.h5",
                 tag=f"{chain_tag(cfg)}:{s.logpost.data_hash()}:{s.name}",

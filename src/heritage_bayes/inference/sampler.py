@@ -61,7 +61,6 @@ from heritage_bayes.inference.backend import (
 __all__ = [
     "ChainResult",
     "compact_checkpoint",
-    "default_tau_discard",
     "make_moves",
     "run_sampler",
     "start_ensemble",
@@ -265,23 +264,6 @@ def _next_check(done: int, check_every: int) -> int:
     return b
 
 
-#: ``sampler.tau_discard`` where the walkers move in node time constants (the default).
-TAU_DISCARD_NODE_TAU = 0.5
-
-
-def default_tau_discard(coordinates) -> float:
-    """The fraction of the chain left out of the estimate of τ when ``sampler.tau_discard``
-    is not set: :data:`TAU_DISCARD_NODE_TAU` for chains in node time constants (the
-    three-node networks, or ``sampler.coordinates: node_tau``), 0 (the whole chain) in
-    the log coordinates, whose chains (the two-node models) are pinned by the
-    statistical tests (recovery, SBC, demo) and stay as they were until those are re-run
-    with it. Measured on the demo's thermal_4a (``benchmarks/bench_coordinates.py
-    demo_4a --only node_tau``, 40 000 steps): τmax 1 285 on the whole chain, 775 on its
-    second half, so 50 τ are reached near 40 000 steps instead of 64 000.
-    """
-    return TAU_DISCARD_NODE_TAU if coordinates is not None else 0.0
-
-
 def _tau(chain: np.ndarray, discard: float = 0.0) -> np.ndarray:
     """Integrated autocorrelation time per parameter [steps] of ``chain`` (steps,
     walkers, d), estimated on the steps after its first ``discard`` fraction."""
@@ -443,12 +425,15 @@ def _run_sampler(
         damaged one: see :class:`_Checkpoint`).
     tau_discard : float
         Fraction of the chain left out of the estimate of τ, in [0, 1) (0: the whole
-        chain). The walkers start in a small ball around the MAP and spread over the
-        posterior first; that transient makes each walker's series non-stationary and
-        inflates τ estimated on the whole chain (demo thermal_4a, node time constants,
-        40 000 steps: τmax 1 285 on the whole chain, 775 on its second half). Leaving
-        out the first half is the classical burn-in of Gelman et al. [4]_; the retained
-        draws come from the part τ was estimated on (burn-in at least that fraction).
+        chain, the default); the retained draws then come from the part τ was estimated
+        on (burn-in at least that fraction). Leaving out the first half is the classical
+        burn-in of Gelman et al. [4]_ and removes the walkers' spread from their start
+        ball from the estimate; it is not the default because on the demo's thermal_4a
+        (node time constants) τ of the second half was 775 at 40 000 steps, so 50 τ
+        seemed reached, but R-hat/ESS were not, and as the chain went on τ of its
+        second half grew to 1 579 at 74 500 steps (a slow direction, ``fsol``, still
+        being explored): the whole-chain estimate (1 285 at 40 000) was the better
+        guide. See ``benchmarks/README.md``.
     max_rhat, min_ess : float or None
         Once the chain is long enough for τ, it also runs until the rank-normalised
         R-hat (walkers as chains) is at most ``max_rhat`` and the bulk ESS at least

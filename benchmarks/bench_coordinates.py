@@ -40,6 +40,7 @@ import bench_sampling
 from _common import config_map
 from heritage_bayes.config import load_config
 from heritage_bayes.inference.coordinates import node_time_constants
+from heritage_bayes.inference.sampler import _tau
 
 ROOT = Path(__file__).resolve().parents[1]
 #: name -> (config, section, model (None: the config's own))
@@ -60,8 +61,8 @@ def _config(path: Path, section: str, model_name: str | None):
     return cfg
 
 
-def _run(label, lp, mp, coords, cfg, args):
-    return bench_sampling._run(
+def _run(label, lp, mp, coords, cfg, args, moves, walkers=None):
+    out = bench_sampling._run(
         label,
         lp,
         mp.x,
@@ -69,11 +70,23 @@ def _run(label, lp, mp, coords, cfg, args):
         lp.params.bounds,
         cfg,
         args.max_time,
-        moves=cfg.sampler.moves,
+        moves=moves,
+        nwalkers=walkers,
         max_steps=args.max_steps,
         max_draws=cfg.sampler.max_draws,
         coordinates=coords,
     )
+    res = out[0]
+    # τ of the chain's second half: without the ensemble's spread from its start ball
+    # (the package's rule estimates τ on the whole chain)
+    half = _tau(res.chain[res.chain.shape[0] // 2 :])
+    print(
+        f"  {label}: {res.chain.shape[1]} walkers, τmax {np.nanmax(res.tau):.0f} on the "
+        f"whole chain, {np.nanmax(half):.0f} on its second half; acceptance "
+        f"{float(np.mean(res.acceptance)):.3f}",
+        flush=True,
+    )
+    return out
 
 
 def main() -> None:
@@ -82,6 +95,18 @@ def main() -> None:
     ap.add_argument("--max-steps", type=int, default=200_000)
     ap.add_argument("--max-time", type=float, default=1800.0, help="per chain [s]")
     ap.add_argument("--only", choices=("log", "node_tau"), default=None)
+    ap.add_argument(
+        "--moves",
+        default=None,
+        help="comma-separated sampler.moves to run in node_tau coordinates (the first is "
+        "the reference of the ratios; default: the config's)",
+    )
+    ap.add_argument(
+        "--walkers",
+        default=None,
+        help="comma-separated ensemble sizes, each run with every --moves in node_tau "
+        "coordinates (default: the sampler's, max(32, 2 d + 2))",
+    )
     args = ap.parse_args()
     for name in args.problems:
         cfg = _config(*PROBLEMS[name])
@@ -94,18 +119,24 @@ def main() -> None:
             flush=True,
         )
         runs = {}
-        for label, c in (("log", None), ("node_tau", coords)):
-            if args.only not in (None, label) or (label == "node_tau" and c is None):
-                continue
-            runs[label] = _run(label, lp, mp, c, cfg, args)
+        moves = args.moves.split(",") if args.moves else [cfg.sampler.moves]
+        if args.only != "node_tau":
+            runs["log"] = _run("log", lp, mp, None, cfg, args, moves[0])
+        sizes = [int(w) for w in args.walkers.split(",")] if args.walkers else [None]
+        for w in sizes if args.only != "log" else ():
+            for m in moves:
+                label = "node_tau" + (f"/{m}" if len(moves) > 1 else "")
+                label += f"/{w}w" if w is not None else ""
+                runs[label] = _run(label, lp, mp, coords, cfg, args, m, w)
         names = lp.params.free_names
         print("  τ per parameter [steps]: " + "  ".join(f"{n:>8s}" for n in names))
         for label, (res, _, _) in runs.items():
             print(f"  {label:<22s}  " + "  ".join(f"{t:8.0f}" for t in res.tau))
-        if len(runs) == 2:
-            (a, ca, ra), (b, cb, rb) = runs["log"], runs["node_tau"]
+        labels = list(runs)
+        for other in labels[1:]:
+            (a, ca, ra), (b, cb, rb) = runs[labels[0]], runs[other]
             print(
-                f"  node_tau / log: τmax {np.nanmax(b.tau) / np.nanmax(a.tau):.2f}, "
+                f"  {other} / {labels[0]}: τmax {np.nanmax(b.tau) / np.nanmax(a.tau):.2f}, "
                 f"CPU {cb / ca:.2f}, ESS/CPU-s {rb / ra:.2f}",
                 flush=True,
             )

@@ -13,6 +13,7 @@ import math
 
 import numpy as np
 import pytest
+import xarray as xr
 import yaml
 
 from _report_browser import find_chromium, open_page
@@ -26,6 +27,7 @@ from heritage_bayes.compare import (
     elpd_validation,
     load_inference,
 )
+from heritage_bayes.config.sampler import SamplerSettings
 from heritage_bayes.inference.predictive import PREDICTIVE_DRAWS
 
 TINY = {
@@ -68,10 +70,9 @@ def test_run_groups_share_draws_and_loglik_has_only_observed_hours(compared):
     out, _ = compared
     idata = load_inference([out / "thermal_2c"])["thermal_2c"]
     post = idata.posterior
-    for g in ("log_likelihood", "log_likelihood_validation"):
-        ds = idata[g]
-        np.testing.assert_array_equal(ds["chain"].values, post["chain"].values)
-        np.testing.assert_array_equal(ds["draw"].values, post["draw"].values)
+    ds = idata["log_likelihood"]
+    np.testing.assert_array_equal(ds["chain"].values, post["chain"].values)
+    np.testing.assert_array_equal(ds["draw"].values, post["draw"].values)
     # the predictive: about PREDICTIVE_DRAWS of the same draws (labels kept), and bands
     # over all of them
     pp = idata.posterior_predictive
@@ -85,12 +86,15 @@ def test_run_groups_share_draws_and_loglik_has_only_observed_hours(compared):
     assert np.all(np.isfinite(ll.values))
     # warm-up (2 days) and the one-day gap are not in the likelihood: 10 - 2 - 1 days
     assert ll.shape[-1] == (10 - 2 - 1) * 24
-    lv = idata["log_likelihood_validation"]["thermal.Ti"]
-    assert lv.shape[-1] == 5 * 24 and np.all(np.isfinite(lv.values))
-    # every group holds sampler.n_predictive (default 1000) draws, or all retained ones
+    # the validation hours: one log predictive density each, not the terms per draw
+    assert "log_likelihood_validation" not in idata.groups()
+    lv = idata["log_predictive_density_validation"]["thermal.Ti"]
+    assert lv.shape == (5 * 24,) and np.all(np.isfinite(lv.values))
+    # every group holds sampler.n_predictive draws (its default), or all retained ones
     summ = json.loads((out / "thermal_2c" / "summary.json").read_text())
     per_walker = summ["models"]["thermal"]["chain"]["draws_per_walker"]
-    assert post.sizes["draw"] == min(per_walker, math.ceil(1000 / post.sizes["chain"]))
+    n_saved = SamplerSettings().n_predictive
+    assert post.sizes["draw"] == min(per_walker, math.ceil(n_saved / post.sizes["chain"]))
 
 
 def test_az_loo_and_compare_on_run_directories_are_finite(compared):
@@ -116,11 +120,39 @@ def test_validation_elpd_is_the_log_mean_density(compared):
     out, _ = compared
     d = load_inference([out / "thermal_1c"])["thermal_1c"]
     ev = elpd_validation(d)
-    lv = d["log_likelihood_validation"]["thermal.Ti"].values.astype(float).reshape(-1, 120)
-    expected = np.log(np.mean(np.exp(lv), axis=0)).sum()
+    lv = d["log_predictive_density_validation"]["thermal.Ti"]
     assert ev["n"] == 120
-    np.testing.assert_allclose(ev["elpd"], expected, rtol=1e-9)
+    np.testing.assert_allclose(ev["elpd"], lv.values.sum(), rtol=1e-12)
+    np.testing.assert_array_equal(ev["times"], lv["time.thermal.Ti"].values)
     assert ev["se"] > 0
+
+
+def test_validation_elpd_of_stored_densities_equals_that_of_terms_per_draw():
+    """A run written before issue 28 (terms per draw) and one written now (the log mean
+    density per hour, :func:`_validation_lpd`) give the same ELPD and standard error;
+    ``log_mean_exp`` is the naive formula where that does not overflow, and stable
+    where it would."""
+    from heritage_bayes.inference.idata import _validation_lpd
+    from heritage_bayes.inference.interop import log_mean_exp
+
+    rng = np.random.default_rng(3)
+    t = np.arange(96).astype("datetime64[h]").astype("datetime64[ns]")
+    terms = xr.DataArray(
+        rng.normal(-1.0, 0.3, (4, 25, 96)),
+        dims=("chain", "draw", "time.thermal.Ti"),
+        coords={"chain": np.arange(4), "draw": np.arange(25), "time.thermal.Ti": t},
+    )
+    naive = np.log(np.mean(np.exp(terms.values.reshape(100, 96)), axis=0))
+    np.testing.assert_allclose(log_mean_exp(terms.values), naive, rtol=1e-13)
+    np.testing.assert_allclose(log_mean_exp(terms.values - 1000.0), naive - 1000.0, rtol=1e-13)
+    old = az.InferenceData(log_likelihood_validation=xr.Dataset({"thermal.Ti": terms}))
+    new = az.InferenceData(
+        log_predictive_density_validation=xr.Dataset({"thermal.Ti": _validation_lpd(terms, 100)})
+    )
+    a, b = elpd_validation(old), elpd_validation(new)
+    np.testing.assert_allclose(a["elpd"], b["elpd"], rtol=1e-13)
+    np.testing.assert_allclose(a["se"], b["se"], rtol=1e-12)
+    np.testing.assert_array_equal(a["times"], b["times"])
 
 
 def test_comparison_json(compared):

@@ -163,3 +163,30 @@ def test_default_coordinates_re_coordinate_three_node_networks_only():
     c = default_coordinates(lp4)
     names = lp4.params.free_names
     assert sorted(names[k] for k, _ in c.nodes) == ["Ci", "Cint", "Cw"]
+
+
+def test_sampler_coordinates_key_chooses_them_and_enters_the_chain_tag():
+    """``sampler.coordinates``: auto is the size rule, log none, node_tau the node time
+    constants of a two-node network too; a non-default choice changes the chain tag
+    (``--resume`` refuses a chain sampled otherwise), the default leaves earlier tags."""
+    from heritage_bayes.config import parse_config
+    from heritage_bayes.config.calibration import chain_tag
+    from heritage_bayes.errors import ConfigError
+    from heritage_bayes.inference.coordinates import sampling_coordinates
+
+    lp2, _ = _logpost("thermal_2c")
+    assert sampling_coordinates(lp2, "auto") is None
+    assert sampling_coordinates(lp2, "log") is None
+    c = sampling_coordinates(lp2, "node_tau")
+    assert isinstance(c, NodeTimeConstants) and len(c.nodes) == 2
+    with pytest.raises(ValueError, match=r"sampler\.coordinates"):
+        sampling_coordinates(lp2, "laplace")
+    base = {"name": "t", "data": {"demo": {"seed": 7}}, "thermal": {"model": "thermal_2c"}}
+    tags = {
+        k: chain_tag(parse_config({**base, "sampler": {"coordinates": k}}))
+        for k in ("auto", "log", "node_tau")
+    }
+    assert tags["auto"] == chain_tag(parse_config(base))
+    assert len(set(tags.values())) == 3
+    with pytest.raises(ConfigError, match="coordinates"):
+        parse_config({**base, "sampler": {"coordinates": "laplace"}})

@@ -104,6 +104,9 @@ def test_written_file_is_compressed_packed_and_read_back_within_the_quantum(tmp_
         ds = f["posterior_predictive/thermal.Ti"]
         assert ds.compression == "gzip" and ds.shuffle and ds.dtype == np.int32
         assert f["log_likelihood/thermal.Ti"].compression == "gzip"
+        # every draw of up to 256 hours per chunk (the draws of one hour compress together)
+        assert f["log_likelihood/thermal.Ti"].chunks == (W, D, 256)
+        assert f["posterior_predictive/thermal.Ti"].chunks[2] == 256
         stored = sum(
             f[g][v].id.get_storage_size() for g in f for v in f[g] if hasattr(f[g][v], "id")
         )

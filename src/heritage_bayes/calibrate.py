@@ -294,7 +294,7 @@ def _calibrate_into(
     t_start = time.perf_counter()
     say = _Progress(quiet)
     # the heavy imports (arviz, scipy.optimize, emcee) only once the config is valid
-    from heritage_bayes.inference.coordinates import default_coordinates
+    from heritage_bayes.inference.coordinates import sampling_coordinates
     from heritage_bayes.inference.idata import CONVERGENCE, build_run_outputs
     from heritage_bayes.inference.optimize import find_map, laplace, seconds_left, share_deadline
     from heritage_bayes.inference.sampler import run_sampler
@@ -363,6 +363,7 @@ def _calibrate_into(
         _say_findings(say, s, getattr(cfg, s.name).priors)
         t0 = time.perf_counter()
         update = say.sampler(s.name, cfg.sampler.max_steps)
+        coords = sampling_coordinates(s.logpost, cfg.sampler.coordinates)
         try:
             s.chain = run_sampler(
                 s.logpost,
@@ -376,6 +377,7 @@ def _calibrate_into(
                 check_every=cfg.sampler.check_every,
                 tau_factor=cfg.sampler.tau_factor,
                 tau_rtol=cfg.sampler.tau_rtol,
+                tau_discard=cfg.sampler.tau_discard,
                 init_ball=cfg.sampler.init_ball,
                 checkpoint=out / f"chain_{s.name}.h5",
                 tag=f"{chain_tag(cfg)}:{s.logpost.data_hash()}:{s.name}",
@@ -385,7 +387,7 @@ def _calibrate_into(
                 max_rhat=CONVERGENCE["max_rhat"],
                 min_ess=CONVERGENCE["min_ess_bulk"],
                 max_draws=cfg.sampler.max_draws,
-                coordinates=default_coordinates(s.logpost),
+                coordinates=coords,
                 compact=True,
             )
         finally:

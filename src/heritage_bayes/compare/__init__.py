@@ -14,7 +14,9 @@ sets them side by side:
   :math:`\\sum_t \\log \\frac{1}{S}\\sum_s p(y_t \\mid \\theta_s, y_{t-1})`: with AR(1)
   noise each term is the one-step-ahead predictive density of the hour given the
   previous residual, from the simulation continued past the calibration period (the
-  ``log_likelihood_validation`` group of ``posterior.nc``);
+  ``log_predictive_density_validation`` group of ``posterior.nc`` holds each hour's
+  inner term; runs written before issue 28 the terms per draw,
+  ``log_likelihood_validation``);
 - **blocked PSIS-LOO** on the calibration period: the pointwise log-likelihood summed
   over blocks of ``block_hours`` consecutive hours (default one day), then Pareto-smoothed
   importance-sampling LOO over the blocks (``az.loo``) and ``az.compare`` across models.

@@ -14,6 +14,7 @@ import xarray as xr
 
 from heritage_bayes._arviz import az
 from heritage_bayes.errors import InputError
+from heritage_bayes.inference.interop import VALIDATION_LPD, log_mean_exp, split_outputs
 
 
 def load_inference(run_dirs: Sequence[str | Path] | Mapping[str, str | Path]) -> dict:
@@ -51,14 +52,15 @@ def pointwise_terms(idata, var_name: str | None = None) -> xr.Dataset:
     """The group holding the per-output calibration terms ``var_name`` (``thermal.Ti``).
 
     A run with one output keeps them in ``log_likelihood``; a run with several keeps
-    their combination there (the default of ``az.loo``) and the per-output terms in
-    ``log_likelihood_outputs`` (see :func:`heritage_bayes.inference.interop.loglik_groups`).
+    their combination there (the default of ``az.loo``), from which the per-output terms
+    are rebuilt (:func:`heritage_bayes.inference.interop.split_outputs`); runs written
+    before issue 28 also hold them in ``log_likelihood_outputs``.
     """
-    if "log_likelihood_outputs" in idata.groups() and (
-        var_name is None or var_name not in idata.log_likelihood
-    ):
+    if var_name is not None and var_name in idata.log_likelihood:
+        return idata.log_likelihood
+    if "log_likelihood_outputs" in idata.groups():
         return idata["log_likelihood_outputs"]
-    return idata.log_likelihood
+    return split_outputs(idata.log_likelihood)
 
 
 def _one_var(ds: xr.Dataset, var_name: str | None, where: str) -> str:
@@ -108,13 +110,6 @@ def blocked_loo_data(idata, var_name: str | None = None, block_hours: float = 24
     )
 
 
-def _logmeanexp(a: np.ndarray) -> np.ndarray:
-    """log mean exp over the first two axes (chain, draw)."""
-    flat = np.asarray(a, dtype=float).reshape(-1, *a.shape[2:])
-    m = np.max(flat, axis=0)
-    return m + np.log(np.mean(np.exp(flat - m), axis=0))
-
-
 def elpd_validation(idata, var_name: str | None = None, block_hours: float = 24.0) -> dict:
     """Expected log predictive density of the validation hours.
 
@@ -126,12 +121,17 @@ def elpd_validation(idata, var_name: str | None = None, block_hours: float = 24.
         array and ``times`` (n,) of the hours; None when the run has no validation
         period.
     """
-    if "log_likelihood_validation" not in idata.groups():
+    if VALIDATION_LPD in idata.groups():  # stored per hour (issue 28)
+        ds = idata[VALIDATION_LPD]
+        v = _one_var(ds, var_name, VALIDATION_LPD)
+        pw = np.asarray(ds[v].values, dtype=float)
+    elif "log_likelihood_validation" in idata.groups():  # runs written before
+        ds = idata["log_likelihood_validation"]
+        v = _one_var(ds, var_name, "log_likelihood_validation")
+        pw = log_mean_exp(ds[v].values)
+    else:
         return None
-    ds = idata["log_likelihood_validation"]
-    v = _one_var(ds, var_name, "log_likelihood_validation")
     da = ds[v]
-    pw = _logmeanexp(da.values)
     times = da[da.dims[-1]].values
     return {
         "elpd": float(pw.sum()),

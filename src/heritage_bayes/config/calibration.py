@@ -207,6 +207,8 @@ def chain_tag(cfg: CalibrationConfig) -> str:
     ``tau_factor``, ...) and outputs, so that ``--resume`` may extend a run."""
     d = cfg.resolved()
     keep = {k: d["sampler"][k] for k in ("walkers", "moves", "init_ball")}
+    if d["sampler"].get("coordinates", "auto") != "auto":  # (tags of earlier runs kept)
+        keep["coordinates"] = d["sampler"]["coordinates"]
     d = {**d, "sampler": keep}
     for k in ("report", "ladder", "name", "building", "room", "notes"):
         d.pop(k, None)

@@ -34,7 +34,12 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["NodeTimeConstants", "default_coordinates", "node_time_constants"]
+__all__ = [
+    "NodeTimeConstants",
+    "default_coordinates",
+    "node_time_constants",
+    "sampling_coordinates",
+]
 
 #: Networks with at least this many capacity nodes are sampled along node time
 #: constants by default (:func:`default_coordinates`).
@@ -128,6 +133,20 @@ def node_time_constants(logpost) -> NodeTimeConstants | None:
     return coords if coords.nodes else None
 
 
+def sampling_coordinates(logpost, choice: str = "auto") -> NodeTimeConstants | None:
+    """The coordinates of ``sampler.coordinates``: ``"auto"`` (:func:`default_coordinates`),
+    ``"log"`` (None: the log-posterior's own) or ``"node_tau"`` (node time constants
+    wherever a capacity is a free log-scale parameter, whatever the network's size).
+    """
+    if choice == "auto":
+        return default_coordinates(logpost)
+    if choice == "log":
+        return None
+    if choice == "node_tau":
+        return node_time_constants(logpost)
+    raise ValueError(f"sampler.coordinates must be 'auto', 'log' or 'node_tau' (got {choice!r})")
+
+
 def default_coordinates(logpost) -> NodeTimeConstants | None:
     """The sampling coordinates ``hbayes calibrate`` uses: node time constants for
     networks of :data:`MIN_NODES` or more capacity nodes, the log coordinates (None)
@@ -141,9 +160,9 @@ def default_coordinates(logpost) -> NodeTimeConstants | None:
     second × 1.05 and × 0.87): their node time constants are nearly their modes'
     already, and the log coordinates are kept there. TRH-1's thermal_2c (a loose
     envelope node, 30 000 steps) gained most (τmax 2 889 → 855, ESS per CPU second
-    × 6.3): pass ``node_time_constants(logpost)`` to ``run_sampler`` for such rooms;
-    the default for two-node networks stays until the statistical tests that pin
-    their chains have been re-run with it.
+    × 6.3): ``sampler.coordinates: node_tau`` in a config chooses them for such rooms
+    (:func:`sampling_coordinates`); the default for two-node networks stays until the
+    statistical tests that pin their chains have been re-run with it.
     """
     if logpost.model.n_states < MIN_NODES:
         return None

@@ -2,7 +2,9 @@
 
 - :func:`loglik_groups`: the ``log_likelihood`` group that ``az.loo(idata)`` and
   ``az.waic(idata)`` read without ``var_name`` (one combined variable when a run has
-  several outputs), and the per-output terms beside it;
+  several outputs); :func:`split_outputs` gives the per-output terms back;
+- :func:`log_mean_exp`: the log of the posterior-mean density of each hour (the
+  ``log_predictive_density_validation`` group, expected log predictive density);
 - :func:`convergence_stats`: R-hat and bulk/tail ESS with the estimators of
   ``az.summary`` on the draws the file stores, so that the report's figures are
   reproduced by ``az.summary(az.from_netcdf("posterior.nc"))``.
@@ -15,10 +17,19 @@ import xarray as xr
 
 from heritage_bayes._arviz import az
 
-__all__ = ["JOINT_LOGLIK", "convergence_stats", "loglik_groups"]
+__all__ = [
+    "JOINT_LOGLIK",
+    "VALIDATION_LPD",
+    "convergence_stats",
+    "log_mean_exp",
+    "loglik_groups",
+    "split_outputs",
+]
 
 #: Name of the combined pointwise log-likelihood of a run with several outputs.
 JOINT_LOGLIK = "all_outputs"
+#: Group of ``posterior.nc`` holding the log predictive density of each validation hour.
+VALIDATION_LPD = "log_predictive_density_validation"
 
 
 def loglik_groups(loglik: dict[str, xr.DataArray], coords: dict, attrs: dict) -> dict:
@@ -31,9 +42,9 @@ def loglik_groups(loglik: dict[str, xr.DataArray], coords: dict, attrs: dict) ->
     (each an hour of one output; the noise of different outputs is independent, so the
     terms still sum to the log-likelihood the sampler used), with the coordinates
     ``observation_variable`` and ``observation_time`` saying which hour of which output
-    each is; the per-output variables go to ``log_likelihood_outputs`` (not an arviz
-    group: ``az.loo(idata, var_name=...)`` does not see it; read it with
-    :func:`heritage_bayes.compare.scores.pointwise_terms`).
+    each is. The per-output terms are not stored a second time (they would double the
+    largest part of the file: 7.3 MB of the demo's 25.6 MB ``posterior.nc``, issue 28):
+    :func:`split_outputs` rebuilds them from the combined variable.
     """
     if len(loglik) <= 1:
         return {"log_likelihood": xr.Dataset(loglik, coords=coords, attrs=attrs)}
@@ -51,10 +62,50 @@ def loglik_groups(loglik: dict[str, xr.DataArray], coords: dict, attrs: dict) ->
         },
         attrs={"description": f"pointwise terms of {', '.join(names)} on one axis"},
     )
-    return {
-        "log_likelihood": xr.Dataset({JOINT_LOGLIK: joint}, coords=coords, attrs=attrs),
-        "log_likelihood_outputs": xr.Dataset(loglik, coords=coords, attrs=attrs),
-    }
+    return {"log_likelihood": xr.Dataset({JOINT_LOGLIK: joint}, coords=coords, attrs=attrs)}
+
+
+def split_outputs(ds: xr.Dataset) -> xr.Dataset:
+    """The per-output terms of a ``log_likelihood`` group written by :func:`loglik_groups`.
+
+    With several outputs the group holds :data:`JOINT_LOGLIK` on an ``observation``
+    axis; this returns one variable per output (``thermal.Ti``) on its own time axis
+    (``time.thermal.Ti``), the terms and hours exactly as stored. A group without the
+    combined variable (one output) is returned as it is.
+    """
+    if JOINT_LOGLIK not in ds.data_vars or "observation_variable" not in ds.coords:
+        return ds
+    joint = ds[JOINT_LOGLIK]
+    names = joint["observation_variable"].values.astype(str)
+    when = joint["observation_time"].values
+    out = {}
+    for name in dict.fromkeys(names):  # in stored order
+        idx = np.flatnonzero(names == name)
+        dim = f"time.{name}"
+        out[name] = xr.DataArray(
+            joint.values[..., idx],
+            dims=(*joint.dims[:-1], dim),
+            coords={**{d: joint[d].values for d in joint.dims[:-1]}, dim: when[idx]},
+        )
+    return xr.Dataset(out, attrs=ds.attrs)
+
+
+def log_mean_exp(a) -> np.ndarray:
+    """log of the mean of exp(``a``) over its first two axes (chain, draw), float64.
+
+    Of pointwise log densities ℓ_i(θ_s) [nats]: the log pointwise predictive density
+    log (1/S Σ_s p(y_i | θ_s)) of each observation (Vehtari, Gelman & Gabry 2017 [1]_,
+    eq. 3), computed stably (the maximum factored out).
+
+    References
+    ----------
+    .. [1] A. Vehtari, A. Gelman, J. Gabry, "Practical Bayesian model evaluation using
+       leave-one-out cross-validation and WAIC", *Statistics and Computing* 27 (2017)
+       1413-1432. doi:10.1007/s11222-016-9696-4
+    """
+    flat = np.asarray(a, dtype=float).reshape(-1, *np.shape(a)[2:])
+    m = np.max(flat, axis=0)
+    return m + np.log(np.mean(np.exp(flat - m), axis=0))
 
 
 def convergence_stats(post: dict[str, xr.DataArray], names: list[str]):

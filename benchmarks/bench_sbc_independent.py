@@ -30,7 +30,7 @@ truth, the fit's input for the draws): the physical effect, which does not depen
 which sky model scaled the aperture.
 
     python benchmarks/bench_sbc_independent.py --reps 50 --jobs 2 --log sbc_ind.jsonl
-    python benchmarks/bench_sbc_independent.py --table sbc_ind.jsonl
+    python benchmarks/bench_sbc_independent.py --table sbc_ind.jsonl [more.jsonl ...]
     python benchmarks/bench_sbc_independent.py --reps 4 --models thermal_2c
 
 Each replicate's room, weather stretch and noise come from ``(seed, replicate)``; one
@@ -253,6 +253,33 @@ def replicate(args) -> dict:
     return result
 
 
+def read_logs(paths: list[str]) -> list[dict]:
+    """The replicates of one or more ``--log`` files, one record per (model, replicate)
+    with the variants of every file merged; a variant found twice for the same replicate
+    (a replicate repeated, e.g. a pilot extended from an overlapping ``--first-rep``)
+    must agree, since each replicate is a function of ``(seed, replicate)``."""
+    merged: dict[tuple[str, int], dict] = {}
+    for path in paths:
+        with open(path) as f:
+            for line in f:
+                if not line.strip():
+                    continue
+                r = json.loads(line)
+                key = (r["model"], int(r["rep"]))
+                if key not in merged:
+                    merged[key] = {**r, "variants": dict(r["variants"])}
+                    continue
+                have = merged[key]["variants"]
+                for v, x in r["variants"].items():
+                    if v in have and have[v]["ranks"] != x["ranks"]:
+                        raise SystemExit(
+                            f"{path}: {r['model']} replicate {r['rep']} {v} differs from "
+                            "an earlier log's (another seed or code?)"
+                        )
+                    have.setdefault(v, x)
+    return [merged[k] for k in sorted(merged)]
+
+
 def zscore_lines(results: list[dict], variant: str) -> list[str]:
     """Per model and quantity the rms of z = (posterior median - truth) / posterior sd
     over the replicates: about 1 for calibrated intervals, the factor by which they are
@@ -289,7 +316,13 @@ def main(argv=None) -> int:
         help="comma-separated parts of the generator left out: within_hour, sky, substeps "
         "(then the room is simulated with the fit's hourly zero-order hold of its inputs)",
     )
-    ap.add_argument("--table", help="only tabulate a --log file of an earlier study")
+    ap.add_argument(
+        "--table",
+        nargs="+",
+        metavar="LOG",
+        help="only tabulate the --log file(s) of earlier studies (several: a study "
+        "extended with --first-rep, or variants run apart on the same replicates)",
+    )
     args = ap.parse_args(argv)
     variants = args.noise or ["ar1_white:estimate"]
     without = tuple(w for w in args.without.split(",") if w)
@@ -297,8 +330,11 @@ def main(argv=None) -> int:
     if set(without) - parts:
         ap.error(f"--without: unknown {sorted(set(without) - parts)}; use {sorted(parts)}")
     if args.table:
-        results = [json.loads(line) for line in open(args.table)]
-        print(f"SBC (independent generator) table of {args.table}: {len(results)} replicates")
+        results = read_logs(args.table)
+        print(
+            f"SBC (independent generator) table of {' '.join(args.table)}: "
+            f"{len(results)} replicates"
+        )
         for v in sorted({v for r in results for v in r["variants"]}):
             for line in table(results, v, QUANTITIES) + zscore_lines(results, v):
                 print(line)

@@ -120,6 +120,12 @@ def test_independent_table_merges_logs(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "thermal_2c [kalman:estimate]: 4 replicates" in out
     assert "thermal_2c [ar1_white:estimate]: 2 replicates" in out
+    # the markdown table: every truth inside at 90 %; at 50 % those of rank 0.5 (kalman)
+    # and none of rank 0.1 (ar1_white); z = (1.0 - 1.2) / 0.5 = -0.4 for each
+    md = bench.markdown_table(merged, "kalman:estimate")
+    assert md[2] == "| thermal_2c (4, 4) | τ1 | 4 | 1.00 | 1.00 | — | 0.40 |"
+    md = bench.markdown_table(merged, "ar1_white:estimate")
+    assert md[2] == "| thermal_2c (2, 2) | τ1 | 2 | 1.00 | 0.00 | — | 0.40 |"
     bad.write_text(json.dumps(rec(1, {"kalman:estimate": var(0.9)})) + "\n")
     with pytest.raises(SystemExit, match=r"b\.jsonl: thermal_2c replicate 1"):
         bench.read_logs([str(pilot), str(bad)])

@@ -120,6 +120,82 @@ def test_kalman_matches_a_dense_gaussian():
     assert np.nansum(pw) == pytest.approx(ref, rel=1e-8)
 
 
+def test_kalman_ar1_matches_a_dense_gaussian():
+    """``kalman_ar1``: process noise on the nodes + AR(1) output error + white noise.
+    Its filter (the AR(1) state appended to the modal state) equals the dense normal
+    density whose covariance is the ``kalman`` one plus sigma_ar² phi^|j-k|, gaps
+    included; the one-step terms add up to it; its priors carry ar1_white's cap on phi."""
+    lp0, theta0 = _problem(n=90)
+    noise = get_noise_model("kalman_ar1")
+    ps = parameters_for(lp0.model, noise, room_volume=200)
+    assert ps.names[-2:] == ("sigma_ar_Ti", "phi_Ti")
+    assert ps["phi_Ti"].prior.upper == pytest.approx(0.96, abs=1e-3)
+    lp = LogPosterior(
+        lp0.model,
+        ps,
+        noise,
+        lp0.inputs,
+        lp0.observed,
+        warmup=0,
+        init_window=48,
+        initial_state="estimate",
+    )
+    sig_ar, phi = 0.4, 0.9
+    theta = np.append(theta0, [sig_ar, phi])
+    Ad, Bd, C, Qd = _discrete(lp0, theta0)
+    xm, P0 = _x0_prior(lp0, theta0)
+    N, n = lp.inputs.shape[0], Ad.shape[0]
+    mean = np.empty(N)
+    G = np.zeros((N, n))
+    H = np.zeros((N, N, n))
+    x, Ak = xm.copy(), np.eye(n)
+    for k in range(N):
+        mean[k] = (C @ x)[0]
+        G[k] = (C @ Ak)[0]
+        for j in range(k):
+            H[k, j] = (C @ np.linalg.matrix_power(Ad, k - 1 - j))[0]
+        x = Ad @ x + Bd @ lp.inputs[k]
+        Ak = Ad @ Ak
+    k = np.arange(N)
+    cov = (
+        G @ P0 @ G.T
+        + np.einsum("kjn,nm,ljm->kl", H, Qd, H)
+        + 0.2**2 * np.eye(N)
+        + sig_ar**2 * phi ** np.abs(k[:, None] - k[None, :])
+    )
+    ok = np.isfinite(lp.observed[:, 0])
+    ref = multivariate_normal(mean[ok], cov[np.ix_(ok, ok)]).logpdf(lp.observed[ok, 0])
+    assert lp.log_likelihood(theta[None])[0] == pytest.approx(ref, rel=1e-8)
+    assert np.nansum(lp.pointwise_log_likelihood(theta[None])) == pytest.approx(ref, rel=1e-8)
+    # without the AR(1) part it is the kalman likelihood
+    off = np.append(theta0, [1e-9, 0.0])
+    assert lp.log_likelihood(off[None])[0] == pytest.approx(
+        lp0.log_likelihood(theta0[None])[0], rel=1e-9
+    )
+
+
+def test_kalman_ar1_free_run_noise_moments():
+    """The free-run predictive noise of ``kalman_ar1`` adds the AR(1) error to the
+    process and measurement noise: its variance is the sum (Monte-Carlo, 4000 paths:
+    relative standard error of a variance sqrt(2/4000) = 2.2 %, tolerance 4.5 σ)."""
+    lp0, theta0 = _problem(n=30)
+    noise = get_noise_model("kalman_ar1")
+    theta = np.append(theta0, [0.5, 0.8])
+    tn = theta[None, lp0.n_model :]
+    mf = modal_form(lp0.model, np.repeat(theta[None, : lp0.n_model], 4000, axis=0), DT)
+    rng = np.random.default_rng(4)
+    K = 4000
+    e = noise.sample_statespace(rng, mf, np.repeat(tn, K, axis=0), 30, 1)[:, :, 0]
+    base = get_noise_model("kalman").sample_statespace(
+        np.random.default_rng(5), mf, np.repeat(tn[:, :-2], K, axis=0), 30, 1
+    )[:, :, 0]
+    var_expected = base.var(axis=0)[-1] + 0.5**2
+    assert e.var(axis=0)[-1] == pytest.approx(var_expected, rel=4.5 * np.sqrt(2 / K) * 1.5)
+    # lag-1 covariance of the AR part: phi sigma² on top of the model's own
+    cov1 = np.mean(e[:, -1] * e[:, -2]) - np.mean(base[:, -1] * base[:, -2])
+    assert cov1 == pytest.approx(0.8 * 0.5**2, abs=0.05)
+
+
 @pytest.mark.parametrize("gaps", [False, True])
 def test_kalman_steady_gains_match_statsmodels(gaps):
     """Long gap-free stretches: the filter switches to its steady-state gains once the

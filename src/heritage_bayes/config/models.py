@@ -57,11 +57,12 @@ class ModelSection(_Strict):
         "humidistat, source (hbayes models)",
         default_factory=dict,
     )
-    noise: Literal["ar1_white", "ar1", "iid", "kalman"] = key(
+    noise: Literal["ar1_white", "ar1", "iid", "kalman", "kalman_ar1"] = key(
         "ar1_white",
         unit=None,
         description="noise model: AR(1) model error + white sensor noise, a single AR(1), "
-        "iid, or a Kalman filter on the stochastic RC model",
+        "iid, a Kalman filter on the stochastic RC model (process noise on every node), "
+        "or that filter with an AR(1) output error added (kalman_ar1)",
     )
     initial_state: Literal["estimate", "steady"] | dict[str, float] | None = key(
         None,

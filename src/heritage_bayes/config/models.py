@@ -57,12 +57,11 @@ class ModelSection(_Strict):
         "humidistat, source (hbayes models)",
         default_factory=dict,
     )
-    noise: Literal["ar1_white", "ar1", "iid", "kalman", "kalman_ar1"] = key(
+    noise: Literal["ar1_white", "ar1", "iid", "kalman"] = key(
         "ar1_white",
         unit=None,
         description="noise model: AR(1) model error + white sensor noise, a single AR(1), "
-        "iid, a Kalman filter on the stochastic RC model (process noise on every node), "
-        "or that filter with an AR(1) output error added (kalman_ar1)",
+        "iid, or a Kalman filter on the stochastic RC model",
     )
     initial_state: Literal["estimate", "steady"] | dict[str, float] | None = key(
         None,

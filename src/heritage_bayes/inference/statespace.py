@@ -45,15 +45,10 @@ import math
 import numba
 import numpy as np
 
-from heritage_bayes.inference.likelihoods import (
-    NOISE_MODELS,
-    AR1WhiteNoise,
-    NoiseModel,
-    _ar1_sample,
-)
+from heritage_bayes.inference.likelihoods import NOISE_MODELS, NoiseModel
 from heritage_bayes.rc.discretize import modal_form
 
-__all__ = ["KalmanAR1Noise", "KalmanNoise", "modal_process_noise"]
+__all__ = ["KalmanNoise", "modal_process_noise"]
 
 _LOG2PI = math.log(2.0 * math.pi)
 
@@ -269,106 +264,4 @@ class KalmanNoise(NoiseModel):
         return out + np.sqrt(R)[:, None, :] * rng.standard_normal((K, N, n_out))
 
 
-class KalmanAR1Noise(KalmanNoise):
-    """Process noise on every node, an AR(1) model error on each output, and white
-    measurement noise: ``noise: kalman_ar1``.
-
-    .. math::
-
-        dx = (A x + B u)\\,dt + \\Sigma\\, dW, \\qquad
-        y_k = C x_k + \\eta_k + v_k, \\qquad
-        \\eta_k = \\phi\\,\\eta_{k-1} + \\sqrt{1-\\phi^2}\\,\\sigma_{ar}\\,\\xi_k.
-
-    Two kinds of model error at once: what enters the room's nodes and propagates with
-    its own time constants (an input that is wrong for a while: the facade irradiance
-    of another sky model, weather that varies within the hour), and a misfit of the
-    output that decays with its own correlation time, capped as in ``ar1_white``
-    (:attr:`~heritage_bayes.inference.likelihoods.AR1WhiteNoise.TAU_MAX_H`) so that it
-    cannot carry a slow response. Exact: the AR(1) state joins the modal state of the
-    filter (``n + n_out`` states, the same compiled filter).
-
-    Parameters: ``sigma_<output>`` (white measurement noise [K] or [Pa]),
-    ``q_<node>`` (diffusion [K/√h] or [Pa/√h]), ``sigma_ar_<output>`` (marginal sd of
-    the AR(1) error [K] or [Pa]) and ``phi_<output>`` [-] per time step.
-    """
-
-    name = "kalman_ar1"
-    TAU_MAX_H = AR1WhiteNoise.TAU_MAX_H
-
-    def parameter_specs(self, output_names, state_names=()) -> list[tuple[str, str, str]]:
-        specs = super().parameter_specs(output_names, state_names)
-        specs += [(f"sigma_ar_{o}", "sigma", o) for o in output_names]
-        return specs + [(f"phi_{o}", "phi", o) for o in output_names]
-
-    def priors_for(self, dt: float = 3600.0) -> dict:
-        """Default priors that depend on the time step ``dt`` [s]: phi's cap."""
-        return AR1WhiteNoise.priors_for(self, dt)
-
-    def split_statespace(self, noise: np.ndarray, n_out: int):
-        """(K, n_out) measurement variances, (K, n) diffusions [per √s]."""
-        n = noise.shape[1] - 3 * n_out
-        return super().split_statespace(noise[:, : n_out + n], n_out)
-
-    @staticmethod
-    def split_ar(noise: np.ndarray, n_out: int) -> tuple[np.ndarray, np.ndarray]:
-        """(K, n_out) marginal sd and (K, n_out) coefficient of the AR(1) errors."""
-        return noise[:, -2 * n_out : -n_out], noise[:, -n_out:]
-
-    def filter(self, model, mf, U, Yobs, noise, x0_mean, P0, want_point=False):
-        K, n = mf.lam.shape
-        n_out = mf.Cz.shape[1]
-        R, q = self.split_statespace(noise, n_out)
-        sig, phi = self.split_ar(noise, n_out)
-        na = n + n_out
-        Qd = np.zeros((K, na, na))
-        Qd[:, :n, :n] = modal_process_noise(mf, q)
-        Pa = np.zeros((K, na, na))
-        Ti = mf.Tinv
-        Pa[:, :n, :n] = Ti @ P0 @ np.swapaxes(Ti, 1, 2)
-        for o in range(n_out):
-            Qd[:, n + o, n + o] = sig[:, o] ** 2 * (1.0 - phi[:, o] ** 2)
-            Pa[:, n + o, n + o] = sig[:, o] ** 2  # stationary start
-        n_in = U.shape[1]
-        W = np.zeros((U.shape[0], K, na))
-        W[:, :, :n] = (U @ mf.Bdz.reshape(K * n, n_in).T).reshape(U.shape[0], K, n)
-        if mf.ez.any():
-            W[:, :, :n] += mf.edz[None]
-        ad = np.concatenate([mf.ad, phi], axis=1)
-        Cz = np.concatenate([mf.Cz, np.broadcast_to(np.eye(n_out), (K, n_out, n_out))], axis=2)
-        z = np.concatenate([mf.to_modal(x0_mean), np.zeros((K, n_out))], axis=1)
-        shape = (K, Yobs.shape[0], n_out) if want_point else (1, 1, 1)
-        point, pred = np.empty(shape), np.empty((2, *shape))
-        ll = _kalman_modal(
-            np.ascontiguousarray(ad),
-            W,
-            np.ascontiguousarray(Qd),
-            np.ascontiguousarray(Cz),
-            np.ascontiguousarray(Yobs, dtype=float),
-            np.ascontiguousarray(R),
-            np.ascontiguousarray(z),
-            np.ascontiguousarray(Pa),
-            point,
-            pred,
-            want_point,
-        )
-        return (ll, point, pred[0], pred[1]) if want_point else ll
-
-    def sample_statespace(self, rng, mf, noise, N: int, n_out: int) -> np.ndarray:
-        """(K, N, n_out) free-run predictive noise: the process noise through the modes,
-        the AR(1) errors and the measurement noise."""
-        out = super().sample_statespace(rng, mf, noise, N, n_out)
-        sig, phi = self.split_ar(noise, n_out)
-        for o in range(n_out):
-            e = np.empty((noise.shape[0], N))
-            _ar1_sample(
-                rng.standard_normal((noise.shape[0], N)),
-                np.ascontiguousarray(phi[:, o]),
-                np.ascontiguousarray(sig[:, o]),
-                e,
-            )
-            out[:, :, o] += e
-        return out
-
-
 NOISE_MODELS["kalman"] = KalmanNoise  # get_noise_model("kalman")
-NOISE_MODELS["kalman_ar1"] = KalmanAR1Noise

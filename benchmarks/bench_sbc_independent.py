@@ -30,7 +30,8 @@ truth, the fit's input for the draws): the physical effect, which does not depen
 which sky model scaled the aperture.
 
     python benchmarks/bench_sbc_independent.py --reps 50 --jobs 2 --log sbc_ind.jsonl
-    python benchmarks/bench_sbc_independent.py --table sbc_ind.jsonl
+    python benchmarks/bench_sbc_independent.py --table sbc_ind.jsonl [more.jsonl ...]
+    python benchmarks/bench_sbc_independent.py --table sbc_ind.jsonl --markdown
     python benchmarks/bench_sbc_independent.py --reps 4 --models thermal_2c
 
 Each replicate's room, weather stretch and noise come from ``(seed, replicate)``; one
@@ -52,6 +53,7 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 
 import numpy as np
 import pandas as pd
+from scipy import stats
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
@@ -253,6 +255,33 @@ def replicate(args) -> dict:
     return result
 
 
+def read_logs(paths: list[str]) -> list[dict]:
+    """The replicates of one or more ``--log`` files, one record per (model, replicate)
+    with the variants of every file merged; a variant found twice for the same replicate
+    (a replicate repeated, e.g. a pilot extended from an overlapping ``--first-rep``)
+    must agree, since each replicate is a function of ``(seed, replicate)``."""
+    merged: dict[tuple[str, int], dict] = {}
+    for path in paths:
+        with open(path) as f:
+            for line in f:
+                if not line.strip():
+                    continue
+                r = json.loads(line)
+                key = (r["model"], int(r["rep"]))
+                if key not in merged:
+                    merged[key] = {**r, "variants": dict(r["variants"])}
+                    continue
+                have = merged[key]["variants"]
+                for v, x in r["variants"].items():
+                    if v in have and have[v]["ranks"] != x["ranks"]:
+                        raise SystemExit(
+                            f"{path}: {r['model']} replicate {r['rep']} {v} differs from "
+                            "an earlier log's (another seed or code?)"
+                        )
+                    have.setdefault(v, x)
+    return [merged[k] for k in sorted(merged)]
+
+
 def zscore_lines(results: list[dict], variant: str) -> list[str]:
     """Per model and quantity the rms of z = (posterior median - truth) / posterior sd
     over the replicates: about 1 for calibrated intervals, the factor by which they are
@@ -273,6 +302,57 @@ def zscore_lines(results: list[dict], variant: str) -> list[str]:
     return lines
 
 
+#: how the markdown table names the quantities
+LABELS = {
+    "tau_1_h": "τ1",
+    "gain_Ti_Te": "gain from Te",
+    "gain_Ti_I_S": "gain from I_S",
+    "gain_Ti_Tf": "gain from Tf",
+    "solar_warming_K": "mean solar warming",
+    "gain_Pi_Pe": "gain from Pe",
+    "offset_Pi_Pf": "offset from Pf",
+}
+
+
+def markdown_table(results: list[dict], variant: str) -> list[str]:
+    """The coverage table of ``variant`` in markdown (docs, README): per model and
+    quantity the replicates, the 90 % and 50 % coverage, the rank χ² p-value (20
+    replicates or more) and the rms z-score."""
+    lines = [
+        "| model (replicates, converged) | quantity | n | 90 % coverage | 50 % | rank χ² p "
+        "| z rms |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for name in sorted({r["model"] for r in results}):
+        rs = [r for r in results if r["model"] == name and variant in r["variants"]]
+        if not rs:
+            continue
+        conv = sum(r["variants"][variant]["converged"] for r in rs)
+        head = f"{name} ({len(rs)}, {conv})"
+        for k in QUANTITIES.get(name, ()):
+            v = [
+                (x, r["truth"][k])
+                for r in rs
+                if (x := r["variants"][variant]["ranks"].get(k)) is not None
+            ]
+            if not v:
+                continue
+            n = len(v)
+            counts = np.histogram([x["rank"] for x, _ in v], bins=10, range=(0, 1))[0]
+            p = stats.chisquare(counts).pvalue if n >= 20 else float("nan")
+            z = [(x["median"] - t) / x["sd"] for x, t in v if x["sd"] > 0]
+            zr = float(np.sqrt(np.mean(np.square(z)))) if z else float("nan")
+            c90 = np.mean([x["in90"] for x, _ in v])
+            c50 = np.mean([x["in50"] for x, _ in v])
+            p_txt = "—" if not np.isfinite(p) else f"{p:.3f}"
+            lines.append(
+                f"| {head} | {LABELS.get(k, k)} | {n} | {c90:.2f} | {c50:.2f} | {p_txt} "
+                f"| {zr:.2f} |"
+            )
+            head = ""
+    return lines
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--reps", type=int, default=50)
@@ -289,7 +369,14 @@ def main(argv=None) -> int:
         help="comma-separated parts of the generator left out: within_hour, sky, substeps "
         "(then the room is simulated with the fit's hourly zero-order hold of its inputs)",
     )
-    ap.add_argument("--table", help="only tabulate a --log file of an earlier study")
+    ap.add_argument(
+        "--table",
+        nargs="+",
+        metavar="LOG",
+        help="only tabulate the --log file(s) of earlier studies (several: a study "
+        "extended with --first-rep, or variants run apart on the same replicates)",
+    )
+    ap.add_argument("--markdown", action="store_true", help="with --table: the tables in markdown")
     args = ap.parse_args(argv)
     variants = args.noise or ["ar1_white:estimate"]
     without = tuple(w for w in args.without.split(",") if w)
@@ -297,10 +384,18 @@ def main(argv=None) -> int:
     if set(without) - parts:
         ap.error(f"--without: unknown {sorted(set(without) - parts)}; use {sorted(parts)}")
     if args.table:
-        results = [json.loads(line) for line in open(args.table)]
-        print(f"SBC (independent generator) table of {args.table}: {len(results)} replicates")
+        results = read_logs(args.table)
+        print(
+            f"SBC (independent generator) table of {' '.join(args.table)}: "
+            f"{len(results)} replicates"
+        )
         for v in sorted({v for r in results for v in r["variants"]}):
-            for line in table(results, v, QUANTITIES) + zscore_lines(results, v):
+            if args.markdown:
+                print(f"\nnoise model {v}:\n")
+                lines = markdown_table(results, v)
+            else:
+                lines = table(results, v, QUANTITIES) + zscore_lines(results, v)
+            for line in lines:
                 print(line)
         return 0
     tasks = [

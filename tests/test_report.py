@@ -826,3 +826,30 @@ def test_weakly_separated_pairs_are_named_in_words():
     assert len(words) == 1
     assert words[0].startswith("gain_Pi_Pe [-] and offset_Pi_Pf [Pa] trade off")
     assert "one rises as the other falls" in words[0]
+    # the widening over the conditional interval, 1/sqrt(1 - r²), in words
+    r = np.corrcoef(a.reshape(-1), coords[2].draws.reshape(-1))[0, 1]
+    assert f"about {1 / np.sqrt(1 - r * r):.1f} times as wide" in words[0]
+
+
+def test_tradeoff_threshold_follows_the_widening():
+    """A pair at r = -0.85 (each interval 1.9x its conditional width) is named, one at
+    r = 0.5 (1.15x) is not: the words start where the trade-off widens an interval
+    by 1/sqrt(1 - 0.8²) = 1.7x (the gain and offset of a hygric_2c_fixed fit of the
+    demo room, r = -0.80)."""
+    from heritage_bayes.report.identifiable import Coord
+    from heritage_bayes.report.sections.identifiability import TRADEOFF_R, tradeoff_words
+
+    assert TRADEOFF_R == pytest.approx(0.8)
+    rng = np.random.default_rng(11)
+    n = 20000
+    x = rng.normal(size=n)
+
+    def partner(r):
+        return r * x + np.sqrt(1 - r * r) * rng.normal(size=n)
+
+    def coord(name, d):
+        return Coord(name, f"{name} [-]", False, d.reshape(8, -1), None, None)
+
+    named = tradeoff_words([coord("gain_Pi_Pe", x), coord("offset_Pi_Pf", partner(-0.85))])
+    assert len(named) == 1 and "about 1.9 times as wide" in named[0]
+    assert tradeoff_words([coord("gain_Pi_Pe", x), coord("offset_Pi_Pf", partner(0.5))]) == []

@@ -80,3 +80,52 @@ def test_independent_generator_machinery():
         t["gain_Ti_I_S"] * r["irradiance_mean"]["generator"]
     )
     assert t["gain_Ti_Te"] + t["gain_Ti_Tf"] == pytest.approx(1.0)
+
+
+def test_independent_table_merges_logs(tmp_path, capsys):
+    """``--table`` over several logs (a pilot with two noise models, a study extending
+    one of them): one record per (model, replicate) with the variants merged, a
+    replicate present in both logs counted once, and a replicate whose ranks differ
+    between logs (another seed or code) refused with the file named."""
+    import json
+
+    bench = pytest.importorskip("bench_sbc_independent")
+
+    def rec(rep, variants):
+        return {"model": "thermal_2c", "rep": rep, "truth": {"tau_1_h": 1.2}, "variants": variants}
+
+    def var(rank):
+        x = {"in50": rank > 0.25, "in90": True, "rank": rank, "median": 1.0, "sd": 0.5}
+        return {"ranks": {"tau_1_h": x}, "converged": True, "steps": 100, "cpu": 1.0}
+
+    pilot, study, bad = tmp_path / "pilot.jsonl", tmp_path / "study.jsonl", tmp_path / "b.jsonl"
+    pilot.write_text(
+        "".join(
+            json.dumps(rec(r, {"ar1_white:estimate": var(0.1), "kalman:estimate": var(0.5)})) + "\n"
+            for r in (0, 1)
+        )
+    )
+    study.write_text(
+        "".join(json.dumps(rec(r, {"kalman:estimate": var(0.5)})) + "\n" for r in (1, 2, 3))
+    )
+    merged = bench.read_logs([str(pilot), str(study)])
+    assert [r["rep"] for r in merged] == [0, 1, 2, 3]
+    assert [sorted(r["variants"]) for r in merged] == [
+        ["ar1_white:estimate", "kalman:estimate"],
+        ["ar1_white:estimate", "kalman:estimate"],
+        ["kalman:estimate"],
+        ["kalman:estimate"],
+    ]
+    assert bench.main(["--table", str(pilot), str(study)]) == 0
+    out = capsys.readouterr().out
+    assert "thermal_2c [kalman:estimate]: 4 replicates" in out
+    assert "thermal_2c [ar1_white:estimate]: 2 replicates" in out
+    # the markdown table: every truth inside at 90 %; at 50 % those of rank 0.5 (kalman)
+    # and none of rank 0.1 (ar1_white); z = (1.0 - 1.2) / 0.5 = -0.4 for each
+    md = bench.markdown_table(merged, "kalman:estimate")
+    assert md[2] == "| thermal_2c (4, 4) | τ1 | 4 | 1.00 | 1.00 | — | 0.40 |"
+    md = bench.markdown_table(merged, "ar1_white:estimate")
+    assert md[2] == "| thermal_2c (2, 2) | τ1 | 2 | 1.00 | 0.00 | — | 0.40 |"
+    bad.write_text(json.dumps(rec(1, {"kalman:estimate": var(0.9)})) + "\n")
+    with pytest.raises(SystemExit, match=r"b\.jsonl: thermal_2c replicate 1"):
+        bench.read_logs([str(pilot), str(bad)])

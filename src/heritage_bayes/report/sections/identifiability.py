@@ -154,8 +154,10 @@ def _coordinate_figures(coords: list, title: str) -> dict:
 
 
 #: |posterior correlation| from which two identifiable coordinates are called a
-#: weakly separated pair in words
-TRADEOFF_R = 0.9
+#: weakly separated pair in words: at 0.8 each one's interval is 1/sqrt(1 - r²) = 1.7
+#: times as wide as it would be with the other known (a hygric_2c_fixed fit of the demo
+#: room, which has no fixed node: gain_Pi_Pe and offset_Pi_Pf at r = -0.80)
+TRADEOFF_R = 0.8
 
 
 def tradeoff_words(coords: list) -> list[str]:
@@ -163,7 +165,9 @@ def tradeoff_words(coords: list) -> list[str]:
     offsets, scale) whose posterior correlation reaches ±:data:`TRADEOFF_R`: the data
     determine mainly a combination of the two (how the response splits between outdoor
     air and a slow boundary, a fixed node's gain and its offset, envelope and interior
-    mass), and each interval is as wide as that trade-off leaves it."""
+    mass), and each interval is wide because of that trade-off, by the factor
+    :math:`1/\\sqrt{1 - r^2}` (the ratio of a Gaussian's marginal to its conditional
+    standard deviation) over what it would be with the other quantity known."""
     from heritage_bayes.report.identifiable import identifiable_correlation
 
     if len(coords) < 2:
@@ -177,11 +181,14 @@ def tradeoff_words(coords: list) -> list[str]:
                 continue
             a, b = coords[i], coords[j]
             sign = "one rises as the other falls" if rij < 0 else "they rise and fall together"
+            widen = 1.0 / math.sqrt(max(1.0 - rij * rij, 1e-12))
             out.append(
                 f"{a.label} and {b.label} trade off (posterior correlation {rij:+.2f}: "
-                f"{sign}). These data determine mainly a combination of the two; each "
-                "one's 90 % interval is as wide as that trade-off leaves it, and knowledge "
-                "of either (a prior) narrows the other."
+                f"{sign}). These data cannot separate the two well and determine mainly "
+                f"a combination of them: each one's 90 % interval is about {widen:.1f} "
+                "times as wide as it would be with the other known. The width is the "
+                "data's, not a failure of the fit; knowledge of either (a prior) "
+                "narrows the other."
             )
     return out
 

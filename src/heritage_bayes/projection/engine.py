@@ -34,6 +34,16 @@ import pandas as pd
 
 from heritage_bayes.climate.psychro import saturation_vapour_pressure
 from heritage_bayes.errors import ConfigError, InputError
+from heritage_bayes.projection._modal import (
+    _HOURS_YEAR,
+    _NO_MODAL,
+    _controlled,
+    _coupled_series,
+    _modal_arrays,
+    _modal_form,
+    _noise,
+    _work,
+)
 from heritage_bayes.rc.control import N_COST, N_CP
 
 
@@ -374,9 +384,6 @@ def _simulate(
     ]
 
 
-_HOURS_YEAR = 8760
-
-
 def _hours_of_use(v, c) -> np.ndarray:
     """The hours of use (N,) of a measure's heating schedule on case ``c`` [-]."""
     if v is None or not v.controlled:
@@ -479,95 +486,6 @@ class _CaseOut:
                 index=pd.RangeIndex(self.par.shape[0]),
             ),
         )
-
-
-def _modal_form(m, P: np.ndarray, dt: float, free: bool = False):
-    """The modal form of a free-running model (None for a controlled one: it is
-    simulated by its own ``forward``); ``free``: of the model's network whatever it is
-    (a measure's controllers are stepped on it)."""
-    from heritage_bayes.rc.discretize import modal_form
-    from heritage_bayes.rc.model import RCModel
-
-    if m.n_states > _MAX_MODES or (type(m).forward is not RCModel.forward and not free):
-        return None
-    return modal_form(m, P, dt)
-
-
-def _modal_arrays(mf, u0: np.ndarray, source=None) -> tuple:
-    """(ad, Bdz, edz, Cz of the first output, z0) as ``RCModel.forward`` sets them up;
-    ``source``: (forcing, steady-state shift) of a constant source, added to ``edz`` and
-    ``z0`` as ``ControlledModel.forward`` does."""
-    with np.errstate(divide="ignore", invalid="ignore"):
-        z0 = mf.steady_state_modal(u0)
-    z0 = np.where(np.isfinite(z0), z0, 0.0)
-    z0 = np.ascontiguousarray(np.broadcast_to(z0, mf.lam.shape))
-    c = np.ascontiguousarray
-    edz = mf.edz
-    if source is not None:
-        edz, z0 = edz + source[0], c(z0 + source[1])
-    return c(mf.ad), c(mf.Bdz), c(edz), c(mf.Cz[:, 0, :]), z0
-
-
-_MAX_MODES = 64
-_NO_MODAL = (np.zeros((0, 1)), np.zeros((0, 1, 1)), np.zeros((0, 1)), np.zeros((0, 1)),
-             np.zeros((0, 1)))  # fmt: skip
-
-
-def _noise(draws: Draws, sl: slice, N: int, seed: int, i: int) -> dict:
-    """The noise of chunk ``i`` for series of ``N`` hours, section by section."""
-    rng = np.random.default_rng([seed, i])
-    return {
-        s: np.ascontiguousarray(nm.sample(rng, draws.noise[s][sl], N, 1)[..., 0])
-        for s, nm in draws.noise_models.items()
-    }
-
-
-def _work(plan, slots: int, N: int) -> tuple:
-    """Work arrays of the compiled pass: the plan's, four series and the modal state
-    and forcing of each slot."""
-    from heritage_bayes.climate.risk._fused import BLOCK
-
-    return (
-        *plan.workspace(slots),
-        np.empty((slots, 4, N)),
-        np.empty((slots, _MAX_MODES)),
-        np.empty((slots, _MAX_MODES, BLOCK)),
-    )
-
-
-def _controlled(run, P, c: _Case, o: _CaseOut | None, rows, dt, w, measure) -> dict:
-    """The reference path: noise-free ``Ti``, ``Pi`` (section -> (k, N)) of draws
-    ``rows`` through :meth:`Measure.simulate`; its running costs stored as sums in ``o``
-    (the compiled pass's :data:`~heritage_bayes.rc.control.N_COST` columns)."""
-    u0 = {s: c.U[s][: max(1, w)].mean(axis=0) for s in run.models}
-    Y, costs = measure.simulate(run, {s: P[s][rows] for s in run.models}, c.U, u0, dt,
-                                index=c.index)  # fmt: skip
-    if o is not None:
-        o.cost[rows] = measure.cost_sums(costs, dt, c.N / _HOURS_YEAR)
-    return Y
-
-
-def _coupled_series(c: _Case, modal: dict, ctrl: tuple, sig, rows, w: int, cost=None):
-    """Noise-free ``Ti``, ``Pi`` (section -> (k, N)) of the chunk's draws ``rows``
-    (positions in the chunk) with a measure's controllers
-    (:func:`heritage_bayes.rc.control.coupled_draw`, the compiled pass's arithmetic)."""
-    from heritage_bayes.rc.control import coupled_draw
-
-    ctl, bdT, bdP, spin, src = ctrl
-    mT = _modal_arrays(modal["thermal"], c.U["thermal"][: max(1, w)].mean(axis=0),
-                       src.get("thermal"))  # fmt: skip
-    mP = _modal_arrays(modal["hygric"], c.U["hygric"][: max(1, w)].mean(axis=0),
-                       src.get("hygric"))  # fmt: skip
-    Y = {"thermal": np.empty((len(rows), c.N)), "hygric": np.empty((len(rows), c.N))}
-    for j, i in enumerate(rows):
-        nT, nP = mT[0].shape[1], mP[0].shape[1]
-        acc = np.zeros(N_COST) if cost is None else cost[i]
-        coupled_draw(
-            *(x[i] for x in mT), c.Ut["thermal"], *(x[i] for x in mP), c.Ut["hygric"],
-            bdT[i], bdP[i], ctl[i], sig, spin, Y["thermal"][j], Y["hygric"][j], acc,
-            np.empty(nT), np.empty(nP), np.empty(nT), np.empty(nP),
-        )  # fmt: skip
-    return Y
 
 
 def _run_chunk(

@@ -33,6 +33,7 @@ from heritage_bayes.inference.predictive import (
     predictive_noise,
 )
 from heritage_bayes.inference.results import coverage, fit_metrics
+from heritage_bayes.inference.runinfo import _periods, _truth_for, _versions
 from heritage_bayes.rc.discretize import modal_form
 from heritage_bayes.rc.identify import derived_quantities, derived_units
 
@@ -498,42 +499,6 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
     return idata, summary
 
 
-def _truth_for(cfg, prep, section) -> tuple[dict, dict]:
-    """True parameter values and derived quantities to show beside the posterior.
-
-    Only for generated data (the demo). Parameters are compared when the calibrated
-    model is the generating one; otherwise only the model-independent properties of the
-    room are: the static gains, constant-boundary offsets and the slowest time constant.
-    """
-    truth = (prep.truth or {}).get(section.name) or {}
-    gen = (((prep.sources or {}).get("demo") or {}).get("models") or {}).get(section.name)
-    if not truth or gen is None:
-        return {}, {}
-    from heritage_bayes.rc.catalog import model as catalog_model
-
-    if gen == section.model.name:
-        gen_model = section.model
-        params_truth = truth
-    else:
-        try:
-            opts = {}
-            if section.model.domain == "thermal" and gen != "thermal_4a_nosolar":
-                opts["surfaces"] = tuple(cfg.data.surfaces)
-            gen_model = catalog_model(gen, **opts)
-        except ValueError:
-            return {}, {}
-        params_truth = {}
-    p = {k: v for k, v in truth.items() if k in gen_model.parameter_names}
-    if len(p) != len(gen_model.parameter_names):
-        return params_truth, {}
-    dq = {
-        k: float(np.asarray(v).reshape(-1)[0]) for k, v in derived_quantities(gen_model, p).items()
-    }
-    if gen != section.model.name:
-        dq = {k: v for k, v in dq.items() if not k.startswith("tau_") or k == "tau_1_h"}
-    return params_truth, dq
-
-
 def _hours(seconds: float | None) -> float | None:
     """Seconds -> hours; None for none or infinity (JSON has no infinity)."""
     return None if seconds is None or not np.isfinite(seconds) else seconds / 3600.0
@@ -548,51 +513,6 @@ def _frozen_share(tau_h, lp) -> float | None:
         return None
     record_h = lp.record_seconds / 3600.0
     return float(np.mean(np.asarray(tau_h).reshape(-1) > FROZEN_RECORDS * record_h))
-
-
-def _versions() -> dict:
-    """Versions of the key libraries that produced the run."""
-    from importlib.metadata import PackageNotFoundError, version
-
-    out = {}
-    for name in (
-        "heritage_bayes",
-        "numpy",
-        "scipy",
-        "pandas",
-        "numba",
-        "emcee",
-        "arviz",
-        "xarray",
-        "matplotlib",
-        "corner",
-        "pvlib",
-        "h5py",
-        "pydantic",
-    ):
-        try:
-            out[name] = version(name)
-        except PackageNotFoundError:
-            out[name] = None
-    import platform
-
-    out["python"] = platform.python_version()
-    return out
-
-
-def _periods(prep) -> dict:
-    idx = prep.frame.index
-    out = {}
-    for name in ("calibration", "validation"):
-        sl = getattr(prep, name)
-        if sl is None:
-            continue
-        out[name] = {
-            "start": idx[sl.start].isoformat(),
-            "end": (idx[sl.stop - 1] + (idx[1] - idx[0])).isoformat(),
-            "steps": int(sl.stop - sl.start),
-        }
-    return out
 
 
 def _metrics_for(prep, codes, outputs, pp_outputs, one_step=None) -> dict:

@@ -1,0 +1,93 @@
+"""What a run's summary records beside the posterior: truths, periods, versions.
+
+The true parameters and derived quantities of generated data (the demo), shown beside
+the posterior; the calibration and validation periods; the versions of the libraries
+that produced the run. Split from :mod:`heritage_bayes.inference.idata`, which calls them.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from heritage_bayes.rc.identify import derived_quantities
+
+
+def _truth_for(cfg, prep, section) -> tuple[dict, dict]:
+    """True parameter values and derived quantities to show beside the posterior.
+
+    Only for generated data (the demo). Parameters are compared when the calibrated
+    model is the generating one; otherwise only the model-independent properties of the
+    room are: the static gains, constant-boundary offsets and the slowest time constant.
+    """
+    truth = (prep.truth or {}).get(section.name) or {}
+    gen = (((prep.sources or {}).get("demo") or {}).get("models") or {}).get(section.name)
+    if not truth or gen is None:
+        return {}, {}
+    from heritage_bayes.rc.catalog import model as catalog_model
+
+    if gen == section.model.name:
+        gen_model = section.model
+        params_truth = truth
+    else:
+        try:
+            opts = {}
+            if section.model.domain == "thermal" and gen != "thermal_4a_nosolar":
+                opts["surfaces"] = tuple(cfg.data.surfaces)
+            gen_model = catalog_model(gen, **opts)
+        except ValueError:
+            return {}, {}
+        params_truth = {}
+    p = {k: v for k, v in truth.items() if k in gen_model.parameter_names}
+    if len(p) != len(gen_model.parameter_names):
+        return params_truth, {}
+    dq = {
+        k: float(np.asarray(v).reshape(-1)[0]) for k, v in derived_quantities(gen_model, p).items()
+    }
+    if gen != section.model.name:
+        dq = {k: v for k, v in dq.items() if not k.startswith("tau_") or k == "tau_1_h"}
+    return params_truth, dq
+
+
+def _versions() -> dict:
+    """Versions of the key libraries that produced the run."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    out = {}
+    for name in (
+        "heritage_bayes",
+        "numpy",
+        "scipy",
+        "pandas",
+        "numba",
+        "emcee",
+        "arviz",
+        "xarray",
+        "matplotlib",
+        "corner",
+        "pvlib",
+        "h5py",
+        "pydantic",
+    ):
+        try:
+            out[name] = version(name)
+        except PackageNotFoundError:
+            out[name] = None
+    import platform
+
+    out["python"] = platform.python_version()
+    return out
+
+
+def _periods(prep) -> dict:
+    idx = prep.frame.index
+    out = {}
+    for name in ("calibration", "validation"):
+        sl = getattr(prep, name)
+        if sl is None:
+            continue
+        out[name] = {
+            "start": idx[sl.start].isoformat(),
+            "end": (idx[sl.stop - 1] + (idx[1] - idx[0])).isoformat(),
+            "steps": int(sl.stop - sl.start),
+        }
+    return out

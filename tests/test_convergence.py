@@ -304,7 +304,7 @@ def test_every_moves_choice_of_the_config_builds_emcee_moves_and_samples():
     import emcee
 
     from heritage_bayes.config.sampler import SamplerSettings
-    from heritage_bayes.inference.sampler import MOVES, make_moves
+    from heritage_bayes.inference.monitor import MOVES, make_moves
 
     choices = typing.get_args(SamplerSettings.model_fields["moves"].annotation)
     assert set(choices) == set(MOVES)

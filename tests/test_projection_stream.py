@@ -258,3 +258,38 @@ def test_no_baseline_no_band(setup):
                                 noise=False, baseline=False)  # fmt: skip
     assert "en15757_outside_baseline" not in got[1].parametric.columns
     assert np.isnan(got[1].annual_parametric[..., 3]).all()
+
+
+def test_kalman_noise_in_projections_carries_the_process_noise():
+    """A ``noise: kalman`` run's projection noise is its process noise propagated through
+    each draw's modes plus the measurement noise (as the calibration's bands), not the
+    measurement noise alone (which made its projected bands too narrow)."""
+    from heritage_bayes.inference.statespace import KalmanNoise
+    from heritage_bayes.projection._modal import _noise
+    from heritage_bayes.projection.engine import Draws
+    from heritage_bayes.rc.catalog import model as catalog_model
+    from heritage_bayes.rc.discretize import modal_form
+
+    m = catalog_model("thermal_1c")
+    # Ci 5e6 J/K, Ge 100 W/K, Gf 20 W/K: tau = Ci/(Ge+Gf) = 11.6 h
+    P = np.tile([5e6, 100.0, 20.0, 0.5, 0.5, 0.5, 0.5], (4, 1))
+    sigma, q = 0.05, 0.3  # [K], [K/sqrt(h)]
+    noise = np.tile([sigma, q], (4, 1))
+    draws = Draws(np.arange(4), {"thermal": P}, {"thermal": noise}, {"thermal": KalmanNoise()})
+    N = 20000
+    e = _noise(draws, slice(0, 4), N, 7, 0, {"thermal": m}, 3600.0)["thermal"]
+    # the same stream as the calibration's free-run noise
+    rng = np.random.default_rng([7, 0])
+    ref = KalmanNoise().sample_statespace(rng, modal_form(m, P, 3600.0), noise, N, 1)[..., 0]
+    np.testing.assert_array_equal(e, ref)
+    # stationary variance of the node: q^2 tau / 2 (q per sqrt(h), tau in h) + sigma^2
+    tau_h = 5e6 / 120.0 / 3600.0
+    expected = q**2 * tau_h / 2 + sigma**2
+    var = e[:, 2000:].var(axis=1)
+    # 18 000 hours with a correlation time of 11.6 h: ~780 independent values per draw,
+    # the variance estimate's relative sd sqrt(2/780) = 5 %; 4 draws pooled: 2.5 %
+    assert abs(var.mean() / expected - 1) < 0.1
+    assert var.mean() > 10 * sigma**2
+    # without the models the state-space noise cannot be drawn: a clear error
+    with pytest.raises(ValueError, match="state-space"):
+        _noise(draws, slice(0, 4), 10, 7, 0)

@@ -90,13 +90,31 @@ def _coupled_series(c: _Case, modal: dict, ctrl: tuple, sig, rows, w: int, cost=
     return Y
 
 
-def _noise(draws: Draws, sl: slice, N: int, seed: int, i: int) -> dict:
-    """The noise of chunk ``i`` for series of ``N`` hours, section by section."""
+def _noise(draws: Draws, sl: slice, N: int, seed: int, i: int, models=None, dt=3600.0) -> dict:
+    """The noise of chunk ``i`` for series of ``N`` hours, section by section.
+
+    A state-space noise model (``noise: kalman``) carries its model error as process
+    noise on the nodes: its free-run noise is that process noise propagated through each
+    draw's own modes plus the measurement noise
+    (:meth:`~heritage_bayes.inference.statespace.KalmanNoise.sample_statespace`, as the
+    calibration's predictive bands), so ``models`` (section -> RC model) and the step
+    ``dt`` [s] are needed for it; the residual noise models draw from their parameters
+    alone."""
+    from heritage_bayes.rc.discretize import modal_form
+
     rng = np.random.default_rng([seed, i])
-    return {
-        s: np.ascontiguousarray(nm.sample(rng, draws.noise[s][sl], N, 1)[..., 0])
-        for s, nm in draws.noise_models.items()
-    }
+    out = {}
+    for s, nm in draws.noise_models.items():
+        if getattr(nm, "statespace", False):
+            if models is None:
+                raise ValueError(f"section {s!r}: a state-space noise model needs its RC model")
+            with np.errstate(all="ignore"):
+                mf = modal_form(models[s], draws.model[s][sl], dt)
+            e = nm.sample_statespace(rng, mf, draws.noise[s][sl], N, 1)[..., 0]
+        else:
+            e = nm.sample(rng, draws.noise[s][sl], N, 1)[..., 0]
+        out[s] = np.ascontiguousarray(e)
+    return out
 
 
 def _controlled(run, P, c: _Case, o: _CaseOut | None, rows, dt, w, measure) -> dict:

@@ -334,7 +334,11 @@ def _simulate(
 
     def draw_noise(i: int) -> tuple[dict, float]:
         t0 = time.perf_counter()
-        e = {N: _noise(draws, chunks[i], N, seed, i) for N in lengths} if noise else {}
+        e = (
+            {N: _noise(draws, chunks[i], N, seed, i, run.models, dt) for N in lengths}
+            if noise
+            else {}
+        )
         return e, time.perf_counter() - t0
 
     # the noise of the next chunk is drawn while this one is reduced (numpy's generator

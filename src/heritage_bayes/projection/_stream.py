@@ -225,6 +225,17 @@ def _annual_row(T, RH, N, hoy, mode, en, en_col, row, band, out, ma, cnt):  # pr
     annual_values(T, RH, N, hoy, mode if en_col >= 0 else 0, e, band, out, ma, cnt)
 
 
+@njit(cache=True, error_model="numpy")
+def _reduce(T, RH, N, ea_r, fpar, ipar, kinds, cls, ws, tmp, btmp, hist, vals, hoy, mode, en,
+            en_col, band, ann, ma, cnt):  # fmt: skip  # pragma: no cover - compiled
+    """One series reduced: its indicators into ``vals`` (status returned, as
+    :func:`series_indicators`) and its per-year values into ``ann``
+    (:func:`_annual_row`)."""
+    st = series_indicators(T, RH, N, ea_r, fpar, ipar, kinds, cls, ws, tmp, btmp, hist, vals)
+    _annual_row(T, RH, N, hoy, mode, en, en_col, vals, band, ann, ma, cnt)
+    return st
+
+
 @njit(parallel=True, cache=True, error_model="numpy")
 def chunk_kernel(
     YT, YP, mT, mP, UT, UP, eT, eP, noise, starts,
@@ -288,12 +299,9 @@ def chunk_kernel(
             if par_on or not noise:
                 for t in range(N):
                     RHx[t] = _rh(Ts[t], Ps[t])
-                spar[i] = series_indicators(
-                    Ts, RHx, N, ea_r, fpar, ipar, kinds, cls, ws[s], tmp[s], btmp[s],
-                    hist[s], par[i],
-                )  # fmt: skip
-                _annual_row(Ts, RHx, N, hoy, mode, en, en_col, par[i], bpar[i], apar[i],
-                            mabuf[s], cbuf[s])  # fmt: skip
+                spar[i] = _reduce(Ts, RHx, N, ea_r, fpar, ipar, kinds, cls, ws[s], tmp[s],
+                                  btmp[s], hist[s], par[i], hoy, mode, en, en_col, bpar[i],
+                                  apar[i], mabuf[s], cbuf[s])  # fmt: skip
             else:
                 spar[i] = 0
                 par[i, :] = math.nan
@@ -305,12 +313,9 @@ def chunk_kernel(
                     x = Ts[t] + ei[t]
                     Tx[t] = x
                     RHx[t] = _rh(x, Ps[t] + pi[t])
-                spred[i] = series_indicators(
-                    Tx, RHx, N, ea_r, fpar, ipar, kinds, cls, ws[s], tmp[s], btmp[s],
-                    hist[s], pred[i],
-                )  # fmt: skip
-                _annual_row(Tx, RHx, N, hoy, mode, en, en_col, pred[i], bpred[i], apred[i],
-                            mabuf[s], cbuf[s])  # fmt: skip
+                spred[i] = _reduce(Tx, RHx, N, ea_r, fpar, ipar, kinds, cls, ws[s], tmp[s],
+                                   btmp[s], hist[s], pred[i], hoy, mode, en, en_col, bpred[i],
+                                   apred[i], mabuf[s], cbuf[s])  # fmt: skip
                 _monthly(Tx, starts, Tm[i])
             else:
                 spred[i] = spar[i]

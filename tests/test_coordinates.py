@@ -190,3 +190,75 @@ def test_sampler_coordinates_key_chooses_them_and_enters_the_chain_tag():
     assert len(set(tags.values())) == 3
     with pytest.raises(ConfigError, match="coordinates"):
         parse_config({**base, "sampler": {"coordinates": "laplace"}})
+
+
+def _logpost_4a(surfaces=("S", "N"), priors=None):
+    m = hb.model("thermal_4a", surfaces=surfaces)
+    noise = get_noise_model("ar1")
+    U = np.ones((48, len(m.input_names)))
+    ps = parameters_for(m, noise, priors or {})
+    return LogPosterior(m, ps, noise, U, np.ones((48, 1)), warmup=0)
+
+
+def test_split_solar_apertures_are_sampled_as_the_aperture_to_the_air():
+    """thermal_4a: log fI_s is replaced by log(fI_s (1 - fsol)) (the aperture to the air
+    node [m²]), fsol's logit coordinate kept; then log of the aperture to the mass is
+    that coordinate plus logit(fsol): both linear. A bijection with unit Jacobian.
+    Opt-in (``solar=True``): on the demo it left fsol's τ unchanged."""
+    lp = _logpost_4a()
+    c = node_time_constants(lp, solar=True)
+    names = lp.params.free_names
+    ((f, lo, width, gains),) = c.splits
+    assert names[f] == "fsol" and (lo, width) == (0.0, 1.0)
+    assert sorted(names[g] for g in gains) == ["fI_N", "fI_S"]
+    rng = np.random.default_rng(2)
+    theta = lp.params.sample_prior(rng, 30)
+    X = lp.params.to_unconstrained(theta)
+    Y = c.to_y(X)
+    fsol = theta[:, lp.params.names.index("fsol")]
+    for s in ("S", "N"):
+        fI = theta[:, lp.params.names.index(f"fI_{s}")]
+        k = names.index(f"fI_{s}")
+        np.testing.assert_allclose(Y[:, k], np.log(fI * (1 - fsol)), rtol=1e-12)
+        np.testing.assert_allclose(Y[:, k] + Y[:, f], np.log(fI * fsol), rtol=1e-10)
+    np.testing.assert_allclose(c.to_x(Y), X, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(c(Y), lp(X), rtol=1e-12)
+    y0 = Y[0]
+    d, h = y0.size, 1e-6
+    J = np.empty((d, d))
+    for j in range(d):
+        e = np.zeros(d)
+        e[j] = h
+        J[:, j] = (c.to_x(y0 + e)[0] - c.to_x(y0 - e)[0]) / (2 * h)
+    assert np.linalg.det(J) == pytest.approx(1.0, abs=1e-6)
+    # the fsol column of the Jacobian is dlog fI_s/dv = σ(v) off the diagonal: not zero
+    assert abs(J[gains[0], f]) > 1e-3
+    # the default (solar=False, what hbayes samples in): the apertures stay in the log
+    # coordinates; measured no gain in τ on the demo (benchmarks/README.md)
+    c0 = node_time_constants(lp)
+    assert c0.splits == []
+    keep = [k for k in range(d) if k not in [n for n, _ in c0.nodes]]
+    np.testing.assert_array_equal(c0.to_y(X)[:, keep], X[:, keep])
+
+
+def test_split_solar_prior_narrower_than_the_unit_interval_and_fixed_fsol():
+    """A prior on fsol over [lo, lo + w] ⊂ [0, 1] uses log(1 - f) directly; a fixed fsol
+    or a fixed aperture leaves nothing (or only the free apertures) to re-coordinate."""
+    lp = _logpost_4a(priors={"fsol": {"dist": "uniform", "lower": 0.2, "upper": 0.9}})
+    c = node_time_constants(lp, solar=True)
+    ((f, lo, width, _),) = c.splits
+    assert (lo, width) == pytest.approx((0.2, 0.7))
+    rng = np.random.default_rng(3)
+    X = lp.params.to_unconstrained(lp.params.sample_prior(rng, 10))
+    np.testing.assert_allclose(c.to_x(c.to_y(X)), X, rtol=0, atol=1e-12)
+    theta = lp.params.values(X)
+    k = lp.params.free_names.index("fI_S")
+    fs = theta[:, lp.params.names.index("fsol")]
+    fI = theta[:, lp.params.names.index("fI_S")]
+    np.testing.assert_allclose(c.to_y(X)[:, k], np.log(fI * (1 - fs)), rtol=1e-12)
+    assert (
+        node_time_constants(_logpost_4a(priors={"fsol": {"fixed": 0.3}}), solar=True).splits == []
+    )
+    c1 = node_time_constants(_logpost_4a(priors={"fI_N": {"fixed": 1.0}}), solar=True)
+    names = c1.logpost.params.free_names
+    assert [names[g] for g in c1.splits[0][3]] == ["fI_S"]

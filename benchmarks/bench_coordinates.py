@@ -116,6 +116,12 @@ def main() -> None:
         help="node_tau with the split-solar coordinates (log fI_s -> log fI_s (1 - fsol))",
     )
     ap.add_argument(
+        "--air-share",
+        action="store_true",
+        help="node_tau with split fractions (fsol) sampled as log(1 - fsol), the log of "
+        "the air's share",
+    )
+    ap.add_argument(
         "--save-chain",
         default=None,
         help="write each chain (steps, walkers, d) in the log coordinates to "
@@ -126,7 +132,7 @@ def main() -> None:
         cfg = _config(*PROBLEMS[name])
         section = PROBLEMS[name][1]
         _, model, lp, mp = config_map(cfg, section)
-        coords = node_time_constants(lp, solar=args.solar)
+        coords = node_time_constants(lp, solar=args.solar, air_share=args.air_share)
         print(
             f"{name}: {model.name}, {lp.ndim} free parameters, MAP {mp.log_post:.1f}; "
             f"{len(coords.nodes) if coords else 0} node(s) and "

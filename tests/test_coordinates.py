@@ -262,3 +262,39 @@ def test_split_solar_prior_narrower_than_the_unit_interval_and_fixed_fsol():
     c1 = node_time_constants(_logpost_4a(priors={"fI_N": {"fixed": 1.0}}), solar=True)
     names = c1.logpost.params.free_names
     assert [names[g] for g in c1.splits[0][3]] == ["fI_S"]
+
+
+def test_fsol_sampled_as_the_log_of_the_air_share_with_its_jacobian():
+    """air_share=True: fsol's coordinate is log(1 - fsol) [-]; the log-density in it is
+    the log-posterior plus log|dv/dy| (v = logit fsol), checked against a numerical
+    determinant, for the default prior on [0, 1] and a narrower one."""
+    for priors in ({}, {"fsol": {"dist": "uniform", "lower": 0.2, "upper": 0.9}}):
+        lp = _logpost_4a(priors=priors)
+        c = node_time_constants(lp, air_share=True)
+        names = lp.params.free_names
+        ((k, lo, width),) = c.shares
+        assert names[k] == "fsol"
+        rng = np.random.default_rng(4)
+        theta = lp.params.sample_prior(rng, 10)
+        X = lp.params.to_unconstrained(theta)
+        Y = c.to_y(X)
+        fsol = theta[:, lp.params.names.index("fsol")]
+        np.testing.assert_allclose(Y[:, k], np.log1p(-fsol), rtol=1e-12)
+        np.testing.assert_allclose(c.to_x(Y), X, rtol=0, atol=1e-10)
+        for i in range(3):
+            y0 = Y[i]
+            d, h = y0.size, 1e-6
+            J = np.empty((d, d))
+            for j in range(d):
+                e = np.zeros(d)
+                e[j] = h
+                J[:, j] = (c.to_x(y0 + e)[0] - c.to_x(y0 - e)[0]) / (2 * h)
+            logdet = np.log(abs(np.linalg.det(J)))
+            assert c(Y[i : i + 1])[0] - lp(X[i : i + 1])[0] == pytest.approx(logdet, abs=1e-6)
+        # outside the support (fsol < lo or > lo + width): -inf, never an exception
+        Y[0, k] = 0.5  # 1 - fsol > 1
+        # fsol above the prior's upper bound (fsol = 1 for the prior on [0, 1])
+        Y[1, k] = np.log1p(-(lo + width)) - 0.1 if lo + width < 1 else -np.inf
+        out = c(Y[:3])
+        assert out[0] == -np.inf and out[1] == -np.inf and np.isfinite(out[2])
+    assert node_time_constants(_logpost_4a(), air_share=False).shares == []

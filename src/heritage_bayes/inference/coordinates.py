@@ -93,7 +93,7 @@ class NodeTimeConstants:
 
     name = "node_tau"
 
-    def __init__(self, logpost, solar: bool = False):
+    def __init__(self, logpost, solar: bool = False, air_share: bool = False):
         self.logpost = logpost
         params, model = logpost.params, logpost.model
         free = {int(j): k for k, j in enumerate(params._free_idx)}
@@ -115,6 +115,10 @@ class NodeTimeConstants:
                 gs.append((free.get(g), float(p.fixed or 0.0), bool(p.prior.log_scale)))
             self.nodes.append((free[c], gs))
         self.splits = _splits(params, model, free) if solar else []
+        # (free index, lo, width) of split fractions sampled as log(1 - f) [-]
+        self.shares = (
+            [(k, lo, w) for k, lo, w, _ in _splits(params, model, free)] if air_share else []
+        )
 
     @property
     def ndim(self) -> int:
@@ -139,9 +143,27 @@ class NodeTimeConstants:
         with np.errstate(divide="ignore", invalid="ignore"):
             return np.log1p(-(lo + width * expit(v)))
 
+    def _share_to_logit(self, Y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """log(1 - f) coordinates -> (the logit coordinates of f (K, len(shares)),
+        log|dv/dy| summed (K,)); outside the prior's support NaN and -inf."""
+        V = np.empty((Y.shape[0], len(self.shares)))
+        logj = np.zeros(Y.shape[0])
+        for i, (k, lo, width) in enumerate(self.shares):
+            with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+                s = (-np.expm1(Y[:, k]) - lo) / width  # σ(v) = (1 - e^y - lo) / width
+                ok = (s > 0) & (s < 1)
+                V[:, i] = np.where(ok, np.log(s) - np.log1p(-s), np.nan)
+                # |dv/dy| = e^y / (width σ (1 - σ))
+                logj += np.where(ok, Y[:, k] - np.log(width) - np.log(s) - np.log1p(-s), -np.inf)
+        return V, logj
+
     def to_x(self, Y: np.ndarray) -> np.ndarray:
         """Time-constant coordinates (K, d) -> the sampler's log coordinates (K, d)."""
         X = np.array(np.atleast_2d(Y), dtype=float, copy=True)
+        if self.shares:
+            V, _ = self._share_to_logit(X)
+            for i, (k, _, _) in enumerate(self.shares):
+                X[:, k] = V[:, i]
         for c, gs in self.nodes:  # conductance coordinates are the same in x and y
             X[:, c] = X[:, c] + self._log_conductance_sum(X, gs)
         for f, lo, width, gains in self.splits:  # f's coordinate is the same in x and y
@@ -160,16 +182,19 @@ class NodeTimeConstants:
             share = self._log_air_share(X[:, f], lo, width)
             for g in gains:
                 Y[:, g] = X[:, g] + share
+        for k, lo, width in self.shares:
+            Y[:, k] = self._log_air_share(X[:, k], lo, width)
         return Y
 
     def __call__(self, Y: np.ndarray) -> np.ndarray:
         """(K,) log-posterior at time-constant coordinates (unit Jacobian)."""
         X = self.to_x(Y)
+        logj = self._share_to_logit(np.atleast_2d(Y))[1] if self.shares else 0.0
         ok = np.all(np.isfinite(X), axis=1)
         out = np.full(X.shape[0], -np.inf)
         if ok.any():
             out[ok] = self.logpost(X[ok])
-        return out
+        return out + logj
 
 
 def _splits(params, model, free: dict[int, int]) -> list[tuple[int, float, float, list[int]]]:
@@ -197,12 +222,14 @@ def _splits(params, model, free: dict[int, int]) -> list[tuple[int, float, float
     return splits
 
 
-def node_time_constants(logpost, solar: bool = False) -> NodeTimeConstants | None:
+def node_time_constants(
+    logpost, solar: bool = False, air_share: bool = False
+) -> NodeTimeConstants | None:
     """:class:`NodeTimeConstants` for a log-posterior, or None when no node's capacity
     is a free log-scale parameter and no solar gain is split (nothing to re-coordinate).
     ``solar=False`` leaves the split solar apertures in the log coordinates."""
-    coords = NodeTimeConstants(logpost, solar=solar)
-    return coords if coords.nodes or coords.splits else None
+    coords = NodeTimeConstants(logpost, solar=solar, air_share=air_share)
+    return coords if coords.nodes or coords.splits or coords.shares else None
 
 
 def sampling_coordinates(logpost, choice: str = "auto") -> NodeTimeConstants | None:

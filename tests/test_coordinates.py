@@ -32,6 +32,17 @@ def _logpost(name="thermal_2c", N=24 * 20, priors=None, seed=0):
     return LogPosterior(m, ps, noise, U, y[:, None], warmup=24, init_window=24), truth
 
 
+def _jacobian(c, y0: np.ndarray, h: float = 1e-6) -> np.ndarray:
+    """(d, d) central-difference Jacobian dx/dy of the coordinates c at y0 (d,)."""
+    d = y0.size
+    J = np.empty((d, d))
+    for j in range(d):
+        e = np.zeros(d)
+        e[j] = h
+        J[:, j] = (c.to_x(y0 + e)[0] - c.to_x(y0 - e)[0]) / (2 * h)
+    return J
+
+
 def test_node_time_constants_are_capacity_over_attached_conductances():
     lp, truth = _logpost()
     c = NodeTimeConstants(lp)
@@ -57,13 +68,7 @@ def test_the_change_of_variables_is_a_bijection_with_unit_jacobian():
     # unit Jacobian: the log-density is the same at corresponding points
     np.testing.assert_allclose(c(c.to_y(X)), lp(X), rtol=1e-12)
     # and the map really has determinant 1 (central differences)
-    y0 = c.to_y(X[:1])[0]
-    d, h = y0.size, 1e-6
-    J = np.empty((d, d))
-    for j in range(d):
-        e = np.zeros(d)
-        e[j] = h
-        J[:, j] = (c.to_x(y0 + e)[0] - c.to_x(y0 - e)[0]) / (2 * h)
+    J = _jacobian(c, c.to_y(X[:1])[0])
     assert np.linalg.det(J) == pytest.approx(1.0, abs=1e-6)
     # outside the prior's support (or non-finite) it is -inf, never an exception
     Y = c.to_y(X[:3])
@@ -163,6 +168,9 @@ def test_default_coordinates_re_coordinate_three_node_networks_only():
     c = default_coordinates(lp4)
     names = lp4.params.free_names
     assert sorted(names[k] for k, _ in c.nodes) == ["Ci", "Cint", "Cw"]
+    # fsol as the log of the air's share (measured: τmax of the demo 4a lower); the
+    # apertures stay in log coordinates (measured: no gain)
+    assert [names[k] for k, _, _ in c.shares] == ["fsol"] and c.splits == []
 
 
 def test_sampler_coordinates_key_chooses_them_and_enters_the_chain_tag():
@@ -223,13 +231,8 @@ def test_split_solar_apertures_are_sampled_as_the_aperture_to_the_air():
         np.testing.assert_allclose(Y[:, k] + Y[:, f], np.log(fI * fsol), rtol=1e-10)
     np.testing.assert_allclose(c.to_x(Y), X, rtol=0, atol=1e-12)
     np.testing.assert_allclose(c(Y), lp(X), rtol=1e-12)
-    y0 = Y[0]
-    d, h = y0.size, 1e-6
-    J = np.empty((d, d))
-    for j in range(d):
-        e = np.zeros(d)
-        e[j] = h
-        J[:, j] = (c.to_x(y0 + e)[0] - c.to_x(y0 - e)[0]) / (2 * h)
+    J = _jacobian(c, Y[0])
+    d = J.shape[0]
     assert np.linalg.det(J) == pytest.approx(1.0, abs=1e-6)
     # the fsol column of the Jacobian is dlog fI_s/dv = σ(v) off the diagonal: not zero
     assert abs(J[gains[0], f]) > 1e-3
@@ -282,14 +285,7 @@ def test_fsol_sampled_as_the_log_of_the_air_share_with_its_jacobian():
         np.testing.assert_allclose(Y[:, k], np.log1p(-fsol), rtol=1e-12)
         np.testing.assert_allclose(c.to_x(Y), X, rtol=0, atol=1e-10)
         for i in range(3):
-            y0 = Y[i]
-            d, h = y0.size, 1e-6
-            J = np.empty((d, d))
-            for j in range(d):
-                e = np.zeros(d)
-                e[j] = h
-                J[:, j] = (c.to_x(y0 + e)[0] - c.to_x(y0 - e)[0]) / (2 * h)
-            logdet = np.log(abs(np.linalg.det(J)))
+            logdet = np.log(abs(np.linalg.det(_jacobian(c, Y[i]))))
             assert c(Y[i : i + 1])[0] - lp(X[i : i + 1])[0] == pytest.approx(logdet, abs=1e-6)
         # outside the support (fsol < lo or > lo + width): -inf, never an exception
         Y[0, k] = 0.5  # 1 - fsol > 1

@@ -7,7 +7,9 @@ and its convergence rule (≥ 50 τ, τ stable, R-hat ≤ 1.01, bulk ESS ≥ 400
 
 - ``log``: the reference, emcee in the sampler's log θ / θ / logit coordinates;
 - ``node_tau``: emcee in :class:`heritage_bayes.inference.coordinates.NodeTimeConstants`
-  (log C_i replaced by the log of the node time constant C_i / Σ G_ik).
+  (log C_i replaced by the log of the node time constant C_i / Σ G_ik, and where a solar
+  gain is split by a fraction, thermal_4a's ``fsol``, log fI_s by the log of the
+  aperture to the air fI_s (1 - fsol) with ``--solar``: measured, not the default).
 
 Both chains are measured in the same coordinates (log θ), so the integrated
 autocorrelation time τ [steps] of each parameter is comparable; printed per parameter,
@@ -17,7 +19,8 @@ CPU time is the figure to compare. A τ from a chain shorter than 50 τ is a low
 bound (emcee's estimate): the converged column says which.
 
     python benchmarks/bench_coordinates.py demo_2c demo_4a demo_hygric trh1_2c orholm_4a \
-        [--max-steps N] [--max-time SECONDS] [--only log|node_tau]
+        [--max-steps N] [--max-time SECONDS] [--only log|node_tau] [--solar] \\
+        [--save-chain PREFIX]
 """
 
 from __future__ import annotations
@@ -107,15 +110,34 @@ def main() -> None:
         help="comma-separated ensemble sizes, each run with every --moves in node_tau "
         "coordinates (default: the sampler's, max(32, 2 d + 2))",
     )
+    ap.add_argument(
+        "--solar",
+        action="store_true",
+        help="node_tau with the split-solar coordinates (log fI_s -> log fI_s (1 - fsol))",
+    )
+    ap.add_argument(
+        "--air-share",
+        action="store_true",
+        help="node_tau with split fractions (fsol) sampled as log(1 - fsol), the log of "
+        "the air's share",
+    )
+    ap.add_argument(
+        "--save-chain",
+        default=None,
+        help="write each chain (steps, walkers, d) in the log coordinates to "
+        "<SAVE_CHAIN>_<problem>_<label>.npz with the free parameters' names",
+    )
     args = ap.parse_args()
     for name in args.problems:
         cfg = _config(*PROBLEMS[name])
         section = PROBLEMS[name][1]
         _, model, lp, mp = config_map(cfg, section)
-        coords = node_time_constants(lp)
+        coords = node_time_constants(lp, solar=args.solar, air_share=args.air_share)
         print(
             f"{name}: {model.name}, {lp.ndim} free parameters, MAP {mp.log_post:.1f}; "
-            f"{len(coords.nodes) if coords else 0} node(s) re-coordinated",
+            f"{len(coords.nodes) if coords else 0} node(s) and "
+            f"{sum(len(g) for *_, g in coords.splits) if coords else 0} split solar "
+            "aperture(s) re-coordinated",
             flush=True,
         )
         runs = {}
@@ -129,6 +151,9 @@ def main() -> None:
                 label += f"/{w}w" if w is not None else ""
                 runs[label] = _run(label, lp, mp, coords, cfg, args, m, w)
         names = lp.params.free_names
+        for label, (res, _, _) in runs.items() if args.save_chain else ():
+            out = f"{args.save_chain}_{name}_{label.replace('/', '_')}.npz"
+            np.savez_compressed(out, chain=res.chain, names=np.array(names))
         print("  τ per parameter [steps]: " + "  ".join(f"{n:>8s}" for n in names))
         for label, (res, _, _) in runs.items():
             print(f"  {label:<22s}  " + "  ".join(f"{t:8.0f}" for t in res.tau))

@@ -32,6 +32,17 @@ def _logpost(name="thermal_2c", N=24 * 20, priors=None, seed=0):
     return LogPosterior(m, ps, noise, U, y[:, None], warmup=24, init_window=24), truth
 
 
+def _jacobian(c, y0: np.ndarray, h: float = 1e-6) -> np.ndarray:
+    """(d, d) central-difference Jacobian dx/dy of the coordinates c at y0 (d,)."""
+    d = y0.size
+    J = np.empty((d, d))
+    for j in range(d):
+        e = np.zeros(d)
+        e[j] = h
+        J[:, j] = (c.to_x(y0 + e)[0] - c.to_x(y0 - e)[0]) / (2 * h)
+    return J
+
+
 def test_node_time_constants_are_capacity_over_attached_conductances():
     lp, truth = _logpost()
     c = NodeTimeConstants(lp)
@@ -57,13 +68,7 @@ def test_the_change_of_variables_is_a_bijection_with_unit_jacobian():
     # unit Jacobian: the log-density is the same at corresponding points
     np.testing.assert_allclose(c(c.to_y(X)), lp(X), rtol=1e-12)
     # and the map really has determinant 1 (central differences)
-    y0 = c.to_y(X[:1])[0]
-    d, h = y0.size, 1e-6
-    J = np.empty((d, d))
-    for j in range(d):
-        e = np.zeros(d)
-        e[j] = h
-        J[:, j] = (c.to_x(y0 + e)[0] - c.to_x(y0 - e)[0]) / (2 * h)
+    J = _jacobian(c, c.to_y(X[:1])[0])
     assert np.linalg.det(J) == pytest.approx(1.0, abs=1e-6)
     # outside the prior's support (or non-finite) it is -inf, never an exception
     Y = c.to_y(X[:3])
@@ -163,6 +168,9 @@ def test_default_coordinates_re_coordinate_three_node_networks_only():
     c = default_coordinates(lp4)
     names = lp4.params.free_names
     assert sorted(names[k] for k, _ in c.nodes) == ["Ci", "Cint", "Cw"]
+    # fsol as the log of the air's share (measured: τmax of the demo 4a lower); the
+    # apertures stay in log coordinates (measured: no gain)
+    assert [names[k] for k, _, _ in c.shares] == ["fsol"] and c.splits == []
 
 
 def test_sampler_coordinates_key_chooses_them_and_enters_the_chain_tag():
@@ -190,3 +198,99 @@ def test_sampler_coordinates_key_chooses_them_and_enters_the_chain_tag():
     assert len(set(tags.values())) == 3
     with pytest.raises(ConfigError, match="coordinates"):
         parse_config({**base, "sampler": {"coordinates": "laplace"}})
+
+
+def _logpost_4a(surfaces=("S", "N"), priors=None):
+    m = hb.model("thermal_4a", surfaces=surfaces)
+    noise = get_noise_model("ar1")
+    U = np.ones((48, len(m.input_names)))
+    ps = parameters_for(m, noise, priors or {})
+    return LogPosterior(m, ps, noise, U, np.ones((48, 1)), warmup=0)
+
+
+def test_split_solar_apertures_are_sampled_as_the_aperture_to_the_air():
+    """thermal_4a: log fI_s is replaced by log(fI_s (1 - fsol)) (the aperture to the air
+    node [m²]), fsol's logit coordinate kept; then log of the aperture to the mass is
+    that coordinate plus logit(fsol): both linear. A bijection with unit Jacobian.
+    Opt-in (``solar=True``): on the demo it left fsol's τ unchanged."""
+    lp = _logpost_4a()
+    c = node_time_constants(lp, solar=True)
+    names = lp.params.free_names
+    ((f, lo, width, gains),) = c.splits
+    assert names[f] == "fsol" and (lo, width) == (0.0, 1.0)
+    assert sorted(names[g] for g in gains) == ["fI_N", "fI_S"]
+    rng = np.random.default_rng(2)
+    theta = lp.params.sample_prior(rng, 30)
+    X = lp.params.to_unconstrained(theta)
+    Y = c.to_y(X)
+    fsol = theta[:, lp.params.names.index("fsol")]
+    for s in ("S", "N"):
+        fI = theta[:, lp.params.names.index(f"fI_{s}")]
+        k = names.index(f"fI_{s}")
+        np.testing.assert_allclose(Y[:, k], np.log(fI * (1 - fsol)), rtol=1e-12)
+        np.testing.assert_allclose(Y[:, k] + Y[:, f], np.log(fI * fsol), rtol=1e-10)
+    np.testing.assert_allclose(c.to_x(Y), X, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(c(Y), lp(X), rtol=1e-12)
+    J = _jacobian(c, Y[0])
+    d = J.shape[0]
+    assert np.linalg.det(J) == pytest.approx(1.0, abs=1e-6)
+    # the fsol column of the Jacobian is dlog fI_s/dv = σ(v) off the diagonal: not zero
+    assert abs(J[gains[0], f]) > 1e-3
+    # the default (solar=False, what hbayes samples in): the apertures stay in the log
+    # coordinates; measured no gain in τ on the demo (benchmarks/README.md)
+    c0 = node_time_constants(lp)
+    assert c0.splits == []
+    keep = [k for k in range(d) if k not in [n for n, _ in c0.nodes]]
+    np.testing.assert_array_equal(c0.to_y(X)[:, keep], X[:, keep])
+
+
+def test_split_solar_prior_narrower_than_the_unit_interval_and_fixed_fsol():
+    """A prior on fsol over [lo, lo + w] ⊂ [0, 1] uses log(1 - f) directly; a fixed fsol
+    or a fixed aperture leaves nothing (or only the free apertures) to re-coordinate."""
+    lp = _logpost_4a(priors={"fsol": {"dist": "uniform", "lower": 0.2, "upper": 0.9}})
+    c = node_time_constants(lp, solar=True)
+    ((f, lo, width, _),) = c.splits
+    assert (lo, width) == pytest.approx((0.2, 0.7))
+    rng = np.random.default_rng(3)
+    X = lp.params.to_unconstrained(lp.params.sample_prior(rng, 10))
+    np.testing.assert_allclose(c.to_x(c.to_y(X)), X, rtol=0, atol=1e-12)
+    theta = lp.params.values(X)
+    k = lp.params.free_names.index("fI_S")
+    fs = theta[:, lp.params.names.index("fsol")]
+    fI = theta[:, lp.params.names.index("fI_S")]
+    np.testing.assert_allclose(c.to_y(X)[:, k], np.log(fI * (1 - fs)), rtol=1e-12)
+    assert (
+        node_time_constants(_logpost_4a(priors={"fsol": {"fixed": 0.3}}), solar=True).splits == []
+    )
+    c1 = node_time_constants(_logpost_4a(priors={"fI_N": {"fixed": 1.0}}), solar=True)
+    names = c1.logpost.params.free_names
+    assert [names[g] for g in c1.splits[0][3]] == ["fI_S"]
+
+
+def test_fsol_sampled_as_the_log_of_the_air_share_with_its_jacobian():
+    """air_share=True: fsol's coordinate is log(1 - fsol) [-]; the log-density in it is
+    the log-posterior plus log|dv/dy| (v = logit fsol), checked against a numerical
+    determinant, for the default prior on [0, 1] and a narrower one."""
+    for priors in ({}, {"fsol": {"dist": "uniform", "lower": 0.2, "upper": 0.9}}):
+        lp = _logpost_4a(priors=priors)
+        c = node_time_constants(lp, air_share=True)
+        names = lp.params.free_names
+        ((k, lo, width),) = c.shares
+        assert names[k] == "fsol"
+        rng = np.random.default_rng(4)
+        theta = lp.params.sample_prior(rng, 10)
+        X = lp.params.to_unconstrained(theta)
+        Y = c.to_y(X)
+        fsol = theta[:, lp.params.names.index("fsol")]
+        np.testing.assert_allclose(Y[:, k], np.log1p(-fsol), rtol=1e-12)
+        np.testing.assert_allclose(c.to_x(Y), X, rtol=0, atol=1e-10)
+        for i in range(3):
+            logdet = np.log(abs(np.linalg.det(_jacobian(c, Y[i]))))
+            assert c(Y[i : i + 1])[0] - lp(X[i : i + 1])[0] == pytest.approx(logdet, abs=1e-6)
+        # outside the support (fsol < lo or > lo + width): -inf, never an exception
+        Y[0, k] = 0.5  # 1 - fsol > 1
+        # fsol above the prior's upper bound (fsol = 1 for the prior on [0, 1])
+        Y[1, k] = np.log1p(-(lo + width)) - 0.1 if lo + width < 1 else -np.inf
+        out = c(Y[:3])
+        assert out[0] == -np.inf and out[1] == -np.inf and np.isfinite(out[2])
+    assert node_time_constants(_logpost_4a(), air_share=False).shares == []

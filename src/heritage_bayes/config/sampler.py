@@ -84,7 +84,8 @@ class SamplerSettings(_Strict):
         "auto",
         unit=None,
         description="what the walkers move in: log (log C, log G), node_tau (log node time "
-        "constants in place of log capacities), or auto: node_tau for networks of three or "
+        "constants in place of log capacities, and a split solar fraction such as "
+        "thermal_4a's fsol as log(1 - fsol)), or auto: node_tau for networks of three or "
         "more nodes, log for smaller ones; the chain is stored in log coordinates either "
         "way",
     )

@@ -2,7 +2,7 @@
 
 For the thermal section of the demo (``configs/demo.yaml``), TRH-1 with thermal_2c
 (``configs/trh1_attic.yaml``, which itself uses thermal_1c) and TRH-1 4a
-(``configs/trh1_attic_4a.yaml``): the
+(``benchmarks/configs/trh1_attic_4a.yaml``): the
 MAP search as ``hbayes calibrate`` does it, then emcee (default DE/snooker moves, the
 convergence rule of :func:`heritage_bayes.inference.sampler.run_sampler`: ≥ 50 τ, τ
 stable, R-hat ≤ 1.01, bulk ESS ≥ 400) in two coordinate systems, in the same run:
@@ -46,7 +46,7 @@ ROOT = Path(__file__).resolve().parents[1]
 PROBLEMS = {  # config, thermal model (None: the config's own)
     "demo": (ROOT / "configs" / "demo.yaml", None),
     "trh1_2c": (ROOT / "configs" / "trh1_attic.yaml", "thermal_2c"),
-    "trh1_4a": (ROOT / "configs" / "trh1_attic_4a.yaml", None),
+    "trh1_4a": (ROOT / "benchmarks" / "configs" / "trh1_attic_4a.yaml", None),
 }
 
 

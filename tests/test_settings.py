@@ -233,7 +233,12 @@ def test_quoted_and_plain_values_still_load(tmp_path):
 # -- every shipped config is valid under the stricter schema --------------------------------
 
 
-@pytest.mark.parametrize("path", sorted(CONFIGS.glob("*.yaml")), ids=lambda p: p.name)
+@pytest.mark.parametrize(
+    "path",
+    sorted(CONFIGS.glob("*.yaml"))
+    + sorted((CONFIGS.parent / "benchmarks" / "configs").glob("*.yaml")),
+    ids=lambda p: p.name,
+)
 def test_shipped_configs_have_no_bare_durations_or_tags(path):
     raw, _ = read_yaml(path)
     if "data" in raw:  # a calibration config (others: projection, portfolio)

@@ -131,6 +131,12 @@ def main() -> None:
         "the air's share",
     )
     ap.add_argument(
+        "--series",
+        action="store_true",
+        help="node_tau with a node between exactly two conductances (the envelope's Cw "
+        "with Gw, Gi) sampled along the log series conductance and the log ratio",
+    )
+    ap.add_argument(
         "--save-chain",
         default=None,
         help="write each chain (steps, walkers, d) in the log coordinates to "
@@ -141,7 +147,9 @@ def main() -> None:
         cfg = _config(*PROBLEMS[name])
         section = PROBLEMS[name][1]
         _, model, lp, mp = config_map(cfg, section)
-        coords = node_time_constants(lp, solar=args.solar, air_share=args.air_share)
+        coords = node_time_constants(
+            lp, solar=args.solar, air_share=args.air_share, series=args.series
+        )
         print(
             f"{name}: {model.name}, {lp.ndim} free parameters, MAP {mp.log_post:.1f}; "
             f"{len(coords.nodes) if coords else 0} node(s) and "

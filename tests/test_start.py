@@ -81,3 +81,41 @@ def test_a_laplace_start_is_already_spread_and_samples_the_same():
     n_eff = min(x.shape[0], lap.steps * 16 / np.max(lap.tau) / 2)
     assert np.all(np.abs(x.mean(axis=0) / (sd / np.sqrt(n_eff))) < 4)
     np.testing.assert_allclose(x.std(axis=0) / sd, 1.0, atol=4 / np.sqrt(2 * n_eff))
+
+
+def test_sampler_start_key_chooses_the_laplace_start_for_rich_networks_only():
+    """``sampler.start``: auto starts networks of three or more nodes from the Laplace
+    approximation, smaller ones from the ball (their chains unchanged); ball and
+    laplace force either; a Laplace approximation that could not be taken (None)
+    falls back to the ball; the key changes the chain's tag only when not auto."""
+    from pathlib import Path
+
+    import pytest
+
+    from heritage_bayes.config import load_config
+    from heritage_bayes.config.calibration import chain_tag
+    from heritage_bayes.inference.start import start_hessian
+    from test_coordinates import _logpost
+
+    class Lap:
+        hessian = np.eye(2)
+
+    lp2, _ = _logpost("thermal_2c")
+    lp1, _ = _logpost("thermal_1c")
+    assert start_hessian(lp2, Lap(), "auto") is None
+    assert start_hessian(lp1, Lap(), "auto") is None
+    assert start_hessian(lp2, Lap(), "laplace") is Lap.hessian
+    assert start_hessian(lp2, None, "laplace") is None
+    assert start_hessian(lp2, Lap(), "ball") is None
+    lp4 = type("LP", (), {"model": type("M", (), {"n_states": 3})()})()
+    assert start_hessian(lp4, Lap(), "auto") is Lap.hessian
+    with pytest.raises(ValueError, match=r"sampler\.start"):
+        start_hessian(lp2, Lap(), "centre")
+    base = load_config(Path(__file__).resolve().parents[1] / "configs" / "demo.yaml")
+    assert base.sampler.start == "auto"
+
+    def with_start(v):
+        return base.model_copy(update={"sampler": base.sampler.model_copy(update={"start": v})})
+
+    assert chain_tag(with_start("auto")) == chain_tag(base)
+    assert chain_tag(with_start("laplace")) != chain_tag(base)

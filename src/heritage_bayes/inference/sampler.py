@@ -2,7 +2,8 @@
 
 The ensemble starts in a small ball around the MAP, kept inside the prior's support
 whatever the MAP (see :func:`start_ensemble`: a MAP on or next to a bound is moved
-inward and the ball reflected off the walls), and runs in chunks of ``check_every``
+inward and the ball reflected off the walls), or drawn from the Laplace approximation
+(``start_hessian``, :mod:`heritage_bayes.inference.start`), and runs in chunks of ``check_every``
 steps until converged: the chain is longer than ``tau_factor`` × the integrated
 autocorrelation time τ of every parameter, and τ changed by less than ``tau_rtol``
 since the previous check (Foreman-Mackey et al.'s recipe), and R-hat/bulk ESS meet

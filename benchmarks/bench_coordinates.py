@@ -43,6 +43,7 @@ import bench_sampling
 from _common import config_map
 from heritage_bayes.config import load_config
 from heritage_bayes.inference.coordinates import node_time_constants
+from heritage_bayes.inference.optimize import laplace
 from heritage_bayes.inference.sampler import _tau
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -64,7 +65,7 @@ def _config(path: Path, section: str, model_name: str | None):
     return cfg
 
 
-def _run(label, lp, mp, coords, cfg, args, moves, walkers=None):
+def _run(label, lp, mp, coords, cfg, args, moves, walkers=None, hessian=None):
     out = bench_sampling._run(
         label,
         lp,
@@ -78,6 +79,7 @@ def _run(label, lp, mp, coords, cfg, args, moves, walkers=None):
         max_steps=args.max_steps,
         max_draws=cfg.sampler.max_draws,
         coordinates=coords,
+        start_hessian=hessian,
     )
     res = out[0]
     # τ of the chain's second half: without the ensemble's spread from its start ball
@@ -111,6 +113,13 @@ def main() -> None:
         "coordinates (default: the sampler's, max(32, 2 d + 2))",
     )
     ap.add_argument(
+        "--start",
+        default="ball",
+        help="comma-separated starts of the node_tau runs: ball (the init_ball around the "
+        "MAP) and/or laplace (walkers drawn from N(MAP, H^-1), "
+        "heritage_bayes.inference.start)",
+    )
+    ap.add_argument(
         "--solar",
         action="store_true",
         help="node_tau with the split-solar coordinates (log fI_s -> log fI_s (1 - fsol))",
@@ -120,6 +129,12 @@ def main() -> None:
         action="store_true",
         help="node_tau with split fractions (fsol) sampled as log(1 - fsol), the log of "
         "the air's share",
+    )
+    ap.add_argument(
+        "--series",
+        action="store_true",
+        help="node_tau with a node between exactly two conductances (the envelope's Cw "
+        "with Gw, Gi) sampled along the log series conductance and the log ratio",
     )
     ap.add_argument(
         "--save-chain",
@@ -132,7 +147,9 @@ def main() -> None:
         cfg = _config(*PROBLEMS[name])
         section = PROBLEMS[name][1]
         _, model, lp, mp = config_map(cfg, section)
-        coords = node_time_constants(lp, solar=args.solar, air_share=args.air_share)
+        coords = node_time_constants(
+            lp, solar=args.solar, air_share=args.air_share, series=args.series
+        )
         print(
             f"{name}: {model.name}, {lp.ndim} free parameters, MAP {mp.log_post:.1f}; "
             f"{len(coords.nodes) if coords else 0} node(s) and "
@@ -145,11 +162,16 @@ def main() -> None:
         if args.only != "node_tau":
             runs["log"] = _run("log", lp, mp, None, cfg, args, moves[0])
         sizes = [int(w) for w in args.walkers.split(",")] if args.walkers else [None]
-        for w in sizes if args.only != "log" else ():
-            for m in moves:
-                label = "node_tau" + (f"/{m}" if len(moves) > 1 else "")
-                label += f"/{w}w" if w is not None else ""
-                runs[label] = _run(label, lp, mp, coords, cfg, args, m, w)
+        starts = args.start.split(",")
+        hessian = laplace(lp, mp.x).hessian if "laplace" in starts else None
+        for start in starts if args.only != "log" else ():
+            for w in sizes:
+                for m in moves:
+                    label = "node_tau" + (f"/{m}" if len(moves) > 1 else "")
+                    label += f"/{w}w" if w is not None else ""
+                    label += f"/{start}" if len(starts) > 1 else ""
+                    h = hessian if start == "laplace" else None
+                    runs[label] = _run(label, lp, mp, coords, cfg, args, m, w, h)
         names = lp.params.free_names
         for label, (res, _, _) in runs.items() if args.save_chain else ():
             out = f"{args.save_chain}_{name}_{label.replace('/', '_')}.npz"

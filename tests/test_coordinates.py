@@ -294,3 +294,28 @@ def test_fsol_sampled_as_the_log_of_the_air_share_with_its_jacobian():
         out = c(Y[:3])
         assert out[0] == -np.inf and out[1] == -np.inf and np.isfinite(out[2])
     assert node_time_constants(_logpost_4a(), air_share=False).shares == []
+
+
+def test_series_coordinates_of_a_node_between_two_conductances_have_unit_jacobian():
+    """``series=True``: the envelope node's Gw and Gi sampled as the log of their series
+    conductance Gw Gi / (Gw + Gi) [W/K] and the log of their ratio; a bijection with
+    |Jacobian| 1, so the log-density is unchanged."""
+    lp, truth = _logpost()
+    c = node_time_constants(lp, series=True)
+    names = lp.params.free_names
+    # (the conductance to the other node first, then the one to the boundary)
+    assert [(names[a], names[b]) for a, b in c.pairs] == [("Gi", "Gw")]
+    theta = np.array([[truth.get(n, 0.1) if n != "phi_Ti" else 0.5 for n in lp.params.names]])
+    Y = c.to_y(lp.params.to_unconstrained(theta))
+    assert Y[0, names.index("Gi")] == pytest.approx(np.log(150.0 * 300.0 / 450.0))
+    assert Y[0, names.index("Gw")] == pytest.approx(np.log(300.0 / 150.0))
+    assert Y[0, names.index("Cw")] == pytest.approx(np.log(5e7 / 450.0))
+    rng = np.random.default_rng(2)
+    X = lp.params.to_unconstrained(lp.params.sample_prior(rng, 20))
+    np.testing.assert_allclose(c.to_x(c.to_y(X)), X, rtol=0, atol=1e-11)
+    # the round trip through softplus costs ~1e-15 in x, which log-densities of 1e7
+    # (prior draws far from the data) turn into ~1e-12 relative
+    np.testing.assert_allclose(c(c.to_y(X)), lp(X), rtol=1e-9)
+    J = _jacobian(c, c.to_y(X[:1])[0])
+    assert abs(np.linalg.det(J)) == pytest.approx(1.0, abs=1e-6)
+    assert node_time_constants(lp).pairs == []  # opt-in

@@ -298,6 +298,7 @@ def _calibrate_into(
     from heritage_bayes.inference.idata import CONVERGENCE, build_run_outputs
     from heritage_bayes.inference.optimize import find_map, laplace, seconds_left, share_deadline
     from heritage_bayes.inference.sampler import run_sampler
+    from heritage_bayes.inference.start import start_hessian
     from heritage_bayes.prepare import prepare
     from heritage_bayes.rc.identify import structural_identifiability
 
@@ -364,6 +365,7 @@ def _calibrate_into(
         t0 = time.perf_counter()
         update = say.sampler(s.name, cfg.sampler.max_steps)
         coords = sampling_coordinates(s.logpost, cfg.sampler.coordinates)
+        hessian = start_hessian(s.logpost, s.laplace, cfg.sampler.start)
         try:
             s.chain = run_sampler(
                 s.logpost,
@@ -389,6 +391,7 @@ def _calibrate_into(
                 max_draws=cfg.sampler.max_draws,
                 coordinates=coords,
                 compact=True,
+                start_hessian=hessian,
             )
         finally:
             say.close()

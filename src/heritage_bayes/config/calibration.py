@@ -209,6 +209,8 @@ def chain_tag(cfg: CalibrationConfig) -> str:
     keep = {k: d["sampler"][k] for k in ("walkers", "moves", "init_ball")}
     if d["sampler"].get("coordinates", "auto") != "auto":  # (tags of earlier runs kept)
         keep["coordinates"] = d["sampler"]["coordinates"]
+    if d["sampler"].get("start", "auto") != "auto":
+        keep["start"] = d["sampler"]["start"]
     d = {**d, "sampler": keep}
     for k in ("report", "ladder", "name", "building", "room", "notes"):
         d.pop(k, None)

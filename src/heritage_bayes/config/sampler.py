@@ -89,6 +89,15 @@ class SamplerSettings(_Strict):
         "more nodes, log for smaller ones; the chain is stored in log coordinates either "
         "way",
     )
+    start: Literal["auto", "ball", "laplace"] = key(
+        "auto",
+        unit=None,
+        description="where the walkers start: ball (init_ball around the MAP), laplace "
+        "(drawn from the Laplace approximation N(MAP, H^-1), flat directions at most the "
+        "widest prior range), or auto: laplace for networks of three or more nodes, ball "
+        "for smaller ones (demo thermal_4a at 60 000 steps: τmax 1 683 from the ball, 969 "
+        "from laplace)",
+    )
     init_ball: float = key(
         1e-3,
         unit="-",

@@ -93,7 +93,7 @@ class NodeTimeConstants:
 
     name = "node_tau"
 
-    def __init__(self, logpost, solar: bool = False, air_share: bool = False):
+    def __init__(self, logpost, solar: bool = False, air_share: bool = False, series: bool = False):
         self.logpost = logpost
         params, model = logpost.params, logpost.model
         free = {int(j): k for k, j in enumerate(params._free_idx)}
@@ -115,6 +115,9 @@ class NodeTimeConstants:
                 gs.append((free.get(g), float(p.fixed or 0.0), bool(p.prior.log_scale)))
             self.nodes.append((free[c], gs))
         self.splits = _splits(params, model, free) if solar else []
+        # (free index of G_a, of G_b) of nodes between exactly two free log-scale
+        # conductances, sampled as log G_a G_b / (G_a + G_b) and log G_a / G_b
+        self.pairs = _pairs(self.nodes) if series else []
         # (free index, lo, width) of split fractions sampled as log(1 - f) [-]
         self.shares = (
             [(k, lo, w) for k, lo, w, _ in _splits(params, model, free)] if air_share else []
@@ -160,6 +163,10 @@ class NodeTimeConstants:
     def to_x(self, Y: np.ndarray) -> np.ndarray:
         """Time-constant coordinates (K, d) -> the sampler's log coordinates (K, d)."""
         X = np.array(np.atleast_2d(Y), dtype=float, copy=True)
+        for ka, kb in self.pairs:  # (log series conductance, log ratio) -> log G_a, log G_b
+            s, r = X[:, ka].copy(), X[:, kb].copy()
+            X[:, ka] = s + np.logaddexp(0.0, r)
+            X[:, kb] = s + np.logaddexp(0.0, -r)
         if self.shares:
             V, _ = self._share_to_logit(X)
             for i, (k, _, _) in enumerate(self.shares):
@@ -184,6 +191,10 @@ class NodeTimeConstants:
                 Y[:, g] = X[:, g] + share
         for k, lo, width in self.shares:
             Y[:, k] = self._log_air_share(X[:, k], lo, width)
+        for ka, kb in self.pairs:
+            a, b = X[:, ka], X[:, kb]
+            Y[:, ka] = a + b - np.logaddexp(a, b)
+            Y[:, kb] = a - b
         return Y
 
     def __call__(self, Y: np.ndarray) -> np.ndarray:
@@ -195,6 +206,33 @@ class NodeTimeConstants:
         if ok.any():
             out[ok] = self.logpost(X[ok])
         return out + logj
+
+
+def _pairs(nodes) -> list[tuple[int, int]]:
+    """The conductance pairs of :attr:`NodeTimeConstants.pairs`: per re-coordinated node
+    with exactly two attached conductances, both free and log-scale (an envelope node
+    between the outdoor and the indoor air: thermal_2c's and thermal_4a's ``Cw`` with
+    ``Gw`` and ``Gi``), their free indices; a conductance is in one pair at most.
+
+    The data see the steady conductance of the path through the node, G_a G_b / (G_a +
+    G_b) [W/K], far better than how it splits (G_a / G_b sets where the node's
+    temperature sits between the two sides); in log G_a, log G_b a constant series
+    conductance is a curve (log G_b constant where G_a >> G_b, log G_a where G_a <<
+    G_b). The map (log G_a, log G_b) -> (s, r) = (log G_a G_b/(G_a + G_b), log G_a/G_b)
+    has the inverse log G_a = s + softplus(r), log G_b = s + softplus(-r) and Jacobian
+    determinant -1 (∂s/∂ log G_a = G_b/(G_a + G_b), ∂s/∂ log G_b = G_a/(G_a + G_b)):
+    unit |Jacobian|, no term in the log-density."""
+    out: list[tuple[int, int]] = []
+    used: set[int] = set()
+    for _, gs in nodes:
+        if len(gs) != 2 or not all(k is not None and log for k, _, log in gs):
+            continue
+        (ka, _, _), (kb, _, _) = gs
+        if ka == kb or ka in used or kb in used:
+            continue
+        used |= {ka, kb}
+        out.append((ka, kb))
+    return out
 
 
 def _splits(params, model, free: dict[int, int]) -> list[tuple[int, float, float, list[int]]]:
@@ -223,12 +261,12 @@ def _splits(params, model, free: dict[int, int]) -> list[tuple[int, float, float
 
 
 def node_time_constants(
-    logpost, solar: bool = False, air_share: bool = False
+    logpost, solar: bool = False, air_share: bool = False, series: bool = False
 ) -> NodeTimeConstants | None:
     """:class:`NodeTimeConstants` for a log-posterior, or None when no node's capacity
     is a free log-scale parameter and no solar gain is split (nothing to re-coordinate).
     ``solar=False`` leaves the split solar apertures in the log coordinates."""
-    coords = NodeTimeConstants(logpost, solar=solar, air_share=air_share)
+    coords = NodeTimeConstants(logpost, solar=solar, air_share=air_share, series=series)
     return coords if coords.nodes or coords.splits or coords.shares else None
 
 

@@ -1,8 +1,9 @@
 """emcee's moves by name, and the schedule and τ estimate of the convergence monitor.
 
 :data:`MOVES` and :func:`make_moves` (the ``sampler.moves`` key), :func:`_next_check`
-(when the monitor estimates τ) and :func:`_tau` (the integrated autocorrelation time
-per parameter, Goodman & Weare 2010; Foreman-Mackey et al. 2013). Split from
+(when the monitor estimates τ), :func:`_tau` (the integrated autocorrelation time
+per parameter, Goodman & Weare 2010; Foreman-Mackey et al. 2013) and
+:class:`ChainBuffer` (the chain in memory while it grows). Split from
 :mod:`heritage_bayes.inference.sampler`, which uses them.
 """
 
@@ -53,3 +54,46 @@ def _tau(chain: np.ndarray, discard: float = 0.0) -> np.ndarray:
     walkers, d), estimated on the steps after its first ``discard`` fraction."""
     start = int(discard * chain.shape[0])
     return emcee.autocorr.integrated_time(chain[start:], c=5, tol=0, quiet=True)
+
+
+class ChainBuffer:
+    """The chain (steps, walkers, d) and its log-probabilities, grown chunk by chunk in
+    place.
+
+    The sampler appends a chunk after every convergence check and estimates τ (and
+    R-hat) on the whole chain each time; a list of chunks concatenated for each check
+    held the chain twice at every check (and three times at the R-hat check). Here the
+    rows live in one array whose capacity grows by a quarter at a time (amortised
+    copies, at most 25 % slack), and :attr:`chain` is a view of the rows filled.
+    Measured on the demo's thermal_4a at 74 500 steps × 34 walkers × 16 parameters:
+    324 MB of float64 either way, the copies for the checks gone.
+    """
+
+    def __init__(self, nwalkers: int, d: int, capacity: int = 0):
+        self._x = np.empty((capacity, nwalkers, d))
+        self._lp = np.empty((capacity, nwalkers))
+        self.n = 0
+
+    def append(self, x: np.ndarray, lp: np.ndarray) -> None:
+        """Add the rows of a chunk, x (k, walkers, d) and lp (k, walkers)."""
+        k = x.shape[0]
+        if self.n + k > self._x.shape[0]:
+            cap = max(self.n + k, int(1.25 * self._x.shape[0]))
+            for name in ("_x", "_lp"):
+                old = getattr(self, name)
+                new = np.empty((cap, *old.shape[1:]), dtype=old.dtype)
+                new[: self.n] = old[: self.n]
+                setattr(self, name, new)
+        self._x[self.n : self.n + k] = x
+        self._lp[self.n : self.n + k] = lp
+        self.n += k
+
+    @property
+    def chain(self) -> np.ndarray:
+        """(steps, walkers, d) view of the rows filled."""
+        return self._x[: self.n]
+
+    @property
+    def log_prob(self) -> np.ndarray:
+        """(steps, walkers) view of the rows filled."""
+        return self._lp[: self.n]

@@ -2,7 +2,8 @@
 
 The ensemble starts in a small ball around the MAP, kept inside the prior's support
 whatever the MAP (see :func:`start_ensemble`: a MAP on or next to a bound is moved
-inward and the ball reflected off the walls), and runs in chunks of ``check_every``
+inward and the ball reflected off the walls), or drawn from the Laplace approximation
+(``start_hessian``, :mod:`heritage_bayes.inference.start`), and runs in chunks of ``check_every``
 steps until converged: the chain is longer than ``tau_factor`` × the integrated
 autocorrelation time τ of every parameter, and τ changed by less than ``tau_rtol``
 since the previous check (Foreman-Mackey et al.'s recipe), and R-hat/bulk ESS meet
@@ -57,7 +58,8 @@ from heritage_bayes.inference.backend import (
     read_compact,
     write_compact,
 )
-from heritage_bayes.inference.monitor import _next_check, _tau, make_moves
+from heritage_bayes.inference.monitor import ChainBuffer, _next_check, _tau, make_moves
+from heritage_bayes.inference.start import laplace_ensemble
 
 __all__ = [
     "ChainResult",
@@ -311,6 +313,13 @@ def start_ensemble(
     )
 
 
+def _support(bounds, d: int) -> tuple[np.ndarray, np.ndarray]:
+    """(lo, hi) of the support, ±inf arrays when ``bounds`` is None."""
+    if bounds is None:
+        return np.full(d, -np.inf), np.full(d, np.inf)
+    return tuple(np.asarray(b, dtype=float) for b in bounds)
+
+
 def _tell(notice, msg: str) -> None:
     if notice is not None:
         notice(msg)
@@ -350,6 +359,7 @@ def _run_sampler(
     max_draws: int = 4000,
     coordinates=None,
     compact: bool = False,
+    start_hessian: np.ndarray | None = None,
 ) -> ChainResult:
     """Sample the posterior with emcee until converged (see module docstring).
 
@@ -397,6 +407,11 @@ def _run_sampler(
         ``min_ess`` for every parameter, on the draws kept after burn-in and thinning
         (at most ``max_draws``); None skips that check. Both statistics are invariant
         under the monotone transforms of the sampling space.
+    start_hessian : (d, d) array, optional
+        Hessian of the negative log-posterior at ``x_map``: the walkers start from the
+        Laplace approximation N(x_map, H⁻¹) (:func:`heritage_bayes.inference.start.
+        laplace_ensemble`) instead of the ``init_ball`` around it (the fallback when
+        that start finds no finite log-posterior).
     """
     d = int(np.size(x_map))
     if not 0.0 <= tau_discard < 1.0:
@@ -420,8 +435,7 @@ def _run_sampler(
 
     sampler = emcee.EnsembleSampler(nwalkers, d, target, vectorize=True, moves=make_moves(moves))
     ck = _Checkpoint(Path(checkpoint), tag) if checkpoint is not None else None
-    chunks_x: list[np.ndarray] = []
-    chunks_lp: list[np.ndarray] = []
+    buf = ChainBuffer(nwalkers, d)
     accepted = np.zeros(nwalkers)
     tau_hist: list[tuple[float, float]] = []
     done = 0
@@ -466,18 +480,23 @@ def _run_sampler(
                         f"{ck.path}: rewritten from the valid steps; the damaged "
                         f"file is kept as {kept}",
                     )
-                chunks_x.append(saved.chain)
-                chunks_lp.append(saved.log_prob)
-                state = emcee.State(
-                    to_y(saved.chain[-1]), log_prob=saved.log_prob[-1], random_state=rs
-                )
+                buf.append(saved.chain, saved.log_prob)
+                del saved
+                state = emcee.State(to_y(buf.chain[-1]), log_prob=buf.log_prob[-1], random_state=rs)
                 sampler.random_state = rs
     resumed_from = done
     if done == 0:
         rng = np.random.default_rng(seed)
-        p0, lp_init = start_ensemble(
+        got = None
+        if start_hessian is not None:
+            got = laplace_ensemble(
+                logpost, x_map, start_hessian, nwalkers, rng, bounds=_support(bounds, d)
+            )
+        p0, lp_init = got or start_ensemble(
             logpost, x_map, nwalkers, rng, init_ball=init_ball, bounds=bounds
         )
+        if coordinates is not None:  # the density emcee compares: in its own coordinates
+            lp_init = np.asarray(target(to_y(p0)), dtype=float)
         sampler.random_state = np.random.RandomState(seed).get_state()
         state = emcee.State(to_y(p0), log_prob=lp_init, random_state=sampler.random_state)
         if ck is not None:
@@ -488,14 +507,12 @@ def _run_sampler(
     converged = False
     tau = np.full(d, np.nan)
     if done > 0:  # resumed: the saved chain may already be long enough
-        tau = _tau(np.concatenate(chunks_x), tau_discard)
+        tau = _tau(buf.chain, tau_discard)
         tmax = float(np.max(tau))
         stable = bool(tau_hist) and abs(tmax - tau_hist[-1][1]) / tmax < tau_rtol
         converged = bool(done >= tau_factor * tmax and stable and np.all(np.isfinite(tau)))
         if converged and (max_rhat is not None or min_ess is not None):
-            converged = _mixing_ok(
-                np.concatenate(chunks_x), tau, max_rhat, min_ess, max_draws, tau_discard
-            )
+            converged = _mixing_ok(buf.chain, tau, max_rhat, min_ess, max_draws, tau_discard)
     # SIGINT/SIGTERM only set a flag while sampling: the chain stops after the current
     # step, the steps done are committed, then KeyboardInterrupt (never an exception
     # inside emcee's likelihood call, which would print the parameter matrix)
@@ -526,10 +543,9 @@ def _run_sampler(
                 raise KeyboardInterrupt from None
             x, lp = to_x(sampler.get_chain()), sampler.get_log_prob()
             accepted = accepted + sampler.backend.accepted
-            chunks_x.append(x)
-            chunks_lp.append(lp)
+            buf.append(x, lp)
             done += n
-            tau = _tau(np.concatenate(chunks_x), tau_discard)
+            tau = _tau(buf.chain, tau_discard)
             tmax = float(np.max(tau))
             stable = bool(tau_hist) and abs(tmax - tau_hist[-1][1]) / tmax < tau_rtol
             tau_hist.append((float(done), tmax))
@@ -537,9 +553,7 @@ def _run_sampler(
                 ck.append(x, lp, accepted, state.random_state, tau_hist)
             converged = done >= tau_factor * tmax and stable and np.all(np.isfinite(tau))
             if converged and (max_rhat is not None or min_ess is not None):
-                converged = _mixing_ok(
-                    np.concatenate(chunks_x), tau, max_rhat, min_ess, max_draws, tau_discard
-                )
+                converged = _mixing_ok(buf.chain, tau, max_rhat, min_ess, max_draws, tau_discard)
             if progress is not None:
                 progress(
                     done,
@@ -553,8 +567,7 @@ def _run_sampler(
                 )
             if converged:
                 break
-    chain = np.concatenate(chunks_x)
-    log_prob = np.concatenate(chunks_lp)
+    chain, log_prob = buf.chain, buf.log_prob
     burn, thin = _burn_thin(tau, chain.shape[0], tau_discard)
     result = ChainResult(
         chain=chain,

@@ -117,6 +117,10 @@ class LogPosterior:
     initial_state_sd: float | None = None
     initial_state_horizon: float | None = None
     time_constant_cap: float | None = None
+    #: the likelihood's temperature κ ≥ 1 (log L / κ in the posterior; 1: none), see
+    #: :mod:`heritage_bayes.inference.tempering`; log_likelihood and the pointwise
+    #: terms (LOO) stay untempered
+    temperature: float = 1.0
 
     def __post_init__(self):
         self.inputs = np.ascontiguousarray(self.inputs, dtype=float)
@@ -476,7 +480,7 @@ class LogPosterior:
                 val[inside] = (
                     lp[inside]
                     + self.time_constant_log_prior(th[:, : self.n_model])
-                    + self._loglik(th)
+                    + self._loglik(th) / self.temperature
                 )
             val[~np.isfinite(val)] = -np.inf
             out[ok] = val

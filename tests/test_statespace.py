@@ -217,34 +217,3 @@ def test_kalman_run_has_one_step_bands(tmp_path):
         assert c == pytest.approx(np.mean((obs[rows] >= lo) & (obs[rows] <= hi)), abs=1e-9)
     html = (out / "report.html").read_text()
     assert "fig-fit-thermal-Ti-1step" in html and "one step ahead" in html
-
-
-def test_kalman_air_is_kalman_without_envelope_noise():
-    """``noise: kalman_air`` (process noise on the measured air node only) is ``kalman``
-    with zero diffusion on every other node: same log-likelihood to rounding, and the
-    same as statsmodels' filter on that discrete model; its only process-noise
-    parameter is ``q_Ti``."""
-    lp, theta = _problem()
-    theta[lp.params.names.index("q_Tw")] = 0.0
-    air = get_noise_model("kalman_air")
-    ps = parameters_for(lp.model, air, room_volume=200)
-    assert [n for n in ps.names if n.startswith("q_")] == ["q_Ti"]
-    lpa = LogPosterior(
-        lp.model,
-        ps,
-        air,
-        lp.inputs,
-        lp.observed,
-        warmup=0,
-        init_window=48,
-        initial_state="estimate",
-    )
-    vals = {**TRUTH, "sigma_Ti": 0.2, "q_Ti": 0.3}
-    theta_a = np.array([vals[k] for k in ps.names])
-    ll_air = lpa.log_likelihood(theta_a[None])[0]
-    assert ll_air == pytest.approx(lp.log_likelihood(theta[None])[0], rel=1e-10)
-    ref = _statsmodels(lp, theta, lp.observed[:, 0]).loglike([])
-    assert ll_air == pytest.approx(ref, rel=1e-8)
-    # and the envelope noise matters: kalman with q_Tw > 0 differs
-    theta[lp.params.names.index("q_Tw")] = 0.05
-    assert abs(lp.log_likelihood(theta[None])[0] - ll_air) > 1e-3

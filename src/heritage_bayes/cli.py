@@ -97,7 +97,7 @@ def _build_parser() -> argparse.ArgumentParser:
     mod.add_argument(
         "--noise",
         default="ar1_white",
-        choices=["ar1_white", "ar1", "iid", "kalman", "kalman_air"],
+        choices=["ar1_white", "ar1", "iid", "kalman"],
         help="noise model (default ar1_white)",
     )
     mod.set_defaults(func=_cmd_models)

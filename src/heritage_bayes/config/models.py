@@ -57,12 +57,11 @@ class ModelSection(_Strict):
         "humidistat, source (hbayes models)",
         default_factory=dict,
     )
-    noise: Literal["ar1_white", "ar1", "iid", "kalman", "kalman_air"] = key(
+    noise: Literal["ar1_white", "ar1", "iid", "kalman"] = key(
         "ar1_white",
         unit=None,
         description="noise model: AR(1) model error + white sensor noise, a single AR(1), "
-        "iid, or a Kalman filter on the stochastic RC model with process noise on every "
-        "node (kalman) or on the measured air node only (kalman_air)",
+        "iid, or a Kalman filter on the stochastic RC model",
     )
     initial_state: Literal["estimate", "steady"] | dict[str, float] | None = key(
         None,

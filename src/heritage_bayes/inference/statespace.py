@@ -48,7 +48,7 @@ import numpy as np
 from heritage_bayes.inference.likelihoods import NOISE_MODELS, NoiseModel
 from heritage_bayes.rc.discretize import modal_form
 
-__all__ = ["KalmanAirNoise", "KalmanNoise", "modal_process_noise"]
+__all__ = ["KalmanNoise", "modal_process_noise"]
 
 _LOG2PI = math.log(2.0 * math.pi)
 
@@ -186,15 +186,10 @@ class KalmanNoise(NoiseModel):
         return specs + [(f"q_{s}", "diffusion", s) for s in state_names]
 
     def split_statespace(self, noise: np.ndarray, n_out: int):
-        """(K, n_out) measurement variances [potential²], (K, n_q) diffusions [per √s]
-        of the nodes that carry process noise (every node here)."""
+        """(K, n_out) measurement variances [potential²], (K, n) diffusions [per √s]."""
         sig = noise[:, :n_out]
         q = noise[:, n_out:] / math.sqrt(3600.0)  # [potential/√h] -> [potential/√s]
         return sig * sig, q
-
-    def node_diffusion(self, mf, q: np.ndarray) -> np.ndarray:
-        """(K, n) diffusion of every node [potential/√s] from the sampled ``q``."""
-        return q
 
     def filter(self, model, mf, U, Yobs, noise, x0_mean, P0, want_point=False):
         """(K,) log-likelihood from a modal form, inputs ``U`` (N, m), initial mean
@@ -208,7 +203,7 @@ class KalmanNoise(NoiseModel):
         K, n = mf.lam.shape
         n_out = mf.Cz.shape[1]
         R, q = self.split_statespace(noise, n_out)
-        Qd = modal_process_noise(mf, self.node_diffusion(mf, q))
+        Qd = modal_process_noise(mf, q)
         n_in = U.shape[1]
         W = (U @ mf.Bdz.reshape(K * n, n_in).T).reshape(U.shape[0], K, n)  # (N, K, n)
         if mf.ez.any():
@@ -259,7 +254,7 @@ class KalmanNoise(NoiseModel):
         the model's modes, plus measurement noise (added to a noise-free simulation)."""
         K, n = mf.lam.shape
         R, q = self.split_statespace(noise, n_out)
-        Qd = modal_process_noise(mf, self.node_diffusion(mf, q))
+        Qd = modal_process_noise(mf, q)
         L = np.linalg.cholesky(Qd + 1e-30 * np.eye(n))
         d = np.zeros((K, n))
         out = np.empty((K, N, n_out))
@@ -269,36 +264,4 @@ class KalmanNoise(NoiseModel):
         return out + np.sqrt(R)[:, None, :] * rng.standard_normal((K, N, n_out))
 
 
-class KalmanAirNoise(KalmanNoise):
-    """Process noise on the measured node(s) only (the room air) + white measurement
-    noise: ``q_<output>`` and ``sigma_<output>``.
-
-    The errors the RC model cannot resolve mostly reach the air directly: the weather
-    between the hourly readings (ventilation), the facade irradiance of a sky model, an
-    unmodelled source. Entering at the air node, the error still spreads to the slow
-    nodes through the network's conductances and has the model's own time constants,
-    but no node of the envelope carries a free random walk of its own: the slowest mode
-    stays the simulation's to explain (with ``kalman`` a detached envelope node, Gw at
-    its lower bound, can follow its own process noise; docs/science/noise.md).
-    """
-
-    name = "kalman_air"
-
-    def parameter_specs(self, output_names, state_names=()) -> list[tuple[str, str, str]]:
-        specs = [(f"sigma_{o}", "sigma_meas", o) for o in output_names]
-        return specs + [(f"q_{o}", "diffusion", o) for o in output_names]
-
-    def node_diffusion(self, mf, q: np.ndarray) -> np.ndarray:
-        """(K, n) diffusions: ``q`` (K, n_out) on each output's node, zero elsewhere.
-        The node of an output is where its row of the physical output matrix
-        :math:`C = C_z T^{-1}` is one (outputs are nodes of the RC network)."""
-        C = mf.Cz @ mf.Tinv  # (K, n_out, n), one-hot rows
-        full = np.zeros(mf.lam.shape)
-        for o in range(q.shape[1]):
-            j = np.argmax(np.abs(np.nan_to_num(C[:, o, :])), axis=1)
-            full[np.arange(full.shape[0]), j] += q[:, o]
-        return full
-
-
 NOISE_MODELS["kalman"] = KalmanNoise  # get_noise_model("kalman")
-NOISE_MODELS["kalman_air"] = KalmanAirNoise

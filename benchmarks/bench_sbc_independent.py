@@ -168,7 +168,8 @@ def generator_weather(seed: int, without: tuple = ()) -> dict:
 
 def fit_inputs(hourly: pd.DataFrame, models=(), full: bool = False):
     """The hourly inputs ``hbayes calibrate`` builds from the station record: the south
-    facade by :func:`surface_irradiance` (its defaults) and :func:`align` on 1 h.
+    facade by :func:`heritage_bayes.inputs.solar_inputs` (an hour-ending mean, held over
+    its hour) and :func:`align` on 1 h.
 
     ``models`` (RC models with slope inputs, :meth:`RCModel.with_slopes`) get their
     ``<input>_slope`` columns from :func:`heritage_bayes.inputs.add_slope_columns`, as
@@ -176,13 +177,12 @@ def fit_inputs(hourly: pd.DataFrame, models=(), full: bool = False):
     instantaneous reading over the step (the first-order hold), zeros for the
     hour-ending irradiance means. ``full``: the :class:`~heritage_bayes.io.Aligned`
     too, as ``(frame, aligned)``."""
-    from heritage_bayes.climate.solar import surface_irradiance
-    from heritage_bayes.inputs import add_slope_columns
+    from heritage_bayes.inputs import add_slope_columns, solar_inputs
     from heritage_bayes.io.align import align
 
-    irr = surface_irradiance(hourly[["ghi"]], SITE, {"S": (90.0, 180.0)})
-    irr = irr.rename(columns={"S": "I_S"})
-    irr.attrs["source"] = "facade"
+    # the facade as prepare builds it (its transposition, albedo and labels: the
+    # irradiance stays an hour-ending mean, held over its hour)
+    irr = solar_inputs(hourly[["ghi"]], SITE, {"S": (90.0, 180.0)}, "measured")[0]
     met = hourly[["Te", "Pe"]].copy()
     met.attrs.update(averaged=(), interval="1h", source="station")
     aligned = align([met, irr], step="1h", max_gap="0h")

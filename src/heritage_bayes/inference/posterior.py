@@ -103,6 +103,10 @@ class LogPosterior:
     initial_state_horizon : float, optional
         Time [s] beyond which a mode's start deviation is damped (see the module
         docstring); default the length of ``inputs``; ``math.inf`` switches it off.
+    temperature : float
+        Divides the log-likelihood in the log-posterior (a tempered likelihood,
+        :mod:`heritage_bayes.inference.tempering`); default 1 (none).
+        :meth:`log_likelihood` and the pointwise terms stay untempered.
     """
 
     model: RCModel
@@ -117,9 +121,6 @@ class LogPosterior:
     initial_state_sd: float | None = None
     initial_state_horizon: float | None = None
     time_constant_cap: float | None = None
-    #: the likelihood's temperature κ ≥ 1 (log L / κ in the posterior; 1: none), see
-    #: :mod:`heritage_bayes.inference.tempering`; log_likelihood and the pointwise
-    #: terms (LOO) stay untempered
     temperature: float = 1.0
 
     def __post_init__(self):

@@ -234,7 +234,9 @@ def fit_and_rank(
     name = model.name
     out = {}
     for variant in variants:
-        noise_name, init = variant.split(":")
+        # NOISE:INIT or NOISE:INIT:temper=L (the likelihood tempered by the long-run
+        # variance ratio of the MAP's innovations, Bartlett window of L hours)
+        noise_name, init, *temper = variant.split(":")
         t0 = time.process_time()
         noise = get_noise_model(noise_name)
         known = {k: v for k, v in priors.items() if k in model.parameter_names}
@@ -260,6 +262,18 @@ def fit_and_rank(
             time_constant_cap=ModelSection(model=name).cap_seconds(model.domain),
         )
         mp = find_map(lp, seed=rep, method="differential_evolution", popsize=15, maxiter=200)
+        kappas = {}
+        if temper:
+            from heritage_bayes.inference.tempering import (
+                innovations_at,
+                likelihood_temperature,
+                long_run_variance_ratio,
+            )
+
+            bandwidth = int(temper[0].removeprefix("temper="))
+            w = innovations_at(lp, mp.theta)[:, 0]
+            kappas = {str(b): long_run_variance_ratio(w, b) for b in (24, 72, 168, 336)}
+            lp.temperature = likelihood_temperature(lp, mp.theta, bandwidth)
         chain = run_sampler(
             lp,
             mp.x,
@@ -295,6 +309,8 @@ def fit_and_rank(
             "steps": int(chain.steps),
             "cpu": time.process_time() - t0,
         }
+        if temper:
+            out[variant].update(temperature=lp.temperature, kappa_by_bandwidth=kappas)
     return out
 
 

@@ -166,18 +166,31 @@ def generator_weather(seed: int, without: tuple = ()) -> dict:
     return {"fine": {"Te": te_f, "Pe": pe_f, "I_S": i_s}, "hourly": hourly, "t0": hours[0]}
 
 
-def fit_inputs(hourly: pd.DataFrame) -> pd.DataFrame:
+def fit_inputs(hourly: pd.DataFrame, models=(), full: bool = False):
     """The hourly inputs ``hbayes calibrate`` builds from the station record: the south
-    facade by :func:`surface_irradiance` (its defaults) and :func:`align` on 1 h."""
-    from heritage_bayes.climate.solar import surface_irradiance
+    facade by :func:`heritage_bayes.inputs.solar_inputs` (an hour-ending mean, held over
+    its hour) and :func:`align` on 1 h.
+
+    ``models`` (RC models with slope inputs, :meth:`RCModel.with_slopes`) get their
+    ``<input>_slope`` columns from :func:`heritage_bayes.inputs.add_slope_columns`, as
+    ``hbayes calibrate`` adds them with ``data.input_hold: exact``: the change of each
+    instantaneous reading over the step (the first-order hold), zeros for the
+    hour-ending irradiance means. ``full``: the :class:`~heritage_bayes.io.Aligned`
+    too, as ``(frame, aligned)``."""
+    from heritage_bayes.inputs import add_slope_columns, solar_inputs
     from heritage_bayes.io.align import align
 
-    irr = surface_irradiance(hourly[["ghi"]], SITE, {"S": (90.0, 180.0)})
-    irr = irr.rename(columns={"S": "I_S"})
-    irr.attrs["source"] = "facade"
+    # the facade as prepare builds it (its transposition, albedo and labels: the
+    # irradiance stays an hour-ending mean, held over its hour)
+    irr = solar_inputs(hourly[["ghi"]], SITE, {"S": (90.0, 180.0)}, "measured")[0]
     met = hourly[["Te", "Pe"]].copy()
     met.attrs.update(averaged=(), interval="1h", source="station")
-    return align([met, irr], step="1h", max_gap="0h").frame
+    aligned = align([met, irr], step="1h", max_gap="0h")
+    frame = aligned.frame.copy()
+    frame.attrs = dict(aligned.frame.attrs)
+    if models:
+        add_slope_columns(frame, models, aligned.slopes)
+    return (frame, aligned) if full else frame
 
 
 def replicate(args) -> dict:
@@ -190,6 +203,7 @@ def replicate(args) -> dict:
     floor = args[6] if len(args) > 6 else FLOOR
     envelope = args[7] if len(args) > 7 else ENVELOPE
     without = args[8] if len(args) > 8 else ()
+    hold = args[9] if len(args) > 9 else "exact"
     rng = np.random.default_rng([seed, rep])
     opts = {"surfaces": ("S",)} if name.startswith("thermal") else {}
     model = hb.model(name, **opts)
@@ -205,17 +219,21 @@ def replicate(args) -> dict:
     X = simulate_reference(model, p, Uf, DT_SUB, x0)  # exact 10-minute steps
     out = model.output_names[0]
     y_hour = X[::SUB, model.state_names.index(out)]  # the node at every full hour
-    frame = fit_inputs(gw["hourly"])
+    # the fit's model and inputs, as hbayes calibrate builds them for this input hold
+    fit_model = model.with_slopes(model.network.inputs if hold == "exact" else ())
+    frame = fit_inputs(gw["hourly"], [fit_model])
     U = np.column_stack(
         [
             frame[c].to_numpy(float) if c in frame else np.full(len(frame), 10.0)
-            for c in model.input_names
+            for c in fit_model.input_names
         ]
     )
-    if "Tf" in model.input_names:
+    if "Tf" in model.input_names:  # constant: its slope column (if any) stays zero
         U[:, model.input_names.index("Tf")] = fine["Te"].mean()
     if "substeps" in without:  # the fit's own discretisation: hourly ZOH of its inputs
-        y_hour = simulate_reference(model, p, U, 3600.0, x0)[:, model.state_names.index(out)]
+        m_net = len(model.network.inputs)
+        y_hour = simulate_reference(model, p, U[:, :m_net], 3600.0, x0)
+        y_hour = y_hour[:, model.state_names.index(out)]
     n = min(len(U), y_hour.size)
     spin = int(rng.integers(7, MAX_SPIN_DAYS + 1)) * 24
     rows = slice(spin, spin + cal_days * 24)
@@ -246,11 +264,14 @@ def replicate(args) -> dict:
         "truth": dq_true,
         "truth_parameters": p,
         "generator": "independent",
+        "input_hold": hold,
+        # the fit's upper bounds on the hygric buffer from the envelope area
+        "hygric_envelope": bool(envelope) and not name.startswith("thermal"),
     }
     if extra is not None:
         result["irradiance_mean"] = {"generator": mean_true, "fit": mean_fit}
     result["variants"] = fit_and_rank(
-        model, U[rows], y, dq_true, variants, rep, max_steps, {}, floor, envelope, extra
+        fit_model, U[rows], y, dq_true, variants, rep, max_steps, {}, floor, envelope, extra
     )
     return result
 
@@ -267,6 +288,15 @@ def read_logs(paths: list[str]) -> list[dict]:
                 if not line.strip():
                     continue
                 r = json.loads(line)
+                # logs from before the fit's first-order hold held every input at its
+                # interval mean: their variants are tabulated apart ("...@interval_mean")
+                hold = r.get("input_hold", "interval_mean")
+                if hold != "exact":
+                    r["variants"] = {f"{v}@{hold}": x for v, x in r["variants"].items()}
+                # hygric fits from before the envelope's bounds on the hygric buffer
+                # (Gw, Cw from --envelope-area, as for the thermal envelope)
+                if r["model"].startswith("hygric") and not r.get("hygric_envelope", False):
+                    r["variants"] = {f"{v}@unbounded": x for v, x in r["variants"].items()}
                 key = (r["model"], int(r["rep"]))
                 if key not in merged:
                     merged[key] = {**r, "variants": dict(r["variants"])}
@@ -370,6 +400,23 @@ def main(argv=None) -> int:
         "(then the room is simulated with the fit's hourly zero-order hold of its inputs)",
     )
     ap.add_argument(
+        "--envelope-area",
+        type=float,
+        default=ENVELOPE,
+        help="exterior area of walls and roof [m²] given to every fit: upper bounds on the "
+        "envelope (thermal) or buffer (hygric) node's Gw and Cw; 0: none "
+        f"(default {ENVELOPE:g})",
+    )
+    ap.add_argument(
+        "--input-hold",
+        choices=("exact", "interval_mean"),
+        default="exact",
+        help="how the fit holds its inputs over each hour (data.input_hold): exact (the "
+        "default of hbayes calibrate for files: readings linear between the hours) or "
+        "interval_mean (every input held at its hourly mean, as before the first-order "
+        "hold; tabulated as NOISE:INIT@interval_mean)",
+    )
+    ap.add_argument(
         "--table",
         nargs="+",
         metavar="LOG",
@@ -399,7 +446,18 @@ def main(argv=None) -> int:
                 print(line)
         return 0
     tasks = [
-        (m, r, variants, args.seed, args.max_steps, CAL_DAYS, FLOOR, ENVELOPE, without)
+        (
+            m,
+            r,
+            variants,
+            args.seed,
+            args.max_steps,
+            CAL_DAYS,
+            FLOOR,
+            args.envelope_area or None,
+            without,
+            args.input_hold,
+        )
         for r in range(args.first_rep, args.first_rep + args.reps)
         for m in args.models.split(",")
     ]

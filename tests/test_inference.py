@@ -294,19 +294,24 @@ def test_floor_area_sets_the_ground_prior_of_thermal_models_only():
         parse_config({**raw, "floor_area": -5})
 
 
-def test_envelope_area_bounds_the_envelope_node_of_thermal_models_only():
-    """envelope_area [m²]: Gw ≤ 25 W/(m²K) × area (the exterior film, EN ISO 6946) and
-    Cw ≤ 7.5 MJ/(m²K) × area (3 m of granite), lower bounds and family the defaults';
-    4a's interior mass and a hygric model's Gw/Cw keep their defaults; the config key
-    reaches the parameters; the sampler's support follows the bound; an area that puts
-    a bound below the default's lower one is a ConfigError naming the key."""
+def test_envelope_area_bounds_the_envelope_node():
+    """envelope_area [m²]: 0.1 W/(m²K) × area ≤ Gw ≤ 25 W/(m²K) × area (a passive-house
+    wall; the exterior film, EN ISO 6946) and Cw ≤ 7.5 MJ/(m²K) × area (3 m of
+    granite), the family and Cw's lower bound the defaults'; 4a's interior mass keeps
+    its defaults; a hygric buffer's Gw ≤ 2e-9 kg/(m²·s·Pa) × area (s_d 0.1 m) and
+    Cw ≤ 0.04 kg/(m²·Pa) × area (10 cm of wood at 0 °C); the config key reaches the
+    parameters; the sampler's support follows the bound; an area that puts a bound
+    below the default's lower one is a ConfigError naming the key."""
     import heritage_bayes as hb
     from heritage_bayes.config import parse_config
     from heritage_bayes.errors import ConfigError
     from heritage_bayes.inference.likelihoods import get_noise_model
     from heritage_bayes.inference.parameters import (
+        C_BUFFER_MAX,
         C_ENVELOPE_MAX,
+        G_VAPOUR_MAX,
         H_EXTERIOR,
+        U_ENVELOPE_MIN,
         default_prior,
         envelope_priors,
         parameters_for,
@@ -319,9 +324,11 @@ def test_envelope_area_bounds_the_envelope_node_of_thermal_models_only():
     prior = {p.name: p.prior for p in ps.parameters}
     assert prior["Gw"].upper == pytest.approx(25.0 * 259.0) == H_EXTERIOR * 259.0
     assert prior["Cw"].upper == pytest.approx(7.5e6 * 259.0) == C_ENVELOPE_MAX * 259.0
+    assert prior["Gw"].lower == pytest.approx(0.1 * 259.0) == U_ENVELOPE_MIN * 259.0
+    assert prior["Cw"].lower == default_prior("thermal", "capacity").lower
     for name, kind in (("Gw", "conductance"), ("Cw", "capacity")):
         d = default_prior("thermal", kind)
-        assert (prior[name].dist, prior[name].lower) == (d.dist, d.lower)
+        assert prior[name].dist == d.dist
         assert prior[name].upper < d.upper
     assert prior["Cint"] == default_prior("thermal", "capacity")
     assert prior["Gi"] == default_prior("thermal", "conductance")
@@ -331,7 +338,13 @@ def test_envelope_area_bounds_the_envelope_node_of_thermal_models_only():
     assert np.exp(hi[j]) == pytest.approx(H_EXTERIOR * 259.0)
     hy = hb.model("hygric_2c")
     hps = parameters_for(hy, noise, envelope_area=259.0)
-    assert hps.parameters[hps.names.index("Gw")].prior == default_prior("hygric", "conductance")
+    hprior = {p.name: p.prior for p in hps.parameters}
+    assert hprior["Gw"].upper == pytest.approx(2e-9 * 259.0) == G_VAPOUR_MAX * 259.0
+    assert hprior["Cw"].upper == pytest.approx(0.04 * 259.0) == C_BUFFER_MAX * 259.0
+    for name, kind in (("Gw", "conductance"), ("Cw", "capacity")):
+        d = default_prior("hygric", kind)
+        assert (hprior[name].dist, hprior[name].lower) == (d.dist, d.lower)
+    assert hprior["Gi"] == default_prior("hygric", "conductance")
     with pytest.raises(ConfigError, match="envelope_area"):
         envelope_priors(1e-4)
     raw = {"data": {"demo": {"seed": 7}}, "envelope_area": 259, "thermal": {"model": "thermal_2c"}}

@@ -70,7 +70,18 @@ def test_independent_generator_machinery():
     i_gen = fine["I_S"].reshape(-1, bench.SUB).mean(axis=1)
     ratio = frame["I_S"].sum() / i_gen.sum()
     assert 0.75 < ratio < 1.25 and abs(ratio - 1) > 1e-3
+    # the fit holds the readings exactly, as hbayes calibrate does: slope columns from
+    # align (the change of each reading over the hour), zeros for the hour-ending
+    # irradiance means
+    import heritage_bayes as hb
+
+    m = hb.model("thermal_2c", surfaces=("S",))
+    fit_model = m.with_slopes(m.network.inputs)
+    frame = bench.fit_inputs(hourly, [fit_model])
+    np.testing.assert_allclose(frame["Te_slope"].to_numpy(), np.diff(te), atol=1e-9)
+    assert (frame["I_S_slope"] == 0).all() and frame.attrs["input_hold"] == "exact"
     r = bench.replicate(("thermal_2c", 0, ["ar1_white:estimate"], 11, 600, 28))
+    assert r["input_hold"] == "exact"
     ranks = r["variants"]["ar1_white:estimate"]["ranks"]
     assert set(bench.QUANTITIES["thermal_2c"]) <= set(ranks)
     for x in ranks.values():
@@ -91,8 +102,15 @@ def test_independent_table_merges_logs(tmp_path, capsys):
 
     bench = pytest.importorskip("bench_sbc_independent")
 
-    def rec(rep, variants):
-        return {"model": "thermal_2c", "rep": rep, "truth": {"tau_1_h": 1.2}, "variants": variants}
+    def rec(rep, variants, **extra):
+        return {
+            "model": "thermal_2c",
+            "rep": rep,
+            "truth": {"tau_1_h": 1.2},
+            "variants": variants,
+            "input_hold": "exact",
+            **extra,
+        }
 
     def var(rank):
         x = {"in50": rank > 0.25, "in90": True, "rank": rank, "median": 1.0, "sd": 0.5}
@@ -129,3 +147,18 @@ def test_independent_table_merges_logs(tmp_path, capsys):
     bad.write_text(json.dumps(rec(1, {"kalman:estimate": var(0.9)})) + "\n")
     with pytest.raises(SystemExit, match=r"b\.jsonl: thermal_2c replicate 1"):
         bench.read_logs([str(pilot), str(bad)])
+    # logs of fits that held every input at its interval mean (before the first-order
+    # hold; no "input_hold" key) and hygric fits without the buffer's bounds are
+    # tabulated apart, not mixed with the current fits
+    old = tmp_path / "old.jsonl"
+    r_old = rec(1, {"kalman:estimate": var(0.9)})
+    del r_old["input_hold"]
+    r_hyg = {**rec(1, {"kalman:estimate": var(0.9)}), "model": "hygric_2c_fixed"}
+    old.write_text(json.dumps(r_old) + "\n" + json.dumps(r_hyg) + "\n")
+    merged = {(r["model"], r["rep"]): r for r in bench.read_logs([str(pilot), str(old)])}
+    assert sorted(merged["thermal_2c", 1]["variants"]) == [
+        "ar1_white:estimate",
+        "kalman:estimate",
+        "kalman:estimate@interval_mean",
+    ]
+    assert sorted(merged["hygric_2c_fixed", 1]["variants"]) == ["kalman:estimate@unbounded"]

@@ -67,7 +67,8 @@ class CalibrationConfig(_Strict):
     envelope_area: float | None = key(
         None,
         unit="m²",
-        description="exterior area of walls and roof: upper bounds on thermal Gw and Cw",
+        description="exterior area of walls and roof: bounds on the envelope node's Gw "
+        "and Cw (thermal) and on the moisture buffer's Gw and Cw (hygric)",
         gt=0,
     )
     data: Data = key(unit=None, description="weather and logger files (or the demo)")

@@ -415,12 +415,26 @@ def ground_prior(floor_area: float, *, u_value: float = U_GROUND, sigma: float =
 #: (EN ISO 6946:2017, Table 7): nothing outside the envelope node couples it to the
 #: outdoor air better than the film on its outer face.
 H_EXTERIOR = 25.0
+#: Best-insulated envelope per m² of its surface [W/(m²·K)]: U = 0.1, a passive-house
+#: wall (EN ISO 6946 gives U; masonry of monuments is 1-3): the envelope node's Gw, its
+#: conductance to the outdoor air through the outer part of the wall, is at least U × area.
+U_ENVELOPE_MIN = 0.1
 #: Heaviest envelope per m² of its surface [J/(m²·K)]: 3 m of granite or dense
 #: stone at ρc ≈ 2.5 MJ/(m³·K) (EN ISO 10456: granite 2 500 kg/m³ × 1 000 J/(kg·K)).
 C_ENVELOPE_MAX = 3.0 * 2.5e6
 
 
-def envelope_priors(envelope_area: float) -> dict[str, Prior]:
+#: Most vapour-open envelope per m² [kg/(m²·s·Pa)]: a layer of equivalent air
+#: thickness s_d = 0.1 m (δ_air ≈ 2e-10 kg/(m·s·Pa), EN ISO 12572; a thin open board;
+#: masonry walls have s_d of metres, EN ISO 10456). Air leaks are Gfast's.
+G_VAPOUR_MAX = 2e-9
+#: Largest moisture buffer per m² of envelope [kg/(m²·Pa)]: 10 cm of wood (moisture
+#: capacity dw/dφ ≈ 250 kg/m³ at high RH) in equilibrium at 0 °C (p_sat 611 Pa):
+#: 0.1 × 250 / 611 ≈ 0.04, generous enough to include the interior's contents.
+C_BUFFER_MAX = 0.04
+
+
+def envelope_priors(envelope_area: float, domain: str = "thermal") -> dict[str, Prior]:
     """Upper bounds on a thermal envelope node from its exterior surface area.
 
     ``Gw`` (envelope node - outdoor air) [W/K] at most ``H_EXTERIOR × area`` and
@@ -437,24 +451,45 @@ def envelope_priors(envelope_area: float) -> dict[str, Prior]:
     259 m²) 16 in 24, and over 100 such rooms the solar gain's coverage rose from 0.81
     to 0.86 (README: simulation-based calibration).
 
+    And ``Gw`` at least ``U_ENVELOPE_MIN × area``: an envelope node nearly detached
+    from the outdoor air (Gw 0.01-0.3 W/K for a 259 m² envelope) is the trap of the
+    Kalman likelihoods, whose process noise then makes the detached node a random walk
+    that carries the slow response (``noise: kalman``, independent SBC rooms 4 and 12:
+    Gw 0.27 and 0.01 W/K for truths of 92 and 369 W/K; docs/science/noise.md).
+
+    Hygric models (``domain="hygric"``): the buffer node's ``Gw`` (buffer - outdoor)
+    [kg/(s·Pa)] at most ``G_VAPOUR_MAX × area`` and ``Cw`` [kg/Pa] at most
+    ``C_BUFFER_MAX × area``. Without them hygric_2c_fixed holds the same kind of ridge:
+    a buffer welded to the outdoor air (Gw at the default's 1e-3) with a capacity of
+    1e3 kg/Pa (a tonne of water per pascal), a low-pass filtered Pe that trades the
+    gain from Pe against the fixed node's offset (measured by
+    ``benchmarks/bench_sbc_independent.py``: MAPs of 13 of 27 rooms there, gain from Pe
+    z +1.2 on average; docs/science/noise.md).
+
     Parameters
     ----------
     envelope_area : float
         Exterior surface area of walls and roof [m²] (not the floor on the ground).
+    domain : str
+        ``"thermal"`` or ``"hygric"``.
     """
     out = {}
+    limits = (H_EXTERIOR, C_ENVELOPE_MAX) if domain == "thermal" else (G_VAPOUR_MAX, C_BUFFER_MAX)
     for name, kind, limit in (
-        ("Gw", "conductance", H_EXTERIOR * envelope_area),
-        ("Cw", "capacity", C_ENVELOPE_MAX * envelope_area),
+        ("Gw", "conductance", limits[0] * envelope_area),
+        ("Cw", "capacity", limits[1] * envelope_area),
     ):
-        d = default_prior("thermal", kind)
+        d = default_prior(domain, kind)
         if not limit > d.lower:
             raise ConfigError(
                 f"envelope_area: {envelope_area:g} m² bounds {name} at {limit:.3g}, below its "
                 f"default lower bound {d.lower:g}; expected the exterior area of walls and "
                 "roof in m² (tens to thousands)"
             )
-        out[name] = Prior(d.dist, d.lower, limit)
+        lower = d.lower
+        if (domain, name) == ("thermal", "Gw"):
+            lower = max(lower, U_ENVELOPE_MIN * envelope_area)
+        out[name] = Prior(d.dist, lower, limit)
     return out
 
 
@@ -711,8 +746,8 @@ def parameters_for(
             prior = ventilation_prior(domain, room_volume, air_change_rate, sigma=air_change_sigma)
         if name == "Gf" and floor_area is not None and (domain, kind) == ("thermal", "conductance"):
             prior = ground_prior(floor_area)
-        if envelope_area is not None and domain == "thermal" and name in ("Gw", "Cw"):
-            prior = envelope_priors(envelope_area)[name]
+        if envelope_area is not None and name in ("Gw", "Cw"):
+            prior = envelope_priors(envelope_area, domain)[name]
         spec = priors.get(name)
         fixed = None
         if spec is not None:

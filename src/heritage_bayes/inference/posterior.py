@@ -103,6 +103,10 @@ class LogPosterior:
     initial_state_horizon : float, optional
         Time [s] beyond which a mode's start deviation is damped (see the module
         docstring); default the length of ``inputs``; ``math.inf`` switches it off.
+    temperature : float
+        Divides the log-likelihood in the log-posterior (a tempered likelihood,
+        :mod:`heritage_bayes.inference.tempering`); default 1 (none).
+        :meth:`log_likelihood` and the pointwise terms stay untempered.
     """
 
     model: RCModel
@@ -117,6 +121,7 @@ class LogPosterior:
     initial_state_sd: float | None = None
     initial_state_horizon: float | None = None
     time_constant_cap: float | None = None
+    temperature: float = 1.0
 
     def __post_init__(self):
         self.inputs = np.ascontiguousarray(self.inputs, dtype=float)
@@ -476,7 +481,7 @@ class LogPosterior:
                 val[inside] = (
                     lp[inside]
                     + self.time_constant_log_prior(th[:, : self.n_model])
-                    + self._loglik(th)
+                    + self._loglik(th) / self.temperature
                 )
             val[~np.isfinite(val)] = -np.inf
             out[ok] = val

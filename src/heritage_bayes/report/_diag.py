@@ -20,6 +20,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from heritage_bayes.inference.tempering import ar1_white_innovations
+
+# the standardised innovations of ar1_white live beside the tempered likelihood that
+# uses them (inference/tempering.py); the report reads them from there
+kalman_innovations = ar1_white_innovations
+
 __all__ = ["acf", "cumulative_periodogram", "innovations", "kalman_innovations"]
 
 
@@ -75,33 +81,6 @@ def innovations(e: np.ndarray, phi: float) -> np.ndarray:
     if phi == 0:
         w[0] = e[0]
     return w
-
-
-def kalman_innovations(e: np.ndarray, sigma: float, phi: float, w: float) -> np.ndarray:
-    """Standardised one-step innovations of ``ar1_white`` (AR(1) error of marginal sd
-    ``sigma`` and coefficient ``phi`` plus white noise of sd ``w``): the scalar Kalman
-    filter of :class:`heritage_bayes.inference.likelihoods.AR1WhiteNoise`, exact across
-    gaps (NaN where a value is missing). White, unit variance if the noise model is
-    right.
-    """
-    e = np.asarray(e, dtype=float)
-    out = np.full(e.shape, np.nan)
-    s2, w2 = sigma * sigma, w * w
-    m, P, last = 0.0, s2, -1
-    for k in range(e.size):
-        if not np.isfinite(e[k]):
-            continue
-        if last < 0:
-            mp, Pp = 0.0, s2
-        else:
-            phd = phi ** (k - last)
-            mp, Pp = phd * m, phd * phd * P + s2 * (1.0 - phd * phd)
-        F = Pp + w2
-        v = e[k] - mp
-        out[k] = v / np.sqrt(F)
-        g = Pp / F
-        m, P, last = mp + g * v, Pp * w2 / F, k
-    return out
 
 
 def cumulative_periodogram(e: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:

@@ -210,7 +210,7 @@ def chain_tag(cfg: CalibrationConfig) -> str:
     keep = {k: d["sampler"][k] for k in ("walkers", "moves", "init_ball")}
     if d["sampler"].get("coordinates", "auto") != "auto":  # (tags of earlier runs kept)
         keep["coordinates"] = d["sampler"]["coordinates"]
-    if d["sampler"].get("start", "auto") != "auto":
+    if d["sampler"].get("start", "ball") != "ball":
         keep["start"] = d["sampler"]["start"]
     d = {**d, "sampler": keep}
     for k in ("report", "ladder", "name", "building", "room", "notes"):

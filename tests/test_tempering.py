@@ -7,11 +7,10 @@ import numpy as np
 import pytest
 
 import heritage_bayes as hb
-from heritage_bayes.inference.likelihoods import get_noise_model
+from heritage_bayes.inference.likelihoods import ar1_white_innovations, get_noise_model
 from heritage_bayes.inference.parameters import parameters_for
 from heritage_bayes.inference.posterior import LogPosterior
 from heritage_bayes.inference.tempering import (
-    ar1_white_innovations,
     innovations_at,
     likelihood_temperature,
     long_run_variance_ratio,

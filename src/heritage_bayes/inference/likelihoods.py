@@ -48,6 +48,7 @@ __all__ = [
     "AR1WhiteNoise",
     "IIDNoise",
     "NoiseModel",
+    "ar1_white_innovations",
     "fit_free_run_error",
     "get_noise_model",
 ]
@@ -435,6 +436,33 @@ class AR1WhiteNoise(NoiseModel):
         """Default priors that depend on the time step ``dt`` [s]: phi's cap."""
         cap = round(math.exp(-dt / 3600.0 / self.TAU_MAX_H), 4)
         return {(dom, "phi"): Prior("uniform", 0.0, cap) for dom in ("thermal", "hygric")}
+
+
+def ar1_white_innovations(e: np.ndarray, sigma: float, phi: float, w: float) -> np.ndarray:
+    """Standardised one-step innovations of ``ar1_white`` (AR(1) error of marginal sd
+    ``sigma`` and coefficient ``phi`` plus white noise of sd ``w``): the scalar Kalman
+    filter of :class:`heritage_bayes.inference.likelihoods.AR1WhiteNoise`, exact across
+    gaps (NaN where a value is missing). White, unit variance if the noise model is
+    right. ``ar1`` is ``w = 0``, ``iid`` is ``phi = w = 0``.
+    """
+    e = np.asarray(e, dtype=float)
+    out = np.full(e.shape, np.nan)
+    s2, w2 = sigma * sigma, w * w
+    m, P, last = 0.0, s2, -1
+    for k in range(e.size):
+        if not np.isfinite(e[k]):
+            continue
+        if last < 0:
+            mp, Pp = 0.0, s2
+        else:
+            phd = phi ** (k - last)
+            mp, Pp = phd * m, phd * phd * P + s2 * (1.0 - phd * phd)
+        F = Pp + w2
+        v = e[k] - mp
+        out[k] = v / np.sqrt(F)
+        g = Pp / F
+        m, P, last = mp + g * v, Pp * w2 / F, k
+    return out
 
 
 NOISE_MODELS: dict[str, type[NoiseModel]] = {

@@ -435,11 +435,12 @@ C_BUFFER_MAX = 0.04
 
 
 def envelope_priors(envelope_area: float, domain: str = "thermal") -> dict[str, Prior]:
-    """Upper bounds on a thermal envelope node from its exterior surface area.
+    """Bounds on an envelope node (thermal) or a moisture buffer (hygric) from the
+    exterior surface area.
 
     ``Gw`` (envelope node - outdoor air) [W/K] at most ``H_EXTERIOR × area`` and
-    ``Cw`` [J/K] at most ``C_ENVELOPE_MAX × area``; the lower bounds (and the
-    log-uniform family) stay the defaults'. Why: without them a 2c or 4a posterior
+    ``Cw`` [J/K] at most ``C_ENVELOPE_MAX × area``; the log-uniform family and Cw's
+    lower bound stay the defaults' (Gw's lower bound: below). Why: without them a 2c or 4a posterior
     can hold a ridge running to an envelope node clamped to the outdoor air (Gw at the
     default's 1e5 W/K) that keeps its slow mode with a capacity of 1e11 J/K: a low-pass
     filtered outdoor temperature, physically a wall tens of metres thick. Along the
@@ -463,8 +464,8 @@ def envelope_priors(envelope_area: float, domain: str = "thermal") -> dict[str, 
     a buffer welded to the outdoor air (Gw at the default's 1e-3) with a capacity of
     1e3 kg/Pa (a tonne of water per pascal), a low-pass filtered Pe that trades the
     gain from Pe against the fixed node's offset (measured by
-    ``benchmarks/bench_sbc_independent.py``: MAPs of 13 of 27 rooms there, gain from Pe
-    z +1.2 on average; docs/science/noise.md).
+    ``benchmarks/bench_sbc_independent.py`` before these bounds: the MAPs of 9 of 27 rooms
+    with ``ar1_white`` and 27 of 39 with ``kalman``; docs/science/noise.md).
 
     Parameters
     ----------

@@ -38,11 +38,11 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["MIN_NODES", "laplace_ensemble", "laplace_factor", "start_hessian"]
+# ``sampler.start: auto`` starts from the Laplace approximation the networks that are
+# sampled along node time constants by default: at least this many capacity nodes
+from heritage_bayes.inference.coordinates import MIN_NODES
 
-#: ``sampler.start: auto`` starts networks of at least this many capacity nodes from
-#: the Laplace approximation (those sampled along node time constants by default).
-MIN_NODES = 3
+__all__ = ["laplace_ensemble", "laplace_factor", "start_hessian"]
 
 
 def start_hessian(logpost, lap, choice: str = "auto") -> np.ndarray | None:
@@ -50,7 +50,8 @@ def start_hessian(logpost, lap, choice: str = "auto") -> np.ndarray | None:
 
     ``"ball"``: None; ``"laplace"``: ``lap.hessian`` (None when the Laplace approximation
     could not be taken, ``lap`` None); ``"auto"``: as ``"laplace"`` for networks of
-    :data:`MIN_NODES` or more capacity nodes, the ball for smaller ones.
+    :data:`~heritage_bayes.inference.coordinates.MIN_NODES` or more
+    capacity nodes, the ball for smaller ones.
 
     Chosen by measured τ (``benchmarks/bench_coordinates.py demo_4a --only node_tau
     --air-share --start ball|laplace --max-steps 60000``, same MAP and seed): on the

@@ -20,13 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from heritage_bayes.inference.tempering import ar1_white_innovations
-
-# the standardised innovations of ar1_white live beside the tempered likelihood that
-# uses them (inference/tempering.py); the report reads them from there
-kalman_innovations = ar1_white_innovations
-
-__all__ = ["acf", "cumulative_periodogram", "innovations", "kalman_innovations"]
+__all__ = ["acf", "cumulative_periodogram", "innovations"]
 
 
 def acf(e: np.ndarray, max_lag: int) -> tuple[np.ndarray, np.ndarray, int]:

@@ -128,16 +128,12 @@ def _residual_check(
 ) -> dict:
     """Whiteness of what the noise model leaves: AR(1) innovations, or with ``white``
     = (sigma, phi, sigma_meas) the standardised Kalman innovations of ``ar1_white``."""
-    from heritage_bayes.report._diag import (
-        acf,
-        cumulative_periodogram,
-        innovations,
-        kalman_innovations,
-    )
+    from heritage_bayes.inference.likelihoods import ar1_white_innovations
+    from heritage_bayes.report._diag import acf, cumulative_periodogram, innovations
 
     max_lag = max(1, round(72 / dt_hours))
     _, rho, n = acf(resid, max_lag)
-    w = kalman_innovations(resid, *white) if white else innovations(resid, phi or 0.0)
+    w = ar1_white_innovations(resid, *white) if white else innovations(resid, phi or 0.0)
     _, rho_w, n_w = acf(w, max_lag)
     band = 1.96 / math.sqrt(max(n_w, 1))
     out_share = float(np.mean(np.abs(rho_w[1:]) > band)) if rho_w.size > 1 else float("nan")

@@ -277,10 +277,7 @@ def start_ensemble(
     """
     x_map = np.asarray(x_map, dtype=float)
     d = x_map.size
-    if bounds is None:
-        lo, hi = np.full(d, -np.inf), np.full(d, np.inf)
-    else:
-        lo, hi = (np.asarray(b, dtype=float) for b in bounds)
+    lo, hi = _support(bounds, d)
     width = hi - lo
     finite = np.isfinite(width)
     scale = np.where(finite, width, 1.0)

@@ -259,10 +259,11 @@ def test_sampler_same_seed_same_chain_and_resume_continues_it(tmp_path):
         run_sampler(lp, x0, checkpoint=tmp_path / "c.h5", tag="other", resume=True, **kw)
 
 
-def test_floor_area_sets_the_ground_prior_of_thermal_models_only():
+def test_floor_area_sets_the_ground_prior_of_thermal_models():
     """floor_area [m²]: Gf ~ lognormal(median 0.4 W/(m²K) × area, σ_log 1) on thermal
-    models; a hygric model's Gf (to a fixed vapour pressure) keeps its default; the
-    config key reaches the parameters; a bad area is a ConfigError naming it."""
+    models; a hygric model's Gf (to a fixed vapour pressure) gets its own, the vapour
+    diffusion through the floor (tests/test_fixed_node.py); the config key reaches the
+    parameters; a bad area is a ConfigError naming it."""
     import heritage_bayes as hb
     from heritage_bayes.config import parse_config
     from heritage_bayes.errors import ConfigError
@@ -279,7 +280,7 @@ def test_floor_area_sets_the_ground_prior_of_thermal_models_only():
     assert default.dist == "loguniform"
     hy = hb.model("hygric_2c_fixed")
     hps = parameters_for(hy, noise, floor_area=80)
-    assert hps.parameters[hps.names.index("Gf")].prior.dist == "loguniform"
+    assert hps.parameters[hps.names.index("Gf")].prior.mu == pytest.approx(3.2e-8)  # kg/(s·Pa)
     with pytest.raises(ConfigError, match="floor_area"):
         ground_prior(0.0)
     raw = {

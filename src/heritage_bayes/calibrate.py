@@ -306,6 +306,10 @@ def _calibrate_into(
     t0 = time.perf_counter()
     prep = prepare(cfg)
     t_prep = time.perf_counter() - t0
+    if (fixed := prep.sources.get("fixed_node_temperature")) is not None:
+        # the Pf prior's centre, resolved from the data: recorded in config.yaml, so
+        # that every reader of the run rebuilds the very prior the chain sampled
+        cfg = cfg.model_copy(update={"fixed_node_temperature": fixed["value"]})
     for w in prep.sources.get("clock", {}).get("warnings", []):  # see sources.check_clocks
         say.warn(w)
     say.say(

@@ -18,6 +18,7 @@ __all__ = [
     "add_slope_columns",
     "annual_mean_temperature",
     "calendar_inputs",
+    "fixed_node_temperature",
     "solar_inputs",
     "weather_inputs",
 ]
@@ -29,6 +30,47 @@ _MIN_DAYS = 350
 #: Transposition model and ground albedo used for the surfaces.
 _TRANSPOSITION = "perez"
 _ALBEDO = 0.2
+
+
+def fixed_node_temperature(
+    frame: pd.DataFrame, rows: slice, te: pd.Series | None, constant: float | None = None
+) -> dict:
+    """Temperature [°C] of the ground or crypt behind a hygric fixed vapour-pressure node
+    (the centre of :func:`heritage_bayes.inference.parameters.fixed_vapour_pressure_prior`).
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        The prepared grid; its ``Tf`` column [°C], when the thermal model has one, is
+        the ground temperature to use.
+    rows : slice
+        Row positions of the calibration period in ``frame``.
+    te : pandas.Series or None
+        Outdoor air temperature [°C], the whole weather record (tz-aware index).
+    constant : float, optional
+        ``data.ground_temperature``'s constant [°C] (mode ``constant``).
+
+    Returns
+    -------
+    dict
+        ``value`` [°C] (rounded to 0.01 K) and ``method`` (plain words): the mean of
+        ``Tf`` over ``rows``, else the constant, else the mean over ``rows`` of the
+        annual mean outdoor temperature (:func:`annual_mean_temperature`).
+    """
+    if "Tf" in frame.columns:
+        value, method = frame["Tf"].iloc[rows].mean(), "the thermal model's Tf, mean"
+    elif constant is not None:
+        value, method = constant, "data.ground_temperature's constant"
+    elif te is None:
+        raise ConfigError(
+            "fixed_node_temperature: the weather has no outdoor temperature Te to take the "
+            "annual mean of; give the temperature behind the fixed vapour-pressure node [°C]"
+        )
+    else:
+        step = frame.index[1] - frame.index[0] if len(frame) > 1 else pd.Timedelta(0)
+        tf, _ = annual_mean_temperature(te, frame.index[rows] + step / 2)
+        value, method = float(np.mean(tf)), "the annual mean outdoor temperature, mean"
+    return {"value": round(float(value), 2), "method": f"{method} (calibration period)"}
 
 
 def annual_mean_temperature(te: pd.Series, times: pd.DatetimeIndex) -> tuple[np.ndarray, dict]:

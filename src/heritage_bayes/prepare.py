@@ -57,6 +57,7 @@ from heritage_bayes.inputs import (
     add_slope_columns,
     annual_mean_temperature,
     calendar_inputs,
+    fixed_node_temperature,
     solar_inputs,
     weather_inputs,
 )
@@ -513,6 +514,9 @@ def prepare(cfg) -> Prepared:
             kind = sec_cfg.noise if sec_cfg is not None else "ar1_white"
             truth[sec].update(nominal_noise(monument, out, rows, noise=kind))
 
+    if cfg.fixed_node_temperature is None and any("Pf" in m.parameter_names for m in models):
+        te, const = weather.get("Te"), (gt.value if gt.mode == "constant" else None)
+        sources["fixed_node_temperature"] = fixed_node_temperature(frame, cal, te, const)
     return Prepared(
         frame=frame,
         flags=flags,

@@ -64,6 +64,17 @@ class CalibrationConfig(_Strict):
         description="floor on the ground: log-normal prior on the thermal Gf",
         gt=0,
     )
+    fixed_node_temperature: float | None = key(
+        None,
+        unit="°C",
+        description="temperature of the ground, water or crypt behind hygric_2c_fixed's "
+        "fixed vapour-pressure node: a log-normal prior on Pf, median 0.9 × its saturation "
+        "vapour pressure, sd of log 0.25; default: the ground temperature "
+        "(data.ground_temperature's constant, else the annual mean outdoor temperature "
+        "over the calibration period), recorded in the run's config.yaml",
+        ge=-40,
+        le=40,
+    )
     envelope_area: float | None = key(
         None,
         unit="m²",

@@ -494,6 +494,86 @@ def envelope_priors(envelope_area: float, domain: str = "thermal") -> dict[str, 
     return out
 
 
+#: Relative humidity of the air or water surface behind a fixed vapour-pressure node
+#: [-]: soil air and a wet wall (Kramer et al.'s canal) are at or near saturation, a
+#: crypt or cellar at 80-100 % RH; the median of :func:`fixed_vapour_pressure_prior`.
+RH_FIXED_NODE = 0.9
+#: sd of log(Pf) [-]: the source's RH (0.75-1.0, sd 0.08 in log), its temperature
+#: against the annual mean outdoor one (± 2 K at 6.8 %/K near 10 °C: sd 0.14), and
+#: room for what the node also lumps (a moisture source the model lacks).
+SIGMA_FIXED_NODE = 0.25
+#: Equivalent air-layer thickness s_d [m] of a ground floor laid on soil, the median of
+#: :func:`vapour_ground_prior` (brick or stone on sand with open joints, no membrane:
+#: 0.2-1.5 m within one sd; EN ISO 10456 gives mu of 5-10 for brick, 50-100 for dense
+#: stone, whose joints short-circuit it).
+SD_FLOOR = 0.5
+#: Vapour permeability of still air [kg/(m·s·Pa)] (EN ISO 12572, ~20 °C).
+DELTA_AIR = 2e-10
+
+
+def fixed_vapour_pressure_prior(
+    temperature: float, *, rh: float = RH_FIXED_NODE, sigma: float = SIGMA_FIXED_NODE
+) -> Prior:
+    """Log-normal prior on the fixed node's vapour pressure ``Pf`` [Pa] of
+    ``hygric_2c_fixed`` from the temperature of what lies behind it.
+
+    Median ``rh × p_sat(temperature)``, width ``sigma``, bounds median × exp(±5 σ).
+    Kramer, van Schijndel & Schellen introduce the node for a basement wall in contact
+    with a canal, "analogous to the thermal situation with ground contact": ground,
+    water or crypt air at the ground temperature (the annual mean outdoor temperature),
+    near saturation (Hens, *Building Physics: Heat, Air and Moisture*, 2nd ed., 2012,
+    §2.4: soil air is at capillary saturation below the first decimetres).
+
+    Why: the gain from ``Pe`` and the node's offset ``Gf/(ΣG) × Pf`` trade along a ridge
+    three months of data barely resolve; the former default (uniform on 0-5 000 Pa) gives
+    the weak-node, high-``Pf`` end of the ridge most of its volume, so the posterior
+    leant there. Measured on eight rooms the fitted model generated (``python
+    benchmarks/bench_sbc.py --reps 8 --models hygric_2c_fixed --noise
+    ar1_white:estimate``): gain from Pe above the truth in 7 of 8 (mean z +1.36), no
+    chain converged in 12 000 steps; with the fit's priors equal to the truth's
+    distribution (``--truth-priors``) mean z +0.34, 7 of 8 converged (τ 55-220 steps).
+
+    Parameters
+    ----------
+    temperature : float
+        Temperature of the ground, water or space behind the node [°C].
+    rh : float
+        Median relative humidity there [-].
+    sigma : float
+        sd of log(Pf) [-].
+    """
+    from heritage_bayes.climate.psychro import saturation_vapour_pressure
+
+    if not (math.isfinite(temperature) and -40.0 <= temperature <= 40.0):
+        raise ConfigError(
+            f"fixed_node_temperature: expected a ground temperature in -40..40 °C "
+            f"(got {temperature!r})"
+        )
+    median = rh * float(saturation_vapour_pressure(temperature))
+    return Prior(
+        "lognormal", median * math.exp(-5 * sigma), median * math.exp(5 * sigma), median, sigma
+    )
+
+
+def vapour_ground_prior(floor_area: float, *, s_d: float = SD_FLOOR, sigma: float = 1.0) -> Prior:
+    """Log-normal prior on the vapour conductance ``Gf`` [kg/(s·Pa)] between indoor
+    air and a fixed vapour-pressure node under the floor, from the floor area [m²].
+
+    Median ``DELTA_AIR / s_d × floor_area`` (diffusion through a floor of equivalent
+    air-layer thickness ``s_d`` [m]; 1.6e-8 kg/(s·Pa) for 80 m² at s_d 0.5 m),
+    σ_log = 1 (s_d 0.18-1.4 m within one σ). The hygric counterpart of
+    :func:`ground_prior`: the default log-uniform prior over nine decades puts most of
+    its volume on a node too weak to matter (gain from Pe → 1), the end of the
+    gain-offset ridge the posterior leant to (:func:`fixed_vapour_pressure_prior`).
+    """
+    if not floor_area > 0:
+        raise ConfigError(f"floor_area must be > 0 m² (got {floor_area})")
+    median = DELTA_AIR / s_d * floor_area
+    return Prior(
+        "lognormal", median * math.exp(-5 * sigma), median * math.exp(5 * sigma), median, sigma
+    )
+
+
 @dataclass(frozen=True)
 class Parameter:
     """A named model or noise parameter (lmfit's Parameter, with a prior).
@@ -665,6 +745,7 @@ def parameters_for(
     air_change_sigma: float = 1.0,
     floor_area: float | None = None,
     envelope_area: float | None = None,
+    fixed_node_temperature: float | None = None,
     where: str = "priors",
     dt: float = 3600.0,
 ) -> ParameterSet:
@@ -686,11 +767,15 @@ def parameters_for(
         Air changes per hour [1/h] (needs ``room_volume``): a log-normal prior of width
         ``air_change_sigma`` on ``Gfast`` (see :func:`ventilation_prior`).
     floor_area : float, optional
-        Floor area on the ground [m²]: a log-normal prior on a thermal model's ``Gf``
-        (see :func:`ground_prior`).
+        Floor area on the ground [m²]: a log-normal prior on ``Gf``, the ground coupling
+        of a thermal model (:func:`ground_prior`) or the fixed vapour-pressure node's of
+        a hygric one (:func:`vapour_ground_prior`).
     envelope_area : float, optional
         Exterior surface area of walls and roof [m²]: upper bounds on a thermal
         model's envelope node, ``Gw`` and ``Cw`` (see :func:`envelope_priors`).
+    fixed_node_temperature : float, optional
+        Temperature [°C] of the ground or space behind a fixed vapour-pressure node: a
+        log-normal prior on ``Pf`` (see :func:`fixed_vapour_pressure_prior`).
     where : str
         Key path used in error messages.
     """
@@ -747,6 +832,10 @@ def parameters_for(
             prior = ventilation_prior(domain, room_volume, air_change_rate, sigma=air_change_sigma)
         if name == "Gf" and floor_area is not None and (domain, kind) == ("thermal", "conductance"):
             prior = ground_prior(floor_area)
+        if name == "Gf" and floor_area is not None and (domain, kind) == ("hygric", "conductance"):
+            prior = vapour_ground_prior(floor_area)
+        if name == "Pf" and fixed_node_temperature is not None and kind == "constant":
+            prior = fixed_vapour_pressure_prior(fixed_node_temperature)
         if envelope_area is not None and name in ("Gw", "Cw"):
             prior = envelope_priors(envelope_area, domain)[name]
         spec = priors.get(name)

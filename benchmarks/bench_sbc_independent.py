@@ -267,6 +267,9 @@ def replicate(args) -> dict:
         "input_hold": hold,
         # the fit's upper bounds on the hygric buffer from the envelope area
         "hygric_envelope": bool(envelope) and not name.startswith("thermal"),
+        # the fixed node's Pf and Gf drawn from, and fitted with, the physical priors
+        # (fixed_vapour_pressure_prior, vapour_ground_prior)
+        "fixed_node_prior": "physical" if "Pf" in model.parameter_names else None,
     }
     if extra is not None:
         result["irradiance_mean"] = {"generator": mean_true, "fit": mean_fit}
@@ -297,6 +300,10 @@ def read_logs(paths: list[str]) -> list[dict]:
                 # (Gw, Cw from --envelope-area, as for the thermal envelope)
                 if r["model"].startswith("hygric") and not r.get("hygric_envelope", False):
                     r["variants"] = {f"{v}@unbounded": x for v, x in r["variants"].items()}
+                # hygric_2c_fixed rooms from before the physical priors of the fixed
+                # node (Pf uniform 900-1400 Pa in the truths, 0-5 000 Pa in the fit)
+                if r["model"] == "hygric_2c_fixed" and r.get("fixed_node_prior") is None:
+                    r["variants"] = {f"{v}@flat_pf": x for v, x in r["variants"].items()}
                 key = (r["model"], int(r["rep"]))
                 if key not in merged:
                     merged[key] = {**r, "variants": dict(r["variants"])}

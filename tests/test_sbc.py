@@ -48,6 +48,30 @@ def test_small_sbc_thermal_2c_intervals_cover_the_truth():
     assert np.all([np.isfinite(r["truth"]["tau_1_h"]) for r in results])
 
 
+def test_hygric_truths_of_the_fixed_node_are_drawn_from_the_fit_priors():
+    """SBC is exact only where the truths come from the prior the fit uses: the fixed
+    node's Pf and Gf of 200 rooms follow fixed_vapour_pressure_prior (at the record's
+    mean temperature) and vapour_ground_prior (80 m²): mean of log(x / median) within 4
+    standard errors of 0 (σ/√200), its sd within 4 standard errors (σ/√400) of σ."""
+    import heritage_bayes as hb
+    from heritage_bayes.inference.parameters import (
+        fixed_vapour_pressure_prior,
+        vapour_ground_prior,
+    )
+
+    model = hb.model("hygric_2c_fixed")
+    rng = np.random.default_rng(5)
+    draws = [bench_sbc.truth(model, rng, bench_sbc.FLOOR) for _ in range(200)]
+    for name, prior in (
+        ("Pf", fixed_vapour_pressure_prior(bench_sbc.ground_temperature())),
+        ("Gf", vapour_ground_prior(bench_sbc.FLOOR)),
+    ):
+        z = np.log([d[name] for d in draws]) - np.log(prior.mu)
+        assert abs(z.mean()) < 4 * prior.sigma / np.sqrt(200), name
+        assert abs(z.std() - prior.sigma) < 4 * prior.sigma / np.sqrt(400), name
+    assert 10.0 < bench_sbc.ground_temperature() < 12.0  # De Bilt 2011-2020 [°C]
+
+
 # ------------------------------------------- the independent generator (issue 31)
 def test_independent_generator_machinery():
     """One thermal room of ``bench_sbc_independent`` (the full study: 50 replicates per
@@ -161,4 +185,13 @@ def test_independent_table_merges_logs(tmp_path, capsys):
         "kalman:estimate",
         "kalman:estimate@interval_mean",
     ]
-    assert sorted(merged["hygric_2c_fixed", 1]["variants"]) == ["kalman:estimate@unbounded"]
+    # (and, from before the fixed node's physical priors, "@flat_pf")
+    assert sorted(merged["hygric_2c_fixed", 1]["variants"]) == [
+        "kalman:estimate@unbounded@flat_pf"
+    ]
+    bounded = {**r_hyg, "rep": 2, "hygric_envelope": True}
+    physical = {**bounded, "rep": 3, "fixed_node_prior": "physical"}
+    old.write_text(json.dumps(bounded) + "\n" + json.dumps(physical) + "\n")
+    merged = {(r["model"], r["rep"]): r for r in bench.read_logs([str(old)])}
+    assert list(merged["hygric_2c_fixed", 2]["variants"]) == ["kalman:estimate@flat_pf"]
+    assert list(merged["hygric_2c_fixed", 3]["variants"]) == ["kalman:estimate"]

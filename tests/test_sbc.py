@@ -186,9 +186,7 @@ def test_independent_table_merges_logs(tmp_path, capsys):
         "kalman:estimate@interval_mean",
     ]
     # (and, from before the fixed node's physical priors, "@flat_pf")
-    assert sorted(merged["hygric_2c_fixed", 1]["variants"]) == [
-        "kalman:estimate@unbounded@flat_pf"
-    ]
+    assert sorted(merged["hygric_2c_fixed", 1]["variants"]) == ["kalman:estimate@unbounded@flat_pf"]
     bounded = {**r_hyg, "rep": 2, "hygric_envelope": True}
     physical = {**bounded, "rep": 3, "fixed_node_prior": "physical"}
     old.write_text(json.dumps(bounded) + "\n" + json.dumps(physical) + "\n")

@@ -339,6 +339,38 @@ def zscore_lines(results: list[dict], variant: str) -> list[str]:
     return lines
 
 
+def solar_lines(results: list[dict], variant: str) -> list[str]:
+    """Is the solar gain's bias the sky models' difference? Over the thermal rooms of
+    ``variant``: the ratio of the generator's to the fit's mean facade irradiance (if
+    the data fixed the solar warming, the fitted gain would be the true one times this
+    ratio), the posterior median of the solar gain and of the mean solar warming over
+    their truths (medians over the rooms, the rooms below 1) and the room-to-room
+    correlation of the gain's ratio with the irradiance ratio (logs)."""
+    rs = [
+        r
+        for r in results
+        if "irradiance_mean" in r
+        and variant in r["variants"]
+        and {"gain_Ti_I_S", "solar_warming_K"} <= set(r["variants"][variant]["ranks"])
+    ]
+    if len(rs) < 2:
+        return []
+    irr = np.array([r["irradiance_mean"]["generator"] / r["irradiance_mean"]["fit"] for r in rs])
+    ratio = {
+        k: np.array([r["variants"][variant]["ranks"][k]["median"] / r["truth"][k] for r in rs])
+        for k in ("gain_Ti_I_S", "solar_warming_K")
+    }
+    corr = np.corrcoef(np.log(ratio["gain_Ti_I_S"]), np.log(irr))[0, 1]
+    return [
+        f"  solar [{variant}] ({len(rs)} rooms): irradiance generator/fit median "
+        f"{np.median(irr):.3f} ({irr.min():.3f}-{irr.max():.3f}); posterior median / truth: "
+        + ", ".join(
+            f"{k} {np.median(x):.3f} (below 1 in {int(np.sum(x < 1))})" for k, x in ratio.items()
+        )
+        + f"; corr(log gain ratio, log irradiance ratio) {corr:.2f}"
+    ]
+
+
 #: how the markdown table names the quantities
 LABELS = {
     "tau_1_h": "τ1",
@@ -449,6 +481,7 @@ def main(argv=None) -> int:
                 lines = markdown_table(results, v)
             else:
                 lines = table(results, v, QUANTITIES) + zscore_lines(results, v)
+                lines += solar_lines(results, v)
             for line in lines:
                 print(line)
         return 0

@@ -145,7 +145,7 @@ def test_prepare_resolves_the_temperature_for_a_fixed_node_only():
 
 
 def test_a_run_records_the_temperature_and_its_readers_rebuild_the_prior(tmp_path):
-    """A tiny hygric_2c_fixed calibration (ten days of the demo, 200 steps) writes the
+    """A tiny hygric_2c_fixed calibration (a week of the demo, 100 steps) writes the
     resolved ``fixed_node_temperature`` into its config.yaml; the loaded run's config
     rebuilds the Pf prior the chain sampled (summary's prior_spec)."""
     import yaml
@@ -160,12 +160,12 @@ def test_a_run_records_the_temperature_and_its_readers_rebuild_the_prior(tmp_pat
         "room_volume": 400,
         "floor_area": 80,
         "periods": {
-            "calibration": {"start": "2019-02-01", "end": "2019-02-11"},
-            "validation": {"start": "2019-02-11", "end": "2019-02-16"},
+            "calibration": {"start": "2019-02-01", "end": "2019-02-08"},
+            "validation": {"start": "2019-02-08", "end": "2019-02-10"},
             "init_window": "2d",
         },
         "hygric": {"model": "hygric_2c_fixed"},
-        "sampler": {"max_steps": 200, "check_every": 100, "max_draws": 100, "n_predictive": 10},
+        "sampler": {"max_steps": 100, "check_every": 50, "max_draws": 100, "n_predictive": 10},
         "optimizer": {"maxiter": 10, "starts": 1, "popsize": 4},
         "ladder": False,
         "report": False,

@@ -193,3 +193,28 @@ def test_independent_table_merges_logs(tmp_path, capsys):
     merged = {(r["model"], r["rep"]): r for r in bench.read_logs([str(old)])}
     assert list(merged["hygric_2c_fixed", 2]["variants"]) == ["kalman:estimate@flat_pf"]
     assert list(merged["hygric_2c_fixed", 3]["variants"]) == ["kalman:estimate"]
+
+
+def test_solar_lines_compare_the_gain_bias_with_the_sky_models_ratio():
+    """Two rooms whose fitted gain is the truth times the generator/fit irradiance ratio
+    (the data fixed the solar warming exactly): the gain's ratio equals the irradiance
+    ratio (correlation 1), the warming's is 1."""
+    bench = pytest.importorskip("bench_sbc_independent")
+
+    def room(rep, ratio):
+        warming = 0.9 * ratio  # [K]: the true gain 0.01 K/(W/m²) × 90 W/m² × ratio
+        truth = {"gain_Ti_I_S": 0.01, "solar_warming_K": warming}
+        x = {"gain_Ti_I_S": {"median": 0.01 * ratio}, "solar_warming_K": {"median": warming}}
+        return {
+            "model": "thermal_2c",
+            "rep": rep,
+            "truth": truth,
+            "irradiance_mean": {"generator": 90.0 * ratio, "fit": 90.0},
+            "variants": {"kalman:estimate": {"ranks": x}},
+        }
+
+    (line,) = bench.solar_lines([room(0, 0.9), room(1, 0.8)], "kalman:estimate")
+    assert "(2 rooms)" in line and "median 0.850 (0.800-0.900)" in line
+    assert "gain_Ti_I_S 0.850 (below 1 in 2)" in line
+    assert "solar_warming_K 1.000 (below 1 in 0)" in line and "irradiance ratio) 1.00" in line
+    assert bench.solar_lines([room(0, 0.9)], "kalman:estimate") == []

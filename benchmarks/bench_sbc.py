@@ -103,6 +103,14 @@ def _solve_capacity(A_of_cw, target_tau_h: float) -> float:
 HYGRIC_TRUTH = {"Gw": (5e-9, 5e-8), "Gi": (3e-7, 3e-6), "Gf": (2e-8, 2e-7)}
 #: sd of log(Ci) and log(Gfast) of the truths around the volume's priors' medians
 TRUTH_SIGMA = 0.5
+#: ``--flat-fixed-node``: the study before the node's physical priors: truths of Pf
+#: uniform on this range [Pa] (Gf log-uniform on ``HYGRIC_TRUTH``), fitted with the
+#: former default priors of the node, :data:`FLAT_NODE_PRIORS`
+PF_FLAT = (900.0, 1400.0)
+FLAT_NODE_PRIORS = {
+    "Pf": {"dist": "uniform", "lower": 0.0, "upper": 5000.0},
+    "Gf": {"dist": "loguniform", "lower": 1e-12, "upper": 1e-3},
+}
 
 
 def ground_temperature() -> float:
@@ -113,7 +121,9 @@ def ground_temperature() -> float:
     return float(np.nanmean(_knmi_cache()["Te"].to_numpy(float)))
 
 
-def truth_priors(model, floor_area: float | None = None) -> dict[str, dict]:
+def truth_priors(
+    model, floor_area: float | None = None, flat_node: bool = False
+) -> dict[str, dict]:
     """Prior specs equal to the distributions :func:`truth` draws a hygric model's
     parameters from (``Cw`` excepted: it is solved for a slow time constant of 2-3
     weeks, and keeps the fit's default prior). SBC is exact only when the truths are
@@ -124,7 +134,7 @@ def truth_priors(model, floor_area: float | None = None) -> dict[str, dict]:
     dom = model.domain
     if dom != "hygric":
         raise ValueError("--truth-priors: for the hygric models only")
-    drawn = ("Gw", "Gi") if floor_area else ("Gw", "Gi", "Gf")
+    drawn = ("Gw", "Gi") if floor_area and not flat_node else ("Gw", "Gi", "Gf")
     out = {
         k: {"dist": "loguniform", "lower": lo, "upper": hi}
         for k, (lo, hi) in HYGRIC_TRUTH.items()
@@ -135,15 +145,19 @@ def truth_priors(model, floor_area: float | None = None) -> dict[str, dict]:
         ("Gfast", ventilation_prior(dom, VOLUME, ACH)),
     ):
         out[name] = {"dist": "lognormal", "median": prior.mu, "sigma": TRUTH_SIGMA}
+    if flat_node and "Pf" in model.parameter_names:
+        out["Pf"] = {"dist": "uniform", "lower": PF_FLAT[0], "upper": PF_FLAT[1]}
     return out
 
 
-def truth(model, rng, floor_area: float | None = None) -> dict[str, float]:
+def truth(model, rng, floor_area: float | None = None, flat_node: bool = False) -> dict[str, float]:
     """True parameters: air capacity and ventilation near the prior knowledge, the rest
     log-uniform, and the envelope capacity set for a slow tau of 2-3 weeks. With
     ``floor_area`` [m²] the ground coupling Gf too is drawn near the prior knowledge
     (its median times exp(N(0, 0.5)), like Ci and Gfast); without, log-uniform on
-    5-40 W/K (the study before the floor-area prior)."""
+    5-40 W/K (the study before the floor-area prior). A hygric fixed node's Pf and Gf
+    from the fit's physical priors (Gf's with ``floor_area``), or with ``flat_node``
+    from the ranges of the study before them (:data:`PF_FLAT`, ``HYGRIC_TRUTH``)."""
     from heritage_bayes.inference.parameters import (
         air_capacity_prior,
         fixed_vapour_pressure_prior,
@@ -169,14 +183,16 @@ def truth(model, rng, floor_area: float | None = None) -> dict[str, float]:
         for k in ("Gw", "Gi"):
             p[k] = float(np.exp(rng.uniform(*np.log(HYGRIC_TRUTH[k]))))
         if "Pf" in model.parameter_names:  # the fit's default priors, drawn from
-            gf = vapour_ground_prior(floor_area) if floor_area else None
+            gf = vapour_ground_prior(floor_area) if floor_area and not flat_node else None
             p["Gf"] = float(
                 gf.mu * np.exp(gf.sigma * rng.normal())
                 if gf
                 else np.exp(rng.uniform(*np.log(HYGRIC_TRUTH["Gf"])))
             )
             pf = fixed_vapour_pressure_prior(ground_temperature())
-            p["Pf"] = float(pf.mu * np.exp(pf.sigma * rng.normal()))
+            p["Pf"] = float(
+                rng.uniform(*PF_FLAT) if flat_node else pf.mu * np.exp(pf.sigma * rng.normal())
+            )
     if floor_area and dom == "thermal":
         p["Gf"] = ground_prior(floor_area).mu * float(np.exp(rng.normal(0, 0.5)))
     target = rng.uniform(336, 504)
@@ -222,10 +238,11 @@ def replicate(args) -> dict:
     # observation noise (see repeat_room); None: the study's own draw, every component
     redraw, without = args[8] if len(args) > 8 else (None, ())
     envelope = args[9] if len(args) > 9 else None
+    flat_node = args[10] if len(args) > 10 else False
     rng = np.random.default_rng([seed, rep])
     opts = {"surfaces": ("S",)} if name in ("thermal_2c", "thermal_4a") else {}
     model = hb.model(name, **opts)
-    p = truth(model, rng, floor)
+    p = truth(model, rng, floor, flat_node)
     w = weather(int(rng.integers(2**31)))
     U = np.column_stack(
         [w[c] if c in w else np.full(len(w["Te"]), 10.0) for c in model.input_names]
@@ -519,6 +536,13 @@ def main() -> None:
         "a likelihood or sampler one",
     )
     ap.add_argument(
+        "--flat-fixed-node",
+        action="store_true",
+        help="hygric_2c_fixed as before the node's physical priors: truths of Pf uniform on "
+        "900-1 400 Pa and Gf log-uniform on 2e-8..2e-7 kg/(s·Pa), fitted with Pf uniform "
+        "on 0-5 000 Pa and Gf log-uniform on 1e-12..1e-3",
+    )
+    ap.add_argument(
         "--floor-area",
         type=float,
         default=FLOOR,
@@ -569,11 +593,15 @@ def main() -> None:
         name, _, vals = spec.partition("=")
         median, sigma = (float(v) for v in vals.split(","))
         priors[name] = {"dist": "lognormal", "median": median, "sigma": sigma}
+    if args.flat_fixed_node:
+        if set(args.models.split(",")) != {"hygric_2c_fixed"}:
+            ap.error("--flat-fixed-node: with --models hygric_2c_fixed only")
+        priors = {**FLAT_NODE_PRIORS, **priors}
     if args.truth_priors:
         import heritage_bayes as hb
 
         for m in args.models.split(","):
-            priors.update(truth_priors(hb.model(m), args.floor_area or None))
+            priors.update(truth_priors(hb.model(m), args.floor_area or None, args.flat_fixed_node))
     floor = args.floor_area or None
     envelope = args.envelope_area or None
     if args.room is not None:
@@ -610,7 +638,19 @@ def main() -> None:
                 print(line)
         return
     tasks = [
-        (m, r, variants, args.seed, args.max_steps, CAL_DAYS, priors, floor, (None, ()), envelope)
+        (
+            m,
+            r,
+            variants,
+            args.seed,
+            args.max_steps,
+            CAL_DAYS,
+            priors,
+            floor,
+            (None, ()),
+            envelope,
+            args.flat_fixed_node,
+        )
         for r in range(args.first_rep, args.first_rep + args.reps)
         for m in args.models.split(",")
     ]  # models interleaved: a study cut short still covers every model

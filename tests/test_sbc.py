@@ -70,6 +70,9 @@ def test_hygric_truths_of_the_fixed_node_are_drawn_from_the_fit_priors():
         assert abs(z.mean()) < 4 * prior.sigma / np.sqrt(200), name
         assert abs(z.std() - prior.sigma) < 4 * prior.sigma / np.sqrt(400), name
     assert 10.0 < bench_sbc.ground_temperature() < 12.0  # De Bilt 2011-2020 [°C]
+    # --flat-fixed-node: the study before these priors (Pf uniform on 900-1 400 Pa)
+    flat = [bench_sbc.truth(model, rng, bench_sbc.FLOOR, True) for _ in range(20)]
+    assert all(900.0 <= d["Pf"] <= 1400.0 and 2e-8 <= d["Gf"] <= 2e-7 for d in flat)
 
 
 # ------------------------------------------- the independent generator (issue 31)

@@ -604,24 +604,30 @@ def main() -> None:
             priors.update(truth_priors(hb.model(m), args.floor_area or None, args.flat_fixed_node))
     floor = args.floor_area or None
     envelope = args.envelope_area or None
+
+    def task(model: str, rep: int, observation=(None, ())) -> tuple:
+        """:func:`replicate`'s arguments (``observation``: see its ``redraw``)."""
+        return (
+            model,
+            rep,
+            variants,
+            args.seed,
+            args.max_steps,
+            CAL_DAYS,
+            priors,
+            floor,
+            observation,
+            envelope,
+            args.flat_fixed_node,
+        )
+
     if args.room is not None:
         without = tuple(w for w in args.without.split(",") if w)
         unknown = set(without) - {"model_error", "rounding", "gap"}
         if unknown:
             ap.error(f"--without: unknown {sorted(unknown)}; use model_error, rounding, gap")
         tasks = [
-            (
-                args.models.split(",")[0],
-                args.room,
-                variants,
-                args.seed,
-                args.max_steps,
-                CAL_DAYS,
-                priors,
-                floor,
-                (k, without),
-                envelope,
-            )
+            task(args.models.split(",")[0], args.room, (k, without))
             for k in range(args.first_rep, args.first_rep + args.reps)
         ]
         with ProcessPoolExecutor(max(1, args.jobs)) as ex:
@@ -638,19 +644,7 @@ def main() -> None:
                 print(line)
         return
     tasks = [
-        (
-            m,
-            r,
-            variants,
-            args.seed,
-            args.max_steps,
-            CAL_DAYS,
-            priors,
-            floor,
-            (None, ()),
-            envelope,
-            args.flat_fixed_node,
-        )
+        task(m, r)
         for r in range(args.first_rep, args.first_rep + args.reps)
         for m in args.models.split(",")
     ]  # models interleaved: a study cut short still covers every model

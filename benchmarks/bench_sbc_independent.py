@@ -23,11 +23,13 @@ discretisation and no solar model with the fit:
   rounding to 0.1 and a one-week gap, as in ``bench_sbc.py``.
 
 Truths are those of the continuous-time room (time constants, static gains, the fixed
-node's gain and offset), independent of any discretisation. The **mean solar warming**
-``solar_warming_K`` [K] is the static solar gain times the mean facade irradiance over
-the calibration period, each in its own irradiance model (the generator's for the
-truth, the fit's input for the draws): the physical effect, which does not depend on
-which sky model scaled the aperture.
+node's gain and offset), independent of any discretisation; the parameters are drawn
+as in ``bench_sbc.truth`` (the hygric fixed node's Pf and Gf from the fit's physical
+default priors, at De Bilt's mean temperature and the hall's 80 m² floor). The
+**mean solar warming** ``solar_warming_K`` [K] is the static solar gain times the mean
+facade irradiance over the calibration period, each in its own irradiance model (the
+generator's for the truth, the fit's input for the draws): the physical effect, which
+does not depend on which sky model scaled the aperture.
 
     python benchmarks/bench_sbc_independent.py --reps 50 --jobs 2 --log sbc_ind.jsonl
     python benchmarks/bench_sbc_independent.py --table sbc_ind.jsonl [more.jsonl ...]

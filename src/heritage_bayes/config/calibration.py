@@ -61,7 +61,8 @@ class CalibrationConfig(_Strict):
     floor_area: float | None = key(
         None,
         unit="m²",
-        description="floor on the ground: log-normal prior on the thermal Gf",
+        description="floor on the ground: log-normal prior on Gf, the thermal ground "
+        "coupling and hygric_2c_fixed's vapour conductance to its fixed node",
         gt=0,
     )
     fixed_node_temperature: float | None = key(

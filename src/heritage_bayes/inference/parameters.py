@@ -521,8 +521,9 @@ def fixed_vapour_pressure_prior(
     Kramer, van Schijndel & Schellen introduce the node for a basement wall in contact
     with a canal, "analogous to the thermal situation with ground contact": ground,
     water or crypt air at the ground temperature (the annual mean outdoor temperature),
-    near saturation (Hens, *Building Physics: Heat, Air and Moisture*, 2nd ed., 2012,
-    §2.4: soil air is at capillary saturation below the first decimetres).
+    near saturation: soil air below the surface layer and air over water are close to
+    100 % RH (ground-contact constructions: Hens, *Building Physics: Heat, Air and
+    Moisture*, 2nd ed., Ernst & Sohn, 2012).
 
     Why: the gain from ``Pe`` and the node's offset ``Gf/(ΣG) × Pf`` trade along a ridge
     three months of data barely resolve; the former default (uniform on 0-5 000 Pa) gives

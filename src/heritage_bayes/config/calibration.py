@@ -70,9 +70,10 @@ class CalibrationConfig(_Strict):
         unit="°C",
         description="temperature of the ground, water or crypt behind hygric_2c_fixed's "
         "fixed vapour-pressure node: a log-normal prior on Pf, median 0.9 × its saturation "
-        "vapour pressure, sd of log 0.25; default: the ground temperature "
-        "(data.ground_temperature's constant, else the annual mean outdoor temperature "
-        "over the calibration period), recorded in the run's config.yaml",
+        "vapour pressure, sd of log 0.25; default: the ground temperature (the thermal "
+        "model's Tf, else data.ground_temperature's constant, else the annual mean outdoor "
+        "temperature), its mean over the calibration period, recorded in the run's "
+        "config.yaml",
         ge=-40,
         le=40,
     )

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
 import signal
 import threading
 from dataclasses import dataclass
@@ -93,6 +94,9 @@ class _Saved:
     random_state: tuple | None
     tau_history: list
     problem: str | None = None  # what was wrong with the file, if anything
+    stride: int = 1  # steps per stored row (a thinned chain)
+    steps: int | None = None  # steps of the chain (None: one per row)
+    last: tuple | None = None  # (positions, log-probabilities) of its last step
 
 
 class _Checkpoint:
@@ -136,8 +140,14 @@ class _Checkpoint:
 
         atomic_write(self.path, write)
 
-    def append(self, chain, log_prob, accepted, random_state, tau_history) -> None:
-        """Write ``chain``/``log_prob`` rows after the last commit, then commit them."""
+    def append(self, chain, log_prob, accepted, random_state, tau_history, **thinned) -> None:
+        """Write ``chain``/``log_prob`` rows after the last commit, then commit them.
+
+        A thinned chain (keyword ``stride`` > 1 steps per row, see
+        :class:`heritage_bayes.inference.monitor.ChainBuffer`) also commits its length
+        ``steps`` and ``last`` = (positions (walkers, d), log-probabilities (walkers,))
+        of its last step, where ``--resume`` continues (the last step is not always a
+        stored row); at stride 1 the commit record is as before."""
         from heritage_bayes.inference.results import ensure_free_space
 
         chunk = 64 * int(np.prod(chain.shape[1:])) * 8  # one HDF5 chunk [bytes]
@@ -162,6 +172,10 @@ class _Checkpoint:
                 ],
                 "tau_history": np.asarray(tau_history, dtype=float).reshape(-1, 2).tolist(),
             }
+            if thinned.get("stride", 1) > 1:
+                commit["stride"] = int(thinned["stride"])
+                commit["steps"] = int(thinned["steps"])
+                commit["last"] = [np.asarray(a, dtype=float).tolist() for a in thinned["last"]]
             rows = [
                 np.asarray(r, dtype=f[k].dtype)
                 for k, r in (("chain", chain), ("log_prob", log_prob))
@@ -171,6 +185,17 @@ class _Checkpoint:
             f.attrs["commit"] = json.dumps(commit)  # the commit point
             f.attrs["iteration"] = n0 + n  # informative
             f.flush()
+
+    def rewrite(self, chain, log_prob, accepted, random_state, tau_history, **thinned) -> None:
+        """Replace the file by one holding these rows and this commit (a thinned chain
+        whose stride doubled: :meth:`append`'s keywords), atomically: written under
+        another name, then renamed over the checkpoint, so an interrupt leaves either
+        the old or the new file whole."""
+        tmp = _Checkpoint(self.path.with_name(self.path.name + ".thinning"), self.tag)
+        tmp.create(chain.shape[1], chain.shape[2])
+        tmp.append(chain, log_prob, accepted, random_state, tau_history, **thinned)
+        with _DeferSignals():
+            os.replace(tmp.path, self.path)
 
     def _damaged(self, why: str) -> InputError:
         return InputError(
@@ -238,6 +263,7 @@ class _Checkpoint:
                 )
             problem = None
             rs = None
+            stride, steps, last = 1, None, None
             try:
                 if "commit" in f.attrs:
                     c = json.loads(f.attrs["commit"])
@@ -252,6 +278,10 @@ class _Checkpoint:
                         float(cached),
                     )
                     hist = [tuple(r) for r in c["tau_history"]]
+                    stride, steps = int(c.get("stride", 1)), c.get("steps")
+                    last = c.get("last")
+                    if last is not None:
+                        last = (np.asarray(last[0], dtype=float), np.asarray(last[1], dtype=float))
                 else:  # format 1 (before the commit attribute)
                     n = int(f.attrs.get("iteration", 0))
                     accepted = (
@@ -279,7 +309,12 @@ class _Checkpoint:
                 f"steps {bad} to {n} are damaged; kept the {chain.shape[0]} valid steps before them"
             )
             rs = None  # the saved random state belongs to the end of the damaged part
-        return _Saved(chain, lp, accepted, rs, hist[: max(0, len(hist))], problem)
+            # a thinned chain continues from its last valid row
+            steps = chain.shape[0] * stride
+            last = (chain[-1], lp[-1]) if chain.shape[0] else None
+        return _Saved(
+            chain, lp, accepted, rs, hist[: max(0, len(hist))], problem, stride, steps, last
+        )
 
 
 #: The checksum before the first block.

@@ -298,7 +298,7 @@ def test_envelope_area_bounds_the_envelope_node():
     """envelope_area [m²]: 0.1 W/(m²K) × area ≤ Gw ≤ 25 W/(m²K) × area (a passive-house
     wall; the exterior film, EN ISO 6946) and Cw ≤ 7.5 MJ/(m²K) × area (3 m of
     granite), the family and Cw's lower bound the defaults'; 4a's interior mass keeps
-    its defaults without a floor area; a hygric buffer's Gw ≤ 2e-9 kg/(m²·s·Pa) × area
+    its defaults; a hygric buffer's Gw ≤ 2e-9 kg/(m²·s·Pa) × area
     (s_d 0.1 m) and Cw ≤ 0.04 kg/(m²·Pa) × area (10 cm of wood at 0 °C); the config key reaches the
     parameters; the sampler's support follows the bound; an area that puts a bound
     below the default's lower one is a ConfigError naming the key."""
@@ -331,8 +331,8 @@ def test_envelope_area_bounds_the_envelope_node():
         assert prior[name].dist == d.dist
         assert prior[name].upper < d.upper
     assert prior["Cint"] == default_prior("thermal", "capacity")
-    assert prior["Gint"] == default_prior("thermal", "conductance")  # no floor_area
-    assert prior["Gi"].dist == "lognormal"  # the surface film: test_surface_priors_...
+    assert prior["Gint"] == default_prior("thermal", "conductance")
+    assert prior["Gi"].dist == "lognormal"  # the surface film: see the next test
     # the sampler cannot leave the bounded support
     lo, hi = ps.bounds
     j = ps.free_names.index("Gw")
@@ -356,48 +356,39 @@ def test_envelope_area_bounds_the_envelope_node():
         parse_config({**raw, "envelope_area": 0})
 
 
-def test_surface_priors_put_the_film_on_gi_and_the_interior_mass_on_gint():
-    """envelope_area: Gi log-normal, median 7.7 W/(m²K) × area (R_si 0.13 m²K/W, EN ISO
-    6946), σ_log ln 2; floor_area: 4a's Gint log-normal, median 5 W/(m²K) × floor, σ_log
-    1; bounds ±5 σ; thermal models only (a hygric Gi keeps its default); a model
-    without the conductance is untouched; the demo's truths lie within 1 σ."""
+def test_envelope_area_puts_the_surface_film_prior_on_gi():
+    """envelope_area: a thermal Gi log-normal, median 7.7 W/(m²K) × area (R_si 0.13
+    m²K/W, EN ISO 6946), σ_log ln 2, bounds ±5 σ; a hygric Gi and 4a's Gint keep their
+    defaults; the demo's truth (Gi 1 600 W/K, about 260 m²) lies within 1 σ."""
     import heritage_bayes as hb
     from heritage_bayes.inference.likelihoods import get_noise_model
     from heritage_bayes.inference.parameters import (
-        H_INTERIOR_MASS,
         H_SURFACE_INTERIOR,
         default_prior,
+        film_prior,
         parameters_for,
-        surface_priors,
     )
 
     noise = get_noise_model("ar1_white")
-    th = hb.model("thermal_4a", surfaces=("S",))
-    prior = {
-        p.name: p.prior
-        for p in parameters_for(th, noise, envelope_area=260.0, floor_area=80.0).parameters
-    }
-    gi, gint = prior["Gi"], prior["Gint"]
-    assert (gi.dist, gint.dist) == ("lognormal", "lognormal")
-    assert gi.mu == pytest.approx(1 / 0.13 * 260.0, rel=2e-3) == H_SURFACE_INTERIOR * 260.0
-    assert gint.mu == pytest.approx(400.0) == H_INTERIOR_MASS * 80.0
-    assert gi.sigma == pytest.approx(np.log(2.0)) and gint.sigma == 1.0
-    assert gi.upper / gi.mu == pytest.approx(np.exp(5 * np.log(2.0)))
-    # the demo's truths (heritage_bayes.demo: Gi 1 600 W/K, Gint 400 W/K) within 1 σ
-    assert abs(np.log(1600.0 / gi.mu)) < gi.sigma and abs(np.log(400.0 / gint.mu)) < 1.0
-    # floor_area alone: Gint (and Gf), not Gi; a 2-node model has no Gint
-    two = hb.model("thermal_2c", surfaces=("S",))
-    p2 = {p.name: p.prior for p in parameters_for(two, noise, floor_area=80.0).parameters}
-    assert p2["Gi"] == default_prior("thermal", "conductance")
-    p4 = {p.name: p.prior for p in parameters_for(th, noise, floor_area=80.0).parameters}
-    assert p4["Gi"] == default_prior("thermal", "conductance") and p4["Gint"] == gint
-    # hygric: the film prior is thermal
+    for name in ("thermal_2c", "thermal_4a"):
+        m = hb.model(name, surfaces=("S",))
+        prior = {
+            p.name: p.prior
+            for p in parameters_for(m, noise, envelope_area=260.0, floor_area=80.0).parameters
+        }
+        gi = prior["Gi"]
+        assert gi.dist == "lognormal" and gi == film_prior(260.0)
+        assert gi.mu == pytest.approx(1 / 0.13 * 260.0, rel=2e-3) == H_SURFACE_INTERIOR * 260.0
+        assert gi.sigma == pytest.approx(np.log(2.0))
+        assert gi.upper / gi.mu == pytest.approx(32.0) and gi.mu / gi.lower == pytest.approx(32.0)
+        assert abs(np.log(1600.0 / gi.mu)) < gi.sigma
+        if "Gint" in prior:
+            assert prior["Gint"] == default_prior("thermal", "conductance")
     hy = hb.model("hygric_2c")
     ph = {p.name: p.prior for p in parameters_for(hy, noise, envelope_area=260.0).parameters}
     assert ph["Gi"] == default_prior("hygric", "conductance")
     # a user's own prior wins
-    mine = parameters_for(th, noise, {"Gi": {"fixed": 900}}, envelope_area=260.0)
-    assert mine["Gi"].fixed == 900
-    assert surface_priors() == {}
-    with pytest.raises(ConfigError, match="Gint: area must be > 0"):
-        surface_priors(floor_area=0.0)
+    th = hb.model("thermal_2c", surfaces=("S",))
+    assert parameters_for(th, noise, {"Gi": {"fixed": 900}}, envelope_area=260.0)["Gi"].fixed == 900
+    with pytest.raises(ConfigError, match="envelope_area must be > 0"):
+        film_prior(0.0)

@@ -46,8 +46,8 @@ __all__ = [
     "Prior",
     "air_capacity_prior",
     "default_prior",
+    "film_prior",
     "parameters_for",
-    "surface_priors",
     "ventilation_prior",
 ]
 
@@ -499,67 +499,51 @@ def envelope_priors(envelope_area: float, domain: str = "thermal") -> dict[str, 
 #: for horizontal heat flow (EN ISO 6946:2017, Table 7; 0.10 upwards, 0.17 downwards:
 #: 5.9-10), convection and radiation together.
 H_SURFACE_INTERIOR = 7.7
-#: Coupling of the interior mass (floor, inner walls, contents) to the air per m² of
-#: floor [W/(m²·K)]: a convective coefficient of 2.5-5 W/(m²·K) (EN ISO 13790:2008
-#: §12.2.2 uses h_is = 3.45) over exposed interior surfaces of about 1-2 × the floor.
-H_INTERIOR_MASS = 5.0
 #: σ_log of the surface-film prior on Gi: a factor 2 (h_si from 3.9 to 15 W/(m²·K)
 #: within one σ; the film in series with the wall's inner layer lowers it).
 SIGMA_FILM = math.log(2.0)
-#: σ_log of the interior-mass coupling Gint: a factor 2.7 (the exposed area is known
-#: within 1-3 × the floor at best).
-SIGMA_INTERIOR = 1.0
 
 
-def surface_priors(
-    envelope_area: float | None = None, floor_area: float | None = None
-) -> dict[str, Prior]:
-    """Log-normal priors on a thermal model's surface conductances from survey areas.
+def film_prior(envelope_area: float) -> Prior:
+    """Log-normal prior on a thermal model's ``Gi`` [W/K] (envelope node - indoor air,
+    ``thermal_2c`` and ``thermal_4a``) from the exterior area of walls and roof [m²].
 
-    - ``Gi`` [W/K] (envelope node - indoor air, models ``thermal_2c`` and ``thermal_4a``)
-      from ``envelope_area``: median ``H_SURFACE_INTERIOR × area`` (the interior surface
-      film, EN ISO 6946), σ_log ``SIGMA_FILM``;
-    - ``Gint`` [W/K] (air - interior mass, ``thermal_4a``) from ``floor_area``: median
-      ``H_INTERIOR_MASS × floor_area``, σ_log ``SIGMA_INTERIOR``.
-
-    Bounds at ±5 σ, as the other log-normal survey priors. Why: hourly temperatures of
-    a room whose data do not separate the envelope's outdoor and indoor couplings (the
-    split ``Gw``/``Gi`` is the slowest direction of the demo's ``thermal_4a``, τ ≈ 1 000
-    steps) or do not show an interior mass at all (then ``Gint`` and ``Cint`` are free
-    and the walkers random-walk along them) leave those directions to the prior; the
-    default log-uniform over seven decades is no knowledge a building physicist lacks.
-    Against the demo's documented truth (:mod:`heritage_bayes.demo`: Gi 1 600 W/K for
-    ≈ 260 m² of walls and vault, Gint 400 W/K over an 80 m² floor) the medians are
-    2 000 and 400 W/K.
+    Median ``H_SURFACE_INTERIOR × area`` (the interior surface film, EN ISO 6946),
+    σ_log ``SIGMA_FILM``, bounds at ±5 σ as the other survey priors. Why: how the
+    envelope's heat path splits between the outdoor side ``Gw`` and the indoor side
+    ``Gi`` is the slowest direction of the demo's ``thermal_4a`` (τ of log Gw - log Gi
+    about 1 000 steps): the data see the series conductance and the node's time
+    constant, a building physicist knows the surface film. Against the demo's truth
+    (:mod:`heritage_bayes.demo`: Gi 1 600 W/K for about 260 m² of walls and vault) the
+    median is 2 000 W/K. Measured (``benchmarks/bench_coordinates.py demo_4a_env``,
+    docs/science/benchmarks.md, 60 000 steps, with the Gint prior below on both
+    sides): with ``envelope_area`` the envelope's τ falls (Cw 726 → 395 steps, Gw 535
+    → 446, Gi 1 992 → 1 417, the south aperture 1 138 → 431). A prior on the
+    interior mass's ``Gint`` from the floor area (5 W/(m²·K) × floor) was tried and
+    dropped: on the demo's data, which have no interior mass, it quadrupled τ of
+    ``Cint`` and ``Gint`` (749 → 3 144 and 764 → 3 019 steps at 60 000 steps), the
+    walkers then wandering along ``Cint`` alone.
 
     Parameters
     ----------
-    envelope_area : float, optional
+    envelope_area : float
         Exterior surface area of walls and roof [m²].
-    floor_area : float, optional
-        Floor area [m²].
 
     References
     ----------
     EN ISO 6946:2017, Building components and building elements - Thermal resistance
     and thermal transmittance, Table 7 (surface resistances).
-    EN ISO 13790:2008, Energy performance of buildings - Calculation of energy use for
-    space heating and cooling, §12.2.2 (coupling of the internal surfaces to the air).
     """
-    out = {}
-    for name, area, h, sigma in (
-        ("Gi", envelope_area, H_SURFACE_INTERIOR, SIGMA_FILM),
-        ("Gint", floor_area, H_INTERIOR_MASS, SIGMA_INTERIOR),
-    ):
-        if area is None:
-            continue
-        if not area > 0:
-            raise ConfigError(f"surface prior on {name}: area must be > 0 m² (got {area})")
-        median = h * area
-        out[name] = Prior(
-            "lognormal", median * math.exp(-5 * sigma), median * math.exp(5 * sigma), median, sigma
-        )
-    return out
+    if not envelope_area > 0:
+        raise ConfigError(f"envelope_area must be > 0 m² (got {envelope_area})")
+    median = H_SURFACE_INTERIOR * envelope_area
+    return Prior(
+        "lognormal",
+        median * math.exp(-5 * SIGMA_FILM),
+        median * math.exp(5 * SIGMA_FILM),
+        median,
+        SIGMA_FILM,
+    )
 
 
 @dataclass(frozen=True)
@@ -755,18 +739,16 @@ def parameters_for(
         ``air_change_sigma`` on ``Gfast`` (see :func:`ventilation_prior`).
     floor_area : float, optional
         Floor area on the ground [m²]: a log-normal prior on a thermal model's ``Gf``
-        (see :func:`ground_prior`) and on ``thermal_4a``'s ``Gint`` (see
-        :func:`surface_priors`).
+        (see :func:`ground_prior`).
     envelope_area : float, optional
         Exterior surface area of walls and roof [m²]: upper bounds on a thermal
         model's envelope node, ``Gw`` and ``Cw`` (see :func:`envelope_priors`), and a
-        log-normal prior on ``Gi`` (see :func:`surface_priors`).
+        log-normal prior on ``Gi`` (see :func:`film_prior`).
     where : str
         Key path used in error messages.
     """
     priors = dict(priors or {})
     domain = model.domain
-    surface = surface_priors(envelope_area, floor_area) if domain == "thermal" else {}
     specs: list[Parameter] = []
     noise_specs = (
         noise.parameter_specs(model.output_names, model.state_names)
@@ -820,8 +802,12 @@ def parameters_for(
             prior = ground_prior(floor_area)
         if envelope_area is not None and name in ("Gw", "Cw"):
             prior = envelope_priors(envelope_area, domain)[name]
-        if domain == "thermal" and kind == "conductance" and name in surface:
-            prior = surface[name]
+        if (
+            name == "Gi"
+            and envelope_area is not None
+            and (domain, kind) == ("thermal", "conductance")
+        ):
+            prior = film_prior(envelope_area)
         spec = priors.get(name)
         fixed = None
         if spec is not None:

@@ -515,10 +515,13 @@ def film_prior(envelope_area: float) -> Prior:
     about 1 000 steps): the data see the series conductance and the node's time
     constant, a building physicist knows the surface film. Against the demo's truth
     (:mod:`heritage_bayes.demo`: Gi 1 600 W/K for about 260 m² of walls and vault) the
-    median is 2 000 W/K. Measured (``benchmarks/bench_coordinates.py demo_4a_env``,
-    docs/science/benchmarks.md, 60 000 steps, with the Gint prior below on both
-    sides): with ``envelope_area`` the envelope's τ falls (Cw 726 → 395 steps, Gw 535
-    → 446, Gi 1 992 → 1 417, the south aperture 1 138 → 431). A prior on the
+    median is 2 000 W/K. Measured (``benchmarks/bench_coordinates.py demo_4a
+    demo_4a_env --only node_tau --air-share --max-steps 60000``,
+    docs/science/benchmarks.md): with ``envelope_area: 260`` (this prior and the bounds
+    of :func:`envelope_priors`) τ of the demo's ``thermal_4a`` falls from 1 683 to 691
+    steps (Gw 1 666 → 611, Cw 1 497 → 567, fsol 1 683 → 689), the bulk ESS per CPU
+    second from 1.84 to 7.30; on the demo's ``thermal_2c`` every truth stays in its 90 %
+    interval (13 of 13) and τmax goes from 133 to 115. A prior on the
     interior mass's ``Gint`` from the floor area (5 W/(m²·K) × floor) was tried and
     dropped: on the demo's data, which have no interior mass, it quadrupled τ of
     ``Cint`` and ``Gint`` (749 → 3 144 and 764 → 3 019 steps at 60 000 steps), the

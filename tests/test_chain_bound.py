@@ -141,3 +141,10 @@ def test_the_stride_never_exceeds_a_tenth_of_tau():
     assert short.stride == 1 and short.chain.shape[0] == 300
     longer = run_sampler(iid, np.zeros(2), max_steps=1500, **kw)
     assert longer.stride == 2 and all(h[1] >= 20 for h in longer.tau_history[2:])
+
+
+def test_a_bound_below_two_steps_is_refused():
+    from heritage_bayes.errors import InputError
+
+    with pytest.raises(InputError, match="sampler.max_stored_steps: expected at least 2"):
+        run_sampler(_Ridge(), np.zeros(3), max_steps=100, max_rows=1, **KW)

@@ -265,7 +265,7 @@ def _run_sampler(
         ``max_rows`` steps is held and decided exactly as without the bound.
     """
     if max_rows is not None and max_rows < 2:
-        raise InputError(f"sampler.max_rows: expected at least 2 steps (got {max_rows})")
+        raise InputError(f"sampler.max_stored_steps: expected at least 2 (got {max_rows})")
     d = int(np.size(x_map))
     if not 0.0 <= tau_discard < 1.0:
         raise InputError(f"sampler.tau_discard: expected a fraction in [0, 1) (got {tau_discard})")

@@ -146,5 +146,19 @@ def test_the_stride_never_exceeds_a_tenth_of_tau():
 def test_a_bound_below_two_steps_is_refused():
     from heritage_bayes.errors import InputError
 
-    with pytest.raises(InputError, match="sampler.max_stored_steps: expected at least 2"):
+    with pytest.raises(InputError, match=r"sampler\.max_stored_steps: expected at least 2"):
         run_sampler(_Ridge(), np.zeros(3), max_steps=100, max_rows=1, **KW)
+
+
+def test_a_converged_thinned_chain_compacts_with_its_trace_stride_in_steps(tmp_path):
+    f = _Ridge()
+    kw = dict(KW, tau_factor=30, max_rhat=None, min_ess=None)
+    res = run_sampler(
+        f, np.zeros(3), max_steps=5000, max_rows=300, checkpoint=tmp_path / "c.h5", tag="t",
+        compact=True, **kw,
+    )  # fmt: skip
+    assert res.converged and res.stride >= 2
+    with h5py.File(tmp_path / "c.h5") as h:
+        rows = h["chain"].shape[0]
+        # the trace spans the whole chain: rows × trace_stride ≈ the steps
+        assert abs(rows * int(h.attrs["trace_stride"]) - res.steps) <= h.attrs["trace_stride"]

@@ -410,7 +410,9 @@ COMPACT_FORMAT = "compact-1"
 TRACE_STEPS = 200
 
 
-def write_compact(path: Path, tag: str, draws, log_prob, info: dict, chain, chain_lp) -> None:
+def write_compact(
+    path: Path, tag: str, draws, log_prob, info: dict, chain, chain_lp, row_steps: int = 1
+) -> None:
     """Replace a converged chain's checkpoint by the draws its outputs use.
 
     ``draws`` (kept steps, walkers, d) and ``log_prob`` (kept steps, walkers) are the
@@ -420,7 +422,9 @@ def write_compact(path: Path, tag: str, draws, log_prob, info: dict, chain, chai
     the whole chain for plots, burn-in included: every ``trace_stride``-th step
     (attribute), at most :data:`TRACE_STEPS` per walker, float32. The full chain is
     what ``--resume`` needs while a chain is unconverged; once converged, these draws
-    are all a resumed run needs to rebuild its outputs. Datasets gzip-compressed with
+    are all a resumed run needs to rebuild its outputs. ``row_steps``: steps per row of
+    ``chain`` (a thinned chain, :class:`~heritage_bayes.inference.monitor.ChainBuffer`),
+    so that ``trace_stride`` counts steps. Datasets gzip-compressed with
     Fletcher-32 checksums; written atomically.
     """
     stride = max(1, -(-int(chain.shape[0]) // TRACE_STEPS))
@@ -431,7 +435,7 @@ def write_compact(path: Path, tag: str, draws, log_prob, info: dict, chain, chai
             f.attrs["tag"] = tag
             f.attrs["format"] = COMPACT_FORMAT
             f.attrs["compact"] = json.dumps(info)
-            f.attrs["trace_stride"] = stride
+            f.attrs["trace_stride"] = stride * int(row_steps)
             for name, a, dtype in (
                 ("draws", draws, "f8"),
                 ("draws_log_prob", log_prob, "f8"),

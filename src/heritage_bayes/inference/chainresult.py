@@ -119,7 +119,16 @@ def compact_checkpoint(path, tag: str, result: ChainResult, max_draws: int) -> N
         "accepted": np.asarray(result.accepted, dtype=float).tolist(),
         "max_draws": int(max_draws),
     }
-    write_compact(Path(path), tag, np.swapaxes(X, 0, 1), lp.T, info, result.chain, result.log_prob)
+    write_compact(
+        Path(path),
+        tag,
+        np.swapaxes(X, 0, 1),
+        lp.T,
+        info,
+        result.chain,
+        result.log_prob,
+        row_steps=result.stride,
+    )
 
 
 def _from_compact(path: Path, kept, nwalkers: int, d: int, tau_factor: float) -> ChainResult:

@@ -518,9 +518,11 @@ def film_prior(envelope_area: float) -> Prior:
     median is 2 000 W/K. Measured (``benchmarks/bench_coordinates.py demo_4a
     demo_4a_env --only node_tau --air-share --max-steps 60000``,
     docs/science/benchmarks.md): with ``envelope_area: 260`` (this prior and the bounds
-    of :func:`envelope_priors`) τ of the demo's ``thermal_4a`` falls from 1 683 to 691
-    steps (Gw 1 666 → 611, Cw 1 497 → 567, fsol 1 683 → 689), the bulk ESS per CPU
-    second from 1.84 to 7.30; on the demo's ``thermal_2c`` every truth stays in its 90 %
+    of :func:`envelope_priors`) τ of the demo's ``thermal_4a`` at 60 000 steps falls
+    from 1 683 to 691 steps (Gw 1 666 → 611, Cw 1 497 → 567, fsol 1 683 → 689), the
+    bulk ESS per CPU second from 1.84 to 7.30 (longer, the walkers still find the
+    interior mass the demo's data do not have: τmax 15 539 at 156 000 steps); on the
+    demo's ``thermal_2c`` every truth stays in its 90 %
     interval (13 of 13) and τmax goes from 133 to 115. A prior on the
     interior mass's ``Gint`` from the floor area (5 W/(m²·K) × floor) was tried and
     dropped: on the demo's data, which have no interior mass, it quadrupled τ of

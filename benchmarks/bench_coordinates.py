@@ -47,10 +47,17 @@ from heritage_bayes.inference.optimize import laplace
 from heritage_bayes.inference.sampler import _tau
 
 ROOT = Path(__file__).resolve().parents[1]
+DEMO_ENV = ROOT / "benchmarks" / "configs" / "demo_envelope.yaml"
 #: name -> (config, section, model (None: the config's own))
 PROBLEMS = {
     "demo_2c": (ROOT / "configs" / "demo.yaml", "thermal", None),
     "demo_4a": (ROOT / "configs" / "demo.yaml", "thermal", "thermal_4a"),
+    "demo_2c_env": (ROOT / "benchmarks" / "configs" / "demo_envelope.yaml", "thermal", None),
+    "demo_4a_env": (
+        ROOT / "benchmarks" / "configs" / "demo_envelope.yaml",
+        "thermal",
+        "thermal_4a",
+    ),
     "demo_hygric": (ROOT / "configs" / "demo.yaml", "hygric", None),
     "trh1_2c": (ROOT / "configs" / "trh1_attic.yaml", "thermal", "thermal_2c"),
     "orholm_4a": (ROOT / "configs" / "orholm.yaml", "thermal", "thermal_4a"),

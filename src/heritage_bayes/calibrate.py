@@ -396,6 +396,7 @@ def _calibrate_into(
                 coordinates=coords,
                 compact=True,
                 start_hessian=hessian,
+                max_rows=cfg.sampler.max_stored_steps,
             )
         finally:
             say.close()

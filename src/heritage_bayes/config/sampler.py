@@ -42,6 +42,15 @@ class SamplerSettings(_Strict):
     max_steps: int = key(
         200_000, unit="steps", description="safety cap on the chain length", ge=100
     )
+    max_stored_steps: int | None = key(
+        20_000,
+        unit="steps",
+        description="steps of each chain held in memory and in its checkpoint at most: past "
+        "it the chain is thinned in place (every other stored step dropped, the stride "
+        "doubled, never beyond τ/10) and τ estimated on the thinned chain × the stride; "
+        "null: every step (the demo's thermal_4a chain at 171 500 steps: 0.9 GB)",
+        ge=100,
+    )
     max_time: Budget = key(
         "30min",
         unit=DURATION_UNIT,

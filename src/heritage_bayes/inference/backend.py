@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
 import signal
 import threading
 from dataclasses import dataclass
@@ -93,6 +94,9 @@ class _Saved:
     random_state: tuple | None
     tau_history: list
     problem: str | None = None  # what was wrong with the file, if anything
+    stride: int = 1  # steps per stored row (a thinned chain)
+    steps: int | None = None  # steps of the chain (None: one per row)
+    last: tuple | None = None  # (positions, log-probabilities) of its last step
 
 
 class _Checkpoint:
@@ -105,7 +109,11 @@ class _Checkpoint:
     commit intact. SIGINT/SIGTERM are deferred until the commit is done. The datasets
     carry Fletcher-32 checksums, so damaged chunks are detected on load and the valid
     prefix is kept. The file is created under a unique temporary name (never through
-    a symlink) and renamed into place.
+    a symlink) and renamed into place. The rows are gzip-compressed (lossless): the
+    first 20 000 steps of the demo's thermal_4a chain (34 walkers × 16 parameters,
+    acceptance 0.08) take 8.6 MB instead of 87 MB, for 0.44 s of CPU in all
+    (measured with h5py on the chain of ``benchmarks/bench_coordinates.py demo_4a
+    --save-chain``).
     """
 
     FORMAT = 3
@@ -132,12 +140,22 @@ class _Checkpoint:
                         dtype="f8",
                         chunks=(64, *shape),
                         fletcher32=True,
+                        # lossless: rejected proposals repeat a walker's row, so the
+                        # demo's thermal_4a chain (acceptance 0.08) shrinks 10×
+                        compression="gzip",
+                        compression_opts=4,
                     )
 
         atomic_write(self.path, write)
 
-    def append(self, chain, log_prob, accepted, random_state, tau_history) -> None:
-        """Write ``chain``/``log_prob`` rows after the last commit, then commit them."""
+    def append(self, chain, log_prob, accepted, random_state, tau_history, **thinned) -> None:
+        """Write ``chain``/``log_prob`` rows after the last commit, then commit them.
+
+        A thinned chain (keyword ``stride`` > 1 steps per row, see
+        :class:`heritage_bayes.inference.monitor.ChainBuffer`) also commits its length
+        ``steps`` and ``last`` = (positions (walkers, d), log-probabilities (walkers,))
+        of its last step, where ``--resume`` continues (the last step is not always a
+        stored row); at stride 1 the commit record is as before."""
         from heritage_bayes.inference.results import ensure_free_space
 
         chunk = 64 * int(np.prod(chain.shape[1:])) * 8  # one HDF5 chunk [bytes]
@@ -162,6 +180,10 @@ class _Checkpoint:
                 ],
                 "tau_history": np.asarray(tau_history, dtype=float).reshape(-1, 2).tolist(),
             }
+            if thinned.get("stride", 1) > 1:
+                commit["stride"] = int(thinned["stride"])
+                commit["steps"] = int(thinned["steps"])
+                commit["last"] = [np.asarray(a, dtype=float).tolist() for a in thinned["last"]]
             rows = [
                 np.asarray(r, dtype=f[k].dtype)
                 for k, r in (("chain", chain), ("log_prob", log_prob))
@@ -171,6 +193,17 @@ class _Checkpoint:
             f.attrs["commit"] = json.dumps(commit)  # the commit point
             f.attrs["iteration"] = n0 + n  # informative
             f.flush()
+
+    def rewrite(self, chain, log_prob, accepted, random_state, tau_history, **thinned) -> None:
+        """Replace the file by one holding these rows and this commit (a thinned chain
+        whose stride doubled: :meth:`append`'s keywords), atomically: written under
+        another name, then renamed over the checkpoint, so an interrupt leaves either
+        the old or the new file whole."""
+        tmp = _Checkpoint(self.path.with_name(self.path.name + ".thinning"), self.tag)
+        tmp.create(chain.shape[1], chain.shape[2])
+        tmp.append(chain, log_prob, accepted, random_state, tau_history, **thinned)
+        with _DeferSignals():
+            os.replace(tmp.path, self.path)
 
     def _damaged(self, why: str) -> InputError:
         return InputError(
@@ -238,6 +271,7 @@ class _Checkpoint:
                 )
             problem = None
             rs = None
+            stride, steps, last = 1, None, None
             try:
                 if "commit" in f.attrs:
                     c = json.loads(f.attrs["commit"])
@@ -252,6 +286,10 @@ class _Checkpoint:
                         float(cached),
                     )
                     hist = [tuple(r) for r in c["tau_history"]]
+                    stride, steps = int(c.get("stride", 1)), c.get("steps")
+                    last = c.get("last")
+                    if last is not None:
+                        last = (np.asarray(last[0], dtype=float), np.asarray(last[1], dtype=float))
                 else:  # format 1 (before the commit attribute)
                     n = int(f.attrs.get("iteration", 0))
                     accepted = (
@@ -279,7 +317,12 @@ class _Checkpoint:
                 f"steps {bad} to {n} are damaged; kept the {chain.shape[0]} valid steps before them"
             )
             rs = None  # the saved random state belongs to the end of the damaged part
-        return _Saved(chain, lp, accepted, rs, hist[: max(0, len(hist))], problem)
+            # a thinned chain continues from its last valid row
+            steps = chain.shape[0] * stride
+            last = (chain[-1], lp[-1]) if chain.shape[0] else None
+        return _Saved(
+            chain, lp, accepted, rs, hist[: max(0, len(hist))], problem, stride, steps, last
+        )
 
 
 #: The checksum before the first block.
@@ -367,7 +410,9 @@ COMPACT_FORMAT = "compact-1"
 TRACE_STEPS = 200
 
 
-def write_compact(path: Path, tag: str, draws, log_prob, info: dict, chain, chain_lp) -> None:
+def write_compact(
+    path: Path, tag: str, draws, log_prob, info: dict, chain, chain_lp, row_steps: int = 1
+) -> None:
     """Replace a converged chain's checkpoint by the draws its outputs use.
 
     ``draws`` (kept steps, walkers, d) and ``log_prob`` (kept steps, walkers) are the
@@ -377,7 +422,9 @@ def write_compact(path: Path, tag: str, draws, log_prob, info: dict, chain, chai
     the whole chain for plots, burn-in included: every ``trace_stride``-th step
     (attribute), at most :data:`TRACE_STEPS` per walker, float32. The full chain is
     what ``--resume`` needs while a chain is unconverged; once converged, these draws
-    are all a resumed run needs to rebuild its outputs. Datasets gzip-compressed with
+    are all a resumed run needs to rebuild its outputs. ``row_steps``: steps per row of
+    ``chain`` (a thinned chain, :class:`~heritage_bayes.inference.monitor.ChainBuffer`),
+    so that ``trace_stride`` counts steps. Datasets gzip-compressed with
     Fletcher-32 checksums; written atomically.
     """
     stride = max(1, -(-int(chain.shape[0]) // TRACE_STEPS))
@@ -388,7 +435,7 @@ def write_compact(path: Path, tag: str, draws, log_prob, info: dict, chain, chai
             f.attrs["tag"] = tag
             f.attrs["format"] = COMPACT_FORMAT
             f.attrs["compact"] = json.dumps(info)
-            f.attrs["trace_stride"] = stride
+            f.attrs["trace_stride"] = stride * int(row_steps)
             for name, a, dtype in (
                 ("draws", draws, "f8"),
                 ("draws_log_prob", log_prob, "f8"),

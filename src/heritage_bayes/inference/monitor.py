@@ -58,7 +58,7 @@ def _tau(chain: np.ndarray, discard: float = 0.0) -> np.ndarray:
 
 class ChainBuffer:
     """The chain (steps, walkers, d) and its log-probabilities, grown chunk by chunk in
-    place.
+    place, and thinned in place once it reaches ``max_rows``.
 
     The sampler appends a chunk after every convergence check and estimates τ (and
     R-hat) on the whole chain each time; a list of chunks concatenated for each check
@@ -67,15 +67,36 @@ class ChainBuffer:
     copies, at most 25 % slack), and :attr:`chain` is a view of the rows filled.
     Measured on the demo's thermal_4a at 74 500 steps × 34 walkers × 16 parameters:
     324 MB of float64 either way, the copies for the checks gone.
+
+    Bounded (``max_rows``): the buffer holds every ``stride``-th step, the steps ``s``
+    (0-based) with ``(s + 1) % stride == 0``; :meth:`halve` keeps every other row and
+    doubles ``stride`` (the rows kept are again those of the rule, whatever the chunk
+    sizes, so a resumed chain rebuilds the same rows). Who calls :meth:`halve` decides
+    when (the sampler: only while the stride stays ≤ τ/10, see
+    :func:`heritage_bayes.inference.sampler.run_sampler`). A chain shorter than
+    ``max_rows`` steps is held as before, every step.
     """
 
-    def __init__(self, nwalkers: int, d: int, capacity: int = 0):
+    def __init__(self, nwalkers: int, d: int, capacity: int = 0, stride: int = 1):
         self._x = np.empty((capacity, nwalkers, d))
         self._lp = np.empty((capacity, nwalkers))
         self.n = 0
+        #: steps per stored row
+        self.stride = int(stride)
+        #: steps appended so far (rows × stride, plus the steps after the last row)
+        self.steps = 0
 
-    def append(self, x: np.ndarray, lp: np.ndarray) -> None:
-        """Add the rows of a chunk, x (k, walkers, d) and lp (k, walkers)."""
+    def _keep(self, k: int) -> slice:
+        """Rows of a chunk of ``k`` steps that follow the last appended step to keep."""
+        first = (-(self.steps + 1)) % self.stride  # first s >= steps with (s+1) % stride == 0
+        return slice(first, k, self.stride)
+
+    def append(self, x: np.ndarray, lp: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Add a chunk of consecutive steps, x (k, walkers, d) and lp (k, walkers);
+        returns the rows kept (all of them at stride 1)."""
+        keep = self._keep(x.shape[0])
+        self.steps += x.shape[0]
+        x, lp = x[keep], lp[keep]
         k = x.shape[0]
         if self.n + k > self._x.shape[0]:
             cap = max(self.n + k, int(1.25 * self._x.shape[0]))
@@ -87,13 +108,35 @@ class ChainBuffer:
         self._x[self.n : self.n + k] = x
         self._lp[self.n : self.n + k] = lp
         self.n += k
+        return x, lp
+
+    def load(self, x: np.ndarray, lp: np.ndarray, steps: int) -> None:
+        """Set the rows of a saved chain held at this buffer's ``stride`` (``steps``
+        steps long: the rows of the rule, :meth:`append`'s docstring)."""
+        expect = steps // self.stride
+        if x.shape[0] != expect:
+            raise ValueError(
+                f"a chain of {steps} steps at stride {self.stride} has {expect} rows "
+                f"(got {x.shape[0]})"
+            )
+        self._x, self._lp = np.array(x, dtype=float), np.array(lp, dtype=float)
+        self.n, self.steps = x.shape[0], int(steps)
+
+    def halve(self) -> None:
+        """Keep every other row (the steps of the doubled stride) and double ``stride``."""
+        self.stride *= 2
+        keep = slice(1, self.n, 2)
+        m = len(range(*keep.indices(self.n)))
+        self._x[:m] = self._x[keep]
+        self._lp[:m] = self._lp[keep]
+        self.n = m
 
     @property
     def chain(self) -> np.ndarray:
-        """(steps, walkers, d) view of the rows filled."""
+        """(rows, walkers, d) view of the rows filled."""
         return self._x[: self.n]
 
     @property
     def log_prob(self) -> np.ndarray:
-        """(steps, walkers) view of the rows filled."""
+        """(rows, walkers) view of the rows filled."""
         return self._lp[: self.n]

@@ -45,18 +45,20 @@ from __future__ import annotations
 
 import os
 import time
-from dataclasses import dataclass, field
 from pathlib import Path
 
 import emcee
 import numpy as np
 
 from heritage_bayes.errors import InputError
-from heritage_bayes.inference.backend import (
-    _Checkpoint,
-    _DeferSignals,
-    read_compact,
-    write_compact,
+from heritage_bayes.inference.backend import _Checkpoint, _DeferSignals, read_compact
+from heritage_bayes.inference.chainresult import (
+    ChainResult,
+    _burn_thin,
+    _from_compact,
+    _mixing_ok,
+    _thinned,
+    compact_checkpoint,
 )
 from heritage_bayes.inference.monitor import ChainBuffer, _next_check, _tau, make_moves
 from heritage_bayes.inference.start import laplace_ensemble
@@ -68,166 +70,6 @@ __all__ = [
     "run_sampler",
     "start_ensemble",
 ]
-
-
-@dataclass
-class ChainResult:
-    """The full chain and what convergence monitoring found.
-
-    Attributes
-    ----------
-    chain : (steps, walkers, d) array
-        Unconstrained coordinates.
-    log_prob : (steps, walkers) array
-    accepted : (walkers,) array
-        Accepted proposals per walker.
-    tau : (d,) array
-        Integrated autocorrelation time per parameter [steps] at the end.
-    tau_history : list of (steps, max τ)
-    converged : bool
-        Chain length ≥ tau_factor × max τ and τ stable.
-    burn, thin : int
-        Burn-in and thinning derived from τ.
-    wall_seconds : float
-        Sampling time of this call (resumed runs: only the new part).
-    cpu_seconds : float
-        Process CPU time (user + system) of the same part.
-    stopped_by : str
-        ``"converged"``, ``"max_steps"`` or ``"max_seconds"`` (the time budget).
-    thinned : bool
-        ``chain`` holds only the retained draws (read back from a compacted
-        checkpoint, :func:`compact_checkpoint`); ``burn``/``thin`` describe the chain
-        they came from, ``n_steps`` its length.
-    coordinates : str
-        What emcee moved in: ``"log"`` (the log-posterior's own coordinates) or the
-        ``name`` of the change of variables (``"node_tau"``).
-    """
-
-    chain: np.ndarray
-    log_prob: np.ndarray
-    accepted: np.ndarray
-    tau: np.ndarray
-    tau_history: list = field(default_factory=list)
-    converged: bool = False
-    burn: int = 0
-    thin: int = 1
-    wall_seconds: float = 0.0
-    resumed_from: int = 0
-    cpu_seconds: float = 0.0
-    stopped_by: str = ""  # "converged", "max_steps", "max_seconds"
-    thinned: bool = False
-    n_steps: int | None = None
-    coordinates: str = "log"
-
-    @property
-    def steps(self) -> int:
-        return self.chain.shape[0] if self.n_steps is None else self.n_steps
-
-    @property
-    def acceptance(self) -> np.ndarray:
-        return self.accepted / max(self.steps, 1)
-
-    def draws(self, max_draws: int | None = None) -> tuple[np.ndarray, np.ndarray]:
-        """Post burn-in, thinned samples: (walkers, draws, d) and log-prob (walkers, draws).
-
-        ``max_draws`` caps walkers × draws by thinning further.
-        """
-        if self.thinned:
-            x, lp = self.chain, self.log_prob
-        else:
-            x = self.chain[self.burn :: self.thin]
-            lp = self.log_prob[self.burn :: self.thin]
-        if max_draws is not None and x.shape[0] * x.shape[1] > max_draws:
-            keep = max(1, max_draws // x.shape[1])
-            step = int(np.ceil(x.shape[0] / keep))
-            x, lp = x[-keep * step :: step], lp[-keep * step :: step]
-        return np.swapaxes(x, 0, 1), lp.T
-
-
-def compact_checkpoint(path, tag: str, result: ChainResult, max_draws: int) -> None:
-    """Replace the checkpoint of a converged chain by its retained draws.
-
-    Keeps what the run's outputs were built from (``result.draws(max_draws)``, float64)
-    and what describes the chain (steps, burn, thin, τ, acceptance), so that
-    ``--resume`` on the finished run rebuilds the same outputs without sampling. Why:
-    the full chain of the demo's thermal_2c (8 000 steps × 32 walkers × 13 parameters,
-    float64) is 28.8 MB, its retained draws 0.4 MB, and an unconverged chain (the case
-    ``--resume`` is for) is never compacted.
-    """
-    if not result.converged or result.thinned:
-        return
-    X, lp = result.draws(max_draws)
-    info = {
-        "steps": int(result.steps),
-        "burn": int(result.burn),
-        "thin": int(result.thin),
-        "tau": [float(t) for t in result.tau],
-        "tau_history": [list(map(float, h)) for h in result.tau_history],
-        "accepted": np.asarray(result.accepted, dtype=float).tolist(),
-        "max_draws": int(max_draws),
-    }
-    write_compact(Path(path), tag, np.swapaxes(X, 0, 1), lp.T, info, result.chain, result.log_prob)
-
-
-def _from_compact(path: Path, kept, nwalkers: int, d: int, tau_factor: float) -> ChainResult:
-    """The :class:`ChainResult` of a compacted checkpoint, if it meets ``tau_factor``."""
-    draws, lp, info = kept
-    if draws.shape[1:] != (nwalkers, d):
-        raise InputError(
-            f"{path}: checkpoint has {draws.shape[1]} walkers × {draws.shape[2]} "
-            f"parameters, the run needs {nwalkers} × {d}; run without --resume"
-        )
-    tau = np.asarray(info["tau"], dtype=float)
-    if info["steps"] < tau_factor * np.max(tau):
-        raise InputError(
-            f"{path}: holds the retained draws of a chain that converged after "
-            f"{info['steps']} steps (τmax {np.max(tau):.0f}), fewer than tau_factor "
-            f"{tau_factor:g} × τmax; a converged chain is stored without the steps that "
-            "extending it would need: run without --resume to sample afresh"
-        )
-    return ChainResult(
-        chain=draws,
-        log_prob=lp,
-        accepted=np.asarray(info["accepted"], dtype=float),
-        tau=tau,
-        tau_history=[tuple(h) for h in info["tau_history"]],
-        converged=True,
-        burn=int(info["burn"]),
-        thin=int(info["thin"]),
-        resumed_from=int(info["steps"]),
-        stopped_by="converged",
-        thinned=True,
-        n_steps=int(info["steps"]),
-    )
-
-
-def _burn_thin(tau: np.ndarray, steps: int, discard: float = 0.0) -> tuple[int, int]:
-    """Burn-in and thinning [steps]: 2 τ (at most half the chain), and at least the part
-    of the chain that τ was not estimated on (``discard``); thinning τ_min / 2."""
-    tmax = float(np.nanmax(tau)) if np.isfinite(tau).any() else float(steps)
-    burn = max(min(int(np.ceil(2 * tmax)), steps // 2), int(discard * steps))
-    thin = max(1, int(0.5 * np.nanmin(tau))) if np.isfinite(tau).any() else 1
-    return burn, thin
-
-
-def _mixing_ok(chain, tau, max_rhat, min_ess, max_draws, discard: float = 0.0) -> bool:
-    """R-hat and bulk ESS of the retained draws (walkers as chains) meet the targets."""
-    from heritage_bayes._arviz import az
-
-    burn, thin = _burn_thin(tau, chain.shape[0], discard)
-    res = ChainResult(
-        chain=chain,
-        log_prob=np.zeros(chain.shape[:2]),
-        accepted=np.zeros(chain.shape[1]),
-        tau=tau,
-        burn=burn,
-        thin=thin,
-    )
-    X, _ = res.draws(max_draws)
-    ds = az.convert_to_dataset({"x": X})
-    if max_rhat is not None and float(az.rhat(ds)["x"].max()) > max_rhat:
-        return False
-    return min_ess is None or float(az.ess(ds, method="bulk")["x"].min()) >= min_ess
 
 
 def start_ensemble(
@@ -357,6 +199,7 @@ def _run_sampler(
     coordinates=None,
     compact: bool = False,
     start_hessian: np.ndarray | None = None,
+    max_rows: int | None = None,
 ) -> ChainResult:
     """Sample the posterior with emcee until converged (see module docstring).
 
@@ -409,7 +252,20 @@ def _run_sampler(
         Laplace approximation N(x_map, H⁻¹) (:func:`heritage_bayes.inference.start.
         laplace_ensemble`) instead of the ``init_ball`` around it (the fallback when
         that start finds no finite log-posterior).
+    max_rows : int, optional
+        Bound on the steps held in memory and in the checkpoint (None: every step).
+        Past it, at a convergence check, the chain is thinned in place: every other
+        stored step is dropped and the stride (steps per row) doubles
+        (:class:`heritage_bayes.inference.monitor.ChainBuffer`); τ is then estimated
+        on the thinned chain and scaled by the stride, exact enough while the stride
+        is well below τ, so the stride never exceeds τmax/10 (τmax of the previous
+        check; the chain grows past ``max_rows`` rather than break that). The chain
+        itself (emcee's steps and random stream) does not change, only which of its
+        steps are kept; ``resume=True`` rebuilds the same rows. A chain shorter than
+        ``max_rows`` steps is held and decided exactly as without the bound.
     """
+    if max_rows is not None and max_rows < 2:
+        raise InputError(f"sampler.max_stored_steps: expected at least 2 (got {max_rows})")
     d = int(np.size(x_map))
     if not 0.0 <= tau_discard < 1.0:
         raise InputError(f"sampler.tau_discard: expected a fraction in [0, 1) (got {tau_discard})")
@@ -452,7 +308,7 @@ def _run_sampler(
                 )
             if saved.problem is not None:
                 _tell(notice, f"{ck.path}: {saved.problem}")
-            done = saved.chain.shape[0]
+            done = saved.chain.shape[0] if saved.steps is None else saved.steps
             if done == 0:
                 _tell(notice, f"--resume: {ck.path} holds no steps yet; starting a new chain")
             else:
@@ -471,15 +327,19 @@ def _run_sampler(
                     kept = ck.path.with_name(ck.path.name + ".damaged")
                     os.replace(ck.path, kept)
                     ck.create(nwalkers, d)
-                    ck.append(saved.chain, saved.log_prob, accepted, rs, tau_hist)
+                    ck.append(
+                        saved.chain, saved.log_prob, accepted, rs, tau_hist, **_thinned(saved)
+                    )
                     _tell(
                         notice,
                         f"{ck.path}: rewritten from the valid steps; the damaged "
                         f"file is kept as {kept}",
                     )
-                buf.append(saved.chain, saved.log_prob)
+                buf = ChainBuffer(nwalkers, d, stride=saved.stride)
+                buf.load(saved.chain, saved.log_prob, done)
+                x_last, lp_last = saved.last or (buf.chain[-1], buf.log_prob[-1])
                 del saved
-                state = emcee.State(to_y(buf.chain[-1]), log_prob=buf.log_prob[-1], random_state=rs)
+                state = emcee.State(to_y(x_last), log_prob=lp_last, random_state=rs)
                 sampler.random_state = rs
     resumed_from = done
     if done == 0:
@@ -504,12 +364,14 @@ def _run_sampler(
     converged = False
     tau = np.full(d, np.nan)
     if done > 0:  # resumed: the saved chain may already be long enough
-        tau = _tau(buf.chain, tau_discard)
+        tau = _tau(buf.chain, tau_discard) * buf.stride
         tmax = float(np.max(tau))
         stable = bool(tau_hist) and abs(tmax - tau_hist[-1][1]) / tmax < tau_rtol
         converged = bool(done >= tau_factor * tmax and stable and np.all(np.isfinite(tau)))
         if converged and (max_rhat is not None or min_ess is not None):
-            converged = _mixing_ok(buf.chain, tau, max_rhat, min_ess, max_draws, tau_discard)
+            converged = _mixing_ok(
+                buf.chain, tau / buf.stride, max_rhat, min_ess, max_draws, tau_discard
+            )
     # SIGINT/SIGTERM only set a flag while sampling: the chain stops after the current
     # step, the steps done are committed, then KeyboardInterrupt (never an exception
     # inside emcee's likelihood call, which would print the parameter matrix)
@@ -530,27 +392,47 @@ def _run_sampler(
                 state = step
             except KeyboardInterrupt:
                 if ck is not None and sampler.backend.iteration > 0:
+                    x, lp = to_x(sampler.get_chain()), sampler.get_log_prob()
+                    rows = buf.append(x, lp)
                     ck.append(
-                        to_x(sampler.get_chain()),
-                        sampler.get_log_prob(),
+                        *rows,
                         accepted + sampler.backend.accepted,
                         sampler.backend.random_state,
                         tau_hist,
+                        **_thinned(buf, x[-1], lp[-1]),
                     )
                 raise KeyboardInterrupt from None
             x, lp = to_x(sampler.get_chain()), sampler.get_log_prob()
             accepted = accepted + sampler.backend.accepted
-            buf.append(x, lp)
+            rows = buf.append(x, lp)
             done += n
-            tau = _tau(buf.chain, tau_discard)
+            halved = False
+            while (
+                max_rows is not None
+                and buf.n > max_rows
+                and tau_hist
+                and 2 * buf.stride <= tau_hist[-1][1] / 10
+            ):
+                buf.halve()
+                halved = True
+            tau = _tau(buf.chain, tau_discard) * buf.stride
             tmax = float(np.max(tau))
             stable = bool(tau_hist) and abs(tmax - tau_hist[-1][1]) / tmax < tau_rtol
             tau_hist.append((float(done), tmax))
             if ck is not None:
-                ck.append(x, lp, accepted, state.random_state, tau_hist)
+                thinned = _thinned(buf, x[-1], lp[-1])
+                if halved:
+                    ck.rewrite(
+                        buf.chain, buf.log_prob, accepted, state.random_state, tau_hist, **thinned
+                    )
+                else:
+                    ck.append(*rows, accepted, state.random_state, tau_hist, **thinned)
+            del x, lp, rows
             converged = done >= tau_factor * tmax and stable and np.all(np.isfinite(tau))
             if converged and (max_rhat is not None or min_ess is not None):
-                converged = _mixing_ok(buf.chain, tau, max_rhat, min_ess, max_draws, tau_discard)
+                converged = _mixing_ok(
+                    buf.chain, tau / buf.stride, max_rhat, min_ess, max_draws, tau_discard
+                )
             if progress is not None:
                 progress(
                     done,
@@ -565,7 +447,7 @@ def _run_sampler(
             if converged:
                 break
     chain, log_prob = buf.chain, buf.log_prob
-    burn, thin = _burn_thin(tau, chain.shape[0], tau_discard)
+    burn, thin = _burn_thin(tau / buf.stride, chain.shape[0], tau_discard)
     result = ChainResult(
         chain=chain,
         log_prob=log_prob,
@@ -573,13 +455,15 @@ def _run_sampler(
         tau=tau,
         tau_history=tau_hist,
         converged=bool(converged),
-        burn=burn,
-        thin=thin,
+        burn=burn * buf.stride,
+        thin=thin * buf.stride,
         wall_seconds=time.perf_counter() - t0,
         resumed_from=resumed_from,
         cpu_seconds=time.process_time() - c0,
         stopped_by="converged" if converged else "max_seconds" if out_of_time else "max_steps",
         coordinates="log" if coordinates is None else getattr(coordinates, "name", "custom"),
+        n_steps=buf.steps if buf.stride > 1 else None,
+        stride=buf.stride,
     )
     if compact and ck is not None:
         compact_checkpoint(ck.path, tag, result, max_draws)

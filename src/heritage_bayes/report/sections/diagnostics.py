@@ -12,6 +12,7 @@ the walkers are grouped into 4 blocks (:func:`~heritage_bayes.report.identifiabl
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
@@ -37,8 +38,11 @@ def _traces(rd: RunData, m: str, info: dict):
         return None
     try:
         with h5py.File(path, "r") as f:
-            # a converged chain's checkpoint keeps every trace_stride-th step (issue 28)
+            # a converged chain's checkpoint keeps every trace_stride-th step, a long
+            # unconverged one every stride-th (sampler.max_stored_steps; issue 28)
             kept = int(f.attrs.get("trace_stride", 1))
+            if "commit" in f.attrs:
+                kept = int(json.loads(f.attrs["commit"]).get("stride", 1))
             n = f["chain"].shape[0]
             stride = max(1, math.ceil(n / _TRACE_POINTS))
             X = f["chain"][::stride]

@@ -333,7 +333,7 @@ def test_envelope_area_bounds_the_envelope_node():
         assert prior[name].upper < d.upper
     assert prior["Cint"] == default_prior("thermal", "capacity")
     assert prior["Gint"] == default_prior("thermal", "conductance")
-    assert prior["Gi"].dist == "lognormal"  # the surface film: see the next test
+    assert prior["Gi"] == default_prior("thermal", "conductance")
     # the sampler cannot leave the bounded support
     lo, hi = ps.bounds
     j = ps.free_names.index("Gw")
@@ -355,41 +355,3 @@ def test_envelope_area_bounds_the_envelope_node():
     assert ps2.parameters[ps2.names.index("Gw")].prior.upper == pytest.approx(6475.0)
     with pytest.raises(ConfigError, match="envelope_area"):
         parse_config({**raw, "envelope_area": 0})
-
-
-def test_envelope_area_puts_the_surface_film_prior_on_gi():
-    """envelope_area: a thermal Gi log-normal, median 7.7 W/(m²K) × area (R_si 0.13
-    m²K/W, EN ISO 6946), σ_log ln 2, bounds ±5 σ; a hygric Gi and 4a's Gint keep their
-    defaults; the demo's truth (Gi 1 600 W/K, about 260 m²) lies within 1 σ."""
-    import heritage_bayes as hb
-    from heritage_bayes.inference.likelihoods import get_noise_model
-    from heritage_bayes.inference.parameters import (
-        H_SURFACE_INTERIOR,
-        default_prior,
-        film_prior,
-        parameters_for,
-    )
-
-    noise = get_noise_model("ar1_white")
-    for name in ("thermal_2c", "thermal_4a"):
-        m = hb.model(name, surfaces=("S",))
-        prior = {
-            p.name: p.prior
-            for p in parameters_for(m, noise, envelope_area=260.0, floor_area=80.0).parameters
-        }
-        gi = prior["Gi"]
-        assert gi.dist == "lognormal" and gi == film_prior(260.0)
-        assert gi.mu == pytest.approx(1 / 0.13 * 260.0, rel=2e-3) == H_SURFACE_INTERIOR * 260.0
-        assert gi.sigma == pytest.approx(np.log(2.0))
-        assert gi.upper / gi.mu == pytest.approx(32.0) and gi.mu / gi.lower == pytest.approx(32.0)
-        assert abs(np.log(1600.0 / gi.mu)) < gi.sigma
-        if "Gint" in prior:
-            assert prior["Gint"] == default_prior("thermal", "conductance")
-    hy = hb.model("hygric_2c")
-    ph = {p.name: p.prior for p in parameters_for(hy, noise, envelope_area=260.0).parameters}
-    assert ph["Gi"] == default_prior("hygric", "conductance")
-    # a user's own prior wins
-    th = hb.model("thermal_2c", surfaces=("S",))
-    assert parameters_for(th, noise, {"Gi": {"fixed": 900}}, envelope_area=260.0)["Gi"].fixed == 900
-    with pytest.raises(ConfigError, match="envelope_area must be > 0"):
-        film_prior(0.0)

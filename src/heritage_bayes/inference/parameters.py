@@ -46,7 +46,6 @@ __all__ = [
     "Prior",
     "air_capacity_prior",
     "default_prior",
-    "film_prior",
     "parameters_for",
     "ventilation_prior",
 ]
@@ -576,62 +575,6 @@ def vapour_ground_prior(floor_area: float, *, s_d: float = SD_FLOOR, sigma: floa
     )
 
 
-#: Interior surface heat transfer coefficient [W/(m²·K)]: 1 / R_si, R_si = 0.13 m²K/W
-#: for horizontal heat flow (EN ISO 6946:2017, Table 7; 0.10 upwards, 0.17 downwards:
-#: 5.9-10), convection and radiation together.
-H_SURFACE_INTERIOR = 7.7
-#: σ_log of the surface-film prior on Gi: a factor 2 (h_si from 3.9 to 15 W/(m²·K)
-#: within one σ; the film in series with the wall's inner layer lowers it).
-SIGMA_FILM = math.log(2.0)
-
-
-def film_prior(envelope_area: float) -> Prior:
-    """Log-normal prior on a thermal model's ``Gi`` [W/K] (envelope node - indoor air,
-    ``thermal_2c`` and ``thermal_4a``) from the exterior area of walls and roof [m²].
-
-    Median ``H_SURFACE_INTERIOR × area`` (the interior surface film, EN ISO 6946),
-    σ_log ``SIGMA_FILM``, bounds at ±5 σ as the other survey priors. Why: how the
-    envelope's heat path splits between the outdoor side ``Gw`` and the indoor side
-    ``Gi`` is the slowest direction of the demo's ``thermal_4a`` (τ of log Gw - log Gi
-    about 1 000 steps): the data see the series conductance and the node's time
-    constant, a building physicist knows the surface film. Against the demo's truth
-    (:mod:`heritage_bayes.demo`: Gi 1 600 W/K for about 260 m² of walls and vault) the
-    median is 2 000 W/K. Measured (``benchmarks/bench_coordinates.py demo_4a
-    demo_4a_env --only node_tau --air-share --max-steps 60000``,
-    docs/science/benchmarks.md): with ``envelope_area: 260`` (this prior and the bounds
-    of :func:`envelope_priors`) τ of the demo's ``thermal_4a`` at 60 000 steps falls
-    from 1 683 to 691 steps (Gw 1 666 → 611, Cw 1 497 → 567, fsol 1 683 → 689), the
-    bulk ESS per CPU second from 1.84 to 7.30 (longer, the walkers still find the
-    interior mass the demo's data do not have: τmax 15 539 at 156 000 steps); on the
-    demo's ``thermal_2c`` every truth stays in its 90 %
-    interval (13 of 13) and τmax goes from 133 to 115. A prior on the
-    interior mass's ``Gint`` from the floor area (5 W/(m²·K) × floor) was tried and
-    dropped: on the demo's data, which have no interior mass, it quadrupled τ of
-    ``Cint`` and ``Gint`` (749 → 3 144 and 764 → 3 019 steps at 60 000 steps), the
-    walkers then wandering along ``Cint`` alone.
-
-    Parameters
-    ----------
-    envelope_area : float
-        Exterior surface area of walls and roof [m²].
-
-    References
-    ----------
-    EN ISO 6946:2017, Building components and building elements - Thermal resistance
-    and thermal transmittance, Table 7 (surface resistances).
-    """
-    if not envelope_area > 0:
-        raise ConfigError(f"envelope_area must be > 0 m² (got {envelope_area})")
-    median = H_SURFACE_INTERIOR * envelope_area
-    return Prior(
-        "lognormal",
-        median * math.exp(-5 * SIGMA_FILM),
-        median * math.exp(5 * SIGMA_FILM),
-        median,
-        SIGMA_FILM,
-    )
-
-
 @dataclass(frozen=True)
 class Parameter:
     """A named model or noise parameter (lmfit's Parameter, with a prior).
@@ -830,8 +773,7 @@ def parameters_for(
         a hygric one (:func:`vapour_ground_prior`).
     envelope_area : float, optional
         Exterior surface area of walls and roof [m²]: upper bounds on a thermal
-        model's envelope node, ``Gw`` and ``Cw`` (see :func:`envelope_priors`), and a
-        log-normal prior on ``Gi`` (see :func:`film_prior`).
+        model's envelope node, ``Gw`` and ``Cw`` (see :func:`envelope_priors`).
     fixed_node_temperature : float, optional
         Temperature [°C] of the ground or space behind a fixed vapour-pressure node: a
         log-normal prior on ``Pf`` (see :func:`fixed_vapour_pressure_prior`).
@@ -897,12 +839,6 @@ def parameters_for(
             prior = fixed_vapour_pressure_prior(fixed_node_temperature)
         if envelope_area is not None and name in ("Gw", "Cw"):
             prior = envelope_priors(envelope_area, domain)[name]
-        if (
-            name == "Gi"
-            and envelope_area is not None
-            and (domain, kind) == ("thermal", "conductance")
-        ):
-            prior = film_prior(envelope_area)
         spec = priors.get(name)
         fixed = None
         if spec is not None:

@@ -102,7 +102,8 @@ def select_draws(run, n: int | None, seed: int) -> Draws:
         P, _ = m.param_array({k: v[idx] for k, v in params.items()})
         model[section] = P
         nm = get_noise_model(getattr(run.config, section).noise)
-        names = [name for name, _, _ in nm.parameter_specs(m.output_names)]
+        # kalman's process noise q_<node> too: without it a projection drew none
+        names = [name for name, _, _ in nm.parameter_specs(m.output_names, m.state_names)]
         cols = [post[f"{section}.{name}"].values.reshape(-1)[idx] for name in names]
         noise[section] = np.column_stack(cols) if cols else np.zeros((len(idx), 0))
         # the calibration's predictive error model, where it replaced the posterior's

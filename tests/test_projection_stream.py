@@ -334,3 +334,29 @@ def test_select_draws_of_a_kalman_run_keeps_the_process_noise():
     # q_Ti 0.3 K/√h on an air node of 23 min: sd ≈ 0.3 × √(0.38/2) ≈ 0.13 K, beside the
     # 0.05 K measurement noise (the slow envelope's q is small): well above 0.05 K
     assert e.shape == (10, 500) and e[:, 100:].std() > 2 * 0.05
+
+
+def test_select_draws_of_a_kalman_run_use_its_free_run_error():
+    """Where the calibration replaced ``kalman``'s free-run bands by the free-run error
+    (``predictive_noise`` in the summary, every output), a projection draws that error:
+    AR(1) + white with the fitted parameters for every draw, as the calibration's bands."""
+    import xarray as xr
+
+    from heritage_bayes.inference.likelihoods import AR1WhiteNoise
+
+    m = hb.model("thermal_1c")
+    post = xr.Dataset(
+        {f"thermal.{k}": (("chain", "draw"), np.ones((2, 3))) for k in ("sigma_Ti", "q_Ti")}
+    )
+    fit = {"sigma": 0.4, "phi": 0.97, "sigma_meas": 0.05, "reason": "kalman"}
+    run = SimpleNamespace(
+        idata=SimpleNamespace(posterior=post),
+        models={"thermal": m},
+        config=SimpleNamespace(thermal=SimpleNamespace(noise="kalman")),
+        summary={"models": {"thermal": {"predictive_noise": {"Ti": fit}}}},
+        path="t",
+        draws=lambda s: {p: np.full(6, 1e6) for p in m.parameter_names},
+    )
+    d = engine.select_draws(run, None, 0)
+    assert isinstance(d.noise_models["thermal"], AR1WhiteNoise)
+    np.testing.assert_array_equal(d.noise["thermal"], np.tile([0.4, 0.97, 0.05], (6, 1)))

@@ -293,3 +293,70 @@ def test_kalman_noise_in_projections_carries_the_process_noise():
     # without the models the state-space noise cannot be drawn: a clear error
     with pytest.raises(ValueError, match="state-space"):
         _noise(draws, slice(0, 4), 10, 7, 0)
+
+
+def test_select_draws_of_a_kalman_run_keeps_the_process_noise():
+    """The draws a projection takes from a ``noise: kalman`` run carry ``q_<node>`` beside
+    ``sigma_<out>``, in the order of the calibration's noise vector: the projection used
+    to read ``sigma_Ti`` alone, so that a 1-node room's projected band held the
+    measurement noise only and a 2-node room's projection failed on the missing columns."""
+    import xarray as xr
+
+    from heritage_bayes.inference.statespace import KalmanNoise
+
+    m = hb.model("thermal_2c")
+    rng = np.random.default_rng(3)
+    # the demo room (time constants 104 h and 23 min), each draw 10 % apart
+    params = {p: TRUE_THERMAL[p] * rng.uniform(0.9, 1.1, (2, 5)) for p in m.parameter_names}
+    noise = {"sigma_Ti": np.full((2, 5), 0.05), "q_Tw": np.full((2, 5), 0.01)}
+    noise["q_Ti"] = np.full((2, 5), 0.3)
+    post = xr.Dataset(
+        {f"thermal.{k}": (("chain", "draw"), v) for k, v in {**params, **noise}.items()}
+    )
+    run = SimpleNamespace(
+        idata=SimpleNamespace(posterior=post),
+        models={"thermal": m},
+        config=SimpleNamespace(thermal=SimpleNamespace(noise="kalman")),
+        summary={},
+        path="t",
+        draws=lambda s: {p: v.reshape(-1) for p, v in params.items()},
+    )
+    d = engine.select_draws(run, None, 0)
+    names = [n for n, _, _ in KalmanNoise().parameter_specs(m.output_names, m.state_names)]
+    assert names == ["sigma_Ti", "q_Tw", "q_Ti"]
+    np.testing.assert_array_equal(
+        d.noise["thermal"], np.column_stack([noise[n].reshape(-1) for n in names])
+    )
+    # and the projection's noise of these draws is the propagated process noise
+    from heritage_bayes.projection._modal import _noise
+
+    e = _noise(d, slice(0, 10), 500, 7, 0, run.models, 3600.0)["thermal"]
+    # q_Ti 0.3 K/√h on an air node of 23 min: sd ≈ 0.3 × √(0.38/2) ≈ 0.13 K, beside the
+    # 0.05 K measurement noise (the slow envelope's q is small): well above 0.05 K
+    assert e.shape == (10, 500) and e[:, 100:].std() > 2 * 0.05
+
+
+def test_select_draws_of_a_kalman_run_use_its_free_run_error():
+    """Where the calibration replaced ``kalman``'s free-run bands by the free-run error
+    (``predictive_noise`` in the summary, every output), a projection draws that error:
+    AR(1) + white with the fitted parameters for every draw, as the calibration's bands."""
+    import xarray as xr
+
+    from heritage_bayes.inference.likelihoods import AR1WhiteNoise
+
+    m = hb.model("thermal_1c")
+    post = xr.Dataset(
+        {f"thermal.{k}": (("chain", "draw"), np.ones((2, 3))) for k in ("sigma_Ti", "q_Ti")}
+    )
+    fit = {"sigma": 0.4, "phi": 0.97, "sigma_meas": 0.05, "reason": "kalman"}
+    run = SimpleNamespace(
+        idata=SimpleNamespace(posterior=post),
+        models={"thermal": m},
+        config=SimpleNamespace(thermal=SimpleNamespace(noise="kalman")),
+        summary={"models": {"thermal": {"predictive_noise": {"Ti": fit}}}},
+        path="t",
+        draws=lambda s: {p: np.full(6, 1e6) for p in m.parameter_names},
+    )
+    d = engine.select_draws(run, None, 0)
+    assert isinstance(d.noise_models["thermal"], AR1WhiteNoise)
+    np.testing.assert_array_equal(d.noise["thermal"], np.tile([0.4, 0.97, 0.05], (6, 1)))

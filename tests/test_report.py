@@ -779,6 +779,23 @@ def test_verdict_is_not_green_while_a_truth_marker_misses():
         "thermal.gain_Ti_Te: the true value 0.9 lies outside the 90 % interval "
         "[0.75, 0.85], 3.3 σ from the median"
     ]
+    # only a truth misses: the advice weighs it against chance, not the residuals
+    # (P(at least 1 of 2 outside) = 1 - 0.9**2 = 0.19)
+    assert "residual diagnostics" not in v["advice"]
+    assert "Of 2 derived quantities with a known true value, 1 lies outside" in v["advice"]
+    assert "about 0.2 are expected by chance (at least 1 with probability 0.19" in v["advice"]
+    # the demo's seed 7: 4 of 11 outside, P(at least 4) = 0.019
+    from heritage_bayes.report.verdict import truth_advice
+
+    s["derived"] = {f"q{i}": {"truth": 1.0} for i in range(11)}
+    assert "4 lie outside" in truth_advice(s, 4) and "probability 0.019 " in truth_advice(s, 4)
+    # a failing residual check keeps the residual advice beside the truths'
+    bad = [{"section": "thermal", "output": "Ti", "adequate": False, "check": {}}]
+    s["derived"] = {
+        "thermal.tau_1_h": {"median": 300.0, "q05": 250.0, "q95": 350.0, "sd": 30.0, "truth": 400}
+    }
+    v = convergence_verdict(s, bad)
+    assert "residual diagnostics" in v["advice"] and "1 lies outside" in v["advice"]
 
 
 def test_fit_is_flagged_on_a_nearly_constant_series():

@@ -217,3 +217,33 @@ def test_kalman_run_has_one_step_bands(tmp_path):
         assert c == pytest.approx(np.mean((obs[rows] >= lo) & (obs[rows] <= hi)), abs=1e-9)
     html = (out / "report.html").read_text()
     assert "fig-fit-thermal-Ti-1step" in html and "one step ahead" in html
+
+
+def test_kalman_free_run_bands_use_the_free_run_error():
+    """``kalman``'s free-run bands are drawn from the free-run error (AR(1) + white fitted
+    to the calibration residuals of the posterior-median simulation, as ``ar1_white``'s
+    at its cap), not from the process noise propagated without the data, which covered
+    99.9-100 % of the demo's validation hours (docs/science/noise.md). The posterior's
+    own noise vector is left alone."""
+    from types import SimpleNamespace
+
+    from heritage_bayes.inference.likelihoods import AR1WhiteNoise, fit_free_run_error
+    from heritage_bayes.inference.predictive import predictive_noise
+
+    lp, theta = _problem(n=400)
+    rng = np.random.default_rng(5)
+    ysim = np.full((3, 400, 1), 12.0)  # three draws, the same simulation
+    obs = 12.0 + np.cumsum(rng.normal(0, 0.1, 400))[:, None]  # a slow free-run misfit
+    s = SimpleNamespace(name="thermal", model=lp.model, logpost=lp)
+    prep = SimpleNamespace(observed=lambda name, m: obs, calibration=slice(0, 300), warmup_steps=20)
+    tn = np.repeat(theta[None, lp.n_model :], 3, 0)
+    keep = tn.copy()
+    nm, noise, info = predictive_noise(s, prep, ysim, tn)
+    assert isinstance(nm, AR1WhiteNoise)
+    fit = fit_free_run_error(obs[20:300, 0] - 12.0)
+    assert noise.shape == (3, 3)
+    np.testing.assert_allclose(
+        noise, np.tile([fit["sigma"], fit["phi"], fit["sigma_meas"]], (3, 1))
+    )
+    assert info["Ti"]["sigma"] == fit["sigma"] and "one-step" in info["Ti"]["reason"]
+    np.testing.assert_array_equal(tn, keep)

@@ -225,14 +225,12 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
                     },
                 )
         Ysim, _ = s.logpost.simulate_frame(th_sel, U, prep.calibration.start, x0=x0)
-        tn_pred, pred_info = predictive_noise(s, prep, Ysim, tn_sel)
-        if getattr(s.logpost.noise, "statespace", False):
+        band_nm, tn_pred, pred_info = predictive_noise(s, prep, Ysim, tn_sel)
+        if getattr(band_nm, "statespace", False):
             mf = modal_form(s.model, th_sel[:, : s.logpost.n_model], prep.dt)
-            noise = s.logpost.noise.sample_statespace(
-                rng, mf, tn_pred, U.shape[0], s.model.n_outputs
-            )
+            noise = band_nm.sample_statespace(rng, mf, tn_pred, U.shape[0], s.model.n_outputs)
         else:
-            noise = s.logpost.noise.sample(rng, tn_pred, U.shape[0], s.model.n_outputs)
+            noise = band_nm.sample(rng, tn_pred, U.shape[0], s.model.n_outputs)
         Ypp = Ysim + noise
         saturation = condensation_cap(s, prep, Ysim, Ypp, pp_outputs)
         Y1 = None

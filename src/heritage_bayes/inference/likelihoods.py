@@ -13,7 +13,7 @@ integrates the initial state out exactly.
 
 Interface (what :class:`~heritage_bayes.inference.posterior.LogPosterior` calls):
 
-- ``parameter_specs(output_names)`` -> list of (name, kind, output) with kind
+- ``parameter_specs(output_names, state_names=())`` -> list of (name, kind, output) with kind
   ``"sigma"``, ``"phi"`` or ``"sigma_meas"``; units follow the output (``sigma``,
   ``sigma_meas`` in [K] or [Pa], ``phi`` [-] per time step);
 - ``loglik(Ysim, Yobs, noise)`` -> (K,) log-likelihood, ``Ysim`` (K, N, n_out) simulated,
@@ -262,8 +262,12 @@ class NoiseModel:
     name = "base"
     kinds: tuple[str, ...] = ()
 
-    def parameter_specs(self, output_names) -> list[tuple[str, str, str]]:
-        """[(parameter name, kind, output)] in the order of the noise vector."""
+    def parameter_specs(self, output_names, state_names=()) -> list[tuple[str, str, str]]:
+        """[(parameter name, kind, output)] in the order of the noise vector.
+
+        ``state_names`` (the model's nodes) is taken by every noise model so that callers
+        need not ask which kind they hold: the residual models here have no per-node
+        parameter, ``kalman`` has its process noise ``q_<node>``."""
         return [(f"{k}_{o}", k, o) for o in output_names for k in self.kinds]
 
     def _split(self, noise: np.ndarray, o: int):

@@ -783,11 +783,7 @@ def parameters_for(
     priors = dict(priors or {})
     domain = model.domain
     specs: list[Parameter] = []
-    noise_specs = (
-        noise.parameter_specs(model.output_names, model.state_names)
-        if getattr(noise, "statespace", False)
-        else noise.parameter_specs(model.output_names)
-    )
+    noise_specs = noise.parameter_specs(model.output_names, model.state_names)
     known = set(model.parameter_names) | {n for n, _, _ in noise_specs}
     unknown = sorted(set(priors) - known)
     if unknown:

@@ -2,9 +2,10 @@
 
 What :mod:`heritage_bayes.inference.idata` adds to each posterior draw before the bands
 are drawn: how the initial state was obtained (in words), the noise model of the bands
-(the free-run error when the likelihood's noise model sits at its cap) and the limit
-of predicted vapour pressure at saturation; then what of the predictive is stored: the
-bands over every saved draw and a bounded subset of the draws (issue 28).
+(the free-run error when the likelihood's noise model sits at its cap, and always for
+``kalman``) and the limit of predicted vapour pressure at saturation; then what of the
+predictive is stored: the bands over every saved draw and a bounded subset of the draws
+(issue 28).
 """
 
 from __future__ import annotations
@@ -113,44 +114,69 @@ def condensation_cap(s, prep, Ysim: np.ndarray, Ypp: np.ndarray, pp_outputs: dic
 
 
 def predictive_noise(s, prep, Ysim: np.ndarray, tn: np.ndarray):
-    """Noise parameters of the predictive bands, and what was changed (or None).
+    """Noise model and parameters of the predictive bands, and what was changed.
 
-    When the posterior of an ``ar1_white`` correlation sits at its cap, the noise model
-    of the likelihood describes only the misfit's fast part: bands drawn from it would
-    leave out the slow misfit (configs/orholm.yaml: a 90 % band covering 49 % of the
-    hours). The error of *prediction* is then the free-run error: AR(1) + white noise
-    fitted by maximum likelihood (phi up to 0.999) to the calibration residuals of the
+    Returns ``(noise_model, noise, info)``: the likelihood's own model and ``tn`` when
+    nothing is changed (``info`` None), else the free-run error model and its parameters
+    per draw, with ``info`` (output -> fitted parameters and the reason).
+
+    - ``ar1_white`` whose correlation sits at its cap: the noise model of the likelihood
+      describes only the misfit's fast part, and bands drawn from it would leave out the
+      slow misfit (configs/orholm.yaml: a 90 % band covering 49 % of the hours).
+    - ``kalman`` (a state-space noise model): its process noise is estimated for
+      one-step-ahead prediction; propagated without the data it is not the error of a
+      free run (the demo, seeds 7-12: the Ti band covered 99.9-100 % of the validation
+      hours; TRH-1's Pi band 80 %; docs/science/noise.md).
+
+    The error of *prediction* is then the free-run error: AR(1) + white noise fitted by
+    maximum likelihood (phi up to 0.999) to the calibration residuals of the
     posterior-median simulation (:func:`fit_free_run_error`), used for every draw's
-    predictive noise. The posterior (and the likelihood) are unchanged.
+    predictive noise (``ar1_white``'s parameters). The posterior, the likelihood and
+    ``kalman``'s one-step-ahead band are unchanged.
     """
-    from heritage_bayes.inference.likelihoods import fit_free_run_error
+    from heritage_bayes.inference.likelihoods import AR1WhiteNoise, fit_free_run_error
 
     nm = s.logpost.noise
-    if "phi" not in nm.kinds or "sigma_meas" not in nm.kinds:
-        return tn, None
+    statespace = getattr(nm, "statespace", False)
+    if not statespace and ("phi" not in nm.kinds or "sigma_meas" not in nm.kinds):
+        return nm, tn, None
     q = len(nm.kinds)
     ps = s.logpost.params.parameters[s.logpost.n_model :]
     obs = np.asarray(prep.observed(s.name, s.model), dtype=float)
     cal = prep.calibration
     rows = slice(cal.start + prep.warmup_steps, cal.stop)
     out, info = tn, {}
+    band = AR1WhiteNoise()
+    if statespace:
+        out = np.zeros((tn.shape[0], len(band.kinds) * s.model.n_outputs))
     for o, name in enumerate(s.model.output_names):
-        i_phi = q * o + nm.kinds.index("phi")
-        cap = ps[i_phi].prior.upper
-        if not np.median(tn[:, i_phi]) > cap - 0.05 * (1.0 - cap):
-            continue
+        if statespace:
+            reason = (
+                "process noise is estimated for one-step prediction: free-run bands use "
+                "the free-run error (AR(1) + white fitted to the calibration residuals of "
+                "the posterior-median simulation)"
+            )
+            kinds, width = band.kinds, len(band.kinds)
+        else:
+            i_phi = q * o + nm.kinds.index("phi")
+            cap = ps[i_phi].prior.upper
+            if not np.median(tn[:, i_phi]) > cap - 0.05 * (1.0 - cap):
+                continue
+            reason = (
+                f"phi_{name} at its cap {cap:g}: bands use the free-run error (AR(1) + "
+                "white fitted to the calibration residuals of the posterior-median "
+                "simulation)"
+            )
+            kinds, width = nm.kinds, q
         r = obs[rows, o] - np.median(Ysim[:, rows, o], axis=0)
         fit = fit_free_run_error(r)
         out = out.copy() if out is tn else out
         for kind in ("sigma", "phi", "sigma_meas"):
-            out[:, q * o + nm.kinds.index(kind)] = fit[kind]
-        info[name] = {
-            **fit,
-            "reason": f"phi_{name} at its cap {cap:g}: bands use the free-run error "
-            "(AR(1) + white fitted to the calibration residuals of the posterior-median "
-            "simulation)",
-        }
-    return out, (info or None)
+            out[:, width * o + kinds.index(kind)] = fit[kind]
+        info[name] = {**fit, "reason": reason}
+    if statespace:
+        return band, out, info
+    return nm, out, (info or None)
 
 
 def initial_state_text(lp) -> str:

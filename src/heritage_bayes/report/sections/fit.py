@@ -90,10 +90,18 @@ def fit_context(rd: RunData, outputs: list[dict]) -> list[dict]:
         pred = ((models.get(o["section"]) or {}).get("predictive_noise") or {}).get(o["output"])
         band_note = ""
         if pred:
+            kalman = (models.get(o["section"]) or {}).get("noise") == "kalman"
             band_note = (
-                f" The noise model's correlation sits at its cap (about a day), so its "
-                "error model leaves out the slow misfit; the bands use the free-run "
-                f"error instead: AR(1) of sd {pred['sigma']:.3g} with hourly coefficient "
+                (
+                    " The process noise is estimated for one-step prediction (the "
+                    "one-step band below); propagated without the data it is not the "
+                    "error of a free run, so these bands use the free-run error: "
+                    if kalman
+                    else " The noise model's correlation sits at its cap (about a day), "
+                    "so its error model leaves out the slow misfit; the bands use the "
+                    "free-run error instead: "
+                )
+                + f"AR(1) of sd {pred['sigma']:.3g} with hourly coefficient "
                 f"{pred['phi']:.3f} plus white noise of sd {pred['sigma_meas']:.3g}, fitted "
                 "to the calibration residuals of the posterior-median simulation."
             )

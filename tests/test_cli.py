@@ -245,3 +245,27 @@ def test_air_change_rate_sets_the_ventilation_prior_of_both_models(tiny_run, tmp
     assert s["parameters"]["hygric.Gfast"]["prior_spec"]["median"] == pytest.approx(
         400 * 0.5 / 3600 / (461.52 * 288.15)
     )
+
+
+@pytest.mark.parametrize("sigterm", [True, False])
+def test_an_interrupt_swallowed_by_a_callback_is_delivered_again(monkeypatch, capsys, sigterm):
+    """A KeyboardInterrupt (Ctrl-C or SIGTERM) raised inside a callback Python cannot
+    propagate from (a finaliser, the import system) reaches sys.unraisablehook; main()
+    delivers it again, so a long run stops (exit 130) instead of sampling on."""
+    import sys
+    import time
+    import types
+
+    import heritage_bayes.cli as cli
+
+    def command(argv):
+        exc = cli._Terminated() if sigterm else KeyboardInterrupt()
+        sys.unraisablehook(types.SimpleNamespace(exc_value=exc, exc_type=type(exc)))
+        for _ in range(2000):  # the run goes on: it must be stopped from outside
+            time.sleep(0.005)
+        return 0
+
+    monkeypatch.setattr(cli, "_main", command)
+    assert main(["calibrate", "x.yaml"]) == 130
+    what = "terminated (SIGTERM)" if sigterm else "interrupted"
+    assert f"hbayes: {what}" in capsys.readouterr().err

@@ -437,9 +437,14 @@ def main(argv: list[str] | None = None) -> int:
     swallowed: list = []
     old_hook = sys.unraisablehook
 
-    def hook(u):  # an interrupt inside a callback (e.g. of the import system) is lost
+    def hook(u):
+        # an interrupt raised inside a callback (a finaliser, the import system) would be
+        # lost, and a run with a large max_steps would sample on: deliver it again from
+        # another thread, so that the main thread's handler raises it in ordinary code
         if isinstance(u.exc_value, KeyboardInterrupt):
             swallowed.append(u.exc_value)
+            signum = signal.SIGTERM if isinstance(u.exc_value, _Terminated) else signal.SIGINT
+            threading.Thread(target=signal.raise_signal, args=(signum,), daemon=True).start()
         else:
             old_hook(u)
 

@@ -265,7 +265,15 @@ def test_an_interrupt_swallowed_by_a_callback_is_delivered_again(monkeypatch, ca
             time.sleep(0.005)
         return 0
 
+    import signal
+
     monkeypatch.setattr(cli, "_main", command)
-    assert main(["calibrate", "x.yaml"]) == 130
+    # a fresh interpreter's Ctrl-C handler (an earlier test of the session may have left
+    # another one installed)
+    old = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        assert main(["calibrate", "x.yaml"]) == 130
+    finally:
+        signal.signal(signal.SIGINT, old)
     what = "terminated (SIGTERM)" if sigterm else "interrupted"
     assert f"hbayes: {what}" in capsys.readouterr().err

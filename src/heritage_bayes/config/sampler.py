@@ -82,7 +82,7 @@ class SamplerSettings(_Strict):
         ge=0,
         lt=1,
     )
-    moves: Literal["de_snooker", "de_snooker_50", "de", "stretch"] = key(
+    moves: Literal["de_snooker", "de_snooker_50", "de", "stretch", "de_global", "dime"] = key(
         "de_snooker",
         unit=None,
         description="emcee's proposal moves: de_snooker (differential evolution 80 %, "

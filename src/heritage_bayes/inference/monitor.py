@@ -12,6 +12,8 @@ from __future__ import annotations
 import emcee
 import numpy as np
 
+from heritage_bayes.inference.moves import GlobalDEMove
+
 #: ``sampler.moves``: name -> [(emcee move class, weight), ...] (emcee's defaults for
 #: each move: ``DEMove`` γ₀ = 2.38 / √(2 d), ``DESnookerMove`` γ = 1.7, ``StretchMove``
 #: a = 2).
@@ -20,6 +22,9 @@ MOVES = {
     "de_snooker_50": ((emcee.moves.DEMove, 0.5), (emcee.moves.DESnookerMove, 0.5)),
     "de": ((emcee.moves.DEMove, 1.0),),
     "stretch": ((emcee.moves.StretchMove, 1.0),),
+    # DE with global independence proposals (heritage_bayes.inference.moves)
+    "de_global": ((GlobalDEMove, 0.8), (emcee.moves.DESnookerMove, 0.2)),
+    "dime": ((GlobalDEMove, 1.0),),
 }
 
 
@@ -33,6 +38,15 @@ def make_moves(name: str):
     if name not in MOVES:
         raise ValueError(f"sampler.moves must be one of {sorted(MOVES)} (got {name!r})")
     return [(cls(), w) for cls, w in MOVES[name]]
+
+
+def _last_check(done: int, check_every: int) -> int:
+    """The last convergence check at or before step ``done`` (0 before the first)."""
+    b = last = 0
+    while b <= done:
+        last = b
+        b += check_every * max(1, b // (10 * check_every))
+    return last
 
 
 def _next_check(done: int, check_every: int) -> int:

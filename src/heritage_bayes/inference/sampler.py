@@ -60,7 +60,14 @@ from heritage_bayes.inference.chainresult import (
     _thinned,
     compact_checkpoint,
 )
-from heritage_bayes.inference.monitor import ChainBuffer, _next_check, _tau, make_moves
+from heritage_bayes.inference.monitor import (
+    ChainBuffer,
+    _last_check,
+    _next_check,
+    _tau,
+    make_moves,
+)
+from heritage_bayes.inference.moves import refit_moves
 from heritage_bayes.inference.start import laplace_ensemble
 
 __all__ = [
@@ -286,7 +293,8 @@ def _run_sampler(
     def to_y(a: np.ndarray) -> np.ndarray:
         return a if coordinates is None else coordinates.to_y(a)
 
-    sampler = emcee.EnsembleSampler(nwalkers, d, target, vectorize=True, moves=make_moves(moves))
+    move_list = make_moves(moves)
+    sampler = emcee.EnsembleSampler(nwalkers, d, target, vectorize=True, moves=move_list)
     ck = _Checkpoint(Path(checkpoint), tag) if checkpoint is not None else None
     buf = ChainBuffer(nwalkers, d)
     accepted = np.zeros(nwalkers)
@@ -384,6 +392,10 @@ def _run_sampler(
                 break
             # chunk boundaries at fixed step counts (resume-invariant)
             n = min(_next_check(done, check_every) - done, max_steps - done)
+            # global proposals: refitted to the rows up to the last check (the same
+            # rows after a resume mid-chunk)
+            last = _last_check(done, check_every)
+            refit_moves(move_list, buf.chain[: last // buf.stride], to_y)
             sampler.reset()
             try:
                 for step in sampler.sample(state, iterations=n):  # noqa: B007

@@ -130,9 +130,7 @@ def test_last_check_is_the_check_at_or_before_a_step():
 @pytest.mark.parametrize("max_rows", [None, 300])
 def test_resume_mid_chunk_continues_the_global_chain_bit_for_bit(tmp_path, max_rows):
     f = _Ridge()
-    kw = dict(
-        seed=3, nwalkers=8, check_every=100, tau_factor=1e4, moves="dime", tag="t"
-    )
+    kw = dict(seed=3, nwalkers=8, check_every=100, tau_factor=1e4, moves="dime", tag="t")
     kw["max_rows"] = max_rows
     a = run_sampler(f, np.zeros(3), max_steps=2500, checkpoint=tmp_path / "a.h5", **kw)
 

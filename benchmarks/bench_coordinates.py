@@ -144,12 +144,23 @@ def main() -> None:
         "with Gw, Gi) sampled along the log series conductance and the log ratio",
     )
     ap.add_argument(
+        "--p-global",
+        type=float,
+        default=None,
+        help="probability of a global proposal per walker and step of the de_global and "
+        "dime moves (heritage_bayes.inference.moves.GlobalDEMove.P_GLOBAL)",
+    )
+    ap.add_argument(
         "--save-chain",
         default=None,
         help="write each chain (steps, walkers, d) in the log coordinates to "
         "<SAVE_CHAIN>_<problem>_<label>.npz with the free parameters' names",
     )
     args = ap.parse_args()
+    if args.p_global is not None:
+        from heritage_bayes.inference.moves import GlobalDEMove
+
+        GlobalDEMove.P_GLOBAL = args.p_global
     for name in args.problems:
         cfg = _config(*PROBLEMS[name])
         section = PROBLEMS[name][1]

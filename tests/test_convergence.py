@@ -270,11 +270,14 @@ def test_report_notes_name_a_map_on_a_bound_over_parameterisation_and_a_spent_bu
     assert "Some thermal draws freeze a node" not in [n["title"] for n in run_notes(s, [])]
 
 
-def test_tau_without_the_start_transient_stops_sooner_and_samples_the_same():
+def test_tau_without_the_start_transient_is_not_inflated_and_samples_the_same():
     """Walkers started in a small ball 15 sd away from the mode first drift and spread
     (a non-stationary start): τ on the whole chain is inflated by it, τ on the second
-    half is not; ``tau_discard=0.5`` estimates τ there (the chain meets 50 τ no later;
-    here R-hat/ESS decide) and keeps draws only from there, which sample N(0, 1)."""
+    half is not; ``tau_discard=0.5`` estimates τ there and keeps draws only from there,
+    which sample N(0, 1). It need not stop sooner: the estimate of τ on half the chain
+    is noisier, so its 5 % stability test passes later (with numpy 2.4 / arviz 0.23:
+    τ 4.4 → 9.0 → 7.9 between checks, stable at 2 000 steps, against 1 250 for the
+    whole-chain rule; an earlier environment's stream stopped it sooner)."""
     from heritage_bayes.inference.sampler import _tau
 
     f = _BoxGauss(mu=[0.0, 0.0], sd=[1.0, 1.0], lo=[-np.inf] * 2, hi=[np.inf] * 2)
@@ -285,7 +288,7 @@ def test_tau_without_the_start_transient_stops_sooner_and_samples_the_same():
     # the transient inflates τ of the whole chain, not of its second half
     assert np.max(_tau(full.chain, 0.5)) < 0.8 * np.max(_tau(full.chain))
     np.testing.assert_allclose(half.tau, _tau(half.chain, 0.5))
-    assert half.steps <= full.steps and half.burn >= half.steps // 2
+    assert half.steps <= 2 * full.steps and half.burn >= half.steps // 2
     X, _ = half.draws()
     x = X.reshape(-1, 2)
     n_eff = min(x.shape[0], half.steps * 16 / np.max(half.tau))  # ≥ 50 × 16 by the rule

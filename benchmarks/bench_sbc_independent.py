@@ -267,6 +267,8 @@ def replicate(args) -> dict:
         "truth_parameters": p,
         "generator": "independent",
         "input_hold": hold,
+        # parts of the generator left out (--without)
+        "without": sorted(without),
         # the fit's upper bounds on the hygric buffer from the envelope area
         "hygric_envelope": bool(envelope) and not name.startswith("thermal"),
         # the fixed node's Pf and Gf drawn from, and fitted with, the physical priors
@@ -338,6 +340,68 @@ def zscore_lines(results: list[dict], variant: str) -> list[str]:
             if z:
                 parts.append(f"{k} {np.sqrt(np.mean(np.square(z))):.2f}")
         lines.append(f"  {name} [{variant}] z rms ({len(rs)} rooms): " + ", ".join(parts))
+    return lines
+
+
+def _zscores(results: list[dict], variant: str, name: str) -> tuple[list[dict], dict]:
+    """The rooms of ``name`` fitted with ``variant`` and, per quantity, z = (posterior
+    median - truth) / posterior sd of each room (NaN where not ranked)."""
+    rs = [r for r in results if r["model"] == name and variant in r["variants"]]
+    z = {}
+    for k in QUANTITIES.get(name, ()):
+        vals = []
+        for r in rs:
+            x = r["variants"][variant]["ranks"].get(k)
+            ok = x is not None and x["sd"] > 0
+            vals.append((x["median"] - r["truth"][k]) / x["sd"] if ok else np.nan)
+        z[k] = np.array(vals)
+    return rs, z
+
+
+def bias_lines(results: list[dict], variant: str) -> list[str]:
+    """Bias or width? Per model and quantity the mean and sd of z over the rooms (z =
+    (median - truth)/sd; calibrated: mean 0 ± 1/sqrt(n), sd 1) and the rooms above the
+    truth; then the room-to-room correlation of z between quantities and with the log
+    of the generator/fit mean facade irradiance ratio (thermal rooms)."""
+    lines = []
+    for name in sorted({r["model"] for r in results}):
+        rs, z = _zscores(results, variant, name)
+        parts = []
+        for k, v in z.items():
+            v = v[np.isfinite(v)]
+            if v.size > 1:
+                parts.append(
+                    f"{k} {v.mean():+.2f} / {v.std(ddof=1):.2f} ({int(np.sum(v > 0))}/{v.size})"
+                )
+        if not parts:
+            continue
+        lines.append(
+            f"  {name} [{variant}] mean z / sd z (rooms above the truth): " + ", ".join(parts)
+        )
+        keys = ("tau_1_h", "gain_Ti_Te", "gain_Ti_I_S", "solar_warming_K")
+        keys = [k for k in keys if k in z and np.isfinite(z[k]).any()]
+        if len(keys) < 2:
+            continue
+        Z = np.column_stack([z[k] for k in keys])
+        ok = np.all(np.isfinite(Z), axis=1)
+        if ok.sum() < 3:
+            continue
+        C = np.corrcoef(Z[ok].T)
+        pairs = [
+            f"{keys[i]}~{keys[j]} {C[i, j]:+.2f}"
+            for i in range(len(keys))
+            for j in range(i + 1, len(keys))
+        ]
+        line = f"  {name} [{variant}] corr of z: " + ", ".join(pairs)
+        if all("irradiance_mean" in r for r in rs):
+            irr = np.log(
+                [r["irradiance_mean"]["generator"] / r["irradiance_mean"]["fit"] for r in rs]
+            )[ok]
+            if np.ptp(irr) > 1e-9:  # (1 in every room without the other sky model)
+                line += "; with log irradiance ratio: " + ", ".join(
+                    f"{k} {np.corrcoef(Z[ok, i], irr)[0, 1]:+.2f}" for i, k in enumerate(keys)
+                )
+        lines.append(line)
     return lines
 
 
@@ -483,7 +547,7 @@ def main(argv=None) -> int:
                 lines = markdown_table(results, v)
             else:
                 lines = table(results, v, QUANTITIES) + zscore_lines(results, v)
-                lines += solar_lines(results, v)
+                lines += bias_lines(results, v) + solar_lines(results, v)
             for line in lines:
                 print(line)
         return 0

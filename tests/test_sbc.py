@@ -221,3 +221,32 @@ def test_solar_lines_compare_the_gain_bias_with_the_sky_models_ratio():
     assert "gain_Ti_I_S 0.850 (below 1 in 2)" in line
     assert "solar_warming_K 1.000 (below 1 in 0)" in line and "irradiance ratio) 1.00" in line
     assert bench.solar_lines([room(0, 0.9)], "kalman:estimate") == []
+
+
+def test_bias_lines_separate_bias_from_width():
+    """Three rooms with z = -1, -2, -3 for the Te gain (mean -2, sd 1, none above) and
+    +1, +2, +3 for the solar warming: correlation -1 between the two; the irradiance
+    ratio's correlation is printed only where the ratio varies."""
+    bench = pytest.importorskip("bench_sbc_independent")
+
+    def room(rep, z, irr):
+        truth = {"gain_Ti_Te": 0.8, "solar_warming_K": 1.0}
+        x = {
+            "gain_Ti_Te": {"median": 0.8 - 0.01 * z, "sd": 0.01},
+            "solar_warming_K": {"median": 1.0 + 0.1 * z, "sd": 0.1},
+        }
+        return {
+            "model": "thermal_2c",
+            "rep": rep,
+            "truth": truth,
+            "irradiance_mean": {"generator": 90.0 * irr, "fit": 90.0},
+            "variants": {"ar1_white:estimate": {"ranks": x}},
+        }
+
+    rooms = [room(0, 1, 0.9), room(1, 2, 0.8), room(2, 3, 1.0)]
+    mean_sd, corr = bench.bias_lines(rooms, "ar1_white:estimate")
+    assert "gain_Ti_Te -2.00 / 1.00 (0/3)" in mean_sd
+    assert "solar_warming_K +2.00 / 1.00 (3/3)" in mean_sd
+    assert "gain_Ti_Te~solar_warming_K -1.00" in corr and "irradiance ratio" in corr
+    same = [room(0, 1, 1.0), room(1, 2, 1.0), room(2, 3, 1.0)]
+    assert "irradiance ratio" not in bench.bias_lines(same, "ar1_white:estimate")[1]

@@ -206,6 +206,7 @@ def replicate(args) -> dict:
     envelope = args[7] if len(args) > 7 else ENVELOPE
     without = args[8] if len(args) > 8 else ()
     hold = args[9] if len(args) > 9 else "exact"
+    noise_free = args[10] if len(args) > 10 else False
     rng = np.random.default_rng([seed, rep])
     opts = {"surfaces": ("S",)} if name.startswith("thermal") else {}
     model = hb.model(name, **opts)
@@ -247,6 +248,20 @@ def replicate(args) -> dict:
     sensor = 0.1 if thermal else 12.0  # [K]; [Pa] ~ 1 %RH at 10 °C
     y = np.round(y_hour[:n] + e + rng.normal(0, sensor, n), 1)[rows]
     g0 = int(rng.integers(7 * 24, cal_days * 24 - 14 * 24))
+    fixed = {}
+    if noise_free:
+        # the room's own noise-free record (same gap), fitted with the noise parameters
+        # fixed at the truths of the observation model (the sensor's sd with rounding's):
+        # the posterior's width is the study's, its centre the generator's systematic
+        # error plus the prior's pull, so z = (median - truth)/sd is the deterministic
+        # part of the study's z in its own sd
+        y = y_hour[:n][rows].copy()
+        o = model.output_names[0]
+        fixed = {
+            f"sigma_{o}": {"fixed": sd},
+            f"phi_{o}": {"fixed": phi},
+            f"sigma_meas_{o}": {"fixed": float(np.hypot(sensor, 0.1 / np.sqrt(12)))},
+        }
     y[g0 : g0 + 7 * 24] = np.nan
     dq_true = {k: float(np.ravel(v)[0]) for k, v in derived_quantities(model, p).items()}
     extra = None
@@ -269,6 +284,7 @@ def replicate(args) -> dict:
         "input_hold": hold,
         # parts of the generator left out (--without)
         "without": sorted(without),
+        "noise_free": bool(noise_free),
         # the fit's upper bounds on the hygric buffer from the envelope area
         "hygric_envelope": bool(envelope) and not name.startswith("thermal"),
         # the fixed node's Pf and Gf drawn from, and fitted with, the physical priors
@@ -278,7 +294,7 @@ def replicate(args) -> dict:
     if extra is not None:
         result["irradiance_mean"] = {"generator": mean_true, "fit": mean_fit}
     result["variants"] = fit_and_rank(
-        fit_model, U[rows], y, dq_true, variants, rep, max_steps, {}, floor, envelope, extra
+        fit_model, U[rows], y, dq_true, variants, rep, max_steps, fixed, floor, envelope, extra
     )
     return result
 
@@ -308,6 +324,8 @@ def read_logs(paths: list[str]) -> list[dict]:
                 # node (Pf uniform 900-1400 Pa in the truths, 0-5 000 Pa in the fit)
                 if r["model"] == "hygric_2c_fixed" and r.get("fixed_node_prior") is None:
                     r["variants"] = {f"{v}@flat_pf": x for v, x in r["variants"].items()}
+                if r.get("noise_free"):
+                    r["variants"] = {f"{v}@noise_free": x for v, x in r["variants"].items()}
                 key = (r["model"], int(r["rep"]))
                 if key not in merged:
                     merged[key] = {**r, "variants": dict(r["variants"])}
@@ -522,6 +540,14 @@ def main(argv=None) -> int:
         "hold; tabulated as NOISE:INIT@interval_mean)",
     )
     ap.add_argument(
+        "--noise-free",
+        action="store_true",
+        help="fit each room's noise-free record (same gap) with the noise parameters fixed "
+        "at the observation model's truths: z = (median - truth)/sd is then the "
+        "deterministic part of the study's z (the generator's systematic error and the "
+        "prior's pull), in the study's own sd; tabulated as NOISE:INIT@noise_free",
+    )
+    ap.add_argument(
         "--table",
         nargs="+",
         metavar="LOG",
@@ -563,6 +589,7 @@ def main(argv=None) -> int:
             args.envelope_area or None,
             without,
             args.input_hold,
+            args.noise_free,
         )
         for r in range(args.first_rep, args.first_rep + args.reps)
         for m in args.models.split(",")

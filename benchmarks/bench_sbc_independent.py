@@ -299,6 +299,123 @@ def replicate(args) -> dict:
     return result
 
 
+def misfit(rep: int, seed: int, without: tuple = ()) -> dict:
+    """The generator's noise-free error against the fit's model, without a fit: thermal
+    replicate ``rep``'s hourly indoor temperature from the generator (the parts
+    ``without`` left out, as :func:`replicate` draws them) minus the fit's own model
+    (exact input hold) with the true parameters on the fit's hourly inputs, from the
+    same state, over the calibration period. Returns its mean, sd and the sd of its
+    daily means [K] and its correlation with the fit's facade irradiance: the error
+    that the AR(1) + white noise model has to take up, by part of the generator."""
+    import heritage_bayes as hb
+
+    rng = np.random.default_rng([seed, rep])
+    model = hb.model("thermal_2c", surfaces=("S",))
+    p = truth(model, rng, FLOOR)
+    gw = generator_weather(int(rng.integers(2**31)), without)
+    fine = gw["fine"]
+    nf = fine["Te"].size
+    Uf = np.column_stack([fine[c] if c in fine else np.full(nf, 10.0) for c in model.input_names])
+    j_tf, j_s = model.input_names.index("Tf"), model.input_names.index("I_S")
+    Uf[:, j_tf] = fine["Te"].mean()
+    A, B, _, _ = model.state_space(p)
+    x0 = np.linalg.solve(-A, B @ Uf[: 24 * SUB].mean(axis=0) + model.offset(p))
+    fit_model = model.with_slopes(model.network.inputs)
+    frame = fit_inputs(gw["hourly"], [fit_model])
+    U = np.column_stack(
+        [
+            frame[c].to_numpy(float) if c in frame else np.full(len(frame), 10.0)
+            for c in fit_model.input_names
+        ]
+    )
+    U[:, j_tf] = fine["Te"].mean()
+    i = model.state_names.index(model.output_names[0])
+    if "substeps" in without:
+        y = simulate_reference(model, p, U[:, : len(model.network.inputs)], 3600.0, x0)[:, i]
+    else:
+        y = simulate_reference(model, p, Uf, DT_SUB, x0)[::SUB, i]
+    n = min(len(U), y.size)
+    spin = int(rng.integers(7, MAX_SPIN_DAYS + 1)) * 24
+    rows = slice(spin, spin + CAL_DAYS * 24)
+    d = (y[:n] - hb.simulate(fit_model, p, U[:n], 3600.0, x0)[:, 0])[rows]
+    daily = d[: d.size // 24 * 24].reshape(-1, 24).mean(axis=1)
+    # what another aperture cannot take up: the error less its least-squares fit by the
+    # room's response to the fit's facade irradiance alone (and a constant)
+    Us = np.zeros_like(U[:n])
+    Us[:, j_s] = U[:n, j_s]
+    resp = hb.simulate(fit_model, p, Us, 3600.0, np.zeros(len(x0)))[:, 0][rows]
+    X = np.column_stack([resp, np.ones_like(resp)])
+    coef = np.linalg.lstsq(X, d, rcond=None)[0]
+    rest = d - X @ coef
+    return {
+        "mean": float(d.mean()),
+        "sd": float(d.std()),
+        "daily_sd": float(daily.std()),
+        "corr_I_S": float(np.corrcoef(d, U[rows, j_s])[0, 1]),
+        "sd_unscaled": float(rest.std()),
+        "scale": float(1.0 + coef[0]),
+    }
+
+
+def misfit_lines(reps, seed: int) -> list[str]:
+    """:func:`misfit` over the replicates ``reps`` for the generator with every part and
+    with each part left out: medians over the rooms."""
+    cases = {
+        "every part": (),
+        "without sky": ("sky",),
+        "without within_hour": ("within_hour",),
+        "without within_hour,sky,substeps": ("within_hour", "sky", "substeps"),
+    }
+    lines = [
+        f"noise-free generator - fit's model with the true parameters, thermal_2c, "
+        f"{len(reps)} rooms (medians): |mean|, sd, sd of daily means [K], corr with I_S; "
+        "sd [K] left after the best scaling of the solar response, that scaling"
+    ]
+    for label, without in cases.items():
+        m = [misfit(r, seed, without) for r in reps]
+        med = {k: float(np.median([abs(x[k]) if k == "mean" else x[k] for x in m])) for k in m[0]}
+        lines.append(
+            f"  {label:34s} {med['mean']:.3f} {med['sd']:.3f} {med['daily_sd']:.3f} "
+            f"{med['corr_I_S']:+.2f} {med['sd_unscaled']:.3f} {med['scale']:.3f}"
+        )
+    return lines
+
+
+def paired_lines(a: list[dict], b: list[dict]) -> list[str]:
+    """Two studies of the same rooms (logs of one generator variant each, e.g. every
+    part and ``--without sky``): per model and quantity over the replicates in both,
+    the correlation of z between them and the mean, sd and rms of z_a - z_b, the shift
+    the difference between the studies makes in the posterior's own sd (the rooms'
+    noise is the same, so it cancels in the difference)."""
+    lines = []
+    for name in sorted({r["model"] for r in a} & {r["model"] for r in b}):
+        ra = {r["rep"]: r for r in a if r["model"] == name}
+        rb = {r["rep"]: r for r in b if r["model"] == name}
+        reps = sorted(set(ra) & set(rb))
+        if len(reps) < 3:
+            continue
+        va, vb = (sorted({v for r in x.values() for v in r["variants"]}) for x in (ra, rb))
+        if len(va) != 1 or len(vb) != 1:
+            raise SystemExit("--paired: one variant per log")
+        _, za = _zscores([ra[r] for r in reps], va[0], name)
+        _, zb = _zscores([rb[r] for r in reps], vb[0], name)
+        parts = []
+        for k in za:
+            ok = np.isfinite(za[k]) & np.isfinite(zb[k])
+            if ok.sum() < 3:
+                continue
+            d = za[k][ok] - zb[k][ok]
+            corr = np.corrcoef(za[k][ok], zb[k][ok])[0, 1]
+            parts.append(
+                f"{k} corr {corr:+.2f}, diff {d.mean():+.2f} / {d.std(ddof=1):.2f} / "
+                f"{np.sqrt(np.mean(d**2)):.2f}"
+            )
+        lines.append(
+            f"  {name} ({len(reps)} rooms in both) z_a - z_b mean / sd / rms: " + "; ".join(parts)
+        )
+    return lines
+
+
 def read_logs(paths: list[str]) -> list[dict]:
     """The replicates of one or more ``--log`` files, one record per (model, replicate)
     with the variants of every file merged; a variant found twice for the same replicate
@@ -555,12 +672,37 @@ def main(argv=None) -> int:
         "extended with --first-rep, or variants run apart on the same replicates)",
     )
     ap.add_argument("--markdown", action="store_true", help="with --table: the tables in markdown")
+    ap.add_argument(
+        "--paired",
+        nargs=2,
+        metavar="LOG",
+        help="two logs of the same rooms (one generator variant each): the correlation "
+        "of z between them and the mean, sd and rms of the difference, per quantity",
+    )
+    ap.add_argument(
+        "--misfit",
+        action="store_true",
+        help="no fit: the noise-free error of the generator (every part, and each left "
+        "out) against the fit's model with the true parameters, thermal rooms "
+        "--first-rep .. --first-rep + --reps",
+    )
     args = ap.parse_args(argv)
     variants = args.noise or ["ar1_white:estimate"]
     without = tuple(w for w in args.without.split(",") if w)
     parts = {"within_hour", "sky", "substeps"}
     if set(without) - parts:
         ap.error(f"--without: unknown {sorted(set(without) - parts)}; use {sorted(parts)}")
+    if args.paired:
+        a, b = (read_logs([p]) for p in args.paired)
+        print(f"paired z: {args.paired[0]} - {args.paired[1]}")
+        for line in paired_lines(a, b):
+            print(line)
+        return 0
+    if args.misfit:
+        reps = range(args.first_rep, args.first_rep + args.reps)
+        for line in misfit_lines(reps, args.seed):
+            print(line)
+        return 0
     if args.table:
         results = read_logs(args.table)
         print(

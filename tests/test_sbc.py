@@ -250,3 +250,25 @@ def test_bias_lines_separate_bias_from_width():
     assert "gain_Ti_Te~solar_warming_K -1.00" in corr and "irradiance ratio" in corr
     same = [room(0, 1, 1.0), room(1, 2, 1.0), room(2, 3, 1.0)]
     assert "irradiance ratio" not in bench.bias_lines(same, "ar1_white:estimate")[1]
+
+
+def test_paired_lines_difference_of_z_on_the_same_rooms():
+    """Two logs of the same three rooms: z of the second is z of the first minus 1 in
+    every room (correlation 1, difference +1 with sd 0); a room in one log only is
+    left out."""
+    bench = pytest.importorskip("bench_sbc_independent")
+
+    def room(rep, z):
+        x = {"tau_1_h": {"median": 400.0 + 10.0 * z, "sd": 10.0}}
+        return {
+            "model": "thermal_2c",
+            "rep": rep,
+            "truth": {"tau_1_h": 400.0},
+            "variants": {"ar1_white:estimate": {"ranks": x}},
+        }
+
+    a = [room(0, 1.0), room(1, -0.5), room(2, 2.0), room(3, 9.0)]
+    b = [room(0, 0.0), room(1, -1.5), room(2, 1.0)]
+    (line,) = bench.paired_lines(a, b)
+    assert "(3 rooms in both)" in line
+    assert "tau_1_h corr +1.00, diff +1.00 / 0.00 / 1.00" in line

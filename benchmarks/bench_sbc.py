@@ -305,7 +305,11 @@ def fit_and_rank(
         noise_name, init, *temper = variant.split(":")
         t0 = time.process_time()
         noise = get_noise_model(noise_name)
-        known = {k: v for k, v in priors.items() if k in model.parameter_names}
+        # the model's parameters and (bench_sbc_independent --noise-free) the noise's
+        names = set(model.parameter_names) | {
+            n for n, *_ in noise.parameter_specs(model.output_names, model.state_names)
+        }
+        known = {k: v for k, v in priors.items() if k in names}
         ps = parameters_for(
             model,
             noise,

@@ -206,6 +206,7 @@ def replicate(args) -> dict:
     envelope = args[7] if len(args) > 7 else ENVELOPE
     without = args[8] if len(args) > 8 else ()
     hold = args[9] if len(args) > 9 else "exact"
+    noise_free = args[10] if len(args) > 10 else False
     rng = np.random.default_rng([seed, rep])
     opts = {"surfaces": ("S",)} if name.startswith("thermal") else {}
     model = hb.model(name, **opts)
@@ -247,6 +248,20 @@ def replicate(args) -> dict:
     sensor = 0.1 if thermal else 12.0  # [K]; [Pa] ~ 1 %RH at 10 °C
     y = np.round(y_hour[:n] + e + rng.normal(0, sensor, n), 1)[rows]
     g0 = int(rng.integers(7 * 24, cal_days * 24 - 14 * 24))
+    fixed = {}
+    if noise_free:
+        # the room's own noise-free record (same gap), fitted with the noise parameters
+        # fixed at the truths of the observation model (the sensor's sd with rounding's):
+        # the posterior's width is the study's, its centre the generator's systematic
+        # error plus the prior's pull, so z = (median - truth)/sd is the deterministic
+        # part of the study's z in its own sd
+        y = y_hour[:n][rows].copy()
+        o = model.output_names[0]
+        fixed = {
+            f"sigma_{o}": {"fixed": sd},
+            f"phi_{o}": {"fixed": phi},
+            f"sigma_meas_{o}": {"fixed": float(np.hypot(sensor, 0.1 / np.sqrt(12)))},
+        }
     y[g0 : g0 + 7 * 24] = np.nan
     dq_true = {k: float(np.ravel(v)[0]) for k, v in derived_quantities(model, p).items()}
     extra = None
@@ -267,6 +282,9 @@ def replicate(args) -> dict:
         "truth_parameters": p,
         "generator": "independent",
         "input_hold": hold,
+        # parts of the generator left out (--without)
+        "without": sorted(without),
+        "noise_free": bool(noise_free),
         # the fit's upper bounds on the hygric buffer from the envelope area
         "hygric_envelope": bool(envelope) and not name.startswith("thermal"),
         # the fixed node's Pf and Gf drawn from, and fitted with, the physical priors
@@ -276,9 +294,126 @@ def replicate(args) -> dict:
     if extra is not None:
         result["irradiance_mean"] = {"generator": mean_true, "fit": mean_fit}
     result["variants"] = fit_and_rank(
-        fit_model, U[rows], y, dq_true, variants, rep, max_steps, {}, floor, envelope, extra
+        fit_model, U[rows], y, dq_true, variants, rep, max_steps, fixed, floor, envelope, extra
     )
     return result
+
+
+def misfit(rep: int, seed: int, without: tuple = ()) -> dict:
+    """The generator's noise-free error against the fit's model, without a fit: thermal
+    replicate ``rep``'s hourly indoor temperature from the generator (the parts
+    ``without`` left out, as :func:`replicate` draws them) minus the fit's own model
+    (exact input hold) with the true parameters on the fit's hourly inputs, from the
+    same state, over the calibration period. Returns its mean, sd and the sd of its
+    daily means [K] and its correlation with the fit's facade irradiance: the error
+    that the AR(1) + white noise model has to take up, by part of the generator."""
+    import heritage_bayes as hb
+
+    rng = np.random.default_rng([seed, rep])
+    model = hb.model("thermal_2c", surfaces=("S",))
+    p = truth(model, rng, FLOOR)
+    gw = generator_weather(int(rng.integers(2**31)), without)
+    fine = gw["fine"]
+    nf = fine["Te"].size
+    Uf = np.column_stack([fine[c] if c in fine else np.full(nf, 10.0) for c in model.input_names])
+    j_tf, j_s = model.input_names.index("Tf"), model.input_names.index("I_S")
+    Uf[:, j_tf] = fine["Te"].mean()
+    A, B, _, _ = model.state_space(p)
+    x0 = np.linalg.solve(-A, B @ Uf[: 24 * SUB].mean(axis=0) + model.offset(p))
+    fit_model = model.with_slopes(model.network.inputs)
+    frame = fit_inputs(gw["hourly"], [fit_model])
+    U = np.column_stack(
+        [
+            frame[c].to_numpy(float) if c in frame else np.full(len(frame), 10.0)
+            for c in fit_model.input_names
+        ]
+    )
+    U[:, j_tf] = fine["Te"].mean()
+    i = model.state_names.index(model.output_names[0])
+    if "substeps" in without:
+        y = simulate_reference(model, p, U[:, : len(model.network.inputs)], 3600.0, x0)[:, i]
+    else:
+        y = simulate_reference(model, p, Uf, DT_SUB, x0)[::SUB, i]
+    n = min(len(U), y.size)
+    spin = int(rng.integers(7, MAX_SPIN_DAYS + 1)) * 24
+    rows = slice(spin, spin + CAL_DAYS * 24)
+    d = (y[:n] - hb.simulate(fit_model, p, U[:n], 3600.0, x0)[:, 0])[rows]
+    daily = d[: d.size // 24 * 24].reshape(-1, 24).mean(axis=1)
+    # what another aperture cannot take up: the error less its least-squares fit by the
+    # room's response to the fit's facade irradiance alone (and a constant)
+    Us = np.zeros_like(U[:n])
+    Us[:, j_s] = U[:n, j_s]
+    resp = hb.simulate(fit_model, p, Us, 3600.0, np.zeros(len(x0)))[:, 0][rows]
+    X = np.column_stack([resp, np.ones_like(resp)])
+    coef = np.linalg.lstsq(X, d, rcond=None)[0]
+    rest = d - X @ coef
+    return {
+        "mean": float(d.mean()),
+        "sd": float(d.std()),
+        "daily_sd": float(daily.std()),
+        "corr_I_S": float(np.corrcoef(d, U[rows, j_s])[0, 1]),
+        "sd_unscaled": float(rest.std()),
+        "scale": float(1.0 + coef[0]),
+    }
+
+
+def misfit_lines(reps, seed: int) -> list[str]:
+    """:func:`misfit` over the replicates ``reps`` for the generator with every part and
+    with each part left out: medians over the rooms."""
+    cases = {
+        "every part": (),
+        "without sky": ("sky",),
+        "without within_hour": ("within_hour",),
+        "without within_hour,sky,substeps": ("within_hour", "sky", "substeps"),
+    }
+    lines = [
+        f"noise-free generator - fit's model with the true parameters, thermal_2c, "
+        f"{len(reps)} rooms (medians): |mean|, sd, sd of daily means [K], corr with I_S; "
+        "sd [K] left after the best scaling of the solar response, that scaling"
+    ]
+    for label, without in cases.items():
+        m = [misfit(r, seed, without) for r in reps]
+        med = {k: float(np.median([abs(x[k]) if k == "mean" else x[k] for x in m])) for k in m[0]}
+        lines.append(
+            f"  {label:34s} {med['mean']:.3f} {med['sd']:.3f} {med['daily_sd']:.3f} "
+            f"{med['corr_I_S']:+.2f} {med['sd_unscaled']:.3f} {med['scale']:.3f}"
+        )
+    return lines
+
+
+def paired_lines(a: list[dict], b: list[dict]) -> list[str]:
+    """Two studies of the same rooms (logs of one generator variant each, e.g. every
+    part and ``--without sky``): per model and quantity over the replicates in both,
+    the correlation of z between them and the mean, sd and rms of z_a - z_b, the shift
+    the difference between the studies makes in the posterior's own sd (the rooms'
+    noise is the same, so it cancels in the difference)."""
+    lines = []
+    for name in sorted({r["model"] for r in a} & {r["model"] for r in b}):
+        ra = {r["rep"]: r for r in a if r["model"] == name}
+        rb = {r["rep"]: r for r in b if r["model"] == name}
+        reps = sorted(set(ra) & set(rb))
+        if len(reps) < 3:
+            continue
+        va, vb = (sorted({v for r in x.values() for v in r["variants"]}) for x in (ra, rb))
+        if len(va) != 1 or len(vb) != 1:
+            raise SystemExit("--paired: one variant per log")
+        _, za = _zscores([ra[r] for r in reps], va[0], name)
+        _, zb = _zscores([rb[r] for r in reps], vb[0], name)
+        parts = []
+        for k in za:
+            ok = np.isfinite(za[k]) & np.isfinite(zb[k])
+            if ok.sum() < 3:
+                continue
+            d = za[k][ok] - zb[k][ok]
+            corr = np.corrcoef(za[k][ok], zb[k][ok])[0, 1]
+            parts.append(
+                f"{k} corr {corr:+.2f}, diff {d.mean():+.2f} / {d.std(ddof=1):.2f} / "
+                f"{np.sqrt(np.mean(d**2)):.2f}"
+            )
+        lines.append(
+            f"  {name} ({len(reps)} rooms in both) z_a - z_b mean / sd / rms: " + "; ".join(parts)
+        )
+    return lines
 
 
 def read_logs(paths: list[str]) -> list[dict]:
@@ -306,6 +441,8 @@ def read_logs(paths: list[str]) -> list[dict]:
                 # node (Pf uniform 900-1400 Pa in the truths, 0-5 000 Pa in the fit)
                 if r["model"] == "hygric_2c_fixed" and r.get("fixed_node_prior") is None:
                     r["variants"] = {f"{v}@flat_pf": x for v, x in r["variants"].items()}
+                if r.get("noise_free"):
+                    r["variants"] = {f"{v}@noise_free": x for v, x in r["variants"].items()}
                 key = (r["model"], int(r["rep"]))
                 if key not in merged:
                     merged[key] = {**r, "variants": dict(r["variants"])}
@@ -338,6 +475,68 @@ def zscore_lines(results: list[dict], variant: str) -> list[str]:
             if z:
                 parts.append(f"{k} {np.sqrt(np.mean(np.square(z))):.2f}")
         lines.append(f"  {name} [{variant}] z rms ({len(rs)} rooms): " + ", ".join(parts))
+    return lines
+
+
+def _zscores(results: list[dict], variant: str, name: str) -> tuple[list[dict], dict]:
+    """The rooms of ``name`` fitted with ``variant`` and, per quantity, z = (posterior
+    median - truth) / posterior sd of each room (NaN where not ranked)."""
+    rs = [r for r in results if r["model"] == name and variant in r["variants"]]
+    z = {}
+    for k in QUANTITIES.get(name, ()):
+        vals = []
+        for r in rs:
+            x = r["variants"][variant]["ranks"].get(k)
+            ok = x is not None and x["sd"] > 0
+            vals.append((x["median"] - r["truth"][k]) / x["sd"] if ok else np.nan)
+        z[k] = np.array(vals)
+    return rs, z
+
+
+def bias_lines(results: list[dict], variant: str) -> list[str]:
+    """Bias or width? Per model and quantity the mean and sd of z over the rooms (z =
+    (median - truth)/sd; calibrated: mean 0 ± 1/sqrt(n), sd 1) and the rooms above the
+    truth; then the room-to-room correlation of z between quantities and with the log
+    of the generator/fit mean facade irradiance ratio (thermal rooms)."""
+    lines = []
+    for name in sorted({r["model"] for r in results}):
+        rs, z = _zscores(results, variant, name)
+        parts = []
+        for k, v in z.items():
+            v = v[np.isfinite(v)]
+            if v.size > 1:
+                parts.append(
+                    f"{k} {v.mean():+.2f} / {v.std(ddof=1):.2f} ({int(np.sum(v > 0))}/{v.size})"
+                )
+        if not parts:
+            continue
+        lines.append(
+            f"  {name} [{variant}] mean z / sd z (rooms above the truth): " + ", ".join(parts)
+        )
+        keys = ("tau_1_h", "gain_Ti_Te", "gain_Ti_I_S", "solar_warming_K")
+        keys = [k for k in keys if k in z and np.isfinite(z[k]).any()]
+        if len(keys) < 2:
+            continue
+        Z = np.column_stack([z[k] for k in keys])
+        ok = np.all(np.isfinite(Z), axis=1)
+        if ok.sum() < 3:
+            continue
+        C = np.corrcoef(Z[ok].T)
+        pairs = [
+            f"{keys[i]}~{keys[j]} {C[i, j]:+.2f}"
+            for i in range(len(keys))
+            for j in range(i + 1, len(keys))
+        ]
+        line = f"  {name} [{variant}] corr of z: " + ", ".join(pairs)
+        if all("irradiance_mean" in r for r in rs):
+            irr = np.log(
+                [r["irradiance_mean"]["generator"] / r["irradiance_mean"]["fit"] for r in rs]
+            )[ok]
+            if np.ptp(irr) > 1e-9:  # (1 in every room without the other sky model)
+                line += "; with log irradiance ratio: " + ", ".join(
+                    f"{k} {np.corrcoef(Z[ok, i], irr)[0, 1]:+.2f}" for i, k in enumerate(keys)
+                )
+        lines.append(line)
     return lines
 
 
@@ -458,6 +657,14 @@ def main(argv=None) -> int:
         "hold; tabulated as NOISE:INIT@interval_mean)",
     )
     ap.add_argument(
+        "--noise-free",
+        action="store_true",
+        help="fit each room's noise-free record (same gap) with the noise parameters fixed "
+        "at the observation model's truths: z = (median - truth)/sd is then the "
+        "deterministic part of the study's z (the generator's systematic error and the "
+        "prior's pull), in the study's own sd; tabulated as NOISE:INIT@noise_free",
+    )
+    ap.add_argument(
         "--table",
         nargs="+",
         metavar="LOG",
@@ -465,12 +672,37 @@ def main(argv=None) -> int:
         "extended with --first-rep, or variants run apart on the same replicates)",
     )
     ap.add_argument("--markdown", action="store_true", help="with --table: the tables in markdown")
+    ap.add_argument(
+        "--paired",
+        nargs=2,
+        metavar="LOG",
+        help="two logs of the same rooms (one generator variant each): the correlation "
+        "of z between them and the mean, sd and rms of the difference, per quantity",
+    )
+    ap.add_argument(
+        "--misfit",
+        action="store_true",
+        help="no fit: the noise-free error of the generator (every part, and each left "
+        "out) against the fit's model with the true parameters, thermal rooms "
+        "--first-rep .. --first-rep + --reps",
+    )
     args = ap.parse_args(argv)
     variants = args.noise or ["ar1_white:estimate"]
     without = tuple(w for w in args.without.split(",") if w)
     parts = {"within_hour", "sky", "substeps"}
     if set(without) - parts:
         ap.error(f"--without: unknown {sorted(set(without) - parts)}; use {sorted(parts)}")
+    if args.paired:
+        a, b = (read_logs([p]) for p in args.paired)
+        print(f"paired z: {args.paired[0]} - {args.paired[1]}")
+        for line in paired_lines(a, b):
+            print(line)
+        return 0
+    if args.misfit:
+        reps = range(args.first_rep, args.first_rep + args.reps)
+        for line in misfit_lines(reps, args.seed):
+            print(line)
+        return 0
     if args.table:
         results = read_logs(args.table)
         print(
@@ -483,7 +715,7 @@ def main(argv=None) -> int:
                 lines = markdown_table(results, v)
             else:
                 lines = table(results, v, QUANTITIES) + zscore_lines(results, v)
-                lines += solar_lines(results, v)
+                lines += bias_lines(results, v) + solar_lines(results, v)
             for line in lines:
                 print(line)
         return 0
@@ -499,6 +731,7 @@ def main(argv=None) -> int:
             args.envelope_area or None,
             without,
             args.input_hold,
+            args.noise_free,
         )
         for r in range(args.first_rep, args.first_rep + args.reps)
         for m in args.models.split(",")

@@ -221,3 +221,54 @@ def test_solar_lines_compare_the_gain_bias_with_the_sky_models_ratio():
     assert "gain_Ti_I_S 0.850 (below 1 in 2)" in line
     assert "solar_warming_K 1.000 (below 1 in 0)" in line and "irradiance ratio) 1.00" in line
     assert bench.solar_lines([room(0, 0.9)], "kalman:estimate") == []
+
+
+def test_bias_lines_separate_bias_from_width():
+    """Three rooms with z = -1, -2, -3 for the Te gain (mean -2, sd 1, none above) and
+    +1, +2, +3 for the solar warming: correlation -1 between the two; the irradiance
+    ratio's correlation is printed only where the ratio varies."""
+    bench = pytest.importorskip("bench_sbc_independent")
+
+    def room(rep, z, irr):
+        truth = {"gain_Ti_Te": 0.8, "solar_warming_K": 1.0}
+        x = {
+            "gain_Ti_Te": {"median": 0.8 - 0.01 * z, "sd": 0.01},
+            "solar_warming_K": {"median": 1.0 + 0.1 * z, "sd": 0.1},
+        }
+        return {
+            "model": "thermal_2c",
+            "rep": rep,
+            "truth": truth,
+            "irradiance_mean": {"generator": 90.0 * irr, "fit": 90.0},
+            "variants": {"ar1_white:estimate": {"ranks": x}},
+        }
+
+    rooms = [room(0, 1, 0.9), room(1, 2, 0.8), room(2, 3, 1.0)]
+    mean_sd, corr = bench.bias_lines(rooms, "ar1_white:estimate")
+    assert "gain_Ti_Te -2.00 / 1.00 (0/3)" in mean_sd
+    assert "solar_warming_K +2.00 / 1.00 (3/3)" in mean_sd
+    assert "gain_Ti_Te~solar_warming_K -1.00" in corr and "irradiance ratio" in corr
+    same = [room(0, 1, 1.0), room(1, 2, 1.0), room(2, 3, 1.0)]
+    assert "irradiance ratio" not in bench.bias_lines(same, "ar1_white:estimate")[1]
+
+
+def test_paired_lines_difference_of_z_on_the_same_rooms():
+    """Two logs of the same three rooms: z of the second is z of the first minus 1 in
+    every room (correlation 1, difference +1 with sd 0); a room in one log only is
+    left out."""
+    bench = pytest.importorskip("bench_sbc_independent")
+
+    def room(rep, z):
+        x = {"tau_1_h": {"median": 400.0 + 10.0 * z, "sd": 10.0}}
+        return {
+            "model": "thermal_2c",
+            "rep": rep,
+            "truth": {"tau_1_h": 400.0},
+            "variants": {"ar1_white:estimate": {"ranks": x}},
+        }
+
+    a = [room(0, 1.0), room(1, -0.5), room(2, 2.0), room(3, 9.0)]
+    b = [room(0, 0.0), room(1, -1.5), room(2, 1.0)]
+    (line,) = bench.paired_lines(a, b)
+    assert "(3 rooms in both)" in line
+    assert "tau_1_h corr +1.00, diff +1.00 / 0.00 / 1.00" in line

@@ -233,13 +233,14 @@ def test_project_compares_measures_and_draws_the_page(projected):
     row = csv[(csv.measure == "conservation heating") & (csv.indicator == "twpi")
               & (csv.case == "warm 2050")].iloc[0]  # fmt: skip
     d = ch["indicators"]["twpi"]
-    assert row["change_vs"] == "do nothing" and row["p_better"] == pytest.approx(d["p_better"])
-    assert row["change_q50"] == pytest.approx(d["q50"])
+    assert row["change_vs"] == "do nothing"
+    assert row["p_better"] == pytest.approx(d["p_better"], rel=1e-5)
+    assert row["change_q50"] == pytest.approx(d["q50"], rel=1e-5)  # the CSV keeps 6 digits
     tw = ds["twpi_measure"].sel(measure="conservation heating", case="warm 2050")
     assert row["q50"] == pytest.approx(float(tw.median()), rel=1e-5)
     cost = csv[(csv.indicator == "cost_heating_energy") & (csv.case == "warm 2050")]
     assert list(cost["measure"]) == ["conservation heating"]
-    assert cost["q50"].iloc[0] == pytest.approx(ch["costs"]["heating_energy"]["q50"])
+    assert cost["q50"].iloc[0] == pytest.approx(ch["costs"]["heating_energy"]["q50"], rel=1e-5)
     assert set(csv[csv.measure == "do nothing"]["change_vs"].dropna()) == {"baseline"}
     html = Path(p.paths["html"]).read_text(encoding="utf-8")
     assert 'id="interventions"' in html
@@ -416,7 +417,9 @@ def test_conservation_heating_with_a_dehumidifier_is_one_coupled_room(run, case)
     Td, Pd, _ = _series(run, case, Measure("dh", dehumidifier=dh))
     assert np.all(Tb <= Th + 1e-9) and np.any(Tb < Th - 1e-3)
     assert np.all(Tb >= Td - 1e-9)  # Td: free-running (a dehumidifier does not heat)
-    assert np.all(Pb >= Pd * (1 - 1e-9)) and np.all(Pb <= Ph * (1 + 1e-9))
+    # (to 1e-9 of the magnitude: some draws of this fixture's run go below 0 Pa, where
+    # a factor (1 - 1e-9) would move the bound the other way)
+    assert np.all(Pb >= Pd - 1e-9 * np.abs(Pd)) and np.all(Pb <= Ph + 1e-9 * np.abs(Ph))
 
 
 def test_a_calibrated_constant_source_stays_with_the_measure(run, case):

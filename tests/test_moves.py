@@ -159,32 +159,3 @@ def test_resume_mid_chunk_continues_the_global_chain_bit_for_bit(tmp_path, max_r
     np.testing.assert_array_equal(c.chain, a.chain)
     np.testing.assert_array_equal(c.tau, a.tau)
     assert c.tau_history == a.tau_history
-
-
-def test_auto_chooses_de_global_for_three_or_more_nodes_only():
-    from heritage_bayes.config.sampler import SamplerSettings
-    from heritage_bayes.inference.moves import default_moves, sampling_moves
-
-    assert SamplerSettings().moves == "auto"
-    assert [default_moves(n) for n in (1, 2, 3, 4)] == [
-        "de_snooker",
-        "de_snooker",
-        "de_global",
-        "de_global",
-    ]
-    assert sampling_moves("stretch", 4) == "stretch"
-    assert sampling_moves("auto", 2) == "de_snooker"
-
-
-def test_auto_on_a_two_node_model_is_the_de_snooker_chain_bit_for_bit():
-    f = _Ridge()
-    f.model = type("TwoNodes", (), {"n_states": 2})()
-    kw = dict(seed=4, nwalkers=8, max_steps=1500, check_every=500, tau_factor=1e4)
-    a = run_sampler(f, np.zeros(3), moves="auto", **kw)
-    b = run_sampler(f, np.zeros(3), moves="de_snooker", **kw)
-    np.testing.assert_array_equal(a.chain, b.chain)
-    f.model = type("ThreeNodes", (), {"n_states": 3})()
-    c = run_sampler(f, np.zeros(3), moves="auto", **kw)
-    d = run_sampler(f, np.zeros(3), moves="de_global", **kw)
-    np.testing.assert_array_equal(c.chain, d.chain)
-    assert not np.array_equal(a.chain, c.chain)

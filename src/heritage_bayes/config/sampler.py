@@ -82,18 +82,15 @@ class SamplerSettings(_Strict):
         ge=0,
         lt=1,
     )
-    moves: Literal["auto", "de_snooker", "de_snooker_50", "de", "stretch", "de_global", "dime"] = (
-        key(
-            "auto",
-            unit=None,
-            description="emcee's proposal moves: de_snooker (differential evolution 80 %, "
-            "snooker 20 %), de_global (de_snooker whose DE part is replaced, for a walker "
-            "in ten, by an independent draw from a Student-t fitted to the chain so far), "
-            "dime (DE with those draws, no snooker), de, stretch, or auto: de_global for "
-            "networks of three or more nodes, de_snooker for smaller ones (measured on "
-            "the demo's thermal_4a, 40 000 steps: τmax 1 049 with de_snooker, 712 with "
-            "de_global, 2 129 with dime)",
-        )
+    moves: Literal["de_snooker", "de_snooker_50", "de", "stretch", "de_global", "dime"] = key(
+        "de_snooker",
+        unit=None,
+        description="emcee's proposal moves: de_snooker (differential evolution 80 %, "
+        "snooker 20 %), de_global (de_snooker whose DE part is replaced, for a walker in "
+        "ten, by an independent draw from a Student-t fitted to the chain so far), dime "
+        "(DE with those draws, no snooker), de, or stretch (measured on the demo's "
+        "thermal_4a, 40 000 steps: τmax 1 049 with de_snooker, 712 with de_global, 2 129 "
+        "with dime; on Ørholm's thermal_4a 319 and 372)",
     )
     coordinates: Literal["auto", "log", "node_tau"] = key(
         "auto",

@@ -32,10 +32,7 @@ from __future__ import annotations
 import emcee
 import numpy as np
 
-__all__ = ["GlobalDEMove", "default_moves", "refit_moves", "sampling_moves"]
-
-#: networks of this many capacity nodes or more sample with ``de_global`` by default
-MIN_NODES = 3
+__all__ = ["GlobalDEMove", "refit_moves"]
 
 #: at most this many points (walkers × rows) enter a fit of the global proposal
 MAX_FIT_POINTS = 8000
@@ -138,20 +135,3 @@ def refit_moves(moves, chain: np.ndarray, to_y=None) -> None:
         pts = to_y(pts)
     for m in movers:
         m.fit(pts)
-
-
-def default_moves(n_states: int) -> str:
-    """The ``sampler.moves`` that ``auto`` means for a network of ``n_states`` capacity
-    nodes: ``de_global`` from :data:`MIN_NODES` nodes on, ``de_snooker`` below.
-
-    Chosen by measured τ (``benchmarks/bench_coordinates.py``, the same MAP, seed and
-    40 000 steps; docs/science/benchmarks.md): on the demo's thermal_4a every
-    parameter's τ fell (τmax 1 049 → 712 steps, min bulk ESS per CPU second × 1.96); the
-    two-node models keep de_snooker, their chains unchanged bit for bit.
-    """
-    return "de_global" if n_states >= MIN_NODES else "de_snooker"
-
-
-def sampling_moves(choice: str, n_states: int) -> str:
-    """``sampler.moves`` resolved: ``auto`` by :func:`default_moves`, else ``choice``."""
-    return default_moves(n_states) if choice == "auto" else choice

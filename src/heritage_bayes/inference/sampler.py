@@ -16,10 +16,11 @@ Default moves: a mix of differential-evolution moves, 80 % ``DEMove`` and 20 %
 and time constants are well identified, absolute levels much less), with strong linear
 correlations in log space; DE proposals are built from differences of walkers and so
 adapt to that shape, and the snooker update helps along curved ridges and between
-modes. The stretch move is available (``moves: stretch``). Networks of three or more
-nodes (``moves: auto``) add global proposals to the DE part: a walker in ten proposes
-an independent draw from a Student-t refitted to the chain at each convergence check
-(``de_global``, :mod:`heritage_bayes.inference.moves`).
+modes. The stretch move is available (``moves: stretch``), and ``de_global`` adds
+global proposals to the DE part: a walker in ten proposes an independent draw from a
+Student-t refitted to the chain at each convergence check
+(:mod:`heritage_bayes.inference.moves`; not the default: measured in
+docs/science/benchmarks.md).
 
 Checkpoint: emcee's own HDF5 backend writes every step (several ms each here, more than
 the step itself), so the sampler runs in memory and each chunk is appended to an HDF5
@@ -70,7 +71,7 @@ from heritage_bayes.inference.monitor import (
     _tau,
     make_moves,
 )
-from heritage_bayes.inference.moves import refit_moves, sampling_moves
+from heritage_bayes.inference.moves import refit_moves
 from heritage_bayes.inference.start import laplace_ensemble
 
 __all__ = [
@@ -189,7 +190,7 @@ def _run_sampler(
     *,
     seed: int,
     nwalkers: int | None = None,
-    moves: str = "auto",
+    moves: str = "de_snooker",
     max_steps: int = 200_000,
     max_seconds: float | None = None,
     bounds: tuple[np.ndarray, np.ndarray] | None = None,
@@ -296,8 +297,7 @@ def _run_sampler(
     def to_y(a: np.ndarray) -> np.ndarray:
         return a if coordinates is None else coordinates.to_y(a)
 
-    model = getattr(logpost, "model", None)  # auto: by the network's node count
-    move_list = make_moves(sampling_moves(moves, getattr(model, "n_states", 0)))
+    move_list = make_moves(moves)
     sampler = emcee.EnsembleSampler(nwalkers, d, target, vectorize=True, moves=move_list)
     ck = _Checkpoint(Path(checkpoint), tag) if checkpoint is not None else None
     buf = ChainBuffer(nwalkers, d)

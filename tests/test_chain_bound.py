@@ -14,21 +14,10 @@ import h5py
 import numpy as np
 import pytest
 
+from _chain_helpers import Ridge as _Ridge
+from _chain_helpers import interrupt_at
 from heritage_bayes.inference.monitor import ChainBuffer
 from heritage_bayes.inference.sampler import run_sampler
-
-
-class _Ridge:
-    """A 3-d Gaussian with correlations 0.99 (a ridge: τ of tens of steps), vectorised."""
-
-    def __init__(self):
-        c = np.full((3, 3), 0.99) + 0.01 * np.eye(3)
-        self.P = np.linalg.inv(c)
-
-    def __call__(self, X):
-        X = np.atleast_2d(X)
-        return -0.5 * np.einsum("ki,ij,kj->k", X, self.P, X)
-
 
 KW = dict(seed=3, nwalkers=8, check_every=100, tau_factor=1e4, moves="stretch")
 
@@ -94,27 +83,8 @@ def test_resume_after_an_interrupt_rebuilds_the_same_thinned_chain(tmp_path):
     a = run_sampler(f, np.zeros(3), max_steps=2500, checkpoint=tmp_path / "a.h5", **kw)
     assert a.stride >= 4
 
-    class Interrupting:
-        """Ctrl-C in the middle of a chunk after the chain was thinned twice."""
-
-        def __init__(self, after):
-            self.n, self.after = 0, after
-
-        def __call__(self, X):
-            self.n += 1
-            if self.n == self.after:
-                raise KeyboardInterrupt
-            return f(X)
-
-    # emcee calls the log-posterior twice per step (two half-ensembles) plus once at start
-    with pytest.raises(KeyboardInterrupt):
-        run_sampler(
-            Interrupting(2 * 1650 + 1),
-            np.zeros(3),
-            max_steps=2500,
-            checkpoint=tmp_path / "c.h5",
-            **kw,
-        )
+    # Ctrl-C in the middle of a chunk after the chain was thinned twice
+    interrupt_at(f, tmp_path / "c.h5", step=1650, max_steps=2500, **kw)
     with h5py.File(tmp_path / "c.h5") as fc:
         rows_saved = fc["chain"].shape[0]
     c = run_sampler(f, np.zeros(3), max_steps=2500, checkpoint=tmp_path / "c.h5", resume=True, **kw)

@@ -16,21 +16,11 @@ import pytest
 from scipy import stats
 from threadpoolctl import threadpool_limits
 
+from _chain_helpers import Ridge as _Ridge
+from _chain_helpers import interrupt_at
 from heritage_bayes.inference.monitor import _last_check, _next_check, make_moves
 from heritage_bayes.inference.moves import MAX_FIT_POINTS, GlobalDEMove, refit_moves
 from heritage_bayes.inference.sampler import run_sampler
-
-
-class _Ridge:
-    """A 3-d Gaussian with correlations 0.99 (a ridge), vectorised."""
-
-    def __init__(self):
-        self.cov = np.full((3, 3), 0.99) + 0.01 * np.eye(3)
-        self.P = np.linalg.inv(self.cov)
-
-    def __call__(self, X):
-        X = np.atleast_2d(X)
-        return -0.5 * np.einsum("ki,ij,kj->k", X, self.P, X)
 
 
 def _skewed(X):
@@ -134,26 +124,8 @@ def test_resume_mid_chunk_continues_the_global_chain_bit_for_bit(tmp_path, max_r
     kw["max_rows"] = max_rows
     a = run_sampler(f, np.zeros(3), max_steps=2500, checkpoint=tmp_path / "a.h5", **kw)
 
-    class Interrupting:
-        def __init__(self, after):
-            self.n, self.after = 0, after
-
-        def __call__(self, X):
-            self.n += 1
-            if self.n == self.after:
-                raise KeyboardInterrupt
-            return f(X)
-
-    # two log-posterior calls per step (half-ensembles) plus one at the start: step 1650,
-    # in the middle of the chunk that ends at the check at 1 700
-    with pytest.raises(KeyboardInterrupt):
-        run_sampler(
-            Interrupting(2 * 1650 + 1),
-            np.zeros(3),
-            max_steps=2500,
-            checkpoint=tmp_path / "c.h5",
-            **kw,
-        )
+    # step 1650: in the middle of the chunk that ends at the check at 1 700
+    interrupt_at(f, tmp_path / "c.h5", step=1650, max_steps=2500, **kw)
     c = run_sampler(f, np.zeros(3), max_steps=2500, checkpoint=tmp_path / "c.h5", resume=True, **kw)
     assert 1600 < c.resumed_from < 1700
     np.testing.assert_array_equal(c.chain, a.chain)

@@ -40,15 +40,6 @@ def make_moves(name: str):
     return [(cls(), w) for cls, w in MOVES[name]]
 
 
-def _last_check(done: int, check_every: int) -> int:
-    """The last convergence check at or before step ``done`` (0 before the first)."""
-    b = last = 0
-    while b <= done:
-        last = b
-        b += check_every * max(1, b // (10 * check_every))
-    return last
-
-
 def _next_check(done: int, check_every: int) -> int:
     """The first convergence check after step ``done``.
 
@@ -61,6 +52,15 @@ def _next_check(done: int, check_every: int) -> int:
     while b <= done:
         b += check_every * max(1, b // (10 * check_every))
     return b
+
+
+def _last_check(done: int, check_every: int) -> int:
+    """The last convergence check at or before step ``done`` (0 before the first): the
+    schedule of :func:`_next_check`."""
+    last = 0
+    while (b := _next_check(last, check_every)) <= done:
+        last = b
+    return last
 
 
 def _tau(chain: np.ndarray, discard: float = 0.0) -> np.ndarray:

@@ -2,8 +2,11 @@
 
 Runs the command as a user would, in a fresh output folder, and prints its wall time,
 the CPU time of the whole process tree (user + system, workers included), the peak of
-the summed resident memory of the process tree (sampled every 0.2 s with psutil: what
-the machine had to hold at once) and the bytes it wrote (``du -b`` per file and in
+the summed resident memory of the process tree (sampled every 0.2 s with psutil), both
+as RSS (each process's resident pages, so the shared libraries that every process of
+the tree maps are counted once per process: an upper bound) and as PSS (each shared
+page divided among the processes that map it: what the machine had to hold at once),
+and the bytes it wrote (``du -b`` per file and in
 all). Targets of issue 28: compare ≤ 5 min wall on two cores, ≤ 1 GB peak, ≤ 100 MB
 on disk; a demo run directory ≤ 15 MB; the portfolio demo ≤ 60 MB.
 
@@ -44,19 +47,22 @@ def _tree(proc: psutil.Process) -> list[psutil.Process]:
 
 
 def run_measured(cmd: list[str], poll: float = 0.2) -> dict:
-    """Run ``cmd``; wall [s], CPU [s] of the tree, peak summed RSS [bytes], exit code."""
+    """Run ``cmd``; wall [s], CPU [s] of the tree, peak summed RSS and PSS [bytes], exit
+    code (PSS where the system reports it: Linux; else equal to RSS)."""
     t0 = time.perf_counter()
     child = subprocess.Popen(cmd, cwd=ROOT)
     proc = psutil.Process(child.pid)
-    peak = 0
+    peak = peak_pss = 0
     while child.poll() is None:
-        rss = 0
+        rss = pss = 0
         for p in _tree(proc):
             try:
-                rss += p.memory_info().rss
+                mem = p.memory_full_info()
             except psutil.NoSuchProcess:
                 continue
-        peak = max(peak, rss)
+            rss += mem.rss
+            pss += getattr(mem, "pss", mem.rss)
+        peak, peak_pss = max(peak, rss), max(peak_pss, pss)
         time.sleep(poll)
     wall = time.perf_counter() - t0
     # every descendant was waited for by its parent: RUSAGE_CHILDREN holds them all
@@ -65,6 +71,7 @@ def run_measured(cmd: list[str], poll: float = 0.2) -> dict:
         "wall": wall,
         "cpu": ru.ru_utime + ru.ru_stime,
         "peak_rss": peak,
+        "peak_pss": peak_pss,
         "returncode": child.returncode,
     }
 
@@ -98,7 +105,8 @@ def main(argv: list[str] | None = None) -> int:
     total, files = disk_usage(out) if out.exists() else (0, [])
     print(
         f"{args.command} {config}: exit {m['returncode']}, wall {m['wall']:.1f} s, CPU "
-        f"{m['cpu']:.1f} s, peak memory of the process tree {m['peak_rss'] / 1e9:.2f} GB, "
+        f"{m['cpu']:.1f} s, peak memory of the process tree {m['peak_pss'] / 1e9:.2f} GB PSS "
+        f"({m['peak_rss'] / 1e9:.2f} GB RSS), "
         f"on disk {total / 1e6:.1f} MB in {len(files)} files ({out})",
         flush=True,
     )

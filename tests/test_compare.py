@@ -62,8 +62,27 @@ def cfg_path(tmp_path_factory):
 def compared(cfg_path, tmp_path_factory):
     out = tmp_path_factory.mktemp("compare") / "cmp"
     args = ["compare", str(cfg_path), "--models", ",".join(MODELS), "--out", str(out)]
-    assert main([*args, "--quiet", "--no-report"]) == 0
+    # two at a time: thermal_2c in this process, thermal_1c in a worker process
+    assert main([*args, "--quiet", "--no-report", "--workers", "2"]) == 0
     return out, json.loads((out / "comparison.json").read_text())
+
+
+def test_results_do_not_depend_on_where_a_candidate_ran(compared, cfg_path, tmp_path):
+    """The parent calibrates the largest candidate itself, a worker the other (issue 28):
+    each candidate's chain is its seed's, so one after the other in this process gives
+    the very same draws and comparison."""
+    out, res = compared
+    one = tmp_path / "one"
+    args = ["compare", str(cfg_path), "--models", ",".join(MODELS), "--out", str(one)]
+    assert main([*args, "--quiet", "--no-report", "--workers", "1"]) == 0
+    for m in MODELS:
+        a = az.from_netcdf(out / m / "posterior.nc").posterior
+        b = az.from_netcdf(one / m / "posterior.nc").posterior
+        assert set(a.data_vars) == set(b.data_vars)
+        for v in a.data_vars:
+            np.testing.assert_array_equal(a[v].values, b[v].values, err_msg=f"{m}: {v}")
+    again = json.loads((one / "comparison.json").read_text())
+    assert again["recommendation"] == res["recommendation"]
 
 
 def test_run_groups_share_draws_and_loglik_has_only_observed_hours(compared):

@@ -134,8 +134,9 @@ def _build_parser() -> argparse.ArgumentParser:
         "--workers",
         type=int,
         metavar="N",
-        help="candidates calibrated at once, each in its own process (default: one per "
-        "core, at most one per model; 1: one after the other)",
+        help="candidates calibrated at once (default: one per core, at most one per "
+        "model; the largest in this process, the others in N-1 worker processes; 1: one "
+        "after the other)",
     )
     cmp_.set_defaults(func=_cmd_compare)
 

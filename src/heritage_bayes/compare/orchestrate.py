@@ -214,10 +214,7 @@ def run_compare(
             # without a waiting parent that holds the libraries of a calibration (about
             # 0.3 GB resident) on top of those of the workers (issue 28)
             own, rest = order[0], order[1:]
-            tell(
-                f"calibrating {', '.join(order)}, {n_workers} at a time "
-                f"({own} in this process)"
-            )
+            tell(f"calibrating {', '.join(order)}, {n_workers} at a time ({own} in this process)")
             ctx = multiprocessing.get_context("spawn")  # no forked numba/BLAS threads
             pool_size = min(n_workers - 1, len(rest))
             with ProcessPoolExecutor(pool_size, mp_context=ctx, max_tasks_per_child=1) as pool:

@@ -415,6 +415,32 @@ def test_convergence_verdict_levels():
     assert convergence_verdict(_summary(float("nan"), 5000))["level"] == "red"
 
 
+def test_the_verdict_follows_the_runs_decision_and_then_weighs_the_truths():
+    """A run the stopping rule declared converged is converged in the report too: the
+    saved draws' R-hat a little above 1.01 (a thinned subset) is stated, not counted
+    against it (issue 31: the demo printed "converged" while its report read "Nearly
+    converged" and left its four truth misses out of the verdict)."""
+    s = _summary(1.0112, 1030, converged=True)
+    v = convergence_verdict(s)
+    assert v["level"] == "green", v
+    assert "stopping rule met: yes" in v["stats"] and "of the saved draws" in v["stats"]
+    assert "all criteria of the stopping rule met" in v["models"][0]
+    assert "R-hat up to 1.011 for Ci" in v["models"][0]
+    # with a truth outside its interval the verdict says so (amber, the check listed)
+    s["derived"] = {
+        "thermal.tau_1_h": {"truth": 103.7, "q05": 104.1, "q95": 108.0, "median": 106.0, "sd": 1.2},
+    }
+    v = convergence_verdict(s)
+    assert v["level"] == "amber" and "checks below fail" in v["title"]
+    assert any("thermal.tau_1_h" in c and "outside" in c for c in v["checks"])
+    # the saved draws far off (beyond the amber limits) are not waved through
+    assert convergence_verdict(_summary(1.08, 1030, converged=True))["level"] == "red"
+    # not converged by the rule: the saved draws' R-hat is a problem as before
+    v = convergence_verdict(_summary(1.0112, 1030, converged=False))
+    assert v["level"] == "amber" and "Nearly converged" in v["title"]
+    assert "the walkers disagree: R-hat up to 1.011 for Ci" in v["models"][0]
+
+
 def test_verdict_classes_and_notes():
     assert [rhat_class(r, 1.01) for r in (1.005, 1.03, 1.2, None, float("nan"))] == [
         "ok",

@@ -323,3 +323,18 @@ def test_zscore_table_and_noise_lines():
     noise, corr = bench_sbc.noise_lines(rs, "ar1_white:estimate")
     assert "sigma_Ti median / truth 1.000" in noise and "phi_Ti median - truth +0.030" in noise
     assert "phi_Ti +0.50 (+0.50..+0.50)" in corr and "tau_1_h +0.00 (-0.50..+0.50)" in corr
+
+
+def test_independent_generator_with_ghi_as_the_solar_input():
+    """``bench_sbc_independent --without sky --solar ghi``: the fit's I_S is the hourly
+    ghi aligned as an hour-ending mean (row k the hour ending at row k + 1), which the
+    generator holds over each hour; Te and Pe are those of the facade rooms."""
+    bench = pytest.importorskip("bench_sbc_independent")
+    fac = bench.generator_weather(3, ("sky",))
+    gw = bench.generator_weather(3, ("sky",), "ghi")
+    np.testing.assert_array_equal(gw["fine"]["Te"], fac["fine"]["Te"])
+    frame = bench.fit_inputs(gw["hourly"], solar="ghi")
+    np.testing.assert_allclose(frame["I_S"].to_numpy(), gw["hourly"]["ghi"].to_numpy()[1:])
+    np.testing.assert_allclose(gw["fine"]["I_S"], np.repeat(frame["I_S"].to_numpy(), bench.SUB))
+    with pytest.raises(ValueError, match="sky"):
+        bench.generator_weather(3, (), "ghi")

@@ -23,6 +23,14 @@ posterior is calibrated; reported as a chi-square test on 10 bins (p-value).
     python benchmarks/bench_sbc.py --reps 10 --models thermal_2c --noise ar1:steady
     python benchmarks/bench_sbc.py --room 64 --reps 24 --models thermal_2c \
         --noise ar1_white:estimate --without rounding,gap --jobs 2
+    python benchmarks/bench_sbc.py --reps 50 --models thermal_2c \
+        --noise ar1_white:estimate --solar facade --log facade.jsonl
+
+``--solar facade`` feeds the thermal rooms the south-facade irradiance ``hbayes
+calibrate`` computes from the hourly station record (Erbs + Perez, :func:`facade_south`)
+as I_S instead of the global horizontal irradiance; the rooms are otherwise the same
+(truths, weather stretch, start, noise, gap), and the generator and the fit share the
+input either way.
 
 ``--noise NAME:INIT`` pairs a noise model with an initial state (``estimate`` or
 ``steady``; ``steady`` adds the old 14-day warm-up). Default: the new default
@@ -54,9 +62,18 @@ CAL_DAYS, MAX_SPIN_DAYS = 90, 56
 DT = 3600.0
 
 
-def weather(seed: int) -> dict[str, np.ndarray]:
+#: ``--solar`` choices: the solar input I_S of the thermal rooms
+SOLAR = ("ghi", "facade")
+#: De Bilt, KNMI station 260 [°N, °E, m] (as bench_sbc_independent.SITE)
+SITE = {"latitude": 52.10, "longitude": 5.18, "altitude": 1.9}
+
+
+def weather(seed: int, solar: str = "ghi") -> dict[str, np.ndarray]:
     """A random stretch of De Bilt hourly weather: Te [°C], Pe [Pa], south irradiance
-    proxy [W/m²] (global horizontal), long enough for the spin-up and calibration."""
+    [W/m²], long enough for the spin-up and calibration. ``solar``: ``"ghi"`` (the
+    global horizontal irradiance as a proxy, as recorded: the mean of the hour ending at
+    the row's time) or ``"facade"`` (:func:`facade_south` of the same stretch: the mean
+    over the row's hour, as ``hbayes calibrate`` aligns it)."""
     from heritage_bayes.climate.psychro import vapour_pressure
 
     w = _knmi_cache()
@@ -67,7 +84,31 @@ def weather(seed: int) -> dict[str, np.ndarray]:
     te = part["Te"].interpolate(limit_direction="both").to_numpy(float)
     rh = part["RHe"].interpolate(limit_direction="both").to_numpy(float)
     ghi = part["ghi"].interpolate(limit_direction="both").to_numpy(float)
+    if solar == "facade":  # one more hour: the mean over the last row's hour
+        ghi = facade_south(w.iloc[start : start + n + 1][["Te", "ghi"]])[:n]
+    elif solar != "ghi":
+        raise ValueError(f"solar must be one of {SOLAR} (got {solar!r})")
     return {"Te": te, "Pe": vapour_pressure(te, rh), "I_S": ghi}
+
+
+def facade_south(hourly) -> np.ndarray:
+    """The south facade's irradiance [W/m²] that ``hbayes calibrate`` builds from an
+    hourly station record (``ghi`` hour-ending means; gaps interpolated): transposed by
+    :func:`heritage_bayes.inputs.solar_inputs` (Erbs + Perez at mid-hour) and aligned
+    by :func:`heritage_bayes.io.align` on 1 h, as ``bench_sbc_independent.fit_inputs``
+    does. Row k is the mean over the hour from ``hourly``'s k-th time: one row fewer."""
+    from heritage_bayes.inputs import solar_inputs
+    from heritage_bayes.io.align import align
+
+    h = hourly.interpolate(limit_direction="both")
+    g = h[["ghi"]].copy()
+    g.attrs.update(averaged=("ghi",), interval="1h", source="station")
+    irr = solar_inputs(g, SITE, {"S": (90.0, 180.0)}, "measured")[0]
+    met = h[["Te"]].copy()
+    met.attrs.update(averaged=(), interval="1h", source="station")
+    frame = align([met, irr], step="1h", max_gap="0h").frame
+    assert frame.index[0] == h.index[0] and len(frame) == len(h) - 1
+    return frame["I_S"].to_numpy(float)
 
 
 _W = None
@@ -239,11 +280,12 @@ def replicate(args) -> dict:
     redraw, without = args[8] if len(args) > 8 else (None, ())
     envelope = args[9] if len(args) > 9 else None
     flat_node = args[10] if len(args) > 10 else False
+    solar = args[11] if len(args) > 11 else "ghi"
     rng = np.random.default_rng([seed, rep])
     opts = {"surfaces": ("S",)} if name in ("thermal_2c", "thermal_4a") else {}
     model = hb.model(name, **opts)
     p = truth(model, rng, floor, flat_node)
-    w = weather(int(rng.integers(2**31)))
+    w = weather(int(rng.integers(2**31)), solar if "I_S" in model.input_names else "ghi")
     U = np.column_stack(
         [w[c] if c in w else np.full(len(w["Te"]), 10.0) for c in model.input_names]
     )
@@ -273,6 +315,10 @@ def replicate(args) -> dict:
         y[g0 : g0 + 7 * 24] = np.nan
     dq_true = {k: float(np.ravel(v)[0]) for k, v in derived_quantities(model, p).items()}
     result = {"model": name, "rep": rep, "truth": dq_true, "truth_parameters": p}
+    # the observation model's truths: AR(1) model error (marginal sd), sensor's sd
+    result["noise_truth"] = {"phi": float(phi), "sd": float(sd), "sensor": sensor}
+    if "I_S" in model.input_names:
+        result["solar"] = solar
     result["variants"] = fit_and_rank(
         model, U[rows], y, dq_true, variants, rep, max_steps, priors, floor, envelope
     )
@@ -373,8 +419,28 @@ def fit_and_rank(
                 "median": float(np.median(d)),
                 "sd": float(np.std(d)),
             }
+        # every parameter's posterior median and sd (the noise's too), and the posterior
+        # correlation of the solar gain with each parameter (where there is one)
+        post = {
+            n: {"median": float(np.median(theta[:, j])), "sd": float(np.std(theta[:, j]))}
+            for j, n in enumerate(ps.names)
+        }
+        corr = {}
+        if "gain_Ti_I_S" in dq:
+            gs = np.asarray(dq["gain_Ti_I_S"], float).reshape(-1)
+            others = {n: theta[:, j] for j, n in enumerate(ps.names)}
+            others.update(
+                {k: np.asarray(dq[k], float).reshape(-1) for k in ("tau_1_h", "gain_Ti_Te")}
+            )
+            corr = {
+                n: float(np.corrcoef(gs, x)[0, 1])
+                for n, x in others.items()
+                if np.ptp(x) > 0 and np.ptp(gs) > 0
+            }
         out[variant] = {
             "ranks": ranks,
+            "posterior": post,
+            "corr_gain_Ti_I_S": corr,
             "converged": bool(chain.converged),
             "map": dict(zip(ps.names, map(float, mp.theta), strict=True)),
             "steps": int(chain.steps),
@@ -437,6 +503,87 @@ def table(results: list[dict], variant: str, quantities: dict | None = None) -> 
                 f"    {k:16s} n {n:3d}   50 %: {c50:5.2f}   90 %: {c90:5.2f}   "
                 f"rank chi² p {p:5.3f}{conv_cov}"
             )
+    return lines
+
+
+def zscore_table(results: list[dict], variant: str) -> list[str]:
+    """Per model and quantity of ``variant``: mean and sd of z = (posterior median -
+    truth) / posterior sd over the replicates (calibrated: mean 0 ± 1/sqrt(n), sd 1)
+    and the replicates above the truth."""
+    lines = []
+    for name in sorted({r["model"] for r in results}):
+        parts = []
+        for k in QUANTITIES.get(name, ()):
+            z = np.array(
+                [
+                    (x["median"] - r["truth"][k]) / x["sd"]
+                    for r in results
+                    if r["model"] == name
+                    and variant in r["variants"]
+                    and (x := r["variants"][variant]["ranks"].get(k))
+                    and x["sd"] > 0
+                ]
+            )
+            if z.size > 1:
+                parts.append(
+                    f"{k} {z.mean():+.2f} / {z.std(ddof=1):.2f} ({int(np.sum(z > 0))}/{z.size})"
+                )
+        if parts:
+            lines.append(f"  {name} [{variant}] mean z / sd z (above truth): " + ", ".join(parts))
+    return lines
+
+
+def noise_lines(results: list[dict], variant: str) -> list[str]:
+    """The thermal rooms' noise posteriors against the observation model's truths (log
+    lines with ``posterior`` and ``noise_truth``): per noise parameter the median over
+    the rooms of its posterior median / its truth (phi: minus its truth; sigma: the
+    AR(1) model error's marginal sd; sigma_meas: the sensor's sd with rounding's), and
+    the mean (min-max) over the rooms of the solar gain's posterior correlation with
+    each parameter and with tau_1 and the gain from Te."""
+    rs = [
+        r
+        for r in results
+        if variant in r["variants"]
+        and "posterior" in r["variants"][variant]
+        and "noise_truth" in r
+        and r["model"].startswith("thermal")
+    ]
+    if not rs:
+        return []
+    o = "Ti"
+    truths = {
+        f"sigma_{o}": lambda t: t["sd"],
+        f"phi_{o}": lambda t: t["phi"],
+        f"sigma_meas_{o}": lambda t: float(np.hypot(t["sensor"], 0.1 / np.sqrt(12))),
+    }
+    parts = []
+    for n, f in truths.items():
+        v = [
+            (r["variants"][variant]["posterior"][n]["median"], f(r["noise_truth"]))
+            for r in rs
+            if n in r["variants"][variant]["posterior"]
+        ]
+        if not v:
+            continue
+        d = np.array([m - t if n.startswith("phi") else m / t for m, t in v])
+        op = "-" if n.startswith("phi") else "/"
+        parts.append(
+            f"{n} median {op} truth {np.median(d):+.3f}"
+            if op == "-"
+            else f"{n} median {op} truth {np.median(d):.3f}"
+        )
+    lines = [f"  noise [{variant}] ({len(rs)} rooms), median over rooms: " + ", ".join(parts)]
+    corr = [r["variants"][variant].get("corr_gain_Ti_I_S", {}) for r in rs]
+    names = sorted({k for c in corr for k in c})
+    if names:
+        lines.append(
+            f"  corr(gain_Ti_I_S, .) [{variant}] mean (min..max) over rooms: "
+            + ", ".join(
+                f"{k} {np.mean(x):+.2f} ({np.min(x):+.2f}..{np.max(x):+.2f})"
+                for k in names
+                if (x := [c[k] for c in corr if k in c])
+            )
+        )
     return lines
 
 
@@ -561,6 +708,14 @@ def main() -> None:
         help="exterior area of walls and roof [m²] given to every fit (upper bounds on Gw "
         f"and Cw); 0: none, as in the studies before those bounds (default {ENVELOPE:g})",
     )
+    ap.add_argument(
+        "--solar",
+        choices=SOLAR,
+        default="ghi",
+        help="the thermal rooms' solar input I_S, in the generator and the fit alike: ghi "
+        "(global horizontal, default) or facade (the south facade hbayes calibrate "
+        "computes from the hourly record: Erbs + Perez); recorded in each log line",
+    )
     ap.add_argument("--table", help="only tabulate a --log file of an earlier study")
     ap.add_argument(
         "--room",
@@ -589,7 +744,7 @@ def main() -> None:
         found = sorted({v for r in results for v in r["variants"]})
         print(f"SBC table of {args.table}: {len(results)} replicates")
         for v in found:
-            for line in table(results, v):
+            for line in table(results, v) + zscore_table(results, v) + noise_lines(results, v):
                 print(line)
         return
     priors = {}
@@ -623,6 +778,7 @@ def main() -> None:
             observation,
             envelope,
             args.flat_fixed_node,
+            args.solar,
         )
 
     if args.room is not None:

@@ -35,6 +35,12 @@ does not depend on which sky model scaled the aperture.
     python benchmarks/bench_sbc_independent.py --table sbc_ind.jsonl [more.jsonl ...]
     python benchmarks/bench_sbc_independent.py --table sbc_ind.jsonl --markdown
     python benchmarks/bench_sbc_independent.py --reps 4 --models thermal_2c
+    python benchmarks/bench_sbc_independent.py --reps 38 --models thermal_2c \
+        --noise ar1_white:estimate --without within_hour,sky,substeps --solar ghi
+
+``--solar ghi`` (with ``sky`` left out): the generator and the fit both take the global
+horizontal irradiance (aligned as an hour-ending mean) as I_S instead of the south
+facade, the rooms otherwise the same: ``bench_sbc.py``'s input on these rooms.
 
 Each replicate's room, weather stretch and noise come from ``(seed, replicate)``; one
 JSON line per replicate is appended to ``--log`` as soon as it is done (a study cut
@@ -95,7 +101,7 @@ def _fluctuation(rng, n: int, sd: float, tau_steps: float) -> np.ndarray:
     return e
 
 
-def generator_weather(seed: int, without: tuple = ()) -> dict:
+def generator_weather(seed: int, without: tuple = (), solar: str = "facade") -> dict:
     """A random De Bilt stretch on the 10-minute grid and as a station logs it hourly.
 
     Returns ``fine`` (10-minute Te [°C], Pe [Pa], I_S [W/m²], each the value over the
@@ -106,6 +112,8 @@ def generator_weather(seed: int, without: tuple = ()) -> dict:
     readings describe the hour exactly), ``"sky"`` (the generator's facade irradiance
     is the fit's own, held over each hour); :func:`replicate` also knows
     ``"substeps"`` (the room simulated in hourly steps of the fit's own inputs).
+    ``solar``: with ``"sky"`` left out, the fit's I_S the generator holds
+    (:func:`fit_inputs`: ``"facade"`` or ``"ghi"``).
     """
     import pvlib
 
@@ -164,11 +172,13 @@ def generator_weather(seed: int, without: tuple = ()) -> dict:
     i_s = np.clip(np.nan_to_num(np.asarray(poa["poa_global"], float)), 0.0, None)
     i_s[ghi_f <= 0] = 0.0
     if "sky" in without:  # the fit's facade irradiance, held over its hour
-        i_s = np.repeat(fit_inputs(hourly)["I_S"].to_numpy(), SUB)
+        i_s = np.repeat(fit_inputs(hourly, solar=solar)["I_S"].to_numpy(), SUB)
+    elif solar != "facade":
+        raise ValueError("solar 'ghi' needs the generator's sky model left out ('sky')")
     return {"fine": {"Te": te_f, "Pe": pe_f, "I_S": i_s}, "hourly": hourly, "t0": hours[0]}
 
 
-def fit_inputs(hourly: pd.DataFrame, models=(), full: bool = False):
+def fit_inputs(hourly: pd.DataFrame, models=(), full: bool = False, solar: str = "facade"):
     """The hourly inputs ``hbayes calibrate`` builds from the station record: the south
     facade by :func:`heritage_bayes.inputs.solar_inputs` (an hour-ending mean, held over
     its hour) and :func:`align` on 1 h.
@@ -178,13 +188,18 @@ def fit_inputs(hourly: pd.DataFrame, models=(), full: bool = False):
     ``hbayes calibrate`` adds them with ``data.input_hold: exact``: the change of each
     instantaneous reading over the step (the first-order hold), zeros for the
     hour-ending irradiance means. ``full``: the :class:`~heritage_bayes.io.Aligned`
-    too, as ``(frame, aligned)``."""
+    too, as ``(frame, aligned)``. ``solar="ghi"``: the global horizontal irradiance
+    itself as I_S (an hour-ending mean, held over its hour), not the facade."""
     from heritage_bayes.inputs import add_slope_columns, solar_inputs
     from heritage_bayes.io.align import align
 
     # the facade as prepare builds it (its transposition, albedo and labels: the
     # irradiance stays an hour-ending mean, held over its hour)
-    irr = solar_inputs(hourly[["ghi"]], SITE, {"S": (90.0, 180.0)}, "measured")[0]
+    if solar == "ghi":
+        irr = hourly[["ghi"]].rename(columns={"ghi": "I_S"})
+        irr.attrs.update(averaged=("I_S",), interval="1h", source="station")
+    else:
+        irr = solar_inputs(hourly[["ghi"]], SITE, {"S": (90.0, 180.0)}, "measured")[0]
     met = hourly[["Te", "Pe"]].copy()
     met.attrs.update(averaged=(), interval="1h", source="station")
     aligned = align([met, irr], step="1h", max_gap="0h")
@@ -207,11 +222,12 @@ def replicate(args) -> dict:
     without = args[8] if len(args) > 8 else ()
     hold = args[9] if len(args) > 9 else "exact"
     noise_free = args[10] if len(args) > 10 else False
+    solar = args[11] if len(args) > 11 else "facade"
     rng = np.random.default_rng([seed, rep])
     opts = {"surfaces": ("S",)} if name.startswith("thermal") else {}
     model = hb.model(name, **opts)
     p = truth(model, rng, floor)
-    gw = generator_weather(int(rng.integers(2**31)), without)
+    gw = generator_weather(int(rng.integers(2**31)), without, solar)
     fine = gw["fine"]
     nf = fine["Te"].size
     Uf = np.column_stack([fine[c] if c in fine else np.full(nf, 10.0) for c in model.input_names])
@@ -224,7 +240,7 @@ def replicate(args) -> dict:
     y_hour = X[::SUB, model.state_names.index(out)]  # the node at every full hour
     # the fit's model and inputs, as hbayes calibrate builds them for this input hold
     fit_model = model.with_slopes(model.network.inputs if hold == "exact" else ())
-    frame = fit_inputs(gw["hourly"], [fit_model])
+    frame = fit_inputs(gw["hourly"], [fit_model], solar=solar)
     U = np.column_stack(
         [
             frame[c].to_numpy(float) if c in frame else np.full(len(frame), 10.0)
@@ -285,6 +301,8 @@ def replicate(args) -> dict:
         # parts of the generator left out (--without)
         "without": sorted(without),
         "noise_free": bool(noise_free),
+        # the solar input I_S of generator and fit (--solar)
+        "solar": solar,
         # the fit's upper bounds on the hygric buffer from the envelope area
         "hygric_envelope": bool(envelope) and not name.startswith("thermal"),
         # the fixed node's Pf and Gf drawn from, and fitted with, the physical priors
@@ -441,6 +459,8 @@ def read_logs(paths: list[str]) -> list[dict]:
                 # node (Pf uniform 900-1400 Pa in the truths, 0-5 000 Pa in the fit)
                 if r["model"] == "hygric_2c_fixed" and r.get("fixed_node_prior") is None:
                     r["variants"] = {f"{v}@flat_pf": x for v, x in r["variants"].items()}
+                if r.get("solar", "facade") != "facade":
+                    r["variants"] = {f"{v}@{r['solar']}": x for v, x in r["variants"].items()}
                 if r.get("noise_free"):
                     r["variants"] = {f"{v}@noise_free": x for v, x in r["variants"].items()}
                 key = (r["model"], int(r["rep"]))
@@ -665,6 +685,14 @@ def main(argv=None) -> int:
         "prior's pull), in the study's own sd; tabulated as NOISE:INIT@noise_free",
     )
     ap.add_argument(
+        "--solar",
+        choices=("facade", "ghi"),
+        default="facade",
+        help="the solar input I_S: the south facade (default) or, with --without sky, the "
+        "global horizontal irradiance in generator and fit alike (bench_sbc.py's input); "
+        "tabulated as NOISE:INIT@ghi",
+    )
+    ap.add_argument(
         "--table",
         nargs="+",
         metavar="LOG",
@@ -692,6 +720,8 @@ def main(argv=None) -> int:
     parts = {"within_hour", "sky", "substeps"}
     if set(without) - parts:
         ap.error(f"--without: unknown {sorted(set(without) - parts)}; use {sorted(parts)}")
+    if args.solar != "facade" and "sky" not in without:
+        ap.error("--solar ghi: with --without sky (the generator's sky model is a facade's)")
     if args.paired:
         a, b = (read_logs([p]) for p in args.paired)
         print(f"paired z: {args.paired[0]} - {args.paired[1]}")
@@ -732,6 +762,7 @@ def main(argv=None) -> int:
             without,
             args.input_hold,
             args.noise_free,
+            args.solar,
         )
         for r in range(args.first_rep, args.first_rep + args.reps)
         for m in args.models.split(",")

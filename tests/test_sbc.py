@@ -272,3 +272,69 @@ def test_paired_lines_difference_of_z_on_the_same_rooms():
     (line,) = bench.paired_lines(a, b)
     assert "(3 rooms in both)" in line
     assert "tau_1_h corr +1.00, diff +1.00 / 0.00 / 1.00" in line
+
+
+def test_facade_solar_input_is_what_calibrate_computes():
+    """``--solar facade``: the same weather stretch (Te, Pe unchanged) with the south
+    facade of ``hbayes calibrate`` as I_S, i.e. ``bench_sbc_independent.fit_inputs``'s
+    I_S for the same hourly record (row k the mean over the hour from row k)."""
+    bench = pytest.importorskip("bench_sbc_independent")
+    ghi, fac = bench_sbc.weather(5), bench_sbc.weather(5, "facade")
+    np.testing.assert_array_equal(ghi["Te"], fac["Te"])
+    np.testing.assert_array_equal(ghi["Pe"], fac["Pe"])
+    assert fac["I_S"].shape == ghi["I_S"].shape and np.all(fac["I_S"] >= 0)
+    w = bench_sbc._knmi_cache()
+    n = ghi["Te"].size
+    start = int(np.random.default_rng(5).integers(0, len(w) - n))  # as weather draws it
+    hourly = w.iloc[start : start + n + 1][["Te", "RHe", "ghi"]].interpolate(limit_direction="both")
+    hourly = hourly.assign(Pe=0.0)
+    hourly.attrs.update(averaged=("ghi",), interval="1h", source="station")
+    np.testing.assert_allclose(bench.fit_inputs(hourly)["I_S"].to_numpy(), fac["I_S"])
+    # the hour-ending ghi of row k + 1 is the hour the facade's row k averages
+    night = ghi["I_S"][1:] == 0
+    assert np.all(fac["I_S"][:-1][night] == 0)
+    with pytest.raises(ValueError, match="solar"):
+        bench_sbc.weather(5, "roof")
+
+
+def test_zscore_table_and_noise_lines():
+    """``--table``'s mean / sd of z and the noise posteriors against their truths."""
+
+    def room(rep, z, phi_med, sig_med):
+        v = {
+            "ranks": {"tau_1_h": {"median": 400.0 + 10.0 * z, "sd": 10.0}},
+            "posterior": {
+                "phi_Ti": {"median": phi_med, "sd": 0.01},
+                "sigma_Ti": {"median": sig_med, "sd": 0.01},
+            },
+            "corr_gain_Ti_I_S": {"phi_Ti": 0.5, "tau_1_h": -0.5 + rep},
+        }
+        return {
+            "model": "thermal_2c",
+            "rep": rep,
+            "truth": {"tau_1_h": 400.0},
+            "noise_truth": {"phi": 0.9, "sd": 0.2, "sensor": 0.1},
+            "variants": {"ar1_white:estimate": v},
+        }
+
+    rs = [room(0, 1.0, 0.92, 0.3), room(1, -1.0, 0.94, 0.1)]
+    (line,) = bench_sbc.zscore_table(rs, "ar1_white:estimate")
+    assert "tau_1_h +0.00 / 1.41 (1/2)" in line
+    noise, corr = bench_sbc.noise_lines(rs, "ar1_white:estimate")
+    assert "sigma_Ti median / truth 1.000" in noise and "phi_Ti median - truth +0.030" in noise
+    assert "phi_Ti +0.50 (+0.50..+0.50)" in corr and "tau_1_h +0.00 (-0.50..+0.50)" in corr
+
+
+def test_independent_generator_with_ghi_as_the_solar_input():
+    """``bench_sbc_independent --without sky --solar ghi``: the fit's I_S is the hourly
+    ghi aligned as an hour-ending mean (row k the hour ending at row k + 1), which the
+    generator holds over each hour; Te and Pe are those of the facade rooms."""
+    bench = pytest.importorskip("bench_sbc_independent")
+    fac = bench.generator_weather(3, ("sky",))
+    gw = bench.generator_weather(3, ("sky",), "ghi")
+    np.testing.assert_array_equal(gw["fine"]["Te"], fac["fine"]["Te"])
+    frame = bench.fit_inputs(gw["hourly"], solar="ghi")
+    np.testing.assert_allclose(frame["I_S"].to_numpy(), gw["hourly"]["ghi"].to_numpy()[1:])
+    np.testing.assert_allclose(gw["fine"]["I_S"], np.repeat(frame["I_S"].to_numpy(), bench.SUB))
+    with pytest.raises(ValueError, match="sky"):
+        bench.generator_weather(3, (), "ghi")

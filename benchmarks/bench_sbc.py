@@ -506,6 +506,24 @@ def table(results: list[dict], variant: str, quantities: dict | None = None) -> 
     return lines
 
 
+def room_zscores(
+    results: list[dict], variant: str, name: str, quantities: dict | None = None
+) -> tuple[list[dict], dict]:
+    """The rooms of ``name`` fitted with ``variant`` and, per quantity of
+    ``quantities`` (default :data:`QUANTITIES`), z = (posterior median - truth) /
+    posterior sd of each room (NaN where not ranked)."""
+    rs = [r for r in results if r["model"] == name and variant in r["variants"]]
+    z = {}
+    for k in (QUANTITIES if quantities is None else quantities).get(name, ()):
+        vals = []
+        for r in rs:
+            x = r["variants"][variant]["ranks"].get(k)
+            ok = x is not None and x["sd"] > 0
+            vals.append((x["median"] - r["truth"][k]) / x["sd"] if ok else np.nan)
+        z[k] = np.array(vals)
+    return rs, z
+
+
 def zscore_table(results: list[dict], variant: str) -> list[str]:
     """Per model and quantity of ``variant``: mean and sd of z = (posterior median -
     truth) / posterior sd over the replicates (calibrated: mean 0 ± 1/sqrt(n), sd 1)
@@ -513,17 +531,8 @@ def zscore_table(results: list[dict], variant: str) -> list[str]:
     lines = []
     for name in sorted({r["model"] for r in results}):
         parts = []
-        for k in QUANTITIES.get(name, ()):
-            z = np.array(
-                [
-                    (x["median"] - r["truth"][k]) / x["sd"]
-                    for r in results
-                    if r["model"] == name
-                    and variant in r["variants"]
-                    and (x := r["variants"][variant]["ranks"].get(k))
-                    and x["sd"] > 0
-                ]
-            )
+        for k, z in room_zscores(results, variant, name)[1].items():
+            z = z[np.isfinite(z)]
             if z.size > 1:
                 parts.append(
                     f"{k} {z.mean():+.2f} / {z.std(ddof=1):.2f} ({int(np.sum(z > 0))}/{z.size})"

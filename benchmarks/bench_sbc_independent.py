@@ -74,6 +74,7 @@ from bench_sbc import (  # the benchmark directory is not a package
     _knmi_cache,
     fit_and_rank,
     print_study,
+    room_zscores,
     run_tasks,
     simulate_reference,
     table,
@@ -484,33 +485,19 @@ def zscore_lines(results: list[dict], variant: str) -> list[str]:
     too narrow otherwise (with n replicates its standard error is about 1/sqrt(2n))."""
     lines = []
     for name in sorted({r["model"] for r in results}):
-        rs = [r for r in results if r["model"] == name and variant in r["variants"]]
-        parts = []
-        for k in QUANTITIES.get(name, ()):
-            z = [
-                (x["median"] - r["truth"][k]) / x["sd"]
-                for r in rs
-                if (x := r["variants"][variant]["ranks"].get(k)) and x["sd"] > 0
-            ]
-            if z:
-                parts.append(f"{k} {np.sqrt(np.mean(np.square(z))):.2f}")
+        rs, zs = _zscores(results, variant, name)
+        parts = [
+            f"{k} {np.sqrt(np.mean(np.square(z[np.isfinite(z)]))):.2f}"
+            for k, z in zs.items()
+            if np.isfinite(z).any()
+        ]
         lines.append(f"  {name} [{variant}] z rms ({len(rs)} rooms): " + ", ".join(parts))
     return lines
 
 
 def _zscores(results: list[dict], variant: str, name: str) -> tuple[list[dict], dict]:
-    """The rooms of ``name`` fitted with ``variant`` and, per quantity, z = (posterior
-    median - truth) / posterior sd of each room (NaN where not ranked)."""
-    rs = [r for r in results if r["model"] == name and variant in r["variants"]]
-    z = {}
-    for k in QUANTITIES.get(name, ()):
-        vals = []
-        for r in rs:
-            x = r["variants"][variant]["ranks"].get(k)
-            ok = x is not None and x["sd"] > 0
-            vals.append((x["median"] - r["truth"][k]) / x["sd"] if ok else np.nan)
-        z[k] = np.array(vals)
-    return rs, z
+    """:func:`bench_sbc.room_zscores` with this study's quantities (the solar warming)."""
+    return room_zscores(results, variant, name, QUANTITIES)
 
 
 def bias_lines(results: list[dict], variant: str) -> list[str]:

@@ -156,8 +156,8 @@ def run_compare(
         and ``workers - 1`` worker processes the others, each calibrating one
         candidate and exiting: memory holds one model's calibration per process, and
         no idle parent holds a copy of the libraries. The comparison then reads the
-        runs one at a time. Every candidate has its own seed-determined chain, so the results do not
-        depend on ``workers``.
+        runs one at a time. Every candidate has its own seed-determined chain, so the
+        results do not depend on ``workers``.
 
     Raises
     ------
@@ -218,15 +218,12 @@ def run_compare(
             ctx = multiprocessing.get_context("spawn")  # no forked numba/BLAS threads
             pool_size = min(n_workers - 1, len(rest))
             with ProcessPoolExecutor(pool_size, mp_context=ctx, max_tasks_per_child=1) as pool:
+                quiet_kw = {**kwargs, "quiet": True}
                 futs = {
-                    pool.submit(
-                        _calibrate_candidate, cands[n], str(out / n), {**kwargs, "quiet": True}
-                    ): n
+                    pool.submit(_calibrate_candidate, cands[n], str(out / n), quiet_kw): n
                     for n in rest
                 }
-                run_dir, wall, cpu = _calibrate_candidate(
-                    cands[own], str(out / own), {**kwargs, "quiet": True}
-                )
+                run_dir, wall, cpu = _calibrate_candidate(cands[own], str(out / own), quiet_kw)
                 dirs[own] = Path(run_dir)
                 tell(f"{own} done ({wall:.0f} s wall, {cpu:.0f} s CPU)")
                 _release_memory()  # while the workers run on

@@ -189,39 +189,33 @@ def convergence_verdict(summary: dict, residuals: list[dict] | None = None) -> d
                 )
             else:
                 problems.append("the autocorrelation-time (τ) criterion was not met")
-        saved = []  # the saved draws' R-hat / ESS beyond the targets, in words
+        rhat_text = ess_text = None  # the saved draws' R-hat / ESS beyond the targets
         if pr:
             worst_r = max(pr, key=lambda k: _nan_low(pr[k].get("r_hat")))
             worst_e = min(pr, key=lambda k: _nan_high(pr[k].get("ess_bulk")))
             rmax = _nan_low(pr[worst_r].get("r_hat"))
             emin = _nan_high(pr[worst_e].get("ess_bulk"))
             if not rmax <= r_ok:
-                saved.append((f"R-hat up to {rmax:.3f} for {worst_r}", "the walkers disagree"))
+                rhat_text = f"R-hat up to {rmax:.3f} for {worst_r}"
             if not emin >= e_ok:
-                saved.append(
-                    (
-                        f"bulk ESS down to {fmt_int(emin)} for {worst_e}",
-                        "too few independent samples",
-                    )
-                )
+                ess_text = f"bulk ESS down to {fmt_int(emin)} for {worst_e}"
         name = f"{m} ({info.get('model', '?')})"
+        saved = [t for t in (rhat_text, ess_text) if t]
         if rule_ok and not problems and saved:
             # the stopping rule, checked on the sampler's retained draws, decided: the
             # saved subset's figures are stated, not counted against the run
             lines.append(
                 f"{name}: all criteria of the stopping rule met on the sampler's retained "
                 "draws; the draws saved in posterior.nc give "
-                + " and ".join(t for t, _ in saved)
+                + " and ".join(saved)
                 + f" (targets R-hat ≤ {r_ok:g}, ESS ≥ {e_ok:g}): a thinned subset in the "
                 "parameters' own coordinates, whose R-hat and ESS scatter about the rule's."
             )
             continue
-        problems += [
-            f"{why}: {t} (should be ≤ {r_ok:g})"
-            if t.startswith("R-hat")
-            else f"{why}: {t} (should be ≥ {e_ok:g})"
-            for t, why in saved
-        ]
+        if rhat_text:
+            problems.append(f"the walkers disagree: {rhat_text} (should be ≤ {r_ok:g})")
+        if ess_text:
+            problems.append(f"too few independent samples: {ess_text} (should be ≥ {e_ok:g})")
         if problems:
             lines.append(f"{name}: " + "; ".join(problems) + ".")
         else:

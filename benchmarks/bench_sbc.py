@@ -142,6 +142,9 @@ def _solve_capacity(A_of_cw, target_tau_h: float) -> float:
 #: priors (:func:`~heritage_bayes.inference.parameters.fixed_vapour_pressure_prior`,
 #: :func:`~heritage_bayes.inference.parameters.vapour_ground_prior`).
 HYGRIC_TRUTH = {"Gw": (5e-9, 5e-8), "Gi": (3e-7, 3e-6), "Gf": (2e-8, 2e-7)}
+#: log-uniform ranges of the thermal truths [W/K], [W/K], [W/K] (Gf: without a floor
+#: area), [m²]
+THERMAL_TRUTH = {"Gw": (80.0, 400.0), "Gi": (300.0, 2000.0), "Gf": (5.0, 40.0), "fI_S": (1.0, 6.0)}
 #: sd of log(Ci) and log(Gfast) of the truths around the volume's priors' medians
 TRUTH_SIGMA = 0.5
 #: ``--flat-fixed-node``: the study before the node's physical priors: truths of Pf
@@ -165,22 +168,27 @@ def ground_temperature() -> float:
 def truth_priors(
     model, floor_area: float | None = None, flat_node: bool = False
 ) -> dict[str, dict]:
-    """Prior specs equal to the distributions :func:`truth` draws a hygric model's
-    parameters from (``Cw`` excepted: it is solved for a slow time constant of 2-3
-    weeks, and keeps the fit's default prior). SBC is exact only when the truths are
-    drawn from the prior the fit uses: ``--truth-priors`` measures what is left of a
-    bias once the prior and the truth distribution agree."""
-    from heritage_bayes.inference.parameters import air_capacity_prior, ventilation_prior
+    """Prior specs equal to the distributions :func:`truth` draws a model's parameters
+    from (``Cw`` excepted: it is solved for a slow time constant of 2-3 weeks, and keeps
+    the fit's default prior). SBC is exact only when the truths are drawn from the prior
+    the fit uses: ``--truth-priors`` measures what is left of a bias once the prior and
+    the truth distribution agree."""
+    from heritage_bayes.inference.parameters import (
+        air_capacity_prior,
+        ground_prior,
+        ventilation_prior,
+    )
 
     dom = model.domain
-    if dom != "hygric":
-        raise ValueError("--truth-priors: for the hygric models only")
-    drawn = ("Gw", "Gi") if floor_area and not flat_node else ("Gw", "Gi", "Gf")
+    ranges = HYGRIC_TRUTH if dom == "hygric" else THERMAL_TRUTH
+    drawn = ("Gw", "Gi", "fI_S") if floor_area and not flat_node else ("Gw", "Gi", "Gf", "fI_S")
     out = {
         k: {"dist": "loguniform", "lower": lo, "upper": hi}
-        for k, (lo, hi) in HYGRIC_TRUTH.items()
+        for k, (lo, hi) in ranges.items()
         if k in model.parameter_names and k in drawn
     }
+    if dom == "thermal" and floor_area and "Gf" in model.parameter_names:
+        out["Gf"] = {"dist": "lognormal", "median": ground_prior(floor_area).mu, "sigma": 0.5}
     for name, prior in (
         ("Ci", air_capacity_prior(dom, VOLUME)),
         ("Gfast", ventilation_prior(dom, VOLUME, ACH)),
@@ -215,10 +223,7 @@ def truth(model, rng, floor_area: float | None = None, flat_node: bool = False) 
     }
     if dom == "thermal":
         p.update(
-            Gw=float(np.exp(rng.uniform(np.log(80), np.log(400)))),
-            Gi=float(np.exp(rng.uniform(np.log(300), np.log(2000)))),
-            Gf=float(np.exp(rng.uniform(np.log(5), np.log(40)))),
-            fI_S=float(np.exp(rng.uniform(np.log(1), np.log(6)))),
+            **{k: float(np.exp(rng.uniform(*np.log(THERMAL_TRUTH[k])))) for k in THERMAL_TRUTH}
         )
     else:
         for k in ("Gw", "Gi"):
@@ -268,17 +273,41 @@ def simulate_reference(model, params, U: np.ndarray, dt: float = DT, x0=None) ->
 
 def replicate(args) -> dict:
     """One room: generate, calibrate, and rank the truth of each quantity."""
+    room = room_data(args)
+    model, rows, y, result = room["model"], room["rows"], room["y"], room["result"]
+    variants, max_steps = args[2], args[4]
+    priors = args[6] if len(args) > 6 else {}
+    floor = args[7] if len(args) > 7 else None
+    envelope = args[9] if len(args) > 9 else None
+    result["variants"] = fit_and_rank(
+        model,
+        room["U"][rows],
+        y,
+        result["truth"],
+        variants,
+        args[1],
+        max_steps,
+        priors,
+        floor,
+        envelope,
+    )
+    return result
+
+
+def room_data(args) -> dict:
+    """One replicate's room as :func:`replicate` generates it (``args``: its task):
+    ``model``, the inputs ``U`` (all rows, spin-up included), the calibration ``rows``,
+    the observations ``y`` (N,) of those rows (NaN: the gap) and the log line's
+    ``result`` so far (truths, noise truths)."""
     import heritage_bayes as hb
     from heritage_bayes.rc.derived import derived_quantities
 
     name, rep, variants, seed, max_steps = args[:5]
     cal_days = args[5] if len(args) > 5 else CAL_DAYS
-    priors = args[6] if len(args) > 6 else {}
     floor = args[7] if len(args) > 7 else None
     # (noise draw, components left out): the same room, weather and start with fresh
     # observation noise (see repeat_room); None: the study's own draw, every component
     redraw, without = args[8] if len(args) > 8 else (None, ())
-    envelope = args[9] if len(args) > 9 else None
     flat_node = args[10] if len(args) > 10 else False
     solar = args[11] if len(args) > 11 else "ghi"
     rng = np.random.default_rng([seed, rep])
@@ -319,10 +348,7 @@ def replicate(args) -> dict:
     result["noise_truth"] = {"phi": float(phi), "sd": float(sd), "sensor": sensor}
     if "I_S" in model.input_names:
         result["solar"] = solar
-    result["variants"] = fit_and_rank(
-        model, U[rows], y, dq_true, variants, rep, max_steps, priors, floor, envelope
-    )
-    return result
+    return {"model": model, "U": U, "rows": rows, "y": y, "result": result}
 
 
 def fit_and_rank(
@@ -453,6 +479,116 @@ def fit_and_rank(
         if temper:
             out[variant].update(temperature=lp.temperature, kappa_by_bandwidth=kappas)
     return out
+
+
+def likelihood_at_truth(room: dict, variant: dict, floor, envelope, priors=None) -> dict:
+    """The likelihood ratio of the truth against the maximum, for one fitted room.
+
+    ``room`` from :func:`room_data`, ``variant`` its log line's entry for
+    ``ar1_white:estimate`` (its MAP starts the search). Returns ``{"lr": 2Δ, "df": k}``:
+    2Δ = 2 (max log L − max over the noise parameters of log L at the true model
+    parameters), log L the likelihood the fit samples (start state integrated out).
+    If that likelihood is the data's, 2Δ follows χ² with k = the number of model
+    parameters less the one scale direction hourly data leave to the priors (Wilks);
+    and a quantity's marginal z (median − truth)/sd then rarely exceeds √(2Δ)
+    (never, for a Gaussian posterior without a prior).
+    """
+    from scipy.optimize import minimize
+    from scipy.special import expit, logit
+
+    from heritage_bayes.config import ModelSection
+    from heritage_bayes.inference.likelihoods import get_noise_model
+    from heritage_bayes.inference.parameters import parameters_for
+    from heritage_bayes.inference.posterior import LogPosterior
+
+    model = room["model"]
+    noise = get_noise_model("ar1_white")
+    ps = parameters_for(
+        model,
+        noise,
+        dict(priors or {}),
+        room_volume=VOLUME,
+        air_change_rate=ACH,
+        floor_area=floor,
+        envelope_area=envelope,
+        fixed_node_temperature=ground_temperature() if "Pf" in model.parameter_names else None,
+    )
+    lp = LogPosterior(
+        model,
+        ps,
+        noise,
+        room["U"][room["rows"]],
+        room["y"][:, None],
+        init_window=720,
+        initial_state="estimate",
+        time_constant_cap=ModelSection(model=model.name).cap_seconds(model.domain),
+    )
+    names, nm = ps.names, lp.n_model
+    is_phi = np.array([n.startswith("phi_") for n in names])
+
+    def to_theta(v):  # log scale, phi on the logit scale
+        return np.where(is_phi, expit(v), np.exp(v))
+
+    def to_v(theta):
+        return np.where(is_phi, logit(theta), np.log(theta))
+
+    def nll(theta):
+        return -float(lp.log_likelihood(theta[None])[0])
+
+    opts = {"maxiter": 20_000, "xatol": 1e-7, "fatol": 1e-5}
+    start = np.array([variant["map"][n] for n in names])
+    best = minimize(lambda v: nll(to_theta(v)), to_v(start), method="Nelder-Mead", options=opts)
+    for _ in range(2):  # restarts: Nelder-Mead stalls in 10 dimensions
+        best = minimize(lambda v: nll(to_theta(v)), best.x, method="Nelder-Mead", options=opts)
+    tm = np.array([room["result"]["truth_parameters"][n] for n in names[:nm]])
+    at_truth = minimize(
+        lambda v: nll(np.concatenate([tm, to_theta(np.r_[np.zeros(nm), v])[nm:]])),
+        to_v(start)[nm:],
+        method="Nelder-Mead",
+        options=opts,
+    )
+    return {"lr": float(2.0 * (at_truth.fun - best.fun)), "df": nm - 1}
+
+
+def lr_study(log: str, task) -> None:
+    """``--lr LOG``: :func:`likelihood_at_truth` for every converged room of an earlier
+    study's log (regenerated from ``task(model, rep)``, which must be that study's
+    settings: the truths are checked) and each quantity's z against √(2Δ)."""
+    from scipy import stats
+
+    results = [json.loads(line) for line in open(log)]
+    rows = []
+    for r in results:
+        v = r["variants"].get("ar1_white:estimate")
+        if v is None or not v["converged"]:
+            continue
+        args = task(r["model"], r["rep"])
+        room = room_data(args)
+        if room["result"]["truth_parameters"] != r["truth_parameters"]:
+            raise SystemExit(f"--lr: room {r['rep']} differs from the log's: other settings?")
+        out = likelihood_at_truth(room, v, args[7], args[9], args[6])
+        z = {k: (g["median"] - r["truth"][k]) / g["sd"] for k, g in v["ranks"].items()}
+        rows.append((r["rep"], out["lr"], out["df"], z))
+        zs = "  ".join(f"{k} {x:+.2f}" for k, x in z.items())
+        print(
+            f"  room {r['rep']:3d}: 2Δ {out['lr']:6.1f} (χ²_{out['df']} p "
+            f"{stats.chi2.sf(out['lr'], out['df']):.3f})  z: {zs}",
+            flush=True,
+        )
+    lr = np.array([x[1] for x in rows])
+    df = rows[0][2]
+    print(
+        f"{len(rows)} rooms: 2Δ at the truth, median {np.median(lr):.1f} (χ²_{df}: "
+        f"{stats.chi2.median(df):.1f}), mean {lr.mean():.1f} ({df}); above χ²_{df}'s 90 % "
+        f"quantile {np.mean(lr > stats.chi2.ppf(0.9, df)):.2f} (0.10); KS p "
+        f"{stats.kstest(lr, stats.chi2(df).cdf).pvalue:.3f}"
+    )
+    for k in rows[0][3]:
+        zk = np.array([x[3].get(k, np.nan) for x in rows])
+        print(
+            f"  {k:16s} rooms with z² > 2Δ: {int(np.sum(zk**2 > lr))} of {len(rows)}; "
+            f"|z| > 2: {int(np.sum(np.abs(zk) > 2))}"
+        )
 
 
 QUANTITIES = {
@@ -691,7 +827,7 @@ def main() -> None:
     ap.add_argument(
         "--truth-priors",
         action="store_true",
-        help="give every hygric fit priors equal to the distributions the truths are drawn "
+        help="give every fit priors equal to the distributions the truths are drawn "
         "from (Cw excepted): SBC as its theory has it, to separate a prior-volume bias from "
         "a likelihood or sampler one",
     )
@@ -726,6 +862,13 @@ def main() -> None:
         "computes from the hourly record: Erbs + Perez); recorded in each log line",
     )
     ap.add_argument("--table", help="only tabulate a --log file of an earlier study")
+    ap.add_argument(
+        "--lr",
+        metavar="LOG",
+        help="the likelihood ratio of the truth against the maximum for each converged "
+        "room of an earlier study's log (give the study's own --seed, --solar, ...): "
+        "χ² if the fit's likelihood is the data's; against each quantity's z",
+    )
     ap.add_argument(
         "--room",
         type=int,
@@ -790,6 +933,9 @@ def main() -> None:
             args.solar,
         )
 
+    if args.lr:
+        lr_study(args.lr, task)
+        return
     if args.room is not None:
         without = tuple(w for w in args.without.split(",") if w)
         unknown = set(without) - {"model_error", "rounding", "gap"}

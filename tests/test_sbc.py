@@ -75,6 +75,52 @@ def test_hygric_truths_of_the_fixed_node_are_drawn_from_the_fit_priors():
     assert all(900.0 <= d["Pf"] <= 1400.0 and 2e-8 <= d["Gf"] <= 2e-7 for d in flat)
 
 
+def test_thermal_truth_priors_are_the_distributions_the_truths_come_from():
+    """``--truth-priors`` on thermal_2c: each drawn parameter's prior is the distribution
+    its truths follow (log-uniform ranges, log-normal around the survey's medians); 300
+    truths checked against each prior's support and, for the log-normal ones, mean and
+    sd of log(x / median) within 4 standard errors."""
+    import heritage_bayes as hb
+
+    model = hb.model("thermal_2c", surfaces=("S",))
+    priors = bench_sbc.truth_priors(model, bench_sbc.FLOOR)
+    assert set(priors) == {"Gw", "Gi", "fI_S", "Gf", "Ci", "Gfast"}  # Cw: solved for τ1
+    rng = np.random.default_rng(11)
+    draws = [bench_sbc.truth(model, rng, bench_sbc.FLOOR) for _ in range(300)]
+    for name, spec in priors.items():
+        x = np.array([d[name] for d in draws])
+        if spec["dist"] == "loguniform":
+            assert spec["lower"] <= x.min() and x.max() <= spec["upper"], name
+            # and they fill the range: a quarter of the log-range at each end is used
+            span = np.log(spec["upper"] / spec["lower"])
+            assert np.log(x.min() / spec["lower"]) < span / 4, name
+            assert np.log(spec["upper"] / x.max()) < span / 4, name
+        else:
+            z = np.log(x / spec["median"])
+            assert abs(z.mean()) < 4 * spec["sigma"] / np.sqrt(300), name
+            assert abs(z.std() - spec["sigma"]) < 4 * spec["sigma"] / np.sqrt(600), name
+
+
+def test_likelihood_ratio_at_the_truth_tells_the_truth_from_a_wrong_room():
+    """``--lr``: 2Δ of the true parameters is of the size χ²_6 gives (below its 99.9 %
+    quantile), and of a room whose solar aperture is taken twice the truth far above it
+    (the same data: the diagnostic sees the difference)."""
+    task = ("thermal_2c", 0, [], 7, 0, 28, {}, bench_sbc.FLOOR, (None, ()), bench_sbc.ENVELOPE)
+    room = bench_sbc.room_data(task)
+    res = room["result"]
+    nt = res["noise_truth"]
+    start = dict(res["truth_parameters"])
+    start.update(
+        sigma_Ti=nt["sd"], phi_Ti=nt["phi"], sigma_meas_Ti=float(np.hypot(nt["sensor"], 0.029))
+    )
+    out = bench_sbc.likelihood_at_truth(room, {"map": start}, bench_sbc.FLOOR, bench_sbc.ENVELOPE)
+    assert out["df"] == 6
+    assert -0.1 < out["lr"] < stats.chi2.ppf(0.999, 6)
+    res["truth_parameters"] = {**res["truth_parameters"], "fI_S": 2 * start["fI_S"]}
+    wrong = bench_sbc.likelihood_at_truth(room, {"map": start}, bench_sbc.FLOOR, bench_sbc.ENVELOPE)
+    assert wrong["lr"] > 10 * stats.chi2.ppf(0.999, 6)
+
+
 # ------------------------------------------- the independent generator (issue 31)
 def test_independent_generator_machinery():
     """One thermal room of ``bench_sbc_independent`` (the full study: 50 replicates per

@@ -166,13 +166,14 @@ def ground_temperature() -> float:
 
 
 def truth_priors(
-    model, floor_area: float | None = None, flat_node: bool = False
+    model, floor_area: float | None = None, flat_node: bool = False, cw_range=None
 ) -> dict[str, dict]:
     """Prior specs equal to the distributions :func:`truth` draws a model's parameters
-    from (``Cw`` excepted: it is solved for a slow time constant of 2-3 weeks, and keeps
-    the fit's default prior). SBC is exact only when the truths are drawn from the prior
-    the fit uses: ``--truth-priors`` measures what is left of a bias once the prior and
-    the truth distribution agree."""
+    from (``Cw`` excepted unless ``cw_range`` (lo, hi) [J/K or kg/Pa] draws it too: it is
+    otherwise solved for a slow time constant of 2-3 weeks, and keeps the fit's default
+    prior). SBC is exact only when the truths are drawn from the prior the fit uses:
+    ``--truth-priors`` measures what is left of a bias once the prior and the truth
+    distribution agree."""
     from heritage_bayes.inference.parameters import (
         air_capacity_prior,
         ground_prior,
@@ -196,10 +197,14 @@ def truth_priors(
         out[name] = {"dist": "lognormal", "median": prior.mu, "sigma": TRUTH_SIGMA}
     if flat_node and "Pf" in model.parameter_names:
         out["Pf"] = {"dist": "uniform", "lower": PF_FLAT[0], "upper": PF_FLAT[1]}
+    if cw_range is not None:
+        out["Cw"] = {"dist": "loguniform", "lower": cw_range[0], "upper": cw_range[1]}
     return out
 
 
-def truth(model, rng, floor_area: float | None = None, flat_node: bool = False) -> dict[str, float]:
+def truth(
+    model, rng, floor_area: float | None = None, flat_node: bool = False, cw_range=None
+) -> dict[str, float]:
     """True parameters: air capacity and ventilation near the prior knowledge, the rest
     log-uniform, and the envelope capacity set for a slow tau of 2-3 weeks. With
     ``floor_area`` [m²] the ground coupling Gf too is drawn near the prior knowledge
@@ -247,7 +252,10 @@ def truth(model, rng, floor_area: float | None = None, flat_node: bool = False) 
         q = {**p, "Cw": cw}
         return model.state_space({k: q[k] for k in model.parameter_names})[0]
 
-    p["Cw"] = _solve_capacity(A_of, target)
+    if cw_range is None:
+        p["Cw"] = _solve_capacity(A_of, target)
+    else:  # drawn like the others (the same stream: the rest of the room is unchanged)
+        p["Cw"] = float(np.exp(rng.uniform(*np.log(cw_range))))
     return {k: float(p[k]) for k in model.parameter_names}
 
 
@@ -279,6 +287,7 @@ def replicate(args) -> dict:
     priors = args[6] if len(args) > 6 else {}
     floor = args[7] if len(args) > 7 else None
     envelope = args[9] if len(args) > 9 else None
+    tau_factor = args[12] if len(args) > 12 else 50.0
     result["variants"] = fit_and_rank(
         model,
         room["U"][rows],
@@ -290,6 +299,7 @@ def replicate(args) -> dict:
         priors,
         floor,
         envelope,
+        tau_factor=tau_factor,
     )
     return result
 
@@ -313,7 +323,7 @@ def room_data(args) -> dict:
     rng = np.random.default_rng([seed, rep])
     opts = {"surfaces": ("S",)} if name in ("thermal_2c", "thermal_4a") else {}
     model = hb.model(name, **opts)
-    p = truth(model, rng, floor, flat_node)
+    p = truth(model, rng, floor, flat_node, args[13] if len(args) > 13 else None)
     w = weather(int(rng.integers(2**31)), solar if "I_S" in model.input_names else "ghi")
     U = np.column_stack(
         [w[c] if c in w else np.full(len(w["Te"]), 10.0) for c in model.input_names]
@@ -352,14 +362,27 @@ def room_data(args) -> dict:
 
 
 def fit_and_rank(
-    model, U, y, dq_true, variants, rep, max_steps, priors, floor, envelope, extra=None
+    model,
+    U,
+    y,
+    dq_true,
+    variants,
+    rep,
+    max_steps,
+    priors,
+    floor,
+    envelope,
+    extra=None,
+    tau_factor: float = 50.0,
 ) -> dict:
     """Calibrate one replicate with ``hbayes calibrate``'s defaults and rank the truths.
 
     ``U`` (N, m) inputs and ``y`` (N,) observations (NaN = missing) of the calibration
     period; ``dq_true`` the true derived quantities; ``extra`` an optional function
     ``(dq, theta) -> {name: draws}`` of further quantities (their truths in
-    ``dq_true``). Returns ``{variant: {ranks, converged, map, steps, cpu}}``.
+    ``dq_true``); ``tau_factor`` the convergence rule's chain length in τ (the
+    package's 50; larger: a longer chain than the rule asks for, ``--tau-factor``).
+    Returns ``{variant: {ranks, converged, map, steps, cpu}}``.
     """
     from heritage_bayes.config import ModelSection
     from heritage_bayes.inference.likelihoods import get_noise_model
@@ -424,6 +447,7 @@ def fit_and_rank(
             nwalkers=max(32, 2 * lp.ndim + 2),
             bounds=ps.bounds,
             max_steps=max_steps,
+            tau_factor=tau_factor,
         )
         Xd, _ = chain.draws(4000)
         theta = ps.values(Xd.reshape(-1, Xd.shape[-1]))
@@ -678,6 +702,45 @@ def zscore_table(results: list[dict], variant: str) -> list[str]:
     return lines
 
 
+def error_lines(results: list[dict], variant: str) -> list[str]:
+    """Which parameter's error goes with a gain's miss: over the rooms of each model
+    (log lines with ``posterior``), the Spearman correlation of a quantity's z with each
+    model parameter's (posterior median - truth) / posterior sd."""
+    from scipy import stats
+
+    lines = []
+    for name in sorted({r["model"] for r in results}):
+        rs, z = room_zscores(results, variant, name)
+        rs_ok = [r for r in rs if "posterior" in r["variants"][variant]]
+        if len(rs_ok) < 5 or len(rs_ok) != len(rs):
+            continue
+        params = list(rs[0]["truth_parameters"])
+        err = {
+            n: np.array(
+                [
+                    (r["variants"][variant]["posterior"][n]["median"] - r["truth_parameters"][n])
+                    / r["variants"][variant]["posterior"][n]["sd"]
+                    for r in rs
+                ]
+            )
+            for n in params
+        }
+        for k in ("gain_Ti_I_S", "gain_Ti_Te", "gain_Pi_Pe"):
+            ok = np.isfinite(z[k]) if k in z else np.zeros(0, bool)
+            if ok.sum() < 3:
+                continue
+            parts = [
+                f"{n} {stats.spearmanr(z[k][ok], e[ok]).statistic:+.2f}"
+                for n, e in err.items()
+                if np.ptp(e[ok]) > 0
+            ]
+            lines.append(
+                f"  {name} [{variant}] Spearman of {k}'s z with each parameter's error "
+                f"z over {int(ok.sum())} rooms: " + ", ".join(parts)
+            )
+    return lines
+
+
 def noise_lines(results: list[dict], variant: str) -> list[str]:
     """The thermal rooms' noise posteriors against the observation model's truths (log
     lines with ``posterior`` and ``noise_truth``): per noise parameter the median over
@@ -861,6 +924,24 @@ def main() -> None:
         "(global horizontal, default) or facade (the south facade hbayes calibrate "
         "computes from the hourly record: Erbs + Perez); recorded in each log line",
     )
+    ap.add_argument(
+        "--tau-factor",
+        type=float,
+        default=50.0,
+        help="chain length the convergence rule asks for, in τ (default 50, the package's): "
+        "a larger factor runs each fit longer than hbayes calibrate would, to see whether "
+        "a posterior changes with the chain's length (the sampler) or not (the posterior)",
+    )
+    ap.add_argument(
+        "--cw-range",
+        type=lambda v: tuple(float(x) for x in v.split(",")),
+        default=None,
+        metavar="LO,HI",
+        help="draw the envelope capacity Cw of the truths log-uniform on LO-HI [J/K or "
+        "kg/Pa] instead of solving it for a slow time constant of 2-3 weeks; with "
+        "--truth-priors the fit's prior on Cw is the same, so every parameter's truth "
+        "comes from the fit's prior (SBC as its theory has it)",
+    )
     ap.add_argument("--table", help="only tabulate a --log file of an earlier study")
     ap.add_argument(
         "--lr",
@@ -896,7 +977,8 @@ def main() -> None:
         found = sorted({v for r in results for v in r["variants"]})
         print(f"SBC table of {args.table}: {len(results)} replicates")
         for v in found:
-            for line in table(results, v) + zscore_table(results, v) + noise_lines(results, v):
+            lines = table(results, v) + zscore_table(results, v) + noise_lines(results, v)
+            for line in lines + error_lines(results, v):
                 print(line)
         return
     priors = {}
@@ -912,7 +994,11 @@ def main() -> None:
         import heritage_bayes as hb
 
         for m in args.models.split(","):
-            priors.update(truth_priors(hb.model(m), args.floor_area or None, args.flat_fixed_node))
+            priors.update(
+                truth_priors(
+                    hb.model(m), args.floor_area or None, args.flat_fixed_node, args.cw_range
+                )
+            )
     floor = args.floor_area or None
     envelope = args.envelope_area or None
 
@@ -931,6 +1017,8 @@ def main() -> None:
             envelope,
             args.flat_fixed_node,
             args.solar,
+            args.tau_factor,
+            args.cw_range,
         )
 
     if args.lr:

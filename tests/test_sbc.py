@@ -371,6 +371,31 @@ def test_zscore_table_and_noise_lines():
     assert "phi_Ti +0.50 (+0.50..+0.50)" in corr and "tau_1_h +0.00 (-0.50..+0.50)" in corr
 
 
+def test_error_lines_rank_a_gains_miss_with_each_parameters_error():
+    """``--table``'s Spearman of the solar gain's z with each parameter's error: +1 for
+    a parameter whose error follows the gain's z, -1 for one against it."""
+
+    def room(rep, z):
+        v = {
+            "ranks": {"gain_Ti_I_S": {"median": 0.01 + 0.001 * z, "sd": 0.001}},
+            "posterior": {
+                "Gw": {"median": 100.0 + 10.0 * z, "sd": 10.0},
+                "Cw": {"median": 4e8 - 1e7 * z**3, "sd": 1e7},
+            },
+        }
+        return {
+            "model": "thermal_2c",
+            "rep": rep,
+            "truth": {"gain_Ti_I_S": 0.01},
+            "truth_parameters": {"Gw": 100.0, "Cw": 4e8},
+            "variants": {"ar1_white:estimate": v},
+        }
+
+    rs = [room(k, z) for k, z in enumerate((-2.0, -0.5, 0.1, 0.7, 1.5, 3.0))]
+    (line,) = bench_sbc.error_lines(rs, "ar1_white:estimate")
+    assert "over 6 rooms: Gw +1.00, Cw -1.00" in line
+
+
 def test_independent_generator_with_ghi_as_the_solar_input():
     """``bench_sbc_independent --without sky --solar ghi``: the fit's I_S is the hourly
     ghi aligned as an hour-ending mean (row k the hour ending at row k + 1), which the

@@ -156,6 +156,13 @@ def main() -> None:
         help="write each chain (steps, walkers, d) in the log coordinates to "
         "<SAVE_CHAIN>_<problem>_<label>.npz with the free parameters' names",
     )
+    ap.add_argument(
+        "--seed",
+        type=int,
+        default=None,
+        help="the config's seed (MAP search and sampler; the demo's data keep theirs): "
+        "a second chain of the same problem, for the scatter of τ estimated from one chain",
+    )
     args = ap.parse_args()
     if args.p_global is not None:
         from heritage_bayes.inference.moves import GlobalDEMove
@@ -163,6 +170,8 @@ def main() -> None:
         GlobalDEMove.P_GLOBAL = args.p_global
     for name in args.problems:
         cfg = _config(*PROBLEMS[name])
+        if args.seed is not None:
+            cfg = cfg.model_copy(update={"seed": args.seed})
         section = PROBLEMS[name][1]
         _, model, lp, mp = config_map(cfg, section)
         coords = node_time_constants(

@@ -361,6 +361,44 @@ def room_data(args) -> dict:
     return {"model": model, "U": U, "rows": rows, "y": y, "result": result}
 
 
+def log_posterior(model, noise, U, y, priors, floor, envelope, init: str):
+    """The parameter set and log-posterior a replicate is fitted with: ``hbayes
+    calibrate``'s defaults (survey priors from the room's volume, air change rate, floor
+    and envelope areas; the soft cap on time constants) with ``priors`` (those of the
+    model's and the noise's parameters) over them, ``init`` the initial state
+    (``estimate`` or ``steady``, the latter with a 14-day warm-up)."""
+    from heritage_bayes.config import ModelSection
+    from heritage_bayes.inference.parameters import parameters_for
+    from heritage_bayes.inference.posterior import LogPosterior
+
+    # the model's parameters and (bench_sbc_independent --noise-free) the noise's
+    names = set(model.parameter_names) | {
+        n for n, *_ in noise.parameter_specs(model.output_names, model.state_names)
+    }
+    ps = parameters_for(
+        model,
+        noise,
+        {k: v for k, v in priors.items() if k in names},
+        room_volume=VOLUME,
+        air_change_rate=ACH,
+        floor_area=floor,
+        envelope_area=envelope,
+        fixed_node_temperature=ground_temperature() if "Pf" in model.parameter_names else None,
+    )
+    lp = LogPosterior(
+        model,
+        ps,
+        noise,
+        U,
+        y[:, None],
+        warmup=336 if init == "steady" else 0,
+        init_window=720,
+        initial_state=init,
+        time_constant_cap=ModelSection(model=model.name).cap_seconds(model.domain),
+    )
+    return ps, lp
+
+
 def fit_and_rank(
     model,
     U,
@@ -384,15 +422,11 @@ def fit_and_rank(
     package's 50; larger: a longer chain than the rule asks for, ``--tau-factor``).
     Returns ``{variant: {ranks, converged, map, steps, cpu}}``.
     """
-    from heritage_bayes.config import ModelSection
     from heritage_bayes.inference.likelihoods import get_noise_model
     from heritage_bayes.inference.optimize import find_map
-    from heritage_bayes.inference.parameters import parameters_for
-    from heritage_bayes.inference.posterior import LogPosterior
     from heritage_bayes.inference.sampler import run_sampler
     from heritage_bayes.rc.derived import derived_quantities
 
-    name = model.name
     out = {}
     for variant in variants:
         # NOISE:INIT or NOISE:INIT:temper=L (the likelihood tempered by the long-run
@@ -400,33 +434,7 @@ def fit_and_rank(
         noise_name, init, *temper = variant.split(":")
         t0 = time.process_time()
         noise = get_noise_model(noise_name)
-        # the model's parameters and (bench_sbc_independent --noise-free) the noise's
-        names = set(model.parameter_names) | {
-            n for n, *_ in noise.parameter_specs(model.output_names, model.state_names)
-        }
-        known = {k: v for k, v in priors.items() if k in names}
-        ps = parameters_for(
-            model,
-            noise,
-            known,
-            room_volume=VOLUME,
-            air_change_rate=ACH,
-            floor_area=floor,
-            envelope_area=envelope,
-            fixed_node_temperature=ground_temperature() if "Pf" in model.parameter_names else None,
-        )
-        lp = LogPosterior(
-            model,
-            ps,
-            noise,
-            U,
-            y[:, None],
-            warmup=336 if init == "steady" else 0,
-            init_window=720,
-            initial_state=init,
-            # the defaults of hbayes calibrate (the soft cap on time constants)
-            time_constant_cap=ModelSection(model=name).cap_seconds(model.domain),
-        )
+        ps, lp = log_posterior(model, noise, U, y, priors, floor, envelope, init)
         mp = find_map(lp, seed=rep, method="differential_evolution", popsize=15, maxiter=200)
         kappas = {}
         if temper:
@@ -520,33 +528,12 @@ def likelihood_at_truth(room: dict, variant: dict, floor, envelope, priors=None)
     from scipy.optimize import minimize
     from scipy.special import expit, logit
 
-    from heritage_bayes.config import ModelSection
     from heritage_bayes.inference.likelihoods import get_noise_model
-    from heritage_bayes.inference.parameters import parameters_for
-    from heritage_bayes.inference.posterior import LogPosterior
 
     model = room["model"]
     noise = get_noise_model("ar1_white")
-    ps = parameters_for(
-        model,
-        noise,
-        dict(priors or {}),
-        room_volume=VOLUME,
-        air_change_rate=ACH,
-        floor_area=floor,
-        envelope_area=envelope,
-        fixed_node_temperature=ground_temperature() if "Pf" in model.parameter_names else None,
-    )
-    lp = LogPosterior(
-        model,
-        ps,
-        noise,
-        room["U"][room["rows"]],
-        room["y"][:, None],
-        init_window=720,
-        initial_state="estimate",
-        time_constant_cap=ModelSection(model=model.name).cap_seconds(model.domain),
-    )
+    U, y = room["U"][room["rows"]], room["y"]
+    ps, lp = log_posterior(model, noise, U, y, priors or {}, floor, envelope, "estimate")
     names, nm = ps.names, lp.n_model
     is_phi = np.array([n.startswith("phi_") for n in names])
 

@@ -537,24 +537,23 @@ def likelihood_at_truth(room: dict, variant: dict, floor, envelope, priors=None)
     names, nm = ps.names, lp.n_model
     is_phi = np.array([n.startswith("phi_") for n in names])
 
-    def to_theta(v):  # log scale, phi on the logit scale
-        return np.where(is_phi, expit(v), np.exp(v))
-
-    def to_v(theta):
-        return np.where(is_phi, logit(theta), np.log(theta))
+    def to_theta(v, phi=is_phi):  # log scale, phi on the logit scale
+        return np.where(phi, expit(v), np.exp(v))
 
     def nll(theta):
         return -float(lp.log_likelihood(theta[None])[0])
 
     opts = {"maxiter": 20_000, "xatol": 1e-7, "fatol": 1e-5}
     start = np.array([variant["map"][n] for n in names])
-    best = minimize(lambda v: nll(to_theta(v)), to_v(start), method="Nelder-Mead", options=opts)
-    for _ in range(2):  # restarts: Nelder-Mead stalls in 10 dimensions
-        best = minimize(lambda v: nll(to_theta(v)), best.x, method="Nelder-Mead", options=opts)
+    v_start = np.where(is_phi, logit(start), np.log(start))
+    v0 = v_start
+    for _ in range(3):  # two restarts: Nelder-Mead stalls in 10 dimensions
+        best = minimize(lambda v: nll(to_theta(v)), v0, method="Nelder-Mead", options=opts)
+        v0 = best.x
     tm = np.array([room["result"]["truth_parameters"][n] for n in names[:nm]])
     at_truth = minimize(
-        lambda v: nll(np.concatenate([tm, to_theta(np.r_[np.zeros(nm), v])[nm:]])),
-        to_v(start)[nm:],
+        lambda v: nll(np.concatenate([tm, to_theta(v, is_phi[nm:])])),
+        v_start[nm:],
         method="Nelder-Mead",
         options=opts,
     )
@@ -698,19 +697,17 @@ def error_lines(results: list[dict], variant: str) -> list[str]:
     lines = []
     for name in sorted({r["model"] for r in results}):
         rs, z = room_zscores(results, variant, name)
-        rs_ok = [r for r in rs if "posterior" in r["variants"][variant]]
-        if len(rs_ok) < 5 or len(rs_ok) != len(rs):
+        posts = [r["variants"][variant].get("posterior") for r in rs]
+        if len(rs) < 5 or None in posts:
             continue
-        params = list(rs[0]["truth_parameters"])
         err = {
             n: np.array(
                 [
-                    (r["variants"][variant]["posterior"][n]["median"] - r["truth_parameters"][n])
-                    / r["variants"][variant]["posterior"][n]["sd"]
-                    for r in rs
+                    (q[n]["median"] - r["truth_parameters"][n]) / q[n]["sd"]
+                    for r, q in zip(rs, posts, strict=True)
                 ]
             )
-            for n in params
+            for n in rs[0]["truth_parameters"]
         }
         for k in ("gain_Ti_I_S", "gain_Ti_Te", "gain_Pi_Pe"):
             ok = np.isfinite(z[k]) if k in z else np.zeros(0, bool)

@@ -68,16 +68,16 @@ SOLAR = ("ghi", "facade")
 SITE = {"latitude": 52.10, "longitude": 5.18, "altitude": 1.9}
 
 
-def weather(seed: int, solar: str = "ghi") -> dict[str, np.ndarray]:
+def weather(seed: int, solar: str = "ghi", cal_days: int = CAL_DAYS) -> dict[str, np.ndarray]:
     """A random stretch of De Bilt hourly weather: Te [°C], Pe [Pa], south irradiance
-    [W/m²], long enough for the spin-up and calibration. ``solar``: ``"ghi"`` (the
+    [W/m²], long enough for the spin-up and ``cal_days`` of calibration. ``solar``: ``"ghi"`` (the
     global horizontal irradiance as a proxy, as recorded: the mean of the hour ending at
     the row's time) or ``"facade"`` (:func:`facade_south` of the same stretch: the mean
     over the row's hour, as ``hbayes calibrate`` aligns it)."""
     from heritage_bayes.climate.psychro import vapour_pressure
 
     w = _knmi_cache()
-    n = (CAL_DAYS + MAX_SPIN_DAYS + 1) * 24
+    n = (cal_days + MAX_SPIN_DAYS + 1) * 24
     rng = np.random.default_rng(seed)
     start = int(rng.integers(0, len(w) - n))
     part = w.iloc[start : start + n]
@@ -324,7 +324,7 @@ def room_data(args) -> dict:
     opts = {"surfaces": ("S",)} if name in ("thermal_2c", "thermal_4a") else {}
     model = hb.model(name, **opts)
     p = truth(model, rng, floor, flat_node, args[13] if len(args) > 13 else None)
-    w = weather(int(rng.integers(2**31)), solar if "I_S" in model.input_names else "ghi")
+    w = weather(int(rng.integers(2**31)), solar if "I_S" in model.input_names else "ghi", cal_days)
     U = np.column_stack(
         [w[c] if c in w else np.full(len(w["Te"]), 10.0) for c in model.input_names]
     )
@@ -399,6 +399,25 @@ def log_posterior(model, noise, U, y, priors, floor, envelope, init: str):
     return ps, lp
 
 
+def slow_time_constant_prior(lp, median_s: float, sigma: float) -> None:
+    """Add to ``lp`` a log-normal prior on the slowest time constant τ1 [s] (median
+    ``median_s``, sd of log ``sigma``), on top of its soft cap (``--variant
+    NOISE:INIT:tau1=MEDIAN_H/SIGMA``, issue 31's study of a prior a building physicist
+    can state on the slow direction)."""
+    base = lp.time_constant_log_prior
+
+    def with_slow(theta_model, _base=base, _lp=lp):
+        out = _base(theta_model)
+        with np.errstate(all="ignore"):
+            c, G, _, _ = _lp.model.network_matrices(theta_model)
+            r = 1.0 / np.sqrt(c)
+            lam = np.linalg.eigvalsh(r[:, :, None] * G * r[:, None, :])
+            z = (np.log(1.0 / lam[:, 0]) - np.log(median_s)) / sigma
+        return np.where(np.isfinite(z), out - 0.5 * z * z, -np.inf)
+
+    lp.time_constant_log_prior = with_slow
+
+
 def fit_and_rank(
     model,
     U,
@@ -429,14 +448,23 @@ def fit_and_rank(
 
     out = {}
     for variant in variants:
-        # NOISE:INIT or NOISE:INIT:temper=L (the likelihood tempered by the long-run
-        # variance ratio of the MAP's innovations, Bartlett window of L hours)
-        noise_name, init, *temper = variant.split(":")
+        # NOISE:INIT[:OPTION...]: temper=L (the likelihood tempered by the long-run
+        # variance ratio of the MAP's innovations, Bartlett window of L hours), T=X (by a
+        # fixed temperature X), tau1=MEDIAN_H/SIGMA (slow_time_constant_prior)
+        noise_name, init, *opts = variant.split(":")
+        temper = [o for o in opts if o.startswith("temper=")]
+        slow = [o for o in opts if o.startswith("tau1=")]
+        fixed_t = [float(o.removeprefix("T=")) for o in opts if o.startswith("T=")]
         t0 = time.process_time()
         noise = get_noise_model(noise_name)
         ps, lp = log_posterior(model, noise, U, y, priors, floor, envelope, init)
+        if slow:  # NOISE:INIT:tau1=MEDIAN_H/SIGMA: a log-normal prior on the slowest τ
+            median_h, sigma = map(float, slow[0].removeprefix("tau1=").split("/"))
+            slow_time_constant_prior(lp, median_h * 3600.0, sigma)
         mp = find_map(lp, seed=rep, method="differential_evolution", popsize=15, maxiter=200)
         kappas = {}
+        if fixed_t:  # NOISE:INIT:T=2: log L divided by a fixed temperature
+            lp.temperature = fixed_t[0]
         if temper:
             from heritage_bayes.inference.tempering import (
                 innovations_at,
@@ -926,6 +954,14 @@ def main() -> None:
         "--truth-priors the fit's prior on Cw is the same, so every parameter's truth "
         "comes from the fit's prior (SBC as its theory has it)",
     )
+    ap.add_argument(
+        "--cal-days",
+        type=int,
+        default=CAL_DAYS,
+        help=f"days of calibration record per room (default {CAL_DAYS}): the same rooms "
+        "(truths) with a longer record, to see whether intervals too narrow on a slow "
+        "envelope come from a record only a few of its time constants long",
+    )
     ap.add_argument("--table", help="only tabulate a --log file of an earlier study")
     ap.add_argument(
         "--lr",
@@ -994,7 +1030,7 @@ def main() -> None:
             variants,
             args.seed,
             args.max_steps,
-            CAL_DAYS,
+            args.cal_days,
             priors,
             floor,
             observation,

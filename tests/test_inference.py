@@ -295,6 +295,66 @@ def test_floor_area_sets_the_ground_prior_of_thermal_models():
         parse_config({**raw, "floor_area": -5})
 
 
+def test_glazing_area_sets_the_aperture_priors():
+    """glazing_area [m²] per surface: a log-normal prior on that surface's aperture fI,
+    median 0.4 × the area (EN ISO 13790's collecting area), sd of log 0.7, bounds at
+    ±5 sd; unlisted surfaces keep the default; a model without solar inputs (hygric)
+    ignores it; a surface the model or data.surfaces lacks, an area ≤ 0 and a key with
+    no solar input are ConfigErrors naming the key."""
+    from heritage_bayes.config import parse_config
+    from heritage_bayes.inference.parameters import (
+        APERTURE_PER_GLAZING,
+        aperture_prior,
+        default_prior,
+        parameters_for,
+    )
+    from heritage_bayes.run import section_parameters
+
+    p = aperture_prior(8.0)
+    assert (p.dist, p.mu, p.sigma) == ("lognormal", pytest.approx(3.2), 0.7)
+    assert APERTURE_PER_GLAZING == 0.4
+    assert p.lower == pytest.approx(3.2 * math.exp(-3.5))
+    assert p.upper == pytest.approx(3.2 * math.exp(3.5))
+    noise = get_noise_model("ar1_white")
+    th = hb.model("thermal_2c", surfaces=("N", "S"))
+    ps = parameters_for(th, noise, glazing_area={"S": 8.0})
+    prior = {q.name: q.prior for q in ps.parameters}
+    assert prior["fI_S"] == aperture_prior(8.0)
+    assert prior["fI_N"] == default_prior("thermal", "gain")
+    # an explicit prior in the section still wins over the survey's
+    ps = parameters_for(
+        th, noise, {"fI_S": {"dist": "uniform", "lower": 0, "upper": 5}}, glazing_area={"S": 8}
+    )
+    assert {q.name: q.prior for q in ps.parameters}["fI_S"].dist == "uniform"
+    with pytest.raises(ConfigError, match=r"glazing_area: surface\(s\) \['E'\]"):
+        parameters_for(th, noise, glazing_area={"E": 4.0})
+    with pytest.raises(ConfigError, match=r"glazing_area\.S"):
+        parameters_for(th, noise, glazing_area={"S": -1.0})
+    hy = hb.model("hygric_2c")
+    assert (
+        parameters_for(hy, noise, glazing_area={"S": 8.0}).names == parameters_for(hy, noise).names
+    )
+    raw = {
+        "data": {"demo": {"seed": 7}},
+        "glazing_area": {"N": 1, "S": 8},
+        "thermal": {"model": "thermal_2c"},
+    }
+    cfg = parse_config(raw)
+    _, ps2 = section_parameters(cfg, "thermal", hb.model("thermal_2c"), {})
+    got = {q.name: q.prior for q in ps2.parameters}
+    assert got["fI_N"].mu == pytest.approx(0.4) and got["fI_S"].mu == pytest.approx(3.2)
+    assert got["fI_E"] == default_prior("thermal", "gain")
+    for bad, match in (
+        ({"X": 1}, r"glazing_area: surface\(s\) \['X'\] are not in data.surfaces"),
+        ({"N": 0}, "glazing_area: every area must be > 0"),
+        ({"N": "abc"}, "glazing_area.N"),
+    ):
+        with pytest.raises(ConfigError, match=match):
+            parse_config({**raw, "glazing_area": bad})
+    with pytest.raises(ConfigError, match=r"glazing_area: given, but data\.irradiance is .none."):
+        parse_config({**raw, "data": {"demo": {"seed": 7}, "irradiance": "none"}})
+
+
 def test_envelope_area_bounds_the_envelope_node():
     """envelope_area [m²]: 0.1 W/(m²K) × area ≤ Gw ≤ 25 W/(m²K) × area (a passive-house
     wall; the exterior film, EN ISO 6946) and Cw ≤ 7.5 MJ/(m²K) × area (3 m of

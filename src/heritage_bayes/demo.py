@@ -41,9 +41,11 @@ name       value       unit        physical reasoning
                                    ventilation plus ≈ 11 m² of single glazing × 5.8 W/(m²K)
 ``Gf``     25          W/K         weak coupling of the air to the ground temperature
 ``fI_N``   0.5         m²          effective solar apertures (window area × transmittance ×
-``fI_E``   2.0         m²          shading): most glass faces south, little north
-``fI_S``   4.0         m²
-``fI_W``   2.0         m²
+``fI_E``   2.0         m²          shading): most glass faces south, little north; the
+``fI_S``   4.0         m²          11 m² of windows (N 1, E 2.5, S 5, W 2.5 m²,
+``fI_W``   2.0         m²          ``configs/demo.yaml``'s ``glazing_area``) pass 0.8 of
+                                   their area, 0.5 on the shaded north (the package's prior
+                                   assumes 0.4: the survey's median lies below the truth)
 ``fsol``   0.7         –           70 % of the transmitted sun is absorbed by the floor and
                                    contents (``Cint``), 30 % heats the air directly
 =========  ==========  ==========  ==============================================================

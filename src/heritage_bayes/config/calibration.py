@@ -84,6 +84,14 @@ class CalibrationConfig(_Strict):
         "and Cw (thermal) and on the moisture buffer's Gw and Cw (hygric)",
         gt=0,
     )
+    glazing_area: dict[str, float] | None = key(
+        None,
+        unit="m²",
+        description="glazed area of the windows per solar surface (the names of "
+        "data.surfaces), e.g. {S: 8, E: 4}: a log-normal prior on each listed surface's "
+        "effective aperture fI, median 0.4 × the area (EN ISO 13790), sd of log 0.7; "
+        "the other surfaces keep the wide default",
+    )
     data: Data = key(unit=None, description="weather and logger files (or the demo)")
     periods: Periods = key(
         unit=None,
@@ -132,6 +140,24 @@ class CalibrationConfig(_Strict):
             "epw",
             "tmy3",
         )
+        if self.glazing_area is not None:
+            bad = {k: v for k, v in self.glazing_area.items() if not v > 0}
+            if bad:
+                raise ValueError(
+                    f"glazing_area: every area must be > 0 m² (got {bad}); leave a surface "
+                    "without windows out to keep its wide default prior"
+                )
+            if self.data.irradiance == "none":
+                raise ValueError(
+                    "glazing_area: given, but data.irradiance is 'none' (no solar input); "
+                    "remove 'glazing_area' or set data.irradiance"
+                )
+            stray = sorted(set(self.glazing_area) - set(self.data.surfaces))
+            if stray:
+                raise ValueError(
+                    f"glazing_area: surface(s) {stray} are not in data.surfaces "
+                    f"{sorted(self.data.surfaces)}"
+                )
         needs_sun = self.data.irradiance != "none" and self.data.demo is None
         if needs_sun and self.site is None and not site_in_file:
             raise ValueError(

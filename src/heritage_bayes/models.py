@@ -199,8 +199,10 @@ def describe_model(name: str, noise: str = "ar1_white") -> str:
         "room_volume [m³] and air_change_rate [1/h] set log-normal priors on Ci and Gfast.",
         *(
             [
+                "glazing_area {surface: m²} sets log-normal priors on the apertures fI "
+                "(median 0.4 × the glazed area).",
                 "Options (under options:): ground (true | false | estimate), heating; the "
-                "solar surfaces come from data.surfaces."
+                "solar surfaces come from data.surfaces.",
             ]
             if net.domain == "thermal"
             else []

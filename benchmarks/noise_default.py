@@ -32,6 +32,8 @@ import sys
 import tempfile
 from pathlib import Path
 
+import numpy as np
+
 NOISES = ("ar1_white", "ar1", "iid", "kalman")
 
 
@@ -162,7 +164,9 @@ def _f(v, fmt: str) -> str:
 
 def table(paths: list[str]) -> None:
     """Markdown tables: one row per run and output; the demo truths per seed and quantity."""
-    recs = [json.loads(line) for p in paths for line in Path(p).read_text().splitlines()]
+    recs = [
+        {**json.loads(line), "_log": p} for p in paths for line in Path(p).read_text().splitlines()
+    ]
     print(
         "| config | noise | seed | output | val FIT % | val MAE | 90 % band | 1-step 90 % "
         "| steps / τmax | max R-hat | min ESS | CPU s |"
@@ -202,14 +206,26 @@ def table(paths: list[str]) -> None:
             + " | ".join(cells)
             + " |"
         )
-    for noise in dict.fromkeys(r["noise"] for r in truths):
-        rs = [r for r in truths if r["noise"] == noise]
+    # per log and noise model: coverage, mean and sd of z, and how each quantity's z goes
+    # with the gain from Te's over the seeds (which misses travel together)
+    for log, noise in dict.fromkeys((r["_log"], r["noise"]) for r in truths):
+        rs = [r for r in truths if (r["_log"], r["noise"]) == (log, noise)]
+        z = {k: np.array([r["truths"][k]["z"] for r in rs if k in r["truths"]]) for k in keys}
         per = {k: sum(r["truths"][k]["inside"] for r in rs if k in r["truths"]) for k in keys}
-        rms = {k: math.sqrt(sum(r["truths"][k]["z"] ** 2 for r in rs) / len(rs)) for k in keys}
+        inside = sum(per.values())
+        worst = max(abs(v["z"]) for r in rs for v in r["truths"].values())
         print(
-            f"\n{noise}: {len(rs)} seeds, inside per quantity: "
-            + ", ".join(f"{k} {per[k]}/{len(rs)} (z rms {rms[k]:.2f})" for k in keys)
+            f"\n{log} [{noise}]: {len(rs)} seeds, {inside} of {len(rs) * len(keys)} truths "
+            f"inside, seeds with >= {len(keys) - 2} of {len(keys)}: "
+            f"{sum(sum(v['inside'] for v in r['truths'].values()) >= len(keys) - 2 for r in rs)}, "
+            f"largest |z| {worst:.2f}; per quantity inside, mean z / sd z:"
         )
+        for k in keys:
+            line = f"  {k:24s} {per[k]}/{len(rs)}  {z[k].mean():+.2f} / {z[k].std():.2f}"
+            ref = z.get("thermal.gain_Ti_Te")
+            if ref is not None and k != "thermal.gain_Ti_Te" and len(rs) > 2 and z[k].std() > 0:
+                line += f"  corr with the Te gain's z {np.corrcoef(ref, z[k])[0, 1]:+.2f}"
+            print(line)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -243,6 +243,9 @@ def test_parameter_tables(report, run_dir):
     assert summary["models"]["hygric"]["time_constant_cap_h"] is None
     assert 'id="tau-cap-thermal"' in html and "(τ / 8760 h)²" in html
     assert 'id="tau-cap-hygric"' not in html
+    # an untempered likelihood (the default) is recorded and not announced
+    assert summary["models"]["thermal"]["likelihood_temperature"] == 1.0
+    assert 'id="temperature-thermal"' not in html
     # ... but the model-independent quantities have one (gains, slowest time constant)
     gains = html[html.index('id="table-gains-thermal"') :]
     gains = gains[: gains.index("</table>")]

@@ -93,3 +93,44 @@ def test_temperature_divides_the_likelihood_only(noise_name):
     assert lp.log_likelihood(theta[None])[0] == pytest.approx(ll, rel=1e-12)
     w = innovations_at(lp, theta)
     assert w.shape == lp.observed.shape and np.isfinite(w).all()
+
+
+def test_likelihood_temperature_config_reaches_the_posterior():
+    """``thermal.likelihood_temperature`` (default 1, at least 1): the section's
+    LogPosterior divides its log-likelihood by it (the prior untouched), and a
+    temperature below 1 is a ConfigError naming the key."""
+    from heritage_bayes.calibrate import _log_posterior
+    from heritage_bayes.config import parse_config
+    from heritage_bayes.errors import ConfigError
+    from heritage_bayes.models import build_model
+    from heritage_bayes.prepare import prepare
+
+    raw = {
+        "data": {"demo": {"seed": 7}},
+        "periods": {
+            "calibration": {"start": "2019-01-02", "end": "2019-01-20"},
+            "validation": {"start": "2019-01-20", "end": "2019-01-25"},
+        },
+        "thermal": {"model": "thermal_1c", "likelihood_temperature": 2.0},
+    }
+    cfg = parse_config(raw)
+    assert cfg.thermal.likelihood_temperature == 2.0
+    prep = prepare(cfg)
+    m = build_model(cfg, "thermal")
+    lp2 = _log_posterior(cfg, prep, "thermal", m, {})
+    cfg1 = parse_config({**raw, "thermal": {"model": "thermal_1c"}})
+    lp1 = _log_posterior(cfg1, prep, "thermal", m, {})
+    assert (lp1.temperature, lp2.temperature) == (1.0, 2.0)
+    values = {"Ci": 2e7, "Ge": 150.0, "Gf": 25.0, "sigma_Ti": 0.2, "phi_Ti": 0.9}
+    theta = np.array(
+        [[values.get(n, 1.0 if n.startswith("fI") else 0.1) for n in lp1.params.names]]
+    )
+    theta = np.vstack([theta, theta * np.where(np.array(lp1.params.names) == "Ge", 1.5, 1.0)])
+    x = lp1.params.to_unconstrained(theta)
+    ll = lp1.log_likelihood(theta)
+    assert np.isfinite(ll).all()
+    d1, d2 = lp1(x), lp2(x)
+    # the same prior in both: the difference is half the log-likelihood
+    np.testing.assert_allclose(d1 - d2, ll / 2.0, rtol=1e-9)
+    with pytest.raises(ConfigError, match="likelihood_temperature"):
+        parse_config({**raw, "thermal": {"model": "thermal_1c", "likelihood_temperature": 0.5}})

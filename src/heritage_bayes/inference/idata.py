@@ -372,6 +372,7 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
             # the share of draws whose slowest mode is frozen (a second posterior branch)
             "frozen_share": _frozen_share(dq_all.get("tau_1_h"), s.logpost),
             "time_constant_cap_h": _hours(s.logpost.time_constant_cap),
+            "likelihood_temperature": float(s.logpost.temperature),
             "practical_identifiability": (
                 s.laplace.to_dict(ps.free_names) if getattr(s, "laplace", None) else None
             ),

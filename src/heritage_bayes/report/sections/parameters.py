@@ -93,6 +93,9 @@ def parameter_tables(rd: RunData) -> list[dict]:
                 "cap_h": None
                 if info.get("time_constant_cap_h") is None
                 else fmt(info["time_constant_cap_h"]),
+                "temperature": None
+                if (info.get("likelihood_temperature") or 1.0) == 1.0
+                else fmt(info["likelihood_temperature"]),
             }
         )
     return tables

@@ -409,10 +409,7 @@ def slow_time_constant_prior(lp, median_s: float, sigma: float) -> None:
     def with_slow(theta_model, _base=base, _lp=lp):
         out = _base(theta_model)
         with np.errstate(all="ignore"):
-            c, G, _, _ = _lp.model.network_matrices(theta_model)
-            r = 1.0 / np.sqrt(c)
-            lam = np.linalg.eigvalsh(r[:, :, None] * G * r[:, None, :])
-            z = (np.log(1.0 / lam[:, 0]) - np.log(median_s)) / sigma
+            z = (np.log(1.0 / _lp.decay_rates(theta_model)[:, 0]) - np.log(median_s)) / sigma
         return np.where(np.isfinite(z), out - 0.5 * z * z, -np.inf)
 
     lp.time_constant_log_prior = with_slow

@@ -841,7 +841,7 @@ def parameters_for(
             f"{model.name!r} with noise {noise.name!r}; parameters are "
             f"{sorted(known)}"
         )
-    apertures = {n[len("fI_") :] for n in model.parameter_names if n.startswith("fI_")}
+    apertures = {n.removeprefix("fI_") for n in model.parameter_names if n.startswith("fI_")}
     glazing = dict(glazing_area or {}) if apertures else {}
     stray = sorted(set(glazing) - apertures)
     if stray:
@@ -892,11 +892,12 @@ def parameters_for(
             prior = fixed_vapour_pressure_prior(fixed_node_temperature)
         if envelope_area is not None and name in ("Gw", "Cw"):
             prior = envelope_priors(envelope_area, domain)[name]
-        if name.startswith("fI_") and name[len("fI_") :] in glazing and kind == "gain":
+        surface = name.removeprefix("fI_")
+        if surface in glazing and kind == "gain":
             try:
-                prior = aperture_prior(glazing[name[len("fI_") :]])
+                prior = aperture_prior(glazing[surface])
             except ConfigError as exc:
-                raise ConfigError(f"glazing_area.{name[len('fI_') :]}: {exc}") from None
+                raise ConfigError(f"glazing_area.{surface}: {exc}") from None
         spec = priors.get(name)
         fixed = None
         if spec is not None:

@@ -207,11 +207,16 @@ class LogPosterior:
         if cap is None or not np.isfinite(cap):
             return np.zeros(K)
         with np.errstate(all="ignore"):
-            c, G, _, _ = self.model.network_matrices(theta_model)
-            r = 1.0 / np.sqrt(c)  # decay rates: eigenvalues of C^-1/2 G C^-1/2 [1/s]
-            lam = np.linalg.eigvalsh(r[:, :, None] * G * r[:, None, :])
-            out = -np.log1p((1.0 / (lam * cap)) ** 2).sum(axis=1)
+            out = -np.log1p((1.0 / (self.decay_rates(theta_model) * cap)) ** 2).sum(axis=1)
         return np.where(np.isfinite(out), out, -np.inf)
+
+    def decay_rates(self, theta_model: np.ndarray) -> np.ndarray:
+        """(K, n) decay rates [1/s] of the model's modes, ascending (the slowest first):
+        the eigenvalues of :math:`C^{-1/2} G C^{-1/2}`, i.e. 1/τ of each mode."""
+        with np.errstate(all="ignore"):
+            c, G, _, _ = self.model.network_matrices(theta_model)
+            r = 1.0 / np.sqrt(c)
+            return np.linalg.eigvalsh(r[:, :, None] * G * r[:, None, :])
 
     def data_hash(self) -> str:
         """SHA-256 (16 hex digits) of the inputs and observations (what a chain

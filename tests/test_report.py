@@ -243,9 +243,12 @@ def test_parameter_tables(report, run_dir):
     assert summary["models"]["hygric"]["time_constant_cap_h"] is None
     assert 'id="tau-cap-thermal"' in html and "(τ / 8760 h)²" in html
     assert 'id="tau-cap-hygric"' not in html
-    # an untempered likelihood (the default) is recorded and not announced
-    assert summary["models"]["thermal"]["likelihood_temperature"] == 1.0
-    assert 'id="temperature-thermal"' not in html
+    # the default temperatures are recorded; the thermal one (2) is announced beside
+    # its table, the hygric one (1, untempered) is not
+    assert summary["models"]["thermal"]["likelihood_temperature"] == 2.0
+    assert summary["models"]["hygric"]["likelihood_temperature"] == 1.0
+    assert 'id="temperature-thermal"' in html and "divided by 2" in html
+    assert 'id="temperature-hygric"' not in html
     # ... but the model-independent quantities have one (gains, slowest time constant)
     gains = html[html.index('id="table-gains-thermal"') :]
     gains = gains[: gains.index("</table>")]

@@ -96,9 +96,10 @@ def test_temperature_divides_the_likelihood_only(noise_name):
 
 
 def test_likelihood_temperature_config_reaches_the_posterior():
-    """``thermal.likelihood_temperature`` (default 1, at least 1): the section's
-    LogPosterior divides its log-likelihood by it (the prior untouched), and a
-    temperature below 1 is a ConfigError naming the key."""
+    """``thermal.likelihood_temperature`` (default 2 for a thermal section, 1 for a
+    hygric one; at least 1): the section's LogPosterior divides its log-likelihood by
+    it (the prior untouched), and a temperature below 1 is a ConfigError naming the
+    key."""
     from heritage_bayes.calibrate import _log_posterior
     from heritage_bayes.config import parse_config
     from heritage_bayes.errors import ConfigError
@@ -118,9 +119,18 @@ def test_likelihood_temperature_config_reaches_the_posterior():
     prep = prepare(cfg)
     m = build_model(cfg, "thermal")
     lp2 = _log_posterior(cfg, prep, "thermal", m, {})
-    cfg1 = parse_config({**raw, "thermal": {"model": "thermal_1c"}})
+    cfg1 = parse_config({**raw, "thermal": {"model": "thermal_1c", "likelihood_temperature": 1}})
     lp1 = _log_posterior(cfg1, prep, "thermal", m, {})
     assert (lp1.temperature, lp2.temperature) == (1.0, 2.0)
+    # the defaults by domain: 2 for the thermal section, 1 for the hygric one
+    cfg_d = parse_config(
+        {**raw, "thermal": {"model": "thermal_1c"}, "hygric": {"model": "hygric_1c"}}
+    )
+    assert cfg_d.thermal.likelihood_temperature is None
+    assert _log_posterior(cfg_d, prep, "thermal", m, {}).temperature == 2.0
+    prep_d = prepare(cfg_d)
+    lp_h = _log_posterior(cfg_d, prep_d, "hygric", build_model(cfg_d, "hygric"), {})
+    assert lp_h.temperature == 1.0
     values = {"Ci": 2e7, "Ge": 150.0, "Gf": 25.0, "sigma_Ti": 0.2, "phi_Ti": 0.9}
     theta = np.array(
         [[values.get(n, 1.0 if n.startswith("fI") else 0.1) for n in lp1.params.names]]

@@ -17,7 +17,12 @@ from pydantic import PlainSerializer, PlainValidator, WithJsonSchema
 from heritage_bayes.config._base import DURATION_UNIT, _duration, _Strict, key
 from heritage_bayes.convert import format_timedelta
 
-__all__ = ["DurationOrNone", "ModelSection"]
+__all__ = ["DEFAULT_LIKELIHOOD_TEMPERATURE", "DurationOrNone", "ModelSection"]
+
+#: ``likelihood_temperature`` where a section does not set it, by model domain:
+#: measured by simulation-based calibration on rooms the package did not generate
+#: (docs/science/sbc.md, "A tempered likelihood"); 1 for a domain not listed.
+DEFAULT_LIKELIHOOD_TEMPERATURE = {"thermal": 2.0, "hygric": 1.0}
 
 
 def _duration_or_none(v: Any) -> pd.Timedelta | str | None:
@@ -84,13 +89,13 @@ class ModelSection(_Strict):
         description="soft prior 1/(1 + (τ/cap)²) on every time constant; 'none': no cap "
         "(default: 365d for thermal models, none for hygric ones)",
     )
-    likelihood_temperature: float = key(
-        1.0,
+    likelihood_temperature: float | None = key(
+        None,
         unit="-",
         description="divide the log-likelihood by this (a tempered likelihood: posterior "
-        "sd about √T times wider); 1: none. Opt-in: T 2 brought thermal_2c's 90 % "
-        "intervals on 50 rooms the package did not generate to 0.88-0.92 (τ1, gains from "
-        "Te and Tf, solar warming; docs: Simulation-based calibration)",
+        "sd about √T times wider); 1: none (default: 2 for thermal models, 1 for hygric "
+        "ones, chosen by simulation-based calibration on rooms the package did not "
+        "generate; docs: Simulation-based calibration)",
         ge=1,
         le=10,
     )
@@ -111,6 +116,15 @@ class ModelSection(_Strict):
         if self.time_constant_cap is None:
             return 365 * 86400.0 if domain == "thermal" else math.inf
         return _seconds(self.time_constant_cap)
+
+    def temperature(self, domain: str) -> float:
+        """``likelihood_temperature``; the default by domain: 2 for thermal models (their
+        90 % intervals on 50 rooms the package did not generate cover 0.88-0.92 with
+        it, 0.74-0.82 without), 1 for hygric ones (``hygric_2c_fixed`` covers
+        0.86-0.90 untempered)."""
+        if self.likelihood_temperature is None:
+            return DEFAULT_LIKELIHOOD_TEMPERATURE.get(domain, 1.0)
+        return float(self.likelihood_temperature)
 
     @property
     def horizon_seconds(self) -> float | None:

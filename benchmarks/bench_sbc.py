@@ -431,6 +431,10 @@ def fit_and_rank(
 ) -> dict:
     """Calibrate one replicate with ``hbayes calibrate``'s defaults and rank the truths.
 
+    The likelihood is untempered unless a variant says ``T=X`` (``hbayes calibrate``
+    tempers thermal sections by 2 since commit ca9b55f: ``ar1_white:estimate:T=2`` is
+    its default there), so the commands in the docs reproduce the tables they head.
+
     ``U`` (N, m) inputs and ``y`` (N,) observations (NaN = missing) of the calibration
     period; ``dq_true`` the true derived quantities; ``extra`` an optional function
     ``(dq, theta) -> {name: draws}`` of further quantities (their truths in

@@ -19,7 +19,12 @@ its distance from the posterior median in posterior sd.
         --log real.jsonl
     python benchmarks/noise_default.py configs/demo.yaml --noise ar1_white kalman \\
         --seeds 7 8 9 10 11 12 --log seeds.jsonl
+    python benchmarks/noise_default.py configs/demo.yaml --noise ar1_white \\
+        --temperature thermal=1 --seeds 7 8 9 --log untempered.jsonl
     python benchmarks/noise_default.py --table real.jsonl seeds.jsonl
+
+``--temperature SECTION=T`` sets a section's ``likelihood_temperature`` (default: the
+package's, 2 for thermal sections and 1 for hygric ones; each line records the values).
 """
 
 from __future__ import annotations
@@ -61,10 +66,13 @@ def translate_priors(priors: dict, outputs: list[str], noise: str) -> dict:
     return out
 
 
-def variant(cfg, noise: str, seed: int | None, split: str | None = None):
+def variant(
+    cfg, noise: str, seed: int | None, split: str | None = None, temperature: dict | None = None
+):
     """``cfg`` with ``noise`` in every model section, no ladder, (demo) data seed and,
     with ``split``, calibration before that instant and validation from it to the end
-    of the configured calibration period (a record with no validation period)."""
+    of the configured calibration period (a record with no validation period);
+    ``temperature`` {section: T} sets those sections' ``likelihood_temperature``."""
     from heritage_bayes.config.periods import Period
     from heritage_bayes.models import build_model
 
@@ -89,9 +97,10 @@ def variant(cfg, noise: str, seed: int | None, split: str | None = None):
                 ("sigma_meas_" + k[6:] if k in {f"sigma_{o}" for o in outputs} else k): v
                 for k, v in priors.items()
             }
-        update[name] = sec.model_copy(
-            update={"noise": noise, "priors": translate_priors(priors, outputs, noise)}
-        )
+        sec_update = {"noise": noise, "priors": translate_priors(priors, outputs, noise)}
+        if temperature and name in temperature:
+            sec_update["likelihood_temperature"] = temperature[name]
+        update[name] = sec.model_copy(update=sec_update)
     if seed is not None:
         demo = cfg.data.demo.model_copy(update={"seed": seed})
         update["data"] = cfg.data.model_copy(update={"demo": demo})
@@ -132,7 +141,12 @@ def row_of(summary: dict) -> dict:
 
 
 def run(
-    config: str, noises: list[str], seeds: list[int | None], log: Path, split: str | None
+    config: str,
+    noises: list[str],
+    seeds: list[int | None],
+    log: Path,
+    split: str | None,
+    temperature: dict | None = None,
 ) -> None:
     from heritage_bayes.calibrate import run_calibration
     from heritage_bayes.config import load_config
@@ -140,8 +154,13 @@ def run(
     cfg0 = load_config(config)
     for seed in seeds:
         for noise in noises:
-            cfg = variant(cfg0, noise, seed, split)
+            cfg = variant(cfg0, noise, seed, split, temperature)
             rec = {"config": config, "noise": noise, "data_seed": seed, "split": split}
+            rec["likelihood_temperature"] = {
+                name: getattr(cfg, name).temperature(name)
+                for name in ("thermal", "hygric")
+                if getattr(cfg, name) is not None
+            }
             c0 = _cpu()
             with tempfile.TemporaryDirectory(prefix="hb-noise-") as tmp:
                 try:
@@ -238,6 +257,13 @@ def main(argv: list[str] | None = None) -> int:
         metavar="INSTANT",
         help="calibrate before INSTANT, validate from it to the calibration period's end",
     )
+    ap.add_argument(
+        "--temperature",
+        nargs="+",
+        metavar="SECTION=T",
+        default=[],
+        help="set a section's likelihood_temperature (e.g. thermal=1: untempered)",
+    )
     ap.add_argument("--log", type=Path, default=Path("noise_default.jsonl"))
     ap.add_argument("--table", nargs="+", metavar="JSONL", help="tabulate logs and exit")
     a = ap.parse_args(argv)
@@ -246,7 +272,15 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     if not a.config:
         ap.error("a config (or --table)")
-    run(a.config, a.noise, a.seeds or [None], a.log, a.split)
+    temperature = {}
+    for item in a.temperature:
+        name, _, value = item.partition("=")
+        if name not in ("thermal", "hygric") or not value:
+            ap.error(
+                f"--temperature: expected SECTION=T with SECTION thermal or hygric, got {item!r}"
+            )
+        temperature[name] = float(value)
+    run(a.config, a.noise, a.seeds or [None], a.log, a.split, temperature)
     return 0
 
 

@@ -18,6 +18,7 @@ from heritage_bayes.inference.predictive import (
 from heritage_bayes.inference.results import (
     PREDICTIVE_QUANTUM,
     _round_mantissa,
+    as_stored,
     write_inference_data,
 )
 from heritage_bayes.report.rundata import predictive_quantiles
@@ -97,6 +98,9 @@ def test_written_file_is_compressed_packed_and_read_back_within_the_quantum(tmp_
         assert np.abs(got - want).max() <= q / 2 + 1e-6 * np.abs(want).max()
         bands = predictive_quantiles(back, k, [0.05, 0.5, 0.95])
         assert np.abs(bands - idata["predictive_bands"][k].values[[0, 2, 4]]).max() <= q
+        # as_stored gives the values the file gives back, bit for bit (the summary's
+        # band coverage is computed from them: a reader recomputes the same figure)
+        np.testing.assert_array_equal(as_stored(want, pp[k].attrs["unit"]), got)
     # log-likelihood terms: relative error 2**-13
     d = np.abs(back.log_likelihood["thermal.Ti"].values - ll.values)
     assert np.all(d <= np.abs(ll.values) * 2.0**-13)

@@ -32,7 +32,7 @@ from heritage_bayes.inference.predictive import (
     predictive_bands,
     predictive_noise,
 )
-from heritage_bayes.inference.results import coverage, fit_metrics
+from heritage_bayes.inference.results import as_stored, coverage, fit_metrics
 from heritage_bayes.inference.runinfo import _periods, _truth_for, _versions
 from heritage_bayes.rc.discretize import modal_form
 from heritage_bayes.rc.identify import derived_quantities, derived_units
@@ -518,13 +518,21 @@ def _metrics_for(prep, codes, outputs, pp_outputs, one_step=None) -> dict:
     """Fit criteria of the posterior-median simulation and band coverage per period;
     with ``one_step`` (output -> (K, N) one-step-ahead samples of a state-space noise
     model) also the coverage of the one-step bands (``coverage50_1step``,
-    ``coverage90_1step``)."""
+    ``coverage90_1step``).
+
+    The bands are taken from the draws as ``posterior.nc`` stores them
+    (:func:`~heritage_bayes.inference.results.as_stored`: float32, packed to 0.01 °C,
+    0.1 Pa, 0.01 %RH), so that the coverage read back from the file is the same to the
+    last hour: a measurement on a band's edge would otherwise count on one side here and
+    on the other in the file."""
     res: dict[str, dict] = {}
     for out in outputs:
         if out not in prep.frame:
             continue
         meas = prep.frame[out].to_numpy(dtype=float)
         ypp, ysim = pp_outputs[out]
+        unit = _OUT_UNITS.get(out, "")
+        ypp = as_stored(ypp, unit)
         med = np.median(ysim, axis=0)
         res[out] = {}
         for pname, code in (("calibration", 1), ("validation", 2)):
@@ -535,7 +543,8 @@ def _metrics_for(prep, codes, outputs, pp_outputs, one_step=None) -> dict:
             m["coverage50"] = coverage(meas[rows], ypp[:, rows], 0.5)
             m["coverage90"] = coverage(meas[rows], ypp[:, rows], 0.9)
             if one_step and out in one_step:
-                m["coverage50_1step"] = coverage(meas[rows], one_step[out][:, rows], 0.5)
-                m["coverage90_1step"] = coverage(meas[rows], one_step[out][:, rows], 0.9)
+                y1 = as_stored(one_step[out][:, rows], unit)
+                m["coverage50_1step"] = coverage(meas[rows], y1, 0.5)
+                m["coverage90_1step"] = coverage(meas[rows], y1, 0.9)
             res[out][pname] = m
     return res

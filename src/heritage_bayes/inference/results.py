@@ -65,6 +65,7 @@ from heritage_bayes.rundir.atomic import atomic_write, atomic_write_text
 
 __all__ = [
     "PREDICTIVE_QUANTUM",
+    "as_stored",
     "atomic_write",
     "atomic_write_text",
     "coverage",
@@ -139,6 +140,28 @@ def _encoding(group: str, da) -> dict:
     if group in _PACKED_GROUPS and quantum is not None and np.issubdtype(da.dtype, np.floating):
         enc.update(dtype="int32", scale_factor=quantum, _FillValue=np.iinfo(np.int32).min)
     return enc
+
+
+def as_stored(values: np.ndarray, unit: str) -> np.ndarray:
+    """``values`` as :func:`write_inference_data` stores and xarray reads them back
+    from a predictive group: float32, packed to the multiple of
+    :data:`PREDICTIVE_QUANTUM` [``unit``] where the unit is listed (through xarray's own
+    CF encoder and decoder, the path of the write). Statistics that the summary states
+    and a reader recomputes from ``posterior.nc`` (band coverage: a measurement on a
+    band's edge) are taken from these values, so that the two agree exactly."""
+    import xarray as xr
+
+    a = np.asarray(values, dtype=np.float32)
+    quantum = PREDICTIVE_QUANTUM.get(unit)
+    if quantum is None:
+        return a.astype(float)
+    var = xr.Variable(
+        tuple(f"dim_{i}" for i in range(a.ndim)),
+        a,
+        encoding={"dtype": "int32", "scale_factor": quantum, "_FillValue": np.iinfo(np.int32).min},
+    )
+    encoded = xr.conventions.encode_cf_variable(var)
+    return np.asarray(xr.conventions.decode_cf_variable("values", encoded).values, dtype=float)
 
 
 def write_inference_data(idata, path: str | Path) -> None:

@@ -337,3 +337,38 @@ def test_a_candidate_folder_that_is_not_a_run_needs_force(cfg_path, tmp_path, ca
     assert main([*args, "--quiet", "--no-report", "--force"]) == 0
     assert (out / "comparison.json").is_file()
     assert (out / "thermal_1c" / "summary.json").is_file()
+
+
+def test_tempered_loo_matches_the_closed_form_of_a_tempered_normal_mean():
+    """Draws of a tempered posterior (y_i ~ N(μ, 1), flat prior, log-likelihood / T):
+    μ ~ N(ȳ, T/n), and leaving y_i out leaves N(ȳ_-i, T/(n-1)), so the exact LOO
+    predictive of y_i is N(ȳ_-i, 1 + T/(n-1)). ``tempered_loo`` (weights p^(-1/T))
+    reproduces its ELPD within 0.1 nat (6 sd of its Monte Carlo error over 10 seeds of
+    8 000 draws: 0.016); ``az.loo``'s weights 1/p, right only for T = 1, are off by more
+    than 5 nats (−14.65 against −9.15); with T = 1 the two are the same."""
+    from scipy import stats
+
+    from heritage_bayes.compare.scores import tempered_loo
+
+    n, T = 6, 4.0
+    y = np.array([-1.2, -0.3, 0.1, 0.4, 0.9, 1.6])
+    exact = sum(
+        stats.norm.logpdf(y[i], np.delete(y, i).mean(), np.sqrt(1 + T / (n - 1))) for i in range(n)
+    )
+    rng = np.random.default_rng(0)
+    mu = rng.normal(y.mean(), np.sqrt(T / n), (4, 2000))
+    ll = stats.norm.logpdf(y[None, None, :], mu[..., None], 1.0)
+    data = az.InferenceData(
+        posterior=xr.Dataset({"mu": (("chain", "draw"), mu)}),
+        log_likelihood=xr.Dataset({"y": (("chain", "draw", "obs"), ll)}),
+    )
+    loo = tempered_loo(data, "y", T)
+    assert abs(float(loo.elpd_loo) - exact) < 0.1
+    assert loo.loo_i.shape == (n,) and np.all(np.asarray(loo.pareto_k) < 0.7)
+    assert float(loo.p_loo) > 0
+    assert abs(float(az.loo(data, var_name="y").elpd_loo) - exact) > 5.0
+    one = tempered_loo(data, "y", 1.0)
+    assert float(one.elpd_loo) == float(az.loo(data, var_name="y").elpd_loo)
+    # az.compare takes it
+    table = az.compare({"a": loo, "b": tempered_loo(data, "y", 2.0)}, ic="loo")
+    assert set(table.index) == {"a", "b"}

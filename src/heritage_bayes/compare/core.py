@@ -14,7 +14,12 @@ import numpy as np
 
 from heritage_bayes._arviz import az
 from heritage_bayes.compare.identifiability import _identifiability
-from heritage_bayes.compare.scores import _block_se, blocked_loo_data, elpd_validation
+from heritage_bayes.compare.scores import (
+    _block_se,
+    blocked_loo_data,
+    elpd_validation,
+    tempered_loo,
+)
 from heritage_bayes.errors import InputError
 
 #: ELPD differences smaller than this are negligible whatever their SE (two nearly
@@ -82,10 +87,12 @@ def compare_runs(
         if ev is not None:
             acc["elpd_validation"] = {k: ev[k] for k in ("elpd", "se", "n")}
             val_pw[label] = (ev["pointwise"], ev["times"])
-        loo_data[label] = blocked_loo_data(run.idata, var, block_hours)
+        temperature = float(run.summary["models"][section].get("likelihood_temperature") or 1.0)
         with warnings.catch_warnings():  # high Pareto k: recorded below, not printed
             warnings.simplefilter("ignore", UserWarning)
-            loo = az.loo(loo_data[label], var_name=var)
+            # the draws of a tempered posterior need their own importance weights
+            loo = tempered_loo(blocked_loo_data(run.idata, var, block_hours), var, temperature)
+        loo_data[label] = loo
         k = np.asarray(loo.pareto_k)
         acc["loo_blocked"] = {
             "elpd": float(loo.elpd_loo),
@@ -94,6 +101,7 @@ def compare_runs(
             "n_blocks": int(k.size),
             "max_pareto_k": float(np.max(k)),
             "share_k_above_0.7": float(np.mean(k > 0.7)),
+            "likelihood_temperature": temperature,
         }
         ident = _identifiability(
             run, section, seed=seed, identified_factor=identified_factor, ratio=practical_ratio
@@ -150,7 +158,8 @@ def compare_runs(
             "seed": seed,
             "method": {
                 "calibration": f"blocked PSIS-LOO, blocks of {block_hours:g} h (az.loo over "
-                "block sums of the pointwise log-likelihood)",
+                "block sums of the pointwise log-likelihood; a tempered run's draws weighted "
+                "by p^(-1/T), compare.scores.tempered_loo)",
                 "validation": "sum over validation hours of the log posterior-mean one-step "
                 "predictive density (elpd_val); SE from block sums",
                 "identified": f"90 % interval within a factor {identified_factor:g}",

@@ -150,6 +150,7 @@ def run(
 ) -> None:
     from heritage_bayes.calibrate import run_calibration
     from heritage_bayes.config import load_config
+    from heritage_bayes.models import build_model
 
     cfg0 = load_config(config)
     for seed in seeds:
@@ -157,7 +158,7 @@ def run(
             cfg = variant(cfg0, noise, seed, split, temperature)
             rec = {"config": config, "noise": noise, "data_seed": seed, "split": split}
             rec["likelihood_temperature"] = {
-                name: getattr(cfg, name).temperature(name)
+                name: getattr(cfg, name).temperature(name, build_model(cfg, name).n_states)
                 for name in ("thermal", "hygric")
                 if getattr(cfg, name) is not None
             }

@@ -96,10 +96,10 @@ def test_temperature_divides_the_likelihood_only(noise_name):
 
 
 def test_likelihood_temperature_config_reaches_the_posterior():
-    """``thermal.likelihood_temperature`` (default 2 for a thermal section, 1 for a
-    hygric one; at least 1): the section's LogPosterior divides its log-likelihood by
-    it (the prior untouched), and a temperature below 1 is a ConfigError naming the
-    key."""
+    """``thermal.likelihood_temperature`` (default 2 for a thermal section of one or two
+    capacity nodes, 1 for a richer one and for a hygric one; at least 1): the section's
+    LogPosterior divides its log-likelihood by it (the prior untouched), and a
+    temperature below 1 is a ConfigError naming the key."""
     from heritage_bayes.calibrate import _log_posterior
     from heritage_bayes.config import parse_config
     from heritage_bayes.errors import ConfigError
@@ -131,6 +131,18 @@ def test_likelihood_temperature_config_reaches_the_posterior():
     prep_d = prepare(cfg_d)
     lp_h = _log_posterior(cfg_d, prep_d, "hygric", build_model(cfg_d, "hygric"), {})
     assert lp_h.temperature == 1.0
+    # ... and 1 for a thermal network of more than two capacity nodes (thermal_4a),
+    # unless the config sets it
+    cfg_4a = parse_config({**raw, "thermal": {"model": "thermal_4a"}})
+    m4 = build_model(cfg_4a, "thermal")
+    assert m4.n_states > 2
+    assert _log_posterior(cfg_4a, prepare(cfg_4a), "thermal", m4, {}).temperature == 1.0
+    assert (
+        cfg_4a.thermal.model_copy(update={"likelihood_temperature": 2.0}).temperature(
+            "thermal", m4.n_states
+        )
+        == 2.0
+    )
     values = {"Ci": 2e7, "Ge": 150.0, "Gf": 25.0, "sigma_Ti": 0.2, "phi_Ti": 0.9}
     theta = np.array(
         [[values.get(n, 1.0 if n.startswith("fI") else 0.1) for n in lp1.params.names]]

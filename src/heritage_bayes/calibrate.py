@@ -98,7 +98,7 @@ def _log_posterior(
             initial_state_sd=getattr(cfg, section).initial_state_sd,
             initial_state_horizon=getattr(cfg, section).horizon_seconds,
             time_constant_cap=getattr(cfg, section).cap_seconds(model.domain),
-            temperature=getattr(cfg, section).temperature(model.domain),
+            temperature=getattr(cfg, section).temperature(model.domain, model.n_states),
         )
     except ValueError as exc:
         raise InputError(f"{section}: {exc}") from None

@@ -17,12 +17,24 @@ from pydantic import PlainSerializer, PlainValidator, WithJsonSchema
 from heritage_bayes.config._base import DURATION_UNIT, _duration, _Strict, key
 from heritage_bayes.convert import format_timedelta
 
-__all__ = ["DEFAULT_LIKELIHOOD_TEMPERATURE", "DurationOrNone", "ModelSection"]
+__all__ = [
+    "DEFAULT_LIKELIHOOD_TEMPERATURE",
+    "TEMPERED_MAX_NODES",
+    "DurationOrNone",
+    "ModelSection",
+]
 
 #: ``likelihood_temperature`` where a section does not set it, by model domain:
 #: measured by simulation-based calibration on rooms the package did not generate
-#: (docs/science/sbc.md, "A tempered likelihood"); 1 for a domain not listed.
+#: (docs/science/sbc.md, "A tempered likelihood"); 1 for a domain not listed, and for
+#: networks of more than :data:`TEMPERED_MAX_NODES` capacity nodes.
 DEFAULT_LIKELIHOOD_TEMPERATURE = {"thermal": 2.0, "hygric": 1.0}
+#: The default temperature applies to networks of at most this many capacity nodes
+#: (1c, 2c: where it was measured). Richer ones (thermal_4a) keep 1: the directions
+#: their data leave to the priors widen with it until the chain cannot cross them in
+#: the budget (Ørholm's thermal_4a: 12 000 steps untempered, not converged at 47 000
+#: tempered; docs/science/sbc.md).
+TEMPERED_MAX_NODES = 2
 
 
 def _duration_or_none(v: Any) -> pd.Timedelta | str | None:
@@ -93,9 +105,10 @@ class ModelSection(_Strict):
         None,
         unit="-",
         description="divide the log-likelihood by this (a tempered likelihood: posterior "
-        "sd about √T times wider); 1: none (default: 2 for thermal models, 1 for hygric "
-        "ones, chosen by simulation-based calibration on rooms the package did not "
-        "generate; docs: Simulation-based calibration)",
+        "sd about √T times wider); 1: none (default: 2 for thermal models of one or two "
+        "capacity nodes, chosen by simulation-based calibration on rooms the package did "
+        "not generate; 1 for hygric models and richer networks such as thermal_4a; docs: "
+        "Simulation-based calibration)",
         ge=1,
         le=10,
     )
@@ -117,12 +130,16 @@ class ModelSection(_Strict):
             return 365 * 86400.0 if domain == "thermal" else math.inf
         return _seconds(self.time_constant_cap)
 
-    def temperature(self, domain: str) -> float:
-        """``likelihood_temperature``; the default by domain: 2 for thermal models (their
-        90 % intervals on 50 rooms the package did not generate cover 0.88-0.92 with
-        it, 0.74-0.82 without), 1 for hygric ones (``hygric_2c_fixed`` covers
-        0.86-0.90 untempered)."""
+    def temperature(self, domain: str, n_nodes: int = 1) -> float:
+        """``likelihood_temperature``; the default by domain: 2 for thermal models of
+        at most :data:`TEMPERED_MAX_NODES` capacity nodes (``thermal_2c``'s 90 %
+        intervals on 50 rooms the package did not generate cover 0.88-0.92 with it,
+        0.74-0.82 without), 1 for richer ones and for hygric models
+        (``hygric_2c_fixed`` covers 0.86-0.90 untempered). ``n_nodes``: the model's
+        capacity nodes (``RCModel.n_states``)."""
         if self.likelihood_temperature is None:
+            if n_nodes > TEMPERED_MAX_NODES:
+                return 1.0
             return DEFAULT_LIKELIHOOD_TEMPERATURE.get(domain, 1.0)
         return float(self.likelihood_temperature)
 

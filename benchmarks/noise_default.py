@@ -24,7 +24,8 @@ its distance from the posterior median in posterior sd.
     python benchmarks/noise_default.py --table real.jsonl seeds.jsonl
 
 ``--temperature SECTION=T`` sets a section's ``likelihood_temperature`` (default: the
-package's, 2 for thermal sections and 1 for hygric ones; each line records the values).
+package's, 2 for one- and two-node thermal sections and 1 otherwise; each line's
+``chains`` record the values the runs used).
 """
 
 from __future__ import annotations
@@ -122,6 +123,8 @@ def row_of(summary: dict) -> dict:
         row["chains"][name] = {
             k: ch.get(k) for k in ("steps", "tau_max", "cpu_seconds", "stopped_by")
         }
+        # the temperature the run used (the config's, or the package's default)
+        row["chains"][name]["likelihood_temperature"] = m.get("likelihood_temperature")
     for name, outs in (summary.get("metrics") or {}).items():
         for out, per in outs.items():
             val = per.get("validation") or {}
@@ -150,18 +153,12 @@ def run(
 ) -> None:
     from heritage_bayes.calibrate import run_calibration
     from heritage_bayes.config import load_config
-    from heritage_bayes.models import build_model
 
     cfg0 = load_config(config)
     for seed in seeds:
         for noise in noises:
             cfg = variant(cfg0, noise, seed, split, temperature)
             rec = {"config": config, "noise": noise, "data_seed": seed, "split": split}
-            rec["likelihood_temperature"] = {
-                name: getattr(cfg, name).temperature(name, build_model(cfg, name).n_states)
-                for name in ("thermal", "hygric")
-                if getattr(cfg, name) is not None
-            }
             c0 = _cpu()
             with tempfile.TemporaryDirectory(prefix="hb-noise-") as tmp:
                 try:

@@ -125,6 +125,13 @@ def _round_mantissa(a: np.ndarray, keep: int) -> np.ndarray:
     return out.view(np.float32)
 
 
+def _packing(quantum: float) -> dict:
+    """NetCDF encoding that stores a value as an int32 multiple of ``quantum`` (CF
+    ``scale_factor`` packing): the one definition :func:`_encoding` writes with and
+    :func:`as_stored` reproduces."""
+    return {"dtype": "int32", "scale_factor": quantum, "_FillValue": np.iinfo(np.int32).min}
+
+
 def _encoding(group: str, da) -> dict:
     """NetCDF encoding of one variable of ``group`` (see :func:`write_inference_data`)."""
     if not np.issubdtype(da.dtype, np.number):
@@ -138,7 +145,7 @@ def _encoding(group: str, da) -> dict:
         enc["chunksizes"] = (da.shape[0], da.shape[1], min(_CHUNK_HOURS, da.shape[2]))
     quantum = PREDICTIVE_QUANTUM.get(da.attrs.get("unit", ""))
     if group in _PACKED_GROUPS and quantum is not None and np.issubdtype(da.dtype, np.floating):
-        enc.update(dtype="int32", scale_factor=quantum, _FillValue=np.iinfo(np.int32).min)
+        enc.update(_packing(quantum))
     return enc
 
 
@@ -158,7 +165,7 @@ def as_stored(values: np.ndarray, unit: str) -> np.ndarray:
     var = xr.Variable(
         tuple(f"dim_{i}" for i in range(a.ndim)),
         a,
-        encoding={"dtype": "int32", "scale_factor": quantum, "_FillValue": np.iinfo(np.int32).min},
+        encoding=_packing(quantum),
     )
     encoded = xr.conventions.encode_cf_variable(var)
     return np.asarray(xr.conventions.decode_cf_variable("values", encoded).values, dtype=float)

@@ -41,8 +41,10 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import bench_sampling
 from _common import config_map
+from heritage_bayes.calibrate import identifiability_at_map
 from heritage_bayes.config import load_config
 from heritage_bayes.inference.coordinates import node_time_constants
+from heritage_bayes.inference.moves import block_weight, unidentified_block
 from heritage_bayes.inference.optimize import laplace
 from heritage_bayes.inference.sampler import _tau
 
@@ -72,7 +74,7 @@ def _config(path: Path, section: str, model_name: str | None):
     return cfg
 
 
-def _run(label, lp, mp, coords, cfg, args, moves, walkers=None, hessian=None):
+def _run(label, lp, mp, coords, cfg, args, moves, walkers=None, hessian=None, block=(), bw=0.0):
     out = bench_sampling._run(
         label,
         lp,
@@ -82,6 +84,8 @@ def _run(label, lp, mp, coords, cfg, args, moves, walkers=None, hessian=None):
         cfg,
         args.max_time,
         moves=moves,
+        block=block,
+        block_weight=bw,
         nwalkers=walkers,
         max_steps=args.max_steps,
         max_draws=cfg.sampler.max_draws,
@@ -144,6 +148,13 @@ def main() -> None:
         "with Gw, Gi) sampled along the log series conductance and the log ratio",
     )
     ap.add_argument(
+        "--block-weights",
+        default=None,
+        help="comma-separated sampler.block_weight values, each run with every --moves in "
+        "node_tau coordinates: the share of steps of the block move on the parameters the "
+        "Laplace check flags, as hbayes calibrate takes them (default: the config's)",
+    )
+    ap.add_argument(
         "--p-global",
         type=float,
         default=None,
@@ -173,7 +184,14 @@ def main() -> None:
         if args.seed is not None:
             cfg = cfg.model_copy(update={"seed": args.seed})
         section = PROBLEMS[name][1]
-        _, model, lp, mp = config_map(cfg, section)
+        prep, model, lp, mp = config_map(cfg, section)
+        _, lap = identifiability_at_map(model, lp, mp, prep.dt)
+        block = unidentified_block(lp, lap)
+        weights = (
+            [float(w) for w in args.block_weights.split(",")]
+            if args.block_weights
+            else [block_weight(cfg.sampler.block_weight, model.n_states)]
+        )
         coords = node_time_constants(
             lp, solar=args.solar, air_share=args.air_share, series=args.series
         )
@@ -181,24 +199,26 @@ def main() -> None:
             f"{name}: {model.name}, {lp.ndim} free parameters, MAP {mp.log_post:.1f}; "
             f"{len(coords.nodes) if coords else 0} node(s) and "
             f"{sum(len(g) for *_, g in coords.splits) if coords else 0} split solar "
-            "aperture(s) re-coordinated",
+            "aperture(s) re-coordinated; block move on "
+            f"{[lp.params.free_names[i] for i in block]}",
             flush=True,
         )
         runs = {}
         moves = args.moves.split(",") if args.moves else [cfg.sampler.moves]
         if args.only != "node_tau":
-            runs["log"] = _run("log", lp, mp, None, cfg, args, moves[0])
+            runs["log"] = _run("log", lp, mp, None, cfg, args, moves[0], block=block, bw=weights[0])
         sizes = [int(w) for w in args.walkers.split(",")] if args.walkers else [None]
         starts = args.start.split(",")
         hessian = laplace(lp, mp.x).hessian if "laplace" in starts else None
         for start in starts if args.only != "log" else ():
             for w in sizes:
-                for m in moves:
+                for m, bw in ((m, bw) for m in moves for bw in weights):
                     label = "node_tau" + (f"/{m}" if len(moves) > 1 else "")
                     label += f"/{w}w" if w is not None else ""
                     label += f"/{start}" if len(starts) > 1 else ""
+                    label += f"/bw{bw:g}" if len(weights) > 1 else ""
                     h = hessian if start == "laplace" else None
-                    runs[label] = _run(label, lp, mp, coords, cfg, args, m, w, h)
+                    runs[label] = _run(label, lp, mp, coords, cfg, args, m, w, h, block, bw)
         names = lp.params.free_names
         for label, (res, _, _) in runs.items() if args.save_chain else ():
             out = f"{args.save_chain}_{name}_{label.replace('/', '_')}.npz"
@@ -206,6 +226,8 @@ def main() -> None:
         print("  τ per parameter [steps]: " + "  ".join(f"{n:>8s}" for n in names))
         for label, (res, _, _) in runs.items():
             print(f"  {label:<22s}  " + "  ".join(f"{t:8.0f}" for t in res.tau))
+            half = _tau(res.chain[res.chain.shape[0] // 2 :])
+            print(f"  {'  second half':<22s}  " + "  ".join(f"{t:8.0f}" for t in half))
         labels = list(runs)
         for other in labels[1:]:
             (a, ca, ra), (b, cb, rb) = runs[labels[0]], runs[other]

@@ -124,6 +124,30 @@ class _Section:
     deadline: float | None = None  # time.perf_counter() end of the run's time budget
 
 
+def structural_at_map(model: RCModel, logpost: LogPosterior, map_result, dt: float):
+    """Structural identifiability of ``model`` at a MAP (its fixed parameters held):
+    :func:`heritage_bayes.rc.identify.structural_identifiability`."""
+    from heritage_bayes.rc.identify import structural_identifiability
+
+    n = logpost.n_model
+    fixed = tuple(p.name for p in logpost.params.parameters[:n] if not p.free)
+    point = dict(zip(model.parameter_names, map_result.theta[:n], strict=True))
+    return structural_identifiability(model, point, dt=dt, fixed=fixed)
+
+
+def identifiability_at_map(model: RCModel, logpost: LogPosterior, map_result, dt: float):
+    """(structural identifiability, Laplace check) at a MAP, as ``hbayes calibrate``
+    takes them before sampling: the Laplace standard deviations are conditional on the
+    capacity that pins the overall scale of C and G (the structural check's
+    ``scale_reference``), so that the scale ridge alone flags nothing. The Laplace
+    check's ``unidentified`` parameters are the block of the sampler's block move."""
+    from heritage_bayes.inference.optimize import laplace
+
+    ident = structural_at_map(model, logpost, map_result, dt)
+    ref = ident.scale_reference
+    return ident, laplace(logpost, map_result.x, given=(ref,) if ref else ())
+
+
 def _say_findings(say: _Progress, s: _Section, priors: Mapping | tuple = ()) -> None:
     """Before sampling: a MAP on a prior bound, and parameters the data do not pin.
 
@@ -297,11 +321,11 @@ def _calibrate_into(
     # the heavy imports (arviz, scipy.optimize, emcee) only once the config is valid
     from heritage_bayes.inference.coordinates import sampling_coordinates
     from heritage_bayes.inference.idata import CONVERGENCE, build_run_outputs
-    from heritage_bayes.inference.optimize import find_map, laplace, seconds_left, share_deadline
+    from heritage_bayes.inference.moves import block_weight, unidentified_block
+    from heritage_bayes.inference.optimize import find_map, seconds_left, share_deadline
     from heritage_bayes.inference.sampler import run_sampler
     from heritage_bayes.inference.start import start_hessian
     from heritage_bayes.prepare import prepare
-    from heritage_bayes.rc.identify import structural_identifiability
 
     say.say(f"hbayes {__version__}: calibrating {cfg.name!r} -> {final}")
     t0 = time.perf_counter()
@@ -356,15 +380,7 @@ def _calibrate_into(
             f"{s.map.n_agreed}/{s.map.n_starts} starts agreed"
         )
         t0 = time.perf_counter()
-        tm = s.map.theta[: s.logpost.n_model]
-        fixed = tuple(
-            p.name for p in s.logpost.params.parameters[: s.logpost.n_model] if not p.free
-        )
-        s.identifiability = structural_identifiability(
-            s.model, dict(zip(s.model.parameter_names, tm, strict=True)), dt=prep.dt, fixed=fixed
-        )
-        ref = s.identifiability.scale_reference
-        s.laplace = laplace(s.logpost, s.map.x, given=(ref,) if ref else ())
+        s.identifiability, s.laplace = identifiability_at_map(s.model, s.logpost, s.map, prep.dt)
         s.timings["identifiability_seconds"] = time.perf_counter() - t0
         _say_findings(say, s, getattr(cfg, s.name).priors)
         t0 = time.perf_counter()
@@ -378,6 +394,8 @@ def _calibrate_into(
                 seed=cfg.seed + 101 * i,
                 nwalkers=nwalkers,
                 moves=cfg.sampler.moves,
+                block=unidentified_block(s.logpost, s.laplace),
+                block_weight=block_weight(cfg.sampler.block_weight, s.model.n_states),
                 max_steps=cfg.sampler.max_steps,
                 max_seconds=seconds_left(deadline),
                 bounds=s.logpost.params.bounds,
@@ -479,7 +497,6 @@ def model_ladder(cfg: CalibrationConfig, prep, section: _Section, *, seed: int) 
     """
     from heritage_bayes.inference.optimize import BudgetError, find_map
     from heritage_bayes.inference.results import fit_metrics
-    from heritage_bayes.rc.identify import structural_identifiability
 
     sec_cfg = getattr(cfg, section.name)
     names = list(LADDERS[section.name]) if isinstance(sec_cfg.model, str) else []
@@ -520,11 +537,7 @@ def model_ladder(cfg: CalibrationConfig, prep, section: _Section, *, seed: int) 
                 )
             except BudgetError:  # sampler.max_time is spent: the ladder ends here
                 break
-        tm = mp.theta[: lp.n_model]
-        fixed = tuple(p.name for p in lp.params.parameters[: lp.n_model] if not p.free)
-        ident = structural_identifiability(
-            model, dict(zip(model.parameter_names, tm, strict=True)), dt=prep.dt, fixed=fixed
-        )
+        ident = structural_at_map(model, lp, mp, prep.dt)
         U = prep.model_inputs(section.name, model)
         ysim = lp.simulate_frame(mp.theta[None], U, prep.calibration.start)[0][0]
         obs = prep.observed(section.name, model)

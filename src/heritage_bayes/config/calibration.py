@@ -251,6 +251,8 @@ def chain_tag(cfg: CalibrationConfig) -> str:
         keep["coordinates"] = d["sampler"]["coordinates"]
     if d["sampler"].get("start", "ball") != "ball":
         keep["start"] = d["sampler"]["start"]
+    if d["sampler"].get("block_weight") is not None:
+        keep["block_weight"] = d["sampler"]["block_weight"]
     d = {**d, "sampler": keep}
     for k in ("report", "ladder", "name", "building", "room", "notes"):
         d.pop(k, None)

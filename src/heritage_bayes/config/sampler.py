@@ -10,6 +10,11 @@ from pydantic import PlainSerializer, PlainValidator, WithJsonSchema
 from heritage_bayes.config._base import DURATION_UNIT, _duration, _Strict, key
 from heritage_bayes.convert import format_timedelta
 
+#: ``sampler.block_weight`` of networks of three or more capacity nodes when the key is
+#: not set (measured: docs/science/benchmarks.md, "A block move for what the data leave
+#: to the priors")
+BLOCK_WEIGHT = 0.2
+
 __all__ = ["Budget", "OptimizerSettings", "SamplerSettings"]
 
 
@@ -91,6 +96,19 @@ class SamplerSettings(_Strict):
         "(DE with those draws, no snooker), de, or stretch (measured on the demo's "
         "thermal_4a, 40 000 steps: τmax 1 049 with de_snooker, 712 with de_global, 2 129 "
         "with dime; on Ørholm's thermal_4a 319 and 372)",
+    )
+    block_weight: float | None = key(
+        None,
+        unit="-",
+        description="share of the steps in which only the parameters the Laplace check "
+        "flags as practically not identified move (differential evolution within that "
+        "block; heritage_bayes.inference.moves.BlockDEMove), so that the wide directions "
+        "the data leave to the priors are crossed in larger steps. Default (none): "
+        f"{BLOCK_WEIGHT} for networks of three or more capacity nodes (thermal_4a), 0 for "
+        "smaller ones (their chains as before). With no parameter flagged there is no "
+        "block move; 0 turns it off",
+        ge=0,
+        lt=1,
     )
     coordinates: Literal["auto", "log", "node_tau"] = key(
         "auto",

@@ -12,7 +12,7 @@ from __future__ import annotations
 import emcee
 import numpy as np
 
-from heritage_bayes.inference.moves import GlobalDEMove
+from heritage_bayes.inference.moves import BlockDEMove, GlobalDEMove
 
 #: ``sampler.moves``: name -> [(emcee move class, weight), ...] (emcee's defaults for
 #: each move: ``DEMove`` γ₀ = 2.38 / √(2 d), ``DESnookerMove`` γ = 1.7, ``StretchMove``
@@ -28,16 +28,26 @@ MOVES = {
 }
 
 
-def make_moves(name: str):
+def make_moves(name: str, block=(), block_weight: float = 0.0):
     """emcee moves by name (:data:`MOVES`): ``de_snooker`` (default), ``de_snooker_50``,
     ``de`` or ``stretch``, as emcee's ``[(move, weight), ...]``.
+
+    With a non-empty ``block`` (coordinate indices) and ``block_weight`` > 0, a
+    :class:`~heritage_bayes.inference.moves.BlockDEMove` on those coordinates takes that
+    share of the steps and the named moves the rest in their proportions; otherwise the
+    list is the named moves alone (the same chain as before the block move existed).
 
     The snooker move alone is not offered: from the start ball (walkers 1e-3 apart) it
     does not spread the ensemble (a 3-d Gaussian: posterior sd 0.002 instead of 1 after
     20 000 steps), its proposals lie along lines through other walkers."""
     if name not in MOVES:
         raise ValueError(f"sampler.moves must be one of {sorted(MOVES)} (got {name!r})")
-    return [(cls(), w) for cls, w in MOVES[name]]
+    if not 0.0 <= block_weight < 1.0:
+        raise ValueError(f"sampler.block_weight must lie in [0, 1) (got {block_weight})")
+    if len(block) == 0 or block_weight == 0.0:
+        return [(cls(), w) for cls, w in MOVES[name]]
+    rest = 1.0 - block_weight
+    return [(cls(), w * rest) for cls, w in MOVES[name]] + [(BlockDEMove(block), block_weight)]
 
 
 def _next_check(done: int, check_every: int) -> int:

@@ -191,6 +191,8 @@ def _run_sampler(
     seed: int,
     nwalkers: int | None = None,
     moves: str = "de_snooker",
+    block=(),
+    block_weight: float = 0.0,
     max_steps: int = 200_000,
     max_seconds: float | None = None,
     bounds: tuple[np.ndarray, np.ndarray] | None = None,
@@ -224,6 +226,12 @@ def _run_sampler(
         Seeds the initial ball and emcee's random stream: same seed, same chain.
     nwalkers : int, optional
         Default ``max(32, 2 d + 2)`` (even).
+    block : sequence of int
+        Coordinates (indices) that a :class:`~heritage_bayes.inference.moves.BlockDEMove`
+        moves on their own in a share ``block_weight`` of the steps (see
+        :func:`heritage_bayes.inference.monitor.make_moves`); ``hbayes calibrate`` passes
+        the parameters the Laplace check flags as practically not identified. Empty (or
+        ``block_weight`` 0): the named ``moves`` alone.
     max_steps : int
         Safety cap on the chain length [steps].
     max_seconds : float, optional
@@ -297,7 +305,7 @@ def _run_sampler(
     def to_y(a: np.ndarray) -> np.ndarray:
         return a if coordinates is None else coordinates.to_y(a)
 
-    move_list = make_moves(moves)
+    move_list = make_moves(moves, block, block_weight)
     sampler = emcee.EnsembleSampler(nwalkers, d, target, vectorize=True, moves=move_list)
     ck = _Checkpoint(Path(checkpoint), tag) if checkpoint is not None else None
     buf = ChainBuffer(nwalkers, d)

@@ -18,9 +18,15 @@ CPU second, and the ratio node_tau / log. BLAS single-threaded; on a shared mach
 CPU time is the figure to compare. A τ from a chain shorter than 50 τ is a lower
 bound (emcee's estimate): the converged column says which.
 
-    python benchmarks/bench_coordinates.py demo_2c demo_4a demo_hygric trh1_2c orholm_4a \
+The block move of ``hbayes calibrate`` (``sampler.block_weight``: DE within the
+parameters the Laplace check flags, taken as calibrate takes them) runs with the
+config's weight (0.2 for networks of three or more nodes); ``--block-weights 0,0.2``
+runs each weight from the same start and seed, ``--block NAMES`` replaces the flagged
+parameters. Each run also prints τ per parameter on the chain's second half.
+
+    python benchmarks/bench_coordinates.py demo_2c demo_4a demo_hygric trh1_2c orholm_4a \\
         [--max-steps N] [--max-time SECONDS] [--only log|node_tau] [--solar] \\
-        [--save-chain PREFIX]
+        [--block-weights W,...] [--start ball|laplace] [--save-chain PREFIX]
 """
 
 from __future__ import annotations
@@ -155,6 +161,12 @@ def main() -> None:
         "Laplace check flags, as hbayes calibrate takes them (default: the config's)",
     )
     ap.add_argument(
+        "--block",
+        default=None,
+        help="comma-separated parameter names of the block move in place of those the "
+        "Laplace check flags (an experiment)",
+    )
+    ap.add_argument(
         "--p-global",
         type=float,
         default=None,
@@ -187,6 +199,8 @@ def main() -> None:
         prep, model, lp, mp = config_map(cfg, section)
         _, lap = identifiability_at_map(model, lp, mp, prep.dt)
         block = unidentified_block(lp, lap)
+        if args.block:
+            block = [lp.params.free_names.index(n) for n in args.block.split(",")]
         weights = (
             [float(w) for w in args.block_weights.split(",")]
             if args.block_weights

@@ -20,7 +20,11 @@ modes. The stretch move is available (``moves: stretch``), and ``de_global`` add
 global proposals to the DE part: a walker in ten proposes an independent draw from a
 Student-t refitted to the chain at each convergence check
 (:mod:`heritage_bayes.inference.moves`; not the default: measured in
-docs/science/benchmarks.md).
+docs/science/benchmarks.md). Where the Laplace check flags parameters the data leave to
+their priors, a block move (``block``, ``block_weight``;
+:class:`heritage_bayes.inference.moves.BlockDEMove`) takes a share of the steps and
+moves those parameters alone; ``hbayes calibrate`` uses it for networks of three or
+more nodes.
 
 Checkpoint: emcee's own HDF5 backend writes every step (several ms each here, more than
 the step itself), so the sampler runs in memory and each chunk is appended to an HDF5

@@ -51,10 +51,8 @@ MAX_FIT_POINTS = 8000
 
 
 class BlockDEMove(emcee.moves.DEMove):
-    """Moves within a block of coordinates: differential evolution along the difference
-    of two other walkers, or (probability ``p_global``) an independent draw from a
-    Student-t fitted to the block's coordinates in the chain so far; the other
-    coordinates unchanged.
+    """Differential evolution restricted to a block of coordinates: each walker moves
+    along the difference of two others in those coordinates only, the rest unchanged.
 
     Meant for the parameters the data leave to their priors (thermal_4a's interior mass
     ``Cint``, ``Gint`` and ``fsol`` on a room without one): along them the posterior is
@@ -64,16 +62,15 @@ class BlockDEMove(emcee.moves.DEMove):
     by a random walk of short steps. A step within the block leaves the identified
     parameters where they are (a Metropolis-within-Gibbs update; DE proposals on a
     subspace as in DREAM [4]_), with DE's scale for the block's dimension, γ₀ = 2.38 /
-    √(2 k) for k coordinates. The region the block's parameters may take is often
-    L-shaped (the interior mass is invisible if either its conductance or its capacity
-    is small), which a random walk crosses slowly; the global draws jump across it.
+    √(2 k) for k coordinates.
 
-    The DE proposal is symmetric (the pair of walkers and the block do not depend on the
-    walker's position; the reverse step takes the same pair in the other order), and the
-    global draw carries the independence sampler's Metropolis-Hastings factor, so both
-    leave the posterior invariant. As in :class:`GlobalDEMove`, the t is refitted only
-    at the sampler's convergence checks (:func:`refit_moves`): a chain resumed after an
-    interrupt continues bit for bit.
+    The proposal is symmetric (the pair of walkers and the block do not depend on the
+    walker's position; the reverse step takes the same pair in the other order), so it
+    leaves the posterior invariant as emcee's ``DEMove`` does. Independent draws of the
+    block from a Student-t fitted to the chain (as :class:`GlobalDEMove` makes for all
+    coordinates) were tried and made the demo's thermal_4a slower (τmax 2 285 against
+    1 997 steps at 40 000; docs/science/benchmarks.md): a t fitted to an L-shaped region
+    holds walkers in the region's arms.
 
     Parameters
     ----------
@@ -81,29 +78,16 @@ class BlockDEMove(emcee.moves.DEMove):
         Indices of the coordinates to move (emcee's coordinates: where a network is
         sampled along node time constants, a capacity's index holds its node's log time
         constant).
-    p_global : float
-        Probability that a walker's proposal is the global draw, once fitted.
-    df : float
-        Degrees of freedom of the Student-t.
     **kwargs
         Passed to :class:`emcee.moves.DEMove` (``sigma``; ``gamma0`` defaults as above).
     """
 
-    #: default of ``p_global``
-    P_GLOBAL = 0.5
-
-    def __init__(self, block, p_global: float | None = None, df: float = 5.0, **kwargs):
+    def __init__(self, block, **kwargs):
         self.block = np.unique(np.asarray(block, dtype=int))
         if self.block.size == 0:
             raise ValueError("BlockDEMove: the block holds no coordinate")
         kwargs.setdefault("gamma0", 2.38 / np.sqrt(2 * self.block.size))
         super().__init__(**kwargs)
-        self.t = GlobalDEMove(p_global=self.P_GLOBAL if p_global is None else p_global, df=df)
-
-    def fit(self, points: np.ndarray) -> bool:
-        """Fit the global draws to ``points`` (n, d) in the sampler's coordinates (the
-        block's columns are used); False when they define no proper t."""
-        return self.t.fit(np.asarray(points, dtype=float)[:, self.block])
 
     def get_proposal(self, s, c, random):
         c = np.concatenate(c, axis=0)
@@ -114,20 +98,7 @@ class BlockDEMove(emcee.moves.DEMove):
         gamma = self.g0 * (1 + self.sigma * random.randn(ns, 1))
         q = np.array(s, dtype=float, copy=True)
         q[:, self.block] += gamma * diffs[:, self.block]
-        factors = np.zeros(ns, dtype=np.float64)
-        t = self.t
-        if t.mean is None or t.p_global == 0.0:
-            return q, factors
-        pick = random.rand(ns) < t.p_global
-        k = int(pick.sum())
-        if k:
-            z = random.randn(k, self.block.size)
-            w = random.chisquare(t.df, size=k) / t.df
-            new = t.mean + (z @ t.chol.T) / np.sqrt(w)[:, None]
-            rows = np.flatnonzero(pick)
-            q[np.ix_(rows, self.block)] = new
-            factors[pick] = t._log_q(s[np.ix_(rows, self.block)]) - t._log_q(new)
-        return q, factors
+        return q, np.zeros(ns, dtype=np.float64)
 
 
 def _nondiagonal_pairs(n: int) -> np.ndarray:
@@ -218,13 +189,12 @@ class GlobalDEMove(emcee.moves.DEMove):
 
 
 def refit_moves(moves, chain: np.ndarray, to_y=None) -> None:
-    """Refit every :class:`GlobalDEMove` and :class:`BlockDEMove` (its block's columns)
-    among emcee's ``[(move, weight), ...]`` to the
+    """Refit every :class:`GlobalDEMove` among emcee's ``[(move, weight), ...]`` to the
     second half of ``chain`` (rows, walkers, d), its rows thinned evenly to at most
     :data:`MAX_FIT_POINTS` points and mapped by ``to_y`` (n, d) -> (n, d) into the
     sampler's coordinates (None: already there). A deterministic function of the rows,
     so a resumed chain refits identically."""
-    movers = [m for m, _ in moves if isinstance(m, GlobalDEMove | BlockDEMove)]
+    movers = [m for m, _ in moves if isinstance(m, GlobalDEMove)]
     if not movers or chain.shape[0] < 2:
         return
     rows = chain[chain.shape[0] // 2 :]

@@ -230,6 +230,9 @@ def test_resume_may_extend_a_run(tiny_run, tmp_path):
     assert code == (0 if s["converged"] else 3)
     chain = s["models"]["thermal"]["chain"]
     assert chain["resumed_from"] == 400
+    # the block move is recorded: a one-node model has none (weight 0) whatever is flagged
+    flagged = s["models"]["thermal"]["practical_identifiability"]["unidentified"]
+    assert chain["block_move"] == {"parameters": flagged, "weight": 0.0}
     assert chain["steps"] == 600 or chain["converged_tau"]
 
 

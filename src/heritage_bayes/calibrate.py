@@ -117,6 +117,7 @@ class _Section:
     theta_kept: np.ndarray | None = None  # (walkers, draws, P), all retained draws
     X_kept: np.ndarray | None = None  # the same in sampler coordinates
     laplace: object = None  # LaplaceResult at the MAP (practical identifiability)
+    block_move: dict = field(default_factory=dict)  # the block move's parameters, weight
     map_at_bound: list = field(default_factory=list)  # (name, "lower"/"upper")
     frozen_node: dict | None = None  # the MAP's slowest mode, when many records long
     lp: np.ndarray | None = None
@@ -387,6 +388,11 @@ def _calibrate_into(
         update = say.sampler(s.name, cfg.sampler.max_steps)
         coords = sampling_coordinates(s.logpost, cfg.sampler.coordinates)
         hessian = start_hessian(s.logpost, s.laplace, cfg.sampler.start)
+        block = unidentified_block(s.logpost, s.laplace)
+        s.block_move = {
+            "parameters": [s.logpost.params.free_names[k] for k in block],
+            "weight": block_weight(cfg.sampler.block_weight, s.model.n_states) if block else 0.0,
+        }
         try:
             s.chain = run_sampler(
                 s.logpost,
@@ -394,8 +400,8 @@ def _calibrate_into(
                 seed=cfg.seed + 101 * i,
                 nwalkers=nwalkers,
                 moves=cfg.sampler.moves,
-                block=unidentified_block(s.logpost, s.laplace),
-                block_weight=block_weight(cfg.sampler.block_weight, s.model.n_states),
+                block=block,
+                block_weight=s.block_move["weight"],
                 max_steps=cfg.sampler.max_steps,
                 max_seconds=seconds_left(deadline),
                 bounds=s.logpost.params.bounds,

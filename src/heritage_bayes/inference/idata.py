@@ -352,6 +352,9 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
             "identifiability": s.identifiability.to_dict(),
             "chain": {
                 "coordinates": getattr(s.chain, "coordinates", "log"),
+                # the block move: the flagged parameters and its share of the steps
+                # (0: the named moves alone)
+                "block_move": getattr(s, "block_move", None) or None,
                 "walkers": int(W),
                 "steps": int(s.chain.steps),
                 "burn": int(s.chain.burn),

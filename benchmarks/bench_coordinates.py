@@ -50,7 +50,7 @@ from _common import config_map
 from heritage_bayes.calibrate import identifiability_at_map
 from heritage_bayes.config import load_config
 from heritage_bayes.inference.coordinates import node_time_constants
-from heritage_bayes.inference.moves import block_weight, unidentified_block
+from heritage_bayes.inference.moves import unidentified_block
 from heritage_bayes.inference.optimize import laplace
 from heritage_bayes.inference.sampler import _tau
 
@@ -204,7 +204,7 @@ def main() -> None:
         weights = (
             [float(w) for w in args.block_weights.split(",")]
             if args.block_weights
-            else [block_weight(cfg.sampler.block_weight, model.n_states)]
+            else [cfg.sampler.block_weight_for(model.n_states)]
         )
         coords = node_time_constants(
             lp, solar=args.solar, air_share=args.air_share, series=args.series

@@ -25,7 +25,6 @@ from heritage_bayes.errors import ConfigError
 from heritage_bayes.inference.monitor import make_moves
 from heritage_bayes.inference.moves import (
     BlockDEMove,
-    block_weight,
     unidentified_block,
 )
 from heritage_bayes.inference.sampler import run_sampler
@@ -145,9 +144,9 @@ def _cfg(extra: str = ""):
 def test_the_config_key_its_default_and_the_chain_tag():
     assert _cfg().sampler.block_weight is None
     # unset: the block move for networks of three or more nodes only
-    assert block_weight(None, 3) == BLOCK_WEIGHT > 0
-    assert block_weight(None, 2) == 0.0
-    assert block_weight(0.3, 1) == 0.3
+    assert _cfg().sampler.block_weight_for(3) == BLOCK_WEIGHT > 0
+    assert _cfg().sampler.block_weight_for(2) == 0.0
+    assert _cfg(", block_weight: 0.3").sampler.block_weight_for(1) == 0.3
     # the default leaves the chain tag of earlier runs; a weight set changes it
     assert chain_tag(_cfg(", block_weight: 0.2")) != chain_tag(_cfg())
     with pytest.raises(ConfigError, match="block_weight"):

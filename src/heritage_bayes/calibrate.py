@@ -322,7 +322,7 @@ def _calibrate_into(
     # the heavy imports (arviz, scipy.optimize, emcee) only once the config is valid
     from heritage_bayes.inference.coordinates import sampling_coordinates
     from heritage_bayes.inference.idata import CONVERGENCE, build_run_outputs
-    from heritage_bayes.inference.moves import block_weight, unidentified_block
+    from heritage_bayes.inference.moves import unidentified_block
     from heritage_bayes.inference.optimize import find_map, seconds_left, share_deadline
     from heritage_bayes.inference.sampler import run_sampler
     from heritage_bayes.inference.start import start_hessian
@@ -391,7 +391,7 @@ def _calibrate_into(
         block = unidentified_block(s.logpost, s.laplace)
         s.block_move = {
             "parameters": [s.logpost.params.free_names[k] for k in block],
-            "weight": block_weight(cfg.sampler.block_weight, s.model.n_states) if block else 0.0,
+            "weight": cfg.sampler.block_weight_for(s.model.n_states) if block else 0.0,
         }
         try:
             s.chain = run_sampler(

@@ -10,10 +10,11 @@ from pydantic import PlainSerializer, PlainValidator, WithJsonSchema
 from heritage_bayes.config._base import DURATION_UNIT, _duration, _Strict, key
 from heritage_bayes.convert import format_timedelta
 
-#: ``sampler.block_weight`` of networks of three or more capacity nodes when the key is
-#: not set (measured: docs/science/benchmarks.md, "A block move for what the data leave
-#: to the priors")
+#: ``sampler.block_weight`` of networks of :data:`BLOCK_MIN_NODES` or more capacity nodes
+#: when the key is not set (measured: docs/science/benchmarks.md, "A block move for what
+#: the data leave to the priors"); smaller networks get 0 (their chains as before)
 BLOCK_WEIGHT = 0.2
+BLOCK_MIN_NODES = 3
 
 __all__ = ["Budget", "OptimizerSettings", "SamplerSettings"]
 
@@ -153,6 +154,14 @@ class SamplerSettings(_Strict):
     def max_seconds(self) -> float | None:
         """``max_time`` in seconds (None: no budget)."""
         return None if self.max_time is None else self.max_time.total_seconds()
+
+    def block_weight_for(self, n_nodes: int) -> float:
+        """The share of steps of the block move for a network of ``n_nodes`` capacity
+        nodes: ``block_weight`` when set, else :data:`BLOCK_WEIGHT` from
+        :data:`BLOCK_MIN_NODES` nodes on and 0 below."""
+        if self.block_weight is not None:
+            return float(self.block_weight)
+        return BLOCK_WEIGHT if n_nodes >= BLOCK_MIN_NODES else 0.0
 
 
 class OptimizerSettings(_Strict):

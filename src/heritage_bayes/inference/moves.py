@@ -41,7 +41,6 @@ import numpy as np
 __all__ = [
     "BlockDEMove",
     "GlobalDEMove",
-    "block_weight",
     "refit_moves",
     "unidentified_block",
 ]
@@ -216,16 +215,3 @@ def unidentified_block(logpost, laplace) -> list[int]:
         return []
     names = list(logpost.params.free_names)
     return [names.index(n) for n in laplace.unidentified if n in names]
-
-
-def block_weight(configured: float | None, n_nodes: int) -> float:
-    """The share of steps of the block move: ``sampler.block_weight`` when the config
-    sets it, else :data:`heritage_bayes.config.sampler.BLOCK_WEIGHT` for networks of
-    :data:`heritage_bayes.inference.coordinates.MIN_NODES` or more capacity nodes and 0
-    (the chains of one- and two-node models as before) for smaller ones."""
-    from heritage_bayes.config.sampler import BLOCK_WEIGHT
-    from heritage_bayes.inference.coordinates import MIN_NODES
-
-    if configured is not None:
-        return float(configured)
-    return BLOCK_WEIGHT if n_nodes >= MIN_NODES else 0.0

@@ -68,7 +68,7 @@ class BlockDEMove(emcee.moves.DEMove):
     leaves the posterior invariant as emcee's ``DEMove`` does. Independent draws of the
     block from a Student-t fitted to the chain (as :class:`GlobalDEMove` makes for all
     coordinates) were tried and made the demo's thermal_4a slower (τmax 2 285 against
-    1 997 steps at 40 000; docs/science/benchmarks.md): a t fitted to an L-shaped region
+    1 919 steps at 40 000; docs/science/benchmarks.md): a t fitted to an L-shaped region
     holds walkers in the region's arms.
 
     Parameters

@@ -42,7 +42,7 @@ def main() -> None:
     theta = dict(zip(lp.params.names, mp.theta, strict=True))
     print(
         f"{args.problem}: MAP log-posterior {mp.log_post:.2f} at Gint {theta['Gint']:.3g} W/K, "
-        f"Cint {theta['Cint']:.3g} J/K, fsol {theta.get('fsol', float('nan')):.3g}"
+        f"Cint {theta['Cint']:.3g} J/K" + (f", fsol {theta['fsol']:.3g}" if "fsol" in theta else "")
     )
     at_map = float(np.asarray(lp(mp.x[None]), dtype=float)[0])
     print(
@@ -52,7 +52,7 @@ def main() -> None:
     )
     ig, ic = names.index("Gint"), names.index("Cint")
     jf = names.index("fsol") if "fsol" in names else None
-    shares = [("fsol at the MAP", mp.x[jf] if jf is not None else None)]
+    shares = [("fsol at the MAP", mp.x[jf]) if jf is not None else ("log-density", None)]
     if jf is not None:
         shares.append(("fsol 1/2", 0.0))  # the logit coordinate of 1/2
     rows, X = [], []

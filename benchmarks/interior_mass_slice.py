@@ -8,7 +8,7 @@ grid: the interior mass decoupled (small ``Gint``, any
 ``Cint``) or merged with the air node (small ``Cint``, large ``Gint``), with ``fsol`` at
 its MAP value or at 1/2. One vectorised call; a few seconds after the MAP search.
 
-    python benchmarks/interior_mass_slice.py [demo_4a | orholm_4a]
+    python benchmarks/interior_mass_slice.py [demo_4a | orholm_4a] [--seed N]
 """
 
 from __future__ import annotations
@@ -35,8 +35,11 @@ CINT = (1e4, 1e6, 1e8, 1e10, 9.9e11)  # [J/K]
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("problem", nargs="?", default="demo_4a", choices=sorted(PROBLEMS))
+    ap.add_argument("--seed", type=int, default=None, help="the MAP search's seed (the config's)")
     args = ap.parse_args()
     cfg = _config(*PROBLEMS[args.problem])
+    if args.seed is not None:
+        cfg = cfg.model_copy(update={"seed": args.seed})
     _, _, lp, mp = config_map(cfg, PROBLEMS[args.problem][1])
     names = list(lp.params.free_names)
     theta = dict(zip(lp.params.names, mp.theta, strict=True))

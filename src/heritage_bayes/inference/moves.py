@@ -89,21 +89,12 @@ class BlockDEMove(emcee.moves.DEMove):
         super().__init__(**kwargs)
 
     def get_proposal(self, s, c, random):
-        c = np.concatenate(c, axis=0)
-        ns = s.shape[0]
-        pairs = _nondiagonal_pairs(c.shape[0])
-        pairs = pairs[random.choice(pairs.shape[0], size=ns, replace=True)]
-        diffs = c[pairs[:, 1]] - c[pairs[:, 0]]
-        gamma = self.g0 * (1 + self.sigma * random.randn(ns, 1))
+        # emcee's DE proposal (its pair of walkers and γ, the same random draws), kept
+        # in the block's coordinates only
+        full, factors = super().get_proposal(s, c, random)
         q = np.array(s, dtype=float, copy=True)
-        q[:, self.block] += gamma * diffs[:, self.block]
-        return q, np.zeros(ns, dtype=np.float64)
-
-
-def _nondiagonal_pairs(n: int) -> np.ndarray:
-    """(n (n - 1), 2) ordered pairs of distinct walkers (emcee's DE draws from the same)."""
-    rows, cols = np.tril_indices(n, -1)
-    return np.column_stack([np.concatenate([rows, cols]), np.concatenate([cols, rows])])
+        q[:, self.block] = full[:, self.block]
+        return q, factors
 
 
 class GlobalDEMove(emcee.moves.DEMove):

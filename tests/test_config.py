@@ -333,6 +333,32 @@ def test_yaml_syntax_error_has_line_and_column(tmp_path):
     assert str(path) in msg and "not valid YAML at line 4, column" in msg
 
 
+def test_scientific_notation_is_a_number_as_written(tmp_path):
+    """YAML 1.1 (PyYAML) reads 1.3e7 and 1e7 as text; a config reads them as numbers,
+    and what YAML 1.1 already read (ints, dotted floats, text) is unchanged."""
+    from heritage_bayes.config import load_yaml_text, read_yaml
+
+    text = (
+        "a: 1.3e7\nb: 1e7\nc: -5E-3\nd: 2e+8\ne: .5e3\nf: 1.0e+7\ng: 12\nh: 1_000\n"
+        "i: 1e\nj: e7\nk: '1e7'\nl: 0x1f\nm: 1.5\n"
+    )
+    got = load_yaml_text(text, source="t")
+    assert got == {
+        "a": 1.3e7, "b": 1e7, "c": -5e-3, "d": 2e8, "e": 500.0, "f": 1e7, "g": 12,
+        "h": 1000, "i": "1e", "j": "e7", "k": "1e7", "l": 31, "m": 1.5,
+    }  # fmt: skip
+    assert isinstance(got["b"], float) and isinstance(got["g"], int)
+    path = tmp_path / "c.yaml"
+    path.write_text(text)
+    assert read_yaml(path)[0] == got
+    path.write_text(
+        "data: {demo: {seed: 7}}\n"
+        "thermal:\n  model: thermal_4a\n"
+        "  priors: {Cint: {dist: lognormal, median: 1.3e7, sigma: 1}}\n"
+    )
+    assert load_config(path).thermal.priors["Cint"]["median"] == 1.3e7
+
+
 def test_missing_file(tmp_path):
     with pytest.raises(ConfigError, match="config file not found"):
         load_config(tmp_path / "nope.yaml")

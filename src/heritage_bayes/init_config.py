@@ -538,8 +538,9 @@ def init_config(
         lines += ["questions:", *[f"  - {_yaml_value(MARK + ' ' + q)}" for q in extra], ""]
     text = "\n".join(lines)
     if not questions:  # the same schema as every config: it must load
-        from heritage_bayes.config import parse_config
+        from heritage_bayes.config import load_yaml_text, parse_config
 
-        parse_config(yaml.safe_load(text), source=str(output), base_dir=str(base), name=name)
+        raw = load_yaml_text(text, source=str(output))
+        parse_config(raw, source=str(output), base_dir=str(base), name=name)
     write_new_file(output, text, force=force, what="--output")
     return InitResult(output, text, findings, questions)

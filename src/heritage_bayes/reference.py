@@ -329,13 +329,11 @@ def check_config_snippet(snippet: str, base: str = "configs/demo.yaml") -> str:
     heritage_bayes.ConfigError
         The merged config is not valid; the message names the key path.
     """
-    import yaml
-
     from heritage_bayes.calibrate import check_models
-    from heritage_bayes.config import parse_config, read_yaml
+    from heritage_bayes.config import load_yaml_text, parse_config, read_yaml
 
     raw, _ = read_yaml(base)
-    extra = yaml.safe_load(snippet)
+    extra = load_yaml_text(snippet, source="config snippet")
     if not isinstance(extra, dict):
         raise ValueError(f"a config snippet is a YAML mapping, got {type(extra).__name__}")
     check_models(parse_config(_merge(raw, extra), source=f"snippet merged into {base}"))
@@ -354,9 +352,9 @@ def check_projection_snippet(snippet: str) -> str:
     heritage_bayes.ConfigError
         The file is not valid; the message names the key path.
     """
-    import yaml
-
+    from heritage_bayes.config import load_yaml_text
     from heritage_bayes.projection.config import parse_projection_config
 
-    parse_projection_config(yaml.safe_load(snippet), source="projection snippet")
+    raw = load_yaml_text(snippet, source="projection snippet")
+    parse_projection_config(raw, source="projection snippet")
     return f"```yaml\n{snippet.strip()}\n```"

@@ -65,7 +65,7 @@ from heritage_bayes.config.calibration import (
     load_config,
     parse_config,
 )
-from heritage_bayes.config.loader import read_yaml
+from heritage_bayes.config.loader import load_yaml_text, read_yaml
 from heritage_bayes.config.models import ModelSection
 from heritage_bayes.config.periods import Period, Periods
 from heritage_bayes.config.reference import ConfigKey, config_keys, describe_key
@@ -98,6 +98,7 @@ __all__ = [
     "describe_key",
     "key",
     "load_config",
+    "load_yaml_text",
     "nearest_key",
     "parse_config",
     "parse_duration",

@@ -6,6 +6,7 @@ projection, portfolio configs): YAML's silent choices are refused with the line.
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 from typing import Any
 
@@ -13,7 +14,7 @@ import yaml
 
 from heritage_bayes.errors import ConfigError
 
-__all__ = ["MAX_ALIASES", "MAX_BYTES", "MAX_DEPTH", "MAX_NODES", "read_yaml"]
+__all__ = ["MAX_ALIASES", "MAX_BYTES", "MAX_DEPTH", "MAX_NODES", "load_yaml_text", "read_yaml"]
 
 #: Limits of a settings file: size [bytes], aliases (``*name``) in one file, values
 #: after expanding anchors, nesting depth. A hand-written config uses a handful of each.
@@ -32,7 +33,11 @@ class _Loader(yaml.SafeLoader):
     - more than :data:`MAX_ALIASES` aliases is an error (an "anchor bomb" expands
       exponentially when walked);
     - an impossible date (``2019-13-02``) stays text, so that the config check names its
-      key instead of failing inside the YAML parser.
+      key instead of failing inside the YAML parser;
+    - a number in scientific notation is a number as written (``1.3e7``, ``5e-3``,
+      ``2E+8``): PyYAML follows YAML 1.1, which reads a mantissa without a dot or an
+      exponent without a sign as text, so that ``Cint: {median: 1.3e7}`` was refused as
+      "not a number" (YAML 1.2, and every other reader, takes it as the float).
     """
 
     def __init__(self, stream):
@@ -87,6 +92,14 @@ class _Loader(yaml.SafeLoader):
 
 
 _Loader.add_constructor("tag:yaml.org,2002:timestamp", _Loader._timestamp)
+# YAML 1.2's floats that YAML 1.1 leaves as text: a mantissa without a dot (1e7) or an
+# exponent without a sign (1.3e7). The resolvers already registered (ints, 1.1 floats)
+# are tried first, so nothing they read changes.
+_Loader.add_implicit_resolver(
+    "tag:yaml.org,2002:float",
+    re.compile(r"^[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]*)?|\.[0-9_]+)[eE][-+]?[0-9]+$"),
+    list("-+0123456789."),
+)
 
 
 def _check_size(raw: Any, source: str) -> None:
@@ -140,14 +153,21 @@ def read_yaml(path, *, what: str = "config file") -> tuple[Any, str]:
             f"{p}: not UTF-8 text (byte 0x{data[exc.start]:02x} at offset {exc.start}); "
             "save the file as UTF-8"
         ) from None
+    return load_yaml_text(text, source=str(p)), text
+
+
+def load_yaml_text(text: str, *, source: str) -> Any:
+    """Parse YAML text with the rules of :func:`read_yaml` (``source`` names it in
+    messages): a config ``hbayes init`` writes and a snippet of the manual are read as a
+    config file is."""
     try:
         raw = yaml.load(text, Loader=_Loader)  # a SafeLoader
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
         problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
-        raise ConfigError(f"{p}: not valid YAML{where}: {str(problem)[:200]}") from None
+        raise ConfigError(f"{source}: not valid YAML{where}: {str(problem)[:200]}") from None
     except RecursionError:
-        raise ConfigError(f"{p}: nested more than {MAX_DEPTH} levels deep") from None
-    _check_size(raw, str(p))
-    return raw, text
+        raise ConfigError(f"{source}: nested more than {MAX_DEPTH} levels deep") from None
+    _check_size(raw, source)
+    return raw

@@ -415,3 +415,55 @@ def test_envelope_area_bounds_the_envelope_node():
     assert ps2.parameters[ps2.names.index("Gw")].prior.upper == pytest.approx(6475.0)
     with pytest.raises(ConfigError, match="envelope_area"):
         parse_config({**raw, "envelope_area": 0})
+
+
+def test_interior_area_sets_a_lognormal_prior_on_gint():
+    """interior_area [m²]: Gint log-normal, median 5 W/(m²K) × area (EN ISO 6946's
+    interior convection plus the air node's share of radiation), sd of log 0.7, bounds
+    ±5 sd; a model without an interior mass (2c, hygric) keeps every default; a prior
+    the config states on Gint wins; the config key reaches the parameters; an area ≤ 0
+    is a ConfigError naming the key."""
+    from heritage_bayes.config import parse_config
+    from heritage_bayes.inference.parameters import H_INTERIOR, default_prior, interior_prior
+    from heritage_bayes.run import section_parameters
+
+    noise = get_noise_model("ar1_white")
+    th = hb.model("thermal_4a", surfaces=("S",))
+    prior = {p.name: p.prior for p in parameters_for(th, noise, interior_area=80.0).parameters}
+    g = prior["Gint"]
+    assert H_INTERIOR == 5.0
+    assert (g.dist, g.mu, g.sigma) == ("lognormal", pytest.approx(400.0), 0.7)
+    assert (g.lower, g.upper) == (
+        pytest.approx(400 * math.exp(-3.5)),
+        pytest.approx(400 * math.exp(3.5)),
+    )
+    # the prior's median and spread as stated: P(Gint < 400) = 1/2, P(Gint < 400 e^0.7) ≈ Φ(1)
+    rng = np.random.default_rng(3)
+    draws = g.sample(rng, 20_000)
+    assert np.mean(draws < 400.0) == pytest.approx(0.5, abs=4 * 0.5 / np.sqrt(20_000))
+    assert np.mean(draws < 400.0 * math.exp(0.7)) == pytest.approx(
+        stats.norm.cdf(1.0), abs=4 * 0.5 / np.sqrt(20_000)
+    )
+    for name in ("Cint", "Gi", "Gw", "Cw", "Ci"):
+        kind = "capacity" if name.startswith("C") else "conductance"
+        assert prior[name] == default_prior("thermal", kind)
+    for m in (hb.model("thermal_2c", surfaces=("S",)), hb.model("hygric_2c")):
+        base = parameters_for(m, noise).to_dict()
+        assert parameters_for(m, noise, interior_area=80.0).to_dict() == base
+    own = {"Gint": {"dist": "loguniform", "lower": 10, "upper": 1000}}
+    stated = {
+        p.name: p.prior for p in parameters_for(th, noise, own, interior_area=80.0).parameters
+    }
+    assert (stated["Gint"].dist, stated["Gint"].lower, stated["Gint"].upper) == (
+        "loguniform",
+        10,
+        1000,
+    )
+    raw = {"data": {"demo": {"seed": 7}}, "interior_area": 120, "thermal": {"model": "thermal_4a"}}
+    cfg = parse_config(raw)
+    _, ps = section_parameters(cfg, "thermal", hb.model("thermal_4a", surfaces=("S",)), {})
+    assert ps.parameters[ps.names.index("Gint")].prior.mu == pytest.approx(600.0)
+    with pytest.raises(ConfigError, match="interior_area"):
+        parse_config({**raw, "interior_area": 0})
+    with pytest.raises(ConfigError, match="interior_area"):
+        interior_prior(-1.0)

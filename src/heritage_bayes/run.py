@@ -80,6 +80,7 @@ def section_parameters(cfg: CalibrationConfig, section: str, model: RCModel, pri
         air_change_sigma=cfg.air_change_sigma,
         floor_area=cfg.floor_area,
         envelope_area=cfg.envelope_area,
+        interior_area=cfg.interior_area,
         glazing_area=cfg.glazing_area,
         fixed_node_temperature=cfg.fixed_node_temperature,
         where=f"{section}.priors",

@@ -30,6 +30,7 @@ Layout (see ``configs/demo.yaml`` for a complete, commented example)::
     room_volume: 800               # [m³], optional: log-normal prior on each model's Ci
     floor_area: 160                # [m²] on the ground, optional: log-normal prior on Gf
     envelope_area: 420             # [m²] walls + roof outside, optional: bounds Gw, Cw
+    interior_area: 300             # [m²] floor, inner walls, contents: prior on Gint (4a)
     glazing_area: {S: 12, E: 4}    # [m²] of windows per surface, optional: priors on fI
     data:
       demo: {seed: 7, gap: [2019-03-10, 2019-03-17]}   # the built-in virtual monument

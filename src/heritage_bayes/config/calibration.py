@@ -84,6 +84,15 @@ class CalibrationConfig(_Strict):
         "and Cw (thermal) and on the moisture buffer's Gw and Cw (hygric)",
         gt=0,
     )
+    interior_area: float | None = key(
+        None,
+        unit="m²",
+        description="area of the interior constructions and contents in contact with the "
+        "room air (floor, inner walls, vaults, furniture): a log-normal prior on the "
+        "interior-mass conductance Gint of thermal_4a (and any model with an interior mass "
+        "node), median 5 W/(m²K) × the area, sd of log 0.7",
+        gt=0,
+    )
     glazing_area: dict[str, float] | None = key(
         None,
         unit="m²",

@@ -47,6 +47,7 @@ __all__ = [
     "air_capacity_prior",
     "aperture_prior",
     "default_prior",
+    "interior_prior",
     "parameters_for",
     "ventilation_prior",
 ]
@@ -407,6 +408,49 @@ def ground_prior(floor_area: float, *, u_value: float = U_GROUND, sigma: float =
     if not floor_area > 0:
         raise ConfigError(f"floor_area must be > 0 m² (got {floor_area})")
     median = u_value * floor_area
+    return Prior(
+        "lognormal", median * math.exp(-5 * sigma), median * math.exp(5 * sigma), median, sigma
+    )
+
+
+#: Heat transfer coefficient between the interior mass and the room air [W/(m²·K)]:
+#: the convective part of the interior surface coefficient, h_c ≈ 2.5 W/(m²·K) for walls
+#: (EN ISO 6946:2017, Annex C; 5 upward, 0.7 downward), plus the share of the radiative
+#: exchange h_r ≈ 5 W/(m²·K) (R_si 0.13 m²K/W in all, Table 7) that a lumped air node
+#: carries, since the surfaces the interior mass sees in radiation belong to the air
+#: node's side of the network: between 2.5 and 7.7; the median of
+#: :func:`interior_prior`.
+H_INTERIOR = 5.0
+
+
+def interior_prior(interior_area: float, *, h: float = H_INTERIOR, sigma: float = 0.7) -> Prior:
+    """Log-normal prior on the conductance ``Gint`` [W/K] between the room air and the
+    interior mass (model 4a's ``Cint``: inner walls and floors, vaults, furniture) from
+    the area [m²] of those surfaces.
+
+    Median ``h × interior_area`` (:data:`H_INTERIOR`, 5 W/(m²·K)), width σ_log = 0.7 (a
+    factor 2: 2.5-10 W/(m²·K) within one σ). Why: what couples a mass to the air is its
+    surface, and a building survey knows the surface while hourly temperatures do not.
+    With the default log-uniform prior over seven decades the demo's ``thermal_4a``
+    posterior has an arm in which the interior mass is decoupled (``Gint`` 0.3-3.5 W/K,
+    physically a few tenths of a square metre of surface) and the MAP lies there; the
+    chain crosses between that arm and a merged mass in rare long excursions (τ of
+    ``Gint`` 3 899 steps after 150 000 steps, not converged; docs/science/benchmarks.md,
+    "Interior area").
+
+    Parameters
+    ----------
+    interior_area : float
+        Area of the interior constructions and contents in contact with the room air
+        [m²]: floor, inner walls, vaults, the contents' surfaces.
+    h : float
+        Median surface heat transfer coefficient [W/(m²·K)].
+    sigma : float
+        sd of log(Gint).
+    """
+    if not interior_area > 0:
+        raise ConfigError(f"interior_area must be > 0 m² (got {interior_area})")
+    median = h * interior_area
     return Prior(
         "lognormal", median * math.exp(-5 * sigma), median * math.exp(5 * sigma), median, sigma
     )
@@ -789,6 +833,7 @@ def parameters_for(
     air_change_sigma: float = 1.0,
     floor_area: float | None = None,
     envelope_area: float | None = None,
+    interior_area: float | None = None,
     glazing_area: Mapping[str, float] | None = None,
     fixed_node_temperature: float | None = None,
     where: str = "priors",
@@ -818,6 +863,10 @@ def parameters_for(
     envelope_area : float, optional
         Exterior surface area of walls and roof [m²]: upper bounds on a thermal
         model's envelope node, ``Gw`` and ``Cw`` (see :func:`envelope_priors`).
+    interior_area : float, optional
+        Area of the interior constructions and contents in contact with the room air
+        [m²]: a log-normal prior on the interior-mass conductance ``Gint`` of a thermal
+        model that has one (see :func:`interior_prior`); ignored by the others.
     glazing_area : mapping surface -> float, optional
         Glazed area of the windows [m²] of solar surfaces: a log-normal prior on each
         listed surface's aperture ``fI_<surface>`` (see :func:`aperture_prior`); the
@@ -890,6 +939,12 @@ def parameters_for(
             prior = vapour_ground_prior(floor_area)
         if name == "Pf" and fixed_node_temperature is not None and kind == "constant":
             prior = fixed_vapour_pressure_prior(fixed_node_temperature)
+        if interior_area is not None and (name, domain, kind) == (
+            "Gint",
+            "thermal",
+            "conductance",
+        ):
+            prior = interior_prior(interior_area)
         if envelope_area is not None and name in ("Gw", "Cw"):
             prior = envelope_priors(envelope_area, domain)[name]
         surface = name.removeprefix("fI_")

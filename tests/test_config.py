@@ -376,3 +376,25 @@ def test_name_defaults_to_file_stem(tmp_path):
     cfg = load_config(path)
     assert cfg.name == "my_room"
     assert cfg.path("data.csv") == tmp_path.resolve() / "data.csv"
+
+
+def test_optimizer_restarts_key_its_default_and_the_chain_tag():
+    """optimizer.restarts: unset, 3 global searches for networks of three or more nodes
+    and 1 below (their MAP as before); set, that many for every network; unset keys
+    added later (restarts, interior_area) leave the chain tag of earlier runs, set
+    ones change it."""
+    from heritage_bayes.config import chain_tag
+    from heritage_bayes.config.sampler import RESTARTS
+
+    cfg = parse_config(_with())
+    assert cfg.optimizer.restarts is None and cfg.interior_area is None
+    assert cfg.optimizer.restarts_for(3) == RESTARTS == 3
+    assert cfg.optimizer.restarts_for(2) == cfg.optimizer.restarts_for(1) == 1
+    two = parse_config(_with(optimizer={"restarts": 2}))
+    assert two.optimizer.restarts_for(1) == two.optimizer.restarts_for(4) == 2
+    assert chain_tag(two) != chain_tag(cfg)
+    assert chain_tag(parse_config(_with(interior_area=80))) != chain_tag(cfg)
+    blob = json.dumps(cfg.resolved(), sort_keys=True, default=str)
+    assert '"restarts": null' in blob and '"interior_area": null' in blob
+    for bad in (0, 21, "many"):
+        assert "optimizer.restarts" in _error(_with(optimizer={"restarts": bad}))

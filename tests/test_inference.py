@@ -467,3 +467,96 @@ def test_interior_area_sets_a_lognormal_prior_on_gint():
         parse_config({**raw, "interior_area": 0})
     with pytest.raises(ConfigError, match="interior_area"):
         interior_prior(-1.0)
+
+
+def _optimum(unit, log_post):
+    from heritage_bayes.inference.optimize import MAPResult
+
+    u = np.asarray(unit, dtype=float)
+    return MAPResult(x=u, theta=u, log_post=log_post, n_starts=1, n_agreed=1, unit=u)
+
+
+def test_restarts_report_separate_optima_and_keep_the_first_unless_clearly_worse():
+    """Two optima 0.6 apart in the unit cube: with a deep valley between them (two narrow
+    bumps) they are two modes; with a shallow one (two wide bumps) one; a restart's
+    optimum replaces the first search's only when higher by more than MODE_PICK; optima
+    more than MODE_WINDOW below the best are not modes."""
+    from heritage_bayes.inference.optimize import MODE_PICK, MODE_WINDOW, _with_modes
+
+    a, b = np.array([0.2, 0.5]), np.array([0.8, 0.5])
+
+    def objective(width, ha=0.0, hb=0.0):
+        def f(S):
+            S = np.atleast_2d(S)
+            da = ((S - a) ** 2).sum(axis=1) / (2 * width**2)
+            db = ((S - b) ** 2).sum(axis=1) / (2 * width**2)
+            return -np.logaddexp(ha - da, hb - db)
+
+        return f
+
+    narrow = objective(0.05)  # valley at 0.5: 0.3² / (2 × 0.05²) = 18 units deep
+    r = _with_modes([_optimum(a, 0.0), _optimum(b, -1.0)], narrow)
+    assert r.restarts == 2 and np.array_equal(r.unit, a) and r.log_post == 0.0
+    assert [m["log_posterior"] for m in r.modes] == [0.0, -1.0]
+    wide = objective(0.3)  # valley 0.5 units deep: one broad mode
+    assert len(_with_modes([_optimum(a, 0.0), _optimum(b, 0.0)], wide).modes) == 1
+    # the first is kept unless a restart is clearly higher
+    r = _with_modes([_optimum(a, -(MODE_PICK - 0.5)), _optimum(b, 0.0)], narrow)
+    assert np.array_equal(r.unit, a) and len(r.modes) == 2
+    r = _with_modes([_optimum(a, -(MODE_PICK + 0.5)), _optimum(b, 0.0)], narrow)
+    assert np.array_equal(r.unit, b) and r.modes[0]["log_posterior"] == 0.0
+    # far below the best: not a mode (the search's local optimum, 790 vs 938 on the demo)
+    r = _with_modes([_optimum(a, -(MODE_WINDOW + 1)), _optimum(b, 0.0)], narrow)
+    assert np.array_equal(r.unit, b) and len(r.modes) == 1
+
+
+def test_restarts_on_a_ridge_find_one_mode_and_keep_the_first_search():
+    """thermal_1c without a room volume: the overall scale of C and G is a ridge of
+    equal height. The restarts end at different points of it, which are not modes; the
+    MAP is the first search's, as without restarts; the summary records both."""
+    from heritage_bayes.inference.optimize import MODE_DISTANCE, _Objective, _search
+
+    lp, _ = _problem(room_volume=None)
+    one = find_map(lp, seed=3, maxiter=60, starts=2)
+    three = find_map(lp, seed=3, maxiter=60, starts=2, restarts=3)
+    np.testing.assert_array_equal(one.x, three.x)
+    assert three.restarts == 3 and len(three.modes) == 1 and one.modes == []
+    # the restarts did end at different points of the ridge
+    obj = _Objective(lp)
+    ends = [_search(lp, obj, s, "differential_evolution", 10, 60, 2) for s in (3, [3, 1], [3, 2])]
+    assert max(np.abs(e.unit - ends[0].unit).max() for e in ends[1:]) > MODE_DISTANCE
+    d = three.to_dict(lp.params.names)
+    assert (
+        d["restarts"] == 3
+        and len(d["modes"]) == 1
+        and "restarts" not in one.to_dict(lp.params.names)
+    )
+    with pytest.raises(ValueError, match="restarts"):
+        find_map(lp, seed=3, restarts=0)
+
+
+def test_the_modes_finding_names_where_the_optima_differ():
+    """The warning of a multimodal MAP search: each other optimum's height and the
+    parameters in which it differs (at most four, farthest first), with both values,
+    and the ways out (a survey's area, a prior, the smaller model)."""
+    from types import SimpleNamespace
+
+    from heritage_bayes.findings import modes_finding
+
+    names = ["Cw", "Cint", "Gint", "fsol", "sigma_Ti"]
+    kept = {"log_posterior": 938.0, "theta": np.array([1.2e8, 1e4, 400, 0.41, 0.2])}
+    kept["unit"] = np.array([0.5, 0.0, 0.5, 0.41, 0.3])
+    other = {"log_posterior": 938.75, "theta": np.array([7.7e7, 4.4e7, 433, 0.0, 0.2])}
+    other["unit"] = np.array([0.48, 0.45, 0.51, 0.0, 0.3])
+    s = SimpleNamespace(
+        name="thermal",
+        logpost=SimpleNamespace(params=SimpleNamespace(names=names, free_names=names)),
+        map=SimpleNamespace(modes=[kept, other], restarts=3),
+    )
+    msg = modes_finding(s, "thermal_2c")
+    assert msg.startswith("[thermal] the MAP search found 2 separate optima")
+    assert "(3 searches)" in msg and "log-posterior 938.0;" in msg
+    assert "log-posterior 938.8 with Cint 1e+04 vs 4.4e+07, fsol 0.41 vs 0" in msg
+    assert "Cw 1.2e+08" not in msg and "Gint 400" not in msg  # 0.02 apart: not named
+    assert "multimodal" in msg and "(thermal.model: thermal_2c)" in msg
+    assert "smaller model" not in modes_finding(s, None)

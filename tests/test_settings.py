@@ -265,7 +265,7 @@ def _section_at_cap(noise="ar1_white"):
         name="thermal",
         model=Ns(name="thermal_1c", domain="thermal", parameter_names=["Ci"]),
         logpost=logpost,
-        map=Ns(x=np.zeros(2), theta=np.array([1e7, 0.96])),
+        map=Ns(x=np.zeros(2), theta=np.array([1e7, 0.96]), modes=[]),
         identifiability=ident,
         laplace=None,
         map_at_bound=[],
@@ -275,18 +275,19 @@ def _section_at_cap(noise="ar1_white"):
 
 def test_a_phi_at_its_cap_is_warned_once_and_not_when_the_config_sets_it(monkeypatch, capsys):
     import heritage_bayes.calibrate as cal
+    import heritage_bayes.findings as fin
 
-    monkeypatch.setattr(cal, "frozen_time_constant", lambda *a: None)
-    cal._say_findings(cal._Progress(quiet=False), _section_at_cap())
+    monkeypatch.setattr(fin, "frozen_time_constant", lambda *a: None)
+    fin.say_findings(cal._Progress(quiet=False), _section_at_cap())
     err = capsys.readouterr().err
     assert err.count("hbayes: warning:") == 1  # the cap, not also "MAP on a prior bound"
     assert "phi_Ti at its cap 0.96" in err and "about 24 h" in err
     priors = {"phi_Ti": {"dist": "uniform", "lower": 0, "upper": 0.96}}
-    cal._say_findings(cal._Progress(quiet=False), _section_at_cap(), priors)
+    fin.say_findings(cal._Progress(quiet=False), _section_at_cap(), priors)
     err = capsys.readouterr().err
     assert "warning" not in err and "phi_Ti at its cap 0.96" in err  # said, not warned
     # with a single AR(1) the cap is not explained: the bound is flagged
-    cal._say_findings(cal._Progress(quiet=False), _section_at_cap("ar1"))
+    fin.say_findings(cal._Progress(quiet=False), _section_at_cap("ar1"))
     assert "the MAP lies on a prior bound for phi_Ti (upper)" in capsys.readouterr().err
 
 
@@ -294,14 +295,15 @@ def test_a_parameter_the_config_pins_is_not_flagged_as_unidentified(monkeypatch,
     """demo.yaml closes hygric_2c's Cw-Gw direction with a lognormal prior on Gw: the
     advice 'add an informative prior' is already taken, so no warning for it."""
     import heritage_bayes.calibrate as cal
+    import heritage_bayes.findings as fin
 
-    monkeypatch.setattr(cal, "frozen_time_constant", lambda *a: None)
+    monkeypatch.setattr(fin, "frozen_time_constant", lambda *a: None)
     s = _section_at_cap("ar1")
     s.logpost.params.at_bound = lambda x: []
     s.identifiability.identifiable = {"Ci": True, "Gw": False}
-    cal._say_findings(cal._Progress(quiet=True), s)
+    fin.say_findings(cal._Progress(quiet=True), s)
     assert "over-parameterised for these data (structurally not identifiable: Gw)" in (
         capsys.readouterr().err
     )
-    cal._say_findings(cal._Progress(quiet=True), s, {"Gw": {"dist": "lognormal"}})
+    fin.say_findings(cal._Progress(quiet=True), s, {"Gw": {"dist": "lognormal"}})
     assert capsys.readouterr().err == ""

@@ -26,6 +26,7 @@ from heritage_bayes.config import MAX_SEED, CalibrationConfig, chain_tag, config
 from heritage_bayes.convergence import unconverged_reasons
 from heritage_bayes.convert import format_timedelta
 from heritage_bayes.errors import InputError
+from heritage_bayes.findings import LADDERS, say_findings
 from heritage_bayes.inference.posterior import LogPosterior
 from heritage_bayes.inference.results import (
     atomic_write,
@@ -36,7 +37,6 @@ from heritage_bayes.inference.results import (
 )
 from heritage_bayes.models import SECTIONS, _catalog_options, build_model, initial_state_of
 from heritage_bayes.rc.catalog import model as catalog_model
-from heritage_bayes.rc.derived import frozen_time_constant
 from heritage_bayes.rc.model import RCModel
 from heritage_bayes.run import (  # Run, load_run: re-exported
     Run,
@@ -147,90 +147,6 @@ def identifiability_at_map(model: RCModel, logpost: LogPosterior, map_result, dt
     ident = structural_at_map(model, logpost, map_result, dt)
     ref = ident.scale_reference
     return ident, laplace(logpost, map_result.x, given=(ref,) if ref else ())
-
-
-def _say_findings(say: _Progress, s: _Section, priors: Mapping | tuple = ()) -> None:
-    """Before sampling: a MAP on a prior bound, and parameters the data do not pin.
-
-    Findings about the prior or the model, warned (and kept in the summary); a parameter
-    whose prior the config sets (``priors``) is a decision taken: a capped phi is said,
-    not warned, and one the data do not pin is not flagged (its prior closes it).
-    """
-    s.map_at_bound = s.logpost.params.at_bound(s.map.x)
-    capped = [n for n, side in s.map_at_bound if n.startswith("phi_") and side == "upper"]
-    told = {(n, "upper") for n in capped} if s.logpost.noise.name == "ar1_white" else set()
-    if told:
-        ph = s.logpost.params.parameters[s.logpost.params.names.index(capped[0])].prior.upper
-        hours = -s.logpost.dt / 3600.0 / np.log(ph)
-        (say.say if capped[0] in priors else say.warn)(
-            f"[{s.name}] {', '.join(capped)} at its cap {ph:g}: the misfit stays correlated "
-            f"for longer than the noise model allows (about {hours:.0f} h), so the model "
-            "misses a slow process (a missing input such as solar gains, a heat or "
-            "moisture source, a controlled climate). The simulation is kept responsible "
-            "for the slow response; widen the cap with a prior on "
-            f"{capped[0]} only if the slow misfit is measurement drift"
-        )
-    lp = s.logpost
-    record = lp.record_seconds
-    tau = frozen_time_constant(s.model, s.map.theta[: lp.n_model], record)
-    if tau is not None:  # a frozen node (see frozen_time_constant)
-        free = lp.initial_state == "estimate" or isinstance(lp.initial_state, Mapping)
-        sd = lp.initial_state_sd / np.hypot(1.0, tau / lp.initial_state_horizon) if free else 0.0
-        unit = "K" if s.model.domain == "thermal" else "Pa"
-        s.frozen_node = {
-            "tau_h": tau / 3600.0,
-            "records": tau / record,
-            "start_free": bool(free and sd > 0.5 * lp.initial_state_sd),
-            "start_sd": sd,
-            "unit": unit,
-        }
-        say.warn(
-            f"[{s.name}] the slowest time constant at the MAP, {tau / 3600:.3g} h, is "
-            f"{tau / record:.0f} times the calibration record: that node barely moves, a "
-            "constant standing in for a fixed node, a missing input or a missing node; "
-            + (
-                "its start is estimated freely, so it is a free offset: compare with "
-                "the default initial_state_horizon or initial_state: steady"
-                if s.frozen_node["start_free"]
-                else f"its start is held to the steady state (prior sd {sd:.2g} {unit})"
-            )
-            + ", or model the fixed node (thermal: options.ground; hygric: hygric_2c_fixed)"
-        )
-    if unexplained := [b for b in s.map_at_bound if b not in told]:  # not flagged twice
-        what = ", ".join(f"{n} ({side})" for n, side in unexplained)
-        say.warn(
-            f"[{s.name}] the MAP lies on a prior bound for {what}: the data push "
-            "these parameters to the edge of the allowed range. Check the prior (is the "
-            "bound physical? widen it if not) and the model (a missing input or node "
-            "often shows up this way)"
-        )
-    ident = s.identifiability
-    # the overall scale of C and G (no known heat input) is a null direction only a
-    # prior closes: reported in the identifiability section, not flagged here
-    ok = ident.identifiable_given_scale if ident.has_scale_direction else ident.identifiable
-    structural = [p for p, good in ok.items() if not good and p not in priors]
-    practical = list(s.laplace.unidentified) if s.laplace is not None else []
-    poor = [p for p in practical if p in s.model.parameter_names and p not in priors]
-    if structural or poor:
-        parts = []
-        if structural:
-            parts.append(f"structurally not identifiable: {', '.join(structural)}")
-        if poor:
-            parts.append(
-                "practically not identified at the MAP (Laplace sd > 25 % of the prior "
-                f"range): {', '.join(poor)}"
-            )
-        ladder = LADDERS.get(s.name, ())
-        k = ladder.index(s.model.name) if s.model.name in ladder else 0
-        smaller = ladder[k - 1] if k > 0 else None
-        say.warn(
-            f"[{s.name}] {s.model.name} is over-parameterised for these data ("
-            + "; ".join(parts)
-            + "). The chain will mix slowly and these posteriors will be their priors. "
-            f"Choose: fix them ({s.name}.priors: {{NAME: {{fixed: VALUE}}}}), add an "
-            "informative prior (room_volume, air_change_rate, or a lognormal prior on "
-            "them)" + (f", or use the smaller model ({s.name}.model: {smaller})" if smaller else "")
-        )
 
 
 def run_calibration(
@@ -370,6 +286,7 @@ def _calibrate_into(
             popsize=cfg.optimizer.popsize,
             maxiter=cfg.optimizer.maxiter,
             starts=cfg.optimizer.starts,
+            restarts=cfg.optimizer.restarts_for(s.model.n_states),
             deadline=deadline,
             budget=f"the time budget sampler.max_time = "
             f"{format_timedelta(cfg.sampler.max_time or 0)} ({len(sections) - i} section(s) "
@@ -383,7 +300,7 @@ def _calibrate_into(
         t0 = time.perf_counter()
         s.identifiability, s.laplace = identifiability_at_map(s.model, s.logpost, s.map, prep.dt)
         s.timings["identifiability_seconds"] = time.perf_counter() - t0
-        _say_findings(say, s, getattr(cfg, s.name).priors)
+        say_findings(say, s, getattr(cfg, s.name).priors)
         t0 = time.perf_counter()
         update = say.sampler(s.name, cfg.sampler.max_steps)
         coords = sampling_coordinates(s.logpost, cfg.sampler.coordinates)
@@ -482,12 +399,6 @@ def _calibrate_into(
 
         write_report(out)
         say.say(f"report: {final / 'report.html'}")
-
-
-LADDERS = {
-    "thermal": ("thermal_1c", "thermal_2c", "thermal_4a"),
-    "hygric": ("hygric_1c", "hygric_2c", "hygric_2c_fixed"),
-}
 
 
 def model_ladder(cfg: CalibrationConfig, prep, section: _Section, *, seed: int) -> list[dict]:

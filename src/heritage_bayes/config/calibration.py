@@ -263,6 +263,11 @@ def chain_tag(cfg: CalibrationConfig) -> str:
     if d["sampler"].get("block_weight") is not None:
         keep["block_weight"] = d["sampler"]["block_weight"]
     d = {**d, "sampler": keep}
+    # keys added later enter the tag only when set (tags of earlier runs kept)
+    if d.get("interior_area") is None:
+        d.pop("interior_area", None)
+    if (d.get("optimizer") or {}).get("restarts") is None and "optimizer" in d:
+        d["optimizer"] = {k: v for k, v in d["optimizer"].items() if k != "restarts"}
     for k in ("report", "ladder", "name", "building", "room", "notes"):
         d.pop(k, None)
     blob = json.dumps(d, sort_keys=True, default=str).encode()

@@ -10,6 +10,11 @@ from pydantic import PlainSerializer, PlainValidator, WithJsonSchema
 from heritage_bayes.config._base import DURATION_UNIT, _duration, _Strict, key
 from heritage_bayes.convert import format_timedelta
 
+#: ``optimizer.restarts`` of networks of :data:`BLOCK_MIN_NODES` or more capacity nodes
+#: where the config does not set it: on the demo's data thermal_4a has two optima of
+#: nearly equal height that one search finds one at a time (heritage_bayes.inference.
+#: optimize, "Restarts").
+RESTARTS = 3
 #: ``sampler.block_weight`` of networks of :data:`BLOCK_MIN_NODES` or more capacity nodes
 #: when the key is not set (measured: docs/science/benchmarks.md, "A block move for what
 #: the data leave to the priors"); smaller networks get 0 (their chains as before)
@@ -177,3 +182,23 @@ class OptimizerSettings(_Strict):
         300, unit="generations", description="differential evolution: generations", ge=10
     )
     starts: int = key(4, unit="starts", description="local searches from the best points", ge=1)
+    restarts: int | None = key(
+        None,
+        unit="searches",
+        description="global searches from different seeds; optima within 10 log-posterior "
+        "units of the best, apart and separated by a dip of more than 3 on the line "
+        "between them are reported as modes (a multimodal posterior, which one chain "
+        "does not cross), and a restart's optimum replaces the first's "
+        f"when higher by more than 2. Default (none): {RESTARTS} for networks of "
+        f"{BLOCK_MIN_NODES} or more capacity nodes (thermal_4a), 1 for smaller ones (their "
+        "MAP as before)",
+        ge=1,
+        le=20,
+    )
+
+    def restarts_for(self, n_nodes: int) -> int:
+        """Global searches for a network of ``n_nodes`` capacity nodes: ``restarts`` when
+        set, else :data:`RESTARTS` from :data:`BLOCK_MIN_NODES` nodes on, 1 below."""
+        if self.restarts is not None:
+            return int(self.restarts)
+        return RESTARTS if n_nodes >= BLOCK_MIN_NODES else 1

@@ -14,6 +14,20 @@ multi-start. Local step: L-BFGS-B with batched central-difference gradients. The
 ``starts`` distinct candidates are polished; the number that end within 1 log-posterior
 unit of the best ("agreed") measures how unambiguous the optimum is.
 
+Restarts (``restarts`` > 1): the global search again from other seeds. One population
+of differential evolution collapses into one basin, so the polished starts of one
+search agree even where the posterior has several optima: on the demo's data
+``thermal_4a`` with the survey's ``interior_area`` has one with the interior mass merged
+into the air (log-posterior 938.0 at the optimiser's seeds 1 and 7) and one with a slow
+interior mass the sun does not reach (938.5-938.75, seeds 3-6), and seed 2 stops at
+790.2 (``docs/science/benchmarks.md``, "Several optima"). The first search's optimum is
+kept unless a restart beats it by more than :data:`MODE_PICK`; optima of the restarts
+within :data:`MODE_WINDOW` of the best, apart in the unit cube (:data:`MODE_DISTANCE`)
+and separated by a dip of the log-posterior on the straight line between them
+(:data:`MODE_BARRIER`; points of one ridge are not modes) are reported as ``modes``:
+the posterior is multimodal there, and a chain started at one of them describes that
+one.
+
 References
 ----------
 .. [1] R. Storn, K. Price, "Differential evolution - a simple and efficient heuristic for
@@ -90,6 +104,26 @@ def seconds_left(deadline: float | None) -> float | None:
     return None if deadline is None else max(0.0, deadline - time.perf_counter())
 
 
+#: A restart's optimum replaces the first search's when its log-posterior is higher by
+#: more than this: optima closer than that are equally good starts by their height (the
+#: mass of a mode is its height times its width, which the search does not see), and
+#: keeping the first keeps the chains of configs that found the best optimum before.
+MODE_PICK = 2.0
+#: Optima within this many log-posterior units of the best are reported as modes: one
+#: 10 units lower holds e^-10 of the mass only if it is as wide as the best.
+MODE_WINDOW = 10.0
+#: Optima at least this far apart in some parameter (its position between its prior
+#: bounds, log scale for log-scale priors) are distinct modes ...
+MODE_DISTANCE = 0.1
+#: ... when the log-posterior on the straight line between them drops more than this
+#: below the lower of the two: otherwise they are two points of one ridge or broad mode
+#: (the overall scale of C and G without a known heat input is such a ridge), which a
+#: chain crosses.
+MODE_BARRIER = 3.0
+#: Points on that line (evenly spaced, ends excluded).
+MODE_PATH_POINTS = 15
+
+
 @dataclass
 class MAPResult:
     """Result of :func:`find_map`.
@@ -107,6 +141,14 @@ class MAPResult:
     candidates : list of float
         Final objective of each polished start, best first.
     n_evaluations : int
+    unit : (d,) array, optional
+        The MAP's free parameters in the unit cube of the search.
+    restarts : int
+        Global searches run (the first and its restarts).
+    modes : list of dict
+        Distinct optima of the restarts within :data:`MODE_WINDOW` of the best, this
+        MAP first: ``{"log_posterior": float, "theta": (P,) array, "unit": (d,)
+        array}``; one entry when no other was found.
     """
 
     x: np.ndarray
@@ -117,9 +159,12 @@ class MAPResult:
     candidates: list[float] = field(default_factory=list)
     n_evaluations: int = 0
     method: str = ""
+    unit: np.ndarray | None = None
+    restarts: int = 1
+    modes: list[dict] = field(default_factory=list)
 
     def to_dict(self, names) -> dict:
-        return {
+        out = {
             "values": {n: float(v) for n, v in zip(names, self.theta, strict=True)},
             "log_posterior": float(self.log_post),
             "starts": int(self.n_starts),
@@ -128,6 +173,16 @@ class MAPResult:
             "evaluations": int(self.n_evaluations),
             "method": self.method,
         }
+        if self.restarts > 1:
+            out["restarts"] = int(self.restarts)
+            out["modes"] = [
+                {
+                    "log_posterior": float(m["log_posterior"]),
+                    "values": {n: float(v) for n, v in zip(names, m["theta"], strict=True)},
+                }
+                for m in self.modes
+            ]
+        return out
 
 
 class _Objective:
@@ -199,6 +254,11 @@ def find_map(logpost, **kwargs) -> MAPResult:
     starts : int
         Candidates polished with L-BFGS-B (the best distinct DE members, or random
         starts for ``multistart``).
+    restarts : int
+        Global searches (default 1): the first with ``seed``, restart k with the seed
+        sequence ``[seed, k]``; see the module docstring for which optimum is kept and
+        what is reported as ``modes``. A deadline that passes during a restart ends
+        the restarts and keeps what was found.
     deadline : float, optional
         A :func:`time.perf_counter` value: the search stops when it passes (checked
         every :data:`CHUNK` evaluations, a population of any size included).
@@ -226,13 +286,16 @@ def _find_map(
     popsize: int = 10,
     maxiter: int = 300,
     starts: int = 4,
+    restarts: int = 1,
     deadline: float | None = None,
     budget: str = "the time budget",
 ) -> MAPResult:
     """Implementation of :func:`find_map` (same parameters)."""
+    if restarts < 1:
+        raise ValueError(f"optimizer.restarts must be at least 1 (got {restarts})")
     obj = _Objective(logpost, deadline)
     try:
-        return _search(logpost, obj, seed, method, popsize, maxiter, starts)
+        first = _search(logpost, obj, seed, method, popsize, maxiter, starts)
     except _OutOfTimeError as exc:
         d = logpost.params.ndim
         pop = f"a population of {popsize} × {d} = {popsize * d}" if method != "multistart" else ""
@@ -243,6 +306,57 @@ def _find_map(
             "or lower optimizer.popsize / optimizer.maxiter / optimizer.starts",
             obj.n,
         ) from None
+    if restarts == 1:
+        return first
+    found = [first]
+    for k in range(1, restarts):
+        try:
+            found.append(_search(logpost, obj, [seed, k], method, popsize, maxiter, starts))
+        except _OutOfTimeError:
+            break
+    try:
+        return _with_modes(found, obj)
+    except _OutOfTimeError:  # the deadline passed while the modes were compared
+        return found[0]
+
+
+def _separated(a: MAPResult, b: MAPResult, objective) -> bool:
+    """Two optima apart (:data:`MODE_DISTANCE`) with a dip of more than
+    :data:`MODE_BARRIER` on the straight line between them in the unit cube."""
+    if np.abs(a.unit - b.unit).max() <= MODE_DISTANCE:
+        return False
+    t = np.linspace(0.0, 1.0, MODE_PATH_POINTS + 2)[1:-1, None]
+    path = -objective(a.unit[None, :] + t * (b.unit - a.unit)[None, :])
+    return bool(min(a.log_post, b.log_post) - path.min() > MODE_BARRIER)
+
+
+def _with_modes(found: list[MAPResult], objective) -> MAPResult:
+    """The MAP kept among the searches' optima (``found``, the first search's first) and
+    the separate modes among them (see the module docstring); ``objective``: the
+    negative log-posterior on the unit cube (:class:`_Objective`)."""
+    first = found[0]
+    best = max(found, key=lambda r: r.log_post)
+    keep = best if best.log_post > first.log_post + MODE_PICK else first
+    modes: list[MAPResult] = [keep]
+    for r in sorted(found, key=lambda r: -r.log_post):
+        if r.log_post < best.log_post - MODE_WINDOW or r is keep:
+            continue
+        if all(_separated(m, r, objective) for m in modes):
+            modes.append(r)
+    evaluations = getattr(objective, "n", 0)
+    return MAPResult(
+        x=keep.x,
+        theta=keep.theta,
+        log_post=keep.log_post,
+        n_starts=keep.n_starts,
+        n_agreed=keep.n_agreed,
+        candidates=keep.candidates,
+        n_evaluations=evaluations,
+        method=keep.method,
+        unit=keep.unit,
+        restarts=len(found),
+        modes=[{"log_posterior": m.log_post, "theta": m.theta, "unit": m.unit} for m in modes],
+    )
 
 
 def _search(logpost, obj, seed, method, popsize, maxiter, starts) -> MAPResult:
@@ -311,6 +425,7 @@ def _search(logpost, obj, seed, method, popsize, maxiter, starts) -> MAPResult:
         candidates=[-f for f, _ in finals],
         n_evaluations=obj.n,
         method=method,
+        unit=best_s,
     )
 
 

@@ -1,0 +1,146 @@
+"""What a calibration says before it samples: findings at the MAP.
+
+:func:`say_findings` warns (and the run keeps in its summary) what the MAP and the
+identifiability check show about the priors and the model: a noise parameter at its cap,
+a frozen node, a parameter on a prior bound, several separate optima, parameters the
+data do not pin. Split from :mod:`heritage_bayes.calibrate`, which calls it with each
+section (its model, log-posterior, MAP, identifiability and Laplace results).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+
+from heritage_bayes.rc.derived import frozen_time_constant
+
+__all__ = ["LADDERS", "modes_finding", "say_findings"]
+
+#: The model-order ladder of each section, smallest first (the report's ladder, the
+#: candidates of ``hbayes compare``, the smaller model a finding suggests).
+LADDERS = {
+    "thermal": ("thermal_1c", "thermal_2c", "thermal_4a"),
+    "hygric": ("hygric_1c", "hygric_2c", "hygric_2c_fixed"),
+}
+
+
+def say_findings(say, s, priors: Mapping | tuple = ()) -> None:
+    """Before sampling: a MAP on a prior bound, and parameters the data do not pin.
+
+    Findings about the prior or the model, warned (and kept in the summary); a parameter
+    whose prior the config sets (``priors``) is a decision taken: a capped phi is said,
+    not warned, and one the data do not pin is not flagged (its prior closes it).
+    """
+    s.map_at_bound = s.logpost.params.at_bound(s.map.x)
+    capped = [n for n, side in s.map_at_bound if n.startswith("phi_") and side == "upper"]
+    told = {(n, "upper") for n in capped} if s.logpost.noise.name == "ar1_white" else set()
+    if told:
+        ph = s.logpost.params.parameters[s.logpost.params.names.index(capped[0])].prior.upper
+        hours = -s.logpost.dt / 3600.0 / np.log(ph)
+        (say.say if capped[0] in priors else say.warn)(
+            f"[{s.name}] {', '.join(capped)} at its cap {ph:g}: the misfit stays correlated "
+            f"for longer than the noise model allows (about {hours:.0f} h), so the model "
+            "misses a slow process (a missing input such as solar gains, a heat or "
+            "moisture source, a controlled climate). The simulation is kept responsible "
+            "for the slow response; widen the cap with a prior on "
+            f"{capped[0]} only if the slow misfit is measurement drift"
+        )
+    lp = s.logpost
+    record = lp.record_seconds
+    tau = frozen_time_constant(s.model, s.map.theta[: lp.n_model], record)
+    if tau is not None:  # a frozen node (see frozen_time_constant)
+        free = lp.initial_state == "estimate" or isinstance(lp.initial_state, Mapping)
+        sd = lp.initial_state_sd / np.hypot(1.0, tau / lp.initial_state_horizon) if free else 0.0
+        unit = "K" if s.model.domain == "thermal" else "Pa"
+        s.frozen_node = {
+            "tau_h": tau / 3600.0,
+            "records": tau / record,
+            "start_free": bool(free and sd > 0.5 * lp.initial_state_sd),
+            "start_sd": sd,
+            "unit": unit,
+        }
+        say.warn(
+            f"[{s.name}] the slowest time constant at the MAP, {tau / 3600:.3g} h, is "
+            f"{tau / record:.0f} times the calibration record: that node barely moves, a "
+            "constant standing in for a fixed node, a missing input or a missing node; "
+            + (
+                "its start is estimated freely, so it is a free offset: compare with "
+                "the default initial_state_horizon or initial_state: steady"
+                if s.frozen_node["start_free"]
+                else f"its start is held to the steady state (prior sd {sd:.2g} {unit})"
+            )
+            + ", or model the fixed node (thermal: options.ground; hygric: hygric_2c_fixed)"
+        )
+    if unexplained := [b for b in s.map_at_bound if b not in told]:  # not flagged twice
+        what = ", ".join(f"{n} ({side})" for n, side in unexplained)
+        say.warn(
+            f"[{s.name}] the MAP lies on a prior bound for {what}: the data push "
+            "these parameters to the edge of the allowed range. Check the prior (is the "
+            "bound physical? widen it if not) and the model (a missing input or node "
+            "often shows up this way)"
+        )
+    ident = s.identifiability
+    # the overall scale of C and G (no known heat input) is a null direction only a
+    # prior closes: reported in the identifiability section, not flagged here
+    ok = ident.identifiable_given_scale if ident.has_scale_direction else ident.identifiable
+    structural = [p for p, good in ok.items() if not good and p not in priors]
+    practical = list(s.laplace.unidentified) if s.laplace is not None else []
+    poor = [p for p in practical if p in s.model.parameter_names and p not in priors]
+    ladder = LADDERS.get(s.name, ())
+    k = ladder.index(s.model.name) if s.model.name in ladder else 0
+    smaller = ladder[k - 1] if k > 0 else None
+    if len(s.map.modes) > 1:
+        say.warn(modes_finding(s, smaller))
+    if structural or poor:
+        parts = []
+        if structural:
+            parts.append(f"structurally not identifiable: {', '.join(structural)}")
+        if poor:
+            parts.append(
+                "practically not identified at the MAP (Laplace sd > 25 % of the prior "
+                f"range): {', '.join(poor)}"
+            )
+        say.warn(
+            f"[{s.name}] {s.model.name} is over-parameterised for these data ("
+            + "; ".join(parts)
+            + "). The chain will mix slowly and these posteriors will be their priors. "
+            f"Choose: fix them ({s.name}.priors: {{NAME: {{fixed: VALUE}}}}), add an "
+            "informative prior (room_volume, air_change_rate, or a lognormal prior on "
+            "them)" + (f", or use the smaller model ({s.name}.model: {smaller})" if smaller else "")
+        )
+
+
+def modes_finding(s, smaller: str | None) -> str:
+    """The warning for a MAP search whose restarts found several optima of similar
+    height (:attr:`MAPResult.modes`): where they differ, and what a user can do."""
+    from heritage_bayes.inference.optimize import MODE_DISTANCE
+
+    names = s.logpost.params.names
+    free = s.logpost.params.free_names
+    kept, *others = s.map.modes
+    parts = []
+    for m in others:
+        apart = [
+            free[j]
+            for j in np.argsort(-np.abs(m["unit"] - kept["unit"]))
+            if abs(m["unit"][j] - kept["unit"][j]) > MODE_DISTANCE
+        ][:4]
+        diff = ", ".join(
+            f"{n} {kept['theta'][names.index(n)]:.3g} vs {m['theta'][names.index(n)]:.3g}"
+            for n in apart
+        )
+        parts.append(f"log-posterior {m['log_posterior']:.1f} with {diff}")
+    return (
+        f"[{s.name}] the MAP search found {len(s.map.modes)} separate optima of similar "
+        f"height ({s.map.restarts} searches): the chain starts at the one with "
+        f"log-posterior {kept['log_posterior']:.1f}; the other"
+        + (" has " if len(others) == 1 else "s have ")
+        + "; ".join(parts)
+        + ". The posterior is multimodal: these data fit more than one reading of "
+        "the room, an ensemble sampler rarely crosses between separated optima, and the "
+        "intervals describe the region the chain samples. Decide between them with "
+        "knowledge the data lack (a survey's interior_area, envelope_area, or a prior "
+        "on the parameters named)"
+        + (f", or use the smaller model ({s.name}.model: {smaller})" if smaller else "")
+    )

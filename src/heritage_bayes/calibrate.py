@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from heritage_bayes._memory import release_memory
 from heritage_bayes._progress import Progress as _Progress
 from heritage_bayes._version import __version__
 from heritage_bayes.config import MAX_SEED, CalibrationConfig, chain_tag, config_hash
@@ -397,6 +398,12 @@ def _calibrate_into(
     if cfg.report if report is None else report:
         from heritage_bayes.report import write_report
 
+        # the report reads the run back from its files: the chains, draws and outputs
+        # held here go first, and the heap they leave goes back to the system
+        del idata
+        for s in sections:
+            s.chain = s.X = s.theta = s.theta_kept = s.X_kept = s.lp = None
+        release_memory()
         write_report(out)
         say.say(f"report: {final / 'report.html'}")
 

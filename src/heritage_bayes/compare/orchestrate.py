@@ -8,6 +8,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from pathlib import Path
 
+from heritage_bayes._memory import release_memory
 from heritage_bayes.compare.core import DEFAULT_MODELS, compare_runs
 from heritage_bayes.compare.page import write_comparison
 from heritage_bayes.errors import ConfigError
@@ -87,25 +88,6 @@ def _calibrate_candidate(cand, run_dir: str, kwargs: dict) -> tuple[str, float, 
     t0, c0 = time.perf_counter(), time.process_time()
     out = run_calibration(cand, run_dir, **kwargs)
     return str(out), time.perf_counter() - t0, time.process_time() - c0
-
-
-def _release_memory() -> None:
-    """Hand the memory of a finished calibration back to the system.
-
-    A calibration leaves many small Python objects behind (figures, tables); after a
-    garbage collection glibc keeps the freed heap until ``malloc_trim`` returns it, so
-    the process would hold its peak while it waits for the workers. No-op where the C
-    library has no ``malloc_trim`` (macOS, musl, Windows).
-    """
-    import ctypes
-    import ctypes.util
-    import gc
-
-    gc.collect()
-    try:
-        ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6").malloc_trim(0)
-    except (OSError, AttributeError):
-        pass
 
 
 def _n_free(cand, section: str) -> int:
@@ -226,7 +208,7 @@ def run_compare(
                 run_dir, wall, cpu = _calibrate_candidate(cands[own], str(out / own), quiet_kw)
                 dirs[own] = Path(run_dir)
                 tell(f"{own} done ({wall:.0f} s wall, {cpu:.0f} s CPU)")
-                _release_memory()  # while the workers run on
+                release_memory()  # while the workers run on
                 for f in as_completed(futs):
                     run_dir, wall, cpu = f.result()
                     dirs[futs[f]] = Path(run_dir)

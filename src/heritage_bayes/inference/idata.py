@@ -231,7 +231,8 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
             noise = band_nm.sample_statespace(rng, mf, tn_pred, U.shape[0], s.model.n_outputs)
         else:
             noise = band_nm.sample(rng, tn_pred, U.shape[0], s.model.n_outputs)
-        Ypp = Ysim + noise
+        noise += Ysim  # the predictive draws, in the noise's array (one fewer K x N copy)
+        Ypp, noise = noise, None
         saturation = condensation_cap(s, prep, Ysim, Ypp, pp_outputs)
         Y1 = None
         if getattr(s.logpost.noise, "statespace", False):

@@ -8,8 +8,9 @@
         the MAP of each seed of the search (one differential evolution and its polish,
         as hbayes calibrate with optimizer.restarts: 1; or N searches): its
         log-posterior and where it puts the interior mass
-    python benchmarks/interior_modes.py mass RUN_DIR [RUN_DIR ...]
-        the posterior mass near each run's chain: log Z = log ∫ p(x, y) dx over the
+    python benchmarks/interior_modes.py mass [--seeds 1,3] [--steps N]
+        the chain hbayes calibrate runs from each seed's MAP (at most N steps, default
+        40 000), then the posterior mass near it: log Z = log ∫ p(x, y) dx over the
         region a multivariate t (5 degrees of freedom) fitted to the chain's second
         half covers, by importance sampling (20 000 draws, seed 0), for proposals of
         the fitted and of 1.5 × the fitted scale; with the importance sampling's
@@ -18,9 +19,6 @@
         the walkers split between the MAPs of two seeds, with emcee's DE move at
         γ = 1 (a mode-hopping step, ter Braak 2006) at the given share: how often a
         walker changes mode, τ per parameter
-
-The run directories for ``mass`` come from ``hbayes compare configs/demo.yaml --models
-thermal_4a --seed S --out DIR`` (``DIR/thermal_4a``).
 
 References: C. J. F. ter Braak, "A Markov chain Monte Carlo version of the genetic
 algorithm differential evolution", Stat. Comput. 16 (2006) 239-249.
@@ -44,7 +42,6 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from _common import config_map
 from bench_coordinates import PROBLEMS, _config
-from heritage_bayes.config import load_config
 
 
 def _demo_4a(seed: int | None = None):
@@ -71,30 +68,51 @@ def _maps(args) -> None:
         )
 
 
+def _chain(found, args, moves=None, seed=1):
+    """The chain ``hbayes calibrate --seed SEED`` runs from the first MAP of ``found``
+    (its seed, walkers, coordinates, block move and weight), at most ``args.steps``
+    steps."""
+    import bench_sampling
+    from heritage_bayes.calibrate import identifiability_at_map
+    from heritage_bayes.inference.coordinates import sampling_coordinates
+    from heritage_bayes.inference.moves import unidentified_block
+
+    prep, model, lp, mp = found[0]
+    _, lap = identifiability_at_map(model, lp, mp, prep.dt)
+    cfg = _demo_4a(seed)
+    res, _, _ = bench_sampling._run(
+        "chain",
+        lp,
+        mp.x,
+        lambda x: x,
+        lp.params.bounds,
+        cfg,
+        3600.0,
+        moves=moves or cfg.sampler.moves,
+        block=unidentified_block(lp, lap),
+        block_weight=cfg.sampler.block_weight_for(model.n_states),
+        max_steps=args.steps,
+        max_draws=cfg.sampler.max_draws,
+        coordinates=sampling_coordinates(lp, cfg.sampler.coordinates),
+    )
+    return lp, res
+
+
 def _mass(args) -> None:
-    import h5py
     from scipy import stats
 
-    from heritage_bayes.calibrate import _log_posterior
-    from heritage_bayes.models import build_model
-    from heritage_bayes.prepare import prepare
-
     rng = np.random.default_rng(0)
-    for run in args.runs:
-        cfg = load_config(Path(run) / "config.yaml")
-        prep = prepare(cfg)
-        model = build_model(cfg, "thermal")
-        lp = _log_posterior(cfg, prep, "thermal", model, cfg.thermal.priors)
-        with h5py.File(Path(run) / "chain_thermal.h5", "r") as f:
-            chain = f["chain"][:]
+    for seed in args.seeds:
+        found = [config_map(_demo_4a(seed), "thermal")]
+        lp, res = _chain(found, args, seed=seed)
+        chain = res.chain
         X = chain[chain.shape[0] // 2 :].reshape(-1, chain.shape[2])
-        names = lp.params.free_names
-        ic = names.index("Cint")
+        ic = lp.params.free_names.index("Cint")
         mu, cov = X.mean(axis=0), np.cov(X.T)
         print(
-            f"{run}: {chain.shape[0]} stored steps × {chain.shape[1]} walkers; median Cint "
-            f"{np.exp(np.median(X[:, ic])):.3g} J/K; log-posterior of the draws: median "
-            f"{np.median(np.asarray(lp(X[::50]), dtype=float)):.1f}",
+            f"seed {seed}: MAP {found[0][3].log_post:.2f}; median Cint of the chain's second "
+            f"half {np.exp(np.median(X[:, ic])):.3g} J/K; log-posterior of its draws: "
+            f"median {np.median(np.asarray(lp(X[::50]), dtype=float)):.1f}",
             flush=True,
         )
         for scale in (1.0, 1.5):
@@ -115,18 +133,11 @@ def _mass(args) -> None:
 def _jump(args) -> None:
     import emcee
 
-    import bench_sampling
-    from heritage_bayes.calibrate import identifiability_at_map
     from heritage_bayes.inference import monitor, sampler
-    from heritage_bayes.inference.coordinates import sampling_coordinates
-    from heritage_bayes.inference.moves import unidentified_block
 
     found = [config_map(_demo_4a(s), "thermal") for s in args.seeds]
-    prep, model, lp, mp = found[0]
     for s, (*_, m) in zip(args.seeds, found, strict=True):
         print(f"MAP of seed {s}: {m.log_post:.2f}", flush=True)
-    _, lap = identifiability_at_map(model, lp, mp, prep.dt)
-    block = unidentified_block(lp, lap)
     ball = sampler.start_ensemble
 
     def split(logpost, x_map, nwalkers, rng, init_ball, bounds):
@@ -143,22 +154,7 @@ def _jump(args) -> None:
         (emcee.moves.DESnookerMove, 0.2),
         *(((hop, args.jump),) if args.jump > 0 else ()),
     )
-    cfg = _demo_4a()
-    res, _, _ = bench_sampling._run(
-        "split",
-        lp,
-        mp.x,
-        lambda x: x,
-        lp.params.bounds,
-        cfg,
-        3600.0,
-        moves="split",
-        block=block,
-        block_weight=cfg.sampler.block_weight_for(model.n_states),
-        max_steps=args.steps,
-        max_draws=cfg.sampler.max_draws,
-        coordinates=sampling_coordinates(lp, cfg.sampler.coordinates),
-    )
+    lp, res = _chain(found, args, moves="split")
     names = lp.params.free_names
     mass = res.chain[..., names.index("Cint")] > np.log(1e6)
     n = mass.shape[0]
@@ -181,7 +177,8 @@ def main() -> None:
     m.add_argument("--seeds", type=seeds, default=[1, 2, 3, 4, 5, 6, 7])
     m.add_argument("--restarts", type=int, default=1)
     s = sub.add_parser("mass")
-    s.add_argument("runs", nargs="+")
+    s.add_argument("--seeds", type=seeds, default=[1, 3])
+    s.add_argument("--steps", type=int, default=40_000)
     j = sub.add_parser("jump")
     j.add_argument("--seeds", type=seeds, default=[1, 3])
     j.add_argument("--jump", type=float, default=0.1)

@@ -435,8 +435,9 @@ def interior_prior(interior_area: float, *, h: float = H_INTERIOR, sigma: float 
     posterior has an arm in which the interior mass is decoupled (``Gint`` 0.3-3.5 W/K,
     physically a few tenths of a square metre of surface) and the MAP lies there; the
     chain crosses between that arm and a merged mass in rare long excursions (τ of
-    ``Gint`` 3 899 steps after 150 000 steps, not converged; docs/science/benchmarks.md,
-    "Interior area").
+    ``Gint`` 3 899 steps after 150 000 steps, not converged, on 84701f4); with the demo's
+    80 m² it converges in 9 500 steps (docs/science/benchmarks.md, "The interior area
+    and several optima").
 
     Parameters
     ----------

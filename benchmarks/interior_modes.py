@@ -5,9 +5,11 @@
 (``thermal_2c``, :mod:`heritage_bayes.demo`).
 
     python benchmarks/interior_modes.py maps [--seeds 1,2,...] [--restarts N]
+            [--problem demo_4a|orholm_4a]
         the MAP of each seed of the search (one differential evolution and its polish,
         as hbayes calibrate with optimizer.restarts: 1; or N searches): its
-        log-posterior and where it puts the interior mass
+        log-posterior and where it puts the interior mass (orholm_4a:
+        configs/orholm.yaml with thermal_4a, benchmarks/configs/orholm_4a.yaml)
     python benchmarks/interior_modes.py mass [--seeds 1,3] [--steps N]
         the chain hbayes calibrate runs from each seed's MAP (at most N steps, default
         40 000), then the posterior mass near it: log Z = log ∫ p(x, y) dx over the
@@ -44,8 +46,8 @@ from _common import config_map
 from bench_coordinates import PROBLEMS, _config
 
 
-def _demo_4a(seed: int | None = None):
-    cfg = _config(*PROBLEMS["demo_4a"])
+def _demo_4a(seed: int | None = None, problem: str = "demo_4a"):
+    cfg = _config(*PROBLEMS[problem])
     return cfg if seed is None else cfg.model_copy(update={"seed": seed})
 
 
@@ -53,7 +55,7 @@ def _maps(args) -> None:
     from heritage_bayes.inference.optimize import find_map
 
     for seed in args.seeds:
-        cfg = _demo_4a(seed)
+        cfg = _demo_4a(seed, args.problem)
         t0 = time.perf_counter()
         _, _, lp, mp = config_map(cfg, "thermal")
         if args.restarts > 1:
@@ -176,6 +178,7 @@ def main() -> None:
     m = sub.add_parser("maps")
     m.add_argument("--seeds", type=seeds, default=[1, 2, 3, 4, 5, 6, 7])
     m.add_argument("--restarts", type=int, default=1)
+    m.add_argument("--problem", default="demo_4a", choices=("demo_4a", "orholm_4a"))
     s = sub.add_parser("mass")
     s.add_argument("--seeds", type=seeds, default=[1, 3])
     s.add_argument("--steps", type=int, default=40_000)

@@ -38,7 +38,7 @@ References
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy.optimize import differential_evolution, minimize
@@ -343,17 +343,9 @@ def _with_modes(found: list[MAPResult], objective) -> MAPResult:
             continue
         if all(_separated(m, r, objective) for m in modes):
             modes.append(r)
-    evaluations = getattr(objective, "n", 0)
-    return MAPResult(
-        x=keep.x,
-        theta=keep.theta,
-        log_post=keep.log_post,
-        n_starts=keep.n_starts,
-        n_agreed=keep.n_agreed,
-        candidates=keep.candidates,
-        n_evaluations=evaluations,
-        method=keep.method,
-        unit=keep.unit,
+    return replace(
+        keep,
+        n_evaluations=getattr(objective, "n", 0),
         restarts=len(found),
         modes=[{"log_posterior": m.log_post, "theta": m.theta, "unit": m.unit} for m in modes],
     )

@@ -320,6 +320,22 @@ def _check_fixed(where: str, kind: str, value: float) -> None:
         raise ConfigError(f"{where}: a {kind} must be within {rng} (got {value:g})")
 
 
+def _lognormal(median: float, sigma: float) -> Prior:
+    """The log-normal prior of a survey quantity: ``median``, sd of log ``sigma``, bounded
+    at ±5 sd (the sampler's walls, where the density is e^-12.5 of its peak)."""
+    return Prior(
+        "lognormal", median * math.exp(-5 * sigma), median * math.exp(5 * sigma), median, sigma
+    )
+
+
+def _per_area(key: str, area: float, per_m2: float, sigma: float) -> Prior:
+    """:func:`_lognormal` with median ``per_m2 × area`` for a survey's area [m²] given
+    as the config key ``key`` (an area ≤ 0 is a ConfigError naming it)."""
+    if not area > 0:
+        raise ConfigError(f"{key} must be > 0 m² (got {area})")
+    return _lognormal(per_m2 * area, sigma)
+
+
 def default_prior(domain: str, kind: str) -> Prior:
     """The default prior of a parameter kind in a domain (``thermal``/``hygric``)."""
     try:
@@ -374,9 +390,7 @@ def ventilation_prior(
         raise ConfigError(f"air_change_rate must be > 0 per hour (got {air_change_rate})")
     flow = volume * air_change_rate / 3600.0  # [m³/s]
     median = flow * (RHO_CP_AIR if domain == "thermal" else HYG_CAP_AIR)
-    return Prior(
-        "lognormal", median * math.exp(-5 * sigma), median * math.exp(5 * sigma), median, sigma
-    )
+    return _lognormal(median, sigma)
 
 
 #: Typical thermal transmittance of a large ground floor to the deep ground [W/(m²·K)]
@@ -405,12 +419,7 @@ def ground_prior(floor_area: float, *, u_value: float = U_GROUND, sigma: float =
     sigma : float
         sd of log(Gf).
     """
-    if not floor_area > 0:
-        raise ConfigError(f"floor_area must be > 0 m² (got {floor_area})")
-    median = u_value * floor_area
-    return Prior(
-        "lognormal", median * math.exp(-5 * sigma), median * math.exp(5 * sigma), median, sigma
-    )
+    return _per_area("floor_area", floor_area, u_value, sigma)
 
 
 #: Heat transfer coefficient between the interior mass and the room air [W/(m²·K)]:
@@ -449,12 +458,7 @@ def interior_prior(interior_area: float, *, h: float = H_INTERIOR, sigma: float 
     sigma : float
         sd of log(Gint).
     """
-    if not interior_area > 0:
-        raise ConfigError(f"interior_area must be > 0 m² (got {interior_area})")
-    median = h * interior_area
-    return Prior(
-        "lognormal", median * math.exp(-5 * sigma), median * math.exp(5 * sigma), median, sigma
-    )
+    return _per_area("interior_area", interior_area, h, sigma)
 
 
 #: Effective solar aperture per m² of glazing [-]: EN ISO 13790:2008, 11.3.3,
@@ -494,9 +498,7 @@ def aperture_prior(
     if not (isinstance(glazing_area, (int, float)) and glazing_area > 0):
         raise ConfigError(f"glazing_area must be > 0 m² (got {glazing_area!r})")
     median = factor * glazing_area
-    return Prior(
-        "lognormal", median * math.exp(-5 * sigma), median * math.exp(5 * sigma), median, sigma
-    )
+    return _lognormal(median, sigma)
 
 
 #: Exterior surface heat transfer coefficient [W/(m²·K)]: 1 / R_se, R_se = 0.04 m²K/W
@@ -639,9 +641,7 @@ def fixed_vapour_pressure_prior(
             f"(got {temperature!r})"
         )
     median = rh * float(saturation_vapour_pressure(temperature))
-    return Prior(
-        "lognormal", median * math.exp(-5 * sigma), median * math.exp(5 * sigma), median, sigma
-    )
+    return _lognormal(median, sigma)
 
 
 def vapour_ground_prior(floor_area: float, *, s_d: float = SD_FLOOR, sigma: float = 1.0) -> Prior:
@@ -658,9 +658,7 @@ def vapour_ground_prior(floor_area: float, *, s_d: float = SD_FLOOR, sigma: floa
     if not floor_area > 0:
         raise ConfigError(f"floor_area must be > 0 m² (got {floor_area})")
     median = DELTA_AIR / s_d * floor_area
-    return Prior(
-        "lognormal", median * math.exp(-5 * sigma), median * math.exp(5 * sigma), median, sigma
-    )
+    return _lognormal(median, sigma)
 
 
 @dataclass(frozen=True)

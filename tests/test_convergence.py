@@ -343,3 +343,37 @@ def test_a_converged_run_has_no_reasons_even_when_its_saved_draws_scatter():
     assert unconverged_reasons(summary) == []
     reasons = unconverged_reasons({**summary, "converged": False})
     assert reasons == ["max R-hat 1.018 (thermal.phi_Ti) > 1.01"]
+
+
+def test_report_notes_name_separate_optima():
+    """A MAP search whose restarts found separate optima (summary.json's
+    models.<m>.map.modes): an amber note with their heights and the parameters in
+    which they differ most (a factor of 3, or 0.1 for a fraction), farthest first."""
+    from heritage_bayes.report.verdict import run_notes
+
+    modes = [
+        {
+            "log_posterior": 937.98,
+            "values": {"Cw": 1.19e8, "Cint": 1e4, "Gint": 400.0, "fsol": 0.41},
+        },
+        {
+            "log_posterior": 938.08,
+            "values": {"Cw": 9.2e8, "Cint": 7.2e7, "Gint": 420.0, "fsol": 0.175},
+        },
+    ]
+    s = {
+        "irradiance_source": "measured",
+        "parameters": {},
+        "models": {"thermal": {"map": {"restarts": 3, "modes": modes}}},
+    }
+    (note,) = run_notes(s, [])
+    assert note["title"] == "The thermal posterior has separate optima"
+    assert note["level"] == "amber"
+    assert "(3 global searches" in note["text"]
+    assert "started at log-posterior 938.0, the other is at 938.1 (" in note["text"]
+    assert "(Cint 1e+04 vs 7.2e+07, fsol 0.41 vs 0.175, Cw 1.19e+08 vs 9.2e+08)" in note["text"]
+    assert "Gint 400" not in note["text"]  # 5 % apart: not named
+    s["models"]["thermal"]["map"]["modes"] = modes[:1]
+    assert run_notes(s, []) == []
+    s["models"]["thermal"]["map"] = {"log_posterior": 937.98}  # one search: no modes key
+    assert run_notes(s, []) == []

@@ -333,6 +333,43 @@ def ess_class(e, e_ok: float) -> str:
     return _grade(_nan_high(e) >= e_ok, _nan_high(e) >= AMBER["min_ess_bulk"])
 
 
+def _modes_note(m: str, modes: list[dict], restarts) -> dict:
+    """The note of a MAP search whose restarts found separate optima (``summary.json``'s
+    ``models.<m>.map.modes``, the chain's start first): their heights and the
+    parameters in which they differ most (a factor of 3 or more, or 0.1 for
+    fractions)."""
+    kept = modes[0]["values"]
+
+    def apart(a: float, b: float) -> float:
+        if a > 0 and b > 0 and max(a, b) > 1:
+            return abs(math.log10(a / b)) / math.log10(3.0)
+        return abs(a - b) / 0.1
+
+    parts = []
+    for other in modes[1:]:
+        v = other["values"]
+        far = sorted(
+            (n for n in kept if n in v and apart(kept[n], v[n]) >= 1),
+            key=lambda n: -apart(kept[n], v[n]),
+        )
+        what = ", ".join(f"{n} {kept[n]:.3g} vs {v[n]:.3g}" for n in far[:4])
+        parts.append(f"{other['log_posterior']:.1f}" + (f" ({what})" if what else ""))
+    return {
+        "level": "amber",
+        "title": f"The {m} posterior has separate optima",
+        "text": f"The MAP search ({restarts or len(modes)} global searches from different "
+        f"seeds) found {len(modes)} optima of similar height: the chain started at "
+        f"log-posterior {modes[0]['log_posterior']:.1f}, the other"
+        + (" is at " if len(modes) == 2 else "s are at ")
+        + "; ".join(parts)
+        + ". An ensemble sampler rarely crosses between separated optima, so the "
+        "intervals describe the reading of the room around the first; summary.json "
+        f"(models.{m}.map.modes) holds the others. Decide between them with knowledge "
+        "the data lack (a survey's interior_area or envelope_area, a prior on the "
+        "parameters named), or use the smaller model of the ladder.",
+    }
+
+
 def run_notes(
     summary: dict, chains_missing: list[str], *, irradiance_setting: str | None = None
 ) -> list[dict]:
@@ -456,6 +493,9 @@ def run_notes(
                     "ladder.",
                 }
             )
+        found = i.get("map") or {}
+        if len(modes := found.get("modes") or []) > 1:
+            out.append(_modes_note(m, modes, found.get("restarts")))
         if (i.get("chain") or {}).get("stopped_by") == "max_seconds":
             out.append(
                 {

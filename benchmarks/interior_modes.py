@@ -61,6 +61,7 @@ def _maps(args) -> None:
         if args.restarts > 1:
             mp = find_map(lp, seed=seed, starts=cfg.optimizer.starts, restarts=args.restarts)
         th = dict(zip(lp.params.names, mp.theta, strict=True))
+        th.setdefault("fsol", float("nan"))  # a 4a without solar input has none
         modes = f"; modes {[round(m['log_posterior'], 2) for m in mp.modes]}" if mp.modes else ""
         print(
             f"seed {seed}: log-posterior {mp.log_post:7.2f}  Cw {th['Cw']:.3g} J/K  Cint "

@@ -46,7 +46,7 @@ from _common import config_map
 from bench_coordinates import PROBLEMS, _config
 
 
-def _demo_4a(seed: int | None = None, problem: str = "demo_4a"):
+def _problem(seed: int | None = None, problem: str = "demo_4a"):
     cfg = _config(*PROBLEMS[problem])
     return cfg if seed is None else cfg.model_copy(update={"seed": seed})
 
@@ -55,7 +55,7 @@ def _maps(args) -> None:
     from heritage_bayes.inference.optimize import find_map
 
     for seed in args.seeds:
-        cfg = _demo_4a(seed, args.problem)
+        cfg = _problem(seed, args.problem)
         t0 = time.perf_counter()
         _, _, lp, mp = config_map(cfg, "thermal")
         if args.restarts > 1:
@@ -82,7 +82,7 @@ def _chain(found, args, moves=None, seed=1):
 
     prep, model, lp, mp = found[0]
     _, lap = identifiability_at_map(model, lp, mp, prep.dt)
-    cfg = _demo_4a(seed)
+    cfg = _problem(seed)
     res, _, _ = bench_sampling._run(
         "chain",
         lp,
@@ -106,7 +106,7 @@ def _mass(args) -> None:
 
     rng = np.random.default_rng(0)
     for seed in args.seeds:
-        found = [config_map(_demo_4a(seed), "thermal")]
+        found = [config_map(_problem(seed), "thermal")]
         lp, res = _chain(found, args, seed=seed)
         chain = res.chain
         X = chain[chain.shape[0] // 2 :].reshape(-1, chain.shape[2])
@@ -138,7 +138,7 @@ def _jump(args) -> None:
 
     from heritage_bayes.inference import monitor, sampler
 
-    found = [config_map(_demo_4a(s), "thermal") for s in args.seeds]
+    found = [config_map(_problem(s), "thermal") for s in args.seeds]
     for s, (*_, m) in zip(args.seeds, found, strict=True):
         print(f"MAP of seed {s}: {m.log_post:.2f}", flush=True)
     ball = sampler.start_ensemble
@@ -175,7 +175,10 @@ def _jump(args) -> None:
 def main() -> None:
     ap = argparse.ArgumentParser()
     sub = ap.add_subparsers(dest="what", required=True)
-    seeds = functools.partial(lambda s: [int(x) for x in s.split(",")])
+
+    def seeds(text: str) -> list[int]:
+        return [int(x) for x in text.split(",")]
+
     m = sub.add_parser("maps")
     m.add_argument("--seeds", type=seeds, default=[1, 2, 3, 4, 5, 6, 7])
     m.add_argument("--restarts", type=int, default=1)

@@ -114,21 +114,16 @@ def say_findings(say, s, priors: Mapping | tuple = ()) -> None:
 def modes_finding(s, smaller: str | None) -> str:
     """The warning for a MAP search whose restarts found several optima of similar
     height (:attr:`MAPResult.modes`): where they differ, and what a user can do."""
-    from heritage_bayes.inference.optimize import MODE_DISTANCE
+    from heritage_bayes.inference.optimize import parameters_apart
 
     names = s.logpost.params.names
-    free = s.logpost.params.free_names
     kept, *others = s.map.modes
+    at_kept = dict(zip(names, kept["theta"], strict=True))
     parts = []
     for m in others:
-        apart = [
-            free[j]
-            for j in np.argsort(-np.abs(m["unit"] - kept["unit"]))
-            if abs(m["unit"][j] - kept["unit"][j]) > MODE_DISTANCE
-        ][:4]
+        at_m = dict(zip(names, m["theta"], strict=True))
         diff = ", ".join(
-            f"{n} {kept['theta'][names.index(n)]:.3g} vs {m['theta'][names.index(n)]:.3g}"
-            for n in apart
+            f"{n} {at_kept[n]:.3g} vs {at_m[n]:.3g}" for n in parameters_apart(at_kept, at_m)
         )
         parts.append(f"log-posterior {m['log_posterior']:.1f} with {diff}")
     return (

@@ -14,19 +14,19 @@ multi-start. Local step: L-BFGS-B with batched central-difference gradients. The
 ``starts`` distinct candidates are polished; the number that end within 1 log-posterior
 unit of the best ("agreed") measures how unambiguous the optimum is.
 
-Restarts (``restarts`` > 1): the global search again from other seeds. One population
-of differential evolution collapses into one basin, so the polished starts of one
-search agree even where the posterior has several optima: on the demo's data
-``thermal_4a`` with the survey's ``interior_area`` has one with the interior mass merged
-into the air (log-posterior 938.0 at the optimiser's seeds 1 and 7) and one with a slow
-interior mass the sun does not reach (938.5-938.75, seeds 3-6), and seed 2 stops at
-790.2 (``docs/science/benchmarks.md``, "Several optima"). The first search's optimum is
-kept unless a restart beats it by more than :data:`MODE_PICK`; optima of the restarts
-within :data:`MODE_WINDOW` of the best, apart in the unit cube (:data:`MODE_DISTANCE`)
-and separated by a dip of the log-posterior on the straight line between them
-(:data:`MODE_BARRIER`; points of one ridge are not modes) are reported as ``modes``:
-the posterior is multimodal there, and a chain started at one of them describes that
-one.
+Restarts (``restarts`` > 1): the global search again from other seeds. One population of
+differential evolution collapses into one basin, so the polished starts of one search
+agree even where the posterior has several optima: on the demo's data ``thermal_4a``
+with the survey's ``interior_area`` has one with the interior mass merged into the air
+(log-posterior 938.0 at the optimiser's seeds 1 and 7) and one with a slow interior mass
+the sun does not reach (938.5-938.75, seeds 3-6), and seed 2 stops at 790.2
+(``docs/science/benchmarks.md``, "The interior area and several optima"). The first
+search's optimum is kept unless a restart beats it by more than :data:`MODE_PICK`;
+optima of the restarts within :data:`MODE_WINDOW` of the best, apart in the unit cube
+(:data:`MODE_DISTANCE`) and separated by a dip of the log-posterior on the straight line
+between them (:data:`MODE_BARRIER`; points of one ridge are not modes) are reported as
+``modes``: the posterior is multimodal there, and a chain started at one of them
+describes that one.
 
 References
 ----------
@@ -53,6 +53,7 @@ __all__ = [
     "affine_coordinates",
     "find_map",
     "laplace",
+    "parameters_apart",
     "seconds_left",
     "share_deadline",
 ]
@@ -124,6 +125,21 @@ MODE_BARRIER = 3.0
 MODE_PATH_POINTS = 15
 
 
+def parameters_apart(a: dict, b: dict, most: int = 4) -> list[str]:
+    """Names of the parameters in which two optima (``{name: value}``) differ most,
+    farthest first, at most ``most``: by a factor of 3 or more (positive values above 1:
+    capacities, conductances, apertures), or by 0.1 or more (fractions, noise
+    parameters). What the run's warning and the report's note name."""
+
+    def apart(x: float, y: float) -> float:
+        if x > 0 and y > 0 and max(x, y) > 1:
+            return abs(np.log10(x / y)) / np.log10(3.0)
+        return abs(x - y) / 0.1
+
+    far = [n for n in a if n in b and apart(a[n], b[n]) >= 1]
+    return sorted(far, key=lambda n: -apart(a[n], b[n]))[:most]
+
+
 @dataclass
 class MAPResult:
     """Result of :func:`find_map`.
@@ -147,8 +163,8 @@ class MAPResult:
         Global searches run (the first and its restarts).
     modes : list of dict
         Distinct optima of the restarts within :data:`MODE_WINDOW` of the best, this
-        MAP first: ``{"log_posterior": float, "theta": (P,) array, "unit": (d,)
-        array}``; one entry when no other was found.
+        MAP first: ``{"log_posterior": float, "theta": (P,) array}``; one entry when
+        no other was found.
     """
 
     x: np.ndarray
@@ -347,7 +363,7 @@ def _with_modes(found: list[MAPResult], objective) -> MAPResult:
         keep,
         n_evaluations=getattr(objective, "n", 0),
         restarts=len(found),
-        modes=[{"log_posterior": m.log_post, "theta": m.theta, "unit": m.unit} for m in modes],
+        modes=[{"log_posterior": m.log_post, "theta": m.theta} for m in modes],
     )
 
 

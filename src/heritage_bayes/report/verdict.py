@@ -337,22 +337,14 @@ def _modes_note(m: str, modes: list[dict], restarts) -> dict:
     """The note of a MAP search whose restarts found separate optima (``summary.json``'s
     ``models.<m>.map.modes``, the chain's start first): their heights and the
     parameters in which they differ most (a factor of 3 or more, or 0.1 for
-    fractions)."""
+    fractions; :func:`heritage_bayes.inference.optimize.parameters_apart`)."""
+    from heritage_bayes.inference.optimize import parameters_apart
+
     kept = modes[0]["values"]
-
-    def apart(a: float, b: float) -> float:
-        if a > 0 and b > 0 and max(a, b) > 1:
-            return abs(math.log10(a / b)) / math.log10(3.0)
-        return abs(a - b) / 0.1
-
     parts = []
     for other in modes[1:]:
         v = other["values"]
-        far = sorted(
-            (n for n in kept if n in v and apart(kept[n], v[n]) >= 1),
-            key=lambda n: -apart(kept[n], v[n]),
-        )
-        what = ", ".join(f"{n} {kept[n]:.3g} vs {v[n]:.3g}" for n in far[:4])
+        what = ", ".join(f"{n} {kept[n]:.3g} vs {v[n]:.3g}" for n in parameters_apart(kept, v))
         parts.append(f"{other['log_posterior']:.1f}" + (f" ({what})" if what else ""))
     return {
         "level": "amber",

@@ -796,6 +796,60 @@ def test_every_convergence_number_of_the_report_is_az_summary_of_posterior_nc(re
     assert f"min bulk ESS {fmt_int(diag['ess_bulk'].min())}" in verdict
 
 
+def test_summary_json_is_what_arviz_computes_from_posterior_nc_bit_for_bit(run_dir):
+    """Every R-hat, ESS, quantile, mean and sd that summary.json states for a parameter
+    or a derived quantity is what arviz (``az.summary``) and numpy compute from the
+    draws ``posterior.nc`` stores, to the last bit, on any machine: one estimator (arviz
+    has two R-hat paths that differ when the chains have an odd number of draws) on the
+    same float64 arrays in the same order."""
+    import arviz as az
+
+    summary = json.loads((run_dir / "summary.json").read_text())
+    idata = az.from_netcdf(run_dir / "posterior.nc")
+    n_draws = idata.posterior.sizes["draw"]
+    rows = {**summary["parameters"], **summary["derived"]}
+    checked = {"r_hat": 0, "quantiles": 0}
+    for key, entry in rows.items():
+        x = idata.posterior[key].values
+        flat = x.reshape(-1)
+        q05, q50, q95 = np.quantile(flat, [0.05, 0.5, 0.95])
+        assert (entry["q05"], entry["median"], entry["q95"]) == (q05, q50, q95), key
+        assert entry["mean"] == np.mean(flat) and entry["sd"] == np.std(flat), key
+        checked["quantiles"] += 1
+        if "r_hat" in entry:
+            d = az.summary(idata, var_names=[key], kind="diagnostics", round_to="none")
+            assert entry["r_hat"] == d.loc[key, "r_hat"], (key, entry["r_hat"], d.loc[key])
+            assert entry["ess_bulk"] == d.loc[key, "ess_bulk"], key
+            if "ess_tail" in entry:
+                assert entry["ess_tail"] == d.loc[key, "ess_tail"], key
+            checked["r_hat"] += 1
+    # every free parameter and the varying derived quantities carry diagnostics
+    n_free = sum(v.get("fixed") is None for v in summary["parameters"].values())
+    assert checked["r_hat"] >= n_free > 0 and checked["quantiles"] == len(rows)
+    assert n_draws > 0
+
+
+def test_convergence_stats_is_az_summary_where_az_rhat_differs():
+    """The class of the CI failure: with an odd number of draws per chain arviz's
+    ``az.rhat`` folds the draws about the median of the split halves and ``az.summary``
+    about the median of all draws; they differ where the tail (folded) R-hat decides.
+    The run's figures follow az.summary, what a reader runs."""
+    import arviz as az
+    import xarray as xr
+
+    from heritage_bayes.inference.interop import convergence_stats
+
+    rng = np.random.default_rng(5)
+    # walkers of one location and different spreads: the tail (folded) R-hat decides
+    x = rng.standard_normal((8, 27)) * np.linspace(0.3, 3.0, 8)[:, None]
+    # a non-contiguous view, as the sampler's selection of saved draws may give
+    post = {"a": xr.DataArray(np.asfortranarray(x), dims=("chain", "draw"))}
+    r, eb, et = convergence_stats(post, ["a"])
+    d = az.summary(xr.Dataset({"a": (("chain", "draw"), x)}), kind="diagnostics", round_to="none")
+    assert (r["a"], eb["a"], et["a"]) == tuple(d.loc["a", ["r_hat", "ess_bulk", "ess_tail"]])
+    assert float(az.rhat(xr.Dataset({"a": (("chain", "draw"), x)}))["a"]) != r["a"]
+
+
 def test_verdict_is_not_green_while_a_truth_marker_misses():
     s = _summary(1.004, 1200)
     ok_resid = [{"section": "thermal", "output": "Ti", "adequate": True, "check": {}}]

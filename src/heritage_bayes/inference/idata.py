@@ -190,7 +190,7 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
         tm = s.theta[..., : s.logpost.n_model]
         for j, p in enumerate(ps.parameters):
             post[f"{s.name}.{p.name}"] = xr.DataArray(
-                s.theta[:, sel, j],
+                np.ascontiguousarray(s.theta[:, sel, j], dtype=np.float64),
                 dims=cdims,
                 attrs={"unit": p.unit, "kind": p.kind, "description": p.description},
             )
@@ -201,7 +201,9 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
             arr = np.broadcast_to(np.asarray(v, dtype=float), (W * D,)).reshape(W, D)
             dq_all[k] = arr
             post[f"{s.name}.{k}"] = xr.DataArray(
-                arr[:, sel], dims=cdims, attrs={"unit": units.get(k, "")}
+                np.ascontiguousarray(arr[:, sel], dtype=np.float64),
+                dims=cdims,
+                attrs={"unit": units.get(k, "")},
             )
         stats[f"{s.name}.lp"] = xr.DataArray(s.lp[:, sel], dims=cdims)
         stats[f"{s.name}.acceptance_rate"] = xr.DataArray(
@@ -267,8 +269,9 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
         loglik.update(_pointwise(s, pw, times[prep.calibration], (W, n_sel)))
         pw = _validation_pointwise(s, prep, Ysim, tn_sel, th_sel)
         loglik_val.update(_pointwise(s, pw, times, (W, n_sel)))
-        # parameter summaries: quantiles on all draws the sampler kept; R-hat and ESS
-        # on the draws posterior.nc holds, so that az.summary reproduces them
+        # parameter summaries: quantiles, R-hat and ESS of the draws posterior.nc holds,
+        # as it holds them, so that a reader of the file reproduces every digit;
+        # contraction, bounds and correlations on all draws the sampler kept
         kept = s.theta_kept
         free_vars = [f"{s.name}.{n}" for n in ps.free_names]
         rhat, ess_b, ess_t = convergence_stats(post, free_vars)
@@ -288,7 +291,7 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
                 "prior_spec": None if p.fixed is not None else p.prior.to_dict(),
                 "transform": None if p.fixed is not None else ps.modes[ps.free_names.index(p.name)],
                 "map": mapv[p.name],
-                **_summ(x),
+                **_summ(post[key].values.reshape(-1)),
                 "truth": truth.get(p.name),
             }
             if p.free:
@@ -310,7 +313,7 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
             summary_params[key] = entry
         for k in dq:
             key = f"{s.name}.{k}"
-            x = dq_all[k].reshape(-1)
+            x = post[key].values.reshape(-1)
             summary_derived[key] = {"unit": units.get(k, ""), **_summ(x), "truth": truth_dq.get(k)}
             if np.all(np.isfinite(x)) and np.ptp(x) > 0:
                 r, e, _ = convergence_stats(post, [key])

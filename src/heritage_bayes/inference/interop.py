@@ -5,9 +5,9 @@
   several outputs); :func:`split_outputs` gives the per-output terms back;
 - :func:`log_mean_exp`: the log of the posterior-mean density of each hour (the
   ``log_predictive_density_validation`` group, expected log predictive density);
-- :func:`convergence_stats`: R-hat and bulk/tail ESS with the estimators of
-  ``az.summary`` on the draws the file stores, so that the report's figures are
-  reproduced by ``az.summary(az.from_netcdf("posterior.nc"))``.
+- :func:`convergence_stats`: R-hat and bulk/tail ESS by ``az.summary`` itself on the
+  draws as the file stores them (:func:`as_saved`), so that the report's figures are
+  reproduced bit for bit by ``az.summary(az.from_netcdf("posterior.nc"))``.
 """
 
 from __future__ import annotations
@@ -20,6 +20,7 @@ from heritage_bayes._arviz import az
 __all__ = [
     "JOINT_LOGLIK",
     "VALIDATION_LPD",
+    "as_saved",
     "convergence_stats",
     "log_mean_exp",
     "loglik_groups",
@@ -111,16 +112,21 @@ def log_mean_exp(a) -> np.ndarray:
 def convergence_stats(post: dict[str, xr.DataArray], names: list[str]):
     """Rank-normalised split R-hat, bulk and tail ESS of the saved draws ``names``.
 
-    The estimators of ``az.summary`` (Vehtari et al. 2021 [1]_) on the very arrays
-    ``posterior.nc`` stores (walkers as chains), so that the report's figures are
-    reproduced by ``az.summary(az.from_netcdf("posterior.nc"))``. The sampler's stopping
-    rule checks all its retained draws (:func:`heritage_bayes.inference.sampler.run_sampler`);
-    the saved draws are an evenly thinned subset, nearly independent, so their bulk
-    ESS is close to their number when the chain has converged.
+    Computed by ``az.summary(..., kind="diagnostics", round_to="none")`` itself
+    (Vehtari et al. 2021 [1]_) on the very arrays ``posterior.nc`` stores (walkers as
+    chains, float64, C order), so that ``az.summary(az.from_netcdf("posterior.nc"))``
+    reproduces every figure bit for bit. arviz has two R-hat paths that differ:
+    ``az.rhat`` folds the draws about the median of the *split* chains (dropping the
+    middle draw of an odd-length chain), ``az.summary`` about the median of all draws;
+    the summary's is the one a reader runs, so it is the one used here. The sampler's
+    stopping rule checks all its retained draws
+    (:func:`heritage_bayes.inference.sampler.run_sampler`); the saved draws are an evenly
+    thinned subset, nearly independent, so their bulk ESS is close to their number when
+    the chain has converged.
 
     Returns
     -------
-    (r_hat, ess_bulk, ess_tail) : three ``xarray.Dataset``
+    (r_hat, ess_bulk, ess_tail) : three ``pandas.Series``
         Indexed by the names.
 
     References
@@ -130,5 +136,13 @@ def convergence_stats(post: dict[str, xr.DataArray], names: list[str]):
        convergence of MCMC", *Bayesian Analysis* 16 (2021) 667-718.
        doi:10.1214/20-BA1221
     """
-    ds = xr.Dataset({v: post[v] for v in names})
-    return az.rhat(ds), az.ess(ds, method="bulk"), az.ess(ds, method="tail")
+    ds = xr.Dataset({v: as_saved(post[v]) for v in names})
+    diag = az.summary(ds, kind="diagnostics", round_to="none")
+    return diag["r_hat"], diag["ess_bulk"], diag["ess_tail"]
+
+
+def as_saved(da: xr.DataArray) -> xr.DataArray:
+    """``da`` with its values as ``posterior.nc`` hands them back: a C-ordered float64
+    copy (what ``h5netcdf`` reads). Sums over the draws (means, variances, the ESS's
+    autocovariances) then run in the same order in memory and from the file."""
+    return da.copy(data=np.ascontiguousarray(da.values, dtype=np.float64))

@@ -267,6 +267,27 @@ def test_the_reports_from_python_lines_run_as_printed(tiny_run):
     assert re.search(r"^thermal \{'Ci': [0-9.e+]+, ", res.stdout, re.M)
 
 
+def test_the_from_python_lines_name_the_run_not_its_staging_folder(tiny_run, tmp_path):
+    """calibrate writes the report inside the staging folder ``.<name>.partial`` and
+    then swaps it in as ``<name>``: the lines must open ``<name>``, which exists after
+    the run, never the staging folder, which does not."""
+    import html
+    import re
+    import shutil
+
+    from heritage_bayes.report import write_report
+    from heritage_bayes.rundir.writer import published_path, staging_path
+
+    final = tmp_path / "room"
+    staged = staging_path(final)
+    assert published_path(staged) == final and published_path(final) == final
+    shutil.copytree(tiny_run, staged)
+    page = write_report(staged).read_text(encoding="utf-8")
+    code = html.unescape(re.search(r'id="from-python">(.*?)</pre>', page, re.S).group(1))
+    assert repr(str(final.resolve())) in code
+    assert ".partial" not in page
+
+
 def test_the_readmes_python_block_runs(tiny_run):
     """The README's "From Python" block, on a run in place of ``reports/demo``."""
     import re

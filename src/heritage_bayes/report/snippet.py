@@ -13,6 +13,7 @@ from functools import lru_cache
 from pathlib import Path
 
 from heritage_bayes._version import __version__
+from heritage_bayes.rundir.writer import published_path
 
 __all__ = ["from_python"]
 
@@ -39,7 +40,8 @@ def from_python(run_dir: str | Path, sections, posterior_names) -> str:
     Parameters
     ----------
     run_dir : str or Path
-        The run directory (written into the code resolved to an absolute path).
+        The run directory (written into the code resolved to an absolute path; a
+        staging folder is named by the run directory it becomes).
     sections : iterable of str
         The run's model sections (``"thermal"``, ``"hygric"``).
     posterior_names : iterable of str
@@ -55,7 +57,7 @@ def from_python(run_dir: str | Path, sections, posterior_names) -> str:
     names = [n for n in posterior_names if n.partition(".")[2].startswith(("tau_", "gain_"))]
     return _template().render(
         version=__version__,
-        run_dir=repr(str(Path(run_dir).resolve())),
+        run_dir=repr(str(published_path(Path(run_dir).resolve()))),
         var_names=names,
         sections=list(sections),
     )

@@ -39,6 +39,7 @@ __all__ = [
     "RUN_FILES",
     "RunWriter",
     "is_run_directory",
+    "published_path",
     "run_file_name",
     "saved_chains",
     "staging_path",
@@ -81,6 +82,18 @@ def is_run_directory(path: str | Path) -> bool:
 def staging_path(out: Path) -> Path:
     """Where a run into ``out`` is written until it is complete (a hidden sibling)."""
     return out.parent / f".{out.name}.partial"
+
+
+def published_path(folder: str | Path) -> Path:
+    """The run directory that ``folder`` becomes when its run is complete: the folder
+    itself, or for a staging folder (:func:`staging_path`) the run directory it is
+    swapped into. Text that names a run (the report's Python lines) names this one,
+    not a folder that is gone once the run is committed."""
+    p = Path(folder).absolute()
+    name = p.name
+    if name.startswith(".") and name.endswith(".partial") and len(name) > len("..partial"):
+        return p.parent / name[1 : -len(".partial")]
+    return p
 
 
 def _old_path(out: Path) -> Path:

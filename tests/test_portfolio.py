@@ -2,6 +2,7 @@
 others, the overview table and page, --resume."""
 
 import json
+import re
 import shutil
 
 import pandas as pd
@@ -238,3 +239,34 @@ def test_index_sorts_in_headless_chromium(finished):
     assert got["before"][0] == "bad"  # attention order: the failed room first
     assert got["asc"] == ["a", "b", "bad"] and got["desc"] == ["bad", "b", "a"]
     assert got["links"] == 2
+
+
+def test_index_speaks_in_percent_and_names_the_indicators_at_risk(tmp_path):
+    """Shares and probabilities in % as on the rooms' reports (not 0.91), and the
+    indicators rated "risk" named, not only counted."""
+    from types import SimpleNamespace
+
+    from heritage_bayes.portfolio.page import render_index
+
+    df = pd.DataFrame(
+        [
+            {
+                "attention_rank": 1,
+                "room": "crypt",
+                "status": "done",
+                "thermal.Ti.coverage90_val": 0.913,
+                "risk_flags": 2,
+                "risk_flagged": "vtt_mould_index_max, en15757_outside",
+                "proj.twpi.p_worse": 1.0,
+                "proj.probability": 0.25,
+            }
+        ]
+    )
+    pf = SimpleNamespace(rooms=[object()], name="p", notes="")
+    page = render_index(pf, df, tmp_path)
+    cells = re.findall(r"<td[^>]*>(.*?)</td>", page)
+    assert "91 %" in cells and "100 %" in cells and "25 %" in cells
+    assert "0.91" not in cells and "1.00" not in cells
+    flagged = next(c for c in cells if c.startswith("2: "))
+    assert "mould" in flagged.lower() and "EN 15757" in flagged
+    assert "vtt_mould_index_max" not in flagged

@@ -9,7 +9,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from heritage_bayes.climate.risk.registry import indicator_info
+from heritage_bayes.errors import InputError
 from heritage_bayes.portfolio.spec import Portfolio
+from heritage_bayes.report.format import fmt_pct
 
 __all__ = ["render_index"]
 
@@ -46,12 +49,12 @@ _COLUMNS = [
     ("max_rhat", "max R-hat", "{:.3f}"),
     ("thermal.Ti.FIT_cal", "FIT Ti cal [%]", "{:.1f}"),
     ("thermal.Ti.FIT_val", "FIT Ti val [%]", "{:.1f}"),
-    ("thermal.Ti.coverage90_val", "90 % band cover. Ti val", "{:.2f}"),
+    ("thermal.Ti.coverage90_val", "90 % band covers, Ti val", "pct"),
     ("hygric.Pi.FIT_cal", "FIT Pi cal [%]", "{:.1f}"),
     ("hygric.Pi.FIT_val", "FIT Pi val [%]", "{:.1f}"),
     ("thermal.tau_1_h", "slowest τ thermal [h]", "{:.0f}"),
     ("hygric.tau_1_h", "slowest τ hygric [h]", "{:.0f}"),
-    ("risk_flags", "indicators at risk", "{:d}"),
+    ("risk_flags", "indicators at risk", "risk"),
     ("twpi_years", "TWPI [years]", "{:.0f}"),
     ("emc_range_pct", "EMC range [% MC]", "{:.1f}"),
     ("mould_index_max", "mould index max", "{:.2f}"),
@@ -59,11 +62,11 @@ _COLUMNS = [
     ("risk_note", "measured-risk note", "{}"),
     ("proj.case", "projection: most severe case", "{}"),
     ("proj.twpi.change", "Δ TWPI [years]", "{:+.1f}"),
-    ("proj.twpi.p_worse", "P(TWPI worse)", "{:.2f}"),
+    ("proj.twpi.p_worse", "P(TWPI worse)", "pct"),
     ("proj.vtt_mould_index_max.change", "Δ mould index max", "{:+.2f}"),
-    ("proj.vtt_mould_index_max.p_worse", "P(mould worse)", "{:.2f}"),
+    ("proj.vtt_mould_index_max.p_worse", "P(mould worse)", "pct"),
     ("proj.en15757_outside_baseline.change", "Δ outside baseline EN 15757 band [% h]", "{:+.1f}"),
-    ("proj.probability", "P(statement)", "{:.2f}"),
+    ("proj.probability", "P(statement)", "pct"),
     ("proj.statement", "statement", "{}"),
     ("message", "message", "{}"),
 ]
@@ -75,6 +78,8 @@ def _cell(value, fmt: str) -> tuple[str, str]:
         return "–", ""
     if isinstance(value, bool | np.bool_):
         return ("yes" if value else "no"), str(int(value))
+    if fmt == "pct":  # a share or a probability, in % as on the rooms' reports
+        return fmt_pct(value), str(value)
     if fmt == "{:d}":
         try:
             value = int(value)
@@ -85,6 +90,20 @@ def _cell(value, fmt: str) -> tuple[str, str]:
     except (TypeError, ValueError):
         text = str(value)
     return text, str(value)
+
+
+def _flagged_text(count, codes: str) -> str:
+    """``2: mould index (VTT), EN 15757 band`` — the count and the indicators' names."""
+    names = [c.strip() for c in codes.split(",") if c.strip()]
+    if not names:
+        return "0" if count in (None, 0) else str(count)
+    readable = []
+    for n in names:
+        try:
+            readable.append(indicator_info(n).name)
+        except InputError:  # a column this version does not know: its code
+            readable.append(n)
+    return f"{len(names)}: " + ", ".join(readable)
 
 
 def render_index(pf: Portfolio, df: pd.DataFrame, out: Path) -> str:
@@ -112,6 +131,8 @@ def render_index(pf: Portfolio, df: pd.DataFrame, out: Path) -> str:
             if key == "proj.case" and isinstance(r.get("projection"), str) and r["projection"]:
                 rel = os.path.relpath(str(r["projection"]), start=str(out))
                 text = f"<a href='{html.escape(Path(rel).as_posix())}'>{text}</a>"
+            if key == "risk_flags" and isinstance(r.get("risk_flagged"), str):
+                text = html.escape(_flagged_text(r.get(key), r["risk_flagged"]))
             if key == "message":
                 text = f"<span class='pre-wrap'>{html.escape(str(r.get(key) or '')[:600])}</span>"
             cls = " class='num'" if fmt != "{}" else ""

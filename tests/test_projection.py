@@ -330,6 +330,30 @@ def _no_percentage_above_100(text: str) -> None:
     assert max(found) <= 100.0, sorted(found)[-5:]
 
 
+def test_a_morphing_run_speaks_of_its_own_weather_not_knmi14(proj):
+    """The uncertainty section says what the scenario share leaves out for the weather
+    this projection used: morphing deltas here, never the KNMI'14 tables."""
+    import html as html_mod
+    import re
+
+    from heritage_bayes.projection.page import _scenario_caveat
+
+    _, out = proj
+    text = html_mod.unescape(re.sub(r"<[^>]+>", " ", (out / "projection.html").read_text()))
+    assert "KNMI'14" not in text and "KNMI’14" not in text
+    assert "each morphing case applies one set of monthly changes" in " ".join(text.lower().split())
+
+    def caveat(*methods):
+        cases = [{"weather": {"method": m}} for m in methods]
+        return _scenario_caveat(type("P", (), {"summary": {"cases": cases}})())
+
+    knmi = "KNMI'14 time-series transformation (Bakker 2015, TR-349)"
+    assert caveat(knmi).startswith("The KNMI'14 tables give one change per scenario, so")
+    both = caveat(knmi, "user-supplied future weather file")
+    assert "KNMI'14" in both and "each future weather file is one realisation" in both
+    assert caveat("") == ""
+
+
 def test_page_and_outputs_have_no_share_above_100(proj):
     import html as html_mod
     import re

@@ -260,6 +260,27 @@ def _probability_html(proj) -> str:
     )
 
 
+def _scenario_caveat(proj) -> str:
+    """What the scenario share leaves out, said of the weather this projection used
+    (the KNMI'14 tables, morphing deltas or future files), never of another kind."""
+    methods = {str(c["weather"].get("method", "")) for c in proj.summary["cases"]}
+    said = []
+    if any(m.startswith("KNMI'14") for m in methods):
+        said.append("The KNMI'14 tables give one change per scenario")
+    if any(m.startswith("morphing") for m in methods):
+        said.append("each morphing case applies one set of monthly changes")
+    if any(m.startswith("user-supplied") for m in methods):
+        said.append("each future weather file is one realisation")
+    if not said:
+        return ""
+    text = "; ".join(said)
+    return (
+        f"{text[0].upper()}{text[1:]}, so the spread between climate models is not "
+        "separated from the scenario (give each model's weather as a case of its own to "
+        "see it)."
+    )
+
+
 def _split_html(proj) -> str:
     split = proj.summary["uncertainty_split"]
     fig = _fig_split(proj)
@@ -297,8 +318,7 @@ def _split_html(proj) -> str:
         "the posterior draws; <b>model error</b> — what the noise draw adds; <b>weather "
         "year</b> — the spread between the years of the weather (per-year indicators "
         "only, for one year's value); <b>scenario</b> — the spread of the scenario means "
-        "at a horizon. The KNMI'14 tables give one change per scenario, so the spread "
-        "between climate models is not separated from the scenario. Where the model "
+        f"at a horizon. {_scenario_caveat(proj)} Where the model "
         "error is correlated with the parameters, the covariance is shared in proportion "
         "to the two variances (see heritage_bayes.projection.summary).</p>" + note + "".join(out)
     )

@@ -26,8 +26,9 @@ variances, every group the same size, so that the law of total variance holds ex
   (extremes over the period, shares over all hours) have no weather-year term.
 
 The shares are the components over ``Var(y)``: non-negative, and they sum to 1 by
-construction. The KNMI'14 tables give one change per
-scenario, so a climate-model range is not separated from the scenario term.
+construction. Each case's weather is one change per scenario (the KNMI'14 tables, one
+set of morphing deltas, one file), so a climate-model range is not separated from the
+scenario term unless each model is a case of its own.
 Probabilities are proportions of draws; their Monte-Carlo standard error is
 ``sqrt(p (1 − p) / K)`` for ``K`` draws.
 """

@@ -24,7 +24,7 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-__all__ = ["PageResult", "find_chromium", "open_page"]
+__all__ = ["PHONE_OVERFLOW_JS", "PageResult", "find_chromium", "open_page"]
 
 _FLAGS = [
     "--headless",
@@ -43,6 +43,19 @@ _FLAGS = [
     "--mute-audio",
     "--remote-debugging-pipe",
 ]
+
+
+#: What sticks out of a phone's screen (390 px) outside the sideways-scrolling tables
+#: and code: ``extra_js`` for :func:`open_page`.
+PHONE_OVERFLOW_JS = """(() => {
+  const W = document.documentElement.clientWidth, wide = [];
+  for (const e of document.querySelectorAll('body *')) {
+    if (e.closest('.scroll') || e.closest('pre')) continue;
+    const r = e.getBoundingClientRect();
+    if (r.right > W + 1) wide.push(e.tagName + ': ' + (e.textContent || '').slice(0, 60));
+  }
+  return {W: W, docw: document.documentElement.scrollWidth, wide: wide.slice(0, 10)};
+})()"""
 
 
 def find_chromium() -> str | None:

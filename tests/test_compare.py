@@ -16,7 +16,7 @@ import pytest
 import xarray as xr
 import yaml
 
-from _report_browser import find_chromium, open_page
+from _report_browser import PHONE_OVERFLOW_JS, find_chromium, open_page
 from heritage_bayes._arviz import az
 from heritage_bayes.cli import main
 from heritage_bayes.compare import (
@@ -322,6 +322,12 @@ def test_comparison_page_in_headless_chromium(compared):
     img = mpimg.imread(io.BytesIO(page.screenshot), format="png")[..., :3]
     assert float(np.mean(img.mean(axis=2) < 0.9)) > 0.03, "screenshot is (almost) blank"
     assert res["recommendation"]["model"] in text
+    phone = open_page(
+        out / "comparison.html", chromium=chromium, width=390, height=844,
+        extra_js=PHONE_OVERFLOW_JS,
+    )  # fmt: skip
+    lay = phone.dom["extra"]
+    assert lay["docw"] <= lay["W"] <= 390 and lay["wide"] == [], lay
 
 
 def test_a_candidate_folder_that_is_not_a_run_needs_force(cfg_path, tmp_path, capsys):

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 import yaml
 
-from _report_browser import find_chromium, open_page
+from _report_browser import PHONE_OVERFLOW_JS, find_chromium, open_page
 from heritage_bayes.calibrate import run_calibration
 from heritage_bayes.cli import main
 from heritage_bayes.config import parse_config
@@ -320,6 +320,22 @@ def test_projection_page_in_headless_chromium(proj, size):
         assert d["sw"] <= d["cw"], d
     assert lay["docw"] <= lay["width"] and lay["right"] <= lay["width"], lay["right"]
     _no_percentage_above_100(lay["text"])
+
+
+@pytest.mark.browser
+def test_projection_page_on_a_phone_has_no_horizontal_scroll(proj):
+    """At 390 px nothing but the sideways-scrolling tables is wider than the screen."""
+    chromium = find_chromium()
+    if chromium is None:
+        pytest.skip("chromium not installed: the page was not opened in a real browser")
+    _, out = proj
+    res = open_page(
+        out / "projection.html", chromium=chromium, width=390, height=844,
+        extra_js=PHONE_OVERFLOW_JS,
+    )  # fmt: skip
+    assert res.errors == [], res.errors
+    lay = res.dom["extra"]
+    assert lay["docw"] <= lay["W"] <= 390 and lay["wide"] == [], lay
 
 
 def _no_percentage_above_100(text: str) -> None:

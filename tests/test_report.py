@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from _report_browser import find_chromium, open_page
+from _report_browser import PHONE_OVERFLOW_JS, find_chromium, open_page
 from heritage_bayes.calibrate import run_calibration
 from heritage_bayes.cli import main
 from heritage_bayes.config import parse_config
@@ -571,6 +571,21 @@ def test_report_in_headless_chromium(report):
     assert float(np.mean(rgb.mean(axis=2) < 0.9)) > 0.03, "screenshot is (almost) blank"
     red = (rgb[..., 0] > 0.55) & (rgb[..., 1] < 0.3) & (rgb[..., 2] < 0.3)
     assert red.sum() > 500, "the red verdict banner is not visible"
+
+
+@pytest.mark.browser
+def test_report_on_a_phone_has_no_horizontal_scroll(report):
+    """At 390 px (a phone) nothing but the scrolling tables is wider than the screen:
+    the summary's paths and the long names wrap instead."""
+    chromium = find_chromium()
+    if chromium is None:
+        pytest.skip("chromium not installed: the report was not opened in a real browser")
+    path, _ = report
+    res = open_page(path, chromium=chromium, width=390, height=844, extra_js=PHONE_OVERFLOW_JS)
+    assert res.errors == [], res.errors
+    out = res.dom["extra"]
+    assert out["W"] <= 390 and out["docw"] <= out["W"], out
+    assert out["wide"] == [], out["wide"]
 
 
 def test_verdict_green_only_when_the_noise_model_checks_pass():

@@ -24,7 +24,7 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-__all__ = ["PHONE_OVERFLOW_JS", "PageResult", "find_chromium", "open_page"]
+__all__ = ["BROKEN_WORDS", "PHONE_OVERFLOW_JS", "PageResult", "find_chromium", "open_page"]
 
 _FLAGS = [
     "--headless",
@@ -45,17 +45,49 @@ _FLAGS = [
 ]
 
 
+#: A JavaScript expression: the words of the table cells that a line break cuts in two
+#: (a number, an interval's bound, "conservatio|n"); breaks at a hyphen, a soft hyphen,
+#: a slash or a semicolon are a word's own and are not counted.
+BROKEN_WORDS = r"""(() => {
+  const broken = [];
+  for (const td of document.querySelectorAll('td, th')) {
+    const walker = document.createTreeWalker(td, NodeFilter.SHOW_TEXT);
+    let n;
+    while ((n = walker.nextNode())) {
+      const re = /[^\s\-\u00ad/;]+/g;
+      let m;
+      while ((m = re.exec(n.data))) {
+        const r = document.createRange();
+        r.setStart(n, m.index);
+        r.setEnd(n, m.index + m[0].length);
+        let rects = [...r.getClientRects()].filter(x => x.width >= 1);
+        // Chromium draws the hyphen of a soft-hyphen break as part of the next word
+        if (m.index > 0 && n.data[m.index - 1] === '\u00ad') rects = rects.slice(1);
+        const tops = new Set(rects.map(x => Math.round(x.top)));
+        if (tops.size > 1) broken.push(m[0]);
+      }
+    }
+  }
+  return broken.slice(0, 20);
+})()"""
+
 #: What sticks out of a phone's screen (390 px) outside the sideways-scrolling tables
-#: and code: ``extra_js`` for :func:`open_page`.
-PHONE_OVERFLOW_JS = """(() => {
+#: and code, and the broken words of :data:`BROKEN_WORDS`: ``extra_js`` for
+#: :func:`open_page`.
+PHONE_OVERFLOW_JS = (
+    """(() => {
   const W = document.documentElement.clientWidth, wide = [];
   for (const e of document.querySelectorAll('body *')) {
     if (e.closest('.scroll') || e.closest('pre')) continue;
     const r = e.getBoundingClientRect();
     if (r.right > W + 1) wide.push(e.tagName + ': ' + (e.textContent || '').slice(0, 60));
   }
-  return {W: W, docw: document.documentElement.scrollWidth, wide: wide.slice(0, 10)};
+  return {W: W, docw: document.documentElement.scrollWidth, wide: wide.slice(0, 10),
+          broken: """
+    + BROKEN_WORDS
+    + """};
 })()"""
+)
 
 
 def find_chromium() -> str | None:

@@ -301,6 +301,42 @@ def test_models_name_describes_the_model(capsys):
     assert "thermal_4a" in capsys.readouterr().out
 
 
+def test_the_same_posterior_prints_the_same_digits_on_every_page(compared):
+    """A parameter's median and 90 % interval: comparison.json states the run's own
+    summary.json values (computed from the draws posterior.nc holds), and the
+    comparison page prints them with the report's formatter, so the report, the
+    comparison and the JSON agree digit for digit."""
+    import html as html_mod
+    import re
+
+    from heritage_bayes.report.format import fmt
+
+    out, res = compared
+    page = html_mod.unescape((out / "comparison.html").read_text(encoding="utf-8"))
+    checked = 0
+    for m in MODELS:
+        summary = json.loads((out / m / "summary.json").read_text())
+        post = az.from_netcdf(out / m / "posterior.nc").posterior
+        section = page[page.index(f'<section id="model-{m}">') :]
+        rows = [re.findall(r"<td[^>]*>(.*?)</td>", r) for r in re.findall(r"<tr>.*?</tr>", section)]
+        ident = res["models"][m]["identifiability"]
+        for kind, table in (("parameters", ident["parameters"]), ("derived", ident["derived"])):
+            label = "parameter" if kind == "parameters" else "derived"
+            for name, e in table.items():
+                if e.get("fixed"):
+                    continue
+                stated = summary[kind][f"thermal.{name}"]
+                for q in ("median", "q05", "q95"):
+                    assert e[q] == stated[q], (m, name, q)
+                x = post[f"thermal.{name}"].values.reshape(-1)
+                assert stated["median"] == np.quantile(x, 0.5)
+                cells = next(c for c in rows if c[:2] == [name, label])
+                assert fmt(stated["median"]) in cells, (m, name, cells)
+                assert f"{fmt(stated['q05'])} … {fmt(stated['q95'])}" in cells, (m, name, cells)
+                checked += 1
+    assert checked >= 10
+
+
 def test_comparison_page_in_headless_chromium(compared):
     out, res = compared
     text = (out / "comparison.html").read_text()

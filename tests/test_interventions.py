@@ -268,7 +268,7 @@ def test_shipped_interventions_config_validates():
 @pytest.mark.parametrize("size", [(1280, 800), (1920, 1080)])
 def test_measures_section_in_headless_chromium(projected, size):
     """The measures section and its figure sit in the page; no table wider than its
-    container at 1280 and 1920 px."""
+    container at 1280 and 1920 px, and no word or number of a cell cut in two."""
     from _report_browser import find_chromium, open_page
     from test_projection import _LAYOUT_JS
 
@@ -291,6 +291,8 @@ def test_measures_section_in_headless_chromium(projected, size):
     for d in lay["scrolls"]:
         assert d["sw"] <= d["cw"], d
     assert lay["docw"] <= lay["width"] and lay["right"] <= lay["width"]
+    # no cell cut mid-word or mid-number ("conservatio n heating", "[0.71 6, 0.727 ]")
+    assert lay["broken"] == [], lay["broken"]
 
 
 def test_measures_the_run_cannot_take_are_refused():

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 import yaml
 
-from _report_browser import PHONE_OVERFLOW_JS, find_chromium, open_page
+from _report_browser import BROKEN_WORDS, PHONE_OVERFLOW_JS, find_chromium, open_page
 from heritage_bayes.calibrate import run_calibration
 from heritage_bayes.cli import main
 from heritage_bayes.config import parse_config
@@ -280,8 +280,9 @@ _LAYOUT_JS = """(() => {
   out.docw = document.documentElement.scrollWidth;
   out.right = Math.max(...[...document.querySelectorAll('nav.toc a, h1, h2, p, figure img')]
                            .map(e => e.getBoundingClientRect().right));
+  out.broken = BROKEN;
   return out;
-})()"""
+})()""".replace("BROKEN", BROKEN_WORDS)
 
 
 @pytest.mark.browser
@@ -319,6 +320,7 @@ def test_projection_page_in_headless_chromium(proj, size):
     for d in lay["scrolls"]:
         assert d["sw"] <= d["cw"], d
     assert lay["docw"] <= lay["width"] and lay["right"] <= lay["width"], lay["right"]
+    assert lay["broken"] == [], lay["broken"]  # no number or word cut by a line break
     _no_percentage_above_100(lay["text"])
 
 
@@ -336,6 +338,7 @@ def test_projection_page_on_a_phone_has_no_horizontal_scroll(proj):
     assert res.errors == [], res.errors
     lay = res.dom["extra"]
     assert lay["docw"] <= lay["W"] <= 390 and lay["wide"] == [], lay
+    assert lay["broken"] == [], lay["broken"]
 
 
 def _no_percentage_above_100(text: str) -> None:

@@ -586,6 +586,7 @@ def test_report_on_a_phone_has_no_horizontal_scroll(report):
     out = res.dom["extra"]
     assert out["W"] <= 390 and out["docw"] <= out["W"], out
     assert out["wide"] == [], out["wide"]
+    assert out["broken"] == [], out["broken"]
 
 
 def test_verdict_green_only_when_the_noise_model_checks_pass():

@@ -36,9 +36,15 @@ def _contraction(post: np.ndarray, prior: np.ndarray) -> float | None:
     return float(1.0 - np.var(post) / vp)
 
 
-def _interval(x: np.ndarray) -> dict:
-    x = x[np.isfinite(x)]
-    q05, q50, q95 = np.quantile(x, [0.05, 0.5, 0.95])
+def _interval(x: np.ndarray, stated: dict | None = None) -> dict:
+    """Median and 90 % interval of the draws ``x``: those the run's summary.json states
+    (``stated``: computed from the same saved draws, so every page prints the same
+    digits), else computed here (a run written before the summary stated them)."""
+    if stated and all(stated.get(k) is not None for k in ("median", "q05", "q95")):
+        q05, q50, q95 = (float(stated[k]) for k in ("q05", "median", "q95"))
+    else:
+        x = x[np.isfinite(x)]
+        q05, q50, q95 = np.quantile(x, [0.05, 0.5, 0.95])
     factor = float(q95 / q05) if q05 > 0 and q95 > 0 else None
     return {"median": float(q50), "q05": float(q05), "q95": float(q95), "factor90": factor}
 
@@ -67,7 +73,7 @@ def _identifiability(run, section: str, *, seed: int, identified_factor: float, 
         fixed = info.get("fixed") is not None
         entry = {"unit": info.get("unit", ""), "kind": info.get("kind", ""), "fixed": fixed}
         if not fixed:
-            entry.update(_interval(x))
+            entry.update(_interval(x, info))
             entry["contraction"] = _contraction(x, P_prior[:, j])
             f = entry["factor90"]
             entry["identified"] = bool(f is not None and f <= identified_factor)
@@ -85,7 +91,8 @@ def _identifiability(run, section: str, *, seed: int, identified_factor: float, 
         x = idata.posterior[key].values.reshape(-1)
         if not np.all(np.isfinite(x)):
             continue
-        entry = {"unit": idata.posterior[key].attrs.get("unit", ""), **_interval(x)}
+        stated = summ.get("derived", {}).get(key)
+        entry = {"unit": idata.posterior[key].attrs.get("unit", ""), **_interval(x, stated)}
         entry["contraction"] = _contraction(x, prior)
         f = entry["factor90"]
         entry["identified"] = bool(f is not None and f <= identified_factor)

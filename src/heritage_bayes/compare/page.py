@@ -10,6 +10,8 @@ import math
 from collections.abc import Sequence
 from pathlib import Path
 
+from heritage_bayes.report.format import fmt
+
 
 def fig_tradeoff(result: dict):
     """The paper's trade-off: accuracy against identifiability, one point per model.
@@ -174,8 +176,8 @@ def _quantity_rows(info: dict) -> list[list[str]]:
                     name,
                     kind,
                     e.get("unit", ""),
-                    _f(e.get("median")),
-                    f"{_f(e.get('q05'))} – {_f(e.get('q95'))}",
+                    fmt(e.get("median")),  # the digits of the run's own report
+                    f"{fmt(e.get('q05'))} … {fmt(e.get('q95'))}",
                     _f(e.get("factor90"), "{:.3g}"),
                     _f(e.get("contraction"), "{:.3f}"),
                     _f(e.get("identified")),

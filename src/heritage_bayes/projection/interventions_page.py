@@ -17,7 +17,7 @@ from heritage_bayes.climate.risk.registry import indicator_info
 from heritage_bayes.projection.interventions import COSTS
 from heritage_bayes.projection.interventions import ENERGY as _ENERGY
 from heritage_bayes.report.figures.style import RC_PARAMS, _figure, to_png_uri
-from heritage_bayes.report.format import fmt, fmt_pct
+from heritage_bayes.report.format import fmt, fmt_interval_html, fmt_pct
 
 _MARKERS = ("o", "s", "D", "^", "v", "P", "X", "*")
 #: Indicators of the trade-off figure, first two computed: mould, then chemical decay.
@@ -33,8 +33,12 @@ def _indicators(proj, page_key: tuple) -> list[str]:
 def _cell(d: dict) -> str:
     if not d or d.get("q50") is None:
         return "–"
-    better = "" if d.get("p_better") is None else f"<br>P(better) {fmt_pct(d['p_better'])}"
-    return f"{fmt(d['q50'])} [{fmt(d['q05'])}, {fmt(d['q95'])}]{better}"
+    better = (
+        ""
+        if d.get("p_better") is None
+        else f"<br><span class='nowrap'>P(better) {fmt_pct(d['p_better'])}</span>"
+    )
+    return f"{fmt_interval_html(d['q50'], d['q05'], d['q95'])}{better}"
 
 
 def scale_text(run) -> str:
@@ -171,7 +175,7 @@ def interventions_html(proj, run, page_key: tuple, colour, legend) -> str:
             cells = "".join(f"<td class='num'>{_cell(case['indicators'].get(n))}</td>"
                             for n in names)  # fmt: skip
             cost = "; ".join(
-                f"{escape(COSTS[c][1])}: {fmt(q['q50'])} [{fmt(q['q05'])}, {fmt(q['q95'])}] "
+                f"{escape(COSTS[c][1])}: {fmt_interval_html(q['q50'], q['q05'], q['q95'])} "
                 f"{escape(q['unit'])}"
                 for c, q in case["costs"].items()
             )

@@ -26,7 +26,7 @@ import numpy as np
 
 from heritage_bayes.climate.risk.registry import indicator_info
 from heritage_bayes.report.figures.style import RC_PARAMS, _figure, to_png_uri
-from heritage_bayes.report.format import fmt, fmt_pct
+from heritage_bayes.report.format import fmt, fmt_interval_html, fmt_pct
 
 #: Indicators drawn in the figures (when computed), in this order.
 KEY_INDICATORS = (
@@ -49,7 +49,6 @@ _COMPONENT_NAMES = {
 }
 _CSS = (
     "<style>table.decision, table.split, table.registry {width: 100%; table-layout: auto;}"
-    " table.decision td, table.registry td {overflow-wrap: anywhere;}"
     " table.decision td.num {white-space: normal;}</style>"
 )
 
@@ -177,7 +176,7 @@ def _fig_split(proj) -> str:
 def _q_text(d: dict | None) -> str:
     if not d or d.get("q50") is None:
         return "–"
-    return f"{fmt(d['q50'])} [{fmt(d['q05'])}, {fmt(d['q95'])}]"
+    return fmt_interval_html(d["q50"], d["q05"], d["q95"])
 
 
 def _banner(proj) -> str:

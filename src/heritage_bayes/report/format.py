@@ -16,6 +16,7 @@ __all__ = [
     "OUT_WORDS",
     "fmt",
     "fmt_int",
+    "fmt_interval_html",
     "fmt_pct",
     "fmt_time",
     "is_log_prior",
@@ -72,6 +73,15 @@ def fmt_pct(x, digits: int = 0) -> str:
     if x is None or not math.isfinite(float(x)):
         return "—"
     return f"{100 * float(x):.{digits}f} %"
+
+
+def fmt_interval_html(median, low, high) -> str:
+    """``2.41×10⁶ [1.9×10⁶, 3.1×10⁶]`` as HTML that a narrow column wraps between the
+    median and its interval, never inside a number or inside the interval."""
+    return (
+        f"<span class='nowrap'>{fmt(median)}</span> "
+        f"<span class='nowrap'>[{fmt(low)}, {fmt(high)}]</span>"
+    )
 
 
 def fmt_time(text: str | None) -> str:

@@ -226,7 +226,9 @@ def test_recommendation_rule():
     rec = _recommend(models, "elpd_validation")
     assert rec["model"] == "thermal_2c"
     assert "within 2 SE or 4 nats of thermal_4a (difference -3.0 ± 2.0)" in rec["reason"]
-    assert "thermal_4a is as accurate but not identified: tau_2_h" in rec["reason"]
+    assert (
+        "thermal_4a is as accurate but its time constants are not identified: τ2" in (rec["reason"])
+    )
     assert "thermal_1c is less accurate" in rec["reason"]
     assert "Not converged" not in rec["reason"]
     models["thermal_4a"]["converged"] = False
@@ -234,10 +236,24 @@ def test_recommendation_rule():
     # 2c outside 2 SE: the accurate model is recommended, with its unidentified tau named
     models["thermal_2c"] = model(10, -5.0, 2.0, [])
     rec = _recommend(models, "elpd_validation")
-    assert rec["model"] == "thermal_4a" and "tau_2_h" in rec["reason"]
+    assert rec["model"] == "thermal_4a" and "(τ2; no candidate" in rec["reason"]
+    assert "tau_" not in rec["reason"]  # no code names in the sentence
     # a negligible difference (< 4) counts as equal even with a tiny SE (1c == 2c)
     models["thermal_2c"] = model(10, -0.8, 0.01, [])
     assert _recommend(models, "elpd_validation")["model"] == "thermal_2c"
+    # the sentence agrees with the identifiability table: a time constant shorter than
+    # the step is said to be unidentified and why, and "as accurate" names how many of
+    # the larger model's parameters are identified (0 of 13 here)
+    models["thermal_2c"]["identifiability"]["time_constants_below_step"] = ["tau_2_h"]
+    models["thermal_4a"] = model(13, 0.0, 0.0, [], [f"p{i}" for i in range(13)])
+    rec = _recommend(models, "elpd_validation")
+    assert rec["model"] == "thermal_2c"
+    assert "all its time constants identified" not in rec["reason"]
+    assert "time constants longer than the time step identified (τ2 shorter" in rec["reason"]
+    assert (
+        "thermal_4a is as accurate, its time constants identified, but has more" in (rec["reason"])
+    )
+    assert "0 of its 13 parameters identified" in rec["reason"]
 
 
 def test_block_se_and_practical_rank():

@@ -177,6 +177,12 @@ def _num(x):
     return x if math.isfinite(x) else None
 
 
+def _tau_label(key: str) -> str:
+    """``tau_2_h`` -> ``τ2``: a time constant as the pages name it."""
+    core = key.removeprefix("tau_").removesuffix("_h")
+    return f"τ{core}" if core.isdigit() else key
+
+
 def _recommend(models: dict, score: str) -> dict:
     """The simplest accuracy-equivalent model whose time constants are identified."""
     what = "validation ELPD" if score == "elpd_validation" else "blocked LOO ELPD"
@@ -211,14 +217,19 @@ def _recommend(models: dict, score: str) -> dict:
         )
     if ident["time_constants_identified"]:
         fast = ident["time_constants_below_step"]
-        parts.append(
-            "all its time constants identified"
-            + (f" ({', '.join(fast)} shorter than the time step)" if fast else "")
-        )
+        if fast:
+            parts.append(
+                "its time constants longer than the time step identified ("
+                + ", ".join(_tau_label(k) for k in fast)
+                + " shorter than the step: the data see only its static effect, so it is "
+                "neither identified nor needed)"
+            )
+        else:
+            parts.append("all its time constants identified")
     else:
         parts.append(
             "but not all its time constants are identified ("
-            + ", ".join(ident["time_constants_not_identified"])
+            + ", ".join(_tau_label(k) for k in ident["time_constants_not_identified"])
             + "; no candidate of equal accuracy has all of them)"
         )
     others = []
@@ -230,11 +241,16 @@ def _recommend(models: dict, score: str) -> dict:
             continue
         bad = idf["time_constants_not_identified"]
         if bad:
-            others.append(f"{m} is as accurate but not identified: {', '.join(bad)}")
-        else:
             others.append(
-                f"{m} is as accurate and identified but has more parameters "
-                f"({idf['n_free_physical']} against {ident['n_free_physical']})"
+                f"{m} is as accurate but its time constants are not identified: "
+                + ", ".join(_tau_label(k) for k in bad)
+            )
+        else:
+            n_ok = idf["n_free_physical"] - len(idf.get("parameters_not_identified", []))
+            others.append(
+                f"{m} is as accurate, its time constants identified, but has more "
+                f"parameters ({idf['n_free_physical']} against {ident['n_free_physical']}; "
+                f"{n_ok} of its {idf['n_free_physical']} parameters identified)"
             )
     text = f"{choice}: " + ", ".join(parts) + "."
     if others:

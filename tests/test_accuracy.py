@@ -183,3 +183,16 @@ def test_a_model_without_sun_on_the_demo_is_red_and_named(tmp_path):
     assert "usable" not in v["text"] + v["advice"]
     assert "the sun — the model has no solar input" in v["advice"]
     assert "a slow drift" in v["advice"] and "thermal_2c" in v["advice"]
+
+
+def test_calibrate_warns_when_the_model_does_not_reproduce_the_room(tmp_path, capsys):
+    import json
+
+    from heritage_bayes.cli import _converged_or_3
+
+    (tmp_path / "summary.json").write_text(json.dumps(_summary(2.6)))
+    assert _converged_or_3(tmp_path) == 0  # converged: the exit code follows the sampler
+    err = capsys.readouterr().err
+    assert "this model does not reproduce the room: Ti (thermal): FIT 2.6 %" in err
+    (tmp_path / "summary.json").write_text(json.dumps(_summary(80.0)))
+    assert _converged_or_3(tmp_path) == 0 and capsys.readouterr().err == ""

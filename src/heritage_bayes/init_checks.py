@@ -78,7 +78,7 @@ def _whole_hour_label(est: dict) -> str:
     )
 
 
-def weather_clock(df, lon, declared, findings, where):
+def weather_clock(df, lon, declared, findings, where, *, lat=None, layout=None):
     """The weather file's clock, measured and checked against the declared one.
 
     Parameters
@@ -94,6 +94,12 @@ def weather_clock(df, lon, declared, findings, where):
         Appended to: what was measured.
     where : str
         Label for the findings.
+    lat : float, optional
+        Site latitude [° north]: with ``lon``, the site's zone is the candidate for a
+        daylight-saving clock.
+    layout : TableLayout, optional
+        The file's layout: its stamps as written are tested for DST changes
+        (:func:`~heritage_bayes.io.clock.detect_dst_zone`) when no clock is declared.
 
     Returns
     -------
@@ -107,8 +113,12 @@ def weather_clock(df, lon, declared, findings, where):
     With irradiance: the sun (:func:`~heritage_bayes.io.clock.solar_clock_offset`) under
     the three readings of the stamps; the reading that confirms the declared clock, or
     puts an undeclared one on a whole hour, is kept. Without: the outdoor daily cycle
-    (:func:`~heritage_bayes.io.clock.outdoor_cycle_offset`, ±1.5 h).
+    (:func:`~heritage_bayes.io.clock.outdoor_cycle_offset`, ±1.5 h). A file that names
+    no clock but whose stamps skip the spring hour and repeat the autumn hour of the
+    site's zone keeps that zone, which the sun or the outdoor cycle then confirms.
     """
+    if declared is None and layout is not None:
+        declared = _dst_from_stamps(layout, lat, lon, findings, where)
     if lon is None:
         if declared:
             findings.append(f"{where}: clock {declared} (from the file); not checked (no site)")
@@ -134,6 +144,10 @@ def weather_clock(df, lon, declared, findings, where):
             )
         w, _ = _declared_offsets(declared, df.index)
         if abs(e.offset_h - w) <= 1.5:
+            findings.append(
+                f"{where}: clock {declared} confirmed by the outdoor daily cycle "
+                f"(within 1.5 h of UTC{w:+g}; {e.describe()})"
+            )
             return declared, "end", None
         return (
             declared,
@@ -159,6 +173,12 @@ def weather_clock(df, lon, declared, findings, where):
                     f"use a fixed offset such as {_fmt_h(round(est[lab].offset_h))}"
                 ),
             )
+        if summer is not None and est[lab].follows_dst and abs(est[lab].winter_h - w) < 0.34:
+            findings.append(
+                f"{where}: clock {declared} confirmed by the sun (daylight-saving time: "
+                f"{est[lab].describe()}), irradiance as {_READING[lab]}"
+            )
+            return declared, lab, None
         ok = [k for k in ("end", "instant", "start") if abs(est[k].offset_h - w) < 0.34]
         if ok:
             findings.append(
@@ -181,7 +201,12 @@ def weather_clock(df, lon, declared, findings, where):
             lab,
             (
                 f"the weather file keeps a daylight-saving clock ({est[lab].describe()}): "
-                "name its zone, e.g. Europe/Helsinki"
+                "name its zone"
+                + (
+                    f", e.g. {z}"
+                    if (z := _clock.dst_candidate(round(est[lab].winter_h), lat, lon))
+                    else ""
+                )
             ),
         )
     zone = _fmt_h(round(est[lab].offset_h))
@@ -265,23 +290,32 @@ def choose_periods(s: pd.Timestamp, e: pd.Timestamp) -> tuple[str, str, str, str
     return s0.strftime(f), mid.strftime(f), mid.strftime(f), end.strftime(f), why
 
 
-def logger_clock(layout, df_naive, declared, lon, findings, where):
+def logger_clock(layout, df_naive, declared, lon, findings, where, lat=None):
     """Check a logger's declared clock; return the zone text or an open question.
 
-    A DST zone: its changes against the stamps as written
+    No declared clock: stamps that skip the spring hour and repeat the autumn hour of
+    the site's zone (:func:`~heritage_bayes.io.clock.detect_dst_zone`, ``lat`` and
+    ``lon`` needed) make the clock that zone, checked as if declared; otherwise a
+    question. A DST zone: its changes against the stamps as written
     (:func:`~heritage_bayes.io.clock.dst_structure`; a fixed clock is a question). A
-    fixed offset: the same against the DST zone of that offset
-    (:data:`~heritage_bayes.io.clock.DST_ZONES`; a DST clock is a question). With a
-    longitude: the indoor temperature's daily peak against solar noon [h], a finding
-    (a question when it comes more than half an hour before noon: no free-running room
-    warms before the sun does). No declared clock: a question.
+    fixed offset: the same against the site's DST zone, or the DST zone of that offset
+    without a site (:func:`~heritage_bayes.io.clock.dst_candidate`; a DST clock is a
+    question naming that zone). With a longitude: the indoor temperature's daily peak
+    against solar noon [h], a finding (a question when it comes more than half an hour
+    before noon: no free-running room warms before the sun does).
     """
     question = None
     if declared is None:
+        declared = _dst_from_stamps(layout, lat, lon, findings, where)
+    if declared is None:
         return marked(
             "the logger's clock: UTC, a fixed offset such as UTC+1, or a zone with "
-            "daylight-saving time such as Europe/Amsterdam (see its settings or the "
-            "software it was read out with)"
+            "daylight-saving time such as "
+            + (
+                (lat is not None and lon is not None and _clock.site_zone(lat, lon))
+                or "Europe/Amsterdam"
+            )
+            + " (see its settings or the software it was read out with)"
         )
     from heritage_bayes.io import parse_timezone
 
@@ -298,8 +332,10 @@ def logger_clock(layout, df_naive, declared, lon, findings, where):
             )
     else:  # a fixed offset: does the file jump at the DST changes of its region?
         off = tz.utcoffset(None).total_seconds() / 3600
-        zone = _clock.DST_ZONES.get(int(off)) if off == int(off) else None
-        st = _clock.dst_structure(_raw_times(layout), zone) if zone else None
+        raw = _raw_times(layout)
+        years = range(raw.min().year, raw.max().year + 1) if len(raw) else ()
+        zone = _clock.dst_candidate(off, lat, lon, years)
+        st = _clock.dst_structure(raw, zone) if zone else None
         if st is not None and st.changes:
             findings.append(f"{where}: {st.describe()}")
         if st is not None and st.verdict == "dst":
@@ -326,6 +362,20 @@ def logger_clock(layout, df_naive, declared, lon, findings, where):
                     "outdoor air do; is the logger's clock ahead of the declared one?"
                 )
     return question or declared
+
+
+def _dst_from_stamps(layout, lat, lon, findings, where) -> str | None:
+    """The site's DST zone when a file's own stamps follow its changes (a finding),
+    else None."""
+    found = _clock.detect_dst_zone(_raw_times(layout), lat, lon)
+    if found is None:
+        return None
+    zone, st = found
+    findings.append(
+        f"{where}: no clock named, but the stamps follow daylight-saving time ({st.describe()}): "
+        f"the clock of the site's zone {zone} (from its coordinates)"
+    )
+    return zone
 
 
 def _raw_times(layout: TableLayout) -> pd.DatetimeIndex:

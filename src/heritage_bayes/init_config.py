@@ -394,7 +394,9 @@ def init_config(
             wzone, wq = None, None
             findings.append("weather: time stamps carry their UTC offset")
         else:
-            wzone, wlabel, wq = weather_clock(dw, lon, declared, findings, "weather")
+            wzone, wlabel, wq = weather_clock(
+                dw, lon, declared, findings, "weather", lat=lat, layout=wlay
+            )
         if wq:
             wzone = marked(wq)
             questions.append(f"data.weather.timezone: {wq}")
@@ -422,7 +424,7 @@ def init_config(
         izone = None
         findings.append("logger: time stamps carry their UTC offset")
     else:
-        izone = logger_clock(lay, din, timezone or lay.timezone, lon, findings, "logger")
+        izone = logger_clock(lay, din, timezone or lay.timezone, lon, findings, "logger", lat)
     if izone and izone.startswith(MARK):
         questions.append(f"data.measurements.timezone: {izone[len(MARK) :].strip()}")
     ti_utc = to_utc(din["Ti"], izone)

@@ -1,0 +1,153 @@
+"""hbayes init detects what a new user's files do not say: a logger or weather station on
+daylight-saving time (from its own stamps, the zone from the site's coordinates), on
+files shaped like real exports (written in tmp_path)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from heritage_bayes.config import load_config
+from heritage_bayes.convert import timezone_text
+from heritage_bayes.init_config import init_config
+from heritage_bayes.io.clock import solar_noon_utc
+
+HELSINKI = {"latitude": 60.2, "longitude": 24.7}
+NEW_YORK = {"latitude": 40.71, "longitude": -74.0}
+
+
+def _climate(start: str, end: str, lon: float, seed: int = 3):
+    """Hourly UTC stamps, Te, Ti, RH [%] and ghi [W/m²] of a free-running room."""
+    rng = np.random.default_rng(seed)
+    utc = pd.date_range(start, end, freq="1h", tz="UTC", inclusive="left")
+    noon = solar_noon_utc(utc.normalize().tz_localize(None), lon)
+    h = np.asarray((utc - utc.normalize()) / pd.Timedelta(hours=1))
+    doy = np.asarray(utc.day_of_year)
+    clouds = np.repeat(rng.uniform(0.3, 1.0, len(utc) // 24 + 1), 24)[: len(utc)]
+    season = 0.6 + 0.4 * np.sin(np.pi * doy / 365)
+    ghi = np.round(700 * clouds * season * np.exp(-(((h - noon) / 3.0) ** 2)), 1)
+    te = (
+        5
+        - 10 * np.cos(2 * np.pi * (doy - 15) / 365)
+        + 4 * np.cos(2 * np.pi * (h - noon - 2.4) / 24)
+        + rng.normal(0, 0.3, h.size)
+    )
+    ti = pd.Series(te).ewm(halflife=6).mean().to_numpy() + 3
+    ti += 0.004 * pd.Series(ghi).ewm(halflife=3).mean().to_numpy()
+    rh = np.clip(70 - 2 * (ti - ti.mean()) + rng.normal(0, 1, h.size), 5, 99)
+    return utc, te, ti, rh, ghi
+
+
+def _data(tmp_path: Path) -> Path:
+    d = tmp_path / "data"
+    d.mkdir(exist_ok=True)
+    return d
+
+
+def _european_export(tmp_path: Path) -> tuple[Path, Path]:
+    """A logger export in Finnish local time (split date and time columns, `;`, decimal
+    comma; the spring hour 03:00 missing, the autumn hour 03:00 twice) and an FMI-style
+    weather file on UTC+2 with global radiation."""
+    utc, te, ti, rh, ghi = _climate("2013-03-01", "2013-12-01", HELSINKI["longitude"])
+    wall = utc.tz_convert("Europe/Helsinki").tz_localize(None)
+    rows = ["Date;Time;Temperature (°C);Humidity (%RH)"] + [
+        f"{t:%d.%m.%Y};{t:%H:%M:%S};" + f"{a:.2f};{b:.1f}".replace(".", ",")
+        for t, a, b in zip(wall, ti, rh, strict=True)
+    ]
+    lp = _data(tmp_path) / "logger.csv"
+    lp.write_text("\n".join(rows) + "\n", encoding="utf-8")
+    wp = _data(tmp_path) / "fmi.csv"
+    pd.DataFrame(
+        {
+            "t_UTC+2": (utc.tz_localize(None) + pd.Timedelta(hours=2)).strftime(
+                "%Y-%m-%d %H:%M:%S"
+            ),
+            "Te": te.round(2),
+            "RHe": rh.round(1),
+            "Rglob": ghi,
+        }
+    ).to_csv(wp, index=False)
+    return lp, wp
+
+
+def test_a_european_logger_on_daylight_saving_time_gets_the_sites_zone(tmp_path):
+    lp, wp = _european_export(tmp_path)
+    text = lp.read_text()
+    assert "31.03.2013;03:00:00" not in text and text.count("27.10.2013;03:00:00") == 2
+    out = tmp_path / "room" / "config.yaml"
+    res = init_config(lp, wp, output=out, **HELSINKI)
+    assert res.questions == []
+    cfg = load_config(out)
+    assert timezone_text(cfg.data.measurements[0].timezone) == "Europe/Helsinki"
+    assert any(
+        "the stamps follow daylight-saving time" in f and "Europe/Helsinki" in f
+        for f in res.findings
+    )
+    # declared UTC (the user's guess): the question names the site's zone, not London
+    res = init_config(lp, wp, output=out, force=True, timezone="UTC", **HELSINKI)
+    (q,) = res.questions
+    assert "jump at the DST changes of Europe/Helsinki" in q and "London" not in q
+
+
+def test_a_us_station_on_daylight_saving_time_is_new_york_not_an_odd_offset(tmp_path):
+    """A station export in US Eastern local time (2025-03-09 02:00 skipped, 2025-11-02
+    01:00 twice) without irradiance, and a HOBOware logger on GMT-05:00."""
+    utc, te, ti, rh, _ = _climate("2025-02-01", "2025-12-01", NEW_YORK["longitude"])
+    wall = utc.tz_convert("America/New_York").tz_localize(None)
+    wp = _data(tmp_path) / "station.csv"
+    pd.DataFrame(
+        {
+            "Date/Time": wall.strftime("%Y-%m-%d %H:%M"),
+            "Temp (°C)": te.round(1),
+            "Rel Hum (%)": rh.round(0),
+        }
+    ).to_csv(wp, index=False)
+    assert "2025-03-09 02:00" not in wp.read_text()
+    lines = ['"Plot Title: parlor"', '"#","Date Time, GMT-05:00","Temp, °C","RH, %"']
+    est = utc.tz_localize(None) - pd.Timedelta(hours=5)
+    lines += [
+        f"{i + 1},{t:%m/%d/%y %I:%M:%S %p},{a:.3f},{b:.2f}"
+        for i, (t, a, b) in enumerate(zip(est, ti, rh, strict=True))
+    ]
+    lp = _data(tmp_path) / "hobo.csv"
+    lp.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    out = tmp_path / "room" / "config.yaml"
+    res = init_config(lp, wp, output=out, **NEW_YORK)
+    assert res.questions == []
+    cfg = load_config(out)
+    assert timezone_text(cfg.data.weather.timezone) == "America/New_York"
+    assert timezone_text(cfg.data.measurements[0].timezone) == "UTC-05:00"
+    assert any("confirmed by the outdoor daily cycle" in f for f in res.findings)
+
+
+def test_site_zone_and_the_dst_candidate():
+    from heritage_bayes.io.clock import detect_dst_zone, dst_candidate, site_zone
+
+    assert site_zone(60.2, 24.7) == "Europe/Helsinki"
+    assert site_zone(36.1, -79.95) == "America/New_York"
+    # a declared UTC at Helsinki is tested against Helsinki's changes, not London's
+    assert dst_candidate(0, 60.2, 24.7) == "Europe/Helsinki"
+    assert dst_candidate(0, None, None) == "Europe/London"  # no site: by the offset
+    assert dst_candidate(9, 35.7, 139.7) is None  # Tokyo keeps no DST
+    fixed = pd.date_range("2013-03-01", "2013-12-01", freq="1h")  # stamps of a fixed clock
+    assert detect_dst_zone(fixed, 60.2, 24.7) is None
+    assert detect_dst_zone(fixed, None, None) is None
+
+
+@pytest.mark.parametrize("declared", ["UTC", "UTC+2"])
+def test_calibrate_names_the_sites_zone_for_a_dst_logger_declared_fixed(tmp_path, declared):
+    from heritage_bayes.io import read_csv
+    from heritage_bayes.io.clock import check_declared_clock
+
+    utc = pd.date_range("2013-01-01", "2013-12-31", freq="1h", tz="UTC")
+    wall = utc.tz_convert("Europe/Helsinki").tz_localize(None)
+    p = tmp_path / "dst.csv"
+    pd.DataFrame(
+        {"t": wall.strftime("%Y-%m-%d %H:%M"), "T": 15.0 + np.arange(wall.size) % 7}
+    ).to_csv(p, index=False)
+    df = read_csv(p, time_column="t", columns={"Ti": "T"}, timezone=declared, duplicates="first")
+    (w,) = check_declared_clock(df, 24.7, "data.measurements", 60.2)["warnings"]
+    assert "declare its zone (e.g. Europe/Helsinki)" in w

@@ -151,3 +151,120 @@ def test_calibrate_names_the_sites_zone_for_a_dst_logger_declared_fixed(tmp_path
     df = read_csv(p, time_column="t", columns={"Ti": "T"}, timezone=declared, duplicates="first")
     (w,) = check_declared_clock(df, 24.7, "data.measurements", 60.2)["warnings"]
     assert "declare its zone (e.g. Europe/Helsinki)" in w
+
+
+def _hobo(path: Path, stamps, ti, rh, gmt: str) -> Path:
+    lines = ['"Plot Title: nave"', f'"#","Date Time, GMT{gmt}","Temp, °C","RH, %"']
+    lines += [
+        f"{i + 1},{t:%m/%d/%y %I:%M:%S %p},{a:.3f},{b:.2f}"
+        for i, (t, a, b) in enumerate(zip(stamps, ti, rh, strict=True))
+    ]
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return path
+
+
+def test_periods_stay_inside_the_data_whatever_the_answer_to_an_open_clock(tmp_path):
+    """A weather file that names no clock (kept on UTC-2, no irradiance) with a 35-hour
+    outage: its clock is a question, and the periods init proposes stay inside the data
+    once it is answered (they used to start inside the outage: calibrate refused)."""
+    import yaml
+
+    from heritage_bayes.config import parse_config
+    from heritage_bayes.prepare import prepare
+
+    utc, te, ti, rh, _ = _climate("2021-03-01", "2021-06-01", -30.0)
+    wall = utc.tz_localize(None) - pd.Timedelta(hours=2)
+    keep = ~((wall >= "2021-03-05 13:00") & (wall < "2021-03-07 00:00"))  # 35 h missing
+    wp = _data(tmp_path) / "station.csv"
+    pd.DataFrame(
+        {"time": wall[keep].strftime("%Y-%m-%d %H:%M"), "T_out": te[keep].round(2)}
+    ).to_csv(wp, index=False)
+    lp = _hobo(_data(tmp_path) / "logger.csv", wall, ti, rh, "-02:00")
+    out = tmp_path / "room" / "config.yaml"
+    res = init_config(lp, wp, output=out, latitude=40.0, longitude=-30.0)
+    assert [q.split(":")[0] for q in res.questions] == ["data.weather.timezone"]
+    assert any("a clock is still an open question" in f for f in res.findings)
+    raw = yaml.safe_load(out.read_text(encoding="utf-8"))
+    # the outage ends 2021-03-07 00:00 on the file's clock: 14 h margin, next midnight
+    assert str(raw["periods"]["calibration"]["start"]) == "2021-03-08"
+    for answer in ("UTC-2", "UTC+12", "UTC-12"):
+        raw["data"]["weather"]["timezone"] = answer
+        prepare(parse_config(raw, base_dir=str(out.parent), name="room"))  # no DataError
+
+
+def test_periods_never_start_in_a_short_gap():
+    from heritage_bayes.init_checks import choose_periods
+
+    hours = pd.date_range("2021-01-01", "2021-04-01", freq="1h", tz="UTC")
+    # the stretch (gaps up to 6 h bridged) starts at midnight inside a 3-hour gap; its
+    # last reading is at 23:00, an hour before the end of its last hour
+    present = hours[(hours >= "2021-01-01 03:00") & (hours < "2021-04-01")]
+    s, _, _, end, why = choose_periods(hours[0], hours[-1], present)
+    assert (s, end) == ("2021-01-02", "2021-03-31") and "moved off gaps" in why
+    s, _, _, end, why = choose_periods(hours[0], hours[-1], hours)
+    assert (s, end) == ("2021-01-01", "2021-04-01") and "moved" not in why
+
+
+def test_overlapping_downloads_get_a_sort_setting_that_exists(tmp_path):
+    """Two HOBO downloads joined in one file, the second starting ten days before the
+    first ended: init writes `sort: true` (a real key) and a question that can be
+    answered; the reader without it names the key."""
+    import yaml
+
+    from heritage_bayes.config import parse_config
+    from heritage_bayes.errors import DataError
+    from heritage_bayes.prepare import prepare
+    from heritage_bayes.questions import open_questions
+
+    utc, te, ti, rh, ghi = _climate("2021-03-01", "2021-06-01", 5.0)
+    wall = utc.tz_localize(None) + pd.Timedelta(hours=1)
+    first, second = slice(0, 24 * 50), slice(24 * 40, None)
+    stamps = wall[first].append(wall[second])
+    lp = _hobo(
+        _data(tmp_path) / "logger.csv",
+        stamps,
+        np.r_[ti[first], ti[second]],
+        np.r_[rh[first], rh[second]],
+        "+01:00",
+    )
+    wp = _data(tmp_path) / "weather.csv"
+    pd.DataFrame(
+        {"t_UTC+1": wall.strftime("%Y-%m-%d %H:%M"), "Te": te.round(2), "Rglob": ghi}
+    ).to_csv(wp, index=False)
+    out = tmp_path / "room" / "config.yaml"
+    res = init_config(lp, wp, output=out, latitude=52.0, longitude=5.0)
+    (q,) = res.questions
+    assert "go backwards 1 time(s); `sort: true` below" in q
+    text = out.read_text(encoding="utf-8")
+    assert "    sort: true   # 1 time stamps going backwards" in text
+    raw = yaml.safe_load(text)
+    assert len(open_questions(raw)) == 1
+    raw.pop("questions")  # the user checked: overlapping downloads
+    prepare(parse_config(raw, base_dir=str(out.parent), name="room"))
+    raw["data"]["measurements"].pop("sort")
+    with pytest.raises(DataError, match=r"config key sort: true"):
+        prepare(parse_config(raw, base_dir=str(out.parent), name="room"))
+
+
+def test_the_readme_init_command_works_as_printed(tmp_path, monkeypatch):
+    """The README's `hbayes init` line, run in a folder holding data/logger.csv (a HOBO
+    export on GMT+01:00) and data/weather.csv (UTC+1 with global radiation)."""
+    import shlex
+
+    from heritage_bayes.cli import main
+
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text(encoding="utf-8")
+    (line,) = [
+        x.strip() for x in readme.splitlines() if x.strip().startswith(".venv/bin/hbayes init")
+    ]
+    argv = shlex.split(line)[1:]
+    utc, te, ti, rh, ghi = _climate("2021-03-01", "2021-06-01", 5.2)
+    wall = utc.tz_localize(None) + pd.Timedelta(hours=1)
+    _hobo(_data(tmp_path) / "logger.csv", wall, ti, rh, "+01:00")
+    pd.DataFrame(
+        {"t_UTC+1": wall.strftime("%Y-%m-%d %H:%M"), "Te": te.round(2), "Rglob": ghi}
+    ).to_csv(_data(tmp_path) / "weather.csv", index=False)
+    monkeypatch.chdir(tmp_path)
+    assert main(argv) == 0
+    out = Path(argv[argv.index("-o") + 1])
+    assert out.is_file() and load_config(out).name == "nave"

@@ -26,6 +26,7 @@ __all__ = [
     "logger_clock",
     "longest_stretch",
     "marked",
+    "present_hours",
     "to_utc",
     "weather_clock",
 ]
@@ -223,9 +224,7 @@ def longest_stretch(ti: pd.Series, te: pd.Series) -> tuple[pd.Timestamp, pd.Time
     DataError
         The files overlap in fewer than 48 hours (the message gives both spans).
     """
-    a = ti.dropna().index.floor("h").unique()
-    b = te.dropna().index.floor("h").unique()
-    both = a.intersection(b).sort_values()
+    both = present_hours(ti, te)
     if len(both) < 48:
         raise DataError(
             f"the logger and weather files overlap in {len(both)} hour(s) only "
@@ -240,6 +239,13 @@ def longest_stretch(ti: pd.Series, te: pd.Series) -> tuple[pd.Timestamp, pd.Time
         [f"... {len(gaps) - 5} more"] if len(gaps) > 5 else []
     )
     return both[starts[k]], both[ends[k]] + pd.Timedelta(hours=1), notes
+
+
+def present_hours(ti: pd.Series, te: pd.Series) -> pd.DatetimeIndex:
+    """The hours [UTC] in which both ``ti`` and ``te`` have a value, sorted."""
+    a = ti.dropna().index.floor("h").unique()
+    b = te.dropna().index.floor("h").unique()
+    return a.intersection(b).sort_values()
 
 
 def heating_floor(ti: pd.Series, te: pd.Series) -> tuple[float, int, int]:
@@ -261,14 +267,20 @@ def heating_floor(ti: pd.Series, te: pd.Series) -> tuple[float, int, int]:
     return floor, int(held.sum()), len(both)
 
 
-def choose_periods(s: pd.Timestamp, e: pd.Timestamp) -> tuple[str, str, str, str, str]:
+def choose_periods(
+    s: pd.Timestamp, e: pd.Timestamp, present: pd.DatetimeIndex | None = None
+) -> tuple[str, str, str, str, str]:
     """Calibration ``[start, mid)`` and validation ``[mid, end)`` in whole UTC days
     within the stretch ``[s, e)``, and why: the first whole calendar year (8 months to
     calibrate, 4 to validate: all seasons), else the first 12 whole months, else the
-    stretch's first 2/3 and the rest. Returns ``(start, mid, mid, end, why)`` as text."""
+    stretch's first 2/3 and the rest. With ``present`` (the hours with an input
+    reading), the start and the end are midnights with a reading: a period never starts
+    or ends inside an input gap (or after the last reading), which the simulation
+    cannot bridge. Returns ``(start, mid, mid, end, why)`` as text."""
     day = pd.Timedelta(days=1)
     s0 = s.ceil("D")
     e0 = e.floor("D")
+
     jan = pd.Timestamp(year=s0.year + int((s0.month, s0.day) > (1, 1)), month=1, day=1, tz=s0.tz)
     if s0.day != 1 and (e - s0).days >= YEAR_DAYS + 31:
         s0 = (s0 + pd.offsets.MonthBegin(1)).normalize()
@@ -286,6 +298,17 @@ def choose_periods(s: pd.Timestamp, e: pd.Timestamp) -> tuple[str, str, str, str
         end = e0
         mid = s0 + day * round((e0 - s0).days * 2 / 3)
         why = "the longest stretch: its first 2/3 to calibrate, the rest to validate"
+    if present is not None and len(present):  # no start or end inside a short gap
+        have = set(present)
+        moved = s0
+        while moved < mid and moved not in have:
+            moved += day
+        end_moved = end
+        while end_moved > mid and end_moved not in have:
+            end_moved -= day
+        if (moved, end_moved) != (s0, end):
+            why += "; start and end moved off gaps in the data"
+        s0, end = moved, end_moved
     f = "%Y-%m-%d"
     return s0.strftime(f), mid.strftime(f), mid.strftime(f), end.strftime(f), why
 

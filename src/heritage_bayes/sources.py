@@ -104,6 +104,7 @@ def _csv_kwargs(src) -> dict:
         "interval": src.interval,
         "label": src.label,
         "duplicates": src.duplicates,
+        "sort": src.sort,
         "invalid": src.invalid,
         "skiprows": src.skiprows,
         "encoding": src.encoding,

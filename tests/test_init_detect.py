@@ -43,8 +43,24 @@ def _climate(start: str, end: str, lon: float, seed: int = 3):
 
 def _data(tmp_path: Path) -> Path:
     d = tmp_path / "data"
-    d.mkdir(exist_ok=True)
+    d.mkdir(parents=True, exist_ok=True)
     return d
+
+
+def _fmi(tmp_path: Path, utc, te, rh, ghi) -> Path:
+    """An FMI-style weather CSV on UTC+2 (the clock in the time column's name)."""
+    wp = _data(tmp_path) / "fmi.csv"
+    pd.DataFrame(
+        {
+            "t_UTC+2": (utc.tz_localize(None) + pd.Timedelta(hours=2)).strftime(
+                "%Y-%m-%d %H:%M:%S"
+            ),
+            "Te": te.round(2),
+            "RHe": rh.round(1),
+            "Rglob": ghi,
+        }
+    ).to_csv(wp, index=False)
+    return wp
 
 
 def _european_export(tmp_path: Path) -> tuple[Path, Path]:
@@ -59,18 +75,7 @@ def _european_export(tmp_path: Path) -> tuple[Path, Path]:
     ]
     lp = _data(tmp_path) / "logger.csv"
     lp.write_text("\n".join(rows) + "\n", encoding="utf-8")
-    wp = _data(tmp_path) / "fmi.csv"
-    pd.DataFrame(
-        {
-            "t_UTC+2": (utc.tz_localize(None) + pd.Timedelta(hours=2)).strftime(
-                "%Y-%m-%d %H:%M:%S"
-            ),
-            "Te": te.round(2),
-            "RHe": rh.round(1),
-            "Rglob": ghi,
-        }
-    ).to_csv(wp, index=False)
-    return lp, wp
+    return lp, _fmi(tmp_path, utc, te, rh, ghi)
 
 
 def test_a_european_logger_on_daylight_saving_time_gets_the_sites_zone(tmp_path):
@@ -268,3 +273,83 @@ def test_the_readme_init_command_works_as_printed(tmp_path, monkeypatch):
     assert main(argv) == 0
     out = Path(argv[argv.index("-o") + 1])
     assert out.is_file() and load_config(out).name == "nave"
+
+
+def _attic(tmp_path: Path, *, fahrenheit: bool, rh_fault: str | None = None):
+    """A Finnish attic logger starting in winter (an EasyLog-style CSV: `Time,
+    Temperature,Humidity`, no units in the names) and the FMI-style weather beside it."""
+    utc, te, ti, rh, ghi = _climate("2012-11-01", "2013-08-01", HELSINKI["longitude"])
+    wall = utc.tz_localize(None) + pd.Timedelta(hours=2)
+    t_out = 32 + 1.8 * ti if fahrenheit else ti
+    rh_out = [f"{x:.1f}" for x in rh]
+    if rh_fault in ("range", "range_early"):  # a wet sensor: readings above 100 %
+        a = 3000 if rh_fault == "range" else 100  # beyond or inside init's sample lines
+        rh_out = [
+            f"{min(x + 35, 108):.1f}" if a <= i < a + 400 else s
+            for i, (x, s) in enumerate(zip(rh, rh_out, strict=True))
+        ]
+    elif rh_fault == "empty":
+        rh_out = [""] * len(rh)
+    lp = _data(tmp_path) / "attic.csv"
+    pd.DataFrame(
+        {"Time": wall.strftime("%Y-%m-%d %H:%M"), "Temperature": t_out.round(1), "Humidity": rh_out}
+    ).to_csv(lp, index=False)
+    return lp, _fmi(tmp_path, utc, te, rh, ghi)
+
+
+def test_an_unlabelled_fahrenheit_column_is_recognised_from_the_outdoor_air(tmp_path):
+    lp, wp = _attic(tmp_path, fahrenheit=True)
+    # the first winter months read as °C look plausible (25 to 45, median 32 "°C")
+    from heritage_bayes.io.loggers import inspect_table
+
+    assert inspect_table(lp).first("T").unit == "°C"
+    out = tmp_path / "room" / "config.yaml"
+    res = init_config(lp, wp, output=out, timezone="UTC+2", **HELSINKI)
+    assert res.questions == []
+    cfg = load_config(out)
+    assert cfg.data.measurements[0].units == {"Ti": "°F"}
+    assert any("has no unit in its name" in f and f.endswith(": °F") for f in res.findings)
+    # the same room logged in °C is left alone
+    lp, wp = _attic(tmp_path / "c", fahrenheit=False)
+    res = init_config(
+        lp, wp, output=tmp_path / "c" / "room" / "config.yaml", timezone="UTC+2", **HELSINKI
+    )
+    assert res.questions == [] and "units:" not in res.text
+
+
+def test_fahrenheit_evidence_thresholds():
+    from heritage_bayes.init_columns import F_AGREEMENT_K, F_MEDIAN_C, fahrenheit_evidence
+
+    days = pd.date_range("2013-01-01", periods=40, freq="1D")
+    te = pd.Series(np.linspace(-10, 10, 40), index=days.tz_localize("UTC"))
+    room_c = pd.Series(te.to_numpy() + 2, index=days)
+    assert fahrenheit_evidence(room_c, te)[0] == "°C"
+    assert fahrenheit_evidence(32 + 1.8 * room_c, te)[0] == "°F"
+    # a heated room at 20 °C: the °F reading is no closer to the outdoor air
+    assert fahrenheit_evidence(pd.Series(20.0, index=days), te)[0] == "°C"
+    # the median rule at its boundary
+    assert fahrenheit_evidence(pd.Series(F_MEDIAN_C, index=days), te)[0] == "°F"
+    assert fahrenheit_evidence(pd.Series(F_MEDIAN_C - 0.1, index=days), te)[0] == "°C"
+    # the agreement rule at its boundary: read as °F the room sits F_AGREEMENT_K above Te
+    # (a winter month, -20 to -10 °C, keeps the median rule out of it)
+    cold = te - 10
+    for k, unit in ((F_AGREEMENT_K, "°F"), (F_AGREEMENT_K + 0.01, "°C")):
+        assert fahrenheit_evidence(32 + 1.8 * (cold.tz_localize(None) + k), cold)[0] == unit
+    # values above 70 but no agreement: asked
+    spiky = room_c.copy()
+    spiky.iloc[3] = 85.0
+    assert fahrenheit_evidence(spiky, te)[0] == "?"
+
+
+@pytest.mark.parametrize("fault", ["range", "range_early", "empty"])
+def test_an_rh_column_out_of_range_or_empty_is_a_question_not_a_silent_drop(tmp_path, fault):
+    from heritage_bayes.cli import main
+
+    lp, wp = _attic(tmp_path, fahrenheit=False, rh_fault=fault)
+    out = tmp_path / "room" / "config.yaml"
+    res = init_config(lp, wp, output=out, timezone="UTC+2", **HELSINKI)
+    (q,) = res.questions
+    assert q.startswith("data.measurements.columns.RHi: column 'Humidity'")
+    assert ("holds no value" if fault == "empty" else "above 100 %") in q
+    assert "hygric:" in res.text  # the hygric model waits for the answer
+    assert main(["calibrate", str(out)]) == 2  # calibrate refuses, naming the key

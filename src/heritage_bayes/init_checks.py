@@ -27,6 +27,7 @@ __all__ = [
     "longest_stretch",
     "marked",
     "present_hours",
+    "raw_table",
     "to_utc",
     "weather_clock",
 ]
@@ -403,23 +404,40 @@ def _dst_from_stamps(layout, lat, lon, findings, where) -> str | None:
 
 def _raw_times(layout: TableLayout) -> pd.DatetimeIndex:
     """The stamps as written, in file order (for the DST structure)."""
+    return raw_table(layout).index
+
+
+def raw_table(layout: TableLayout, columns=()) -> pd.DataFrame:
+    """``columns`` of the file as numbers (NaN where empty or unreadable), indexed by
+    the stamps as written, in file order; rows without a readable stamp left out."""
     names = [layout.time_column] if isinstance(layout.time_column, str) else layout.time_column
     from heritage_bayes.io.readers.workbook import is_workbook, table_source
 
+    wanted = set(names) | set(columns)
     raw = pd.read_csv(
         table_source(layout.path)(),
         sep=layout.sep,
         skiprows=layout.skiprows,
         encoding=None if is_workbook(layout.path) else layout.encoding,
         dtype=str,
-        usecols=lambda c: str(c).strip() in names,
+        usecols=lambda c: str(c).strip() in wanted,
     )
     raw.columns = [str(c).strip() for c in raw.columns]
     text = raw[names[0]].str.strip()
     for n in names[1:]:
         text = text + " " + raw[n].str.strip()
     fmt = None if layout.time_format == "ISO8601" else layout.time_format
-    return pd.DatetimeIndex(pd.to_datetime(text, format=fmt, errors="coerce").dropna())
+    t = pd.to_datetime(text, format=fmt, errors="coerce")
+    out = pd.DataFrame(
+        {
+            c: pd.to_numeric(
+                raw[c].str.strip().str.replace(layout.decimal, ".", regex=False), errors="coerce"
+            ).to_numpy()
+            for c in columns
+        },
+        index=pd.DatetimeIndex(t),
+    )
+    return out[out.index.notna()]
 
 
 def clock_step(index: pd.DatetimeIndex) -> str:

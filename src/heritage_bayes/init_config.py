@@ -62,6 +62,7 @@ from heritage_bayes.init_checks import (
     to_utc,
     weather_clock,
 )
+from heritage_bayes.init_columns import fahrenheit_column_check, rh_column_check, usable
 from heritage_bayes.io import clock as _clock
 from heritage_bayes.io.loggers import TableLayout, inspect_table
 from heritage_bayes.questions import MARK
@@ -365,8 +366,8 @@ def init_config(
             f"{indoor.name}: no indoor temperature column found; columns: "
             + "; ".join(f"{c.name!r} ({c.why})" for c in lay.columns)
         )
-    din = _read_naive(lay, icols, iunits)
-    idropped = _dropped_findings(din, "logger", findings, questions)
+    rh_column_check(lay, icols, "RHi", findings, questions, "data.measurements")
+    din = _read_naive(lay, usable(icols), usable(iunits))
     step = clock_step(din.index)
     findings.append(
         f"logger: {len(din)} rows, step {step}, {din.index[0]:%Y-%m-%d} to "
@@ -396,7 +397,8 @@ def init_config(
             raise DataError(
                 f"{weather.name}: no outdoor temperature column found (columns {wlay.header})"
             )
-        dw = _read_naive(wlay, wcols, wunits)
+        rh_column_check(wlay, wcols, "RHe", findings, questions, "data.weather")
+        dw = _read_naive(wlay, usable(wcols), usable(wunits))
         wdropped = _dropped_findings(dw, "weather", findings, questions)
         declared = weather_timezone or wlay.timezone
         if wlay.time_format == "ISO8601":  # stamps with their UTC offset: the clock is known
@@ -427,6 +429,11 @@ def init_config(
         if lon is not None and "ghi" in dw:
             est = _clock.solar_clock_offset(dw.index, dw["ghi"], lon)
             findings.append(f"weather: clock check (the reader's UTC): {est.describe()}")
+
+    # -- the unit of an unlabelled indoor temperature: the outdoor file tells ---------------
+    if fahrenheit_column_check(lay, icols, iunits, te_utc, findings, questions):
+        din = _read_naive(lay, usable(icols), usable(iunits))
+    idropped = _dropped_findings(din, "logger", findings, questions)
 
     # -- the logger's clock (after the weather's) -----------------------------------------------
     if lay.time_format == "ISO8601":  # stamps with their UTC offset: the clock is known
@@ -491,7 +498,9 @@ def init_config(
     # the inputs must hold a reading at both ends of the periods (the outputs need not)
     cs, ce, vs, ve, why = choose_periods(s, e, present_hours(te_utc, te_utc))
     findings.append(f"periods: {why}")
-    hygric = "RHi" in icols and ("RHe" in dw.columns)
+    # an RH column that needs an answer keeps the hygric section: answered, it runs
+    rhe_open = wlay is not None and str(wcols.get("RHe", "")).startswith(MARK)
+    hygric = "RHi" in icols and ("RHe" in dw.columns or rhe_open)
     name = name or (output.parent.name if output.stem == "config" else output.stem) or "room"
     check_name(name, what="--name" if name_given else "name (from --output)")
 

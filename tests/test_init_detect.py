@@ -95,6 +95,10 @@ def test_a_european_logger_on_daylight_saving_time_gets_the_sites_zone(tmp_path)
     res = init_config(lp, wp, output=out, force=True, timezone="UTC", **HELSINKI)
     (q,) = res.questions
     assert "jump at the DST changes of Europe/Helsinki" in q and "London" not in q
+    # no site: the stamps still tell daylight-saving time, and the question says so
+    res = init_config(lp, wp, output=out, force=True)
+    (q,) = [q for q in res.questions if q.startswith("data.measurements.timezone")]
+    assert "the logger's stamps follow daylight-saving time (EU rules" in q
 
 
 def test_a_us_station_on_daylight_saving_time_is_new_york_not_an_odd_offset(tmp_path):

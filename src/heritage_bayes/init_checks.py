@@ -332,14 +332,18 @@ def logger_clock(layout, df_naive, declared, lon, findings, where, lat=None):
     if declared is None:
         declared = _dst_from_stamps(layout, lat, lon, findings, where)
     if declared is None:
+        site = lat is not None and lon is not None
+        rules = None if site else _dst_rules(layout)
+        if rules:
+            return marked(
+                f"the logger's stamps follow daylight-saving time ({rules}): name its zone, "
+                "or give --latitude and --longitude to have it looked up"
+            )
+        example = (site and _clock.site_zone(lat, lon)) or "Europe/Amsterdam"
         return marked(
             "the logger's clock: UTC, a fixed offset such as UTC+1, or a zone with "
-            "daylight-saving time such as "
-            + (
-                (lat is not None and lon is not None and _clock.site_zone(lat, lon))
-                or "Europe/Amsterdam"
-            )
-            + " (see its settings or the software it was read out with)"
+            f"daylight-saving time such as {example} (see its settings or the software it "
+            "was read out with)"
         )
     from heritage_bayes.io import parse_timezone
 
@@ -386,6 +390,17 @@ def logger_clock(layout, df_naive, declared, lon, findings, where, lat=None):
                     "outdoor air do; is the logger's clock ahead of the declared one?"
                 )
     return question or declared
+
+
+def _dst_rules(layout) -> str | None:
+    """Without a site: which daylight-saving rules a file's stamps follow, in words
+    (the EU's, the US'), or None."""
+    times = _raw_times(layout)
+    for zone, words in (("Europe/Paris", "EU rules"), ("America/New_York", "US rules")):
+        st = _clock.dst_structure(times, zone)
+        if st.verdict == "dst":
+            return f"{words}: {st.describe()}"
+    return None
 
 
 def _dst_from_stamps(layout, lat, lon, findings, where) -> str | None:

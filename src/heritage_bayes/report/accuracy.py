@@ -67,6 +67,8 @@ DAILY_CYCLE_RATIO = 0.2
 DRIFT_RATIO = 0.5
 #: [percentage points] a ladder rung fits "clearly better" by at least this much FIT.
 LADDER_MARGIN = 10.0
+#: Unit of a difference of each output, for the words.
+_DIFF_UNITS = {"Ti": " K", "Pi": " Pa", "RHi": " %RH"}
 #: Hours of daylight in local solar time in which a sun-driven residual peaks.
 _SUN_HOURS = (9, 20)
 
@@ -278,12 +280,13 @@ def missing_physics(summary: dict, failures: list[dict], shapes: dict | None) ->
         have = {k.split(".", 1)[1] for k in params if k.startswith(f"{sec}.")}
         found = []
         sh = shapes.get((sec, o))
+        u = _DIFF_UNITS.get(o, "")
         if sh and sh["daily"]:
             share = sh["daily_amplitude"] / max(sh["measured_daily_amplitude"], 1e-12)
             size = (
-                f"a daily cycle of ±{sh['daily_amplitude']:.2g} in the residuals "
+                f"a daily cycle of ±{sh['daily_amplitude']:.2g}{u} in the residuals "
                 f"({100 * share:.0f} % "
-                f"of the measured ±{sh['measured_daily_amplitude']:.2g}, largest at "
+                f"of the measured ±{sh['measured_daily_amplitude']:.2g}{u}, largest at "
                 f"{sh['peak_hour']:02d} h solar time)"
             )
             if o == "Ti" and sh["sunlit"]:
@@ -319,8 +322,8 @@ def missing_physics(summary: dict, failures: list[dict], shapes: dict | None) ->
                 if "Pf" not in have:
                     lack.append("a sink (hygric_2c_fixed's fixed vapour-pressure node)")
             found.append(
-                f"a slow drift of the residuals' day means (RMS {sh['drift']:.2g}, against "
-                f"a measured standard deviation of {sh['measured_sd']:.2g}): "
+                f"a slow drift of the residuals' day means (RMS {sh['drift']:.2g}{u}, against "
+                f"a measured standard deviation of {sh['measured_sd']:.2g}{u}): "
                 + (", ".join(lack) if lack else "a node, a control or a sink the model lacks")
             )
         rung = _better_rung(summary, f)

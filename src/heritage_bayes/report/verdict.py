@@ -333,7 +333,6 @@ def convergence_verdict(
             + "Compare the model orders of the ladder (section 6) and the residual "
             "diagnostics (section 7), change the model, and calibrate again."
         )
-        lines = [f"Accuracy: {f['text']}." for f in failures] + lines
     return {
         "level": level,
         "title": title,

@@ -91,6 +91,14 @@ def test_a_european_logger_on_daylight_saving_time_gets_the_sites_zone(tmp_path)
         "the stamps follow daylight-saving time" in f and "Europe/Helsinki" in f
         for f in res.findings
     )
+    # confirmed by the room's own daily cycle: no hour's jump between the seasons
+    import re
+
+    (peak,) = [f for f in res.findings if "the indoor temperature peaks" in f]
+    summer, winter = map(
+        float, re.search(r"Apr-Sep ([-+.\d]+) h, Nov-Feb ([-+.\d]+) h", peak).groups()
+    )
+    assert abs(summer - winter) < 0.3
     # declared UTC (the user's guess): the question names the site's zone, not London
     res = init_config(lp, wp, output=out, force=True, timezone="UTC", **HELSINKI)
     (q,) = res.questions

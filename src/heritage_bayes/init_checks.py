@@ -379,9 +379,16 @@ def logger_clock(layout, df_naive, declared, lon, findings, where, lat=None):
         lag = _clock._wrap(peak - _clock.solar_noon_utc(pd.DatetimeIndex(peak.index), lon))
         if np.isfinite(lag).sum() >= 5:
             med = float(np.nanmedian(lag))
+            # a clock read with the right DST rule shows no hour's jump between seasons
+            e = _clock.ClockEstimate("indoor peak", pd.Series(lag, index=peak.index))
+            seasons = (
+                f"; Apr-Sep {e.summer_h:+.1f} h, Nov-Feb {e.winter_h:+.1f} h"
+                if e.summer_h is not None and e.winter_h is not None
+                else ""
+            )
             findings.append(
                 f"{where}: the indoor temperature peaks {med:+.1f} h after solar noon on the "
-                f"declared clock (median of {int(np.isfinite(lag).sum())} days)"
+                f"declared clock (median of {int(np.isfinite(lag).sum())} days{seasons})"
             )
             if med < -0.5 and question is None:
                 question = marked(

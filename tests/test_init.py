@@ -88,7 +88,9 @@ def test_init_synthetic_measures_an_undeclared_weather_clock(tmp_path):
     assert cfg.data.weather.path == "../data/weather.csv"
     assert cfg.periods.calibration.start == "2021-03-01"
     assert cfg.periods.validation.start == "2021-05-20"
-    assert cfg.periods.validation.end == "2021-06-29"
+    # the weather's last reading is 2021-06-28 23:00 UTC: the validation ends at the
+    # last midnight with an input reading (2021-06-29 would leave its last hour open)
+    assert cfg.periods.validation.end == "2021-06-28"
     assert any("no clock named in the file; the sun says UTC+1" in f for f in res.findings)
 
 

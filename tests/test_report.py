@@ -908,11 +908,15 @@ def test_fit_is_flagged_on_a_nearly_constant_series():
 
     mae, fit = 2.1, -98.0
     rmse = 1.25 * mae  # Gaussian errors: RMSE ≈ 1.25 MAE
-    words = _nearly_constant({"MAE": mae, "MSE": rmse**2, "FIT": fit})  # no SD: derived
+    # no SD: derived; RH logger resolution 1 %RH
+    words = _nearly_constant({"MAE": mae, "MSE": rmse**2, "FIT": fit}, 1.0)
     assert "nearly constant" in words and "MAE 2.1" in words
     sd = rmse / (1 - fit / 100)
     assert f"standard deviation {fmt(sd)}" in words
-    assert _nearly_constant({"MAE": 0.2, "MSE": 0.0625, "FIT": 80.0, "SD": 1.25}) == ""
+    assert _nearly_constant({"MAE": 0.2, "MSE": 0.0625, "FIT": 80.0, "SD": 1.25}, 1.0) == ""
+    # a poor fit of a series that varies far beyond the sensor's resolution is a poor
+    # fit, not a constant series (a °F file read as °C: SD 10.8 K, FIT 1.2 %)
+    assert _nearly_constant({"MAE": 8.0, "MSE": 110.0, "FIT": 1.2, "SD": 10.8}, 0.1) == ""
     # the SD stored by fit_metrics is the population standard deviation of the measured
     from heritage_bayes.inference.results import fit_metrics
 

@@ -234,8 +234,17 @@ def _converged_or_3(run_dir) -> int:
     from pathlib import Path
 
     from heritage_bayes.convergence import EXIT_UNCONVERGED
+    from heritage_bayes.report.accuracy import accuracy_failures, resolutions
 
     summary = json.loads((Path(run_dir) / "summary.json").read_text(encoding="utf-8"))
+    failures = accuracy_failures(summary, resolutions({}))
+    if failures:
+        print(
+            "hbayes: warning: this model does not reproduce the room: "
+            + "; ".join(f["text"] for f in failures)
+            + f". The report's verdict names what is most likely missing: {run_dir}",
+            file=sys.stderr,
+        )
     if summary.get("converged"):
         return 0
     print(

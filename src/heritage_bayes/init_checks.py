@@ -26,6 +26,8 @@ __all__ = [
     "logger_clock",
     "longest_stretch",
     "marked",
+    "present_hours",
+    "raw_table",
     "to_utc",
     "weather_clock",
 ]
@@ -78,7 +80,7 @@ def _whole_hour_label(est: dict) -> str:
     )
 
 
-def weather_clock(df, lon, declared, findings, where):
+def weather_clock(df, lon, declared, findings, where, *, lat=None, layout=None):
     """The weather file's clock, measured and checked against the declared one.
 
     Parameters
@@ -94,6 +96,12 @@ def weather_clock(df, lon, declared, findings, where):
         Appended to: what was measured.
     where : str
         Label for the findings.
+    lat : float, optional
+        Site latitude [° north]: with ``lon``, the site's zone is the candidate for a
+        daylight-saving clock.
+    layout : TableLayout, optional
+        The file's layout: its stamps as written are tested for DST changes
+        (:func:`~heritage_bayes.io.clock.detect_dst_zone`) when no clock is declared.
 
     Returns
     -------
@@ -107,8 +115,12 @@ def weather_clock(df, lon, declared, findings, where):
     With irradiance: the sun (:func:`~heritage_bayes.io.clock.solar_clock_offset`) under
     the three readings of the stamps; the reading that confirms the declared clock, or
     puts an undeclared one on a whole hour, is kept. Without: the outdoor daily cycle
-    (:func:`~heritage_bayes.io.clock.outdoor_cycle_offset`, ±1.5 h).
+    (:func:`~heritage_bayes.io.clock.outdoor_cycle_offset`, ±1.5 h). A file that names
+    no clock but whose stamps skip the spring hour and repeat the autumn hour of the
+    site's zone keeps that zone, which the sun or the outdoor cycle then confirms.
     """
+    if declared is None and layout is not None:
+        declared = _dst_from_stamps(layout, lat, lon, findings, where)
     if lon is None:
         if declared:
             findings.append(f"{where}: clock {declared} (from the file); not checked (no site)")
@@ -134,6 +146,10 @@ def weather_clock(df, lon, declared, findings, where):
             )
         w, _ = _declared_offsets(declared, df.index)
         if abs(e.offset_h - w) <= 1.5:
+            findings.append(
+                f"{where}: clock {declared} confirmed by the outdoor daily cycle "
+                f"(within 1.5 h of UTC{w:+g}; {e.describe()})"
+            )
             return declared, "end", None
         return (
             declared,
@@ -159,6 +175,12 @@ def weather_clock(df, lon, declared, findings, where):
                     f"use a fixed offset such as {_fmt_h(round(est[lab].offset_h))}"
                 ),
             )
+        if summer is not None and est[lab].follows_dst and abs(est[lab].winter_h - w) < 0.34:
+            findings.append(
+                f"{where}: clock {declared} confirmed by the sun (daylight-saving time: "
+                f"{est[lab].describe()}), irradiance as {_READING[lab]}"
+            )
+            return declared, lab, None
         ok = [k for k in ("end", "instant", "start") if abs(est[k].offset_h - w) < 0.34]
         if ok:
             findings.append(
@@ -181,7 +203,12 @@ def weather_clock(df, lon, declared, findings, where):
             lab,
             (
                 f"the weather file keeps a daylight-saving clock ({est[lab].describe()}): "
-                "name its zone, e.g. Europe/Helsinki"
+                "name its zone"
+                + (
+                    f", e.g. {z}"
+                    if (z := _clock.dst_candidate(round(est[lab].winter_h), lat, lon))
+                    else ""
+                )
             ),
         )
     zone = _fmt_h(round(est[lab].offset_h))
@@ -198,9 +225,7 @@ def longest_stretch(ti: pd.Series, te: pd.Series) -> tuple[pd.Timestamp, pd.Time
     DataError
         The files overlap in fewer than 48 hours (the message gives both spans).
     """
-    a = ti.dropna().index.floor("h").unique()
-    b = te.dropna().index.floor("h").unique()
-    both = a.intersection(b).sort_values()
+    both = present_hours(ti, te)
     if len(both) < 48:
         raise DataError(
             f"the logger and weather files overlap in {len(both)} hour(s) only "
@@ -215,6 +240,13 @@ def longest_stretch(ti: pd.Series, te: pd.Series) -> tuple[pd.Timestamp, pd.Time
         [f"... {len(gaps) - 5} more"] if len(gaps) > 5 else []
     )
     return both[starts[k]], both[ends[k]] + pd.Timedelta(hours=1), notes
+
+
+def present_hours(ti: pd.Series, te: pd.Series) -> pd.DatetimeIndex:
+    """The hours [UTC] in which both ``ti`` and ``te`` have a value, sorted."""
+    a = ti.dropna().index.floor("h").unique()
+    b = te.dropna().index.floor("h").unique()
+    return a.intersection(b).sort_values()
 
 
 def heating_floor(ti: pd.Series, te: pd.Series) -> tuple[float, int, int]:
@@ -236,14 +268,20 @@ def heating_floor(ti: pd.Series, te: pd.Series) -> tuple[float, int, int]:
     return floor, int(held.sum()), len(both)
 
 
-def choose_periods(s: pd.Timestamp, e: pd.Timestamp) -> tuple[str, str, str, str, str]:
+def choose_periods(
+    s: pd.Timestamp, e: pd.Timestamp, present: pd.DatetimeIndex | None = None
+) -> tuple[str, str, str, str, str]:
     """Calibration ``[start, mid)`` and validation ``[mid, end)`` in whole UTC days
     within the stretch ``[s, e)``, and why: the first whole calendar year (8 months to
     calibrate, 4 to validate: all seasons), else the first 12 whole months, else the
-    stretch's first 2/3 and the rest. Returns ``(start, mid, mid, end, why)`` as text."""
+    stretch's first 2/3 and the rest. With ``present`` (the hours with an input
+    reading), the start and the end are midnights with a reading: a period never starts
+    or ends inside an input gap (or after the last reading), which the simulation
+    cannot bridge. Returns ``(start, mid, mid, end, why)`` as text."""
     day = pd.Timedelta(days=1)
     s0 = s.ceil("D")
     e0 = e.floor("D")
+
     jan = pd.Timestamp(year=s0.year + int((s0.month, s0.day) > (1, 1)), month=1, day=1, tz=s0.tz)
     if s0.day != 1 and (e - s0).days >= YEAR_DAYS + 31:
         s0 = (s0 + pd.offsets.MonthBegin(1)).normalize()
@@ -261,27 +299,51 @@ def choose_periods(s: pd.Timestamp, e: pd.Timestamp) -> tuple[str, str, str, str
         end = e0
         mid = s0 + day * round((e0 - s0).days * 2 / 3)
         why = "the longest stretch: its first 2/3 to calibrate, the rest to validate"
+    if present is not None and len(present):  # no start or end inside a short gap
+        have = set(present)
+        moved = s0
+        while moved < mid and moved not in have:
+            moved += day
+        end_moved = end
+        while end_moved > mid and end_moved not in have:
+            end_moved -= day
+        if (moved, end_moved) != (s0, end):
+            why += "; start and end moved off gaps in the data"
+        s0, end = moved, end_moved
     f = "%Y-%m-%d"
     return s0.strftime(f), mid.strftime(f), mid.strftime(f), end.strftime(f), why
 
 
-def logger_clock(layout, df_naive, declared, lon, findings, where):
+def logger_clock(layout, df_naive, declared, lon, findings, where, lat=None):
     """Check a logger's declared clock; return the zone text or an open question.
 
-    A DST zone: its changes against the stamps as written
+    No declared clock: stamps that skip the spring hour and repeat the autumn hour of
+    the site's zone (:func:`~heritage_bayes.io.clock.detect_dst_zone`, ``lat`` and
+    ``lon`` needed) make the clock that zone, checked as if declared; otherwise a
+    question. A DST zone: its changes against the stamps as written
     (:func:`~heritage_bayes.io.clock.dst_structure`; a fixed clock is a question). A
-    fixed offset: the same against the DST zone of that offset
-    (:data:`~heritage_bayes.io.clock.DST_ZONES`; a DST clock is a question). With a
-    longitude: the indoor temperature's daily peak against solar noon [h], a finding
-    (a question when it comes more than half an hour before noon: no free-running room
-    warms before the sun does). No declared clock: a question.
+    fixed offset: the same against the site's DST zone, or the DST zone of that offset
+    without a site (:func:`~heritage_bayes.io.clock.dst_candidate`; a DST clock is a
+    question naming that zone). With a longitude: the indoor temperature's daily peak
+    against solar noon [h], a finding (a question when it comes more than half an hour
+    before noon: no free-running room warms before the sun does).
     """
     question = None
     if declared is None:
+        declared = _dst_from_stamps(layout, lat, lon, findings, where)
+    if declared is None:
+        site = lat is not None and lon is not None
+        rules = None if site else _dst_rules(layout)
+        if rules:
+            return marked(
+                f"the logger's stamps follow daylight-saving time ({rules}): name its zone, "
+                "or give --latitude and --longitude to have it looked up"
+            )
+        example = (site and _clock.site_zone(lat, lon)) or "Europe/Amsterdam"
         return marked(
             "the logger's clock: UTC, a fixed offset such as UTC+1, or a zone with "
-            "daylight-saving time such as Europe/Amsterdam (see its settings or the "
-            "software it was read out with)"
+            f"daylight-saving time such as {example} (see its settings or the software it "
+            "was read out with)"
         )
     from heritage_bayes.io import parse_timezone
 
@@ -298,8 +360,10 @@ def logger_clock(layout, df_naive, declared, lon, findings, where):
             )
     else:  # a fixed offset: does the file jump at the DST changes of its region?
         off = tz.utcoffset(None).total_seconds() / 3600
-        zone = _clock.DST_ZONES.get(int(off)) if off == int(off) else None
-        st = _clock.dst_structure(_raw_times(layout), zone) if zone else None
+        raw = _raw_times(layout)
+        years = range(raw.min().year, raw.max().year + 1) if len(raw) else ()
+        zone = _clock.dst_candidate(off, lat, lon, years)
+        st = _clock.dst_structure(raw, zone) if zone else None
         if st is not None and st.changes:
             findings.append(f"{where}: {st.describe()}")
         if st is not None and st.verdict == "dst":
@@ -315,9 +379,16 @@ def logger_clock(layout, df_naive, declared, lon, findings, where):
         lag = _clock._wrap(peak - _clock.solar_noon_utc(pd.DatetimeIndex(peak.index), lon))
         if np.isfinite(lag).sum() >= 5:
             med = float(np.nanmedian(lag))
+            # a clock read with the right DST rule shows no hour's jump between seasons
+            e = _clock.ClockEstimate("indoor peak", pd.Series(lag, index=peak.index))
+            seasons = (
+                f"; Apr-Sep {e.summer_h:+.1f} h, Nov-Feb {e.winter_h:+.1f} h"
+                if e.summer_h is not None and e.winter_h is not None
+                else ""
+            )
             findings.append(
                 f"{where}: the indoor temperature peaks {med:+.1f} h after solar noon on the "
-                f"declared clock (median of {int(np.isfinite(lag).sum())} days)"
+                f"declared clock (median of {int(np.isfinite(lag).sum())} days{seasons})"
             )
             if med < -0.5 and question is None:
                 question = marked(
@@ -328,25 +399,67 @@ def logger_clock(layout, df_naive, declared, lon, findings, where):
     return question or declared
 
 
+def _dst_rules(layout) -> str | None:
+    """Without a site: which daylight-saving rules a file's stamps follow, in words
+    (the EU's, the US'), or None."""
+    times = _raw_times(layout)
+    for zone, words in (("Europe/Paris", "EU rules"), ("America/New_York", "US rules")):
+        st = _clock.dst_structure(times, zone)
+        if st.verdict == "dst":
+            return f"{words}: {st.describe()}"
+    return None
+
+
+def _dst_from_stamps(layout, lat, lon, findings, where) -> str | None:
+    """The site's DST zone when a file's own stamps follow its changes (a finding),
+    else None."""
+    found = _clock.detect_dst_zone(_raw_times(layout), lat, lon)
+    if found is None:
+        return None
+    zone, st = found
+    findings.append(
+        f"{where}: no clock named, but the stamps follow daylight-saving time ({st.describe()}): "
+        f"the clock of the site's zone {zone} (from its coordinates)"
+    )
+    return zone
+
+
 def _raw_times(layout: TableLayout) -> pd.DatetimeIndex:
     """The stamps as written, in file order (for the DST structure)."""
+    return raw_table(layout).index
+
+
+def raw_table(layout: TableLayout, columns=()) -> pd.DataFrame:
+    """``columns`` of the file as numbers (NaN where empty or unreadable), indexed by
+    the stamps as written, in file order; rows without a readable stamp left out."""
     names = [layout.time_column] if isinstance(layout.time_column, str) else layout.time_column
     from heritage_bayes.io.readers.workbook import is_workbook, table_source
 
+    wanted = set(names) | set(columns)
     raw = pd.read_csv(
         table_source(layout.path)(),
         sep=layout.sep,
         skiprows=layout.skiprows,
         encoding=None if is_workbook(layout.path) else layout.encoding,
         dtype=str,
-        usecols=lambda c: str(c).strip() in names,
+        usecols=lambda c: str(c).strip() in wanted,
     )
     raw.columns = [str(c).strip() for c in raw.columns]
     text = raw[names[0]].str.strip()
     for n in names[1:]:
         text = text + " " + raw[n].str.strip()
     fmt = None if layout.time_format == "ISO8601" else layout.time_format
-    return pd.DatetimeIndex(pd.to_datetime(text, format=fmt, errors="coerce").dropna())
+    t = pd.to_datetime(text, format=fmt, errors="coerce")
+    out = pd.DataFrame(
+        {
+            c: pd.to_numeric(
+                raw[c].str.strip().str.replace(layout.decimal, ".", regex=False), errors="coerce"
+            ).to_numpy()
+            for c in columns
+        },
+        index=pd.DatetimeIndex(t),
+    )
+    return out[out.index.notna()]
 
 
 def clock_step(index: pd.DatetimeIndex) -> str:

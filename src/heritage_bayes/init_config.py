@@ -20,9 +20,11 @@ and ``tests/test_init.py``):
   left fI_N unidentified, and its MAP validation FIT of Ti was 76.7 % against 78.0 % with
   H (calibration Dec 2010-Aug 2011, validation Aug-Dec 2011; 4 facades also sampled
   slowly: τmax 141 after 13 000 steps, stopped).
-* **Periods**: the first whole calendar year of the longest stretch without a gap over
-  6 h (all seasons; 8 months to calibrate, 4 to validate), else its first whole 12
-  months, else 2/3 and 1/3 of it.
+* **Periods**: chosen after the clocks, on UTC: the first whole calendar year of the
+  longest stretch without a gap over 6 h (all seasons; 8 months to calibrate, 4 to
+  validate), else its first whole 12 months, else 2/3 and 1/3 of it; never starting or
+  ending in a gap. While a clock is an open question they keep 14 h (the largest
+  offset) inside the stretch, so that any answer keeps them inside the data.
 * **Models**: thermal_1c and hygric_1c, the smallest of each ladder; the report's
   ladder fits the larger ones.
 * **Irradiance stamps**: the reading of the stamps (interval end, instant, interval
@@ -56,14 +58,19 @@ from heritage_bayes.init_checks import (
     logger_clock,
     longest_stretch,
     marked,
+    present_hours,
     to_utc,
     weather_clock,
 )
+from heritage_bayes.init_columns import fahrenheit_column_check, rh_column_check, usable
 from heritage_bayes.io import clock as _clock
 from heritage_bayes.io.loggers import TableLayout, inspect_table
 from heritage_bayes.questions import MARK
 
 __all__ = ["InitResult", "init_config"]
+
+#: The largest shift an open clock question can bring when answered (UTC+14, UTC-12).
+CLOCK_MARGIN = pd.Timedelta(hours=14)
 
 #: Weather formats ``init`` reads besides CSV (by the readers of :mod:`heritage_bayes.io`).
 WEATHER_FORMATS = ("csv", "epw", "knmi", "tmy3")
@@ -226,6 +233,7 @@ def _source_lines(
 #: calibration read the file the same way (its default would refuse it).
 _POLICIES = {
     "duplicates": ("duplicates: first", "stamps repeated with other values: the first kept"),
+    "sorted": ("sort: true", "time stamps going backwards: the rows sorted by time"),
     "bad_timestamps": ("invalid: nan", "unreadable time stamps: those rows dropped"),
     "unparseable_values": ("invalid: nan", "unreadable values: left out"),
     "out_of_range": ("invalid: nan", "values outside the physical range: left out"),
@@ -248,7 +256,9 @@ def _dropped_findings(df: pd.DataFrame, where: str, findings: list[str], questio
     if dropped.get("sorted"):
         questions.append(
             f"questions: the {where} file's time stamps go backwards {dropped['sorted']} "
-            "time(s) (a clock reset? two files joined?); fix the file, then delete this question"
+            "time(s); `sort: true` below reads its rows sorted by time, right for overlapping "
+            "downloads joined in one file, wrong for a logger whose clock was reset (then "
+            "fix the file's stamps); check which, then delete this question"
         )
     return dropped
 
@@ -356,8 +366,8 @@ def init_config(
             f"{indoor.name}: no indoor temperature column found; columns: "
             + "; ".join(f"{c.name!r} ({c.why})" for c in lay.columns)
         )
-    din = _read_naive(lay, icols, iunits)
-    idropped = _dropped_findings(din, "logger", findings, questions)
+    rh_column_check(lay, icols, "RHi", findings, questions, "data.measurements")
+    din = _read_naive(lay, usable(icols), usable(iunits))
     step = clock_step(din.index)
     findings.append(
         f"logger: {len(din)} rows, step {step}, {din.index[0]:%Y-%m-%d} to "
@@ -387,14 +397,17 @@ def init_config(
             raise DataError(
                 f"{weather.name}: no outdoor temperature column found (columns {wlay.header})"
             )
-        dw = _read_naive(wlay, wcols, wunits)
+        rh_column_check(wlay, wcols, "RHe", findings, questions, "data.weather")
+        dw = _read_naive(wlay, usable(wcols), usable(wunits))
         wdropped = _dropped_findings(dw, "weather", findings, questions)
         declared = weather_timezone or wlay.timezone
         if wlay.time_format == "ISO8601":  # stamps with their UTC offset: the clock is known
             wzone, wq = None, None
             findings.append("weather: time stamps carry their UTC offset")
         else:
-            wzone, wlabel, wq = weather_clock(dw, lon, declared, findings, "weather")
+            wzone, wlabel, wq = weather_clock(
+                dw, lon, declared, findings, "weather", lat=lat, layout=wlay
+            )
         if wq:
             wzone = marked(wq)
             questions.append(f"data.weather.timezone: {wq}")
@@ -417,12 +430,17 @@ def init_config(
             est = _clock.solar_clock_offset(dw.index, dw["ghi"], lon)
             findings.append(f"weather: clock check (the reader's UTC): {est.describe()}")
 
+    # -- the unit of an unlabelled indoor temperature: the outdoor file tells ---------------
+    if fahrenheit_column_check(lay, icols, iunits, te_utc, findings, questions):
+        din = _read_naive(lay, usable(icols), usable(iunits))
+    idropped = _dropped_findings(din, "logger", findings, questions)
+
     # -- the logger's clock (after the weather's) -----------------------------------------------
     if lay.time_format == "ISO8601":  # stamps with their UTC offset: the clock is known
         izone = None
         findings.append("logger: time stamps carry their UTC offset")
     else:
-        izone = logger_clock(lay, din, timezone or lay.timezone, lon, findings, "logger")
+        izone = logger_clock(lay, din, timezone or lay.timezone, lon, findings, "logger", lat)
     if izone and izone.startswith(MARK):
         questions.append(f"data.measurements.timezone: {izone[len(MARK) :].strip()}")
     ti_utc = to_utc(din["Ti"], izone)
@@ -467,9 +485,22 @@ def init_config(
             "days; if so, model the heating (thermal.options: {thermostat: true}) or choose "
             "periods outside the heating season; then delete this question"
         )
-    cs, ce, vs, ve, why = choose_periods(s, e)
+    if any(z and str(z).startswith(MARK) for z in (izone, wzone)):
+        # an open clock moves the data by up to 14 h when answered: periods chosen on the
+        # file's clock keep that far inside the stretch, so any answer keeps them inside
+        s, e = s + CLOCK_MARGIN, e - CLOCK_MARGIN
+        findings.append(
+            "periods: a clock is still an open question: the periods keep "
+            f"{CLOCK_MARGIN / pd.Timedelta(hours=1):.0f} h inside the stretch on the files' "
+            "own clocks, so that any answer keeps them inside the data; after answering, "
+            "`hbayes init` again (--timezone, --weather-timezone) chooses them on UTC"
+        )
+    # the inputs must hold a reading at both ends of the periods (the outputs need not)
+    cs, ce, vs, ve, why = choose_periods(s, e, present_hours(te_utc, te_utc))
     findings.append(f"periods: {why}")
-    hygric = "RHi" in icols and ("RHe" in dw.columns)
+    # an RH column that needs an answer keeps the hygric section: answered, it runs
+    rhe_open = wlay is not None and str(wcols.get("RHe", "")).startswith(MARK)
+    hygric = "RHi" in icols and ("RHe" in dw.columns or rhe_open)
     name = name or (output.parent.name if output.stem == "config" else output.stem) or "room"
     check_name(name, what="--name" if name_given else "name (from --output)")
 

@@ -104,6 +104,7 @@ def _csv_kwargs(src) -> dict:
         "interval": src.interval,
         "label": src.label,
         "duplicates": src.duplicates,
+        "sort": src.sort,
         "invalid": src.invalid,
         "skiprows": src.skiprows,
         "encoding": src.encoding,
@@ -297,11 +298,11 @@ def check_clocks(weather: pd.DataFrame, measurements: list, site: dict | None) -
     """
     from heritage_bayes.io.clock import check_declared_clock
 
-    lon = (site or {}).get("longitude")
-    out = {"data.weather": check_declared_clock(weather, lon, "data.weather")}
+    lon, lat = (site or {}).get("longitude"), (site or {}).get("latitude")
+    out = {"data.weather": check_declared_clock(weather, lon, "data.weather", lat)}
     for i, m in enumerate(measurements):
         key = "data.measurements" + (f"[{i}]" if len(measurements) > 1 else "")
-        out[key] = check_declared_clock(m, lon, key)
+        out[key] = check_declared_clock(m, lon, key, lat)
     out["warnings"] = [w for v in out.values() for w in v["warnings"]]
     return out
 

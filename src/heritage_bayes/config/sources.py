@@ -98,22 +98,12 @@ class DemoData(_Strict):
         return self
 
 
-_CSV_ONLY = (
-    "time_column",
-    "time_format",
-    "time_origin",
-    "timezone",
-    "columns",
-    "sep",
-    "decimal",
-    "averaged",
-    "interval",
-    "label",
-    "duplicates",
-    "na_values",
-    "skiprows",
-    "encoding",
-    "units",
+#: The keys only a csv source takes.
+_CSV_ONLY = tuple(
+    (
+        "time_column time_format time_origin timezone columns sep decimal averaged interval "
+        "label duplicates sort na_values skiprows encoding units"
+    ).split()
 )
 
 
@@ -173,6 +163,13 @@ class Source(_Strict):
     )
     duplicates: Literal["raise", "first", "last", "mean"] = key(
         "raise", unit=None, description="csv: what to do with a repeated time stamp"
+    )
+    sort: bool = key(
+        False,
+        unit=None,
+        description="csv: rows whose time stamps go backwards (overlapping downloads joined "
+        "in one file) sorted by time instead of refused; a stamp then repeated follows "
+        "duplicates",
     )
     na_values: list[str | float] | None = key(
         None, unit=None, description="csv: extra markers of a missing value, e.g. [-999]"

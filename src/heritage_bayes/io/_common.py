@@ -247,8 +247,8 @@ def order_and_deduplicate(
                 i = int(back[0]) + 1
                 raise DataError(
                     f"{name}: timestamps are not in increasing order: {where(i)} comes "
-                    f"after {where(i - 1)}; {back.size} such step(s) back. Fix the file or "
-                    f"pass sort=True to sort the rows by time"
+                    f"after {where(i - 1)}; {back.size} such step(s) back. Fix the file, or "
+                    "sort the rows by time (config key sort: true; read_csv(..., sort=True))"
                 )
             frame = frame.iloc[np.argsort(idx, kind="stable")]
             counts["sorted"] = int(back.size)
@@ -267,7 +267,8 @@ def order_and_deduplicate(
                 raise DataError(
                     f"{name}: {n} duplicate timestamp(s) with different values; first on "
                     f"{where(i)}, the same UTC time as {where(j)}. Pass duplicates='first', "
-                    f"'last' or 'mean' to resolve them, or fix the file"
+                    f"'last' or 'mean' (config key duplicates: first) to resolve them, or "
+                    "fix the file"
                 )
             counts["duplicates"] = n
             if duplicates == "mean":

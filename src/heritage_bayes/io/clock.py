@@ -16,7 +16,10 @@ another zone. Three detectors measure the clock from the data themselves:
 * :func:`dst_structure` — the wall-clock stamps of a file against a daylight-saving zone:
   a clock that follows DST skips the spring hour (a 23-hour day) and repeats the autumn
   hour (a 25-hour day); a fixed clock holds stamps inside the skipped hour and repeats
-  nothing.
+  nothing. The zone to test is the site's own (:func:`site_zone`: the IANA zone
+  boundaries of ``timezonefinder``, offline), so a logger at 60.2 N 24.7 E on
+  daylight-saving time is read as Europe/Helsinki (:func:`detect_dst_zone`), not as
+  the first zone with the same rules.
 
 Offsets are in hours east of UTC (``UTC+2`` is ``+2``). Each detector gives one value per
 day; the medians by season tell a fixed clock (the same offset all year) from a DST clock
@@ -37,13 +40,18 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
+from heritage_bayes.io.zones import DST_ZONES, dst_candidate, keeps_dst, site_zone, zone_transitions
+
 __all__ = [
     "DST_ZONES",
     "TE_PEAK_LAG_H",
     "ClockEstimate",
     "DSTStructure",
+    "detect_dst_zone",
+    "dst_candidate",
     "dst_structure",
     "outdoor_cycle_offset",
+    "site_zone",
     "solar_clock_offset",
     "solar_noon_utc",
 ]
@@ -336,7 +344,7 @@ def dst_structure(naive_times, zone: str) -> DSTStructure:
         return out
     values = t.asi8
     for year in range(t.min().year, t.max().year + 1):
-        for wall, delta in _transitions(tz, year):
+        for wall, delta in zone_transitions(tz, year):
             start, end = wall, wall + delta
             lo = np.searchsorted(values, (start - 3 * step).value)
             hi = np.searchsorted(values, (end + 3 * step).value)
@@ -360,23 +368,6 @@ def dst_structure(naive_times, zone: str) -> DSTStructure:
     return out
 
 
-def _transitions(tz, year: int) -> list[tuple[pd.Timestamp, pd.Timedelta]]:
-    """(wall-clock instant before the change, change of the offset) in ``year``."""
-    found = []
-    t = _dt.datetime(year, 1, 1, tzinfo=_dt.UTC)
-    prev = t.astimezone(tz).utcoffset()
-    hour = _dt.timedelta(hours=1)
-    while t.year == year:
-        nxt = t + hour
-        off = nxt.astimezone(tz).utcoffset()
-        if off != prev:
-            wall = (nxt + prev).replace(tzinfo=None)  # the old clock at the change
-            found.append((pd.Timestamp(wall), pd.Timedelta(off - prev)))
-            prev = off
-        t = nxt
-    return found
-
-
 #: A residual clock error below this [h] is not reported: hourly irradiance means leave
 #: the stamp's place in the hour (start, middle, end) uncertain by half a step.
 TOLERANCE_H = 0.75
@@ -387,7 +378,9 @@ TOLERANCE_H = 0.75
 TE_TOLERANCE_H = 1.5
 
 
-def check_declared_clock(df: pd.DataFrame, longitude: float | None, where: str) -> dict:
+def check_declared_clock(
+    df: pd.DataFrame, longitude: float | None, where: str, latitude: float | None = None
+) -> dict:
     """Check the clock a table was read with (its UTC index) against its own data.
 
     Parameters
@@ -399,6 +392,9 @@ def check_declared_clock(df: pd.DataFrame, longitude: float | None, where: str) 
         Site longitude [° east] (None: only the DST evidence of the reader is used).
     where : str
         The config key of the table, for the messages (``data.weather``).
+    latitude : float, optional
+        Site latitude [° north]: with the longitude, the DST zone a fixed clock is
+        tested against, and named, is the site's own (:func:`dst_candidate`).
 
     Returns
     -------
@@ -420,7 +416,7 @@ def check_declared_clock(df: pd.DataFrame, longitude: float | None, where: str) 
             f"{zone} skips in spring (dropped): the file keeps a fixed clock, not {zone}; "
             f"declare its standard offset (e.g. UTC+1) as timezone"
         )
-    dst = _dst_of_fixed(df.index, zone)
+    dst = _dst_of_fixed(df.index, zone, latitude, longitude)
     if dst is not None and dst.verdict == "dst":
         warnings.append(
             f"{where}: declared the fixed clock {zone}, but the stamps jump at the DST "
@@ -479,12 +475,15 @@ def check_declared_clock(df: pd.DataFrame, longitude: float | None, where: str) 
         and first.winter_h is not None
         and abs(first.summer_h - first.winter_h) > 0.75
     ):
+        years = range(df.index.min().year, df.index.max().year + 1)
+        dst_name = dst_candidate(_zone_offset(df.index, zone), latitude, longitude, years)
         warnings.append(
             f"{where}: the sun puts April-September {first.summer_h - first.winter_h:+.1f} h "
             f"from November-February on the declared timezone {zone} "
             f"({first.describe()}): the file's clock "
             + (
-                "follows daylight-saving time; declare its zone (e.g. Europe/Paris)"
+                "follows daylight-saving time; declare its zone"
+                + (f" ({dst_name})" if dst_name else " with daylight-saving time")
                 if first.summer_h > first.winter_h
                 else "is fixed; declare its standard offset (e.g. UTC+1)"
             )
@@ -504,21 +503,35 @@ def _zone_offset(index: pd.DatetimeIndex, zone) -> float:
     return t.utcoffset().total_seconds() / 3600.0
 
 
-#: The DST zone checked for each fixed offset [h] (EU and US rules).
-DST_ZONES = {
-    0: "Europe/London",
-    1: "Europe/Paris",
-    2: "Europe/Helsinki",
-    -5: "America/New_York",
-    -6: "America/Chicago",
-    -7: "America/Denver",
-    -8: "America/Los_Angeles",
-}
+def detect_dst_zone(
+    naive_times, latitude: float | None, longitude: float | None
+) -> tuple[str, DSTStructure] | None:
+    """A daylight-saving clock recognised from a file's own stamps.
+
+    The stamps as written (``naive_times``, file order) are compared with the changes
+    of the site's zone (:func:`site_zone`): the spring hour missing and the autumn hour
+    stamped twice (:func:`dst_structure`, verdict ``"dst"``) make the file's clock that
+    zone. None without a site, for a zone without DST, or when the stamps do not follow
+    its changes (a fixed clock, or no change covered).
+    """
+    if latitude is None or longitude is None:
+        return None
+    t = pd.DatetimeIndex(naive_times)
+    if len(t) < 3:
+        return None
+    zone = site_zone(float(latitude), float(longitude))
+    if not zone or not keeps_dst(zone, range(t.min().year, t.max().year + 1)):
+        return None
+    st = dst_structure(t, zone)
+    return (zone, st) if st.verdict == "dst" else None
 
 
-def _dst_of_fixed(index: pd.DatetimeIndex, zone) -> DSTStructure | None:
+def _dst_of_fixed(
+    index: pd.DatetimeIndex, zone, latitude=None, longitude=None
+) -> DSTStructure | None:
     """For a table read with a fixed offset: its wall-clock stamps against the DST zone
-    of that offset (a DST clock declared fixed shows a one-hour jump every spring)."""
+    of the site, or of that offset without a site (a DST clock declared fixed shows a
+    one-hour jump every spring)."""
     from heritage_bayes.io._common import parse_timezone
 
     try:
@@ -528,7 +541,8 @@ def _dst_of_fixed(index: pd.DatetimeIndex, zone) -> DSTStructure | None:
     if not isinstance(tz, _dt.timezone) or len(index) < 3:
         return None
     off = tz.utcoffset(None).total_seconds() / 3600.0
-    name = DST_ZONES.get(int(off)) if off == int(off) else None
+    years = range(index.min().year, index.max().year + 1)
+    name = dst_candidate(off, latitude, longitude, years)
     if name is None:
         return None
     wall = index.tz_convert("UTC").tz_localize(None) + pd.Timedelta(hours=off)

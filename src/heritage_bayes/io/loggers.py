@@ -107,7 +107,9 @@ class ColumnGuess:
     ``kind``: ``"T"`` (temperature), ``"RH"``, ``"ghi"``, ``"dhi"``, ``"dni"`` or None;
     ``unit``: the unit in the file (``"°C"``, ``"°F"``, ``"K"``, ``"%"``,
     ``"fraction"``, ``"W/m²"``); ``why``: the evidence; ``stats``: min, median, max of
-    the sampled values.
+    the sampled values; ``named``: the role its name suggests, also when the values
+    refuse it (an RH column out of range or empty); ``labelled``: the name states the
+    unit (``°C``, ``(F)``, ``kelvin``).
     """
 
     name: str
@@ -115,6 +117,8 @@ class ColumnGuess:
     unit: str | None = None
     why: str = ""
     stats: tuple[float, float, float] | None = None
+    named: str | None = None
+    labelled: bool = False
 
 
 @dataclass
@@ -369,7 +373,9 @@ def inspect_table(path, *, what: str = "file") -> TableLayout:
         nums = [_number(v, decimal) for v in cols[name]]
         vals = np.array([v for v in nums if v is not None], dtype=float)
         if vals.size < 0.5 * len(nums) or vals.size == 0:
-            guesses.append(ColumnGuess(name, None, why="not numeric"))
+            empty = sum(not str(v).strip() for v in cols[name])
+            why = "empty" if empty == len(nums) else "not numeric"
+            guesses.append(ColumnGuess(name, None, why=why, named=_named_role(label)))
             continue
         stats = (float(vals.min()), float(np.median(vals)), float(vals.max()))
         guesses.append(_classify(name, label, stats, lines[:h], layout))
@@ -425,14 +431,28 @@ def _first_comma(cols, names) -> str:
     return ""
 
 
+def _named_role(label: str) -> str | None:
+    """The role a column's name suggests (``"skip"`` for non-climate columns)."""
+    low = label.lower()
+    return next((k for k, pat in _ROLE_PATTERNS if re.search(pat, low)), None)
+
+
 def _classify(name: str, label: str, stats, preamble: list[str], layout: str) -> ColumnGuess:
     """The role and unit of one numeric column, from its name and its values."""
+    g = _classify_values(name, label, stats)
+    g.named = _named_role(label)
+    g.labelled = bool(re.search(_UNIT_IN_NAME, label.lower()))
+    return g
+
+
+#: A temperature unit stated in a column's name.
+_UNIT_IN_NAME = r"°\s*[cf]|\([cfk]\)|\[[cfk]\]|deg ?[cf]|fahrenheit|celsius|kelvin"
+
+
+def _classify_values(name: str, label: str, stats) -> ColumnGuess:
+    """The role and unit of one numeric column, from its name and its values."""
     low = label.lower()
-    kind = None
-    for k, pat in _ROLE_PATTERNS:
-        if re.search(pat, low):
-            kind = k
-            break
+    kind = _named_role(label)
     lo, med, hi = stats
     rng = f"values {lo:g} to {hi:g} (median {med:g}; first {_SAMPLE_LINES} lines)"
     if kind == "skip" or kind is None:
@@ -444,7 +464,8 @@ def _classify(name: str, label: str, stats, preamble: list[str], layout: str) ->
             return ColumnGuess(name, "T", "°F", f"name {label!r} says °F; {rng}", stats)
         if re.search(r"\[k\]|\(k\)|kelvin", low) or 200 <= med <= 340:
             return ColumnGuess(name, "T", "K", f"name {label!r}; {rng}: Kelvin", stats)
-        if hi > 70 and med > 32 and not re.search(r"°\s*c|\(c\)|degc", low):
+        if hi > 70 and hi <= 158 and not re.search(r"°\s*c|\(c\)|degc", low):
+            # above 70 is no air temperature in °C; -76 to 158 °F is -60 to 70 °C
             return ColumnGuess(name, "T", "°F", f"name {label!r}; {rng}: above 70, so °F", stats)
         if not -60 <= lo <= hi <= 70:
             return ColumnGuess(

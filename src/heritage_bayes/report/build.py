@@ -21,6 +21,7 @@ import time
 from pathlib import Path
 
 from heritage_bayes._version import __version__
+from heritage_bayes.report.accuracy import residual_shape, resolutions
 from heritage_bayes.report.page import render_page
 from heritage_bayes.report.rundata import REQUIRED_FILES, load_run_data
 from heritage_bayes.report.sections import (
@@ -79,6 +80,29 @@ def _render_figures(obj, dpi: float | None = None):
     return obj
 
 
+def residual_shapes(summary: dict, fits: list[dict], res: dict) -> dict:
+    """(section, output) -> :func:`~heritage_bayes.report.accuracy.residual_shape` of
+    the posterior-median residuals over the validation period (the calibration period
+    without one), hours read in the site's solar time when the run knows the site."""
+    site = (summary.get("sources") or {}).get("site") or {}
+    out = {}
+    for f in fits:
+        if f.get("resid") is None:
+            continue
+        codes = f["codes"]
+        sel = codes == 2 if (codes == 2).any() else codes == 1
+        shape = residual_shape(
+            f["resid"][sel],
+            f["measured"][sel],
+            f["times"][sel],
+            longitude=site.get("longitude"),
+            resolution=res.get(f["output"]),
+        )
+        if shape is not None:
+            out[(f["section"], f["output"])] = shape
+    return out
+
+
 def build_context(run_dir) -> dict:
     """Everything the sections need (figures as data URIs)."""
     import matplotlib
@@ -90,17 +114,23 @@ def build_context(run_dir) -> dict:
     with matplotlib.rc_context(RC_PARAMS):
         fits = fit.fit_context(rd, fit.fit_outputs(rd))
         diag = diagnostics.diagnostics_context(rd, fits)
+        res = resolutions({k: rd.idata.observed_data[k].values for k in rd.idata.observed_data})
         ctx = {
             "sections": SECTIONS,
             "header": summary.header_context(rd),
-            "verdict": convergence_verdict(rd.summary, diag["residuals"]),
+            "verdict": convergence_verdict(
+                rd.summary,
+                diag["residuals"],
+                shapes=residual_shapes(rd.summary, fits, res),
+                resolutions=res,
+            ),
             "warnings": run_notes(
                 rd.summary, diag["missing"], irradiance_setting=rd.cfg.data.irradiance
             )
             + [{"level": "amber", "title": "The run's config", "text": n} for n in rd.run.notes],
             "data": data.data_context(rd),
             "fits": [{k: f[k] for k in ("id", "title", "figure", "caption")} for f in fits],
-            "metrics": metrics.metrics_context(rd),
+            "metrics": metrics.metrics_context(rd, res),
             "parameters": parameters.parameter_tables(rd),
             "identifiability": identifiability.identifiability_context(rd),
             "ladder": identifiability.ladder_context(rd.summary),

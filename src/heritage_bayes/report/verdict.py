@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import math
 
+from heritage_bayes.report.accuracy import accuracy_failures, missing_physics
 from heritage_bayes.report.format import fmt_int, prior_text
 
 __all__ = [
@@ -131,19 +132,37 @@ def truth_advice(summary: dict, k: int) -> str:
     )
 
 
-def convergence_verdict(summary: dict, residuals: list[dict] | None = None) -> dict:
-    """The plain-words verdict of a run's ``summary.json``: convergence, then the
-    noise model's checks (:func:`model_checks`, with the report's ``residuals``).
+def convergence_verdict(
+    summary: dict,
+    residuals: list[dict] | None = None,
+    *,
+    shapes: dict | None = None,
+    resolutions: dict | None = None,
+) -> dict:
+    """The plain-words verdict of a run's ``summary.json``: accuracy, convergence, then
+    the noise model's checks (:func:`model_checks`, with the report's ``residuals``).
+
+    Accuracy comes first: a model whose fit of a measured output fails the rule of
+    :func:`heritage_bayes.report.accuracy.accuracy_failures` (FIT below 50 % on the
+    validation period, or the calibration period without one; the 90 % band covering
+    under 75 % of the validation hours) gets a red verdict "this model does not
+    reproduce the room", whatever the sampler did, with the most likely missing
+    physics as advice (:func:`heritage_bayes.report.accuracy.missing_physics`, from
+    ``shapes``: (section, output) -> residual shape, and the run's model ladder).
+    ``resolutions`` (output -> sensor resolution) exempts nearly constant series
+    from the FIT rule.
 
     Returns
     -------
     dict
-        ``level`` (``"green"``: converged — the stopping rule met: 50 τ with a stable
+        ``level`` (``"red"`` when the model does not reproduce the room; else
+        ``"green"``: converged — the stopping rule met: 50 τ with a stable
         τ, R-hat and bulk ESS within the run's criteria on the sampler's retained
         draws — and the residual, coverage and truth checks pass; ``"amber"``:
         converged but a check fails, or close to converged — max R-hat ≤ 1.05 and min
         bulk ESS ≥ 100; ``"red"``: not converged), ``title``, ``text``, ``models`` (one
-        plain-words line per model and per failed check), ``checks`` and ``advice``.
+        plain-words line per model and per failed check), ``checks``, ``accuracy``
+        (the failures of the accuracy rule) and ``advice``.
 
     Notes
     -----
@@ -289,6 +308,31 @@ def convergence_verdict(summary: dict, residuals: list[dict] | None = None) -> d
             "slow the sampler down: pinning them with prior knowledge, e.g. the "
             "room volume (room_volume), usually helps."
         )
+    failures = accuracy_failures(summary, resolutions)
+    if failures:
+        converged = rule_ok
+        nearly = level == "amber" and not converged
+        level = "red"
+        title = "This model does not reproduce the room"
+        if not converged:
+            title += " — and " + ("not fully converged" if nearly else "NOT CONVERGED")
+        text = (
+            "The posterior-median model misses the measurements: "
+            + "; ".join(f["text"] for f in failures)
+            + ". Its parameters, intervals and projections describe a model that lacks "
+            "part of the room's physics: do not use them to judge the room. "
+            + (
+                "The sampler converged; the fault is the model, not the sampling."
+                if converged
+                else "The sampler did not converge either."
+            )
+        )
+        causes = missing_physics(summary, failures, shapes)
+        advice = (
+            ("Most likely missing: " + " ".join(causes) + " " if causes else "")
+            + "Compare the model orders of the ladder (section 6) and the residual "
+            "diagnostics (section 7), change the model, and calibrate again."
+        )
     return {
         "level": level,
         "title": title,
@@ -296,6 +340,7 @@ def convergence_verdict(summary: dict, residuals: list[dict] | None = None) -> d
         "stats": stats,
         "models": lines,
         "checks": checks,
+        "accuracy": failures,
         "advice": advice.strip(),
     }
 

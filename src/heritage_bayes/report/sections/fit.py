@@ -135,6 +135,7 @@ def fit_context(rd: RunData, outputs: list[dict]) -> list[dict]:
                 )
                 + band_note,
                 "resid": (y - med),
+                "measured": y,
                 "codes": codes,
                 "times": times_pp,
                 **o,

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 
+from heritage_bayes.report.accuracy import NEARLY_CONSTANT_RESOLUTIONS, nearly_constant
 from heritage_bayes.report.format import OUT_UNITS, fmt, fmt_int, fmt_pct
 from heritage_bayes.report.page import Section
 from heritage_bayes.report.rundata import RunData, model_label
@@ -12,7 +13,9 @@ from heritage_bayes.report.sections._fragment import render_fragment
 ID, TITLE = "metrics", "4. Fit metrics"
 
 
-def metrics_context(rd: RunData) -> dict:
+def metrics_context(rd: RunData, resolutions: dict | None = None) -> dict:
+    """The metrics table; ``resolutions`` (output -> sensor resolution) decides where a
+    series is nearly constant (:func:`_nearly_constant`)."""
     metrics = rd.summary.get("metrics") or {}
     groups = []
     for m, outs in metrics.items():
@@ -41,7 +44,7 @@ def metrics_context(rd: RunData) -> dict:
                 if v.get("FIT") is None
                 else f"{v['FIT']:.1f}".replace("-", "−"),
             ]
-            flat = _nearly_constant(v)
+            flat = _nearly_constant(v, (resolutions or {}).get(g["output"]))
             if flat:
                 notes.append(f"{g['label']}, {p}: {flat}")
             cov += [
@@ -54,21 +57,25 @@ def metrics_context(rd: RunData) -> dict:
     return {"groups": groups, "rows": rows, "cov_rows": cov_rows, "notes": notes}
 
 
-def _nearly_constant(v: dict) -> str:
-    """Words when FIT says nothing: the measured series varies less than twice the
-    model's mean absolute error (standard deviation SD ≤ 2 MAE, i.e. FIT ≲ 40 % for
-    Gaussian errors), e.g. a humidistat-held RH; empty otherwise."""
+def _nearly_constant(v: dict, resolution: float | None) -> str:
+    """Words when FIT says nothing: the measured series varies within a few sensor
+    resolutions (:func:`heritage_bayes.report.accuracy.nearly_constant`) and less than
+    twice the model's mean absolute error (standard deviation SD ≤ 2 MAE, i.e. FIT ≲
+    40 % for Gaussian errors), e.g. a humidistat-held RH; empty otherwise (a poor fit
+    of a varying series is a poor fit, not a constant series)."""
     mae, mse, fit = v.get("MAE"), v.get("MSE"), v.get("FIT")
     sd = v.get("SD")
     if sd is None and None not in (mse, fit) and fit < 100:
         sd = math.sqrt(mse) / (1 - fit / 100)  # runs written before SD was stored
     if sd is None or mae is None or not (math.isfinite(sd) and math.isfinite(mae)):
         return ""
-    if sd > 2 * mae:
+    if sd > 2 * mae or not nearly_constant(sd, resolution):
         return ""
     return (
         f"the measurements vary little (standard deviation {fmt(sd)}) against the "
-        f"model's error (MAE {fmt(mae)}): FIT, which divides the error by that "
+        f"model's error (MAE {fmt(mae)}), within "
+        f"{NEARLY_CONSTANT_RESOLUTIONS:g} sensor resolutions ({fmt(resolution)} each): FIT, "
+        "which divides the error by that "
         "variation, is no measure of accuracy on such a nearly constant series. "
         "Read the MAE and the band coverage."
     )

@@ -129,7 +129,8 @@ def main(argv=None) -> int:
     debilt = read_site(args.data, "debilt")
     krs = fit_krs(debilt.loc["2011":"2020"], SITES["debilt"][1])
     print(
-        f"kRs fitted on De Bilt 2011-2020: {krs:.4f} °C^-1/2 (FAO-56 interior default {KRS_INTERIOR})"
+        f"kRs fitted on De Bilt 2011-2020: {krs:.4f} °C^-1/2 "
+        f"(FAO-56 interior default {KRS_INTERIOR})"
     )
     head = (
         f"{'site':<7}{'input':<22}{'days':>6}{'bias MJ/m²':>11}{'RMSE':>7}{'R²':>7}"

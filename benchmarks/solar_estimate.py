@@ -14,9 +14,20 @@ applies the kRs fitted there (least squares of the daily Rs on sqrt(ΔT)·Ra, 20
 to every site. The six TRH-1 sites (FMI weather beside each house; site positions are
 the towns', the houses' are not published) are held out.
 
+``--bristow-campbell``: also the daily R² and bias of Bristow and Campbell's
+Rs = A·(1 - exp(-B·ΔT^C))·Ra (Agric. For. Meteorol. 31 (1984) 159-166,
+doi:10.1016/0168-1923(84)90017-0; ΔT = Tmax - mean of today's and tomorrow's Tmin),
+A, B, C fitted on De Bilt 2011-2020, beside Hargreaves-Samani's with kRs 0.16.
+
+``--fit CONFIG [...]``: instead, the validation FIT [%] of the MAP simulation of each
+config's thermal section with its solar input as measured, estimated and cloudless
+(``data.irradiance`` set to each; the measured columns are then ignored), with a lighter
+optimiser (100 generations, 2 starts) than the configs'.
+
 Usage (from the repository root)::
 
     python benchmarks/solar_estimate.py [--data ../shared/data] [--sites debilt R2 R3 ...]
+    python benchmarks/solar_estimate.py --fit configs/trh1_attic.yaml
 """
 
 from __future__ import annotations
@@ -72,16 +83,9 @@ def read_site(data: Path, name: str) -> pd.DataFrame:
 
 def fit_krs(w: pd.DataFrame, site: dict) -> float:
     """kRs [°C^-1/2] by least squares of daily measured Rs on sqrt(Tmax - Tmin)·Ra."""
-    day = (w.index - pd.Timedelta("30min") + pd.Timedelta(hours=site["longitude"] / 15)).floor("D")
-    g = w.groupby(day).agg(
-        tmax=("Te", "max"), tmin=("Te", "min"), rs=("ghi", "sum"), n=("ghi", "count")
-    )
-    g = g[g["n"] == 24]
-    x = np.sqrt(g["tmax"] - g["tmin"]) * extraterrestrial_radiation_daily(
-        g.index.day_of_year, site["latitude"]
-    )
-    y = g["rs"] * 3600 / 1e6
-    return float((x * y).sum() / (x * x).sum())
+    g = _days(w, site)
+    x = np.sqrt(g["tmax"] - g["tmin"]) * g["ra"]
+    return float((x * g["rs"]).sum() / (x * x).sum())
 
 
 def scores(est: np.ndarray, meas: np.ndarray) -> tuple[float, float, float]:
@@ -121,11 +125,85 @@ def evaluate(w: pd.DataFrame, site: dict, krs_debilt: float) -> list[tuple]:
     return rows
 
 
+def _days(w: pd.DataFrame, site: dict) -> pd.DataFrame:
+    """Complete solar days: Tmax, Tmin, next day's Tmin [°C], Rs and Ra [MJ/m²]."""
+    day = (w.index - pd.Timedelta("30min") + pd.Timedelta(hours=site["longitude"] / 15)).floor("D")
+    g = w.groupby(day).agg(
+        tmax=("Te", "max"), tmin=("Te", "min"), rs=("ghi", "sum"), n=("ghi", "count")
+    )
+    g["tmin_next"] = g["tmin"].shift(-1)
+    g = g[g["n"] == 24].dropna()
+    g["rs"] *= 3600 / 1e6
+    g["ra"] = extraterrestrial_radiation_daily(g.index.day_of_year, site["latitude"])
+    return g
+
+
+def _bristow_campbell(g: pd.DataFrame, a: float, b: float, c: float) -> pd.Series:
+    dt = (g["tmax"] - (g["tmin"] + g["tmin_next"]) / 2).clip(lower=0.0)
+    return a * (1 - np.exp(-b * dt**c)) * g["ra"]
+
+
+def bristow_campbell_check(data: Path, debilt: pd.DataFrame, names) -> None:
+    from scipy.optimize import least_squares
+
+    g = _days(debilt.loc["2011":"2020"], SITES["debilt"][1])
+    fit = least_squares(
+        lambda p: _bristow_campbell(g, *p) - g["rs"],
+        [0.7, 0.01, 2.0],
+        bounds=([0.3, 1e-5, 0.5], [1.0, 1.0, 3.0]),
+    )
+    a, b, c = fit.x
+    print(f"\nBristow-Campbell fitted on De Bilt 2011-2020: A {a:.3f}, B {b:.4f}, C {c:.3f}")
+    print(f"{'site':<7}{'HS 0.16 R²':>11}{'bias':>7}{'BC R²':>8}{'bias':>7}  (daily, MJ/m²)")
+    for name in names:
+        g = _days(debilt if name == "debilt" else read_site(data, name), SITES[name][1])
+        hs = KRS_INTERIOR * np.sqrt(g["tmax"] - g["tmin"]) * g["ra"]
+        bc = _bristow_campbell(g, a, b, c)
+        bh, _, rh = scores(hs.to_numpy(), g["rs"].to_numpy())
+        bb, _, rb = scores(bc.to_numpy(), g["rs"].to_numpy())
+        print(f"{name:<7}{rh:>11.3f}{bh:>7.2f}{rb:>8.3f}{bb:>7.2f}")
+
+
+def map_fits(path: Path) -> dict[str, float]:
+    """Validation FIT [%] of the thermal MAP per solar input (as tests/test_init.py)."""
+    import sys
+
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    from _common import config_map
+    from heritage_bayes.config import load_config
+    from heritage_bayes.inference.results import fit_metrics
+
+    cfg = load_config(path)
+    cfg = cfg.model_copy(
+        update={"optimizer": cfg.optimizer.model_copy(update={"maxiter": 100, "starts": 2})}
+    )
+    out = {}
+    for mode in ("measured", "estimated", "clear_sky"):
+        c = cfg.model_copy(update={"data": cfg.data.model_copy(update={"irradiance": mode})})
+        prep, model, lp, mp = config_map(c, "thermal")
+        y = lp.simulate_frame(
+            mp.theta[None], prep.model_inputs("thermal", model), prep.calibration.start
+        )
+        v, obs = prep.validation, prep.observed("thermal", model)
+        out[mode] = fit_metrics(obs[v.start : v.stop, 0], y[0][0][v.start : v.stop, 0])["FIT"]
+    return out
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--data", type=Path, default=ROOT.parent / "shared" / "data")
     ap.add_argument("--sites", nargs="+", default=list(SITES), choices=list(SITES))
+    ap.add_argument("--bristow-campbell", action="store_true", help="daily BC vs HS")
+    ap.add_argument("--fit", nargs="+", type=Path, help="configs: thermal MAP FIT per input")
     args = ap.parse_args(argv)
+    if args.fit:
+        for path in args.fit:
+            fits = map_fits(path)
+            print(
+                f"{path}: validation FIT Ti (thermal MAP) "
+                + ", ".join(f"{k} {v:.1f} %" for k, v in fits.items())
+            )
+        return 0
     debilt = read_site(args.data, "debilt")
     krs = fit_krs(debilt.loc["2011":"2020"], SITES["debilt"][1])
     print(
@@ -144,6 +222,8 @@ def main(argv=None) -> int:
                 f"{name:<7}{r[0]:<22}{r[1]:>6}{r[2]:>11.2f}{r[3]:>7.2f}{r[4]:>7.2f}"
                 f"{r[5]:>8}{r[6]:>10.1f}{r[7]:>7.1f}{r[8]:>7.2f}"
             )
+    if args.bristow_campbell:
+        bristow_campbell_check(args.data, debilt, args.sites)
     return 0
 
 

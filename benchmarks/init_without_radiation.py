@@ -59,9 +59,14 @@ def map_fits(cfg) -> dict[str, float]:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("sites", nargs="*", default=list(SITES), choices=list(SITES))
+    ap.add_argument("sites", nargs="*", help=f"default: all of {list(SITES)}")
     ap.add_argument("--data", type=Path, default=ROOT.parent / "shared" / "data")
     args = ap.parse_args(argv)
+    args.sites = args.sites or list(SITES)
+    if set(args.sites) - set(SITES):
+        ap.error(
+            f"unknown site(s) {sorted(set(args.sites) - set(SITES))}; choose from {list(SITES)}"
+        )
     print("validation FIT [%] of the MAP, Ti / Pi, by solar input")
     with tempfile.TemporaryDirectory() as tmp:
         for name in args.sites:

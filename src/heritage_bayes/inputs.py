@@ -347,7 +347,9 @@ def solar_inputs(
         te = weather["Te"].copy()
         te.attrs = {"source": attrs.get("source", "weather")}
         try:
-            table = temperature_range_weather(te, dict(site))
+            table = temperature_range_weather(te, dict(site), interval=attrs.get("interval"))
+        except DataError as exc:
+            raise DataError(f"{where}: {exc}") from None
         except InputError as exc:
             raise ConfigError(f"{where}: {exc}") from None
         label = "estimated from the daily Te range (Hargreaves-Samani)"

@@ -7,8 +7,11 @@ copy of the weather without those two columns (written to a temporary folder; in
 writes ``data.irradiance: estimated``); the thermal and hygric MAP validation FIT [%]
 (100 generations, 2 starts: lighter than the configs' optimiser), and for the weather
 without radiation also with ``data.irradiance: clear_sky`` (what init wrote before the
-estimate). Sites at the towns' positions (the houses' are not published). Nothing here
-is tuned: the attics are held out.
+estimate); for the weather as published also with ``data.ground_temperature: {mode:
+annual_mean}`` (the former default of ``Tf``). The thermal MAP's solar aperture ``fI_H``
+[m²] shows what each input does to it (the hygric section does not depend on either
+setting: fitted once per site). Sites at the towns' positions (the houses' are not
+published). Nothing here is tuned: the attics are held out.
 
 Usage (from the repository root)::
 
@@ -43,18 +46,20 @@ SITES = {
 }
 
 
-def map_fits(cfg) -> dict[str, float]:
-    """Validation FIT [%] of each section's MAP simulation (as tests/test_init.py)."""
+def map_fit(cfg, sec: str) -> tuple[float, dict]:
+    """Validation FIT [%] of a section's MAP simulation (as tests/test_init.py) and the
+    MAP parameters."""
     opt = cfg.optimizer.model_copy(update={"maxiter": 100, "starts": 2})
-    cfg = cfg.model_copy(update={"optimizer": opt})
-    out = {}
-    for sec in ("thermal", "hygric"):
-        prep, model, lp, mp = config_map(cfg, sec)
-        u = prep.model_inputs(sec, model)
-        y = lp.simulate_frame(mp.theta[None], u, prep.calibration.start)[0][0]
-        v, obs = prep.validation, prep.observed(sec, model)
-        out[sec] = fit_metrics(obs[v.start : v.stop, 0], y[v.start : v.stop, 0])["FIT"]
-    return out
+    prep, model, lp, mp = config_map(cfg.model_copy(update={"optimizer": opt}), sec)
+    u = prep.model_inputs(sec, model)
+    y = lp.simulate_frame(mp.theta[None], u, prep.calibration.start)[0][0]
+    v, obs = prep.validation, prep.observed(sec, model)
+    fit = fit_metrics(obs[v.start : v.stop, 0], y[v.start : v.stop, 0])["FIT"]
+    return fit, dict(zip(lp.params.names, mp.theta, strict=True))
+
+
+def _variant(cfg, **data):
+    return cfg.model_copy(update={"data": cfg.data.model_copy(update=data)})
 
 
 def main(argv=None) -> int:
@@ -67,7 +72,7 @@ def main(argv=None) -> int:
         ap.error(
             f"unknown site(s) {sorted(set(args.sites) - set(SITES))}; choose from {list(SITES)}"
         )
-    print("validation FIT [%] of the MAP, Ti / Pi, by solar input")
+    print("validation FIT [%] of the MAP and the thermal MAP's aperture, by input")
     with tempfile.TemporaryDirectory() as tmp:
         for name in args.sites:
             folder, lat, lon = SITES[name]
@@ -76,21 +81,31 @@ def main(argv=None) -> int:
             (work / "data").mkdir(parents=True)
             bare = work / "data" / "fmi.csv"
             pd.read_csv(d / "fmi.csv").drop(columns=["Rglob", "Rdif"]).to_csv(bare, index=False)
-            row = [f"{name:<4}"]
+            cfgs = {}
             for label, weather in (("measured", d / "fmi.csv"), ("none", bare)):
                 out = work / label / "config.yaml"
                 out.parent.mkdir()
                 init_config(
                     d / "roofmiddle_airmiddle.csv", weather, output=out, latitude=lat, longitude=lon
                 )
-                cfg = load_config(out)
-                modes = [cfg.data.irradiance] + (["clear_sky"] if label == "none" else [])
-                for irr in modes:
-                    data = cfg.data.model_copy(update={"irradiance": irr})
-                    f = map_fits(cfg.model_copy(update={"data": data}))
-                    row.append(f"{irr} {f['thermal']:.1f} / {f['hygric']:.1f}")
-            row.append(f"({cfg.thermal.model}, {cfg.hygric.model})")
-            print(" | ".join(row), flush=True)
+                cfgs[label] = load_config(out)
+            m, n = cfgs["measured"], cfgs["none"]
+            annual = m.data.ground_temperature.model_copy(update={"mode": "annual_mean"})
+            cases = {
+                f"{m.data.irradiance}": m,
+                "measured, Tf annual mean": _variant(m, ground_temperature=annual),
+                f"no radiation: {n.data.irradiance}": n,
+                "no radiation: clear_sky": _variant(n, irradiance="clear_sky"),
+            }
+            pi, _ = map_fit(m, "hygric")
+            print(f"{name} ({m.thermal.model}, {m.hygric.model}): FIT Pi {pi:.1f} %", flush=True)
+            for label, cfg in cases.items():
+                ti, p = map_fit(cfg, "thermal")
+                print(
+                    f"  {label:<28} FIT Ti {ti:5.1f} %   fI_H {p.get('fI_H', float('nan')):.3g} m²"
+                    f"   Gf {p.get('Gf', float('nan')):.3g} W/K",
+                    flush=True,
+                )
     return 0
 
 

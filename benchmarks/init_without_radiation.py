@@ -8,9 +8,10 @@ writes ``data.irradiance: estimated``); the thermal and hygric MAP validation FI
 (100 generations, 2 starts: lighter than the configs' optimiser), and for the weather
 without radiation also with ``data.irradiance: clear_sky`` (what init wrote before the
 estimate); for the weather as published also with ``data.ground_temperature: {mode:
-annual_mean}`` (the former default of ``Tf``). The thermal MAP's solar aperture ``fI_H``
-[m²] shows what each input does to it (the hygric section does not depend on either
-setting: fitted once per site). Sites at the towns' positions (the houses' are not
+annual_mean}`` (the former default of ``Tf``). Of the thermal MAP, the static solar gain
+fI_H/(Ge + Gf) [K per W/m²] (the scale of Ci, Ge, Gf and fI_H is not identifiable, the
+ratio is) and the ground's share Gf/(Ge + Gf) [-]. The hygric section depends on
+neither setting: fitted once per site. Sites at the towns' positions (the houses' are not
 published). Nothing here is tuned: the attics are held out.
 
 Usage (from the repository root)::
@@ -101,9 +102,10 @@ def main(argv=None) -> int:
             print(f"{name} ({m.thermal.model}, {m.hygric.model}): FIT Pi {pi:.1f} %", flush=True)
             for label, cfg in cases.items():
                 ti, p = map_fit(cfg, "thermal")
+                g = p["Ge"] + p.get("Gf", 0.0)  # [W/K] to the fixed temperatures
                 print(
-                    f"  {label:<28} FIT Ti {ti:5.1f} %   fI_H {p.get('fI_H', float('nan')):.3g} m²"
-                    f"   Gf {p.get('Gf', float('nan')):.3g} W/K",
+                    f"  {label:<28} FIT Ti {ti:5.1f} %   solar gain fI_H/G "
+                    f"{p['fI_H'] / g:.4f} K/(W/m²)   ground share Gf/G {p.get('Gf', 0) / g:.2f}",
                     flush=True,
                 )
     return 0

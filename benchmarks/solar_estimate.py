@@ -19,6 +19,9 @@ Rs = A·(1 - exp(-B·ΔT^C))·Ra (Agric. For. Meteorol. 31 (1984) 159-166,
 doi:10.1016/0168-1923(84)90017-0; ΔT = Tmax - mean of today's and tomorrow's Tmin),
 A, B, C fitted on De Bilt 2011-2020, beside Hargreaves-Samani's with kRs 0.16.
 
+``--monthly``: instead, per site and calendar month, the estimate's and the cloudless
+sky's irradiance summed over the hours with a measurement, divided by the measured sum.
+
 ``--fit CONFIG [...]``: instead, the validation FIT [%] of the MAP simulation of each
 config's thermal section with its solar input as measured, estimated and cloudless
 (``data.irradiance`` set to each; the measured columns are then ignored), with a lighter
@@ -164,6 +167,20 @@ def bristow_campbell_check(data: Path, debilt: pd.DataFrame, names) -> None:
         print(f"{name:<7}{rh:>11.3f}{bh:>7.2f}{rb:>8.3f}{bb:>7.2f}")
 
 
+def monthly_ratios(w: pd.DataFrame, site: dict) -> pd.DataFrame:
+    """Estimate / measured and cloudless / measured irradiance by calendar month [-]."""
+    te = w["Te"].copy()
+    te.attrs = {"interval": "1h"}
+    ok = w["ghi"].notna().to_numpy()
+    cols = {
+        "estimate": temperature_range_weather(te, site)["ghi"],
+        "cloudless": clear_sky_weather(w.index, site, interval="1h")["ghi"],
+        "measured": w["ghi"],
+    }
+    sums = pd.DataFrame({k: v[ok] for k, v in cols.items()}).groupby(w.index[ok].month).sum()
+    return sums[["estimate", "cloudless"]].div(sums["measured"], axis=0).T
+
+
 def map_fits(path: Path) -> dict[str, float]:
     """Validation FIT [%] of the thermal MAP per solar input (as tests/test_init.py)."""
     import sys
@@ -193,9 +210,17 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--data", type=Path, default=ROOT.parent / "shared" / "data")
     ap.add_argument("--sites", nargs="+", default=list(SITES), choices=list(SITES))
+    ap.add_argument("--monthly", action="store_true", help="monthly ratios to measured")
     ap.add_argument("--bristow-campbell", action="store_true", help="daily BC vs HS")
     ap.add_argument("--fit", nargs="+", type=Path, help="configs: thermal MAP FIT per input")
     args = ap.parse_args(argv)
+    if args.monthly:
+        data = args.data
+        for name in args.sites:
+            w = read_site(data, name)
+            print(f"{name}: irradiance / measured by month")
+            print(monthly_ratios(w, SITES[name][1]).round(2).to_string())
+        return 0
     if args.fit:
         for path in args.fit:
             fits = map_fits(path)

@@ -14,6 +14,7 @@ from heritage_bayes.climate.ground import (
     GROUND_DEPTH,
     SOIL_DIFFUSIVITY,
     YEAR_DAYS,
+    damping,
     fit_annual_cycle,
     kusuda_achenbach,
 )
@@ -52,6 +53,8 @@ def test_kusuda_hand_computed_damping_and_lag():
         assert coldest - t0 == pytest.approx(lag, abs=0.05)
         assert tz.mean() == pytest.approx(10.0, abs=0.02)
     assert GROUND_DEPTH == 1.0 and SOIL_DIFFUSIVITY == 0.5e-6
+    assert damping(1.0) == pytest.approx((0.6401, 25.94), abs=1e-2)
+    assert damping(1.0, diffusivity=2e-6) == pytest.approx(damping(0.5), abs=1e-9)  # z/sqrt(α)
     with pytest.raises(InputError, match="depth"):
         kusuda_achenbach(times, 10.0, 8.0, t0, depth=-1.0)
     with pytest.raises(InputError, match="tz-aware"):

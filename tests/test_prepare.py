@@ -428,8 +428,9 @@ def test_estimated_on_request_ignores_measured_irradiance(files):
     raw = _csv_config(files, irradiance="estimated")
     prep = prepare(_load(files, raw))
     assert prep.sources["irradiance"]["mode"] == "estimated"
-    assert "measured ['ghi'] ignored (data.irradiance: estimated)" in (
-        prep.sources["irradiance"]["label"]
+    assert (
+        "measured ['ghi'] ignored (data.irradiance: estimated)"
+        in (prep.sources["irradiance"]["label"])
     )
     assert prepare(_load(files, _csv_config(files))).irradiance_source == "measured"
 

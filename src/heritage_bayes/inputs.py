@@ -190,8 +190,7 @@ def seasonal_ground_temperature(
     values = ground.kusuda_achenbach(
         times, cycle["mean"], cycle["amplitude"], cycle["t_min"], depth=depth
     )
-    omega = 2 * np.pi / ground.YEAR_DAYS
-    damping = float(np.sqrt(2 * ground.SOIL_DIFFUSIVITY * 86_400 / omega))
+    ratio, lag = ground.damping(depth)
     info = {
         "method": (
             f"annual cycle fitted to {cycle['days']} daily means of Te, at {depth:g} m in "
@@ -201,8 +200,8 @@ def seasonal_ground_temperature(
         "amplitude": round(cycle["amplitude"], 2),
         "coldest_day": cycle["coldest_day"],
         "depth": depth,
-        "amplitude_ratio": round(float(np.exp(-depth / damping)), 3),
-        "lag_days": round(depth / damping / omega, 1),
+        "amplitude_ratio": round(ratio, 3),
+        "lag_days": round(lag, 1),
         "min": float(np.min(values)) if len(values) else None,
         "max": float(np.max(values)) if len(values) else None,
     }

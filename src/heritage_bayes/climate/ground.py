@@ -28,6 +28,7 @@ __all__ = [
     "GROUND_DEPTH",
     "SOIL_DIFFUSIVITY",
     "YEAR_DAYS",
+    "damping",
     "fit_annual_cycle",
     "kusuda_achenbach",
 ]
@@ -49,6 +50,20 @@ def _days(times) -> np.ndarray:
     if not isinstance(times, pd.DatetimeIndex) or times.tz is None:
         raise InputError("times must be a tz-aware pandas DatetimeIndex")
     return times.tz_convert("UTC").as_unit("ns").asi8 / _DAY_NS
+
+
+def damping(depth: float, diffusivity: float = SOIL_DIFFUSIVITY) -> tuple[float, float]:
+    """Amplitude ratio [-] and lag [d] of the annual cycle at ``depth`` [m] in a soil of
+    thermal ``diffusivity`` [m²/s]: :math:`e^{-z/d}` and :math:`z/(d\\,\\omega)`, with
+    :math:`d = \\sqrt{2\\alpha/\\omega}` (see :func:`kusuda_achenbach`)."""
+    depth, alpha = float(depth), float(diffusivity)
+    if not depth >= 0.0:
+        raise InputError(f"depth must be >= 0 m (got {depth})")
+    if not alpha > 0.0:
+        raise InputError(f"diffusivity must be > 0 m²/s (got {alpha})")
+    omega = 2.0 * np.pi / YEAR_DAYS  # [1/d]
+    d = np.sqrt(2.0 * alpha * 86_400.0 / omega)  # damping depth [m]
+    return float(np.exp(-depth / d)), float(depth / d / omega)
 
 
 def kusuda_achenbach(
@@ -94,15 +109,9 @@ def kusuda_achenbach(
     :math:`z/(d\\,\\omega)`; at :math:`z = 0` the surface cycle itself. With the defaults
     :math:`d` = 2.24 m: ratio 0.64, lag 26 d at 1 m; 0.41 and 52 d at 2 m.
     """
-    depth, alpha = float(depth), float(diffusivity)
-    if not depth >= 0.0:
-        raise InputError(f"depth must be >= 0 m (got {depth})")
-    if not alpha > 0.0:
-        raise InputError(f"diffusivity must be > 0 m²/s (got {alpha})")
+    ratio, lag = damping(depth, diffusivity)
     omega = 2.0 * np.pi / YEAR_DAYS  # [1/d]
-    d = np.sqrt(2.0 * alpha * 86_400.0 / omega)  # damping depth [m]
-    t = _days(times)
-    return mean - amplitude * np.exp(-depth / d) * np.cos(omega * (t - t_min) - depth / d)
+    return mean - amplitude * ratio * np.cos(omega * (_days(times) - t_min - lag))
 
 
 def fit_annual_cycle(te: pd.Series) -> dict:

@@ -105,8 +105,8 @@ class Prepared:
     warmup_steps, init_steps : int
         Rows of ``periods.warmup`` and ``periods.init_window``.
     irradiance_source : str
-        ``"measured"``, ``"clear-sky proxy (pvlib Ineichen)"``, ``"none"``, or the
-        demo's description.
+        ``"measured"``, ``"estimated from the daily Te range (Hargreaves-Samani)"``,
+        ``"clear-sky proxy (pvlib Ineichen)"``, ``"none"``, or the demo's description.
     truth : dict or None
         Demo only: ``{"thermal": {name: value}, "hygric": {...}}``, the true parameters
         and the **nominal** noise parameters (``sigma_Ti``, ``phi_Ti``, ``sigma_Pi``,

@@ -564,3 +564,24 @@ def test_trh1_attic_config(shared_data):
     summer = f.loc["2011-06-01":"2011-08-31"]
     hourly = summer.groupby(summer.index.hour)["Ti"].mean()
     assert 9 <= int(hourly.idxmax()) <= 14
+
+
+@pytest.mark.shared_data
+def test_trh1_attic_without_sensors_defaults(shared_data):
+    """The shipped TRH-1 file with its defaults for what a site rarely measures: Tf the
+    seasonal ground (no ground_temperature given) and, asked for, the solar estimate."""
+    from heritage_bayes.config import read_yaml
+
+    raw, _ = read_yaml(CONFIGS / "trh1_attic.yaml")
+    raw["data"]["irradiance"] = "estimated"
+    prep = prepare(parse_config(raw, base_dir=str(CONFIGS)))
+    f, gt = prep.frame, prep.sources["ground_temperature"]
+    assert gt["mode"] == "seasonal" and gt["depth"] == 1.0 and gt["lag_days"] == 25.9
+    # Espoo: a 12 K annual swing of the air, 0.64 of it at 1 m, coldest in early March
+    assert 10.0 < gt["amplitude"] < 14.0 and 10 <= gt["coldest_day"] <= 45
+    tf = f["Tf"].resample("1D").mean()
+    assert (tf.max() - tf.min()) / 2 == pytest.approx(0.64 * gt["amplitude"], rel=0.05)
+    assert 40 <= tf.loc["2011"].idxmin().day_of_year <= 80
+    assert prep.sources["irradiance"]["mode"] == "estimated"
+    assert "measured ['ghi', 'dhi'] ignored" in prep.sources["irradiance"]["label"]
+    assert f["I_roof_E"].max() > 200 and (f["I_roof_E"] >= 0).all()

@@ -311,7 +311,10 @@ def test_csv_sources(files):
     assert prep.sources["irradiance"]["label"].startswith("measured; dni/dhi from ghi by Erbs")
     assert prep.sources["site"]["from"] == "config"
     assert prep.sources["measurements"][0]["timezone"] == "UTC+01:00"
-    assert prep.sources["ground_temperature"]["mode"] == "annual_mean"
+    # files' default ground: the seasonal cycle, which 60 days of weather cannot give
+    gt = prep.sources["ground_temperature"]
+    assert gt["mode"] == "seasonal" and "no seasonal cycle: Te spans 60 days" in gt["method"]
+    assert f["Tf"].nunique() == 1
     # UTC+1 logger: the reading stamped 02-01-2020 01:00 is the row 2020-01-02 00:00 UTC
     logger = pd.read_csv(files / "logger.csv", sep=";")
     row = logger.index[logger["stamp"] == "02-01-2020 01:00"][0]
@@ -397,18 +400,39 @@ def test_input_gap_too_long(tmp_path):
     assert prep.alignment["interpolated"]["Te"] == 10
 
 
-def test_clear_sky_and_no_ghi(tmp_path):
+def test_no_ghi_estimated_by_default_clear_sky_on_request(tmp_path):
     _write_files(tmp_path, ghi=False)
     raw = _csv_config(tmp_path)
     del raw["data"]["weather"]["columns"]["ghi"]
+    # the default without a global irradiance: the estimate from the daily Te range
+    est = prepare(_load(tmp_path, raw))
+    assert est.irradiance_source == "estimated from the daily Te range (Hargreaves-Samani)"
+    assert est.sources["irradiance"]["mode"] == "estimated"
+    assert "Hargreaves-Samani, kRs 0.16" in est.sources["irradiance"]["label"]
+    raw["data"]["irradiance"] = "measured"  # asked for, not there: an error naming both
     with pytest.raises(DataError) as exc:
         prepare(_load(tmp_path, raw))
-    assert "data.irradiance is 'measured'" in str(exc.value) and "clear_sky" in str(exc.value)
+    assert "data.irradiance is 'measured'" in str(exc.value) and "estimated" in str(exc.value)
     raw["data"]["irradiance"] = "clear_sky"
     prep = prepare(_load(tmp_path, raw))
     assert prep.irradiance_source == "clear-sky proxy (pvlib Ineichen)"
     assert "clear-sky proxy" in prep.sources["irradiance"]["label"]
     assert prep.frame["I_S"].max() > 100
+    # the estimate: the cloudless sky scaled down day by day (a 10 K daily range in a
+    # Dutch winter: about half of it)
+    ratio = est.frame["I_roof"].sum() / prep.frame["I_roof"].sum()
+    assert 0.3 < ratio < 0.9
+
+
+def test_estimated_on_request_ignores_measured_irradiance(files):
+    raw = _csv_config(files, irradiance="estimated")
+    prep = prepare(_load(files, raw))
+    assert prep.sources["irradiance"]["mode"] == "estimated"
+    assert (
+        "measured ['ghi'] ignored (data.irradiance: estimated)"
+        in (prep.sources["irradiance"]["label"])
+    )
+    assert prepare(_load(files, _csv_config(files))).irradiance_source == "measured"
 
 
 def test_ground_temperature_constant_and_column(files):
@@ -540,3 +564,24 @@ def test_trh1_attic_config(shared_data):
     summer = f.loc["2011-06-01":"2011-08-31"]
     hourly = summer.groupby(summer.index.hour)["Ti"].mean()
     assert 9 <= int(hourly.idxmax()) <= 14
+
+
+@pytest.mark.shared_data
+def test_trh1_attic_without_sensors_defaults(shared_data):
+    """The shipped TRH-1 file with its defaults for what a site rarely measures: Tf the
+    seasonal ground (no ground_temperature given) and, asked for, the solar estimate."""
+    from heritage_bayes.config import read_yaml
+
+    raw, _ = read_yaml(CONFIGS / "trh1_attic.yaml")
+    raw["data"]["irradiance"] = "estimated"
+    prep = prepare(parse_config(raw, base_dir=str(CONFIGS)))
+    f, gt = prep.frame, prep.sources["ground_temperature"]
+    assert gt["mode"] == "seasonal" and gt["depth"] == 1.0 and gt["lag_days"] == 25.9
+    # Espoo: a 12 K annual swing of the air, 0.64 of it at 1 m, coldest in early March
+    assert 10.0 < gt["amplitude"] < 14.0 and 10 <= gt["coldest_day"] <= 45
+    tf = f["Tf"].resample("1D").mean()
+    assert (tf.max() - tf.min()) / 2 == pytest.approx(0.64 * gt["amplitude"], rel=0.05)
+    assert 40 <= tf.loc["2011"].idxmin().day_of_year <= 80
+    assert prep.sources["irradiance"]["mode"] == "estimated"
+    assert "measured ['ghi', 'dhi'] ignored" in prep.sources["irradiance"]["label"]
+    assert f["I_roof_E"].max() > 200 and (f["I_roof_E"] >= 0).all()

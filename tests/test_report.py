@@ -469,6 +469,11 @@ def test_verdict_classes_and_notes():
         "Chain files missing",
     ]
     assert "chain_thermal.h5" in notes[1]["text"]
+    est = {**s, "irradiance_source": "estimated from the daily Te range (Hargreaves-Samani)"}
+    notes = run_notes(est, [])
+    assert [(n["level"], n["title"]) for n in notes] == [
+        ("info", "Solar radiation is estimated from the outdoor temperature")
+    ]
 
 
 def test_house_page_builder():

@@ -9,6 +9,11 @@ import pytest
 
 from _io_helpers import DE_BILT, knmi_2011_2020, pvlib_tmy3_path
 from heritage_bayes.climate import DEFAULT_SURFACES, clear_sky_weather, surface_irradiance
+from heritage_bayes.climate.solar import (
+    extraterrestrial_radiation_daily,
+    hargreaves_samani,
+    temperature_range_weather,
+)
 from heritage_bayes.errors import DataError, InputError
 from heritage_bayes.io import read_tmy3
 
@@ -167,3 +172,89 @@ def test_errors_and_options():
         surface_irradiance(w, DE_BILT, tilt=90)
     out = surface_irradiance(w, {**DE_BILT, "name": "De Bilt"}, {"roof": (30, 200)})
     assert list(out.columns) == ["roof"]
+
+
+# ---------------------------------------------------------------------------------------
+# global radiation from the daily temperature range (no pyranometer)
+# ---------------------------------------------------------------------------------------
+
+
+def test_extraterrestrial_radiation_and_hargreaves_fao56_examples():
+    # FAO-56 example 8: 20° S, 3 September (J = 246): Ra = 32.2 MJ/m²/d
+    assert extraterrestrial_radiation_daily(246, -20.0) == pytest.approx(32.2, abs=0.05)
+    # FAO-56's Lyon example (45°43' N, July; Annex 2 table 2.6 for mid-July): Ra = 40.6,
+    # Tmax 26.6, Tmin 14.8 °C -> Rs = 0.16 * sqrt(11.8) * 40.6 = 22.3 MJ/m²/d
+    assert extraterrestrial_radiation_daily(196, 45 + 43 / 60) == pytest.approx(40.6, abs=0.1)
+    assert hargreaves_samani(26.6, 14.8, 40.6) == pytest.approx(22.3, abs=0.05)
+    assert hargreaves_samani(26.6, 14.8, 40.6, krs=0.19) == pytest.approx(26.5, abs=0.05)
+    # polar night: no sun; midnight sun: more than at the equator on that day
+    assert extraterrestrial_radiation_daily(355, 80.0) == 0.0
+    assert extraterrestrial_radiation_daily(172, 80.0) > extraterrestrial_radiation_daily(172, 0)
+    with pytest.raises(InputError, match="tmax must not be below tmin"):
+        hargreaves_samani(10.0, 12.0, 30.0)
+    with pytest.raises(InputError, match="krs"):
+        hargreaves_samani(20.0, 12.0, 30.0, krs=1.5)
+    with pytest.raises(InputError, match="day_of_year"):
+        extraterrestrial_radiation_daily(0, 50.0)
+
+
+def _daily_swing(days: int, swing: np.ndarray, start="2021-03-01 01:00") -> pd.Series:
+    """Hourly Te (stamps at the hour's end, UTC) whose hourly values span ``swing[d]`` K
+    on day d (minimum at 03:00, maximum at 15:00 UTC)."""
+    idx = pd.date_range(start, periods=24 * days, freq="1h", tz="UTC")
+    half = np.repeat(np.asarray(swing, dtype=float) / 2, 24)
+    return pd.Series(8.0 - half * np.cos(2 * np.pi * (idx.hour - 3) / 24), index=idx)
+
+
+def test_estimate_is_each_days_hargreaves_total_shaped_by_the_cloudless_sky():
+    site = {"latitude": 52.0, "longitude": 0.0}
+    swing = np.array([4.0, 9.0, 1.0, 60.0])  # the last: more than a cloudless day allows
+    te = _daily_swing(4, swing)
+    est = temperature_range_weather(te, site)
+    cs = clear_sky_weather(te.index, site, interval="1h")["ghi"]
+    daily = est["ghi"].groupby((est.index - pd.Timedelta("30min")).floor("D")).sum() * 3600 / 1e6
+    ra = extraterrestrial_radiation_daily(np.arange(60, 64), 52.0)  # 1-4 March 2021
+    expected = 0.16 * np.sqrt(swing[:3]) * ra[:3]
+    np.testing.assert_allclose(daily.to_numpy()[:3], expected, rtol=1e-9)
+    # the shape of the day is the cloudless sky's; capped at it every hour
+    day1 = slice(24, 48)
+    np.testing.assert_allclose(
+        est["ghi"].iloc[day1], cs.iloc[day1] * est["ghi"].iloc[36] / cs.iloc[36]
+    )
+    assert (est["ghi"] <= cs + 1e-9).all()
+    np.testing.assert_allclose(est["ghi"].iloc[72:], cs.iloc[72:])
+    assert est.attrs["averaged"] == ("ghi",) and est.attrs["interval"] == "1h"
+    assert "Hargreaves-Samani, kRs 0.16" in est.attrs["irradiance_source"]
+    assert "clear" not in est.attrs["irradiance_source"]  # not flagged as a clear-sky proxy
+
+
+def test_estimate_fills_days_without_enough_readings_and_refuses_none():
+    site = {"latitude": 52.0, "longitude": 0.0}
+    te = _daily_swing(3, np.array([4.0, 9.0, 16.0]))
+    te.iloc[30:40] = np.nan  # day 2 keeps 14 of 24 readings: too few for its range
+    est = temperature_range_weather(te, site)
+    assert est.attrs["days_filled"] == 1 and est["ghi"].notna().all()
+    cs = clear_sky_weather(te.index, site, interval="1h")["ghi"]
+    k = (est["ghi"] / cs).where(cs > 1).groupby(te.index.floor("D")).mean().to_numpy()
+    # day 2's ratio to the cloudless sky lies between its neighbours'
+    assert k[0] < k[1] < k[2]
+    with pytest.raises(DataError, match="no solar day with at least 75%"):
+        temperature_range_weather(te.iloc[:10], site)
+    with pytest.raises(InputError, match="Series"):
+        temperature_range_weather(te.to_frame("Te"), site)
+
+
+@pytest.mark.shared_data
+def test_estimate_follows_measured_days_at_de_bilt(knmi_2015):
+    site = DE_BILT
+    te = knmi_2015["Te"]
+    est = temperature_range_weather(te, site)["ghi"]
+    cs = clear_sky_weather(te.index, site)["ghi"]
+    day = (te.index - pd.Timedelta("30min") + pd.Timedelta(hours=5.18 / 15)).floor("D")
+    meas = knmi_2015["ghi"].groupby(day).sum()
+    r2 = {
+        k: 1 - ((s.groupby(day).sum() - meas) ** 2).sum() / ((meas - meas.mean()) ** 2).sum()
+        for k, s in (("estimate", est), ("clear sky", cs))
+    }
+    assert r2["estimate"] > 0.75 and r2["clear sky"] < 0.4
+    assert est.sum() == pytest.approx(knmi_2015["ghi"].sum(), rel=0.1)

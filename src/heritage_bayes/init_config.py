@@ -540,7 +540,7 @@ def init_config(
         ]
     elif lat is not None:
         lines += [
-            "  irradiance: clear_sky   # no measured irradiance: a clear-sky proxy (pvlib)",
+            "  irradiance: estimated   # no measured irradiance: from the daily Te range",
             "  surfaces: {H: [0, 0]}   # one aperture on the horizontal (see above)",
         ]
     else:
@@ -554,8 +554,8 @@ def init_config(
         "",
         "# The smallest model of each ladder; the report's ladder fits the larger ones",
         "# (thermal_2c, thermal_4a; hygric_2c, hygric_2c_fixed) and shows whether they pay.",
-        "# Tf, the fixed node, is the annual mean outdoor temperature (the ground under the",
-        "# floor). A room without a floor on the ground (an attic, an upper storey): set",
+        "# Tf, the fixed node, is the outdoor annual cycle 1 m deep in the soil (the ground",
+        "# under the floor). A room without a floor on the ground (an attic, an upper storey): set",
         "# options: {ground: false}, or give the neighbouring space's measured temperature",
         "# (data.ground_temperature: {mode: column, column: ..., source: {...}}).",
         "thermal:",

@@ -19,6 +19,8 @@ __all__ = [
     "annual_mean_temperature",
     "calendar_inputs",
     "fixed_node_temperature",
+    "ground_input",
+    "seasonal_ground_temperature",
     "solar_inputs",
     "weather_inputs",
 ]
@@ -139,6 +141,88 @@ def annual_mean_temperature(te: pd.Series, times: pd.DatetimeIndex) -> tuple[np.
     return np.full(len(times), value), info
 
 
+def seasonal_ground_temperature(
+    te: pd.Series, times: pd.DatetimeIndex, depth: float | None = None
+) -> tuple[np.ndarray, dict]:
+    """Fixed (ground) temperature ``Tf`` [°C] that follows the season, from outdoor air.
+
+    Parameters
+    ----------
+    te : pandas.Series
+        Outdoor air temperature [°C], tz-aware index: the **whole** weather record.
+    times : pandas.DatetimeIndex
+        Tz-aware instants at which ``Tf`` is wanted.
+    depth : float, optional
+        Depth of the ground temperature [m]; default
+        :data:`heritage_bayes.climate.ground.GROUND_DEPTH` (1 m).
+
+    Returns
+    -------
+    values : numpy.ndarray
+        ``Tf`` [°C] at ``times``.
+    info : dict
+        ``method`` (plain words), ``min``, ``max`` [°C] and, when fitted, the surface
+        cycle (``mean`` [°C], ``amplitude`` [K], ``coldest_day``), ``depth`` [m],
+        ``amplitude_ratio`` [-] and ``lag_days`` [d].
+
+    Notes
+    -----
+    The annual cycle of the daily mean air temperature
+    (:func:`heritage_bayes.climate.ground.fit_annual_cycle`), taken as the ground
+    surface's, carried to ``depth`` in a clay/silt soil
+    (:func:`heritage_bayes.climate.ground.kusuda_achenbach`). A record whose daily means
+    span less than 180 days has no cycle to fit: :func:`annual_mean_temperature`, and
+    ``info["method"]`` says so.
+    """
+    from heritage_bayes.climate import ground
+
+    depth = ground.GROUND_DEPTH if depth is None else float(depth)
+    valid = te.index[np.isfinite(np.asarray(te, dtype=float))]
+    span = (valid[-1] - valid[0]) / pd.Timedelta(days=1) if len(valid) else 0.0
+    if span < ground.MIN_SPAN_DAYS + 3:
+        values, info = annual_mean_temperature(te, times)
+        info["method"] += (
+            f"; no seasonal cycle: Te spans {span:.0f} days, the fit needs "
+            f"{ground.MIN_SPAN_DAYS + 3:.0f}"
+        )
+        return values, info
+    cycle = ground.fit_annual_cycle(te)
+    values = ground.kusuda_achenbach(
+        times, cycle["mean"], cycle["amplitude"], cycle["t_min"], depth=depth
+    )
+    ratio, lag = ground.damping(depth)
+    info = {
+        "method": (
+            f"annual cycle fitted to {cycle['days']} daily means of Te, at {depth:g} m in "
+            f"clay/silt soil (Kusuda-Achenbach, diffusivity {ground.SOIL_DIFFUSIVITY:g} m²/s)"
+        ),
+        "mean": round(cycle["mean"], 2),
+        "amplitude": round(cycle["amplitude"], 2),
+        "coldest_day": cycle["coldest_day"],
+        "depth": depth,
+        "amplitude_ratio": round(ratio, 3),
+        "lag_days": round(lag, 1),
+        "min": float(np.min(values)) if len(values) else None,
+        "max": float(np.max(values)) if len(values) else None,
+    }
+    return values, info
+
+
+def ground_input(
+    mode: str, te: pd.Series, times: pd.DatetimeIndex, depth: float | None = None
+) -> tuple[np.ndarray, dict]:
+    """``Tf`` [°C] at ``times`` from the outdoor air ``te`` (whole record) for
+    ``data.ground_temperature`` mode ``seasonal`` (:func:`seasonal_ground_temperature`)
+    or ``annual_mean`` (:func:`annual_mean_temperature`); ``info`` holds ``mode``."""
+    if mode == "seasonal":
+        values, info = seasonal_ground_temperature(te, times, depth)
+    elif mode == "annual_mean":
+        values, info = annual_mean_temperature(te, times)
+    else:
+        raise ValueError(f"mode must be 'seasonal' or 'annual_mean' (got {mode!r})")
+    return values, {"mode": mode} | info
+
+
 def calendar_inputs(models, index: pd.DatetimeIndex, dt: float) -> dict[str, np.ndarray]:
     """Input columns that the models generate from a calendar, on a time grid.
 
@@ -220,42 +304,61 @@ def solar_inputs(
         ``latitude``, ``longitude`` [°], ``altitude`` [m].
     surfaces : mapping
         ``{name: (tilt, azimuth)}`` [°].
-    mode : {"measured", "clear_sky"}
-        Measured irradiance, or the explicit clear-sky proxy (measured columns, if any,
-        are then dropped and the proxy is labelled).
+    mode : {"measured", "estimated", "clear_sky"}
+        Measured irradiance; the global irradiance estimated from the daily range of
+        ``Te`` (:func:`heritage_bayes.climate.solar.temperature_range_weather`); or the
+        cloudless sky. With the last two, measured columns, if any, are dropped and the
+        input is labelled.
 
     Returns
     -------
     table : pandas.DataFrame
         ``I_<name>`` columns, interval averages stamped at the interval end (``attrs``).
     label : str
-        Short label: ``"measured"`` or ``"clear-sky proxy (pvlib Ineichen)"``.
+        Short label: ``"measured"``, ``"estimated from the daily Te range
+        (Hargreaves-Samani)"`` or ``"clear-sky proxy (pvlib Ineichen)"``.
     detail : str
         The full provenance label of :func:`heritage_bayes.climate.surface_irradiance`.
     """
-    from heritage_bayes.climate.solar import surface_irradiance
+    from heritage_bayes.climate.solar import surface_irradiance, temperature_range_weather
 
     present = [c for c in _IRRADIANCE if c in weather.columns]
     attrs = dict(weather.attrs)
+    kwargs = {}
     if mode == "measured":
         if "ghi" not in present:
             raise DataError(
                 f"{where}: data.irradiance is 'measured' but the weather has no global "
                 f"horizontal irradiance 'ghi' (columns: {list(weather.columns)}); map it in "
-                f"{where}.columns.ghi, or set data.irradiance to 'clear_sky' (a labelled "
-                f"clear-sky proxy) or 'none'"
+                f"{where}.columns.ghi, or set data.irradiance to 'estimated' (from the "
+                f"daily temperature range), 'clear_sky' or 'none'"
             )
         table = weather[present].copy()
         table.attrs = attrs
-        kwargs = {}
         label = "measured"
+    elif mode == "estimated":
+        if "Te" not in weather.columns:
+            raise DataError(
+                f"{where}: data.irradiance is 'estimated' (from the daily range of the "
+                f"outdoor temperature) but the weather has no Te (columns: "
+                f"{list(weather.columns)})"
+            )
+        te = weather["Te"].copy()
+        te.attrs = {"source": attrs.get("source", "weather")}
+        try:
+            table = temperature_range_weather(te, dict(site), interval=attrs.get("interval"))
+        except DataError as exc:
+            raise DataError(f"{where}: {exc}") from None
+        except InputError as exc:
+            raise ConfigError(f"{where}: {exc}") from None
+        label = "estimated from the daily Te range (Hargreaves-Samani)"
     elif mode == "clear_sky":
         table = weather.drop(columns=present)
         table.attrs = attrs
         kwargs = {"clear_sky": True}
         label = "clear-sky proxy (pvlib Ineichen)"
     else:
-        raise ValueError(f"mode must be 'measured' or 'clear_sky' (got {mode!r})")
+        raise ValueError(f"mode must be 'measured', 'estimated' or 'clear_sky' (got {mode!r})")
     try:
         irr = surface_irradiance(
             table,
@@ -270,8 +373,8 @@ def solar_inputs(
     except InputError as exc:
         raise ConfigError(f"{where}: {exc}") from None
     detail = irr.attrs.get("irradiance_source", label)
-    if mode == "clear_sky" and present:
-        detail += f"; measured {present} ignored (data.irradiance: clear_sky)"
+    if mode != "measured" and present:
+        detail += f"; measured {present} ignored (data.irradiance: {mode})"
     out = irr.rename(columns={k: f"I_{k}" for k in surfaces})
     out.attrs = dict(irr.attrs)
     out.attrs["averaged"] = tuple(f"I_{k}" for k in irr.attrs.get("averaged", ()))
@@ -319,7 +422,7 @@ def weather_inputs(
     *,
     thermal: bool,
     hygric: bool,
-    irradiance: str,
+    irradiance: str | None,
     site: Mapping | None,
     surfaces: Mapping[str, Sequence[float]],
     where: str = "data.weather",
@@ -330,6 +433,8 @@ def weather_inputs(
     ``extra``: further input columns the models need and the weather table carries
     as they are (e.g. a measured heating power ``Ph`` [W] for a heated test cell, or the
     inputs of a custom network); a missing one is reported when the model asks for it.
+    ``irradiance`` None (``data.irradiance``'s default) is ``"measured"`` when the weather
+    has ``ghi``, else ``"estimated"``.
 
     Returns the tables and a dict ``{"irradiance_source": short, "irradiance": {...}}``.
     """
@@ -352,6 +457,8 @@ def weather_inputs(
         )
     tables = [_table(weather, need)] if need else []
     note: dict = {"irradiance_source": "none", "irradiance": {"mode": "none"}}
+    if irradiance is None:  # the default: measured when there is a global irradiance
+        irradiance = "measured" if "ghi" in weather.columns else "estimated"
     if thermal and irradiance != "none":
         if site is None:
             raise ConfigError(

@@ -33,12 +33,12 @@ of the calibration period, simulated but excluded from the likelihood by the cal
 
 Ground temperature ``Tf``
 -------------------------
-``annual_mean`` (default), see :func:`annual_mean_temperature`: the mean outdoor
-temperature of a year around each instant, from the **whole** weather record (not only
-the frame): constant when the record is shorter than 365 days (a typical-year file),
-otherwise a 365-day centred running mean. ``constant``: a given value. ``column``: a
-measured series (e.g. the heated room below an attic, a crypt), aligned like the other
-inputs.
+``seasonal`` (files' default), :func:`~heritage_bayes.inputs.seasonal_ground_temperature`:
+the annual cycle of the outdoor temperature in the **whole** weather record, damped and
+delayed at a depth in the soil. ``annual_mean`` (the demo's), :func:`annual_mean_temperature`:
+the mean outdoor temperature of a year around each instant (a constant for records
+shorter than 365 days). ``constant``: a given value. ``column``: a measured series (e.g.
+the heated room below an attic, a crypt), aligned like the other inputs.
 """
 
 from __future__ import annotations
@@ -58,6 +58,7 @@ from heritage_bayes.inputs import (
     annual_mean_temperature,
     calendar_inputs,
     fixed_node_temperature,
+    ground_input,
     solar_inputs,
     weather_inputs,
 )
@@ -104,8 +105,8 @@ class Prepared:
     warmup_steps, init_steps : int
         Rows of ``periods.warmup`` and ``periods.init_window``.
     irradiance_source : str
-        ``"measured"``, ``"clear-sky proxy (pvlib Ineichen)"``, ``"none"``, or the
-        demo's description.
+        ``"measured"``, ``"estimated from the daily Te range (Hargreaves-Samani)"``,
+        ``"clear-sky proxy (pvlib Ineichen)"``, ``"none"``, or the demo's description.
     truth : dict or None
         Demo only: ``{"thermal": {name: value}, "hygric": {...}}``, the true parameters
         and the **nominal** noise parameters (``sigma_Ti``, ``phi_Ti``, ``sigma_Pi``,
@@ -212,7 +213,7 @@ def _input_hint(missing: Sequence[str], prep: Prepared) -> str:
         if prep.irradiance_source == "none":
             hints.append(
                 "data.irradiance is 'none': build the thermal model without solar surfaces, "
-                "or set data.irradiance to 'measured' or 'clear_sky'"
+                "or remove data.irradiance (measured irradiance, else estimated)"
             )
         else:
             hints.append(
@@ -289,8 +290,8 @@ def _check_models_vs_irradiance(cfg) -> None:
         raise ConfigError(
             f"thermal.options.surfaces: {list(surf)} are solar surfaces, but data.irradiance "
             f"is 'none' (no solar input): remove thermal.options.surfaces (the thermal model "
-            f"is then built without solar apertures) or set data.irradiance to 'measured' or "
-            f"'clear_sky'"
+            f"is then built without solar apertures) or remove data.irradiance (measured "
+            f"irradiance, else estimated)"
         )
 
 
@@ -400,15 +401,14 @@ def prepare(cfg) -> Prepared:
     n = len(frame)
     s0 = frame.index[0]
 
-    # Tf (annual mean or constant); column mode came through align
+    # Tf (seasonal, annual mean or constant); column mode came through align
     if thermal and gt.mode != "column":
         if gt.mode == "constant":
             tf = np.full(n, float(gt.value))
             sources["ground_temperature"] = {"mode": "constant", "value": float(gt.value)}
         else:
             mids = frame.index + step / 2
-            tf, info = annual_mean_temperature(weather["Te"], mids)
-            sources["ground_temperature"] = {"mode": "annual_mean"} | info
+            tf, sources["ground_temperature"] = ground_input(gt.mode, weather["Te"], mids, gt.depth)
         frame["Tf"] = tf
         flags["Tf"] = False
     from heritage_bayes.models import build_model

@@ -1,6 +1,8 @@
-"""Climate numerics on arrays: psychrometrics, solar on surfaces, risk indicators."""
+"""Climate numerics on arrays: psychrometrics, solar on surfaces (measured, estimated from
+the daily temperature range, or a cloudless sky), the ground's annual cycle, risk
+indicators."""
 
-from heritage_bayes.climate import risk
+from heritage_bayes.climate import ground, risk
 from heritage_bayes.climate.psychro import (
     absolute_humidity,
     dew_point,
@@ -12,6 +14,7 @@ from heritage_bayes.climate.solar import (
     DEFAULT_SURFACES,
     clear_sky_weather,
     surface_irradiance,
+    temperature_range_weather,
 )
 
 __all__ = [
@@ -19,9 +22,11 @@ __all__ = [
     "absolute_humidity",
     "clear_sky_weather",
     "dew_point",
+    "ground",
     "relative_humidity",
     "risk",
     "saturation_vapour_pressure",
     "surface_irradiance",
+    "temperature_range_weather",
     "vapour_pressure",
 ]

@@ -11,7 +11,8 @@ the expected form and the value found, e.g. ``priors.Gw.lower: must be < upper (
 > 200)``. Every key carries a description, unit and default in the schema
 (:func:`config_keys`: the source of the generated configuration reference).
 
-Modules, by topic: :mod:`~heritage_bayes.config.sources` (``site``, ``data``),
+Modules, by topic: :mod:`~heritage_bayes.config.sources` (``site``, the tables),
+:mod:`~heritage_bayes.config.data` (``data``: solar input, ground, grid),
 :mod:`~heritage_bayes.config.periods`, :mod:`~heritage_bayes.config.models` (one
 calibrated model: options, noise, initial state, priors),
 :mod:`~heritage_bayes.config.sampler` (``sampler``, ``optimizer``),
@@ -38,9 +39,11 @@ Layout (see ``configs/demo.yaml`` for a complete, commented example)::
       weather: {format: knmi, path: ../shared/data/knmi-debilt/uurgeg_260_2011-2020.txt.gz}
       measurements: {format: csv, path: logger.csv, time_column: ..., timezone: ...,
                      columns: {Ti: "TEMP C", RHi: "%RH"}}   # or a list of such tables
-      irradiance: measured         # measured | clear_sky (explicit proxy) | none
+      irradiance: measured         # measured | estimated | clear_sky | none (default:
+                                   # measured if the weather has it, else estimated)
       surfaces: {N: [90, 0], E: [90, 90], S: [90, 180], W: [90, 270]}  # (tilt, azimuth)
-      ground_temperature: {mode: annual_mean}   # or {mode: constant, value: 10},
+      ground_temperature: {mode: seasonal, depth: 1}   # or {mode: annual_mean},
+                        # {mode: constant, value: 10},
                         # {mode: column, column: T, source: {format: csv, path: ...}}
       step: 1h
       max_gap: 6h
@@ -66,12 +69,13 @@ from heritage_bayes.config.calibration import (
     load_config,
     parse_config,
 )
+from heritage_bayes.config.data import Data, GroundTemperature
 from heritage_bayes.config.loader import load_yaml_text, read_yaml
 from heritage_bayes.config.models import ModelSection
 from heritage_bayes.config.periods import Period, Periods
 from heritage_bayes.config.reference import ConfigKey, config_keys, describe_key
 from heritage_bayes.config.sampler import OptimizerSettings, SamplerSettings
-from heritage_bayes.config.sources import Data, DemoData, GroundTemperature, Site, Source
+from heritage_bayes.config.sources import DemoData, Site, Source
 from heritage_bayes.convert import parse_duration
 
 __all__ = [

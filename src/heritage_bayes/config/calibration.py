@@ -13,11 +13,12 @@ from pydantic import PrivateAttr, model_validator
 
 from heritage_bayes.config._base import MAX_SEED, _Strict, key
 from heritage_bayes.config._messages import validate
+from heritage_bayes.config.data import Data
 from heritage_bayes.config.loader import read_yaml
 from heritage_bayes.config.models import ModelSection
 from heritage_bayes.config.periods import Periods
 from heritage_bayes.config.sampler import OptimizerSettings, SamplerSettings
-from heritage_bayes.config.sources import Data, Site
+from heritage_bayes.config.sources import Site
 
 __all__ = ["CalibrationConfig", "chain_tag", "config_hash", "load_config", "parse_config"]
 

@@ -1,5 +1,5 @@
-"""Settings of the data sources: ``site``, ``data`` (weather, measurements, demo, solar
-surfaces, ground temperature, step and gaps).
+"""Settings of the data sources: ``site``, the tables to read (weather, measurements) and
+the demo; the ``data`` section that holds them: :mod:`heritage_bayes.config.data`.
 
 How these become model inputs and outputs: :mod:`heritage_bayes.prepare`.
 """
@@ -7,23 +7,22 @@ How these become model inputs and outputs: :mod:`heritage_bayes.prepare`.
 from __future__ import annotations
 
 import re
-from typing import Annotated, Literal
+from typing import Literal
 
 import pandas as pd
-from pydantic import BeforeValidator, field_validator, model_validator
+from pydantic import field_validator, model_validator
 
 from heritage_bayes.config._base import (
     DURATION_UNIT,
     DateText,
     Duration,
-    NonNegativeDuration,
     TimeZone,
     _Strict,
     check_dates,
     key,
 )
 
-__all__ = ["Data", "DemoData", "GroundTemperature", "Site", "Source"]
+__all__ = ["DemoData", "Site", "Source"]
 
 
 class Site(_Strict):
@@ -250,147 +249,3 @@ def _check_time_format(fmt: str) -> None:
         raise ValueError(
             f"time_format: {shown}; use e.g. '%Y-%m-%d %H:%M' or '%d/%m/%Y %H:%M' (got {fmt!r})"
         )
-
-
-class GroundTemperature(_Strict):
-    """The fixed (ground) temperature input ``Tf`` of the thermal models.
-
-    ``annual_mean``: the outdoor temperature averaged over a year, see
-    :func:`heritage_bayes.prepare.annual_mean_temperature`; ``constant``: ``value``
-    [°C]; ``column``: a measured series, the column ``column`` (name in the file) of the
-    CSV table ``source`` or, without ``source``, of the weather or measurement CSV files.
-    """
-
-    mode: Literal["annual_mean", "constant", "column"] = key(
-        "annual_mean",
-        unit=None,
-        description="annual_mean (running annual mean of the outdoor temperature), "
-        "constant (value) or column (a measured series)",
-    )
-    value: float | None = key(
-        None, unit="°C", description="the ground temperature of mode constant", ge=-60, le=70
-    )
-    column: str | None = key(None, unit=None, description="mode column: the column's name")
-    source: Source | None = key(
-        None,
-        unit=None,
-        description="mode column: the CSV table holding it (default: weather or measurements)",
-    )
-
-    @model_validator(mode="after")
-    def _check(self):
-        if self.mode == "constant" and self.value is None:
-            raise ValueError("value: required for mode 'constant' (a temperature in °C)")
-        if self.mode == "column" and not self.column:
-            raise ValueError("column: required for mode 'column' (a column name in a CSV file)")
-        if self.mode != "constant" and self.value is not None:
-            raise ValueError(f"value: only for mode 'constant' (mode is {self.mode!r})")
-        if self.mode != "column" and (self.column is not None or self.source is not None):
-            raise ValueError(f"column/source: only for mode 'column' (mode is {self.mode!r})")
-        if self.source is not None:
-            if self.source.format != "csv":
-                raise ValueError("source: must be a CSV table (format: csv)")
-            if self.source.columns is not None:
-                raise ValueError("source.columns: not used here; name the column with 'column'")
-        return self
-
-
-#: The four vertical facades (the paper's N, E, S, W): name -> (tilt, azimuth) [°].
-DEFAULT_SURFACES = {
-    "N": (90.0, 0.0),
-    "E": (90.0, 90.0),
-    "S": (90.0, 180.0),
-    "W": (90.0, 270.0),
-}
-
-
-def _as_list(v):
-    return [v] if isinstance(v, dict) else v
-
-
-_SURFACE_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
-
-
-class Data(_Strict):
-    """Where the data come from, and the common time grid."""
-
-    demo: DemoData | None = key(
-        None, unit=None, description="the built-in virtual monument instead of files"
-    )
-    weather: Source | None = key(None, unit=None, description="the outdoor weather table")
-    measurements: Annotated[list[Source] | None, BeforeValidator(_as_list)] = key(
-        None,
-        unit=None,
-        description="the indoor logger table, or a list of tables (e.g. separate T and RH loggers)",
-    )
-    irradiance: Literal["measured", "clear_sky", "none"] = key(
-        "measured",
-        unit=None,
-        description="solar input: measured (from the weather), clear_sky (an explicit "
-        "proxy) or none (no solar input)",
-    )
-    surfaces: dict[str, tuple[float, float]] = key(
-        unit="°",
-        description="name -> (tilt, azimuth; 0 = N, 90 = E) of the sunlit surfaces",
-        default_factory=lambda: dict(DEFAULT_SURFACES),
-    )
-    ground_temperature: GroundTemperature = key(
-        unit=None,
-        description="the fixed (ground) temperature input of the thermal models",
-        default_factory=GroundTemperature,
-    )
-    step: Duration = key(
-        "1h",
-        unit=DURATION_UNIT,
-        description="the model's time step: every table is put on this grid",
-        validate_default=True,
-    )
-    max_gap: NonNegativeDuration = key(
-        "6h",
-        unit=DURATION_UNIT,
-        description="longest input gap filled by interpolation",
-        validate_default=True,
-    )
-    input_hold: Literal["exact", "interval_mean"] | None = key(
-        None,
-        unit=None,
-        description="exact: readings at an instant linear between samples (first-order "
-        "hold), interval means (a source's 'averaged' columns) constant over their interval; "
-        "interval_mean: every input held at its mean over the step. Default: exact for "
-        "files, interval_mean for the demo (its generator's hold)",
-    )
-
-    @model_validator(mode="after")
-    def _one_source(self):
-        if self.demo is None and (self.weather is None or self.measurements is None):
-            raise ValueError("give either 'demo' or both 'weather' and 'measurements'")
-        if self.demo is not None and (self.weather or self.measurements):
-            raise ValueError(
-                "'demo' generates its own data: remove 'weather' and "
-                "'measurements' or remove 'demo'"
-            )
-        if self.irradiance == "none" and self.surfaces != DEFAULT_SURFACES:
-            raise ValueError(
-                "surfaces: given, but irradiance is 'none' (no solar input); remove "
-                "'surfaces' or set irradiance to 'measured' or 'clear_sky'"
-            )
-        return self
-
-    @field_validator("surfaces")
-    @classmethod
-    def _surfaces(cls, v):
-        if not v:
-            raise ValueError(
-                "at least one surface is needed for solar input; for none set irradiance: none"
-            )
-        for name, (tilt, az) in v.items():
-            if not _SURFACE_NAME.match(name):
-                raise ValueError(
-                    f"{name!r}: surface names must be letters, digits and '_' starting with "
-                    f"a letter (they become input names I_<name>)"
-                )
-            if not 0 <= tilt <= 180:
-                raise ValueError(f"{name}: tilt must be within 0..180° (got {tilt})")
-            if not 0 <= az <= 360:
-                raise ValueError(f"{name}: azimuth must be within 0..360° (got {az})")
-        return v

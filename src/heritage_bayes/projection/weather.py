@@ -5,7 +5,7 @@ The baseline is the calibration's own weather (the demo's TMY3 file, or the conf
 documented transformation of it (:mod:`heritage_bayes.climate.morph`) or a user file.
 Model inputs are built exactly as for the calibration
 (:func:`heritage_bayes.inputs.weather_inputs`, :func:`heritage_bayes.io.align`,
-:func:`heritage_bayes.inputs.annual_mean_temperature`): same surfaces, irradiance mode,
+:func:`heritage_bayes.inputs.ground_input`): same surfaces, irradiance mode,
 grid step and ground-temperature rule, so the building is the calibrated one and only
 the weather changes.
 """
@@ -191,8 +191,8 @@ def model_inputs(run, pcfg, weather: pd.DataFrame, site: dict | None, where: str
     """
     from heritage_bayes.inputs import (
         add_slope_columns,
-        annual_mean_temperature,
         calendar_inputs,
+        ground_input,
         weather_inputs,
     )
     from heritage_bayes.io import align
@@ -221,13 +221,14 @@ def model_inputs(run, pcfg, weather: pd.DataFrame, site: dict | None, where: str
         gt = pcfg.ground_temperature or data.ground_temperature
         if gt.mode == "constant":
             frame["Tf"] = float(gt.value)
-        elif gt.mode == "annual_mean":
-            frame["Tf"], _ = annual_mean_temperature(weather["Te"], frame.index + step / 2)
+        elif gt.mode in ("seasonal", "annual_mean"):
+            mids = frame.index + step / 2
+            frame["Tf"], _ = ground_input(gt.mode, weather["Te"], mids, gt.depth)
         else:
             raise ConfigError(
                 "ground_temperature: the run measured its ground temperature (mode "
                 "'column'), which has no future; give ground_temperature: {mode: "
-                "annual_mean} or {mode: constant, value: ...} in the projection file"
+                "seasonal} or {mode: constant, value: ...} in the projection file"
             )
     # inputs the models make from a calendar (a thermostat's weekly hours of use): the
     # calibrated use goes on into the future, on the projection's own dates

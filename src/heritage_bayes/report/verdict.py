@@ -441,6 +441,18 @@ def run_notes(
                 "use measured irradiance when it is available.",
             }
         )
+    elif "estimated from the daily" in irr:
+        out.append(
+            {
+                "level": "info",
+                "title": "Solar radiation is estimated from the outdoor temperature",
+                "text": "No irradiance was measured: each day's global radiation was "
+                "estimated from the day's temperature range (Hargreaves-Samani) and spread "
+                f"over the day as the sun's path gives it (source: {irr}). Day-to-day "
+                "cloudiness is followed, cloud within a day is not; use measured "
+                "irradiance when it is available.",
+            }
+        )
     bound = []
     for k, v in (s.get("parameters") or {}).items():
         if v.get("at_bound"):

@@ -1,0 +1,185 @@
+"""Settings of the ``data`` section: the tables (:mod:`heritage_bayes.config.sources`),
+the solar input and its surfaces, the ground temperature, the time grid and the gaps.
+
+How these become model inputs and outputs: :mod:`heritage_bayes.prepare`.
+"""
+
+from __future__ import annotations
+
+import re
+from typing import Annotated, Literal
+
+from pydantic import BeforeValidator, field_validator, model_validator
+
+from heritage_bayes.config._base import (
+    DURATION_UNIT,
+    Duration,
+    NonNegativeDuration,
+    _Strict,
+    key,
+)
+from heritage_bayes.config.sources import DemoData, Source
+
+__all__ = ["DEFAULT_SURFACES", "Data", "GroundTemperature"]
+
+
+class GroundTemperature(_Strict):
+    """The fixed (ground) temperature input ``Tf`` of the thermal models.
+
+    ``seasonal``: the annual cycle of the outdoor temperature, damped and delayed at
+    ``depth`` in the soil, see :func:`heritage_bayes.inputs.seasonal_ground_temperature`;
+    ``annual_mean``: the outdoor temperature averaged over a year, see
+    :func:`heritage_bayes.inputs.annual_mean_temperature`; ``constant``: ``value``
+    [°C]; ``column``: a measured series, the column ``column`` (name in the file) of the
+    CSV table ``source`` or, without ``source``, of the weather or measurement CSV files.
+    """
+
+    mode: Literal["seasonal", "annual_mean", "constant", "column"] = key(
+        "seasonal",
+        unit=None,
+        description="seasonal (the outdoor annual cycle at depth in the soil), annual_mean "
+        "(running annual mean of the outdoor temperature), constant (value) or column (a "
+        "measured series). Default: seasonal for files, annual_mean for the demo (its "
+        "generator's)",
+    )
+    depth: float | None = key(
+        None,
+        unit="m",
+        description="mode seasonal: depth of the ground temperature in clay/silt soil "
+        "(default 1 m: the annual swing × 0.64, 26 days late)",
+        ge=0,
+        le=20,
+    )
+    value: float | None = key(
+        None, unit="°C", description="the ground temperature of mode constant", ge=-60, le=70
+    )
+    column: str | None = key(None, unit=None, description="mode column: the column's name")
+    source: Source | None = key(
+        None,
+        unit=None,
+        description="mode column: the CSV table holding it (default: weather or measurements)",
+    )
+
+    @model_validator(mode="after")
+    def _check(self):
+        if self.mode == "constant" and self.value is None:
+            raise ValueError("value: required for mode 'constant' (a temperature in °C)")
+        if self.mode == "column" and not self.column:
+            raise ValueError("column: required for mode 'column' (a column name in a CSV file)")
+        if self.mode != "seasonal" and self.depth is not None:
+            raise ValueError(f"depth: only for mode 'seasonal' (mode is {self.mode!r})")
+        if self.mode != "constant" and self.value is not None:
+            raise ValueError(f"value: only for mode 'constant' (mode is {self.mode!r})")
+        if self.mode != "column" and (self.column is not None or self.source is not None):
+            raise ValueError(f"column/source: only for mode 'column' (mode is {self.mode!r})")
+        if self.source is not None:
+            if self.source.format != "csv":
+                raise ValueError("source: must be a CSV table (format: csv)")
+            if self.source.columns is not None:
+                raise ValueError("source.columns: not used here; name the column with 'column'")
+        return self
+
+
+#: The four vertical facades (the paper's N, E, S, W): name -> (tilt, azimuth) [°].
+DEFAULT_SURFACES = {
+    "N": (90.0, 0.0),
+    "E": (90.0, 90.0),
+    "S": (90.0, 180.0),
+    "W": (90.0, 270.0),
+}
+
+
+def _as_list(v):
+    return [v] if isinstance(v, dict) else v
+
+
+_SURFACE_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
+
+
+class Data(_Strict):
+    """Where the data come from, and the common time grid."""
+
+    demo: DemoData | None = key(
+        None, unit=None, description="the built-in virtual monument instead of files"
+    )
+    weather: Source | None = key(None, unit=None, description="the outdoor weather table")
+    measurements: Annotated[list[Source] | None, BeforeValidator(_as_list)] = key(
+        None,
+        unit=None,
+        description="the indoor logger table, or a list of tables (e.g. separate T and RH loggers)",
+    )
+    irradiance: Literal["measured", "estimated", "clear_sky", "none"] | None = key(
+        None,
+        unit=None,
+        description="solar input: measured (from the weather), estimated (from the daily "
+        "range of the outdoor temperature, Hargreaves-Samani), clear_sky (a cloudless sky, "
+        "on request) or none (no solar input). Default: measured when the weather has "
+        "global irradiance, else estimated",
+    )
+    surfaces: dict[str, tuple[float, float]] = key(
+        unit="°",
+        description="name -> (tilt, azimuth; 0 = N, 90 = E) of the sunlit surfaces",
+        default_factory=lambda: dict(DEFAULT_SURFACES),
+    )
+    ground_temperature: GroundTemperature = key(
+        unit=None,
+        description="the fixed (ground) temperature input of the thermal models",
+        default_factory=GroundTemperature,
+    )
+    step: Duration = key(
+        "1h",
+        unit=DURATION_UNIT,
+        description="the model's time step: every table is put on this grid",
+        validate_default=True,
+    )
+    max_gap: NonNegativeDuration = key(
+        "6h",
+        unit=DURATION_UNIT,
+        description="longest input gap filled by interpolation",
+        validate_default=True,
+    )
+    input_hold: Literal["exact", "interval_mean"] | None = key(
+        None,
+        unit=None,
+        description="exact: readings at an instant linear between samples (first-order "
+        "hold), interval means (a source's 'averaged' columns) constant over their interval; "
+        "interval_mean: every input held at its mean over the step. Default: exact for "
+        "files, interval_mean for the demo (its generator's hold)",
+    )
+
+    @model_validator(mode="after")
+    def _one_source(self):
+        if self.demo is None and (self.weather is None or self.measurements is None):
+            raise ValueError("give either 'demo' or both 'weather' and 'measurements'")
+        if self.demo is not None and (self.weather or self.measurements):
+            raise ValueError(
+                "'demo' generates its own data: remove 'weather' and "
+                "'measurements' or remove 'demo'"
+            )
+        if self.demo is not None and "mode" not in self.ground_temperature.model_fields_set:
+            self.ground_temperature.mode = "annual_mean"  # the demo generator's Tf
+        if self.irradiance == "none" and self.surfaces != DEFAULT_SURFACES:
+            raise ValueError(
+                "surfaces: given, but irradiance is 'none' (no solar input); remove "
+                "'surfaces' or 'irradiance: none'"
+            )
+        return self
+
+    @field_validator("surfaces")
+    @classmethod
+    def _surfaces(cls, v):
+        if not v:
+            raise ValueError(
+                "at least one surface is needed for solar input; for none set irradiance: none"
+            )
+        for name, (tilt, az) in v.items():
+            if not _SURFACE_NAME.match(name):
+                raise ValueError(
+                    f"{name!r}: surface names must be letters, digits and '_' starting with "
+                    f"a letter (they become input names I_<name>)"
+                )
+            if not 0 <= tilt <= 180:
+                raise ValueError(f"{name}: tilt must be within 0..180° (got {tilt})")
+            if not 0 <= az <= 360:
+                raise ValueError(f"{name}: azimuth must be within 0..360° (got {az})")
+        return v

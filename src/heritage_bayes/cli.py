@@ -230,12 +230,10 @@ def _cmd_calibrate(args) -> int:
 
 def _converged_or_3(run_dir) -> int:
     """0 when the run's ``summary.json`` says converged; else name the reasons, return 3."""
-    import json
-    from pathlib import Path
-
     from heritage_bayes.convergence import EXIT_UNCONVERGED
+    from heritage_bayes.rundir.reader import read_summary
 
-    summary = json.loads((Path(run_dir) / "summary.json").read_text(encoding="utf-8"))
+    summary = read_summary(run_dir)
     if summary.get("converged"):
         return 0
     print(
@@ -349,9 +347,9 @@ def _cmd_compare(args) -> int:
         workers=args.workers,
     )
     if not args.quiet:
-        import json
+        from heritage_bayes.rundir.reader import read_json_object
 
-        res = json.loads((out / "comparison.json").read_text(encoding="utf-8"))
+        res = read_json_object(out / "comparison.json", "the object of a comparison")
         for head, rows in (accuracy_rows(res), identifiability_rows(res)):
             print(" | ".join(head))
             for r in rows:

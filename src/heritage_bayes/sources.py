@@ -16,7 +16,7 @@ from typing import NamedTuple
 
 import pandas as pd
 
-from heritage_bayes.errors import ConfigError, DataError, InputError
+from heritage_bayes.errors import ConfigError, DataError, InputError, quoted
 
 __all__ = [
     "INPUT_COLUMNS",
@@ -36,11 +36,13 @@ OUTPUT_COLUMNS = ("Ti", "RHi", "Pi")
 
 
 def _quote(names) -> str:
-    return ", ".join(repr(n) for n in names)
+    from heritage_bayes.io._common import _quote_list
+
+    return _quote_list(names)
 
 
 def _csv_header(path: Path, src, where: str) -> list[str]:
-    from heritage_bayes.io._common import READ_ERRORS, damaged, sniff_text
+    from heritage_bayes.io._common import READ_ERRORS, damaged, looks_like_table, sniff_text
     from heritage_bayes.io.readers.workbook import is_workbook, table_source
 
     try:
@@ -59,6 +61,12 @@ def _csv_header(path: Path, src, where: str) -> list[str]:
         raise DataError(f"{where}: {damaged(path.name, exc)}") from None
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
         raise DataError(f"{where}: {path.name}: cannot read the header line: {exc}") from None
+    if not is_workbook(path) and not looks_like_table(path, src.sep, src.skiprows, src.encoding):
+        raise DataError(
+            f"{where}: {path.name}: not a table: its first lines do not split into the same "
+            f"two or more fields by the separator {src.sep!r} (check the path and sep; the "
+            "file's content is not shown)"
+        )
     return [str(c).strip() for c in header.columns]
 
 
@@ -71,7 +79,7 @@ def _check_csv_columns(path: Path, src, where: str, allowed: Sequence[str]) -> N
     for c in tcols:
         if c.strip() not in header:
             raise DataError(
-                f"{where}.time_column: column {c!r} not found in {path.name}; columns are: "
+                f"{where}.time_column: column {quoted(c)} not found in {path.name}; columns are: "
                 f"{_quote(header)}"
             )
     for std, col in (src.columns or {}).items():
@@ -87,7 +95,7 @@ def _check_csv_columns(path: Path, src, where: str, allowed: Sequence[str]) -> N
             )
         if str(col).strip() not in header:
             raise DataError(
-                f"{where}.columns.{std}: column {col!r} not found in {path.name}; columns "
+                f"{where}.columns.{std}: column {quoted(col)} not found in {path.name}; columns "
                 f"are: {_quote(header)}"
             )
 

@@ -8,6 +8,7 @@ Private module: the public API is re-exported by :mod:`heritage_bayes.io`.
 
 from __future__ import annotations
 
+import csv
 import datetime as _dt
 import zlib
 from collections.abc import Iterable, Mapping
@@ -18,7 +19,7 @@ import numpy as np
 import pandas as pd
 
 from heritage_bayes.convert import format_timedelta, parse_timezone, to_jsonable
-from heritage_bayes.errors import DataError, InputError
+from heritage_bayes.errors import DataError, InputError, quoted
 
 __all__ = [
     "AVERAGED_BY_DEFAULT",
@@ -178,7 +179,7 @@ def validate_ranges(
             lo_txt = -IRRADIANCE_NOISE if col in IRRADIANCE else lo
             if invalid == "raise":
                 raise DataError(
-                    f"{name}: column {src!r} ({col}) line {int(lines[first])}: value "
+                    f"{name}: column {quoted(src)} ({col}) line {int(lines[first])}: value "
                     f"{values[first]:g} {unit} is outside the physical range "
                     f"[{lo_txt:g}, {hi:g}] {unit} ({int(bad.sum())} such values)"
                     f"{_unit_hint(col, values)}; "
@@ -325,6 +326,32 @@ READ_ERRORS = (OSError, EOFError, zlib.error)
 def damaged(name: str, exc: BaseException) -> DataError:
     """The error for a file that cannot be read to its end."""
     return DataError(f"{name}: cannot read the file (damaged or truncated?): {exc}")
+
+
+def looks_like_table(path: Path, sep, skiprows=None, encoding: str = "utf-8") -> bool:
+    """Whether a text file's first lines split into one number (two or more) of fields
+    by ``sep``: a table, whose header may be quoted in a message. A file that does not
+    (``/etc/passwd`` given as a logger file) is named, its lines never shown: they may
+    not be the user's. True when it cannot tell (a regex separator, a list of rows to
+    skip)."""
+    import gzip
+
+    if not isinstance(sep, str) or len(sep) != 1 or not isinstance(skiprows, int | None):
+        return True
+    try:
+        with gzip.open(path, "rb") if path.suffix == ".gz" else open(path, "rb") as fh:
+            head = fh.read(1 << 16)
+    except READ_ERRORS:
+        return True  # the reader names a damaged file
+    text = head.decode(encoding if encoding else "utf-8", errors="replace")
+    lines = [ln for ln in text.splitlines()[(skiprows or 0) :][:21] if ln.strip()]
+    if len(head) == 1 << 16 and len(lines) > 1:
+        lines = lines[:-1]  # the last line may be cut by the sample's end
+    if not lines:
+        return False
+    widths = [len(next(csv.reader([ln], delimiter=sep))) for ln in lines]
+    same = sum(w == widths[0] for w in widths[1:])
+    return widths[0] >= 2 and same >= 0.8 * (len(widths) - 1)
 
 
 def sniff_text(path: Path, name: str, size: int = 1 << 16) -> None:

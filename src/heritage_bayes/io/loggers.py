@@ -51,7 +51,7 @@ from pathlib import Path
 
 import numpy as np
 
-from heritage_bayes.errors import DataError
+from heritage_bayes.errors import DataError, quoted
 
 __all__ = ["ColumnGuess", "TableLayout", "inspect_table"]
 
@@ -315,7 +315,10 @@ def inspect_table(path, *, what: str = "file") -> TableLayout:
         prop = _split(lines[after[-1]], sep)
         notes.append(
             "Tinytag Explorer export: channels "
-            + ", ".join(f"{header[i]!r} = {prop[i]}" for i in range(2, min(len(prop), len(header))))
+            + ", ".join(
+                f"{quoted(header[i])} = {quoted(prop[i])}"
+                for i in range(2, min(len(prop), len(header)))
+            )
         )
 
     # -- time column -----------------------------------------------------------------------

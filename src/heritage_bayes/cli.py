@@ -250,6 +250,12 @@ def _converged_or_3(run_dir) -> int:
 
 
 def _cmd_init(args) -> int:
+    from heritage_bayes.config import Site
+    from heritage_bayes.config._base import check_in_range
+
+    for name in ("latitude", "longitude"):  # before any file is read
+        if getattr(args, name) is not None:
+            check_in_range(Site, name, getattr(args, name), f"--{name}")
     from heritage_bayes.init_config import init_config
 
     opts = ("weather_format", "latitude", "longitude", "name", "timezone", "weather_timezone")
@@ -323,9 +329,10 @@ def _cmd_models(args) -> int:
         print(_CONTROL_HELP)
         return 0
     try:
-        print(describe_model(args.name, noise=args.noise))
+        text = describe_model(args.name, noise=args.noise)
     except ValueError as exc:
         raise InputError(f"models NAME: {exc}") from None
+    print(text)  # outside the check: the terminal's encoding is not the name's fault
     return 0
 
 
@@ -334,7 +341,12 @@ def _cmd_compare(args) -> int:
     from heritage_bayes.config import load_config
 
     cfg = load_config(args.config)
-    models = args.models.split(",") if args.models else None
+    models = None if args.models is None else _model_list(args.models)
+    if args.seed is not None:
+        from heritage_bayes.config import CalibrationConfig
+        from heritage_bayes.config._base import check_in_range
+
+        check_in_range(CalibrationConfig, "seed", args.seed, "--seed")
     out = run_compare(
         cfg,
         models,
@@ -358,6 +370,22 @@ def _cmd_compare(args) -> int:
         print("recommendation:", res["recommendation"]["reason"])
         print(out / "comparison.html")
     return 0
+
+
+def _model_list(text: str) -> list[str]:
+    """``--models A,B``: the names, none empty (an unset shell variable gives '')."""
+    from heritage_bayes.errors import quoted
+
+    names = [n.strip() for n in text.split(",")]
+    if not any(names):
+        raise InputError(
+            "--models: empty; give catalogue models of one section separated by commas, "
+            "e.g. thermal_1c,thermal_2c (see `hbayes models`), or leave --models out for "
+            "the default candidates"
+        )
+    if not all(names):
+        raise InputError(f"--models: an empty name in {quoted(text)}; separate names by one comma")
+    return names
 
 
 _CONTROL_HELP = """
@@ -448,8 +476,10 @@ def main(argv: list[str] | None = None) -> int:
             old_hook(u)
 
     sys.unraisablehook = hook
+    _tolerant_streams()
     try:
         code = _main(argv)
+        sys.stdout.flush()  # here, not at exit: a reader gone (| head) is handled below
         if swallowed and code == 0:
             print(
                 "hbayes: the interrupt came too late to stop it: the run is complete",
@@ -458,10 +488,55 @@ def main(argv: list[str] | None = None) -> int:
         return code
     except KeyboardInterrupt as exc:  # before or after a command ran
         return _interrupted(exc, None)
+    except BrokenPipeError:
+        return _reader_gone()
     finally:
         sys.unraisablehook = old_hook
         if old is not None:
             signal.signal(signal.SIGTERM, old)
+
+
+#: Exit code when the reader of the output went away (``hbayes models | head -1``):
+#: 128 + SIGPIPE, what a Unix tool killed by the signal returns.
+EXIT_READER_GONE = 128 + 13
+
+
+def _reader_gone() -> int:
+    """Stop quietly when stdout's reader closed it, as Unix tools do; stdout is pointed
+    at the null device so that Python's last flush finds no broken pipe either."""
+    import os
+
+    try:
+        fd = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(fd, sys.stdout.fileno())
+        os.close(fd)
+    except (OSError, ValueError, AttributeError):  # not a file (a test's capture)
+        pass
+    return EXIT_READER_GONE
+
+
+def _tolerant_streams() -> None:
+    """stdout and stderr write what the terminal's encoding cannot hold as escapes
+    (``\\xb0`` for °, ``\\u03c4`` for τ) instead of failing: a Latin-1 or ASCII
+    terminal (``LC_ALL=C``, ``PYTHONIOENCODING=latin-1``) gets every message."""
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.reconfigure(errors="backslashreplace")
+        except (AttributeError, ValueError, OSError):  # not a text file of io
+            pass
+
+
+#: The longest line of a message printed (a safety net: the messages themselves quote
+#: at most :data:`heritage_bayes.errors.QUOTE_LIMIT` characters of a user's data).
+MAX_LINE = 2000
+
+
+def _error(exc: BaseException) -> None:
+    """``hbayes: error: MESSAGE``, every line cut to :data:`MAX_LINE` characters."""
+    from heritage_bayes.errors import shorten
+
+    text = "\n".join(shorten(line, MAX_LINE) for line in str(exc).split("\n"))
+    print(f"hbayes: error: {text}", file=sys.stderr)
 
 
 def _interrupted(exc: BaseException, command: str | None) -> int:
@@ -490,11 +565,13 @@ def _main(argv: list[str] | None) -> int:
     try:
         return int(args.func(args) or 0)
     except InputError as exc:
-        print(f"hbayes: error: {exc}", file=sys.stderr)
+        _error(exc)
         _notes(exc)
         return 2
     except KeyboardInterrupt as exc:
         return _interrupted(exc, args.command)
+    except BrokenPipeError:
+        return _reader_gone()
     except OSError as exc:
         if exc.errno not in _DISK_ERRORS:
             return _internal_error()

@@ -45,15 +45,12 @@ def _csv_header(path: Path, src, where: str) -> list[str]:
     from heritage_bayes.io._common import READ_ERRORS, damaged, looks_like_table, sniff_text
     from heritage_bayes.io.readers.workbook import is_workbook, table_source
 
+    encoding = None
     try:
-        if not is_workbook(path):
-            sniff_text(path, path.name)  # binary, damaged or truncated: say so at once
+        if not is_workbook(path):  # binary, damaged or truncated: say so at once
+            encoding = sniff_text(path, path.name, encoding=src.encoding)
         header = pd.read_csv(
-            table_source(path)(),
-            nrows=0,
-            sep=src.sep,
-            encoding=None if is_workbook(path) else src.encoding,
-            skiprows=src.skiprows,
+            table_source(path)(), nrows=0, sep=src.sep, encoding=encoding, skiprows=src.skiprows
         )
     except DataError as exc:
         raise DataError(f"{where}: {exc}") from None
@@ -61,7 +58,7 @@ def _csv_header(path: Path, src, where: str) -> list[str]:
         raise DataError(f"{where}: {damaged(path.name, exc)}") from None
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
         raise DataError(f"{where}: {path.name}: cannot read the header line: {exc}") from None
-    if not is_workbook(path) and not looks_like_table(path, src.sep, src.skiprows, src.encoding):
+    if encoding is not None and not looks_like_table(path, src.sep, src.skiprows, encoding):
         raise DataError(
             f"{where}: {path.name}: not a table: its first lines do not split into the same "
             f"two or more fields by the separator {src.sep!r} (check the path and sep; the "

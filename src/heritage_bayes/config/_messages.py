@@ -137,9 +137,29 @@ def format_error(err: dict, raw: Any, root: type[BaseModel]) -> str:
         if m and loc:
             return f"{loc}.{m.group(1)}: {msg[m.end() :]}"
         return f"{loc or '(top level)'}: {msg}"
+    if typ in _BOUND_ERRORS:
+        rng = _range_of(err["loc"], root)
+        if rng:
+            return f"{loc}: {_short(found)} is outside the allowed range {rng}"
     if "(got " in msg:  # the check already says what it found
         return f"{loc or '(top level)'}: {msg}"
     return f"{loc or '(top level)'}: {msg} (got {_short(found)})"
+
+
+#: pydantic's error types of a bound (``ge``, ``gt``, ``le``, ``lt``).
+_BOUND_ERRORS = {"greater_than", "greater_than_equal", "less_than", "less_than_equal"}
+
+
+def _range_of(loc, root: type[BaseModel]) -> str:
+    """The allowed range with its unit of the key at ``loc`` (empty if unknown)."""
+    from heritage_bayes.config._base import range_text
+
+    names = [x for x in loc if isinstance(x, str) and "[" not in x]
+    if not names:
+        return ""
+    cls = section_model(loc[: len(loc) - 1 - loc[::-1].index(names[-1])], root)
+    field = cls.model_fields.get(names[-1]) if cls is not None else None
+    return range_text(field) if field is not None else ""
 
 
 def _short(value: Any, limit: int = 120) -> str:

@@ -14,6 +14,7 @@ from pydantic import BeforeValidator, field_validator, model_validator
 
 from heritage_bayes.config._base import (
     DURATION_UNIT,
+    MAX_SEED,
     DateText,
     Duration,
     NonNegativeDuration,
@@ -37,7 +38,9 @@ class Site(_Strict):
 class DemoData(_Strict):
     """The built-in virtual monument (see :mod:`heritage_bayes.demo`)."""
 
-    seed: int = key(7, unit=None, description="seed of the simulated logger's noise")
+    seed: int = key(
+        7, unit=None, description="seed of the simulated logger's noise", ge=0, le=MAX_SEED
+    )
     weather: Literal["greensboro_tmy3", "debilt_knmi"] = key(
         "greensboro_tmy3",
         unit=None,

@@ -73,7 +73,10 @@ def modal_step(index: pd.DatetimeIndex) -> pd.Timedelta | None:
 
 
 def source_name(path) -> str:
-    return Path(path).name
+    """How messages name a data file: its name (a workbook's with the sheet read)."""
+    from heritage_bayes.io.readers.workbook import is_workbook, sheet_label
+
+    return sheet_label(path) if is_workbook(path) and Path(path).is_file() else Path(path).name
 
 
 def check_file(path) -> Path:
@@ -354,9 +357,22 @@ def looks_like_table(path: Path, sep, skiprows=None, encoding: str = "utf-8") ->
     return widths[0] >= 2 and same >= 0.8 * (len(widths) - 1)
 
 
-def sniff_text(path: Path, name: str, size: int = 1 << 16) -> None:
+#: Byte-order marks of UTF-16 text ("Unicode text" of Excel and Windows tools).
+UTF16_BOMS = (b"\xff\xfe", b"\xfe\xff")
+
+
+def text_encoding(head: bytes, declared: str | None = "utf-8") -> str | None:
+    """The encoding to read a text file with: UTF-16 when it starts with a UTF-16
+    byte-order mark and the declared encoding is the default UTF-8 (an export saved as
+    "Unicode text"), otherwise the declared one."""
+    utf8 = declared is None or declared.lower().replace("_", "-") in ("utf-8", "utf8", "utf-8-sig")
+    return "utf-16" if utf8 and head.startswith(UTF16_BOMS) else declared
+
+
+def sniff_text(path: Path, name: str, size: int = 1 << 16, encoding: str | None = "utf-8"):
     """Refuse a binary file, or one without a line break early on, before pandas reads
-    it whole (a 100 MB 'header' of NUL bytes)."""
+    it whole (a 100 MB 'header' of NUL bytes); return the encoding to read it with
+    (:func:`text_encoding`: a UTF-16 export is text, not a binary file)."""
     import gzip
 
     try:
@@ -364,9 +380,13 @@ def sniff_text(path: Path, name: str, size: int = 1 << 16) -> None:
             head = fh.read(size)
     except READ_ERRORS as exc:
         raise damaged(name, exc) from None
-    if b"\x00" in head:
+    encoding = text_encoding(head, encoding)
+    wide = str(encoding).lower().replace("_", "-").startswith(("utf-16", "utf16", "utf-32"))
+    text = head.decode(encoding, errors="replace") if wide else None
+    if (b"\x00" in head) if text is None else ("\x00" in text):
         raise DataError(
             f"{name}: a binary file (NUL bytes in the first {len(head)} bytes), not a text table"
         )
     if len(head) == size and b"\n" not in head and b"\r" not in head:
         raise DataError(f"{name}: no line break in the first {size} bytes: not a text table")
+    return encoding

@@ -202,7 +202,7 @@ def read_csv(
             raise InputError(f"{name}: a workbook is read as sep ',' and decimal '.'")
         read_kw["encoding"] = None
     else:
-        sniff_text(path, name)
+        read_kw["encoding"] = encoding = sniff_text(path, name, encoding=encoding)
     table = table_source(path)
     try:
         header = pd.read_csv(table(), nrows=0, **read_kw)

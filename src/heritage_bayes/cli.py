@@ -23,6 +23,9 @@ import signal
 import sys
 import threading
 
+from heritage_bayes._terminal import print_error as _error
+from heritage_bayes._terminal import reader_gone as _reader_gone
+from heritage_bayes._terminal import tolerant_streams as _tolerant_streams
 from heritage_bayes._version import __version__
 from heritage_bayes.errors import InputError
 
@@ -494,49 +497,6 @@ def main(argv: list[str] | None = None) -> int:
         sys.unraisablehook = old_hook
         if old is not None:
             signal.signal(signal.SIGTERM, old)
-
-
-#: Exit code when the reader of the output went away (``hbayes models | head -1``):
-#: 128 + SIGPIPE, what a Unix tool killed by the signal returns.
-EXIT_READER_GONE = 128 + 13
-
-
-def _reader_gone() -> int:
-    """Stop quietly when stdout's reader closed it, as Unix tools do; stdout is pointed
-    at the null device so that Python's last flush finds no broken pipe either."""
-    import os
-
-    try:
-        fd = os.open(os.devnull, os.O_WRONLY)
-        os.dup2(fd, sys.stdout.fileno())
-        os.close(fd)
-    except (OSError, ValueError, AttributeError):  # not a file (a test's capture)
-        pass
-    return EXIT_READER_GONE
-
-
-def _tolerant_streams() -> None:
-    """stdout and stderr write what the terminal's encoding cannot hold as escapes
-    (``\\xb0`` for °, ``\\u03c4`` for τ) instead of failing: a Latin-1 or ASCII
-    terminal (``LC_ALL=C``, ``PYTHONIOENCODING=latin-1``) gets every message."""
-    for stream in (sys.stdout, sys.stderr):
-        try:
-            stream.reconfigure(errors="backslashreplace")
-        except (AttributeError, ValueError, OSError):  # not a text file of io
-            pass
-
-
-#: The longest line of a message printed (a safety net: the messages themselves quote
-#: at most :data:`heritage_bayes.errors.QUOTE_LIMIT` characters of a user's data).
-MAX_LINE = 2000
-
-
-def _error(exc: BaseException) -> None:
-    """``hbayes: error: MESSAGE``, every line cut to :data:`MAX_LINE` characters."""
-    from heritage_bayes.errors import shorten
-
-    text = "\n".join(shorten(line, MAX_LINE) for line in str(exc).split("\n"))
-    print(f"hbayes: error: {text}", file=sys.stderr)
 
 
 def _interrupted(exc: BaseException, command: str | None) -> int:

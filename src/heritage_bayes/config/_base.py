@@ -125,7 +125,7 @@ def check_in_range(model: type[BaseModel], name: str, value: Any, option: str) -
         TypeAdapter(Annotated[field.annotation, *field.metadata]).validate_python(value)
     except ValidationError:
         raise ConfigError(
-            f"{option}: {value} is outside the allowed range {range_text(field)}"
+            f"{option}: outside the allowed range {range_text(field)} (got {value})"
         ) from None
 
 

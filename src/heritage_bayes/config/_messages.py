@@ -140,7 +140,7 @@ def format_error(err: dict, raw: Any, root: type[BaseModel]) -> str:
     if typ in _BOUND_ERRORS:
         rng = _range_of(err["loc"], root)
         if rng:
-            return f"{loc}: {_short(found)} is outside the allowed range {rng}"
+            return f"{loc}: outside the allowed range {rng} (got {_short(found)})"
     if "(got " in msg:  # the check already says what it found
         return f"{loc or '(top level)'}: {msg}"
     return f"{loc or '(top level)'}: {msg} (got {_short(found)})"

@@ -38,9 +38,7 @@ class Site(_Strict):
 class DemoData(_Strict):
     """The built-in virtual monument (see :mod:`heritage_bayes.demo`)."""
 
-    seed: int = key(
-        7, unit=None, description="seed of the simulated logger's noise", ge=0, le=MAX_SEED
-    )
+    seed: int = key(7, unit=None, description="seed of the simulated noise", ge=0, le=MAX_SEED)
     weather: Literal["greensboro_tmy3", "debilt_knmi"] = key(
         "greensboro_tmy3",
         unit=None,

@@ -10,7 +10,12 @@ Thin: parse arguments, call the library, map outcomes to exit codes:
   ``project``: written, but from an unconverged calibration);
 - 2: a user error (config, data, arguments; a message, no traceback);
 - 1: an internal error (a bug: the traceback is shown);
-- 130: interrupted by SIGINT or SIGTERM at any stage.
+- 130: interrupted by SIGINT or SIGTERM at any stage;
+- 141: the reader of the output went away (``hbayes models | head -1``), as for Unix
+  tools (128 + SIGPIPE); nothing is printed.
+
+Messages are written in the terminal's encoding, with escapes (``\\xb0``) for what it
+cannot hold; a message quotes at most 100 characters of a user's data.
 
 Tested by calling :func:`main` directly, and as a subprocess (``tests/test_faults.py``).
 """

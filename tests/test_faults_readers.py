@@ -374,6 +374,31 @@ def test_a_huge_cell_is_quoted_to_100_characters(tmp_path, capsys, where):
     assert ("timestamp" in err) if where == "time" else ("column 'T'" in err)
 
 
+@pytest.mark.parametrize("where", ["header", "row"])
+def test_init_names_a_huge_line_without_quoting_it(tmp_path, capsys, where):
+    (tmp_path / "data").mkdir()
+    _csv_files(tmp_path / "data")
+    path = tmp_path / "data" / "logger.csv"
+    lines = path.read_text(encoding="utf-8").splitlines()
+    k = 0 if where == "header" else 30
+    lines[k] = lines[k].replace("T", "T" * 1_000_000, 1) if k == 0 else "Q" * 1_000_000
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    argv = ["init", path, "--weather", tmp_path / "data" / "weather.csv", "-o", tmp_path / "r.yaml"]
+    rc, err = _run_case(tmp_path, argv, capsys)
+    assert rc == 2, err[:300]
+    assert f"logger.csv: line {k + 1} has 100000" in err and "not shown" in err, err[:300]
+    assert len(err) < 1000 and _clean(err)
+
+
+def test_a_huge_column_name_is_cut_in_the_list_of_columns(tmp_path, capsys):
+    cfg = _csv_case(tmp_path)
+    path = tmp_path / "logger.csv"
+    text = path.read_text(encoding="utf-8")
+    path.write_text(text.replace("time,T,RH", "time,T,RH" + "H" * 10_000, 1), encoding="utf-8")
+    rc, err = _run_case(tmp_path, ["calibrate", cfg, "--out", tmp_path / "run"], capsys)
+    assert rc == 2 and "column 'RH' not found" in err and len(err) < 1500, err[:900]
+
+
 @pytest.mark.parametrize("what", ["measurements", "weather"])
 def test_a_system_file_given_as_data_is_named_not_quoted(tmp_path, capsys, what):
     cfg = _csv_config()

@@ -275,10 +275,13 @@ def _cmd_init(args) -> int:
         in_data_folder=args.in_data_folder,
         **{k: getattr(args, k) for k in opts},
     )
+    from heritage_bayes._terminal import MAX_LINE
+    from heritage_bayes.errors import shorten
+
     for f in res.findings:
-        print(f"hbayes init: {f}", file=sys.stderr)
+        print(f"hbayes init: {shorten(f, MAX_LINE)}", file=sys.stderr)
     for q in res.questions:
-        print(f"hbayes init: QUESTION {q}", file=sys.stderr)
+        print(f"hbayes init: QUESTION {shorten(q, MAX_LINE)}", file=sys.stderr)
     n = len(res.questions)
     tail = f"; {n} open question(s) to answer in it before `hbayes calibrate`" if n else ""
     print(f"{res.path}{tail}")

@@ -57,6 +57,8 @@ from heritage_bayes.io._common import UTF16_BOMS, _quote_list, source_name
 __all__ = ["ColumnGuess", "TableLayout", "inspect_table"]
 
 _SAMPLE_LINES = 2000
+#: The longest line of an export read [characters]: hundreds of channels fit.
+_MAX_LINE = 1 << 16
 
 #: Time formats tried on the time column (strptime), most specific first.
 TIME_FORMATS = (
@@ -286,6 +288,12 @@ def inspect_table(path, *, what: str = "file") -> TableLayout:
         raise DataError(f"{path}: {what} not found")
     text, encoding = _decode(path)
     lines = text.splitlines()[:_SAMPLE_LINES]
+    long = next((k for k, ln in enumerate(lines) if len(ln) > _MAX_LINE), None)
+    if long is not None:
+        raise DataError(
+            f"{source_name(path)}: line {long + 1} has {len(lines[long])} characters, more than "
+            f"a logger export's {_MAX_LINE}: not a table of readings (the line is not shown)"
+        )
     if len(lines) < 3:
         raise DataError(
             f"{source_name(path)}: {len(lines)} line(s); a {what} needs a header and data"

@@ -162,12 +162,17 @@ def _range_of(loc, root: type[BaseModel]) -> str:
     return range_text(field) if field is not None else ""
 
 
-def _short(value: Any, limit: int = 120) -> str:
-    """``repr`` of a value echoed in a message, cut to a readable length."""
+def _short(value: Any, limit: int | None = None) -> str:
+    """``repr`` of a value echoed in a message, cut to a readable length (a text to
+    :data:`heritage_bayes.errors.QUOTE_LIMIT` characters, as every message does)."""
     import reprlib
 
-    if isinstance(value, str) and len(value) <= limit:
-        return repr(value)
+    from heritage_bayes.errors import QUOTE_LIMIT, quoted
+
+    limit = QUOTE_LIMIT if limit is None else limit
+    if isinstance(value, str):
+        return quoted(value, limit)
+
     r = reprlib.Repr()  # keyword arguments only from Python 3.12
     r.maxstring = r.maxother = limit
     r.maxlist = r.maxtuple = r.maxdict = r.maxset = 8

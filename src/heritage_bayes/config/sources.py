@@ -57,7 +57,7 @@ class DemoData(_Strict):
         0.1, unit="K", description="sd of the temperature sensor's white noise", ge=0
     )
     sensor_noise_RH: float = key(
-        1.0, unit="%RH", description="sd of the RH sensor's white noise", ge=0
+        1.0, unit="%RH", description="sd of the RH sensor's white noise", ge=0, le=100
     )
     model_error_T: float = key(
         0.2, unit="K", description="sd of the AR(1) model error in temperature", ge=0

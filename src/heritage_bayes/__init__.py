@@ -4,8 +4,11 @@ The forward models follow Kramer, van Schijndel & Schellen, "Inverse modeling of
 responses of monumental buildings" (thermal model 4a, hygric model 3).
 """
 
+from heritage_bayes._env import writable_caches
 from heritage_bayes._version import __version__
 from heritage_bayes.errors import ConfigError, DataError, InputError
+
+writable_caches()  # before arviz, numba or matplotlib is imported
 
 #: public name -> module that defines it; imported on first use, so that ``hbayes
 #: --version`` and config errors do not wait for numpy, scipy and pandas

@@ -9,7 +9,7 @@ import warnings
 
 with warnings.catch_warnings():
     warnings.filterwarnings(
-        "ignore", message=".*ArviZ is undergoing a major refactor", category=FutureWarning
+        "ignore", message=r"\s*ArviZ is undergoing a major refactor", category=FutureWarning
     )
     import arviz as az
 

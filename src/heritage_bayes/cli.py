@@ -10,7 +10,12 @@ Thin: parse arguments, call the library, map outcomes to exit codes:
   ``project``: written, but from an unconverged calibration);
 - 2: a user error (config, data, arguments; a message, no traceback);
 - 1: an internal error (a bug: the traceback is shown);
-- 130: interrupted by SIGINT or SIGTERM at any stage.
+- 130: interrupted by SIGINT or SIGTERM at any stage;
+- 141: the reader of the output went away (``hbayes models | head -1``), as for Unix
+  tools (128 + SIGPIPE); nothing is printed.
+
+Messages are written in the terminal's encoding, with escapes (``\\xb0``) for what it
+cannot hold; a message quotes at most 100 characters of a user's data.
 
 Tested by calling :func:`main` directly, and as a subprocess (``tests/test_faults.py``).
 """
@@ -23,6 +28,9 @@ import signal
 import sys
 import threading
 
+from heritage_bayes._terminal import print_error as _error
+from heritage_bayes._terminal import reader_gone as _reader_gone
+from heritage_bayes._terminal import tolerant_streams as _tolerant_streams
 from heritage_bayes._version import __version__
 from heritage_bayes.errors import InputError
 
@@ -230,13 +238,11 @@ def _cmd_calibrate(args) -> int:
 
 def _converged_or_3(run_dir) -> int:
     """0 when the run's ``summary.json`` says converged; else name the reasons, return 3."""
-    import json
-    from pathlib import Path
-
     from heritage_bayes.convergence import EXIT_UNCONVERGED
     from heritage_bayes.report.accuracy import accuracy_failures, resolutions
+    from heritage_bayes.rundir.reader import read_summary
 
-    summary = json.loads((Path(run_dir) / "summary.json").read_text(encoding="utf-8"))
+    summary = read_summary(run_dir)
     failures = accuracy_failures(summary, resolutions({}))
     if failures:
         print(
@@ -261,6 +267,12 @@ def _converged_or_3(run_dir) -> int:
 
 
 def _cmd_init(args) -> int:
+    from heritage_bayes.config import Site
+    from heritage_bayes.config._base import check_in_range
+
+    for name in ("latitude", "longitude"):  # before any file is read
+        if getattr(args, name) is not None:
+            check_in_range(Site, name, getattr(args, name), f"--{name}")
     from heritage_bayes.init_config import init_config
 
     opts = ("weather_format", "latitude", "longitude", "name", "timezone", "weather_timezone")
@@ -272,10 +284,13 @@ def _cmd_init(args) -> int:
         in_data_folder=args.in_data_folder,
         **{k: getattr(args, k) for k in opts},
     )
+    from heritage_bayes._terminal import MAX_LINE
+    from heritage_bayes.errors import shorten
+
     for f in res.findings:
-        print(f"hbayes init: {f}", file=sys.stderr)
+        print(f"hbayes init: {shorten(f, MAX_LINE)}", file=sys.stderr)
     for q in res.questions:
-        print(f"hbayes init: QUESTION {q}", file=sys.stderr)
+        print(f"hbayes init: QUESTION {shorten(q, MAX_LINE)}", file=sys.stderr)
     n = len(res.questions)
     tail = f"; {n} open question(s) to answer in it before `hbayes calibrate`" if n else ""
     print(f"{res.path}{tail}")
@@ -334,9 +349,10 @@ def _cmd_models(args) -> int:
         print(_CONTROL_HELP)
         return 0
     try:
-        print(describe_model(args.name, noise=args.noise))
+        text = describe_model(args.name, noise=args.noise)
     except ValueError as exc:
         raise InputError(f"models NAME: {exc}") from None
+    print(text)  # outside the check: the terminal's encoding is not the name's fault
     return 0
 
 
@@ -345,7 +361,12 @@ def _cmd_compare(args) -> int:
     from heritage_bayes.config import load_config
 
     cfg = load_config(args.config)
-    models = args.models.split(",") if args.models else None
+    models = None if args.models is None else _model_list(args.models)
+    if args.seed is not None:
+        from heritage_bayes.config import CalibrationConfig
+        from heritage_bayes.config._base import check_in_range
+
+        check_in_range(CalibrationConfig, "seed", args.seed, "--seed")
     out = run_compare(
         cfg,
         models,
@@ -358,9 +379,9 @@ def _cmd_compare(args) -> int:
         workers=args.workers,
     )
     if not args.quiet:
-        import json
+        from heritage_bayes.rundir.reader import read_json_object
 
-        res = json.loads((out / "comparison.json").read_text(encoding="utf-8"))
+        res = read_json_object(out / "comparison.json", "the object of a comparison")
         for head, rows in (accuracy_rows(res), identifiability_rows(res)):
             print(" | ".join(head))
             for r in rows:
@@ -369,6 +390,22 @@ def _cmd_compare(args) -> int:
         print("recommendation:", res["recommendation"]["reason"])
         print(out / "comparison.html")
     return 0
+
+
+def _model_list(text: str) -> list[str]:
+    """``--models A,B``: the names, none empty (an unset shell variable gives '')."""
+    from heritage_bayes.errors import quoted
+
+    names = [n.strip() for n in text.split(",")]
+    if not any(names):
+        raise InputError(
+            "--models: empty; give catalogue models of one section separated by commas, "
+            "e.g. thermal_1c,thermal_2c (see `hbayes models`), or leave --models out for "
+            "the default candidates"
+        )
+    if not all(names):
+        raise InputError(f"--models: an empty name in {quoted(text)}; separate names by one comma")
+    return names
 
 
 _CONTROL_HELP = """
@@ -459,8 +496,10 @@ def main(argv: list[str] | None = None) -> int:
             old_hook(u)
 
     sys.unraisablehook = hook
+    _tolerant_streams()
     try:
         code = _main(argv)
+        sys.stdout.flush()  # here, not at exit: a reader gone (| head) is handled below
         if swallowed and code == 0:
             print(
                 "hbayes: the interrupt came too late to stop it: the run is complete",
@@ -469,6 +508,8 @@ def main(argv: list[str] | None = None) -> int:
         return code
     except KeyboardInterrupt as exc:  # before or after a command ran
         return _interrupted(exc, None)
+    except BrokenPipeError:
+        return _reader_gone()
     finally:
         sys.unraisablehook = old_hook
         if old is not None:
@@ -501,11 +542,13 @@ def _main(argv: list[str] | None) -> int:
     try:
         return int(args.func(args) or 0)
     except InputError as exc:
-        print(f"hbayes: error: {exc}", file=sys.stderr)
+        _error(exc)
         _notes(exc)
         return 2
     except KeyboardInterrupt as exc:
         return _interrupted(exc, args.command)
+    except BrokenPipeError:
+        return _reader_gone()
     except OSError as exc:
         if exc.errno not in _DISK_ERRORS:
             return _internal_error()

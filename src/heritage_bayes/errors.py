@@ -7,7 +7,19 @@ without a traceback. Anything else is an internal error (exit code 1).
 
 from __future__ import annotations
 
-__all__ = ["ConfigError", "DataError", "InputError", "check_known_keys"]
+__all__ = [
+    "QUOTE_LIMIT",
+    "ConfigError",
+    "DataError",
+    "InputError",
+    "check_known_keys",
+    "quoted",
+    "shorten",
+]
+
+#: The most characters of a user's data a message quotes (one cell, one line, one name):
+#: a 100 MB line in a logger file is named by its position, not echoed.
+QUOTE_LIMIT = 100
 
 
 class InputError(ValueError):
@@ -50,3 +62,29 @@ def check_known_keys(raw, known, *, source: str, what: str) -> None:
             f"(expected some of {', '.join(known)}); is it the right file? (its content is "
             "not shown: only files a config declares as data are quoted)"
         )
+
+
+def shorten(text: object, limit: int = QUOTE_LIMIT) -> str:
+    """``str(text)`` cut to ``limit`` characters, saying how long it was.
+
+    >>> shorten("x" * 1000, 5)
+    'xxxxx... (1000 characters)'
+    """
+    text = str(text)
+    return text if len(text) <= limit else f"{text[:limit]}... ({len(text)} characters)"
+
+
+def quoted(value: object, limit: int = QUOTE_LIMIT) -> str:
+    """``repr`` of a user's value (a cell, a line, a column name) for a message, cut to
+    ``limit`` characters of its text: ``'abc'``, ``'AAAA'... (2000000 characters)``.
+
+    >>> quoted("abc")
+    "'abc'"
+    >>> quoted("A" * 500, 4)
+    "'AAAA'... (500 characters)"
+    """
+    if not isinstance(value, str):
+        value = str(value)
+    if len(value) <= limit:
+        return repr(value)
+    return f"{value[:limit]!r}... ({len(value)} characters)"

@@ -290,28 +290,34 @@ def load_run(path: str | Path) -> Run:
     ------
     InputError
         The folder or one of ``posterior.nc``, ``summary.json``, ``config.yaml`` is
-        missing, or the recorded config snapshot does not match its SHA-256.
+        missing, truncated, of the wrong type or another file (see
+        :mod:`heritage_bayes.rundir.reader`), or the recorded config snapshot does not
+        match its SHA-256.
     """
-    import json
+    from heritage_bayes.rundir.reader import (
+        check_run_files,
+        damaged,
+        read_posterior,
+        read_summary,
+    )
 
-    from heritage_bayes._arviz import az
-
-    p = Path(path)
-    for name in ("posterior.nc", "summary.json", "config.yaml"):
-        if not (p / name).is_file():
-            raise InputError(
-                f"{p}: not a complete run directory ({name} is missing); "
-                "run `hbayes calibrate` first"
-            )
-    summary = json.loads((p / "summary.json").read_text(encoding="utf-8"))
+    p = check_run_files(path)
+    summary = read_summary(p)
     cfg = None
     if not isinstance(summary.get("provenance"), dict):  # an older run: config.yaml
         raw, _ = read_yaml(p / "config.yaml", what="run config")
         cfg = parse_config(raw, source=str(p / "config.yaml"))
-    idata = az.from_netcdf(str(p / "posterior.nc"), engine="h5netcdf")
+    idata = read_posterior(p)
     recorded, notes = _recorded_config(p, summary, idata)
     cfg = recorded or cfg
     models = {s: build_model(cfg, s) for s in SECTIONS if getattr(cfg, s) is not None}
+    for s, m in models.items():  # a posterior of other models (another run's file)
+        absent = [n for n in m.parameter_names if f"{s}.{n}" not in idata.posterior]
+        if absent:
+            raise damaged(
+                p / "posterior.nc",
+                f"no draws of {s}.{absent[0]} of the run's {m.name}: not this run's posterior",
+            )
     models = hold_as_recorded(models, summary)
     return Run(path=p, config=cfg, idata=idata, summary=summary, models=models, notes=notes)
 

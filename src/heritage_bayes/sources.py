@@ -16,7 +16,7 @@ from typing import NamedTuple
 
 import pandas as pd
 
-from heritage_bayes.errors import ConfigError, DataError, InputError
+from heritage_bayes.errors import ConfigError, DataError, InputError, quoted
 
 __all__ = [
     "INPUT_COLUMNS",
@@ -36,22 +36,21 @@ OUTPUT_COLUMNS = ("Ti", "RHi", "Pi")
 
 
 def _quote(names) -> str:
-    return ", ".join(repr(n) for n in names)
+    from heritage_bayes.io._common import _quote_list
+
+    return _quote_list(names)
 
 
 def _csv_header(path: Path, src, where: str) -> list[str]:
-    from heritage_bayes.io._common import READ_ERRORS, damaged, sniff_text
+    from heritage_bayes.io._common import READ_ERRORS, damaged, looks_like_table, sniff_text
     from heritage_bayes.io.readers.workbook import is_workbook, table_source
 
+    encoding = None
     try:
-        if not is_workbook(path):
-            sniff_text(path, path.name)  # binary, damaged or truncated: say so at once
+        if not is_workbook(path):  # binary, damaged or truncated: say so at once
+            encoding = sniff_text(path, path.name, encoding=src.encoding)
         header = pd.read_csv(
-            table_source(path)(),
-            nrows=0,
-            sep=src.sep,
-            encoding=None if is_workbook(path) else src.encoding,
-            skiprows=src.skiprows,
+            table_source(path)(), nrows=0, sep=src.sep, encoding=encoding, skiprows=src.skiprows
         )
     except DataError as exc:
         raise DataError(f"{where}: {exc}") from None
@@ -59,6 +58,12 @@ def _csv_header(path: Path, src, where: str) -> list[str]:
         raise DataError(f"{where}: {damaged(path.name, exc)}") from None
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
         raise DataError(f"{where}: {path.name}: cannot read the header line: {exc}") from None
+    if encoding is not None and not looks_like_table(path, src.sep, src.skiprows, encoding):
+        raise DataError(
+            f"{where}: {path.name}: not a table: its first lines do not split into the same "
+            f"two or more fields by the separator {src.sep!r} (check the path and sep; the "
+            "file's content is not shown)"
+        )
     return [str(c).strip() for c in header.columns]
 
 
@@ -71,7 +76,7 @@ def _check_csv_columns(path: Path, src, where: str, allowed: Sequence[str]) -> N
     for c in tcols:
         if c.strip() not in header:
             raise DataError(
-                f"{where}.time_column: column {c!r} not found in {path.name}; columns are: "
+                f"{where}.time_column: column {quoted(c)} not found in {path.name}; columns are: "
                 f"{_quote(header)}"
             )
     for std, col in (src.columns or {}).items():
@@ -87,7 +92,7 @@ def _check_csv_columns(path: Path, src, where: str, allowed: Sequence[str]) -> N
             )
         if str(col).strip() not in header:
             raise DataError(
-                f"{where}.columns.{std}: column {col!r} not found in {path.name}; columns "
+                f"{where}.columns.{std}: column {quoted(col)} not found in {path.name}; columns "
                 f"are: {_quote(header)}"
             )
 

@@ -87,7 +87,9 @@ def compare_runs(
         if ev is not None:
             acc["elpd_validation"] = {k: ev[k] for k in ("elpd", "se", "n")}
             val_pw[label] = (ev["pointwise"], ev["times"])
-        temperature = float(run.summary["models"][section].get("likelihood_temperature") or 1.0)
+        temperature = float(
+            (run.summary.get("models") or {}).get(section, {}).get("likelihood_temperature") or 1.0
+        )
         with warnings.catch_warnings():  # high Pareto k: recorded below, not printed
             warnings.simplefilter("ignore", UserWarning)
             # the draws of a tempered posterior need their own importance weights
@@ -109,7 +111,7 @@ def compare_runs(
         out_models[label] = {
             "model": model.name,
             "run_dir": str(run.path),
-            "noise": run.summary["models"][section].get("noise"),
+            "noise": (run.summary.get("models") or {}).get(section, {}).get("noise"),
             "periods": run.summary.get("periods"),
             "converged": bool(run.summary.get("converged")),
             "max_rhat": run.summary.get("max_rhat"),

@@ -37,14 +37,13 @@ def load_inference(run_dirs: Sequence[str | Path] | Mapping[str, str | Path]) ->
     InputError
         A folder is not a complete run directory.
     """
+    from heritage_bayes.rundir.reader import check_run_files, read_posterior
+
     items = run_dirs.items() if isinstance(run_dirs, Mapping) else ((None, p) for p in run_dirs)
     out = {}
     for label, p in items:
-        p = Path(p)
-        nc = p / "posterior.nc"
-        if not nc.is_file():
-            raise InputError(f"{p}: not a run directory (posterior.nc is missing)")
-        out[label or p.name] = az.from_netcdf(str(nc), engine="h5netcdf")
+        p = check_run_files(p, ("posterior.nc",))
+        out[label or p.name] = read_posterior(p)
     return out
 
 

@@ -33,7 +33,9 @@ __all__ = [
     "NonNegativeDuration",
     "TimeZone",
     "check_dates",
+    "check_in_range",
     "key",
+    "range_text",
     "utc",
 ]
 
@@ -74,6 +76,57 @@ def key(
     if not description.strip():
         raise ValueError("key: a description is required")
     return Field(default, description=description, json_schema_extra={"unit": unit}, **kwargs)
+
+
+def range_text(field: Any) -> str:
+    """The allowed range of a key with its unit, from its bounds (``ge``, ``gt``,
+    ``le``, ``lt``): ``'[-20, 40] °C'``, ``'> 0 W'``, ``'0..2147483647'``; empty
+    without bounds."""
+    lo = hi = None
+    lo_open = hi_open = False
+    for m in field.metadata:
+        for attr, is_lo, is_open in (("ge", 1, 0), ("gt", 1, 1), ("le", 0, 0), ("lt", 0, 1)):
+            v = getattr(m, attr, None)
+            if v is None:
+                continue
+            if is_lo:
+                lo, lo_open = v, bool(is_open)
+            else:
+                hi, hi_open = v, bool(is_open)
+    extra = field.json_schema_extra if isinstance(field.json_schema_extra, dict) else {}
+    unit = extra.get("unit")
+    unit = f" {unit}" if unit and unit not in ("-", "duration") else ""
+    if lo is None and hi is None:
+        return ""
+    if field.annotation is int and lo is not None and hi is not None:
+        return f"{lo}..{hi}{unit}"
+    if hi is None:
+        return f"{'>' if lo_open else '>='} {lo:g}{unit}"
+    if lo is None:
+        return f"{'<' if hi_open else '<='} {hi:g}{unit}"
+    return f"{'(' if lo_open else '['}{lo:g}, {hi:g}{')' if hi_open else ']'}{unit}"
+
+
+def check_in_range(model: type[BaseModel], name: str, value: Any, option: str) -> None:
+    """Check a value given outside a config file (a command-line option) against the
+    range of the schema's key ``model.name``: one range per quantity.
+
+    Raises
+    ------
+    ConfigError
+        Naming ``option``, the value and the allowed range with its unit.
+    """
+    from pydantic import TypeAdapter, ValidationError
+
+    from heritage_bayes.errors import ConfigError
+
+    field = model.model_fields[name]
+    try:
+        TypeAdapter(Annotated[field.annotation, *field.metadata]).validate_python(value)
+    except ValidationError:
+        raise ConfigError(
+            f"{option}: outside the allowed range {range_text(field)} (got {value})"
+        ) from None
 
 
 def _duration(v: Any, *, positive: bool) -> pd.Timedelta:

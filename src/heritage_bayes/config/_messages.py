@@ -137,17 +137,42 @@ def format_error(err: dict, raw: Any, root: type[BaseModel]) -> str:
         if m and loc:
             return f"{loc}.{m.group(1)}: {msg[m.end() :]}"
         return f"{loc or '(top level)'}: {msg}"
+    if typ in _BOUND_ERRORS:
+        rng = _range_of(err["loc"], root)
+        if rng:
+            return f"{loc}: outside the allowed range {rng} (got {_short(found)})"
     if "(got " in msg:  # the check already says what it found
         return f"{loc or '(top level)'}: {msg}"
     return f"{loc or '(top level)'}: {msg} (got {_short(found)})"
 
 
-def _short(value: Any, limit: int = 120) -> str:
-    """``repr`` of a value echoed in a message, cut to a readable length."""
+#: pydantic's error types of a bound (``ge``, ``gt``, ``le``, ``lt``).
+_BOUND_ERRORS = {"greater_than", "greater_than_equal", "less_than", "less_than_equal"}
+
+
+def _range_of(loc, root: type[BaseModel]) -> str:
+    """The allowed range with its unit of the key at ``loc`` (empty if unknown)."""
+    from heritage_bayes.config._base import range_text
+
+    names = [x for x in loc if isinstance(x, str) and "[" not in x]
+    if not names:
+        return ""
+    cls = section_model(loc[: len(loc) - 1 - loc[::-1].index(names[-1])], root)
+    field = cls.model_fields.get(names[-1]) if cls is not None else None
+    return range_text(field) if field is not None else ""
+
+
+def _short(value: Any, limit: int | None = None) -> str:
+    """``repr`` of a value echoed in a message, cut to a readable length (a text to
+    :data:`heritage_bayes.errors.QUOTE_LIMIT` characters, as every message does)."""
     import reprlib
 
-    if isinstance(value, str) and len(value) <= limit:
-        return repr(value)
+    from heritage_bayes.errors import QUOTE_LIMIT, quoted
+
+    limit = QUOTE_LIMIT if limit is None else limit
+    if isinstance(value, str):
+        return quoted(value, limit)
+
     r = reprlib.Repr()  # keyword arguments only from Python 3.12
     r.maxstring = r.maxother = limit
     r.maxlist = r.maxtuple = r.maxdict = r.maxset = 8

@@ -14,6 +14,7 @@ from pydantic import field_validator, model_validator
 
 from heritage_bayes.config._base import (
     DURATION_UNIT,
+    MAX_SEED,
     DateText,
     Duration,
     TimeZone,
@@ -36,7 +37,7 @@ class Site(_Strict):
 class DemoData(_Strict):
     """The built-in virtual monument (see :mod:`heritage_bayes.demo`)."""
 
-    seed: int = key(7, unit=None, description="seed of the simulated logger's noise")
+    seed: int = key(7, unit=None, description="seed of the simulated noise", ge=0, le=MAX_SEED)
     weather: Literal["greensboro_tmy3", "debilt_knmi"] = key(
         "greensboro_tmy3",
         unit=None,
@@ -55,7 +56,7 @@ class DemoData(_Strict):
         0.1, unit="K", description="sd of the temperature sensor's white noise", ge=0
     )
     sensor_noise_RH: float = key(
-        1.0, unit="%RH", description="sd of the RH sensor's white noise", ge=0
+        1.0, unit="%RH", description="sd of the RH sensor's white noise", ge=0, le=100
     )
     model_error_T: float = key(
         0.2, unit="K", description="sd of the AR(1) model error in temperature", ge=0

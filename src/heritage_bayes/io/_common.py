@@ -8,6 +8,7 @@ Private module: the public API is re-exported by :mod:`heritage_bayes.io`.
 
 from __future__ import annotations
 
+import csv
 import datetime as _dt
 import zlib
 from collections.abc import Iterable, Mapping
@@ -18,7 +19,7 @@ import numpy as np
 import pandas as pd
 
 from heritage_bayes.convert import format_timedelta, parse_timezone, to_jsonable
-from heritage_bayes.errors import DataError, InputError
+from heritage_bayes.errors import DataError, InputError, quoted
 
 __all__ = [
     "AVERAGED_BY_DEFAULT",
@@ -72,7 +73,10 @@ def modal_step(index: pd.DatetimeIndex) -> pd.Timedelta | None:
 
 
 def source_name(path) -> str:
-    return Path(path).name
+    """How messages name a data file: its name (a workbook's with the sheet read)."""
+    from heritage_bayes.io.readers.workbook import is_workbook, sheet_label
+
+    return sheet_label(path) if is_workbook(path) and Path(path).is_file() else Path(path).name
 
 
 def check_file(path) -> Path:
@@ -178,7 +182,7 @@ def validate_ranges(
             lo_txt = -IRRADIANCE_NOISE if col in IRRADIANCE else lo
             if invalid == "raise":
                 raise DataError(
-                    f"{name}: column {src!r} ({col}) line {int(lines[first])}: value "
+                    f"{name}: column {quoted(src)} ({col}) line {int(lines[first])}: value "
                     f"{values[first]:g} {unit} is outside the physical range "
                     f"[{lo_txt:g}, {hi:g}] {unit} ({int(bad.sum())} such values)"
                     f"{_unit_hint(col, values)}; "
@@ -328,9 +332,48 @@ def damaged(name: str, exc: BaseException) -> DataError:
     return DataError(f"{name}: cannot read the file (damaged or truncated?): {exc}")
 
 
-def sniff_text(path: Path, name: str, size: int = 1 << 16) -> None:
+def looks_like_table(path: Path, sep, skiprows=None, encoding: str = "utf-8") -> bool:
+    """Whether a text file's first lines split into one number (two or more) of fields
+    by ``sep``: a table, whose header may be quoted in a message. A file that does not
+    (``/etc/passwd`` given as a logger file) is named, its lines never shown: they may
+    not be the user's. True when it cannot tell (a regex separator, a list of rows to
+    skip)."""
+    import gzip
+
+    if not isinstance(sep, str) or len(sep) != 1 or not isinstance(skiprows, int | None):
+        return True
+    try:
+        with gzip.open(path, "rb") if path.suffix == ".gz" else open(path, "rb") as fh:
+            head = fh.read(1 << 16)
+    except READ_ERRORS:
+        return True  # the reader names a damaged file
+    text = head.decode(encoding if encoding else "utf-8", errors="replace")
+    lines = [ln for ln in text.splitlines()[(skiprows or 0) :][:21] if ln.strip()]
+    if len(head) == 1 << 16 and len(lines) > 1:
+        lines = lines[:-1]  # the last line may be cut by the sample's end
+    if not lines:
+        return False
+    widths = [len(next(csv.reader([ln], delimiter=sep))) for ln in lines]
+    same = sum(w == widths[0] for w in widths[1:])
+    return widths[0] >= 2 and same >= 0.8 * (len(widths) - 1)
+
+
+#: Byte-order marks of UTF-16 text ("Unicode text" of Excel and Windows tools).
+UTF16_BOMS = (b"\xff\xfe", b"\xfe\xff")
+
+
+def text_encoding(head: bytes, declared: str | None = "utf-8") -> str | None:
+    """The encoding to read a text file with: UTF-16 when it starts with a UTF-16
+    byte-order mark and the declared encoding is the default UTF-8 (an export saved as
+    "Unicode text"), otherwise the declared one."""
+    utf8 = declared is None or declared.lower().replace("_", "-") in ("utf-8", "utf8", "utf-8-sig")
+    return "utf-16" if utf8 and head.startswith(UTF16_BOMS) else declared
+
+
+def sniff_text(path: Path, name: str, size: int = 1 << 16, encoding: str | None = "utf-8"):
     """Refuse a binary file, or one without a line break early on, before pandas reads
-    it whole (a 100 MB 'header' of NUL bytes)."""
+    it whole (a 100 MB 'header' of NUL bytes); return the encoding to read it with
+    (:func:`text_encoding`: a UTF-16 export is text, not a binary file)."""
     import gzip
 
     try:
@@ -338,9 +381,13 @@ def sniff_text(path: Path, name: str, size: int = 1 << 16) -> None:
             head = fh.read(size)
     except READ_ERRORS as exc:
         raise damaged(name, exc) from None
-    if b"\x00" in head:
+    encoding = text_encoding(head, encoding)
+    wide = str(encoding).lower().replace("_", "-").startswith(("utf-16", "utf16", "utf-32"))
+    text = head.decode(encoding, errors="replace") if wide else None
+    if (b"\x00" in head) if text is None else ("\x00" in text):
         raise DataError(
             f"{name}: a binary file (NUL bytes in the first {len(head)} bytes), not a text table"
         )
     if len(head) == size and b"\n" not in head and b"\r" not in head:
         raise DataError(f"{name}: no line break in the first {size} bytes: not a text table")
+    return encoding

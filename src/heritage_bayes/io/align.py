@@ -33,7 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from heritage_bayes.errors import DataError, InputError
+from heritage_bayes.errors import DataError, InputError, quoted
 from heritage_bayes.io._common import (
     AVERAGED_BY_DEFAULT,
     format_timedelta,
@@ -153,7 +153,7 @@ def _input_series(df: pd.DataFrame, label: str, averaged: set[str]) -> list[_Inp
         values = np.full(n, np.nan)
         values[pos] = df[col].to_numpy(dtype=float)
         if np.isnan(values).all():
-            raise DataError(f"{label}: input column {col!r} has no values")
+            raise DataError(f"{label}: input column {quoted(col)} has no values")
         out.append(_Input(col, label, times, values, delta, col in averaged))
     return out
 

@@ -51,11 +51,14 @@ from pathlib import Path
 
 import numpy as np
 
-from heritage_bayes.errors import DataError
+from heritage_bayes.errors import DataError, quoted
+from heritage_bayes.io._common import UTF16_BOMS, _quote_list, source_name
 
 __all__ = ["ColumnGuess", "TableLayout", "inspect_table"]
 
 _SAMPLE_LINES = 2000
+#: The longest line of an export read [characters]: hundreds of channels fit.
+_MAX_LINE = 1 << 16
 
 #: Time formats tried on the time column (strptime), most specific first.
 TIME_FORMATS = (
@@ -153,6 +156,10 @@ def _decode(path: Path) -> tuple[str, str]:
     if is_workbook(path):
         return workbook_text(path), "utf-8"
     data = path.read_bytes()[: 1 << 22]
+    if data.startswith(UTF16_BOMS):  # "Unicode text": UTF-16 with its byte-order mark
+        text = data[: len(data) // 2 * 2].decode("utf-16", errors="replace")
+        if "\x00" not in text[:2048]:
+            return text, "utf-16"
     if b"\x00" in data[:4096]:
         raise DataError(
             f"{path.name}: a binary file, not a text table (workbooks are read when named "
@@ -285,8 +292,16 @@ def inspect_table(path, *, what: str = "file") -> TableLayout:
         raise DataError(f"{path}: {what} not found")
     text, encoding = _decode(path)
     lines = text.splitlines()[:_SAMPLE_LINES]
+    long = next((k for k, ln in enumerate(lines) if len(ln) > _MAX_LINE), None)
+    if long is not None:
+        raise DataError(
+            f"{source_name(path)}: line {long + 1} has {len(lines[long])} characters, more than "
+            f"a logger export's {_MAX_LINE}: not a table of readings (the line is not shown)"
+        )
     if len(lines) < 3:
-        raise DataError(f"{path.name}: {len(lines)} line(s); a {what} needs a header and data")
+        raise DataError(
+            f"{source_name(path)}: {len(lines)} line(s); a {what} needs a header and data"
+        )
     layout, h, after, sep = _layout(lines)
     notes: list[str] = []
     if sep is None:
@@ -305,7 +320,7 @@ def inspect_table(path, *, what: str = "file") -> TableLayout:
         )
         if h is None or width < 2:
             raise DataError(
-                f"{path.name}: no table found (no run of lines with the same number of "
+                f"{source_name(path)}: no table found (no run of lines with the same number of "
                 f"fields separated by ',', ';' or tab)"
             )
     header = [c.strip().strip('"') for c in _split(lines[h], sep)]
@@ -313,13 +328,18 @@ def inspect_table(path, *, what: str = "file") -> TableLayout:
     body = [_split(ln, sep) for k, ln in enumerate(lines) if k > h and k not in skip_set]
     body = [r for r in body if any(c.strip() for c in r)]
     if not body:
-        raise DataError(f"{path.name}: a header line ({lines[h][:80]!r}) but no data lines")
+        raise DataError(
+            f"{source_name(path)}: a header line ({quoted(lines[h], 80)}) but no data lines"
+        )
     cols = {name: [r[i] if i < len(r) else "" for r in body] for i, name in enumerate(header)}
     if layout == "tinytag":  # channel names are on the 'Property' line
         prop = _split(lines[after[-1]], sep)
         notes.append(
             "Tinytag Explorer export: channels "
-            + ", ".join(f"{header[i]!r} = {prop[i]}" for i in range(2, min(len(prop), len(header))))
+            + ", ".join(
+                f"{quoted(header[i])} = {quoted(prop[i])}"
+                for i in range(2, min(len(prop), len(header)))
+            )
         )
 
     # -- time column -----------------------------------------------------------------------
@@ -343,8 +363,8 @@ def inspect_table(path, *, what: str = "file") -> TableLayout:
         time_column, fmt = _split_date_columns(cols)
     if time_column is None:
         raise DataError(
-            f"{path.name}: no column holds time stamps in a known format; columns are "
-            f"{header}; first data line {lines[h + 1][:80]!r}"
+            f"{source_name(path)}: no column holds time stamps in a known format; columns are "
+            f"{_quote_list(header)}; first data line {quoted(lines[h + 1], 80)}"
         )
     tnames = [time_column] if isinstance(time_column, str) else time_column
     if fmt != "ISO8601":  # check the format on the whole sample

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import time
 import traceback
 from collections.abc import Mapping
@@ -21,13 +20,14 @@ __all__ = ["measured_risk", "room_row"]
 def _is_done(run_dir: Path, chash: str) -> bool:
     """A finished run of the same config: a run directory (valid marker) whose
     summary.json has the same config hash."""
+    from heritage_bayes.rundir.reader import read_summary
     from heritage_bayes.rundir.writer import is_run_directory
 
     if not is_run_directory(run_dir):
         return False
     try:
-        s = json.loads((run_dir / "summary.json").read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+        s = read_summary(run_dir)
+    except InputError:  # damaged: calibrated again
         return False
     return s.get("config_hash") == chash
 
@@ -96,14 +96,15 @@ def _project_room(run_dir: Path, projection: Path, resume: bool) -> dict:
     ``projection.json`` of the same run is reused.
     """
     from heritage_bayes.projection import project
+    from heritage_bayes.rundir.reader import read_json_object
 
     dest = run_dir / "projection"
     summary_path = dest / "projection.json"
     summary = None
     if resume and summary_path.is_file():
         try:
-            summary = json.loads(summary_path.read_text(encoding="utf-8"))
-        except ValueError:
+            summary = read_json_object(summary_path, "the object of a projection summary")
+        except InputError:  # damaged: projected again
             summary = None
     if summary is None:
         summary = project(run_dir, projection, out=dest).summary
@@ -147,8 +148,10 @@ def room_row(run_dir: str | Path) -> dict:
     outdoor-temperature gain of each section, and conservation-risk indicators of the
     *measured* indoor climate over the data period (:func:`measured_risk`).
     """
+    from heritage_bayes.rundir.reader import read_summary
+
     run_dir = Path(run_dir)
-    s = json.loads((run_dir / "summary.json").read_text(encoding="utf-8"))
+    s = read_summary(run_dir)
     row: dict[str, Any] = {
         "run_dir": str(run_dir),
         "report": str(run_dir / "report.html") if (run_dir / "report.html").is_file() else "",
@@ -192,15 +195,17 @@ def measured_risk(run_dir: str | Path) -> dict:
     (see ``assess``); the overview sorts by it. Both temperature and RH must have been
     logged; otherwise the columns are absent.
     """
-    from heritage_bayes._arviz import az
     from heritage_bayes.climate import risk
     from heritage_bayes.climate.risk._inputs import MIN_YEAR_HOURS
+    from heritage_bayes.rundir.reader import read_posterior
 
-    path = Path(run_dir) / "posterior.nc"
     try:
-        obs = az.from_netcdf(str(path)).observed_data
-    except (OSError, ValueError, AttributeError):
+        idata = read_posterior(run_dir)
+    except InputError:
         return {}
+    if "observed_data" not in idata.groups():
+        return {}
+    obs = idata.observed_data
     if "Ti" not in obs or "RHi" not in obs:
         return {}
     T = np.asarray(obs["Ti"].values, dtype=float)

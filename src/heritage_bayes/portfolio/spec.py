@@ -70,10 +70,12 @@ def load_portfolio(path: str | Path) -> Portfolio:
     ------
     ConfigError
         Listing *every* bad entry (missing or invalid config, duplicate room name,
-        invalid overrides, missing projection file), each with its room name and key path.
+        invalid overrides, missing or invalid projection file), each with its room name
+        and key path.
     """
     from heritage_bayes.calibrate import check_models
     from heritage_bayes.config import parse_config
+    from heritage_bayes.projection.config import load_projection_config
 
     p = Path(path)
     raw = _read_yaml(p, "portfolio")
@@ -150,6 +152,24 @@ def load_portfolio(path: str | Path) -> Portfolio:
             proj_path = proj_path if proj_path.is_absolute() else base / proj_path
             if not proj_path.is_file():
                 errors.append(f"{where}.projection: file not found: {proj_path}")
+                continue
+            try:  # the file validated now, not after the room's calibration
+                load_projection_config(proj_path)
+            except ConfigError as exc:
+                errors.append(f"{where}.projection: {exc}")
+                continue
+            if cfg.thermal is None or cfg.hygric is None:
+                has = [s for s in ("thermal", "hygric") if getattr(cfg, s) is not None]
+                errors.append(
+                    f"{where}.projection: a projection of risk needs both the thermal and the "
+                    f"hygric model (indoor T and RH); the room's config has {has}"
+                )
+                continue
+            if cfg.data.step.total_seconds() != 3600.0:
+                errors.append(
+                    f"{where}.projection: the risk indicators need an hourly grid; the room's "
+                    f"data.step is {cfg.data.step.total_seconds():g} s"
+                )
                 continue
         specs.append(RoomSpec(rname, cfile, merged, str(cfile.parent), proj_path))
     if errors:

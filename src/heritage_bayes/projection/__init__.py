@@ -178,6 +178,11 @@ def project(
             from heritage_bayes.errors import ConfigError
 
             raise ConfigError(f"--draws: expected a positive number (got {draws})")
+        if seed is not None:
+            from heritage_bayes.config._base import check_in_range
+            from heritage_bayes.projection.config import ProjectionConfig
+
+            check_in_range(ProjectionConfig, "seed", seed, "--seed")
         pcfg = pcfg.model_copy(update=upd)
     dest = None
     if write:  # the output path checked before anything is read

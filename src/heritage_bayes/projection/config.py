@@ -77,6 +77,7 @@ from pydantic import Field, ValidationError, field_validator, model_validator
 
 from heritage_bayes.climate.morph import KNMI14_SCENARIOS
 from heritage_bayes.config import (
+    MAX_SEED,
     GroundTemperature,
     Source,
     _format_error,
@@ -87,6 +88,18 @@ from heritage_bayes.config import (
 from heritage_bayes.errors import ConfigError, check_known_keys
 
 __all__ = ["ProjectionConfig", "load_projection_config", "parse_projection_config"]
+
+#: Bounds of an air temperature set by a measure [°C]: a heated or conserved room's air
+#: (frost protection to comfort heating), not the outdoor or a heater's surface.
+SETPOINT = {"ge": -20.0, "le": 40.0}
+#: Bounds of a heating power [W]: up to 10 MW (a cathedral's plant is below 1 MW).
+POWER = {"gt": 0.0, "le": 1e7}
+#: Bounds of a (de)humidifier's capacity [kg/h]: up to 1000 kg/h (a portable unit
+#: removes about 1 kg/h, an industrial desiccant one tens).
+CAPACITY = {"ge": 0.0, "le": 1000.0}
+#: Bounds of the electric energy per kg of water moved [kWh/kg] (latent heat 0.63,
+#: a steam humidifier about 0.75).
+ENERGY_PER_KG = {"ge": 0.0, "le": 10.0}
 
 Humidity = Literal["constant_rh", "constant_vapour_pressure", "table"]
 
@@ -155,15 +168,19 @@ class ConservationHeating(_Strict):
         unit="%", gt=0, le=100, description="RH the heating keeps the air at or below"
     )
     t_min: float | None = key(
-        None, unit="°C", description="heating floor: the air is never colder (default none)"
+        None,
+        unit="°C",
+        description="heating floor: the air is never colder (default none)",
+        **SETPOINT,
     )
     t_max: float = key(
         unit="°C",
+        **SETPOINT,
         description="the heating never raises the air above this temperature; the RH "
         "limit then yields (comfort, collection, energy)",
     )
     power_max: float | None = key(
-        None, unit="W", gt=0, description="heating power available (default unlimited)"
+        None, unit="W", description="heating power available (default unlimited)", **POWER
     )
 
     @model_validator(mode="after")
@@ -177,9 +194,9 @@ class Heating(_Strict):
     """A thermostat: the air heated to ``t_set`` and, in the hours of use of a weekly
     calendar, to ``t_use`` (intermittent heating of a church), up to ``power_max``."""
 
-    t_set: float = key(unit="°C", description="set-point outside the hours of use")
+    t_set: float = key(unit="°C", description="set-point outside the hours of use", **SETPOINT)
     t_use: float | None = key(
-        None, unit="°C", description="set-point in the hours of use (needs weekly)"
+        None, unit="°C", description="set-point in the hours of use (needs weekly)", **SETPOINT
     )
     weekly: list[str] | None = key(
         None,
@@ -188,7 +205,7 @@ class Heating(_Strict):
     )
     timezone: str = key("UTC", unit=None, description="time zone of the weekly hours")
     power_max: float | None = key(
-        None, unit="W", gt=0, description="heating power available (default unlimited)"
+        None, unit="W", description="heating power available (default unlimited)", **POWER
     )
 
     @model_validator(mode="after")
@@ -208,12 +225,12 @@ class Dehumidification(_Strict):
 
     rh_max: float = key(unit="%", gt=0, le=100, description="RH kept at or below")
     capacity: float = key(
-        unit="kg/h", ge=0, description="water the dehumidifier can remove per hour"
+        unit="kg/h", description="water the dehumidifier can remove per hour", **CAPACITY
     )
     energy_per_kg: float | None = key(
         None,
         unit="kWh/kg",
-        ge=0,
+        **ENERGY_PER_KG,
         description="electric energy per kg of water removed (the unit's data sheet); "
         "without it, the running cost is the water removed only",
     )
@@ -230,25 +247,28 @@ class HumidistatBand(_Strict):
     rh_min: float = key(unit="%", ge=0, lt=100, description="the humidifier keeps the RH above")
     rh_max: float = key(unit="%", gt=0, le=100, description="the dehumidifier keeps the RH below")
     dehumidifier_capacity: float = key(
-        unit="kg/h", ge=0, description="water the dehumidifier can remove per hour (0: none)"
+        unit="kg/h",
+        description="water the dehumidifier can remove per hour (0: none)",
+        **CAPACITY,
     )
     humidifier_capacity: float = key(
-        unit="kg/h", ge=0, description="water the humidifier can add per hour (0: none)"
+        unit="kg/h", description="water the humidifier can add per hour (0: none)", **CAPACITY
     )
     differential: float = key(
         5.0,
         unit="%",
         ge=0,
+        le=100,
         description="switching differential of the humidistat (typical units 3-5 % RH; "
         "0: the RH held at the limit, a modulating unit)",
     )
     dehumidifier_energy_per_kg: float | None = key(
-        None, unit="kWh/kg", ge=0, description="electric energy per kg of water removed"
+        None, unit="kWh/kg", description="electric energy per kg of water removed", **ENERGY_PER_KG
     )
     humidifier_energy_per_kg: float | None = key(
         None,
         unit="kWh/kg",
-        ge=0,
+        **ENERGY_PER_KG,
         description="electric energy per kg of water added (steam: about 0.75; the data sheet)",
     )
 
@@ -270,7 +290,7 @@ class Ventilation(_Strict):
     thermal model (ventilation and glazing: the thermal model lumps them)."""
 
     factor: float = key(
-        unit="-", ge=0, description="factor on the calibrated air exchange (0.5: half)"
+        unit="-", ge=0, le=100, description="factor on the calibrated air exchange (0.5: half)"
     )
 
 
@@ -354,7 +374,9 @@ class ProjectionConfig(_Strict):
     morphing: list[Morphing] = Field(default_factory=list)
     files: list[FutureFile] = Field(default_factory=list)
     draws: int = Field(default=200, ge=1)
-    seed: int = 0
+    seed: int = key(
+        0, unit=None, description="seed of the draws chosen and of the noise", ge=0, le=MAX_SEED
+    )
     noise: bool = Field(default=True, description="add a draw of each section's noise model")
     risk: RiskOptions = Field(default_factory=RiskOptions)
     thresholds: list[Threshold] = Field(default_factory=lambda: list(DEFAULT_THRESHOLDS))

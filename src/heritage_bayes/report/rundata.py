@@ -7,7 +7,6 @@ its ``posterior.nc`` groups and ``summary.json`` into arrays and labels.
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -52,39 +51,20 @@ class RunData:
 
 
 def load_run_data(run_dir) -> RunData:
-    p = Path(run_dir)
-    if not p.is_dir():
-        raise InputError(f"{p}: run directory not found; run `hbayes calibrate` first")
-    missing = [n for n in REQUIRED_FILES if not (p / n).is_file()]
-    if missing:
-        raise InputError(
-            f"{p}: not a complete run directory ({', '.join(missing)} "
-            f"{'is' if len(missing) == 1 else 'are'} missing); run "
-            "`hbayes calibrate` first"
-        )
-    try:
-        json.loads((p / "summary.json").read_text(encoding="utf-8"))
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise InputError(
-            f"{p / 'summary.json'}: not valid JSON ({exc}); the run "
-            "directory is damaged, run `hbayes calibrate` again"
-        ) from None
-    from heritage_bayes.run import load_run
+    """The run directory, checked and loaded (:func:`heritage_bayes.run.load_run`: a
+    missing, truncated, mistyped or foreign file is an InputError naming it)."""
+    from heritage_bayes.run import config_yaml, load_run
+    from heritage_bayes.rundir.reader import check_run_files
 
-    try:
-        run = load_run(p)
-    except InputError:
-        raise
-    except (OSError, ValueError, KeyError) as exc:
-        raise InputError(
-            f"{p / 'posterior.nc'}: cannot be read ({exc}); the run "
-            "directory is damaged, run `hbayes calibrate` again"
-        ) from None
-    from heritage_bayes.run import config_yaml
-
+    p = check_run_files(run_dir, REQUIRED_FILES)
+    run = load_run(p)
     recorded = isinstance(run.summary.get("provenance"), dict)
     # the config that produced the posterior (hash checked by load_run), not an edit
-    text = config_yaml(run.config) if recorded else (p / "config.yaml").read_text("utf-8")
+    text = (
+        config_yaml(run.config)
+        if recorded
+        else (p / "config.yaml").read_text("utf-8", errors="replace")
+    )
     return RunData(path=p, run=run, summary=run.summary, config_text=text)
 
 

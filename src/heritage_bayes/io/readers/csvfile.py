@@ -13,7 +13,7 @@ from os import PathLike
 import numpy as np
 import pandas as pd
 
-from heritage_bayes.errors import DataError, InputError
+from heritage_bayes.errors import DataError, InputError, quoted
 from heritage_bayes.io._common import (
     AVERAGED_BY_DEFAULT,
     DUPLICATE_POLICIES,
@@ -178,7 +178,9 @@ def read_csv(
         raise InputError(f"sort must be True or False (got {sort!r})")
     time_cols = [time_column] if isinstance(time_column, str) else list(time_column)
     if not time_cols or not all(isinstance(c, str) for c in time_cols):
-        raise InputError(f"time_column must be a column name or a list of names ({time_column!r})")
+        raise InputError(
+            f"time_column must be a column name or a list of names ({quoted(time_column)})"
+        )
     skip_list = None
     if not isinstance(skiprows, int | bool) and isinstance(skiprows, Sequence):
         if not all(isinstance(i, int) and not isinstance(i, bool) and i >= 0 for i in skiprows):
@@ -200,7 +202,7 @@ def read_csv(
             raise InputError(f"{name}: a workbook is read as sep ',' and decimal '.'")
         read_kw["encoding"] = None
     else:
-        sniff_text(path, name)
+        read_kw["encoding"] = encoding = sniff_text(path, name, encoding=encoding)
     table = table_source(path)
     try:
         header = pd.read_csv(table(), nrows=0, **read_kw)
@@ -218,7 +220,7 @@ def read_csv(
             raise DataError(
                 f"{name}: no column has a standard name and no columns= mapping was given; "
                 f"columns are: {_quote_list(stripped)}; pass e.g. "
-                f"columns={{'Ti': {stripped[-1]!r}}}"
+                f"columns={{'Ti': {quoted(stripped[-1])}}}"
             )
     if not isinstance(columns, Mapping) or not columns:
         raise InputError("columns must be a non-empty mapping {standard_name: source_column}")
@@ -234,10 +236,12 @@ def read_csv(
         hits = [i for i, c in enumerate(stripped) if c == col]
         if not hits:
             raise DataError(
-                f"{name}: column {col!r} not found; columns are: {_quote_list(stripped)}"
+                f"{name}: column {quoted(col)} not found; columns are: {_quote_list(stripped)}"
             )
         if len(hits) > 1:
-            raise DataError(f"{name}: column name {col!r} appears {len(hits)} times in the header")
+            raise DataError(
+                f"{name}: column name {quoted(col)} appears {len(hits)} times in the header"
+            )
         return hits[0]
 
     time_pos = [position(c) for c in time_cols]
@@ -303,7 +307,7 @@ def read_csv(
             expected = f"format {time_format!r}" if time_format else "the format of line 2"
             shown = text.iloc[i] if isinstance(text.iloc[i], str) else ""
             raise DataError(
-                f"{name}: cannot parse timestamp {shown!r} in column(s) "
+                f"{name}: cannot parse timestamp {quoted(shown)} in column(s) "
                 f"{_quote_list(time_cols)} on line {int(lines[i])} (expected {expected}); "
                 f"{int(bad.sum())} bad timestamp(s). Fix the file or pass invalid='nan' to "
                 f"drop such rows"
@@ -323,8 +327,8 @@ def read_csv(
             i = int(np.flatnonzero(unparsed)[0])
             if invalid == "raise":
                 raise DataError(
-                    f"{name}: column {src!r} line {int(lines[i])}: cannot parse "
-                    f"{raw[src].iloc[i]!r} as a number (decimal mark {decimal!r}); "
+                    f"{name}: column {quoted(src)} line {int(lines[i])}: cannot parse "
+                    f"{quoted(raw[src].iloc[i])} as a number (decimal mark {decimal!r}); "
                     f"{int(unparsed.sum())} such value(s). Declare missing-value markers "
                     f"with na_values= or pass invalid='nan'"
                 )
@@ -343,7 +347,7 @@ def read_csv(
         if tz is not None:
             raise DataError(
                 f"{name}: timestamps carry their own UTC offset (line {int(lines[0])}: "
-                f"{text.iloc[0]!r}); omit timezone= (got {timezone!r})"
+                f"{quoted(text.iloc[0])}); omit timezone= (got {timezone!r})"
             )
         utc = stamp_index.tz_convert("UTC")
         keep = np.ones(len(utc), dtype=bool)
@@ -352,7 +356,7 @@ def read_csv(
         if tz is None:
             raise DataError(
                 f"{name}: timestamps have no UTC offset (line {int(lines[0])}: "
-                f"{text.iloc[0]!r}); pass timezone=, e.g. 'UTC', 'UTC+2' or "
+                f"{quoted(text.iloc[0])}); pass timezone=, e.g. 'UTC', 'UTC+2' or "
                 f"'Europe/Copenhagen'"
             )
         loc = localize(stamp_index, tz)
@@ -371,7 +375,7 @@ def read_csv(
         duplicates=duplicates,
         sort=sort,
         counts=counts,
-        describe=lambda line: f"{line_text[int(line)]!r}",
+        describe=lambda line: quoted(line_text[int(line)]),
     )
     frame = frame.drop(columns="__line")
 

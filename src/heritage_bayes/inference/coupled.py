@@ -1,0 +1,165 @@
+"""The likelihood of a thermo-hygric coupled model: its exact recursion and the noise
+filter in one compiled pass.
+
+A :class:`~heritage_bayes.rc.sorption.CoupledHygricModel` is linear time-varying in its
+states given the temperatures, so it has no constant modal form for
+:meth:`~heritage_bayes.inference.likelihoods.NoiseModel.filter_modal`. This module runs
+its per-step transitions (:func:`heritage_bayes.rc.sorption.coupled_block`) through the
+same Gaussian residual filter (stationary AR(1) model error plus white measurement
+noise, exact across gaps) and returns the same sufficient statistics, with the basis of
+the initial state in **physical** coordinates: the output is linear in the initial state
+given the temperatures (the transitions do not depend on it), so the free responses of
+the unit offsets of each node, propagated by the same transitions, give the gradient g
+and curvature H with which :class:`~heritage_bayes.inference.posterior.LogPosterior`
+integrates the initial state out exactly, as it does for the linear models.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+from heritage_bayes.rc import sorption
+from heritage_bayes.rc.sorption import BLOCK, coupled_block
+
+__all__ = ["coupled_filter_stats"]
+
+_LOG2PI = math.log(2.0 * math.pi)
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _coupled_kf(
+    kp, pe, dpe, rs, ps, slope, dt, x0, yobs, sigma, phi, w, nb, acc
+):  # pragma: no cover - compiled
+    """Recursion + residual filter + initial-state statistics of every walker.
+
+    kp (K, 7) kernel parameters; pe, dpe, rs, ps, slope: the step series of
+    :meth:`~heritage_bayes.rc.sorption.CoupledHygricModel.series`; x0 (K, 2) initial
+    states [Pa]; yobs (N,) observed ``Pi`` (NaN = excluded); sigma, phi, w (K,) noise
+    parameters; nb: 2 (basis of both nodes) or 0; acc (3 + nb + nb², K) as
+    :meth:`NoiseModel.filter_modal` (rows: sum log 2πF, sum e²/F, unused, g, lower
+    triangle of H), in physical coordinates.
+    """
+    K = kp.shape[0]
+    N = pe.size
+    Mf = np.empty((6, BLOCK))
+    bw = np.empty(2)
+    bi = np.empty(2)
+    mb = np.zeros(2)
+    eb = np.zeros(2)
+    for p in range(K):
+        s2 = sigma[p] * sigma[p]
+        w2 = w[p] * w[p]
+        ph = phi[p]
+        xw = x0[p, 0]
+        xi = x0[p, 1]
+        bw[0], bi[0], bw[1], bi[1] = 1.0, 0.0, 0.0, 1.0
+        mb[0] = 0.0
+        mb[1] = 0.0
+        m = 0.0
+        Pv = 0.0
+        last = -1
+        conv = False
+        lF = 0.0
+        iF = 0.0
+        g = 0.0
+        a0 = 0.0
+        a1 = 0.0
+        for k0 in range(0, N, BLOCK):
+            B = min(BLOCK, N - k0)
+            coupled_block(kp[p], pe, dpe, rs, ps, dt, slope, k0, B, Mf)
+            for b in range(B):
+                k = k0 + b
+                y = yobs[k]
+                if y == y:
+                    if last >= 0 and k - last == 1 and conv:
+                        phd = ph
+                    else:
+                        if last < 0:
+                            phd = 0.0
+                            Pp = s2
+                        else:
+                            d = k - last
+                            phd = ph if d == 1 else ph**d
+                            Pp = phd * phd * Pv + s2 * (1.0 - phd * phd)
+                        F = Pp + w2
+                        iF = 1.0 / F
+                        g = Pp * iF
+                        lF = _LOG2PI + math.log(F)
+                        Pn = Pp * w2 * iF
+                        conv = last >= 0 and k - last == 1 and abs(Pn - Pv) <= 1e-13 * Pn
+                        Pv = Pn
+                    e0 = (y - xi) - phd * m
+                    m = phd * m + g * e0
+                    a0 += lF
+                    a1 += e0 * e0 * iF
+                    for j in range(nb):
+                        e = bi[j] - phd * mb[j]
+                        mb[j] = phd * mb[j] + g * e
+                        eb[j] = e
+                        acc[3 + j, p] += e0 * iF * e
+                    for i in range(nb):
+                        for j in range(i + 1):
+                            acc[3 + nb + i * nb + j, p] += eb[i] * eb[j] * iF
+                    last = k
+                xw, xi = (
+                    Mf[0, b] * xw + Mf[1, b] * xi + Mf[4, b],
+                    Mf[2, b] * xw + Mf[3, b] * xi + Mf[5, b],
+                )
+                for j in range(nb):
+                    bw[j], bi[j] = (
+                        Mf[0, b] * bw[j] + Mf[1, b] * bi[j],
+                        Mf[2, b] * bw[j] + Mf[3, b] * bi[j],
+                    )
+        acc[0, p] = a0
+        acc[1, p] = a1
+
+
+def coupled_filter_stats(model, P, series, x0, Yobs, noise_model, noise, *, basis, dt):
+    """Sufficient statistics of the log-likelihood of a coupled model (the layout of
+    :meth:`~heritage_bayes.inference.likelihoods.NoiseModel.filter_modal`, the basis in
+    physical coordinates: the node order of ``model.state_names``).
+
+    Parameters
+    ----------
+    model : CoupledHygricModel
+    P : (K, n_params) array
+        Model parameters, SI units.
+    series : tuple
+        :meth:`~heritage_bayes.rc.sorption.CoupledHygricModel.series` of the inputs.
+    x0 : (K, 2) array
+        Initial states [Pa] (the prior mean).
+    Yobs : (N, 1) array
+        Observed ``Pi`` [Pa], NaN where missing or excluded.
+    noise_model : NoiseModel
+        A residual noise model (``iid``, ``ar1``, ``ar1_white``).
+    noise : (K, q) array
+        Its parameter values.
+    basis : bool
+        Also the statistics of the initial state's free responses.
+    dt : float
+        Time step [s].
+    """
+    K = P.shape[0]
+    nb = 2 if basis else 0
+    sigma, phi, w = noise_model._split(noise, 0)
+    acc = np.zeros((3 + nb + nb * nb, K))
+    x = np.ascontiguousarray(np.where(np.isfinite(x0), x0, 0.0))
+    _coupled_kf(
+        model.kernel_parameters(P),
+        *series,
+        float(dt),
+        x,
+        np.ascontiguousarray(Yobs[:, 0]),
+        sigma,
+        phi,
+        w,
+        nb,
+        acc,
+    )
+    return acc
+
+
+sorption.stamp_cache(globals(), sorption, sorption._vecmath)

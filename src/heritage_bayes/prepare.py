@@ -242,6 +242,13 @@ def _output_hint(missing: Sequence[str]) -> str:
 
 
 # ---------------------------------------------------------------------------------------
+def _section_inputs(cfg, section: str) -> tuple[str, ...]:
+    """The input columns of a section's model."""
+    from heritage_bayes.models import build_model  # the models decide their inputs
+
+    return tuple(build_model(cfg, section).input_names)
+
+
 def _extra_inputs(cfg) -> list[str]:
     """Model inputs beyond those built here (Te, Pe, Tf, I_<surface>), in model order."""
     from heritage_bayes.models import build_model  # the models decide their inputs
@@ -346,7 +353,9 @@ def prepare(cfg) -> Prepared:
     if monument is not None and irradiance_source == "measured":
         irradiance_source = monument.info["irradiance_label"]
     gt = data.ground_temperature
-    if thermal and gt.mode == "column":
+    # the ground temperature Tf: for the thermal section, or a hygric vapour sink at it
+    ground = thermal or (hygric and "Tf" in _section_inputs(cfg, "hygric"))
+    if ground and gt.mode == "column":
         tf_table, sources["ground_temperature"] = _ground_column(cfg, gt, "data.ground_temperature")
         tables.append(tf_table)
 
@@ -401,7 +410,7 @@ def prepare(cfg) -> Prepared:
     s0 = frame.index[0]
 
     # Tf (annual mean or constant); column mode came through align
-    if thermal and gt.mode != "column":
+    if ground and gt.mode != "column":
         if gt.mode == "constant":
             tf = np.full(n, float(gt.value))
             sources["ground_temperature"] = {"mode": "constant", "value": float(gt.value)}

@@ -185,6 +185,29 @@ class CoupledHygricModel(RCModel):
     def __repr__(self) -> str:
         return f"{super().__repr__()[:-1]}, sorption={self.sorption}, sink={self.sink!r})"
 
+    def equations(self) -> tuple[str, ...]:
+        """The balance equations in words (for ``hbayes models``)."""
+        cap = "(Cm/psat(T_ref))" if self.sorption else "Cw"
+        r = "r" if self.sorption else ""
+        out = "Gw·(Pe − Pw) + " if "Gw" in self.parameter_names else ""
+        sink = {
+            "none": "",
+            "constant": " + Gf·(Pf − Pi)",
+            "temperature": " + Gf·(phi_f·psat(Tf) − Pi)",
+        }[self.sink]
+        lines = [
+            f"{cap}·dPw/dt = {out.replace('Pw', r + '·Pw')}Gi·(Pi − {r + '·' if r else ''}Pw)",
+            f"Ci·dPi/dt = Gfast·(Pe − Pi) + Gi·({r + '·' if r else ''}Pw − Pi){sink}",
+        ]
+        if self.sorption:
+            lines += [
+                f"  r = psat(Ti)/psat(T_ref): Pw = φ_w·psat(T_ref) is the buffer's surface RH "
+                f"φ_w expressed at T_ref = {T_REF:g} °C; its surface vapour pressure is "
+                "φ_w·psat(Ti)",
+                "  exact per step with Ti (and Tf) held over the step (heritage_bayes.rc.sorption)",
+            ]
+        return tuple(lines)
+
     # ------------------------------------------------------------------ values
     def _col(self, P: np.ndarray, name: str, default: float = 0.0) -> np.ndarray:
         names = self.parameter_names

@@ -392,13 +392,13 @@ def coupled_block(kp, pe, dpe, rs, ps, dt, slope, k0, B, Mf):  # pragma: no cove
         zeta = (S11 - S22) * iA12 * isr
         t = 1.0 / (abs(zeta) + math.sqrt(1.0 + zeta * zeta))
         t = t if zeta >= 0.0 else -t
-        c = 1.0 / math.sqrt(1.0 + t * t)
-        s = t * c
         l1 = S11 - t * S12
         l2 = S22 + t * S12
         a1, p1, g1 = _gains(l1, dt, slope)
         a2, p2, g2 = _gains(l2, dt, slope)
-        cc, ss, cs = c * c, s * s, c * s
+        # c = cos, s = sin of the rotation, t = s/c: only their products enter
+        cc = 1.0 / (1.0 + t * t)
+        ss, cs = t * t * cc, t * cc
         # y = (v, Pi) with v = r Pw: y+ = C^-1/2 V diag(a) V^T C^1/2 y, then Pw+ = v+/r
         m12 = cs * (a2 - a1)
         Mf[0, b] = cc * a1 + ss * a2

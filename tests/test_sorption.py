@@ -29,17 +29,20 @@ def _weather(N, seed=0):
 
 
 def _reference(m, p, pe, dpe, ti, tf, x0):
-    """Pi at the start of every step by solve_ivp on the ODE of the module docstring,
-    Ti and Tf piecewise constant, Pe linear within a step (mean pe, change dpe)."""
+    """Pi at the start of every step by solve_ivp on the ODE of the module docstring:
+    ``psat(Ti)`` linear between the readings ``ti`` at the step boundaries, Tf held over
+    the step, Pe linear within a step (mean pe, change dpe)."""
     cw = p["Cm"] / P_REF if "Cm" in p else p["Cw"]
     gw, gf = p.get("Gw", 0.0), p.get("Gf", 0.0)
     out, x = [x0[1]], np.array(x0, dtype=float)
     for k in range(pe.size - 1):
-        r = psat(ti[k]) / P_REF if "Cm" in p else 1.0
+        r0, r1 = (psat(ti[k]) / P_REF, psat(ti[k + 1]) / P_REF) if "Cm" in p else (1.0, 1.0)
         sink = p.get("phi_f", 0.0) * psat(tf[k]) if "phi_f" in p else p.get("Pf", 0.0)
 
-        def f(t, x, k=k, r=r, sink=sink):
-            u = pe[k] + dpe[k] * ((t - k * DT) / DT - 0.5)
+        def f(t, x, k=k, r0=r0, r1=r1, sink=sink):
+            a = (t - k * DT) / DT
+            u = pe[k] + dpe[k] * (a - 0.5)
+            r = r0 + a * (r1 - r0)
             flow_w = p["Gi"] * (x[1] - r * x[0]) + gw * (u - r * x[0])
             flow_i = p["Gfast"] * (u - x[1]) + p["Gi"] * (r * x[0] - x[1]) + gf * (sink - x[1])
             return [flow_w / cw, flow_i / p["Ci"]]
@@ -67,9 +70,15 @@ def _reference(m, p, pe, dpe, ti, tf, x0):
     ],
 )
 @pytest.mark.parametrize("slope", [False, True])
-def test_recursion_matches_a_fine_integration_of_the_ode(name, options, p, slope):
+@pytest.mark.parametrize("varying", [False, True])
+def test_recursion_matches_a_fine_integration_of_the_ode(name, options, p, slope, varying):
+    """Exact (1e-5 Pa) with Ti constant (25 °C, away from T_ref); with psat(Ti) linear
+    between hourly readings of an 8 K daily swing plus 1 K hour-to-hour noise, within
+    0.5 Pa of swings of 300 Pa (the step's change of psat(Ti) enters to first order:
+    held at the step's start the error is 110 Pa, at its mean 22 Pa)."""
     N = 240
     pe, ti, tf = _weather(N)
+    ti = ti if varying else np.full(N, 25.0)
     dpe = np.r_[np.diff(pe), 0.0] if slope else np.zeros(N)
     m = hb.model(name, **options)
     if slope:
@@ -81,7 +90,8 @@ def test_recursion_matches_a_fine_integration_of_the_ode(name, options, p, slope
     Y, valid = m.forward(P, U, DT, x0=x0)
     ref = _reference(m, p, pe, dpe, ti, tf, x0)
     assert valid[0]
-    np.testing.assert_allclose(Y[0, :, 0], ref, rtol=0, atol=1e-5)  # [Pa]
+    atol = 0.5 if varying and m.sorption else 1e-5  # [Pa]
+    np.testing.assert_allclose(Y[0, :, 0], ref, rtol=0, atol=atol)
 
 
 def test_at_the_reference_temperature_it_is_the_linear_model():
@@ -153,45 +163,51 @@ def test_kalman_noise_is_refused_with_a_config_error():
 # ------------------------------------------------------------------ independent data
 def _euler_room(seed):
     """A room with a sorbing buffer, generated without the package: explicit Euler with
-    30 s steps, a nonlinear isotherm (moisture capacity dm/dφ = Cm·(1 + 2c(φ - 0.6))),
-    the buffer at the air temperature, inputs linear between hourly readings; RH logged
-    to 0.1 %RH and T to 0.01 K with sensor noise. Returns hourly inputs, the observed
-    Pi, and the truth."""
+    10 s steps, a nonlinear isotherm (moisture capacity dm/dφ = C·(1 + 2c(φ - 0.6)),
+    C = 40 kg, c = 0.2), the buffer at the air temperature, inputs linear between hourly
+    readings; T logged to 0.01 K, RH with 0.3 %RH noise logged to 0.1 %RH. Returns hourly
+    inputs, the observed Pi, the truth and the range of dm/dφ over the record [kg]."""
     rng = np.random.default_rng(seed)
     hours = 24 * 28
     t = np.arange(hours + 1)
     ti = 16 + 6 * np.sin(2 * np.pi * (t - 15) / 24) + np.cumsum(rng.normal(0, 0.3, t.size))
     pe = 1100 + 250 * np.sin(2 * np.pi * (t - 10) / 24) + np.cumsum(rng.normal(0, 25, t.size))
-    truth = dict(Cm=40.0, Ci=2e-3, Gi=1.2e-7, Gfast=2.5e-7)
-    curv = 0.4
-    h = 30.0
+    truth = dict(Ci=2e-3, Gi=1.2e-7, Gfast=2.5e-7)
+    c40, curv, h = 40.0, 0.2, 10.0
     sub = int(DT / h)
     pi, phi = 1100.0, 1100.0 / psat(ti[0])
-    pi_at = [pi]
+    pi_at, caps = [pi], []
     for k in range(hours):
         for j in range(sub):
             a = (j + 0.5) / sub
             T = ti[k] + a * (ti[k + 1] - ti[k])
             P = pe[k] + a * (pe[k + 1] - pe[k])
             flow = truth["Gi"] * (pi - phi * psat(T))
-            cap = truth["Cm"] * (1 + 2 * curv * (phi - 0.6))
+            cap = c40 * (1 + 2 * curv * (phi - 0.6))
+            caps.append(cap)
             pi += h * (truth["Gfast"] * (P - pi) - flow) / truth["Ci"]
             phi += h * flow / cap
         pi_at.append(pi)
     pi_at = np.array(pi_at)
-    t_log = np.round(ti + rng.normal(0, 0.05, t.size), 2)
+    t_log = np.round(ti, 2)
     rh = np.round(100 * pi_at / psat(ti) + rng.normal(0, 0.3, t.size), 1)
     obs = rh / 100 * psat(t_log)
-    # the package's rows: interval means of the readings and their change over the step
+    # the package's rows: Pe as interval means and their change over the step (weather
+    # inputs), Ti as the readings at the step's start (a measurement column)
     pe_mean, dpe = 0.5 * (pe[1:] + pe[:-1]), np.diff(pe)
-    ti_mean = 0.5 * (t_log[1:] + t_log[:-1])
-    U = np.column_stack([pe_mean, dpe, ti_mean])
-    return U, obs[:-1], truth
+    U = np.column_stack([pe_mean, dpe, t_log[:-1]])
+    return U, obs[:-1], truth, (min(caps), max(caps))
 
 
 @pytest.mark.slow
 def test_calibration_recovers_an_independent_room_with_a_nonlinear_isotherm():
-    U, obs, truth = _euler_room(seed=3)
+    """The conductances' 90 % intervals cover the truth; the linearised moisture
+    capacity's interval meets the range of dm/dφ the isotherm spans over the record (its
+    truth is only defined within it). Measured on this generator: 0.05 K of white noise
+    on the logged T biases Gfast by +1.3 % (errors in the input), more than its 90 %
+    interval's half-width; with c = 0.4, Cm comes out 37.4 [36.4, 38.4] kg against a
+    mean dm/dφ of 34.2 kg over the record."""
+    U, obs, truth, (cap_lo, cap_hi) = _euler_room(seed=3)
     m = hb.model("hygric_2c_sorption").with_slopes(["Pe"])
     nm = get_noise_model("ar1_white")
     # the air's capacity known (the room's volume): it pins the overall scale
@@ -202,8 +218,10 @@ def test_calibration_recovers_an_independent_room_with_a_nonlinear_isotherm():
     res = run_sampler(lp, x0, seed=1, max_steps=2500, check_every=500, tau_factor=30)
     X, _ = res.draws(2000)
     th = ps.values(X.reshape(-1, X.shape[-1]))
-    for name in ("Cm", "Gi", "Gfast"):
-        v = th[:, ps.names.index(name)]
-        lo, hi = np.quantile(v, [0.05, 0.95])
+    q = {n: np.quantile(th[:, ps.names.index(n)], [0.05, 0.95]) for n in ("Cm", "Gi", "Gfast")}
+    for name in ("Gi", "Gfast"):
+        lo, hi = q[name]
         assert lo <= truth[name] <= hi, (name, lo, truth[name], hi)
-        assert hi / lo < 3.0, (name, lo, hi)  # informative, not the prior
+        assert hi / lo < 1.3, (name, lo, hi)  # informative, not the prior
+    lo, hi = q["Cm"]
+    assert lo <= cap_hi and hi >= cap_lo and hi / lo < 1.3, (lo, hi, cap_lo, cap_hi)

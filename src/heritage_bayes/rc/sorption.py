@@ -23,15 +23,16 @@ sink at a temperature*, :math:`P_f = \\varphi_f\\,p_{sat}(T_f)`, with the
 ground/neighbour temperature ``Tf`` [°C] an input series and :math:`\\varphi_f` [-]
 estimated (a cold wall, a crawlspace's soil, a canal wall near saturation).
 
-Exact per-step recursion
-------------------------
-Given :math:`T_w` the model is linear time-varying in :math:`(P_w, P_i)`. With
-:math:`T_w` (hence :math:`r`) and :math:`T_f` **held constant over each step** at the
-row's value (the assumption; the vapour-pressure inputs may be held or linear within the
-step, as for the linear models), the step is an exact LTI solution: in the variables
-:math:`(v, P_i)`, :math:`v = r P_w` the surface vapour pressure, the step is the linear
-two-node network with capacities :math:`(C_w/r, C_i)` and the symmetric conductance
-matrix :math:`\\mathbf G`, whose zero-order hold is the modal solution of
+Per-step recursion
+------------------
+Given :math:`T_w` the model is linear time-varying in :math:`(P_w, P_i)`. ``Ti`` is a
+measurement: its row ``k`` is the reading at :math:`t_k`, and :math:`r` is taken
+linear between the readings at :math:`t_k` and :math:`t_{k+1}` (the data layer's
+convention for instantaneous readings). With :math:`r` held at the step's mean
+:math:`\\bar r_k` the step is an exact LTI solution: in the variables
+:math:`(v, P_i)`, :math:`v = \\bar r_k P_w` the surface vapour pressure, it is the linear
+two-node network with capacities :math:`(C_w/\\bar r_k, C_i)` and the symmetric
+conductance matrix :math:`\\mathbf G`, whose zero-order hold is the modal solution of
 :mod:`heritage_bayes.rc.discretize`. Per step, the 2×2 symmetric
 :math:`S = C^{-1/2}\\mathbf G C^{-1/2}` is diagonalised in closed form (one Jacobi
 rotation, :math:`S = V\\Lambda V^T`), and
@@ -40,17 +41,24 @@ rotation, :math:`S = V\\Lambda V^T`), and
 
     y_{k+1} = C^{-1/2} V\\,e^{-\\Lambda\\Delta t}\\,V^T C^{1/2}\\,y_k
               + C^{-1/2} V\\,\\Phi\\,V^T C^{-1/2}\\,\\beta_k
-              (+\\ C^{-1/2} V\\,\\Gamma\\,V^T C^{-1/2}\\,\\delta_k),
+              + C^{-1/2} V\\,\\Gamma\\,V^T C^{-1/2}\\,\\delta_k,
 
 :math:`\\Phi = \\mathrm{diag}((1 - e^{-\\lambda_j\\Delta t})/\\lambda_j)`,
 :math:`\\beta_k` the boundary flows of the row's interval means,
-:math:`\\delta_k` those of the vapour pressure's change over the step with the
-first-order-hold slope gains :math:`\\Gamma` (:func:`heritage_bayes.rc.discretize.foh_weights`);
-then :math:`P_{w,k+1} = v_{k+1}/r_k`. Moisture is conserved across a change of
-:math:`r` between steps (the state is the moisture content, not the vapour pressure).
-The output is linear in the initial state given :math:`T_w` (the transition matrices do
-not depend on the data), so the initial state is integrated out as for the linear
-models. Compiled (numba), batched over parameter sets.
+:math:`\\Gamma` the first-order-hold slope gains
+(:func:`heritage_bayes.rc.discretize.foh_weights`) and :math:`\\delta_k` the flows that
+change linearly over the step with zero mean: that of the vapour pressure's change (its
+``Pe_slope`` column) and the coupling's own, :math:`G_i\\,\\Delta r_k\\,P_{w,k}` from the
+buffer to the air, :math:`\\Delta r_k = r(t_{k+1}) - r(t_k)` (first order in
+:math:`\\Delta r_k`, with :math:`P_w` at the step's start; still linear in the state);
+then :math:`P_{w,k+1} = v_{k+1}/\\bar r_k`. Moisture is conserved across steps (the state
+is the moisture content, not the vapour pressure). **Exactness**: exact when ``Ti`` is
+constant over the step; otherwise the error is of second order in the step's change of
+:math:`r` (measured: docs/science/models.md, "Sorption at the temperature of the
+materials"). ``Tf`` (a sink's temperature, slow) is held over the step at its row's
+value. The output is linear in the initial state given the temperatures (the
+transitions do not depend on it), so the initial state is integrated out as for the
+linear models. Compiled (numba), batched over parameter sets.
 
 With :math:`r \\equiv 1` (``Tw`` constant at :math:`T_{ref}`) the model is exactly the
 linear two-node network (hygric model 3 of Kramer et al. [1]_ without its buffer's link
@@ -270,8 +278,10 @@ class CoupledHygricModel(RCModel):
         """Per-step series of the compiled step from the input columns ``U`` (N, m).
 
         ``pe`` [Pa]; ``dpe`` its change over the step [Pa] (the ``Pe_slope`` column;
-        without one, ``pe``, unused); ``rs`` (3, N): ``r = p_sat(Tw)/p_sat(T_ref)`` [-],
-        its square root and the inverse of that (ones without sorption); ``ps``: the
+        without one, ``pe``, unused); ``rs`` (4, N): the step mean of
+        ``r = p_sat(Ti)/p_sat(T_ref)`` [-] (linear between the readings), its square
+        root, the inverse of that and r's change over the step (ones and zero without
+        sorption, :func:`temperature_ratio`); ``ps``: the
         sink's ``p_sat(Tf)`` [Pa] (``[1.0]`` without a sink at a temperature);
         ``slope``: whether there is a ``Pe_slope`` column."""
         U = np.asarray(U, dtype=float)
@@ -281,10 +291,11 @@ class CoupledHygricModel(RCModel):
         slope = "Pe" + SLOPE_SUFFIX in names
         dpe = np.ascontiguousarray(U[:, names.index("Pe" + SLOPE_SUFFIX)]) if slope else pe
         if self.sorption:
-            ratio = np.empty((3, N))
+            ratio = np.empty((4, N))
             temperature_ratio(np.ascontiguousarray(U[:, names.index("Ti")]), ratio)
         else:
-            ratio = np.ones((3, N))
+            ratio = np.ones((4, N))
+            ratio[3] = 0.0
         if self.sink == "temperature":
             ps = np.empty(N)
             saturation_series(np.ascontiguousarray(U[:, names.index("Tf")]), ps)
@@ -364,10 +375,10 @@ def coupled_block(kp, pe, dpe, rs, ps, dt, slope, k0, B, Mf):  # pragma: no cove
     Into ``Mf[:, :B]`` (``Mf`` (6, >= B), C-contiguous):
     ``(Pw, Pi)[k+1] = [[M0, M1], [M2, M3]] (Pw, Pi)[k] + (f0, f1)`` (module
     docstring). ``kp``: one row of :meth:`CoupledHygricModel.kernel_parameters`;
-    ``rs`` (3, N): the ratio ``r = p_sat(Tw)/p_sat(T_ref)``, its square root and the
-    inverse of that; ``ps`` the sink's ``p_sat(Tf)`` (N,) (or ``[1.0]``: a constant
-    node); ``dpe`` the change of ``pe`` over the step, used with ``slope``. No
-    dependency between steps: the loop vectorises."""
+    ``rs`` (4, N): the step mean of ``r = p_sat(Tw)/p_sat(T_ref)``, its square root, the
+    inverse of that and r's change over the step; ``ps`` the sink's ``p_sat(Tf)`` (N,)
+    (or ``[1.0]``: a constant node); ``dpe`` the change of ``pe`` over the step, used
+    with ``slope``. No dependency between steps: the loop vectorises."""
     cw, ci, gw, gi, gfast, gf, sink = kp[0], kp[1], kp[2], kp[3], kp[4], kp[5], kp[6]
     iw = 1.0 / math.sqrt(cw)
     s2 = 1.0 / math.sqrt(ci)
@@ -394,18 +405,24 @@ def coupled_block(kp, pe, dpe, rs, ps, dt, slope, k0, B, Mf):  # pragma: no cove
         t = t if zeta >= 0.0 else -t
         l1 = S11 - t * S12
         l2 = S22 + t * S12
-        a1, p1, g1 = _gains(l1, dt, slope)
-        a2, p2, g2 = _gains(l2, dt, slope)
+        a1, p1, g1 = _gains(l1, dt, True)
+        a2, p2, g2 = _gains(l2, dt, True)
         # c = cos, s = sin of the rotation, t = s/c: only their products enter
         cc = 1.0 / (1.0 + t * t)
         ss, cs = t * t * cc, t * cc
-        # y = (v, Pi) with v = r Pw: y+ = C^-1/2 V diag(a) V^T C^1/2 y, then Pw+ = v+/r
-        m12 = cs * (a2 - a1)
-        Mf[0, b] = cc * a1 + ss * a2
-        Mf[1, b] = m12 * q1 * isr
-        Mf[2, b] = m12 * q2 * sr
-        Mf[3, b] = ss * a1 + cc * a2
+        h11 = cc * g1 + ss * g2
+        h22 = ss * g1 + cc * g2
+        h12 = cs * (g2 - g1)
         s1 = sr * iw
+        # y = (v, Pi) with v = r Pw: y+ = C^-1/2 V diag(a) V^T C^1/2 y, then Pw+ = v+/r;
+        # r's change over the step, a flow gi·dr·(s/dt - 1/2)·Pw[k] from the buffer to
+        # the air, enters with the first-order-hold slope gains (h)
+        gdr = gi * rs[3, k]
+        m12 = cs * (a2 - a1)
+        Mf[0, b] = cc * a1 + ss * a2 + iw * isr * (h12 * s2 - h11 * s1) * gdr
+        Mf[1, b] = m12 * q1 * isr
+        Mf[2, b] = m12 * q2 * sr + s2 * (h22 * s2 - h12 * s1) * gdr
+        Mf[3, b] = ss * a1 + cc * a2
         b1 = s1 * gw * pe[k]
         b2 = s2 * (gfast * pe[k] + gfs * xs[k] + const)
         k12 = cs * (p2 - p1)
@@ -414,22 +431,28 @@ def coupled_block(kp, pe, dpe, rs, ps, dt, slope, k0, B, Mf):  # pragma: no cove
         if slope:
             d1 = s1 * gw * dpe[k]
             d2 = s2 * gfast * dpe[k]
-            h12 = cs * (g2 - g1)
-            f1 += (cc * g1 + ss * g2) * d1 + h12 * d2
-            f2 += h12 * d1 + (ss * g1 + cc * g2) * d2
+            f1 += h11 * d1 + h12 * d2
+            f2 += h12 * d1 + h22 * d2
         Mf[4, b] = iw * isr * f1  # s1 f1 / r
         Mf[5, b] = s2 * f2
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
 def temperature_ratio(T, out):  # pragma: no cover - compiled
-    """``out[0] = p_sat(T)/p_sat(T_ref)`` [-], ``out[1]`` its square root and ``out[2]``
-    the inverse of that (N,)."""
-    for k in range(T.size):
-        v = psat_water(T[k]) / P_REF
-        out[0, k] = v
-        out[1, k] = math.sqrt(v)
+    """From readings ``T`` [°C] at the step boundaries, ``ρ = p_sat(T)/p_sat(T_ref)``
+    linear between them: ``out[0]`` its step mean ``(ρ[k] + ρ[k+1])/2`` [-], ``out[1]``
+    the square root of that, ``out[2]`` the inverse of ``out[1]``, ``out[3]`` the change
+    ``ρ[k+1] - ρ[k]`` (zero on the last row, whose next reading is unknown) (4, N)."""
+    N = T.size
+    nxt = psat_water(T[0]) / P_REF
+    for k in range(N):
+        v = nxt
+        if k + 1 < N:
+            nxt = psat_water(T[k + 1]) / P_REF
+        out[0, k] = 0.5 * (v + nxt)
+        out[1, k] = math.sqrt(out[0, k])
         out[2, k] = 1.0 / out[1, k]
+        out[3, k] = nxt - v
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")

@@ -242,13 +242,6 @@ def _output_hint(missing: Sequence[str]) -> str:
 
 
 # ---------------------------------------------------------------------------------------
-def _section_inputs(cfg, section: str) -> tuple[str, ...]:
-    """The input columns of a section's model."""
-    from heritage_bayes.models import build_model  # the models decide their inputs
-
-    return tuple(build_model(cfg, section).input_names)
-
-
 def _extra_inputs(cfg) -> list[str]:
     """Model inputs beyond those built here (Te, Pe, Tf, I_<surface>), in model order."""
     from heritage_bayes.models import build_model  # the models decide their inputs
@@ -353,8 +346,9 @@ def prepare(cfg) -> Prepared:
     if monument is not None and irradiance_source == "measured":
         irradiance_source = monument.info["irradiance_label"]
     gt = data.ground_temperature
-    # the ground temperature Tf: for the thermal section, or a hygric vapour sink at it
-    ground = thermal or (hygric and "Tf" in _section_inputs(cfg, "hygric"))
+    from heritage_bayes.models import build_model  # Tf: thermal, or a hygric sink at it
+
+    ground = thermal or (hygric and "Tf" in build_model(cfg, "hygric").input_names)
     if ground and gt.mode == "column":
         tf_table, sources["ground_temperature"] = _ground_column(cfg, gt, "data.ground_temperature")
         tables.append(tf_table)
@@ -420,8 +414,6 @@ def prepare(cfg) -> Prepared:
             sources["ground_temperature"] = {"mode": "annual_mean"} | info
         frame["Tf"] = tf
         flags["Tf"] = False
-    from heritage_bayes.models import build_model
-
     sections = [s for s in _SECTIONS if getattr(cfg, s) is not None]
     models = [build_model(cfg, s) for s in sections]
     for name, col in calendar_inputs(models, frame.index, step.total_seconds()).items():

@@ -261,6 +261,15 @@ class CoupledHygricModel(RCModel):
             q = q * P_REF
         return cap, G, Gu, q
 
+    def state_space(self, params):
+        """Continuous (A, B, C, D) at the reference temperature (:meth:`RCModel.state_space`),
+        with zero columns of B and D for the temperature inputs ``Ti``, ``Tf``: they act
+        through the coupling, not as linear inputs."""
+        A, B, C, D = super().state_space(params)
+        extra = len(self._time_inputs)
+        pad = [(0, 0)] * (B.ndim - 1) + [(0, extra)]
+        return A, np.pad(B, pad), C, np.pad(D, [(0, 0), (0, extra)])
+
     def kernel_parameters(self, P: np.ndarray) -> np.ndarray:
         """(K, 7) per-walker arrays of the compiled step: Cw [kg/Pa at T_ref], Ci
         [kg/Pa], Gw, Gi, Gfast, Gf [kg/(s·Pa)], and the sink's factor (``Pf`` [Pa] for

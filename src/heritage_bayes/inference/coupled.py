@@ -21,6 +21,8 @@ import math
 import numba
 import numpy as np
 
+from heritage_bayes.inference import likelihoods
+from heritage_bayes.inference.likelihoods import ar1_predict
 from heritage_bayes.rc import sorption
 from heritage_bayes.rc.sorption import BLOCK, coupled_block
 
@@ -84,13 +86,7 @@ def _coupled_kf(
                     if last >= 0 and k - last == 1 and conv:
                         phd = ph
                     else:
-                        if last < 0:
-                            phd = 0.0
-                            Pp = s2
-                        else:
-                            d = k - last
-                            phd = ph if d == 1 else ph**d
-                            Pp = phd * phd * Pv + s2 * (1.0 - phd * phd)
+                        phd, Pp = ar1_predict(last, k, ph, Pv, s2)
                         F = Pp + w2
                         iF = 1.0 / F
                         g = Pp * iF
@@ -174,4 +170,4 @@ def coupled_filter_stats(model, P, series, x0, Yobs, noise_model, noise, *, basi
     return acc
 
 
-sorption.stamp_cache(globals(), sorption, sorption._vecmath)
+sorption.stamp_cache(globals(), sorption, sorption._vecmath, likelihoods)

@@ -228,3 +228,28 @@ def test_calibration_recovers_an_independent_room_with_a_nonlinear_isotherm():
         assert hi / lo < 1.3, (name, lo, hi)  # informative, not the prior
     lo, hi = q["Cm"]
     assert lo <= cap_hi and hi >= cap_lo and hi / lo < 1.3, (lo, hi, cap_lo, cap_hi)
+
+
+def test_a_hygric_sink_at_a_temperature_gets_its_ground_temperature_and_prior():
+    """Without a thermal section, the data layer still builds Tf (the ground temperature
+    of data.ground_temperature) for a hygric vapour sink; phi_f gets its near-saturation
+    prior."""
+    from heritage_bayes.config import parse_config
+    from heritage_bayes.models import build_model
+    from heritage_bayes.prepare import prepare
+    from heritage_bayes.run import section_parameters
+
+    cfg = parse_config(
+        {
+            "data": {"demo": {"seed": 1}},
+            "hygric": {"model": "hygric_2c_fixed", "options": {"sink": "temperature"}},
+        }
+    )
+    m = build_model(cfg, "hygric")
+    assert m.input_names == ("Pe", "Tf")
+    prep = prepare(cfg)
+    U = prep.model_inputs("hygric", m)
+    assert np.isfinite(U).all() and 0.0 < U[:, 1].mean() < 30.0
+    assert prep.sources["ground_temperature"]["mode"] == "annual_mean"
+    p = section_parameters(cfg, "hygric", m)[1]["phi_f"]
+    assert (p.kind, p.unit, p.prior.lower, p.prior.upper) == ("saturation", "-", 0.7, 1.0)

@@ -86,7 +86,14 @@ from heritage_bayes.climate.psychro import saturation_vapour_pressure
 from heritage_bayes.rc.model import SLOPE_SUFFIX, RCModel
 from heritage_bayes.rc.network import Link, Network, Node, ParameterInfo
 
-__all__ = ["P_REF", "SINKS", "T_REF", "CoupledHygricModel", "coupled_block", "coupled_network"]
+__all__ = [
+    "P_REF",
+    "SINKS",
+    "T_REF",
+    "CoupledHygricModel",
+    "coupled_block",
+    "coupled_network",
+]
 
 #: Reference temperature [°C] at which the buffer's state is expressed in [Pa].
 T_REF = 15.0
@@ -377,17 +384,11 @@ def _gains(lam, dt, slope):  # pragma: no cover - compiled
     return a, p, g
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
-def coupled_block(kp, pe, dpe, rs, ps, dt, slope, k0, B, Mf):  # pragma: no cover - compiled
-    """Transitions and forcings of steps ``k0 .. k0 + B - 1`` for one parameter set.
-
-    Into ``Mf[:, :B]`` (``Mf`` (6, >= B), C-contiguous):
-    ``(Pw, Pi)[k+1] = [[M0, M1], [M2, M3]] (Pw, Pi)[k] + (f0, f1)`` (module
-    docstring). ``kp``: one row of :meth:`CoupledHygricModel.kernel_parameters`;
-    ``rs`` (4, N): the step mean of ``r = p_sat(Tw)/p_sat(T_ref)``, its square root, the
-    inverse of that and r's change over the step; ``ps`` the sink's ``p_sat(Tf)`` (N,)
-    (or ``[1.0]``: a constant node); ``dpe`` the change of ``pe`` over the step, used
-    with ``slope``. No dependency between steps: the loop vectorises."""
+@numba.njit(inline="always", cache=True, nogil=True, error_model="numpy")
+def walker_constants(kp, each, ps0):  # pragma: no cover - compiled
+    """The per-parameter-set constants of :func:`step_coefficients` (a tuple) from one
+    row ``kp`` of :meth:`CoupledHygricModel.kernel_parameters`; ``each``: the sink's
+    ``p_sat(Tf)`` is a series, else the constant ``ps0`` (1 for a constant node)."""
     cw, ci, gw, gi, gfast, gf, sink = kp[0], kp[1], kp[2], kp[3], kp[4], kp[5], kp[6]
     iw = 1.0 / math.sqrt(cw)
     s2 = 1.0 / math.sqrt(ci)
@@ -395,55 +396,86 @@ def coupled_block(kp, pe, dpe, rs, ps, dt, slope, k0, B, Mf):  # pragma: no cove
     A11 = (gw + gi) * iw * iw  # S11 = A11 r
     A12 = gi * iw * s2  # S12 = -A12 sqrt(r)
     iA12 = 0.5 / A12 if A12 > 0.0 else 1e300  # zeta huge or 0: t = 0 or 1, same M
-    q1, q2 = iw / s2, s2 / iw
-    # the sink's flow gf·sink·ps[k]: a series (ps (N,)) or a constant (ps = [1.0]); a
-    # series read from pe with weight 0 in the constant case keeps the loop branch-free
-    each = ps.size > 1
+    # the sink's flow gf·sink·ps[k]: a series, or a constant (a series read with weight
+    # 0 in the constant case keeps the step branch-free)
     gfs = gf * sink if each else 0.0
-    const = 0.0 if each else gf * sink * ps[0]
+    const = 0.0 if each else gf * sink * ps0
+    return (iw, s2, S22, A11, A12, iA12, gw, gi, gfast, gfs, const)
+
+
+@numba.njit(inline="always", cache=True, nogil=True, error_model="numpy")
+def step_coefficients(c, r, sr, isr, dr, pe, dpe, xs, dt, slope):  # pragma: no cover
+    """Transition ``(M0, M1, M2, M3)`` and forcing ``(f0, f1)`` of one step:
+    ``(Pw, Pi)[k+1] = [[M0, M1], [M2, M3]] (Pw, Pi)[k] + (f0, f1)`` (module docstring).
+    ``c``: :func:`walker_constants`; ``r``, ``sr``, ``isr``, ``dr``: the step mean of
+    ``r = p_sat(Tw)/p_sat(T_ref)``, its square root, the inverse of that and r's change
+    over the step; ``pe``, ``dpe`` the vapour pressure's mean and change (the latter
+    used with ``slope``); ``xs`` the sink's ``p_sat(Tf)``. Branch-free."""
+    iw, s2, S22, A11, A12, iA12, gw, gi, gfast, gfs, const = c
+    S11 = A11 * r
+    S12 = -A12 * sr
+    # one Jacobi rotation: V = [[c, s], [-s, c]], columns the eigenvectors of S (l1, l2);
+    # an uncoupled buffer (S12 = 0, zeta infinite) gives t = 0
+    zeta = (S11 - S22) * iA12 * isr
+    t = 1.0 / (abs(zeta) + math.sqrt(1.0 + zeta * zeta))
+    t = t if zeta >= 0.0 else -t
+    l1 = S11 - t * S12
+    l2 = S22 + t * S12
+    a1, p1, g1 = _gains(l1, dt, True)
+    a2, p2, g2 = _gains(l2, dt, True)
+    # cos² = 1/(1 + t²), t = sin/cos: only the products of cos and sin enter
+    cc = 1.0 / (1.0 + t * t)
+    ss, cs = t * t * cc, t * cc
+    h11 = cc * g1 + ss * g2
+    h22 = ss * g1 + cc * g2
+    h12 = cs * (g2 - g1)
+    s1 = sr * iw
+    # y = (v, Pi) with v = r Pw: y+ = C^-1/2 V diag(a) V^T C^1/2 y, then Pw+ = v+/r; r's
+    # change over the step, a flow gi·dr·(s/dt - 1/2)·Pw[k] from the buffer to the air,
+    # enters with the first-order-hold slope gains (h)
+    gdr = gi * dr
+    m12 = cs * (a2 - a1)
+    M0 = cc * a1 + ss * a2 + iw * isr * (h12 * s2 - h11 * s1) * gdr
+    M1 = m12 * (iw / s2) * isr
+    M2 = m12 * (s2 / iw) * sr + s2 * (h22 * s2 - h12 * s1) * gdr
+    M3 = ss * a1 + cc * a2
+    b1 = s1 * gw * pe
+    b2 = s2 * (gfast * pe + gfs * xs + const)
+    k12 = cs * (p2 - p1)
+    f1 = (cc * p1 + ss * p2) * b1 + k12 * b2
+    f2 = k12 * b1 + (ss * p1 + cc * p2) * b2
+    if slope:
+        d1 = s1 * gw * dpe
+        d2 = s2 * gfast * dpe
+        f1 += h11 * d1 + h12 * d2
+        f2 += h12 * d1 + h22 * d2
+    return M0, M1, M2, M3, iw * isr * f1, s2 * f2  # f0 = s1 f1 / r
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def coupled_block(kp, pe, dpe, rs, ps, dt, slope, k0, B, Mf):  # pragma: no cover - compiled
+    """Transitions and forcings of steps ``k0 .. k0 + B - 1`` for one parameter set
+    (:func:`step_coefficients`), into ``Mf[:, :B]`` (``Mf`` (6, >= B), C-contiguous).
+
+    ``kp``: one row of :meth:`CoupledHygricModel.kernel_parameters`; ``rs`` (4, N): the
+    step mean of ``r = p_sat(Tw)/p_sat(T_ref)``, its square root, the inverse of that
+    and r's change over the step; ``ps`` the sink's ``p_sat(Tf)`` (N,) (or ``[1.0]``: a
+    constant node); ``dpe`` the change of ``pe`` over the step, used with ``slope``. No
+    dependency between steps: the loop vectorises."""
+    each = ps.size > 1
+    c = walker_constants(kp, each, ps[0])
     xs = ps if each else pe
     for b in range(B):
         k = k0 + b
-        r, sr, isr = rs[0, k], rs[1, k], rs[2, k]
-        S11 = A11 * r
-        S12 = -A12 * sr
-        # one Jacobi rotation: V = [[c, s], [-s, c]], columns the eigenvectors of S
-        # (l1, l2); an uncoupled buffer (S12 = 0, zeta infinite) gives t = 0
-        zeta = (S11 - S22) * iA12 * isr
-        t = 1.0 / (abs(zeta) + math.sqrt(1.0 + zeta * zeta))
-        t = t if zeta >= 0.0 else -t
-        l1 = S11 - t * S12
-        l2 = S22 + t * S12
-        a1, p1, g1 = _gains(l1, dt, True)
-        a2, p2, g2 = _gains(l2, dt, True)
-        # c = cos, s = sin of the rotation, t = s/c: only their products enter
-        cc = 1.0 / (1.0 + t * t)
-        ss, cs = t * t * cc, t * cc
-        h11 = cc * g1 + ss * g2
-        h22 = ss * g1 + cc * g2
-        h12 = cs * (g2 - g1)
-        s1 = sr * iw
-        # y = (v, Pi) with v = r Pw: y+ = C^-1/2 V diag(a) V^T C^1/2 y, then Pw+ = v+/r;
-        # r's change over the step, a flow gi·dr·(s/dt - 1/2)·Pw[k] from the buffer to
-        # the air, enters with the first-order-hold slope gains (h)
-        gdr = gi * rs[3, k]
-        m12 = cs * (a2 - a1)
-        Mf[0, b] = cc * a1 + ss * a2 + iw * isr * (h12 * s2 - h11 * s1) * gdr
-        Mf[1, b] = m12 * q1 * isr
-        Mf[2, b] = m12 * q2 * sr + s2 * (h22 * s2 - h12 * s1) * gdr
-        Mf[3, b] = ss * a1 + cc * a2
-        b1 = s1 * gw * pe[k]
-        b2 = s2 * (gfast * pe[k] + gfs * xs[k] + const)
-        k12 = cs * (p2 - p1)
-        f1 = (cc * p1 + ss * p2) * b1 + k12 * b2
-        f2 = k12 * b1 + (ss * p1 + cc * p2) * b2
-        if slope:
-            d1 = s1 * gw * dpe[k]
-            d2 = s2 * gfast * dpe[k]
-            f1 += h11 * d1 + h12 * d2
-            f2 += h12 * d1 + h22 * d2
-        Mf[4, b] = iw * isr * f1  # s1 f1 / r
-        Mf[5, b] = s2 * f2
+        m0, m1, m2, m3, f0, f1 = step_coefficients(
+            c, rs[0, k], rs[1, k], rs[2, k], rs[3, k], pe[k], dpe[k], xs[k], dt, slope
+        )
+        Mf[0, b] = m0
+        Mf[1, b] = m1
+        Mf[2, b] = m2
+        Mf[3, b] = m3
+        Mf[4, b] = f0
+        Mf[5, b] = f1
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")

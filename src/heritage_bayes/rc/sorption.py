@@ -485,15 +485,19 @@ def temperature_ratio(T, out):  # pragma: no cover - compiled
     the square root of that, ``out[2]`` the inverse of ``out[1]``, ``out[3]`` the change
     ``ρ[k+1] - ρ[k]`` (zero on the last row, whose next reading is unknown) (4, N)."""
     N = T.size
-    nxt = psat_water(T[0]) / P_REF
+    if N == 0:
+        return
+    rho = np.empty(N + 1)
+    for k in range(N):  # two passes: each loop vectorises
+        rho[k] = psat_water(T[k]) / P_REF
+    rho[N] = rho[N - 1]
     for k in range(N):
-        v = nxt
-        if k + 1 < N:
-            nxt = psat_water(T[k + 1]) / P_REF
-        out[0, k] = 0.5 * (v + nxt)
-        out[1, k] = math.sqrt(out[0, k])
-        out[2, k] = 1.0 / out[1, k]
-        out[3, k] = nxt - v
+        v = 0.5 * (rho[k] + rho[k + 1])
+        q = math.sqrt(v)
+        out[0, k] = v
+        out[1, k] = q
+        out[2, k] = 1.0 / q
+        out[3, k] = rho[k + 1] - rho[k]
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")

@@ -137,6 +137,8 @@ def test_every_catalogue_model_compiles_and_is_stable(name):
             "gain": 1.0,
             "fraction": 0.3,
             "constant": 10.0,
+            "sorption_capacity": 0.2,  # [kg] per unit RH
+            "saturation": 0.45,
         }[info.kind] * (rng.uniform(0.5, 2) if info.kind != "fraction" else 1)
         if m.domain == "hygric" and info.kind == "capacity":
             params[info.name] = 1e-4

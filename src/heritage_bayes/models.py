@@ -149,7 +149,7 @@ def describe_model(name: str, noise: str = "ar1_white") -> str:
     net = m.network
     pot = "T" if net.domain == "thermal" else "P"
     lines = [f"{name}: {CATALOG[name][1]}", "", "Equations (one balance per capacity node):"]
-    for node in net.nodes:
+    for node in () if hasattr(m, "equations") else net.nodes:
         terms = []
         for lk in net.links:
             if lk.a == node.name:
@@ -164,6 +164,7 @@ def describe_model(name: str, noise: str = "ar1_white") -> str:
             gain = f"{src.gain}·" if isinstance(src.gain, str) else ""
             terms.append(f"{frac}{gain}{src.input}")
         lines.append(f"  {node.C}·d{node.name}/dt = " + " + ".join(terms))
+    lines += [f"  {eq}" for eq in (m.equations() if hasattr(m, "equations") else ())]
     kind = "heat flows [W]" if pot == "T" else "vapour flows [kg/s]"
     lines.append(
         f"  (each term is one of the {kind} into the node; outputs: "
@@ -180,10 +181,9 @@ def describe_model(name: str, noise: str = "ar1_white") -> str:
             f"{p.prior.describe():<28s} {p.description}"
         )
     lines += ["", "Inputs (columns of the prepared data):"]
+    unit_of = getattr(m, "input_unit", net.input_unit)
     for i in m.input_names:
-        lines.append(
-            f"  {i:<9s} {'[' + net.input_unit(i) + ']':<13s} {net.descriptions.get(i, '')}"
-        )
+        lines.append(f"  {i:<9s} {'[' + unit_of(i) + ']':<13s} {net.descriptions.get(i, '')}")
     lines += ["", "Outputs:"]
     unit = "°C" if pot == "T" else "Pa"
     what = "temperature" if pot == "T" else "vapour pressure"
@@ -205,6 +205,12 @@ def describe_model(name: str, noise: str = "ar1_white") -> str:
                 "solar surfaces come from data.surfaces.",
             ]
             if net.domain == "thermal"
+            else [
+                "Options (under options:): sink (hygric_2c_fixed: constant | temperature; "
+                "hygric_2c_sorption: none | constant | temperature); a sink at a temperature "
+                "reads Tf, the thermal section's ground temperature (data.ground_temperature)."
+            ]
+            if name in ("hygric_2c_fixed", "hygric_2c_sorption")
             else []
         ),
     ]

@@ -347,7 +347,10 @@ def prepare(cfg) -> Prepared:
     if monument is not None and irradiance_source == "measured":
         irradiance_source = monument.info["irradiance_label"]
     gt = data.ground_temperature
-    if thermal and gt.mode == "column":
+    from heritage_bayes.models import build_model  # Tf: thermal, or a hygric sink at it
+
+    ground = thermal or (hygric and "Tf" in build_model(cfg, "hygric").input_names)
+    if ground and gt.mode == "column":
         tf_table, sources["ground_temperature"] = _ground_column(cfg, gt, "data.ground_temperature")
         tables.append(tf_table)
 
@@ -402,7 +405,7 @@ def prepare(cfg) -> Prepared:
     s0 = frame.index[0]
 
     # Tf (seasonal, annual mean or constant); column mode came through align
-    if thermal and gt.mode != "column":
+    if ground and gt.mode != "column":
         if gt.mode == "constant":
             tf = np.full(n, float(gt.value))
             sources["ground_temperature"] = {"mode": "constant", "value": float(gt.value)}
@@ -411,8 +414,6 @@ def prepare(cfg) -> Prepared:
             tf, sources["ground_temperature"] = ground_input(gt.mode, weather["Te"], mids, gt.depth)
         frame["Tf"] = tf
         flags["Tf"] = False
-    from heritage_bayes.models import build_model
-
     sections = [s for s in _SECTIONS if getattr(cfg, s) is not None]
     models = [build_model(cfg, s) for s in sections]
     for name, col in calendar_inputs(models, frame.index, step.total_seconds()).items():

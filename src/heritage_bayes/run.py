@@ -21,7 +21,7 @@ import numpy as np
 
 from heritage_bayes.climate.psychro import saturation_vapour_pressure
 from heritage_bayes.config import CalibrationConfig, parse_config, read_yaml
-from heritage_bayes.errors import InputError
+from heritage_bayes.errors import ConfigError, InputError
 from heritage_bayes.models import SECTIONS, build_model
 from heritage_bayes.rc.model import RCModel
 from heritage_bayes.rc.simulate import check_inputs
@@ -71,6 +71,12 @@ def section_parameters(cfg: CalibrationConfig, section: str, model: RCModel, pri
 
     sec_cfg = getattr(cfg, section)
     noise = get_noise_model(sec_cfg.noise)
+    if getattr(model, "time_varying", False) and getattr(noise, "statespace", False):
+        raise ConfigError(
+            f"{section}.noise: {sec_cfg.noise!r} filters a model with a constant modal "
+            f"form; {model.name} is coupled to a temperature (time-varying): use "
+            "ar1_white (the default), ar1 or iid"
+        )
     params = parameters_for(
         model,
         noise,

@@ -70,6 +70,20 @@ def _ar1_sample(z, phi, sigma, out):  # pragma: no cover
             out[p, k] = e
 
 
+@numba.njit(inline="always", cache=True, nogil=True)
+def ar1_predict(last, k, ph, P, s2):  # pragma: no cover - compiled
+    """Prediction of the AR(1) model error at step ``k`` from its filtered variance
+    ``P`` at the last observed step ``last`` (< 0: none yet): the factor
+    :math:`\\phi^d` on the filtered mean and the predicted variance
+    :math:`\\phi^{2d}P + \\sigma^2(1-\\phi^{2d})` (``s2`` = :math:`\\sigma^2`), exact across a gap
+    of ``d = k - last`` steps; the stationary variance for the first observation."""
+    if last < 0:
+        return 0.0, s2
+    d = k - last
+    phd = ph if d == 1 else ph**d
+    return phd, phd * phd * P + s2 * (1.0 - phd * phd)
+
+
 @numba.njit(cache=True, nogil=True)
 def _kf_kernel(Ysim, yobs, sigma, phi, w, point, want_point):  # pragma: no cover
     """Exact log-likelihood of r = yobs - ysim for AR(1) model error + white noise.
@@ -96,14 +110,8 @@ def _kf_kernel(Ysim, yobs, sigma, phi, w, point, want_point):  # pragma: no cove
                 if want_point:
                     point[p, k] = np.nan
                 continue
-            if last < 0:
-                mp = 0.0
-                Pp = s2
-            else:
-                d = k - last
-                phd = ph if d == 1 else ph**d
-                mp = phd * m
-                Pp = phd * phd * P + s2 * (1.0 - phd * phd)
+            phd, Pp = ar1_predict(last, k, ph, P, s2)
+            mp = phd * m
             F = Pp + w2
             e = (y - Ysim[p, k]) - mp
             term = -0.5 * (_LOG2PI + math.log(F) + e * e / F)

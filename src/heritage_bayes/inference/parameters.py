@@ -59,7 +59,7 @@ HYG_CAP_AIR = 1.0 / (461.52 * 288.15)
 
 _DISTS = ("uniform", "loguniform", "normal", "lognormal")
 #: Parameter kinds sampled through a logit (bounded on both sides by nature).
-_LOGIT_KINDS = ("fraction", "phi")
+_LOGIT_KINDS = ("fraction", "phi", "saturation")
 
 
 @dataclass(frozen=True)
@@ -263,6 +263,13 @@ _DEFAULTS: dict[tuple[str, str], Prior] = {
     ("hygric", "fraction"): Prior("uniform", 0.0, 1.0),
     # fixed vapour pressure [Pa]: 0 to saturation at ~33 °C
     ("hygric", "constant"): Prior("uniform", 0.0, 5000.0),
+    # moisture capacity of a sorbing buffer per unit surface RH [kg]: a few kg of a
+    # small room's wooden surface layer (100 m² × 1 mm × 450 kg/m³ × ξ 0.15) to a
+    # church's plaster and timber (1e6)
+    ("hygric", "sorption_capacity"): Prior("loguniform", 1e-2, 1e6),
+    # relative humidity of a vapour sink at a temperature [-]: soil and wet walls sit
+    # near saturation
+    ("hygric", "saturation"): Prior("uniform", 0.7, 1.0),
     # control of the air node (heritage_bayes.rc.control): heating set-points [°C] from
     # frost protection to a warm church; heating power [W] from a radiator (1 kW) to a
     # cathedral's plant (10 MW); RH limits [-]; humidistat capacities [kg/s] from a
@@ -295,6 +302,8 @@ _FIXED_RANGE = {
     "conductance": (0.0, math.inf, True),  # [W/K], [kg/(s·Pa)]: ≥ 0 (0 = no path)
     "gain": (0.0, math.inf, True),
     "fraction": (0.0, 1.0, True),
+    "sorption_capacity": (0.0, math.inf, False),
+    "saturation": (0.0, 1.5, True),
     "sigma": (0.0, math.inf, False),
     "sigma_meas": (0.0, math.inf, False),
     "phi": (-1.0, 1.0, False),

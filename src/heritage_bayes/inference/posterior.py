@@ -62,6 +62,7 @@ from typing import Any
 
 import numpy as np
 
+from heritage_bayes.inference.coupled import coupled_filter_stats
 from heritage_bayes.inference.likelihoods import NoiseModel
 from heritage_bayes.inference.parameters import ParameterSet
 from heritage_bayes.rc.discretize import modal_form
@@ -159,6 +160,16 @@ class LogPosterior:
                 f"initial_state: expected 'estimate', 'steady' or a mapping node -> value "
                 f"(got {mode!r})"
             )
+        self._time_varying = bool(getattr(self.model, "time_varying", False))
+        if self._time_varying:
+            if getattr(self.noise, "statespace", False):
+                raise ValueError(
+                    f"noise: {self.noise.name!r} filters a model with a constant modal form; "
+                    f"{self.model.name!r} is time-varying (coupled to a temperature): use "
+                    "ar1_white (the default), ar1 or iid"
+                )
+            # the per-step series of the inputs (saturation ratios), once
+            self._series = self.model.series(self.inputs)
         if self.model.control is not None and getattr(self.noise, "statespace", False):
             raise ValueError(
                 f"noise: {self.noise.name!r} filters a model that is linear in its state; "
@@ -302,7 +313,7 @@ class LogPosterior:
             ll[~np.isfinite(ll)] = -np.inf
             return ll
         with np.errstate(all="ignore"):
-            mf = modal_form(self.model, tm, self.dt)
+            mf = self._form(tm)
             if getattr(self.noise, "statespace", False):
                 ll = self.noise.filter(
                     self.model, mf, self.inputs, self.observed, tn, *self._x0_prior(mf)
@@ -313,10 +324,25 @@ class LogPosterior:
         ll[~np.isfinite(ll)] = -np.inf
         return ll
 
+    def _form(self, tm: np.ndarray):
+        """The modal form of model parameters (K, P_model); for a time-varying model
+        (:class:`~heritage_bayes.rc.sorption.CoupledHygricModel`) that of its network at
+        the reference temperature (validity, time constants, the initial state's prior
+        covariance), carrying the parameters for its exact recursion."""
+        mf = modal_form(self.model, tm, self.dt)
+        if self._time_varying:
+            mf.theta = tm
+            mf.valid = mf.valid & self.model.valid_mask(tm)
+        return mf
+
     def _x0_mean(self, mf) -> np.ndarray:
         """(K, n) prior mean of the initial state [°C or Pa]: the steady state of the
-        mean inputs over ``init_window``, with the fixed nodes set."""
-        x = np.einsum("kij,kj->ki", mf.T, mf.steady_state_modal(self.u_init))
+        mean inputs over ``init_window`` (of a time-varying model: at their mean
+        temperatures), with the fixed nodes set."""
+        if self._time_varying:
+            x = self.model.steady_state(mf.theta, self.u_init)
+        else:
+            x = np.einsum("kij,kj->ki", mf.T, mf.steady_state_modal(self.u_init))
         for i, v in self.x0_fixed.items():
             x[:, i] = v
         return np.where(np.isfinite(x), x, 0.0)
@@ -396,10 +422,19 @@ class LogPosterior:
         ``conditional`` its conditional posterior mean (K, nf) and covariance
         (K, nf, nf) [°C or Pa] for the estimated nodes ``x0_free``."""
         xm = self._x0_mean(mf)
-        z0 = mf.to_modal(xm)
         free = self.x0_free
         nf = free.size
-        acc = self.noise.filter_modal(mf, self.inputs, z0, self.observed, tn, basis=nf > 0)
+        if self._time_varying:  # the basis in physical coordinates
+            acc = coupled_filter_stats(
+                self.model, mf.theta, self._series, xm, self.observed, self.noise, tn,
+                basis=nf > 0, dt=self.dt,
+            )  # fmt: skip
+            Tinv = np.broadcast_to(np.eye(xm.shape[1]), mf.Tinv.shape)
+        else:
+            acc = self.noise.filter_modal(
+                mf, self.inputs, mf.to_modal(xm), self.observed, tn, basis=nf > 0
+            )
+            Tinv = mf.Tinv
         ll = -0.5 * (acc[0] + acc[1])
         if nf == 0:
             return ll, None, None
@@ -411,7 +446,7 @@ class LogPosterior:
         H[:, il[0], il[1]] = tri[:, il[0], il[1]]
         H = H + np.swapaxes(np.tril(H, -1), 1, 2)
         # modal offset dz = Tinv dx: the statistics in physical coordinates [°C, Pa]
-        Bx = mf.Tinv[:, :, free]  # (K, n, nf)
+        Bx = Tinv[:, :, free]  # (K, n, nf)
         gx = np.einsum("kjf,kj->kf", Bx, g)
         Hx = np.swapaxes(Bx, 1, 2) @ H @ Bx
         P = self._x0_cov(mf)
@@ -454,7 +489,7 @@ class LogPosterior:
             return None
         tm, tn = self.split(theta)
         with np.errstate(all="ignore"):
-            mf = modal_form(self.model, tm, self.dt)
+            mf = self._form(tm)
             x0 = self._x0_mean(mf)
             if self.x0_free.size and getattr(self.noise, "statespace", False):
                 mean, cov = self._statespace_x0(mf, tn, x0)

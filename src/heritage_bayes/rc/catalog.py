@@ -27,8 +27,18 @@ vapour pressure [Pa]), output ``Pi``:
   ``Pi`` (``Ci``, indoor air), conductances ``Gw``, ``Gi``, ``Gfast``.
 - ``hygric_2c_fixed``: adds ``Gf`` to a fixed vapour-pressure node whose pressure ``Pf``
   [Pa] is an estimable constant (the paper's "additional fixed vapour pressure node",
-  e.g. a wall in contact with a canal).
+  e.g. a wall in contact with a canal). Option ``sink: temperature``: the node is a
+  vapour sink at a temperature, pressure ``phi_f · psat(Tf)`` with ``Tf`` [°C] the
+  ground/neighbour temperature input (as the thermal models' ground) and ``phi_f`` [-]
+  estimated (near saturation): a cellar's soil, a crawlspace, a canal wall; ``sink:
+  constant`` (the default) is the paper's constant node.
 - ``hygric_1c``: one air node ``Pi`` with ``Gfast`` to ``Pe`` (ladder bottom).
+- ``hygric_2c_sorption``: thermo-hygric coupling (:mod:`heritage_bayes.rc.sorption`):
+  the air ``Pi`` (``Ci``, ``Gfast`` to ``Pe``) and a sorbing buffer of moisture capacity
+  ``Cm`` [kg] per unit surface RH, exchanging vapour with the air through ``Gi`` at its
+  surface vapour pressure ``φ_w · psat(Ti)``; option ``sink`` (``none``, ``constant``,
+  ``temperature``) adds the fixed node of ``hygric_2c_fixed``. Linear time-varying given
+  the temperature, simulated by an exact per-step recursion.
 
 Options (keywords of :func:`model`): ``surfaces`` (sequence of surface names for the
 thermal models with solar), ``ground`` (default True: ``Gf`` to the input column ``Tf``;
@@ -56,6 +66,7 @@ from collections.abc import Callable, Sequence
 from heritage_bayes.rc.control import _parse_control, controlled
 from heritage_bayes.rc.model import RCModel
 from heritage_bayes.rc.network import Link, Network, Node, Source
+from heritage_bayes.rc.sorption import CoupledHygricModel, coupled_network
 
 __all__ = ["CATALOG", "available_models", "model"]
 
@@ -183,6 +194,24 @@ def _hygric_factory(nodes: str, fixed: bool, name: str) -> Callable[..., Network
     def build() -> Network:
         return _hygric(name, nodes=nodes, fixed=fixed)
 
+    def build_fixed(sink: str = "constant") -> Network | RCModel:
+        if sink == "constant":
+            return _hygric(name, nodes=nodes, fixed=True)
+        if sink != "temperature":
+            raise ValueError(
+                f"model {name!r}: option sink must be 'constant' or 'temperature' (got {sink!r})"
+            )
+        net = coupled_network(name, sorption=False, outdoor=True, sink=sink)
+        return CoupledHygricModel(net, sorption=False, sink=sink)
+
+    return build_fixed if fixed else build
+
+
+def _sorption_factory(name: str) -> Callable[..., RCModel]:
+    def build(sink: str = "none") -> RCModel:
+        net = coupled_network(name, sorption=True, outdoor=False, sink=sink)
+        return CoupledHygricModel(net, sorption=True, sink=sink)
+
     return build
 
 
@@ -214,7 +243,13 @@ CATALOG: dict[str, tuple[Callable[..., Network], str]] = {
     ),
     "hygric_2c_fixed": (
         _hygric_factory("2c", True, "hygric_2c_fixed"),
-        "hygric model 3 with a fixed vapour-pressure node (Gf, Pf)",
+        "hygric model 3 with a fixed vapour-pressure node (Gf, Pf; or sink: temperature, "
+        "a vapour sink at phi_f·psat(Tf))",
+    ),
+    "hygric_2c_sorption": (
+        _sorption_factory("hygric_2c_sorption"),
+        "hygric, air and a sorbing buffer whose surface vapour pressure is "
+        "φ_w·psat(Ti) (thermo-hygric coupling)",
     ),
 }
 
@@ -256,4 +291,12 @@ def model(name: str, **options) -> RCModel:
         raise ValueError(
             f"model {name!r}: unknown option(s) in {sorted(options)}; allowed: {allowed}"
         ) from exc
+    if isinstance(net, RCModel):  # a time-varying model, compiled by its factory
+        if control.active:
+            raise ValueError(
+                f"model {name!r}: the control options (humidistat, source) are not "
+                "available for a thermo-hygric coupled model; use hygric_2c or "
+                "hygric_2c_fixed with its constant node"
+            )
+        return net
     return controlled(net, control)

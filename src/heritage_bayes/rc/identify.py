@@ -91,6 +91,7 @@ from heritage_bayes.rc.derived import (
 )
 from heritage_bayes.rc.discretize import _check_dt, modal_form
 from heritage_bayes.rc.identify_result import (
+    _CONSTANT_KINDS,
     _LOG_KINDS,
     _TRANSFORM,
     IdentifiabilityResult,
@@ -392,7 +393,7 @@ def _matrix_derivatives(model, p0: np.ndarray, kinds):
     dcap = (cap[1 : 1 + npar] - cap[1 + npar :]) * scale
     dG = (G[1 : 1 + npar] - G[1 + npar :]) * scale[:, :, None]
     dGu = (Gu[1 : 1 + npar] - Gu[1 + npar :]) * scale[:, :, None]
-    consts = [j for j, k in enumerate(kinds) if k == "constant"]
+    consts = [j for j, k in enumerate(kinds) if k in _CONSTANT_KINDS]
     n = cap.shape[1]
     qc_unit = np.zeros((len(consts), n))
     dqc = np.zeros((npar, len(consts), n))
@@ -438,7 +439,7 @@ def _jacobian(model, p0: np.ndarray, kinds, omega: np.ndarray) -> np.ndarray:
             rows.append(d.imag[1:])
     # constant boundaries: steady-state contribution y_c = C G^-1 q_c
     if qc_unit.shape[0]:
-        consts = [j for j, k in enumerate(kinds) if k == "constant"]
+        consts = [j for j, k in enumerate(kinds) if k in _CONSTANT_KINDS]
         Ginv_C = np.linalg.solve(G.T, Cm.T).T  # C G^-1: (n_out, n)
         for i, cidx in enumerate(consts):
             g_unit = Ginv_C @ qc_unit[i]  # (n_out,) per unit of the constant

@@ -15,13 +15,17 @@ import numpy as np
 
 __all__ = ["IdentifiabilityResult", "NullDirection"]
 
-_LOG_KINDS = ("capacity", "conductance", "gain")
+_LOG_KINDS = ("capacity", "conductance", "gain", "sorption_capacity")
+#: Kinds of constant boundary potentials (a vapour pressure, or a sink's RH [-]).
+_CONSTANT_KINDS = ("constant", "saturation")
 _TRANSFORM = {
     "capacity": "log",
     "conductance": "log",
     "gain": "log",
     "fraction": "natural",
     "constant": "relative",
+    "sorption_capacity": "log",
+    "saturation": "relative",
 }
 _SCALE_LABEL = "overall scale"
 

@@ -83,16 +83,59 @@ class InitResult:
     questions: list[str] = field(default_factory=list)
 
 
+class _OneLineDumper(yaml.SafeDumper):
+    """The YAML emitter, with strings that hold a line break or a control character
+    written double-quoted (their escapes, ``\\n``, on one line): a value from the
+    user's files (a path, a column name) stays one scalar on one line."""
+
+
+def _str_scalar(dumper, v: str):
+    style = '"' if _comment(v) != v else None
+    return dumper.represent_scalar("tag:yaml.org,2002:str", v, style=style)
+
+
+_OneLineDumper.add_representer(str, _str_scalar)
+
+
 def _yaml_value(v) -> str:
-    text = yaml.safe_dump(v, default_flow_style=True, allow_unicode=True, width=10_000).strip()
+    """``v`` in YAML's flow style on one line (see :class:`_OneLineDumper`)."""
+    text = yaml.dump(
+        v, Dumper=_OneLineDumper, default_flow_style=True, allow_unicode=True, width=10**9
+    ).strip()
     return text[:-4].strip() if text.endswith("\n...") else text.removesuffix("...").strip()
 
 
+def _comment(text: str) -> str:
+    """``text`` made safe inside a YAML comment: every character YAML reads as a line
+    break (``\\n``, ``\\r``, U+0085, U+2028, U+2029) or refuses (control and format
+    characters) is written as its escape (``\\n``, ``\\u2028``), so that text from the
+    user's files (a folder name, a column) cannot end the comment and add a key."""
+    import unicodedata
+
+    return "".join(
+        c.encode("unicode_escape").decode("ascii")
+        if unicodedata.category(c)[0] == "C" or unicodedata.category(c) in ("Zl", "Zp")
+        else c
+        for c in str(text)
+    )
+
+
 def _wrap(text: str, first: str, rest: str, width: int = 92) -> list[str]:
-    """Comment lines of at most ``width`` characters."""
+    """Comment lines of at most ``width`` characters (``text`` escaped, see
+    :func:`_comment`)."""
     import textwrap
 
+    text = _comment(text)
     return textwrap.wrap(text, width, initial_indent=first, subsequent_indent=rest) or [first]
+
+
+def _one_line_each(lines: list[str]) -> str:
+    """The file's text; each entry of ``lines`` must be one line (a bug otherwise: a
+    comment or value that would break the file's structure)."""
+    for line in lines:
+        if any(c in line for c in "\r\n\x85\u2028\u2029"):
+            raise ValueError(f"init: a line of the config is not one line: {line[:100]!r}")
+    return "\n".join(lines)
 
 
 def _doc(path: str) -> list[str]:
@@ -322,7 +365,12 @@ def init_config(
         ``in_data_folder``), a file cannot be read as a table, no
         indoor temperature column, no overlap of the two files.
     """
-    from heritage_bayes.rundir.policy import check_name, resolve_output, write_new_file
+    from heritage_bayes.rundir.policy import (
+        check_name,
+        check_new_file,
+        resolve_output,
+        write_new_file,
+    )
 
     name_given = name is not None
 
@@ -333,11 +381,10 @@ def init_config(
     output = resolve_output(output, what="--output", kind="file", protect=(indoor, weather))
     if not in_data_folder:
         _refuse_data_folder(output, {"INDOOR_FILE": indoor, "--weather": weather})
-    if output.exists() and not force:  # before the inspection: fail at once
-        raise InputError(f"--output: {output} exists; choose another name or add --force")
+    check_new_file(output, force=force, what="--output")  # before the inspection
     findings: list[str] = []
     questions: list[str] = []
-    base = output.resolve().parent
+    base = output.parent  # resolved; a link at the file's own name is not followed
 
     def rel(p: Path) -> str:
         return Path(os.path.relpath(p.resolve(), base)).as_posix()
@@ -475,8 +522,8 @@ def init_config(
 
     lines = [
         f"# Written by `hbayes init` on {_dt.date.today():%Y-%m-%d} from",
-        f"#   logger:  {rel(indoor)}",
-        f"#   weather: {rel(weather)}",
+        f"#   logger:  {_comment(rel(indoor))}",
+        f"#   weather: {_comment(rel(weather))}",
         "# What init found, and why (check each):",
         *[line for f in findings for line in _wrap(f, "#   - ", "#     ")],
         "# Values starting with '??' are open questions: `hbayes calibrate` refuses this file",
@@ -536,11 +583,16 @@ def init_config(
     extra = [q.split(": ", 1)[1] for q in questions if q.startswith("questions: ")]
     if extra:
         lines += ["questions:", *[f"  - {_yaml_value(MARK + ' ' + q)}" for q in extra], ""]
-    text = "\n".join(lines)
+    text = _one_line_each(lines)
     if not questions:  # the same schema as every config: it must load
         from heritage_bayes.config import load_yaml_text, parse_config
 
         raw = load_yaml_text(text, source=str(output))
         parse_config(raw, source=str(output), base_dir=str(base), name=name)
+    if output.is_symlink():  # with --force: the link itself is replaced, not its target
+        findings.append(
+            f"--output {output} was a symbolic link (to {os.readlink(output)}): the link is "
+            "replaced by the config; the file it pointed to is left as it is"
+        )
     write_new_file(output, text, force=force, what="--output")
     return InitResult(output, text, findings, questions)

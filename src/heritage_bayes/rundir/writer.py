@@ -368,8 +368,8 @@ class StagedFolder:
             os.rename(staging, out)
             self.committed = True
             (out / _JOURNAL).unlink(missing_ok=True)
-        if old.exists():
-            _remove_owned(old)
+            if old.exists():  # before a deferred signal ends the process
+                _remove_owned(old)
 
     def left_behind(self) -> str:
         """What an unfinished output leaves, for the error message."""

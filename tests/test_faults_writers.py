@@ -35,28 +35,12 @@ import pytest
 import yaml
 
 from heritage_bayes.cli import main
+from test_faults import TINY as TINY_CFG
 from test_faults import _clean, _env, _hourly_csv
-
-SRC = Path(__file__).resolve().parents[1] / "src"
+from test_paths import snapshot as tree  # every entry: files by content, links by target
 
 
 # ----------------------------------------------------------------------------- helpers
-def tree(root: Path) -> dict[str, tuple]:
-    """Every entry under ``root`` (symlinks not followed): relative path -> identity."""
-    out: dict[str, tuple] = {}
-    for dirpath, dirnames, filenames in os.walk(root, followlinks=False):
-        for name in dirnames + filenames:
-            p = Path(dirpath) / name
-            rel = str(p.relative_to(root))
-            if p.is_symlink():
-                out[rel] = ("link", os.readlink(p))
-            elif p.is_dir():
-                out[rel] = ("dir",)
-            else:
-                out[rel] = ("file", hashlib.sha256(p.read_bytes()).hexdigest())
-    return out
-
-
 def changes(before: dict, after: dict) -> tuple[set, set, set]:
     """(changed, created, removed) relative paths."""
     changed = {k for k in before.keys() & after.keys() if before[k] != after[k]}
@@ -276,23 +260,6 @@ def test_init_hostile_data_folder_adds_no_key(box, capsys, folder):
 
 
 # ---------------------------------------------------------------- output folders
-TINY_CFG = {
-    "name": "faults",
-    "seed": 3,
-    "data": {"demo": {}},
-    "room_volume": 400,
-    "periods": {
-        "calibration": {"start": "2019-01-02", "end": "2019-01-16"},
-        "validation": {"start": "2019-01-16", "end": "2019-01-21"},
-        "warmup": "2D",
-        "init_window": "2D",
-    },
-    "thermal": {"model": "thermal_1c", "noise": "ar1"},
-    "sampler": {"max_steps": 300, "check_every": 50, "max_draws": 200, "n_predictive": 20},
-    "optimizer": {"maxiter": 10, "starts": 1},
-    "ladder": False,
-    "report": False,
-}
 PROJ = {
     "draws": 6,
     "seed": 5,

@@ -45,7 +45,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import pandas as pd
-import yaml
 
 from heritage_bayes.errors import DataError, InputError
 from heritage_bayes.init_checks import (
@@ -62,6 +61,10 @@ from heritage_bayes.init_checks import (
 from heritage_bayes.io import clock as _clock
 from heritage_bayes.io.loggers import TableLayout, inspect_table
 from heritage_bayes.questions import MARK
+from heritage_bayes.yaml_text import comment as _comment
+from heritage_bayes.yaml_text import one_line_each as _one_line_each
+from heritage_bayes.yaml_text import wrap_comment as _wrap
+from heritage_bayes.yaml_text import yaml_value as _yaml_value
 
 __all__ = ["InitResult", "init_config"]
 
@@ -81,61 +84,6 @@ class InitResult:
     text: str
     findings: list[str] = field(default_factory=list)
     questions: list[str] = field(default_factory=list)
-
-
-class _OneLineDumper(yaml.SafeDumper):
-    """The YAML emitter, with strings that hold a line break or a control character
-    written double-quoted (their escapes, ``\\n``, on one line): a value from the
-    user's files (a path, a column name) stays one scalar on one line."""
-
-
-def _str_scalar(dumper, v: str):
-    style = '"' if _comment(v) != v else None
-    return dumper.represent_scalar("tag:yaml.org,2002:str", v, style=style)
-
-
-_OneLineDumper.add_representer(str, _str_scalar)
-
-
-def _yaml_value(v) -> str:
-    """``v`` in YAML's flow style on one line (see :class:`_OneLineDumper`)."""
-    text = yaml.dump(
-        v, Dumper=_OneLineDumper, default_flow_style=True, allow_unicode=True, width=10**9
-    ).strip()
-    return text[:-4].strip() if text.endswith("\n...") else text.removesuffix("...").strip()
-
-
-def _comment(text: str) -> str:
-    """``text`` made safe inside a YAML comment: every character YAML reads as a line
-    break (``\\n``, ``\\r``, U+0085, U+2028, U+2029) or refuses (control and format
-    characters) is written as its escape (``\\n``, ``\\u2028``), so that text from the
-    user's files (a folder name, a column) cannot end the comment and add a key."""
-    import unicodedata
-
-    return "".join(
-        c.encode("unicode_escape").decode("ascii")
-        if unicodedata.category(c)[0] == "C" or unicodedata.category(c) in ("Zl", "Zp")
-        else c
-        for c in str(text)
-    )
-
-
-def _wrap(text: str, first: str, rest: str, width: int = 92) -> list[str]:
-    """Comment lines of at most ``width`` characters (``text`` escaped, see
-    :func:`_comment`)."""
-    import textwrap
-
-    text = _comment(text)
-    return textwrap.wrap(text, width, initial_indent=first, subsequent_indent=rest) or [first]
-
-
-def _one_line_each(lines: list[str]) -> str:
-    """The file's text; each entry of ``lines`` must be one line (a bug otherwise: a
-    comment or value that would break the file's structure)."""
-    for line in lines:
-        if any(c in line for c in "\r\n\x85\u2028\u2029"):
-            raise ValueError(f"init: a line of the config is not one line: {line[:100]!r}")
-    return "\n".join(lines)
 
 
 def _doc(path: str) -> list[str]:

@@ -701,3 +701,16 @@ def test_an_interrupted_compare_stops_its_workers(tmp_path):
     assert rc == 130 and "terminated (SIGTERM)" in err and _clean(err), err
     assert not (work / "cmp" / "thermal_1c").exists()
     assert not list(work.rglob("*.lock")) and not list(work.rglob("*.partial/posterior.nc"))
+
+
+@pytest.mark.parametrize("text", ["x\nroom_volume: 1", "x\u2028seed: 9", "# x: 1\n..."])
+def test_a_runs_config_yaml_is_emitted_by_yaml(text):
+    """The run's ``config.yaml`` (written by the YAML emitter): user text with a line
+    break reads back as itself and adds no key."""
+    from heritage_bayes.config import parse_config
+    from heritage_bayes.run import config_yaml
+
+    cfg = parse_config(TINY_CFG | {"building": text, "room": text})
+    back = yaml.safe_load(config_yaml(cfg))
+    assert back["building"] == text and back["room"] == text
+    assert back["room_volume"] == TINY_CFG["room_volume"] and back["seed"] == TINY_CFG["seed"]

@@ -176,7 +176,11 @@ def _build_parser() -> argparse.ArgumentParser:
     ini.add_argument(
         "-o", "--output", metavar="PATH", default="config.yaml", help="default: config.yaml"
     )
-    ini.add_argument("--force", action="store_true", help="replace an existing file")
+    ini.add_argument(
+        "--force",
+        action="store_true",
+        help="replace an existing file (a symbolic link is replaced itself, never written through)",
+    )
     ini.add_argument(
         "--in-data-folder",
         action="store_true",

@@ -47,7 +47,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import pandas as pd
-import yaml
 
 from heritage_bayes.errors import DataError, InputError
 from heritage_bayes.init_checks import (
@@ -66,6 +65,10 @@ from heritage_bayes.init_columns import fahrenheit_column_check, rh_column_check
 from heritage_bayes.io import clock as _clock
 from heritage_bayes.io.loggers import TableLayout, inspect_table
 from heritage_bayes.questions import MARK
+from heritage_bayes.yaml_text import comment as _comment
+from heritage_bayes.yaml_text import one_line_each as _one_line_each
+from heritage_bayes.yaml_text import wrap_comment as _wrap
+from heritage_bayes.yaml_text import yaml_value as _yaml_value
 
 __all__ = ["InitResult", "init_config"]
 
@@ -88,18 +91,6 @@ class InitResult:
     text: str
     findings: list[str] = field(default_factory=list)
     questions: list[str] = field(default_factory=list)
-
-
-def _yaml_value(v) -> str:
-    text = yaml.safe_dump(v, default_flow_style=True, allow_unicode=True, width=10_000).strip()
-    return text[:-4].strip() if text.endswith("\n...") else text.removesuffix("...").strip()
-
-
-def _wrap(text: str, first: str, rest: str, width: int = 92) -> list[str]:
-    """Comment lines of at most ``width`` characters."""
-    import textwrap
-
-    return textwrap.wrap(text, width, initial_indent=first, subsequent_indent=rest) or [first]
 
 
 def _doc(path: str) -> list[str]:
@@ -332,7 +323,12 @@ def init_config(
         ``in_data_folder``), a file cannot be read as a table, no
         indoor temperature column, no overlap of the two files.
     """
-    from heritage_bayes.rundir.policy import check_name, resolve_output, write_new_file
+    from heritage_bayes.rundir.policy import (
+        check_name,
+        check_new_file,
+        resolve_output,
+        write_new_file,
+    )
 
     name_given = name is not None
 
@@ -343,11 +339,10 @@ def init_config(
     output = resolve_output(output, what="--output", kind="file", protect=(indoor, weather))
     if not in_data_folder:
         _refuse_data_folder(output, {"INDOOR_FILE": indoor, "--weather": weather})
-    if output.exists() and not force:  # before the inspection: fail at once
-        raise InputError(f"--output: {output} exists; choose another name or add --force")
+    check_new_file(output, force=force, what="--output")  # before the inspection
     findings: list[str] = []
     questions: list[str] = []
-    base = output.resolve().parent
+    base = output.parent  # resolved; a link at the file's own name is not followed
 
     def rel(p: Path) -> str:
         return Path(os.path.relpath(p.resolve(), base)).as_posix()
@@ -506,8 +501,8 @@ def init_config(
 
     lines = [
         f"# Written by `hbayes init` on {_dt.date.today():%Y-%m-%d} from",
-        f"#   logger:  {rel(indoor)}",
-        f"#   weather: {rel(weather)}",
+        f"#   logger:  {_comment(rel(indoor))}",
+        f"#   weather: {_comment(rel(weather))}",
         "# What init found, and why (check each):",
         *[line for f in findings for line in _wrap(f, "#   - ", "#     ")],
         "# Values starting with '??' are open questions: `hbayes calibrate` refuses this file",
@@ -567,11 +562,16 @@ def init_config(
     extra = [q.split(": ", 1)[1] for q in questions if q.startswith("questions: ")]
     if extra:
         lines += ["questions:", *[f"  - {_yaml_value(MARK + ' ' + q)}" for q in extra], ""]
-    text = "\n".join(lines)
+    text = _one_line_each(lines)
     if not questions:  # the same schema as every config: it must load
         from heritage_bayes.config import load_yaml_text, parse_config
 
         raw = load_yaml_text(text, source=str(output))
         parse_config(raw, source=str(output), base_dir=str(base), name=name)
+    if output.is_symlink():  # with --force: the link itself is replaced, not its target
+        findings.append(
+            f"--output {output} was a symbolic link (to {os.readlink(output)}): the link is "
+            "replaced by the config; the file it pointed to is left as it is"
+        )
     write_new_file(output, text, force=force, what="--output")
     return InitResult(output, text, findings, questions)

@@ -90,6 +90,32 @@ def _calibrate_candidate(cand, run_dir: str, kwargs: dict) -> tuple[str, float, 
     return str(out), time.perf_counter() - t0, time.process_time() - c0
 
 
+def _worker_candidate(cand, run_dir: str, kwargs: dict) -> tuple[str, float, float]:
+    """:func:`_calibrate_candidate` in a worker process, where SIGTERM (sent by the
+    parent when it is interrupted or fails) ends the calibration as Ctrl-C does: the
+    chains saved for ``--resume``, the lock released."""
+    import signal
+
+    def stop(signum, frame):
+        raise KeyboardInterrupt
+
+    signal.signal(signal.SIGTERM, stop)
+    return _calibrate_candidate(cand, run_dir, kwargs)
+
+
+def _stop_workers(pool) -> None:
+    """Cancel the candidates not started; SIGTERM to the running workers, then wait for
+    them to save their chains and end (a parent that is interrupted must not wait for
+    their whole calibrations)."""
+    procs = list((getattr(pool, "_processes", None) or {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    for proc in procs:
+        if proc.is_alive():
+            proc.terminate()
+    for proc in procs:
+        proc.join()
+
+
 def _n_free(cand, section: str) -> int:
     """Free parameters of a candidate's section (the order in which to start them)."""
     from heritage_bayes.models import build_model
@@ -201,18 +227,22 @@ def run_compare(
             pool_size = min(n_workers - 1, len(rest))
             with ProcessPoolExecutor(pool_size, mp_context=ctx, max_tasks_per_child=1) as pool:
                 quiet_kw = {**kwargs, "quiet": True}
-                futs = {
-                    pool.submit(_calibrate_candidate, cands[n], str(out / n), quiet_kw): n
-                    for n in rest
-                }
-                run_dir, wall, cpu = _calibrate_candidate(cands[own], str(out / own), quiet_kw)
-                dirs[own] = Path(run_dir)
-                tell(f"{own} done ({wall:.0f} s wall, {cpu:.0f} s CPU)")
-                release_memory()  # while the workers run on
-                for f in as_completed(futs):
-                    run_dir, wall, cpu = f.result()
-                    dirs[futs[f]] = Path(run_dir)
-                    tell(f"{futs[f]} done ({wall:.0f} s wall, {cpu:.0f} s CPU)")
+                try:
+                    futs = {
+                        pool.submit(_worker_candidate, cands[n], str(out / n), quiet_kw): n
+                        for n in rest
+                    }
+                    run_dir, wall, cpu = _calibrate_candidate(cands[own], str(out / own), quiet_kw)
+                    dirs[own] = Path(run_dir)
+                    tell(f"{own} done ({wall:.0f} s wall, {cpu:.0f} s CPU)")
+                    release_memory()  # while the workers run on
+                    for f in as_completed(futs):
+                        run_dir, wall, cpu = f.result()
+                        dirs[futs[f]] = Path(run_dir)
+                        tell(f"{futs[f]} done ({wall:.0f} s wall, {cpu:.0f} s CPU)")
+                except BaseException:  # Ctrl-C, SIGTERM, a failed candidate: stop them all
+                    _stop_workers(pool)
+                    raise
             dirs = {n: dirs[n] for n in names}
         result = compare_runs(dirs, section, seed=cfg.seed if seed is None else int(seed))
         result["config"] = {"name": cfg.name, "building": cfg.building, "room": cfg.room}

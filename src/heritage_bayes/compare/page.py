@@ -256,11 +256,15 @@ def render_comparison(result: dict) -> str:
 
 
 def write_comparison(result: dict, out: str | Path) -> tuple[Path, Path]:
-    """Write ``comparison.json`` and ``comparison.html`` into ``out`` (atomically)."""
+    """Write ``comparison.json`` and ``comparison.html`` into ``out`` (each atomically,
+    the page rendered first; SIGINT/SIGTERM wait until both are written: never one
+    comparison's data beside another's page)."""
+    from heritage_bayes.inference.backend import _DeferSignals
     from heritage_bayes.inference.results import atomic_write_text, dump_json
 
     out = Path(out)
-    dump_json(out / "comparison.json", result)
     page = render_comparison(result)
-    atomic_write_text(out / "comparison.html", page)
+    with _DeferSignals():
+        dump_json(out / "comparison.json", result)
+        atomic_write_text(out / "comparison.html", page)
     return out / "comparison.json", out / "comparison.html"

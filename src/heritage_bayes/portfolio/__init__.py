@@ -270,11 +270,13 @@ def _table(rows: list[dict], pf: Portfolio) -> pd.DataFrame:
 
 
 def _write_outputs(pf: Portfolio, out: Path, rows: list[dict], seconds: float) -> pd.DataFrame:
+    """``portfolio.csv``, ``portfolio.json`` and ``index.html``, rendered first and
+    written as a group (SIGINT/SIGTERM wait until all three are written)."""
     from heritage_bayes.convert import to_jsonable
+    from heritage_bayes.inference.backend import _DeferSignals
     from heritage_bayes.inference.results import atomic_write, atomic_write_text
 
     df = _table(rows, pf)
-    atomic_write(out / "portfolio.csv", lambda p: df.to_csv(p, index=False))
     meta = {
         "portfolio": pf.name,
         "source": str(pf.path),
@@ -283,6 +285,10 @@ def _write_outputs(pf: Portfolio, out: Path, rows: list[dict], seconds: float) -
         "wall_seconds": seconds,
         "rows": df.to_dict(orient="records"),
     }
-    atomic_write_text(out / "portfolio.json", json.dumps(to_jsonable(meta), indent=1))
-    atomic_write_text(out / "index.html", render_index(pf, df, out))
+    text = json.dumps(to_jsonable(meta), indent=1)
+    page = render_index(pf, df, out)
+    with _DeferSignals():
+        atomic_write(out / "portfolio.csv", lambda p: df.to_csv(p, index=False))
+        atomic_write_text(out / "portfolio.json", text)
+        atomic_write_text(out / "index.html", page)
     return df

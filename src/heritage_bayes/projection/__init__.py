@@ -23,7 +23,10 @@ stored; the per-year indicators per complete year), ``projection.json`` (quantil
 change relative to the baseline, probability statements, the uncertainty
 decomposition, the indicator registry, the weather transformations, timings),
 ``projection.csv`` (one row per indicator and case, with name, unit, period and source)
-and ``projection.html`` (self-contained decision page).
+and ``projection.html`` (self-contained decision page). The four are written into a
+staging folder beside ``--out`` and swapped in together
+(:class:`~heritage_bayes.rundir.writer.StagedFolder`): an interrupted or failed
+re-projection leaves the previous projection whole.
 
 Measures (``interventions:``, :mod:`heritage_bayes.projection.interventions`):
 conservation heating, a dehumidifier, less ventilation — each simulated draw by draw
@@ -186,13 +189,16 @@ def project(
         pcfg = pcfg.model_copy(update=upd)
     dest = None
     if write:  # the output path checked before anything is read
-        from heritage_bayes.rundir.folder import OutputFolder
+        from heritage_bayes.projection.output import OUTPUT_FILES
+        from heritage_bayes.rundir.writer import StagedFolder
 
         run_dir = Path(run.path if isinstance(run, Run) else run)
-        dest = OutputFolder(
+        dest = StagedFolder(
             Path(out) if out is not None else run_dir / "projection",
             kind="projection",
+            names=OUTPUT_FILES,
             protect=[*_input_files(pcfg), run_dir / "posterior.nc"],
+            noun="projection folder",
         )
         dest.check()
     r = run if isinstance(run, Run) else load_run(run)
@@ -269,10 +275,15 @@ def project(
     from heritage_bayes.projection.output import to_dataset, write_outputs
 
     proj.dataset = to_dataset(proj, r)
-    if dest is not None:
+    if dest is not None:  # staged, then swapped in whole: never a mix of two projections
         with dest:
-            dest.claim(*(f"projection.{x}" for x in ("nc", "json", "csv", "html")))
-            proj.paths = write_outputs(proj, r, dest.path)
+            try:
+                staged = write_outputs(proj, r, dest.staging)
+                dest.commit()
+            except BaseException as exc:
+                exc.add_note(dest.left_behind())
+                raise
+        proj.paths = {k: dest.out / p.name for k, p in staged.items()}
     return proj
 
 

@@ -1,9 +1,11 @@
 """Writing a projection: ``projection.nc``, ``projection.json``, ``projection.csv``,
 ``projection.html``.
 
-All three are rendered in memory first and written atomically
-(:func:`heritage_bayes.inference.results.atomic_write`) into the output folder, which
-is created only when everything is ready: bad input leaves nothing behind.
+All four are rendered in memory first and written atomically
+(:func:`heritage_bayes.inference.results.atomic_write`) into the staging folder of
+:func:`heritage_bayes.projection.project`, which swaps them in as one group
+(:class:`~heritage_bayes.rundir.writer.StagedFolder`): bad input leaves nothing
+behind, an interrupt leaves the previous projection whole.
 """
 
 from __future__ import annotations
@@ -14,6 +16,9 @@ import numpy as np
 
 from heritage_bayes.climate.risk.registry import indicator_info
 from heritage_bayes.inference.results import atomic_write, atomic_write_text
+
+#: What a projection writes into its folder.
+OUTPUT_FILES = tuple(f"projection.{x}" for x in ("nc", "json", "csv", "html"))
 
 
 def _climatology(x: np.ndarray, months) -> np.ndarray:
@@ -182,7 +187,8 @@ def indicator_table(proj):
 
 
 def write_outputs(proj, run, dest: Path) -> dict:
-    """Render everything, then write the four files atomically into ``dest``."""
+    """Render everything, then write the four files (:data:`OUTPUT_FILES`) atomically
+    into ``dest`` (an existing folder: the staging folder of the projection)."""
     from heritage_bayes.convert import to_jsonable
     from heritage_bayes.projection.page import render_projection_page
 

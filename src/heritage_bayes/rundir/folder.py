@@ -66,6 +66,8 @@ class OutputFolder:
     def check(self) -> Path:
         """Resolve and check the folder (creates nothing); return its resolved path."""
         self.path = p = resolve_output(self.typed, what=self.what, protect=self.protect)
+        if self._lock is None:  # a run making the folder now is another run, not a stranger
+            FolderLock(p, what=self.what).check_free()
         if not p.is_dir():
             return p
         marker = read_marker(p)
@@ -99,9 +101,11 @@ class OutputFolder:
             self.marker = marker
         except FileExistsError:
             self._lock.release()
+            self._lock = None
             return self.__enter__()
         except BaseException:
             self._lock.release()
+            self._lock = None
             raise
         return self
 

@@ -42,6 +42,32 @@ class FolderLock:
         st = os.stat(self.out.parent)
         return st.st_dev, st.st_ino, self.out.name
 
+    def _busy(self, fd: int) -> InputError:
+        holder = os.read(fd, 1000).decode("utf-8", "replace").strip() or "unknown"
+        return InputError(
+            f"{self.what} {self.out}: another hbayes run is writing it ({holder}); "
+            "wait for it to end or choose another folder"
+        )
+
+    def check_free(self) -> None:
+        """Raise the message of :meth:`acquire` if another process holds the lock now;
+        creates nothing. Called before a writer looks at the output's folder: a run
+        that is creating its staging folder is then "another run", never a folder
+        left behind."""
+        import fcntl
+
+        try:
+            fd = os.open(self.path, os.O_RDWR | os.O_NOFOLLOW)
+        except OSError:  # no lock file (nobody holds it), or not ours (acquire says so)
+            return
+        try:
+            fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
+        except BlockingIOError:
+            err = self._busy(fd)
+            os.close(fd)
+            raise err from None
+        os.close(fd)  # releases the shared lock
+
     def acquire(self) -> FolderLock:
         import fcntl
 
@@ -51,12 +77,9 @@ class FolderLock:
             try:
                 fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
             except BlockingIOError:
-                holder = os.read(fd, 1000).decode("utf-8", "replace").strip() or "unknown"
+                err = self._busy(fd)
                 os.close(fd)
-                raise InputError(
-                    f"{self.what} {self.out}: another hbayes run is writing it ({holder}); "
-                    "wait for it to end or choose another folder"
-                ) from None
+                raise err from None
             try:  # the file may have been removed by the holder that just released it
                 same = os.stat(self.path).st_ino == os.fstat(fd).st_ino
                 same = same and self.key() == key  # the parent was not swapped meanwhile

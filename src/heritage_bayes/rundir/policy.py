@@ -31,7 +31,13 @@ from pathlib import Path
 
 from heritage_bayes.errors import InputError
 
-__all__ = ["check_name", "protected_paths", "resolve_output", "write_new_file"]
+__all__ = [
+    "check_name",
+    "check_new_file",
+    "protected_paths",
+    "resolve_output",
+    "write_new_file",
+]
 
 #: Longest plain name [characters]: far below NAME_MAX (255 bytes) once the staging
 #: decorations (``.<name>.partial``) and UTF-8 are added.
@@ -97,6 +103,23 @@ def _forbidden_folders() -> list[tuple[Path, str]]:
     return out
 
 
+def _dangling_link(path: Path) -> Path | None:
+    """The first component of ``path`` (absolute, as typed) that is a symbolic link to
+    nothing, or None. Creating the missing folders of such a path would create them at
+    the link's target, wherever that is."""
+    q = Path(path.anchor)
+    for part in path.parts[1:]:
+        q = q / part
+        if os.path.islink(q):
+            try:
+                os.stat(q)
+            except FileNotFoundError:
+                return q
+            except OSError:  # a loop: resolve() names it
+                return None
+    return None
+
+
 def resolve_output(
     path: str | Path,
     *,
@@ -125,20 +148,35 @@ def resolve_output(
     -------
     Path
         Absolute, symlinks resolved (``Path.resolve(strict=False)``: missing trailing
-        components are kept as typed, after the existing part is resolved).
+        components are kept as typed, after the existing part is resolved). For
+        ``kind="file"`` only the folder is resolved: a symbolic link at the file's own
+        name is the output itself, which :func:`write_new_file` refuses (or, with
+        ``force``, replaces), never the file it points to.
 
     Raises
     ------
     InputError
-        Naming the option, the path as typed and as resolved, and the rule it breaks.
+        Naming the option, the path as typed and as resolved, and the rule it breaks;
+        among them a component that is a symbolic link to nothing (its missing folders
+        would be created wherever the link points).
     """
     if kind not in ("dir", "file"):
         raise ValueError(f"kind: expected 'dir' or 'file' (got {kind!r})")
     typed = str(path)
     if not typed or "\x00" in typed:
         raise InputError(f"{what}: {typed!r} is not a path")
+    absolute = Path(typed).expanduser().absolute()
+    # a file is the link itself when it is one (write_new_file never writes through it)
+    own = kind == "file" and absolute.name not in ("", ".", "..")
+    link = _dangling_link(absolute.parent if own else absolute)
+    if link is not None:
+        raise InputError(
+            f"{what}: {typed}: {link} is a symbolic link to {os.readlink(link)}, which does "
+            "not exist; hbayes creates nothing through a link: remove the link or give "
+            "another path"
+        )
     try:
-        p = Path(typed).expanduser().absolute().resolve()
+        p = absolute.parent.resolve() / absolute.name if own else absolute.resolve()
     except (OSError, RuntimeError) as exc:  # a symlink loop
         raise InputError(f"{what}: {typed} cannot be resolved ({exc})") from None
     shown = typed if typed == str(p) else f"{typed} (resolved: {p})"
@@ -160,7 +198,7 @@ def resolve_output(
                 f"{what}: {shown} holds an input file of this command ({f}); choose a "
                 "folder that holds no config or data file"
             )
-    if p.exists() or p.is_symlink():
+    if p.exists() and not p.is_symlink():
         if kind == "dir" and not p.is_dir():
             raise InputError(f"{what}: {shown} is a file, not a folder")
         if kind == "file" and not p.is_file():
@@ -173,6 +211,24 @@ def resolve_output(
     if not os.access(anc, os.W_OK | os.X_OK):
         raise InputError(f"{what}: {shown}: no permission to write in {anc}")
     return p
+
+
+def check_new_file(path: str | Path, *, force: bool = False, what: str = "--output") -> Path:
+    """Raise :class:`InputError` if :func:`write_new_file` would refuse ``path``: a
+    folder; without ``force``, an existing file or any symbolic link (dangling too),
+    named as such. Return ``path``."""
+    path = Path(path)
+    if path.is_dir() and not path.is_symlink():
+        raise InputError(f"{what}: {path} is a folder, not a file")
+    if not force and path.is_symlink():
+        raise InputError(
+            f"{what}: {path} is a symbolic link (to {os.readlink(path)}); hbayes never "
+            "writes through a link: choose another name, or add --force to replace the "
+            "link itself (the file it points to is left as it is)"
+        )
+    if not force and path.exists():
+        raise InputError(f"{what}: {path} exists; choose another name or add --force")
+    return path
 
 
 def write_new_file(
@@ -209,12 +265,11 @@ def write_new_file(
     -------
     Path
     """
-    path = Path(path)
+    path = check_new_file(path, force=force, what=what)
     data = content.encode("utf-8") if isinstance(content, str) else bytes(content)
-    if path.is_dir() and not path.is_symlink():
-        raise InputError(f"{what}: {path} is a folder, not a file")
-    if not force and (path.exists() or path.is_symlink()):
-        raise InputError(f"{what}: {path} exists; choose another name or add --force")
+    link = _dangling_link(path.parent)
+    if link is not None:  # resolve_output refuses it; checked again before mkdir
+        raise InputError(f"{what}: {path}: {link} is a symbolic link to nothing")
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:

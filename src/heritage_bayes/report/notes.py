@@ -1,0 +1,243 @@
+"""The notes on a run shown under its verdict (amber or info), before its results.
+
+Pure functions on the run's ``summary.json`` (a dict): a solar input that was not
+measured (a cloudless sky, or the estimate from the daily temperature range),
+parameters at a prior bound, non-identifiable directions, separate optima of the MAP
+search, missing chain files, synthetic data. The verdict itself is
+:func:`heritage_bayes.report.verdict.convergence_verdict`.
+"""
+
+from __future__ import annotations
+
+from heritage_bayes.report.format import prior_text
+
+__all__ = ["run_notes"]
+
+
+def _modes_note(m: str, modes: list[dict], restarts) -> dict:
+    """The note of a MAP search whose restarts found separate optima (``summary.json``'s
+    ``models.<m>.map.modes``, the chain's start first): their heights and the
+    parameters in which they differ most (a factor of 3 or more, or 0.1 for
+    fractions; :func:`heritage_bayes.inference.optimize.parameters_apart`)."""
+    from heritage_bayes.inference.optimize import parameters_apart
+
+    kept = modes[0]["values"]
+    parts = []
+    for other in modes[1:]:
+        v = other["values"]
+        what = ", ".join(f"{n} {kept[n]:.3g} vs {v[n]:.3g}" for n in parameters_apart(kept, v))
+        parts.append(f"{other['log_posterior']:.1f}" + (f" ({what})" if what else ""))
+    return {
+        "level": "amber",
+        "title": f"The {m} posterior has separate optima",
+        "text": f"The MAP search ({restarts or len(modes)} global searches from different "
+        f"seeds) found {len(modes)} optima of similar height: the chain started at "
+        f"log-posterior {modes[0]['log_posterior']:.1f}, the other"
+        + (" is at " if len(modes) == 2 else "s are at ")
+        + "; ".join(parts)
+        + ". An ensemble sampler rarely crosses between separated optima, so the "
+        "intervals describe the reading of the room around the first; summary.json "
+        f"(models.{m}.map.modes) holds the others. Decide between them with knowledge "
+        "the data lack (a survey's interior_area or envelope_area, a prior on the "
+        "parameters named), or use the smaller model of the ladder.",
+    }
+
+
+def run_notes(
+    summary: dict, chains_missing: list[str], *, irradiance_setting: str | None = None
+) -> list[dict]:
+    """Notes on the run to read before its results (under the verdict).
+
+    Parameters
+    ----------
+    summary : dict
+        The run's ``summary.json``.
+    chains_missing : list of str
+        Chain files (``chain_<model>.h5``) not found in the run directory.
+    irradiance_setting : str, optional
+        The config's ``data.irradiance`` (``"clear_sky"`` flags a clear-sky proxy even when
+        the summary does not say so).
+
+    Returns
+    -------
+    list of dict
+        ``level`` (``"amber"`` or ``"info"``), ``title`` and ``text`` (plain text) per note.
+    """
+    s = summary
+    out = []
+    irr = str(s.get("irradiance_source", ""))
+    if "clear" in irr.lower() or irradiance_setting == "clear_sky":
+        out.append(
+            {
+                "level": "amber",
+                "title": "Solar radiation is a clear-sky proxy",
+                "text": "The solar input was computed for a cloudless sky, not measured "
+                f"(source: {irr}). The solar apertures then absorb the missing "
+                "cloudiness (they are biased) and the fit is poorer on cloudy days; "
+                "use measured irradiance when it is available.",
+            }
+        )
+    elif "estimated from the daily" in irr:
+        out.append(
+            {
+                "level": "info",
+                "title": "Solar radiation is estimated from the outdoor temperature",
+                "text": "No irradiance was measured: each day's global radiation was "
+                "estimated from the day's temperature range (Hargreaves-Samani) and spread "
+                f"over the day as the sun's path gives it (source: {irr}). Day-to-day "
+                "cloudiness is followed, cloud within a day is not; use measured "
+                "irradiance when it is available.",
+            }
+        )
+    bound = []
+    for k, v in (s.get("parameters") or {}).items():
+        if v.get("at_bound"):
+            unit = v.get("unit", "")
+            unit = f" {unit}" if unit and unit != "-" else ""
+            bound.append(
+                f"{k} (at the {v['at_bound']} end of its prior {prior_text(v.get('prior'))}{unit})"
+            )
+    if bound:
+        out.append(
+            {
+                "level": "amber",
+                "title": "Parameters pressed against a prior bound",
+                "text": "The data push these parameters to the edge of the allowed "
+                "range, so their interval is cut off by the prior: "
+                + "; ".join(bound)
+                + ". Check the model and data, or widen "
+                "the prior if the bound is not physical.",
+            }
+        )
+    for m, i in (s.get("models") or {}).items():
+        on_bound = [f"{n} ({side})" for n, side in i.get("map_at_bound") or []]
+        if on_bound:
+            out.append(
+                {
+                    "level": "amber",
+                    "title": f"The {m} MAP lies on a prior bound",
+                    "text": "The most probable parameter set presses against the prior "
+                    f"for {', '.join(on_bound)}: a finding about the prior (is the bound "
+                    "physical? widen it if not) or the model (a node or input the data do "
+                    "not support often shows up this way). The sampler started inside the "
+                    "bounds regardless.",
+                }
+            )
+        fz, share = i.get("frozen_node"), i.get("frozen_share")
+        branch = (
+            f" {share:.0%} of the posterior draws lie on this branch (the slowest time "
+            "constant beyond ten records), the rest on one where every node moves: the "
+            "posterior has two modes, and the intervals of the time constants span both."
+            if share and share >= 0.05
+            else ""
+        )
+        if fz:
+            out.append(
+                {
+                    "level": "amber",
+                    "title": f"A {m} node barely moves over the record",
+                    "text": f"At the MAP the slowest time constant is {fz['tau_h']:.3g} h, "
+                    f"{fz['records']:.0f} times the calibration record: that node keeps its "
+                    "start value, a constant standing in for a fixed node, a missing input "
+                    "or a missing node"
+                    + (
+                        "; its start is estimated freely, so it acts as a free offset "
+                        "(compare with the default initial_state_horizon or "
+                        "initial_state: steady)."
+                        if fz.get("start_free")
+                        else "; its start is held to the steady state of the first "
+                        "window's mean inputs."
+                    )
+                    + branch,
+                }
+            )
+        elif branch:
+            out.append(
+                {
+                    "level": "amber",
+                    "title": f"Some {m} draws freeze a node",
+                    "text": "The MAP's nodes all move over the record, but" + branch,
+                }
+            )
+        flagged = [
+            n
+            for n in (i.get("practical_identifiability") or {}).get("unidentified") or []
+            if not n.startswith(("sigma_", "phi_"))
+        ]
+        if flagged:
+            out.append(
+                {
+                    "level": "amber",
+                    "title": f"The {m} model is over-parameterised for these data",
+                    "text": "At the MAP the data leave "
+                    + ", ".join(flagged)
+                    + " almost as uncertain as their priors (Laplace standard deviation "
+                    "above 25 % of the prior range, with the overall scale held fixed): "
+                    "their posteriors are mostly prior and slow the chain. Choose: fix "
+                    "them, add an informative prior, or use the smaller model of the "
+                    "ladder.",
+                }
+            )
+        found = i.get("map") or {}
+        if len(modes := found.get("modes") or []) > 1:
+            out.append(_modes_note(m, modes, found.get("restarts")))
+        if (i.get("chain") or {}).get("stopped_by") == "max_seconds":
+            out.append(
+                {
+                    "level": "amber",
+                    "title": f"The {m} chain ran out of time",
+                    "text": "The wall-time budget sampler.max_time ended the chain before "
+                    "it converged: raise the budget, or continue it with --resume.",
+                }
+            )
+    nulls = [
+        m
+        for m, i in (s.get("models") or {}).items()
+        if (i.get("identifiability") or {}).get("n_null", 0)
+    ]
+    if nulls:
+        out.append(
+            {
+                "level": "info",
+                "title": "Not every parameter is identifiable",
+                "text": "For the "
+                + " and ".join(nulls)
+                + (" models" if len(nulls) > 1 else " model")
+                + ", some parameter combinations "
+                "cannot be determined from these data (section 6): read the "
+                "time constants, static gains and ratios, not the absolute "
+                "capacities and conductances, unless prior knowledge pins "
+                "them.",
+            }
+        )
+    if chains_missing:
+        out.append(
+            {
+                "level": "amber",
+                "title": "Chain files missing",
+                "text": "Trace plots are not available: "
+                + ", ".join(chains_missing)
+                + " not found in the run directory.",
+            }
+        )
+    if s.get("truth"):
+        p_truth = any(v.get("truth") is not None for v in (s.get("parameters") or {}).values())
+        d_truth = any(v.get("truth") is not None for v in (s.get("derived") or {}).values())
+        if p_truth:
+            where = "the true values are shown next to the estimates"
+        elif d_truth:
+            where = (
+                "the calibrated model is not the generating one, so true values are shown "
+                "only for the quantities both share (static gains, slowest time constant)"
+            )
+        else:
+            where = "the calibrated model is not the generating one: no true values to compare"
+        out.append(
+            {
+                "level": "info",
+                "title": "Synthetic data",
+                "text": "The measurements were generated from known parameters (the "
+                f"built-in virtual monument): {where}.",
+            }
+        )
+    return out

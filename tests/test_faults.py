@@ -852,6 +852,29 @@ def test_disk_full_is_a_clean_exit_2(tiny_fs, tmp_path):
     assert "not enough free disk space" in err and _clean(err), err
 
 
+def test_a_projection_that_fills_the_disk_is_a_clean_exit_2(runs, tiny_fs, tmp_path):
+    """A projection whose files do not fit (the user's own file takes most of the
+    disk): exit 2 naming the output and what to do, no traceback, the user's file
+    byte-identical and nothing left on the disk (the staged projection is removed)."""
+    import hashlib
+
+    filler = tiny_fs / "photos.bin"
+    filler.write_bytes(np.random.default_rng(0).bytes(2 * 2**20 - 160 * 2**10))
+    digest = hashlib.sha256(filler.read_bytes()).hexdigest()
+    proj = _write(
+        tmp_path / "p.yaml",
+        {"name": "p", "draws": 40, "seed": 5, "morphing": [
+            {"scenario": "warm", "horizon": 2050, "method": "shift", "deltas": {"Te": [2.0] * 12}}
+        ]},
+    )  # fmt: skip
+    rc, err = _hbayes("project", runs["root"] / "ref" / "run", proj, "--out", tiny_fs / "p")
+    assert rc == 2 and _clean(err), err
+    assert "No space left on device" in err and str(tiny_fs / "p") in err, err
+    assert "choose another --out" in err
+    assert sorted(x.name for x in tiny_fs.iterdir()) == ["photos.bin"]
+    assert hashlib.sha256(filler.read_bytes()).hexdigest() == digest
+
+
 def test_a_reader_of_the_chain_file_does_not_end_the_run(tmp_path):
     """HDF5 locks the file: a user reading the running chain (h5py, another process)
     made the next append fail with BlockingIOError and ended a 4-minute run; the

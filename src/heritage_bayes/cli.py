@@ -556,8 +556,7 @@ def _main(argv: list[str] | None) -> int:
     except OSError as exc:
         if exc.errno not in _DISK_ERRORS:
             return _internal_error()
-        where = f" ({exc.filename})" if exc.filename else ""
-        print(f"hbayes: error: {exc.strerror}{where}", file=sys.stderr)
+        print(f"hbayes: error: {_disk_error_text(exc, args)}", file=sys.stderr)
         _notes(exc)
         return 2
     except Exception:  # an internal error: a bug, so show where it happened
@@ -566,6 +565,20 @@ def _main(argv: list[str] | None) -> int:
 
 #: A full or read-only disk: the user's to fix, not a bug.
 _DISK_ERRORS = (errno.ENOSPC, errno.EDQUOT, errno.EROFS)
+
+
+def _disk_error_text(exc: OSError, args) -> str:
+    """A full or read-only disk, named by the file or, when the library that wrote
+    (HDF5, NetCDF) did not say which, by the command's output."""
+    where = exc.filename or next(
+        (v for v in (getattr(args, k, None) for k in ("out", "output", "run_dir")) if v), None
+    )
+    text = exc.strerror or str(exc)
+    if where:
+        text += f" while writing {where}"
+    return (
+        text + "; free some space or choose another --out (earlier outputs are kept as they were)"
+    )
 
 
 def _internal_error() -> int:

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from heritage_bayes.climate.risk.registry import indicator_info
-from heritage_bayes.inference.results import atomic_write, atomic_write_text
+from heritage_bayes.inference.results import atomic_write, atomic_write_text, ensure_free_space
 
 #: What a projection writes into its folder.
 OUTPUT_FILES = tuple(f"projection.{x}" for x in ("nc", "json", "csv", "html"))
@@ -208,6 +208,10 @@ def write_outputs(proj, run, dest: Path) -> dict:
         "csv": dest / "projection.csv",
         "html": dest / "projection.html",
     }
+    # a full disk inside an HDF5 write can crash the interpreter at exit: check first,
+    # for the four files (the NetCDF file at most its uncompressed size)
+    texts = sum(len(t.encode("utf-8")) for t in (text, csv, html))
+    ensure_free_space(paths["nc"], int(proj.dataset.nbytes) + texts)
     atomic_write(paths["nc"], lambda p: proj.dataset.to_netcdf(p, engine="h5netcdf"))
     atomic_write_text(paths["json"], text)
     atomic_write_text(paths["csv"], csv)

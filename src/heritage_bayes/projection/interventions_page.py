@@ -126,6 +126,7 @@ def fig_tradeoff(proj, page_key: tuple) -> str:
                 ax.annotate(row["name"], (x["q50"], y[1]), xytext=(5, 4),
                             textcoords="offset points", fontsize=8,
                             color=_COLOURS[j % len(_COLOURS)])  # fmt: skip
+            ax.margins(x=0.25)  # room for the labels right of the markers
             ax.axhline(0.0, color="#888888", lw=0.8)
             ax.set_xlabel("running energy of the measure [kWh/a]")
             ax.set_ylabel(f"improvement [{info.unit}]")

@@ -59,6 +59,17 @@ parameters, noise and weather as doing nothing, on the baseline and every future
 ``dehumidification`` or ``humidistat_band``: both models are stepped together, each
 controller reading the other's air; ``ventilation`` combines with any.)
 
+The decision table of the measures (:mod:`heritage_bayes.projection.decision`) ranks
+them by ``interventions_rank_by`` (an indicator with a direction; default: mould, else
+TWPI) and, with ``tariffs``, gives their annual cost and CO₂::
+
+    interventions_rank_by: vtt_mould_index_max
+    tariffs:
+      electricity_eur_per_kwh: 0.30      # [EUR/kWh]
+      heat_eur_per_kwh: 0.12             # [EUR/kWh] of heat delivered to the air
+      electricity_co2_kg_per_kwh: 0.35   # [kg/kWh] optional: both or neither
+      heat_co2_kg_per_kwh: 0.20          # [kg/kWh]
+
 Probability statements (``thresholds``), on any indicator the projection computes
 (:mod:`heritage_bayes.climate.risk.registry`; an unknown name is refused with the list)::
 

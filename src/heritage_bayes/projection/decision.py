@@ -25,6 +25,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from heritage_bayes.projection.interventions import _q
+
 #: Default ranking indicators, first computed and varying wins: mould (hours above the
 #: lowest isopleth, then the VTT index), then chemical decay (TWPI), then wetness.
 DEFAULT_RANK_BY = ("hours_above_LIM0", "vtt_mould_index_max", "twpi", "time_of_wetness")
@@ -38,12 +40,6 @@ def severe_case(summary: dict) -> str:
     cases = summary["cases"]
     futures = cases[1:] or cases
     return max(futures, key=lambda c: c["mean_Te"])["label"]
-
-
-def _q(x: np.ndarray) -> dict:
-    from heritage_bayes.projection.summary import _q as q
-
-    return q(np.asarray(x, dtype=float))
 
 
 def _varies(name: str, r0, per_case: list) -> bool:

@@ -382,12 +382,15 @@ def _split_html(proj) -> str:
     split = proj.summary["uncertainty_split"]
     fig = _fig_split(proj)
     out = [f"<figure id='fig-split'><img src='{fig}' alt='variance decomposition'></figure>"]
+    everywhere = {n for n, e in proj.summary["indicators"].items() if e.get("degenerate")}
     for g, block in split.items():
-        rows = []
+        rows, here = [], []
         for n, e in block["indicators"].items():
             sh = e["share"]
-            if e.get("degenerate"):
-                continue  # no variance to split: said in words at the top
+            if e.get("degenerate"):  # no variance to split
+                if n not in everywhere:  # (those constant everywhere: said at the top)
+                    here.append(indicator_info(n).name)
+                continue
             cells = "".join(
                 f"<td class='num'>{'–' if sh.get(k) is None else fmt_pct(min(1.0, sh[k]))}</td>"
                 for k in _COMPONENT_NAMES
@@ -402,6 +405,11 @@ def _split_html(proj) -> str:
             f"<h3>{escape(title)} ({escape(', '.join(block['cases']))})</h3>"
             f"<div class='scroll'><table class='split'><thead><tr><th>indicator</th>{head}"
             f"<th>of</th></tr></thead><tbody>{''.join(rows)}</tbody></table></div>"
+            + (
+                f"<p>The same in every draw here (no shares): {escape(', '.join(here))}.</p>"
+                if here
+                else ""
+            )
         )
     years = {c["years"] for c in proj.summary["cases"]}
     note = ""

@@ -3,13 +3,17 @@
 :mod:`heritage_bayes.report.figures.style`).
 
 What a conservator reads, in order: a banner when the calibration did not converge;
-per indicator (human name and unit from :mod:`heritage_bayes.climate.risk.registry`)
-the baseline and each scenario with its interval, the change against the baseline and
-the probability that it is worse; the probability of crossing each named threshold;
-the seasonal cycle of the indoor T and RH (baseline vs scenarios, with bands); the
-distributions of the key indicators per scenario; the measures (interventions) against
-doing nothing (:mod:`heritage_bayes.projection.interventions_page`); where the
-uncertainty comes from
+the verdict (what changes at the warmest future: each key indicator's median, its
+change with the 90 % interval and P(worse); the indicators constant in every draw
+named once, in words, and given no interval or variance shares); per indicator (human
+name and unit from :mod:`heritage_bayes.climate.risk.registry`) the baseline and each
+scenario with its interval, the change against the baseline and the probability that
+it is worse, and the ASHRAE classes in words (the required share of the hours, the best
+class reached, the share of hours within each class); the probability of crossing each
+named threshold; the seasonal cycle of the indoor T and RH (baseline vs scenarios, with
+bands); the distributions of the key indicators per scenario; the measures
+(interventions) against doing nothing, decision table first
+(:mod:`heritage_bayes.projection.interventions_page`); where the uncertainty comes from
 (figure and table of the decomposition of :mod:`heritage_bayes.projection.summary`);
 what every indicator means (definition, source, period); the weather used.
 

@@ -203,6 +203,8 @@ def projected(run, tmp_path_factory):
              "dehumidification": {"rh_max": 50, "capacity": 1.0, "energy_per_kg": 0.7}},
             {"name": "half ventilation", "ventilation": {"factor": 0.5}},
         ],
+        "tariffs": {"electricity_eur_per_kwh": 0.3, "heat_eur_per_kwh": 0.12,
+                    "electricity_co2_kg_per_kwh": 0.4, "heat_co2_kg_per_kwh": 0.2},
     }  # fmt: skip
     return project(run, cfg, out=tmp_path_factory.mktemp("interv_p") / "p")
 
@@ -483,3 +485,87 @@ def test_one_pass_pairs_measures_with_the_same_doing_nothing(run, case):
         per["dh"][0].predictive[cols].to_numpy(float), alone.predictive[cols].to_numpy(float)
     )
     np.testing.assert_array_equal(per["dh"][0].costs.to_numpy(), alone.costs.to_numpy())
+
+
+def _quantiles(x):
+    return np.quantile(np.asarray(x, float), [0.05, 0.5, 0.95])
+
+
+def test_decision_table_ranks_measures_and_totals_their_energy(projected):
+    """The decision table of projection.json against the per-draw arrays of the
+    dataset, recomputed here: the paired change of the ranking risk (default: hours
+    above LIM0, mould) at the warmest future with P(better), ranked best first; one
+    total energy per draw (heat + electricity) and, with the tariffs, cost and CO2."""
+    import json
+
+    p = projected
+    dec = json.loads(Path(p.paths["json"]).read_text())["decision"]
+    assert dec["case"] == "warm 2050" and dec["rank_by"] == "hours_above_LIM0"
+    ds = p.dataset.sel(case="warm 2050")
+    improvement = {}
+    for row in dec["measures"]:
+        m = ds.sel(measure=row["name"])
+        d = (m["hours_above_LIM0_measure"] - ds["hours_above_LIM0"]).values.astype(float)
+        q = _quantiles(d)
+        np.testing.assert_allclose(
+            [row["change"][k] for k in ("q05", "q50", "q95")], q, rtol=1e-4, atol=1e-3
+        )  # fmt: skip  (float32 in the file)
+        assert row["change"]["p_better"] == pytest.approx(np.mean(d < 0))
+        improvement[row["name"]] = -q[1]
+        heat = np.nan_to_num(m["cost_heating_energy"].values.astype(float))
+        elec = sum(np.nan_to_num(m[f"cost_{c}_energy"].values.astype(float))
+                   for c in ("dehumidifier", "humidifier") if f"cost_{c}_energy" in m)  # fmt: skip
+        total = heat + elec
+        np.testing.assert_allclose([row["energy_kwh"][k] for k in ("q05", "q50", "q95")],
+                                   _quantiles(total), rtol=1e-4, atol=1e-3)  # fmt: skip
+        np.testing.assert_allclose(row["cost_eur"]["q50"], np.median(0.12 * heat + 0.3 * elec),
+                                   rtol=1e-4, atol=1e-4)  # fmt: skip
+        np.testing.assert_allclose(row["co2_kg"]["q50"], np.median(0.2 * heat + 0.4 * elec),
+                                   rtol=1e-4, atol=1e-4)  # fmt: skip
+    names = [r["name"] for r in dec["measures"]]
+    assert set(names) == {"conservation heating", "dehumidifier", "half ventilation"}
+    assert [improvement[n] for n in names] == sorted(improvement.values(), reverse=True)
+    # the page: the decision table opens the section, in the same order
+    html = Path(p.paths["html"]).read_text(encoding="utf-8")
+    sec = html[html.index('id="interventions"') :]
+    table = sec[
+        sec.index("id='decision-table'") : sec.index("</table>", sec.index("decision-table"))
+    ]
+    assert sec.index("decision-table") < sec.index("Every case and indicator")
+    assert [table.index(f"{i}. {n}") for i, n in enumerate(names, 1)] == sorted(
+        table.index(f"{i}. {n}") for i, n in enumerate(names, 1)
+    )
+    assert "cost [EUR/a]" in table and "CO₂ [kg/a]" in table
+
+
+def test_tradeoff_figure_has_one_labelled_marker_per_measure(projected, monkeypatch):
+    from heritage_bayes.projection import interventions_page
+    from heritage_bayes.projection.page import KEY_INDICATORS
+
+    figs = []
+    monkeypatch.setattr(interventions_page, "to_png_uri", lambda fig: figs.append(fig) or "x")
+    interventions_page.fig_tradeoff(projected, KEY_INDICATORS)
+    (fig,) = figs
+    names = sorted(projected.summary["interventions"])
+    for ax in fig.axes:
+        assert len(ax.containers) == len(names)  # one errorbar (marker) per measure
+        assert sorted(t.get_text() for t in ax.texts) == names
+    assert not fig.legends and all(ax.get_legend() is None for ax in fig.axes)
+
+
+def test_rank_by_and_tariffs_are_validated(run):
+    bad = [
+        ({"tariffs": {"electricity_eur_per_kwh": -1, "heat_eur_per_kwh": 0.1}},
+         "electricity_eur_per_kwh"),
+        ({"tariffs": {"electricity_eur_per_kwh": 0.3, "heat_eur_per_kwh": 0.1,
+                      "heat_co2_kg_per_kwh": 0.2}}, "both"),
+        ({"tariffs": {"electricity_eur_per_kwh": 0.3}}, "heat_eur_per_kwh"),
+    ]  # fmt: skip
+    for extra, needle in bad:
+        with pytest.raises(ConfigError, match=needle):
+            parse_projection_config({**PROJ, **extra})
+    # refused before anything is simulated: an unknown name, an indicator without a
+    # direction (the EN 15757 band's offset: neither higher nor lower is worse)
+    for name, needle in (("mould", "unknown indicator"), ("en15757_upper_offset", "direction")):
+        with pytest.raises(ConfigError, match=needle):
+            project(run, {**PROJ, "interventions_rank_by": name}, write=False)

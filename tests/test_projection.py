@@ -551,3 +551,66 @@ def test_several_baseline_years_give_a_weather_year_share(run_dir, tmp_path):
     col = "en15757_outside_baseline"
     same = p.results[1].predictive[col].to_numpy()
     np.testing.assert_array_equal(same, p.results[0].predictive[col].to_numpy())
+
+
+# ------------------------------------------------------------------ decisions first
+def test_degenerate_indicators_are_said_once_and_get_no_shares(proj):
+    """An indicator constant in every draw and case (here the EN 15757 band's offsets,
+    fixed by construction) is flagged, named once in the verdict at the top, and has no
+    row in the decision or variance-share tables; decompose() gives it no shares even
+    when rounding leaves a variance of 1e-30 (the "1250 %" of a 300-draw run)."""
+    import html as html_mod
+    import re
+
+    from heritage_bayes.climate.risk.registry import indicator_info
+    from heritage_bayes.projection.summary import decompose
+
+    p, out = proj
+    s = json.loads((out / "projection.json").read_text())
+    const = [n for n, e in s["indicators"].items() if e["degenerate"]]
+    assert const, "the fixture has constant indicators (the EN 15757 offsets)"
+    for n in const:
+        v = np.concatenate([r.predictive[n].to_numpy(float) for r in p.results])
+        assert np.nanmax(v) == np.nanmin(v), n
+        for block in s["uncertainty_split"].values():
+            assert block["indicators"][n]["degenerate"]
+            assert all(x is None for x in block["indicators"][n]["share"].values())
+    varying = [n for n, e in s["indicators"].items() if not e["degenerate"]]
+    assert varying
+    html = (out / "projection.html").read_text()
+    verdict = html[html.index("id='verdict'") : html.index("</div>", html.index("id='verdict'"))]
+    assert html.index("id='verdict'") < html.index("<h2")  # above the first section
+    assert "worse in" in verdict and "Constant in every draw" in verdict
+    for n in const:
+        name = html_mod.escape(indicator_info(n).name)
+        assert name in verdict
+        for sec in ("split", "decision'"):  # no row in the share or decision tables
+            for table in re.findall(rf"<table class='{sec}.*?</table>", html, flags=re.S):
+                assert f"<td>{name}</td>" not in table and f"<b>{name}</b>" not in table
+    y = np.full((2, 300), 14.0) + np.random.default_rng(0).normal(0, 1e-15, (2, 300))
+    d = decompose(y, np.full((2, 300), 14.0))
+    assert d["degenerate"] and all(v is None for v in d["share"].values())
+
+
+def test_ashrae_sentence_gives_required_share_and_closest_class():
+    """ "none" in every draw is said with the required share of the hours and the class
+    that comes closest (median share of hours), not as "none 100 %"."""
+    from types import SimpleNamespace
+
+    from heritage_bayes.projection.page import _ashrae_html
+
+    def ind(q50):
+        return {"cases": {"baseline": {"q05": q50 - 2, "q50": q50, "q95": q50 + 1}}}
+
+    shares = {"AA": 5.0, "As": 10.0, "A": 20.0, "B": 60.0, "C": 87.0}
+    summary = {
+        "ashrae_best_class": {"baseline": {"none": 1.0}},
+        "indicators": {f"ashrae_{c}": ind(v) for c, v in shares.items()},
+    }
+    text = _ashrae_html(SimpleNamespace(labels=["baseline"], summary=summary))
+    assert "no class reaches the required 95 % of the hours in any draw" in text
+    assert "closest: C with 87 %" in text
+    assert "none 100 %" not in text and "B <span class='nowrap'>60<" in text
+    summary["ashrae_best_class"]["baseline"] = {"none": 0.25, "C": 0.75}
+    text = _ashrae_html(SimpleNamespace(labels=["baseline"], summary=summary))
+    assert "best class reached: C in 75 % of the draws, none in 25 % of the draws" in text

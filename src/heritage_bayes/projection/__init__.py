@@ -91,6 +91,22 @@ def _check_thresholds(pcfg, n_hours: int, risk_opts: dict) -> None:
     if "en15757_upper_offset" in cols:
         cols.insert(cols.index("en15757_upper_offset") + 1, "en15757_outside_baseline")
     check_indicator_names([t.indicator for t in pcfg.thresholds], cols, "thresholds")
+    rank_by = pcfg.interventions_rank_by
+    if rank_by is not None:
+        from heritage_bayes.climate.risk.registry import indicator_info
+        from heritage_bayes.errors import ConfigError
+
+        if rank_by not in cols:
+            raise ConfigError(
+                f"interventions_rank_by: unknown indicator {rank_by!r}; this projection "
+                f"computes: {', '.join(cols)}"
+            )
+        if not indicator_info(rank_by).worse:
+            raise ConfigError(
+                f"interventions_rank_by: {rank_by!r} has no direction (neither higher nor "
+                "lower is worse for the collection): give a risk indicator such as "
+                "hours_above_LIM0, vtt_mould_index_max or twpi"
+            )
 
 
 @dataclass
@@ -167,6 +183,7 @@ def project(
     then exits with :data:`EXIT_UNCONVERGED_RUN`.
     """
     from heritage_bayes.climate.risk.registry import indicator_info, years_of
+    from heritage_bayes.projection.decision import decision_table
     from heritage_bayes.projection.engine import select_draws, simulate_measures
     from heritage_bayes.projection.interventions import compare_measures, measures_from_config
     from heritage_bayes.projection.summary import summarize
@@ -250,6 +267,9 @@ def project(
         }
         for c in cases
     ]
+    summary["decision"] = decision_table(
+        labels, results, per_measure, summary, pcfg.interventions_rank_by, pcfg.tariffs
+    )
     summary["assumptions"] = list(ASSUMPTIONS)
     summary["converged"] = converged
     summary["unconverged_reasons"] = list(r.summary.get("unconverged_reasons") or [])

@@ -59,6 +59,17 @@ parameters, noise and weather as doing nothing, on the baseline and every future
 ``dehumidification`` or ``humidistat_band``: both models are stepped together, each
 controller reading the other's air; ``ventilation`` combines with any.)
 
+The decision table of the measures (:mod:`heritage_bayes.projection.decision`) ranks
+them by ``interventions_rank_by`` (an indicator with a direction; default: mould, else
+TWPI) and, with ``tariffs``, gives their annual cost and CO₂::
+
+    interventions_rank_by: vtt_mould_index_max
+    tariffs:
+      electricity_eur_per_kwh: 0.30      # [EUR/kWh]
+      heat_eur_per_kwh: 0.12             # [EUR/kWh] of heat delivered to the air
+      electricity_co2_kg_per_kwh: 0.35   # [kg/kWh] optional: both or neither
+      heat_co2_kg_per_kwh: 0.20          # [kg/kWh]
+
 Probability statements (``thresholds``), on any indicator the projection computes
 (:mod:`heritage_bayes.climate.risk.registry`; an unknown name is refused with the list)::
 
@@ -357,6 +368,38 @@ DEFAULT_THRESHOLDS = (
 )
 
 
+class Tariffs(_Strict):
+    """Prices and emission factors of the running energy of the measures (the decision
+    table of :mod:`heritage_bayes.projection.decision`)."""
+
+    electricity_eur_per_kwh: float = key(
+        ..., unit="EUR/kWh", description="price of electricity (dehumidifier, humidifier)",
+        ge=0.0, le=10.0,
+    )  # fmt: skip
+    heat_eur_per_kwh: float = key(
+        ..., unit="EUR/kWh", description="price of a kWh of heat delivered to the room's air "
+        "(fuel or electricity over the heater's efficiency)", ge=0.0, le=10.0,
+    )  # fmt: skip
+    electricity_co2_kg_per_kwh: float | None = key(
+        None, unit="kg/kWh", description="CO2 emitted per kWh of electricity", ge=0.0, le=2.0
+    )
+    heat_co2_kg_per_kwh: float | None = key(
+        None, unit="kg/kWh", description="CO2 emitted per kWh of heat delivered", ge=0.0, le=2.0
+    )
+
+    @model_validator(mode="after")
+    def _both_co2(self):
+        if (self.electricity_co2_kg_per_kwh is None) != (self.heat_co2_kg_per_kwh is None):
+            raise ValueError(
+                "give both electricity_co2_kg_per_kwh and heat_co2_kg_per_kwh, or neither"
+            )
+        return self
+
+    def has_co2(self) -> bool:
+        """True when the CO2 factors are given."""
+        return self.electricity_co2_kg_per_kwh is not None
+
+
 class ProjectionConfig(_Strict):
     """A validated projection file (see the module docstring)."""
 
@@ -385,6 +428,15 @@ class ProjectionConfig(_Strict):
         unit=None,
         description="measures compared with doing nothing, draw by draw "
         "(heritage_bayes.projection.interventions)",
+    )
+    interventions_rank_by: str | None = key(
+        None,
+        unit=None,
+        description="indicator the measures are ranked by in the decision table (default: "
+        "mould, else TWPI; heritage_bayes.projection.decision)",
+    )
+    tariffs: Tariffs | None = key(
+        None, unit=None, description="prices and CO2 factors of the measures' running energy"
     )
     base_dir: str | None = Field(default=None, description="set by the loader")
 

@@ -1,10 +1,13 @@
 """The "Measures" section of ``projection.html``: each intervention against doing nothing.
 
-Per case (baseline, each scenario), a table of measures × indicators (the paired change
-with its 5–95 % interval and the probability that the measure is better) and the
-running costs with intervals; a figure of risk reduction against annual energy (the
-trade-off a manager decides on), with 5–95 % intervals on both axes; and, in words,
-where the absolute scale of the costs comes from.
+First the decision table (:mod:`heritage_bayes.projection.decision`): the measures
+ranked by the change in one risk at the most severe case, with P(better), one running
+energy per year and, with tariffs, its cost and CO₂; the figure of risk reduction
+against that energy (one labelled marker per measure, 5–95 % intervals on both axes).
+Below, per case (baseline, each scenario), a table of measures × indicators (the
+paired change with its 5–95 % interval and the probability that the measure is
+better) and every running cost with its interval; and, in words, where the absolute
+scale of the costs comes from.
 """
 
 from __future__ import annotations
@@ -15,11 +18,12 @@ import numpy as np
 
 from heritage_bayes.climate.risk.registry import indicator_info
 from heritage_bayes.projection.interventions import COSTS
-from heritage_bayes.projection.interventions import ENERGY as _ENERGY
 from heritage_bayes.report.figures.style import RC_PARAMS, _figure, to_png_uri
 from heritage_bayes.report.format import fmt, fmt_interval_html, fmt_pct
 
 _MARKERS = ("o", "s", "D", "^", "v", "P", "X", "*")
+_COLOURS = ("#1f5fa8", "#c0392b", "#2e8b57", "#e08a00", "#7b3fa0", "#8c564b", "#17becf",
+            "#222222")  # fmt: skip
 #: Indicators of the trade-off figure, first two computed: mould, then chemical decay.
 _TRADEOFF = ("hours_above_LIM0", "vtt_mould_index_max", "twpi", "time_of_wetness")
 
@@ -82,81 +86,142 @@ def scale_text(run) -> str:
     )
 
 
-def _energy(costs: dict) -> dict | None:
-    """Annual energy quantiles [kWh/a] of a measure: its ``total_energy`` (per draw
-    sum) when it has several energy columns, else its one column."""
-    if "total_energy" in costs:
-        return costs["total_energy"]
-    cols = [c for c in _ENERGY if c in costs]
-    return costs[cols[0]] if cols else None
+def _improvement(info, d: dict) -> list[float]:
+    """(low, median, high) of the improvement (positive = better, the registry's
+    direction) from a change's quantiles."""
+    y = sorted(-info.worse * d[k] for k in ("q05", "q95"))
+    return [y[0], -info.worse * d["q50"], y[1]]
 
 
-def fig_tradeoff(proj, page_key: tuple, colour, legend) -> str:
-    """Risk reduction vs annual energy: the first mould indicator and the chemical one
-    computed (:data:`_TRADEOFF`), the improvement (change in the registry's better
-    direction) against the measure's energy [kWh/a] (0 for a measure without one).
-    ``colour(i)``: the page's colour of case ``i``; ``legend(fig, handles, labels,
-    ncol)``: the page's legend below the axes."""
+def fig_tradeoff(proj, page_key: tuple) -> str:
+    """Risk reduction vs annual energy at the decision table's case: one panel per
+    indicator (the ranking one, then the first other of :data:`_TRADEOFF` computed),
+    one marker per measure labelled beside it, 5–95 % bars on both axes; the energy is
+    the per-draw total of the decision table [kWh/a] (0 for a measure without one)."""
     import matplotlib
 
+    dec = proj.summary.get("decision") or {}
     iv = proj.summary.get("interventions") or {}
-    names = _indicators(proj, page_key)
-    mould = [n for n in _TRADEOFF[:2] if n in names][:1]
-    names = (mould + [n for n in _TRADEOFF[2:] if n in names] + names)[:2]
-    names = list(dict.fromkeys(names))
-    if not iv or not names:
+    if not dec or not dec.get("rank_by"):
         return ""
+    case = dec["case"]
+    names = _indicators(proj, page_key)
+    names = list(dict.fromkeys([dec["rank_by"], *[n for n in _TRADEOFF if n in names]]))[:2]
     with matplotlib.rc_context(RC_PARAMS):
-        fig = _figure(9.5, 4.2)
+        fig = _figure(9.5, 4.4)
         axes = np.atleast_1d(fig.subplots(1, len(names)))
-        handles, labels = [], []
         for ax, n in zip(axes, names, strict=True):
             info = indicator_info(n)
-            for j, (mname, e) in enumerate(iv.items()):
-                for i, lab in enumerate(proj.labels):
-                    case = e["cases"][lab]
-                    d = case["indicators"].get(n)
-                    en = _energy(case["costs"])
-                    if not d or d.get("q50") is None:
-                        continue
-                    x = en or {"q05": 0.0, "q50": 0.0, "q95": 0.0}
-                    # improvement: positive = better (the registry's direction)
-                    y = [-info.worse * d[k] for k in ("q05", "q50", "q95")]
-                    h = ax.errorbar(
-                        x["q50"],
-                        y[1],
-                        xerr=[[x["q50"] - x["q05"]], [x["q95"] - x["q50"]]],
-                        yerr=[[y[1] - min(y[0], y[2])], [max(y[0], y[2]) - y[1]]],
-                        fmt=_MARKERS[j % len(_MARKERS)],
-                        color=colour(i),
-                        capsize=2,
-                        alpha=0.85,
-                    )
-                    if ax is axes[0]:
-                        handles.append(h)
-                        labels.append(f"{mname} — {lab}")
+            for j, row in enumerate(dec["measures"]):
+                d = iv[row["name"]]["cases"][case]["indicators"].get(n)
+                if not d or d.get("q50") is None:
+                    continue
+                x = row["energy_kwh"]
+                y = _improvement(info, d)
+                ax.errorbar(x["q50"], y[1],
+                            xerr=[[x["q50"] - x["q05"]], [x["q95"] - x["q50"]]],
+                            yerr=[[y[1] - y[0]], [y[2] - y[1]]],
+                            fmt=_MARKERS[j % len(_MARKERS)], color=_COLOURS[j % len(_COLOURS)],
+                            ms=6, capsize=2, elinewidth=0.8, alpha=0.9)  # fmt: skip
+                ax.annotate(row["name"], (x["q50"], y[1]), xytext=(5, 4),
+                            textcoords="offset points", fontsize=8,
+                            color=_COLOURS[j % len(_COLOURS)])  # fmt: skip
+            ax.margins(x=0.25)  # room for the labels right of the markers
             ax.axhline(0.0, color="#888888", lw=0.8)
-            ax.set_xlabel("annual energy of the measure [kWh/a]")
+            ax.set_xlabel("running energy of the measure [kWh/a]")
             ax.set_ylabel(f"improvement [{info.unit}]")
             ax.set_title(info.name, fontsize=9)
         fig.suptitle(
-            "Improvement against doing nothing vs running cost (median and 5–95 % of the "
-            "draws; above 0: better)"
+            f"{case}: improvement against doing nothing vs running energy (median and "
+            "5–95 % of the draws; above 0: better)"
         )
-        legend(fig, handles, labels, ncol=min(3, max(1, len(labels))))
         return to_png_uri(fig)
 
 
-def interventions_html(proj, run, page_key: tuple, colour, legend) -> str:
-    """The section body (empty string when the projection has no interventions);
-    ``colour``, ``legend``: the page's (see :func:`fig_tradeoff`)."""
+def _fmt_q(d: dict | None, unit: str = "") -> str:
+    if not d or d.get("q50") is None:
+        return "–"
+    return fmt_interval_html(d["q50"], d["q05"], d["q95"]) + (f" {escape(unit)}" if unit else "")
+
+
+def decision_html(proj) -> str:
+    """The decision table (:mod:`heritage_bayes.projection.decision`): measures ranked
+    by the change in the chosen risk at the most severe case, with its interval and
+    P(better), one total running energy per year and, with tariffs, its cost and CO₂."""
+    dec = proj.summary.get("decision") or {}
+    if not dec or not dec.get("rank_by"):
+        return ""
+    info = indicator_info(dec["rank_by"])
+    tariffs = dec.get("tariffs")
+    co2 = bool(tariffs) and tariffs.get("electricity_co2_kg_per_kwh") is not None
+    head = (
+        f"<th>measure</th><th>change in {escape(info.label())}</th><th>P(better)</th>"
+        "<th>running energy [kWh/a]</th>"
+        + ("<th>cost [EUR/a]</th>" if tariffs else "")
+        + ("<th>CO₂ [kg/a]</th>" if co2 else "")
+    )
+    rows = []
+    for rank, row in enumerate(dec["measures"], 1):
+        c = row["change"] or {}
+
+        def money(q, row=row):
+            return _fmt_q(q) if row["has_energy"] else "none"
+
+        energy = _fmt_q(row["energy_kwh"]) if row["has_energy"] else "none"
+        if row["energy_missing"]:
+            energy += f"<br><small>without the {escape(' and '.join(row['energy_missing']))} " \
+                      "(no energy per kg given)</small>"  # fmt: skip
+        pb = c.get("p_better")
+        rows.append(
+            f"<tr><td>{rank}. {escape(row['name'])}</td><td class='num'>{_fmt_q(c)}</td>"
+            f"<td class='num'>{'–' if pb is None else fmt_pct(pb)}</td>"
+            f"<td class='num'>{energy}</td>"
+            + (f"<td class='num'>{money(row['cost_eur'])}</td>" if tariffs else "")
+            + (f"<td class='num'>{money(row['co2_kg'])}</td>" if co2 else "")
+            + "</tr>"
+        )
+    if tariffs:
+        money = (
+            f"Cost at {fmt(tariffs['heat_eur_per_kwh'])} EUR per kWh of heat and "
+            f"{fmt(tariffs['electricity_eur_per_kwh'])} EUR per kWh of electricity"
+            + (
+                f"; CO₂ at {fmt(tariffs['heat_co2_kg_per_kwh'])} and "
+                f"{fmt(tariffs['electricity_co2_kg_per_kwh'])} kg/kWh"
+                if co2
+                else ""
+            )
+            + " (the projection file's tariffs), per draw, then its interval."
+        )
+    else:
+        money = "Give tariffs in the projection file for the annual cost and CO₂."
+    return (
+        f"<p><b>Which measure, at {escape(dec['case'])}</b> (the warmest future): ranked by "
+        f"the median change in {escape(info.name)} against doing nothing, best first; "
+        "median [5 %, 95 %] over the draws, paired draw by draw. <b>P(better)</b>: share "
+        "of the draws in which the measure is better. <b>Running energy</b>: per draw the "
+        "sum of the heat delivered and the units' electricity, then its interval. "
+        f"{money}</p><div class='scroll'><table class='decision' id='decision-table'>"
+        f"<thead><tr>{head}</tr></thead><tbody>{''.join(rows)}</tbody></table></div>"
+    )
+
+
+def interventions_html(proj, run, page_key: tuple) -> str:
+    """The section body (empty string when the projection has no interventions): the
+    decision table first, then the figure and the per-case detail tables."""
     iv = proj.summary.get("interventions") or {}
     if not iv:
         return ""
     names = _indicators(proj, page_key)
     head = "".join(f"<th>{escape(indicator_info(n).label())}</th>" for n in names)
+    fig = fig_tradeoff(proj, page_key)
     parts = [
-        "<p>Each measure is simulated for every posterior draw with the same parameters, "
+        decision_html(proj),
+        f"<figure id='fig-tradeoff'><img src='{fig}' alt='risk reduction against "
+        "running energy per measure'></figure>"
+        if fig
+        else "",
+        "<h3>Every case and indicator</h3><p>Each measure is simulated for every "
+        "posterior draw with the same parameters, "
         "the same noise realisation and the same weather as doing nothing, so the "
         "differences below are paired: a cell gives the median change (measure − "
         "nothing) with its 5–95 % interval over the draws and the share of draws in "
@@ -203,11 +268,5 @@ def interventions_html(proj, run, page_key: tuple, colour, legend) -> str:
             "<th>case</th><th>statement</th><th class='num'>doing nothing</th>"
             f"<th class='num'>with the measure</th></tr></thead><tbody>{''.join(probs)}"
             "</tbody></table></div>"
-        )
-    fig = fig_tradeoff(proj, page_key, colour, legend)
-    if fig:
-        parts.append(
-            f"<figure id='fig-tradeoff'><img src='{fig}' alt='risk reduction against "
-            "annual energy per measure and case'></figure>"
         )
     return "".join(parts)

@@ -3,13 +3,17 @@
 :mod:`heritage_bayes.report.figures.style`).
 
 What a conservator reads, in order: a banner when the calibration did not converge;
-per indicator (human name and unit from :mod:`heritage_bayes.climate.risk.registry`)
-the baseline and each scenario with its interval, the change against the baseline and
-the probability that it is worse; the probability of crossing each named threshold;
-the seasonal cycle of the indoor T and RH (baseline vs scenarios, with bands); the
-distributions of the key indicators per scenario; the measures (interventions) against
-doing nothing (:mod:`heritage_bayes.projection.interventions_page`); where the
-uncertainty comes from
+the verdict (what changes at the warmest future: each key indicator's median, its
+change with the 90 % interval and P(worse); the indicators constant in every draw
+named once, in words, and given no interval or variance shares); per indicator (human
+name and unit from :mod:`heritage_bayes.climate.risk.registry`) the baseline and each
+scenario with its interval, the change against the baseline and the probability that
+it is worse, and the ASHRAE classes in words (the required share of the hours, the best
+class reached, the share of hours within each class); the probability of crossing each
+named threshold; the seasonal cycle of the indoor T and RH (baseline vs scenarios, with
+bands); the distributions of the key indicators per scenario; the measures
+(interventions) against doing nothing, decision table first
+(:mod:`heritage_bayes.projection.interventions_page`); where the uncertainty comes from
 (figure and table of the decomposition of :mod:`heritage_bayes.projection.summary`);
 what every indicator means (definition, source, period); the weather used.
 
@@ -58,7 +62,109 @@ def _colour(i: int) -> str:
 
 
 def _key_names(proj) -> list[str]:
-    return [n for n in KEY_INDICATORS if n in proj.summary["indicators"]]
+    """Key indicators computed and not constant (a constant one is said in words)."""
+    ind = proj.summary["indicators"]
+    return [n for n in KEY_INDICATORS if n in ind and not ind[n].get("degenerate")]
+
+
+def _ashrae_html(proj) -> str:
+    """The ASHRAE classes in words: the required share of the hours, the best class
+    reached (share of the draws) and, per class, the share of hours within it (median
+    [5 %, 95 %] over the draws), so that "none" comes with how close each class is."""
+    import inspect
+
+    from heritage_bayes.climate.risk.standards import ASHRAE_CLASSES, ashrae_classes
+
+    s = proj.summary
+    best = s.get("ashrae_best_class") or {}
+    if not best:
+        return ""
+    need = inspect.signature(ashrae_classes).parameters["threshold"].default
+    names = [c.name for c in ASHRAE_CLASSES if f"ashrae_{c.name}" in s["indicators"]]
+    items = []
+    for lab in proj.labels:
+        per = {c: s["indicators"][f"ashrae_{c}"]["cases"][lab] for c in names}
+        reached = {k: v for k, v in best[lab].items() if k != "none"}
+        shares = ", ".join(
+            f"{escape(c)} {_q_text(per[c])} %" for c in names if per[c]["q50"] is not None
+        )
+        close = max((c for c in names if per[c]["q50"] is not None),
+                    key=lambda c: per[c]["q50"], default=None)  # fmt: skip
+        if not reached:
+            head = f"no class reaches the required {fmt(need)} % of the hours in any draw"
+            if close is not None:
+                head += f"; closest: {escape(close)} with {fmt(per[close]['q50'])} % (median)"
+        else:
+            head = "best class reached: " + ", ".join(
+                f"{escape(k)} in {fmt_pct(v)} of the draws"
+                for k, v in sorted(best[lab].items(), key=lambda kv: -kv[1])
+            )
+        items.append(
+            f"<li><b>{escape(lab)}</b>: {head}. Share of the hours within each class: "
+            f"{shares}.</li>"
+        )
+    return (
+        f"<p>ASHRAE museum classes (a class is met when at least {fmt(need)} % of the "
+        f"hours lie within its limits):</p><ul>{''.join(items)}</ul>"
+    )
+
+
+def _verdict_html(proj) -> str:
+    """The first screen: what changes at the most severe case (the key indicators'
+    median change with its 90 % interval) and how sure (P(worse)); the indicators
+    constant in every draw said once, in words."""
+    from heritage_bayes.projection.decision import severe_case
+
+    s = proj.summary
+    base = proj.labels[0]
+    items, worse, better = [], [], []
+    if len(proj.labels) > 1:
+        case = severe_case(s)
+        for n in _key_names(proj):
+            e = s["indicators"][n]
+            ch = e["change"].get(case) or {}
+            if ch.get("q50") is None:
+                continue
+            pw = ch.get("p_worse")
+            sure = "" if pw is None else f"; worse in {fmt_pct(pw)} of the draws"
+            name = indicator_info(n).name
+            if pw is not None and pw >= 0.9:
+                worse.append(name)
+            elif pw is not None and pw <= 0.1:
+                better.append(name)
+            unit = "" if e["unit"] in ("-", "") else f" {escape(e['unit'])}"
+            items.append(
+                f"<li><b>{escape(name)}</b>: {fmt(e['cases'][base]['q50'])} → "
+                f"{fmt(e['cases'][case]['q50'])}{unit}, change {_q_text(ch)}{sure}</li>"
+            )
+        sure = [
+            f"worse in at least 90 % of the draws: {', '.join(worse)}" if worse else "",
+            f"better in at least 90 %: {', '.join(better)}" if better else "",
+        ]
+        sure = "; ".join(t for t in sure if t) or "no key indicator changes in 90 % of the draws"
+        head = (
+            f"<p><b>At {escape(case)}</b> (the warmest future) against {escape(base)}, "
+            f"{escape(sure)}. Per indicator: the median, and the change with its 90 % "
+            "interval [5 %, 95 %] over the draws.</p>"
+        )
+    else:
+        head = "<p>No future weather: the baseline only.</p>"
+    const = [
+        f"{indicator_info(n).name} {fmt(e['cases'][base]['q50'])}"
+        + ("" if e["unit"] in ("-", "") else f" {e['unit']}")
+        for n, e in s["indicators"].items()
+        if e.get("degenerate")
+    ]
+    said = (
+        "<p>Constant in every draw and case (no interval or source of uncertainty to "
+        f"report): {escape('; '.join(const))}.</p>"
+        if const
+        else ""
+    )
+    body = f"<ul>{''.join(items)}</ul>" if items else ""
+    return (
+        f"<div class='note info' id='verdict'><strong>What changes</strong>{head}{body}{said}</div>"
+    )
 
 
 def _legend_below(fig, handles, labels, ncol: int) -> None:
@@ -198,6 +304,8 @@ def _decision_html(proj) -> str:
     s = proj.summary
     rows = []
     for n, e in s["indicators"].items():
+        if e.get("degenerate") or n.startswith("ashrae_"):
+            continue  # said in words (the summary, the ASHRAE sentence below)
         info = indicator_info(n)
         span = len(proj.labels)
         for j, lab in enumerate(proj.labels):
@@ -214,18 +322,12 @@ def _decision_html(proj) -> str:
                 f"<td class='num'>{'–' if ch is None else _q_text(ch)}</td>"
                 f"<td class='num'>{'–' if pw is None else fmt_pct(pw)}</td></tr>"
             )
-    cls = s.get("ashrae_best_class") or {}
-    extra = ""
-    if cls:
-        items = "".join(
-            f"<li>{escape(lab)}: "
-            + ", ".join(f"{escape(k)} {fmt_pct(v)}" for k, v in sorted(cls[lab].items()))
-            + "</li>"
-            for lab in proj.labels
-        )
-        extra = (
-            "<p>Best ASHRAE class reached (share of the draws; 'none': no class is met for "
-            f"the required share of the hours):</p><ul>{items}</ul>"
+    extra = _ashrae_html(proj)
+    const = [n for n, e in s["indicators"].items() if e.get("degenerate")]
+    if const:
+        extra += (
+            "<p>Left out of this table, constant in every draw and case (see the summary "
+            f"at the top): {escape(', '.join(indicator_info(n).name for n in const))}.</p>"
         )
     return (
         "<p>Median [5 %, 95 %] over the posterior draws, each with a draw of the model "
@@ -284,12 +386,17 @@ def _split_html(proj) -> str:
     split = proj.summary["uncertainty_split"]
     fig = _fig_split(proj)
     out = [f"<figure id='fig-split'><img src='{fig}' alt='variance decomposition'></figure>"]
+    everywhere = {n for n, e in proj.summary["indicators"].items() if e.get("degenerate")}
     for g, block in split.items():
-        rows = []
+        rows, here = [], []
         for n, e in block["indicators"].items():
             sh = e["share"]
+            if e.get("degenerate"):  # no variance to split
+                if n not in everywhere:  # (those constant everywhere: said at the top)
+                    here.append(indicator_info(n).name)
+                continue
             cells = "".join(
-                f"<td class='num'>{'–' if sh.get(k) is None else fmt_pct(sh[k])}</td>"
+                f"<td class='num'>{'–' if sh.get(k) is None else fmt_pct(min(1.0, sh[k]))}</td>"
                 for k in _COMPONENT_NAMES
             )
             rows.append(
@@ -302,6 +409,11 @@ def _split_html(proj) -> str:
             f"<h3>{escape(title)} ({escape(', '.join(block['cases']))})</h3>"
             f"<div class='scroll'><table class='split'><thead><tr><th>indicator</th>{head}"
             f"<th>of</th></tr></thead><tbody>{''.join(rows)}</tbody></table></div>"
+            + (
+                f"<p>The same in every draw here (no shares): {escape(', '.join(here))}.</p>"
+                if here
+                else ""
+            )
         )
     years = {c["years"] for c in proj.summary["cases"]}
     note = ""
@@ -377,6 +489,7 @@ def render_projection_page(proj, run) -> str:
     lead = (
         _CSS
         + _banner(proj)
+        + _verdict_html(proj)
         + "<div class='note info'><p>"
         + f"{s['draws']} posterior draws of the calibrated room, each simulated on the "
         + f"baseline and on {len(proj.labels) - 1} future weather(s)"
@@ -391,7 +504,7 @@ def render_projection_page(proj, run) -> str:
     risk = _fig_risk(proj)
     from heritage_bayes.projection.interventions_page import interventions_html
 
-    measures = interventions_html(proj, run, KEY_INDICATORS, _colour, _legend_below)
+    measures = interventions_html(proj, run, KEY_INDICATORS)
     sections = [
         Section(
             "What the projection assumes", f"<ul>{assumptions}</ul>", id="assumptions", lead=lead

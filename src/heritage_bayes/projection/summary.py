@@ -26,7 +26,11 @@ variances, every group the same size, so that the law of total variance holds ex
   (extremes over the period, shares over all hours) have no weather-year term.
 
 The shares are the components over ``Var(y)``: non-negative, and they sum to 1 by
-construction. Each case's weather is one change per scenario (the KNMI'14 tables, one
+construction. An indicator constant in every draw (:func:`is_degenerate`, e.g. an EMC
+minimum of 0 % or a dimensional change the same for every parameter draw) has no
+variance to split: it is flagged ``degenerate`` and given no shares.
+
+Each case's weather is one change per scenario (the KNMI'14 tables, one
 set of morphing deltas, one file), so a climate-model range is not separated from the
 scenario term unless each model is a case of its own.
 Probabilities are proportions of draws; their Monte-Carlo standard error is
@@ -63,6 +67,14 @@ def _q(x: np.ndarray) -> dict:
     return {"q05": float(q[0]), "q50": float(q[1]), "q95": float(q[2]), "mean": float(x.mean())}
 
 
+def is_degenerate(y: np.ndarray) -> bool:
+    """True when the finite values of ``y`` are all equal (to 1e-12 of their magnitude:
+    a variance of rounding error is not split into shares); False with no finite value."""
+    v = np.asarray(y, float)
+    v = v[np.isfinite(v)]
+    return v.size > 0 and float(np.ptp(v)) <= 1e-12 * max(1.0, float(np.abs(v).max()))
+
+
 def _proportional(a: np.ndarray, b: np.ndarray, axis: int) -> tuple[float, float]:
     """``Var(a + b)`` split into the parts of ``a`` and ``b`` in proportion to
     ``Var(a)`` and ``Var(b)`` (the covariance shared the same way): both non-negative,
@@ -90,7 +102,8 @@ def decompose(y: np.ndarray, x: np.ndarray) -> dict:
     dict
         ``variance`` (component → variance, ``weather_year`` None without years),
         ``total`` and ``share`` (component → share of the total, None where the total
-        is 0 or the component is absent), ``draws`` used.
+        is 0 or the component is absent), ``draws`` used and ``degenerate`` (the values
+        are constant: no shares).
     """
     y = np.asarray(y, float)
     x = np.asarray(x, float)
@@ -99,9 +112,10 @@ def decompose(y: np.ndarray, x: np.ndarray) -> dict:
         y, x = y[:, :, None], x[:, :, None]
     ok = np.isfinite(y).all(axis=(0, 2)) & np.isfinite(x).all(axis=(0, 2))
     y, x = y[:, ok], x[:, ok]
-    if not ok.any():
+    if not ok.any() or is_degenerate(y[:, ok]):
         return {"variance": dict.fromkeys(COMPONENTS), "total": None,
-                "share": dict.fromkeys(COMPONENTS), "draws": 0}  # fmt: skip
+                "share": dict.fromkeys(COMPONENTS), "draws": int(ok.sum()),
+                "degenerate": bool(ok.any())}  # fmt: skip
     d = y - x
     scenario = float(y.mean(axis=(1, 2)).var())
     xb, db = x.mean(axis=2), d.mean(axis=2)  # (S, K): means over the years
@@ -114,7 +128,8 @@ def decompose(y: np.ndarray, x: np.ndarray) -> dict:
     if not yearly:
         parts["noise"] += weather  # 0 without years (one value per draw)
     share = {k: (v / total if (v is not None and total > 0) else None) for k, v in parts.items()}
-    return {"variance": parts, "total": total, "share": share, "draws": int(ok.sum())}
+    return {"variance": parts, "total": total, "share": share, "draws": int(ok.sum()),
+            "degenerate": False}  # fmt: skip
 
 
 def _annual(r, name: str):
@@ -173,6 +188,9 @@ def summarize(labels, horizons, results, baseline: str, thresholds, units) -> di
             "worse": info.worse,
             "cases": {},
             "change": {},
+            "degenerate": is_degenerate(
+                np.concatenate([r.predictive[n].to_numpy(float) for r in results])
+            ),
         }
         for lab, r in zip(labels, results, strict=True):
             v = r.predictive[n].to_numpy(float)

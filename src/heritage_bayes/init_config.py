@@ -25,8 +25,10 @@ and ``tests/test_init.py``):
   validate), else its first whole 12 months, else 2/3 and 1/3 of it; never starting or
   ending in a gap. While a clock is an open question they keep 14 h (the largest
   offset) inside the stretch, so that any answer keeps them inside the data.
-* **Models**: thermal_1c and hygric_1c, the smallest of each ladder; the report's
-  ladder fits the larger ones.
+* **Models**: what the data call for (:mod:`heritage_bayes.init_model`): the control
+  (thermostat, humidistat band, a constant gain), the vapour sink or the sorbing buffer
+  each from a measured signature, two thermal nodes from 60 days of calibration data;
+  the evidence is written above the keys.
 * **Irradiance stamps**: the reading of the stamps (interval end, instant, interval
   start) under which the sun confirms the declared clock (FMI: values at the stamp).
 

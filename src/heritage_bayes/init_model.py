@@ -19,9 +19,10 @@ written as comments above them:
   least :data:`SINK_PA`, in most months (without an RH band, which explains it) →
   ``hygric_2c_fixed`` with ``sink: temperature`` (a sink at ``phi_f·psat(Tf)``, the ground);
 * **sorption**: the hourly departures of indoor vapour pressure from its daily mean
-  follow ``psat(Ti)`` (correlation at least :data:`SORPTION_R`, and above the outdoor
-  vapour pressure's by 0.1): a sorbing buffer at the room's temperature →
-  ``hygric_2c_sorption``.
+  follow those of ``psat(Ti)`` once the outdoor vapour pressure's are accounted for
+  (partial correlation at least :data:`SORPTION_R`), under a daily indoor swing of
+  :data:`SORPTION_SWING_K` or more: a sorbing buffer at the room's temperature →
+  ``hygric_2c_sorption`` (with ``sink: temperature`` when a sink shows too).
 
 The starting order: a calibration period of :data:`LONG_DAYS` days or more of hourly
 data pins two thermal nodes (``thermal_2c``; Kramer et al.'s ``thermal_4a`` is the next
@@ -56,6 +57,10 @@ GAIN_K = 3.0
 SINK_PA = 30.0
 #: Correlation of the hourly vapour-pressure departures with psat(Ti)'s: sorption.
 SORPTION_R = 0.5
+#: ... under a median daily indoor temperature range [K] of at least this: with less,
+#: psat(Ti) hardly moves, and a common daily cycle of heat and moisture (use, occupants)
+#: correlates as well.
+SORPTION_SWING_K = 2.0
 #: Calibration days of hourly data from which the two-node thermal model starts.
 LONG_DAYS = 60
 
@@ -183,16 +188,28 @@ def _hygric(p: ModelProposal, ti, te, rhi, rhe, cal_days: float) -> None:
     def dep(s):  # departures from the daily mean
         return s - s.groupby(s.index.floor("D")).transform("mean")
 
-    r_t = float(np.corrcoef(dep(pi), dep(ps))[0, 1])
-    r_e = float(np.corrcoef(dep(pi), dep(pe))[0, 1])
-    sorption = r_t >= SORPTION_R and r_t >= r_e + 0.1
+    x, y, z = dep(pi).to_numpy(), dep(ps).to_numpy(), dep(pe).to_numpy()
+    r_t = float(np.corrcoef(x, y)[0, 1])
+    r_e = float(np.corrcoef(x, z)[0, 1])
+    r_ty = float(np.corrcoef(y, z)[0, 1])
+    partial = (r_t - r_e * r_ty) / np.sqrt(max((1 - r_e**2) * (1 - r_ty**2), 1e-12))
+    swing = _daily_range(ti)
+    sorption = partial >= SORPTION_R and swing >= SORPTION_SWING_K
     p.hygric_evidence.append(
-        f"daily cycle of indoor vapour pressure: correlation {r_t:.2f} with psat(Ti), "
-        f"{r_e:.2f} with the outdoor vapour pressure: "
+        f"daily cycle of indoor vapour pressure (departures from the daily mean): "
+        f"correlation {r_t:.2f} with psat(Ti), {r_e:.2f} with the outdoor vapour pressure, "
+        f"{partial:.2f} with psat(Ti) once the outdoor one is accounted for (partial), "
+        f"under a daily indoor swing of {swing:.1f} K: "
         + (
             "it follows the room's temperature: sorption in a buffer at Ti"
             if sorption
             else "no sorption signature"
+            + (
+                f" (a swing under {SORPTION_SWING_K:g} K: a common daily cycle of heat and "
+                "moisture, such as use, is as likely)"
+                if partial >= SORPTION_R
+                else ""
+            )
         )
     )
     if not long:

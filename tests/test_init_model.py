@@ -16,6 +16,7 @@ from heritage_bayes.config import load_config
 from heritage_bayes.init_config import init_config
 from heritage_bayes.init_model import propose_model
 from heritage_bayes.io.clock import solar_noon_utc
+from test_init_detect import _fmi
 
 SITE = {"latitude": 60.2, "longitude": 24.7}
 
@@ -41,19 +42,8 @@ def _smooth(x, halflife: float):
 
 
 def _write(tmp_path: Path, utc, te, rhe, ghi, ti, rhi) -> tuple[Path, Path]:
-    d = tmp_path / "data"
-    d.mkdir(exist_ok=True)
-    wp = d / "fmi.csv"
-    pd.DataFrame(
-        {
-            "t_UTC+2": (utc.tz_localize(None) + pd.Timedelta(hours=2)).strftime(
-                "%Y-%m-%d %H:%M:%S"
-            ),
-            "Te": te.round(2),
-            "RHe": rhe.round(1),
-            "Rglob": ghi,
-        }
-    ).to_csv(wp, index=False)
+    wp = _fmi(tmp_path, utc, te, rhe, ghi)
+    d = wp.parent
     lines = ['"Plot Title: room"', '"#","Date Time, GMT+02:00","Temp, °C","RH, %"']
     stamps = utc.tz_localize(None) + pd.Timedelta(hours=2)
     lines += [

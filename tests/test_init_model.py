@@ -152,4 +152,24 @@ def test_the_rh_band_threshold(rh_half_width, band):
         heated=(float("nan"), 0, 30),
     )
     assert ("humidistat" in p.hygric_options) is band
+    # a vapour pressure near the outdoor one: no sink, no source
+    assert "sink" not in p.hygric_options and "source" not in p.hygric_options
     assert p.thermal_model == "thermal_1c" and p.thermal_options == {}
+
+
+@pytest.mark.parametrize("offset_pa, key", [(-150.0, "sink"), (0.0, None), (150.0, "source")])
+def test_sink_and_source_from_the_mean_vapour_pressure(offset_pa, key):
+    utc, te, rhe, _ = _weather(120)
+    ti = _smooth(te, 48) + 2
+    pe = rhe / 100 * saturation_vapour_pressure(te)
+    rng = np.random.default_rng(2)
+    rhi = relative_humidity(ti, _smooth(pe, 24) + offset_pa) + rng.normal(0, 4, ti.size)
+    p = propose_model(
+        *(pd.Series(x, index=utc) for x in (ti, te, rhi, rhe)),
+        start="2013-01-01",
+        mid="2013-03-20",
+        end="2013-05-01",
+        heated=(float("nan"), 0, 120),
+    )
+    assert {k for k in ("sink", "source") if k in p.hygric_options} == ({key} - {None})
+    assert p.hygric_model == ("hygric_2c_fixed" if key == "sink" else "hygric_1c")

@@ -18,6 +18,9 @@ written as comments above them:
 * **a vapour sink**: indoor vapour pressure below the outdoor one on average, by at
   least :data:`SINK_PA`, in most months (without an RH band, which explains it) →
   ``hygric_2c_fixed`` with ``sink: temperature`` (a sink at ``phi_f·psat(Tf)``, the ground);
+* **a moisture source**: indoor vapour pressure above the outdoor one on average, by at
+  least :data:`SOURCE_PA`, in most months (ground moisture, visitors, use; without an
+  RH band) → ``hygric.options: {source: true}``, a constant source ``Ms`` [kg/s];
 * **sorption**: the hourly departures of indoor vapour pressure from its daily mean
   follow those of ``psat(Ti)`` once the outdoor vapour pressure's are accounted for
   (partial correlation at least :data:`SORPTION_R`), under a daily indoor swing of
@@ -55,6 +58,8 @@ BAND_RATIO = 0.4
 GAIN_K = 3.0
 #: Mean indoor minus outdoor vapour pressure [Pa] at or below ``-SINK_PA``: a sink.
 SINK_PA = 30.0
+#: Mean indoor minus outdoor vapour pressure [Pa] at or above this: a moisture source.
+SOURCE_PA = 100.0
 #: Correlation of the hourly vapour-pressure departures with psat(Ti)'s: sorption.
 SORPTION_R = 0.5
 #: ... under a median daily indoor temperature range [K] of at least this: with less,
@@ -180,10 +185,20 @@ def _hygric(p: ModelProposal, ti, te, rhi, rhe, cal_days: float) -> None:
     months = d.resample("MS").mean().dropna()
     below = int((months < 0).sum())
     sink = float(d.mean()) <= -SINK_PA and below >= 2 * len(months) / 3
+    wet = float(d.mean()) >= SOURCE_PA and len(months) - below >= 2 * len(months) / 3
     p.hygric_evidence.append(
         f"vapour pressure: indoors {float(d.mean()):+.0f} Pa from outdoors on average, "
-        f"below in {below} of {len(months)} months: " + ("a vapour sink" if sink else "no sink")
+        f"below in {below} of {len(months)} months: "
+        + (
+            "a vapour sink"
+            if sink
+            else "a moisture source (source: true, a constant Ms [kg/s])"
+            if wet
+            else "no sink"
+        )
     )
+    if wet:
+        p.hygric_options["source"] = True
 
     def dep(s):  # departures from the daily mean
         return s - s.groupby(s.index.floor("D")).transform("mean")

@@ -99,6 +99,13 @@ def _daily_range(s: pd.Series) -> float:
     return float(r.median()) if len(r) else float("nan")
 
 
+def _corr(a: np.ndarray, b: np.ndarray) -> float:
+    """Pearson's correlation; 0 when either series is constant (no cycle to follow)."""
+    if np.std(a) == 0 or np.std(b) == 0:
+        return 0.0
+    return float(np.corrcoef(a, b)[0, 1])
+
+
 def _thermal(p: ModelProposal, ti, te, heated: tuple[float, int, int], cal_days: float) -> None:
     floor, held, ndays = heated
     if held >= max(20, 0.05 * ndays):
@@ -157,7 +164,7 @@ def _hygric(p: ModelProposal, ti, te, rhi, rhe, cal_days: float) -> None:
     controlled = False
     if rhe is not None and len(rhe.dropna()):
         elo, ehi = _span(rhe)
-        controlled = band <= BAND_MAX_PCT and band <= BAND_RATIO * (ehi - elo)
+        controlled = band <= BAND_MAX_PCT and band <= BAND_RATIO * (ehi - elo) and ehi > elo
         p.hygric_evidence.append(
             f"RH band: indoors {lo:.0f}-{hi:.0f} % ({band:.1f} points, 5-95 %) against "
             f"outdoors {elo:.0f}-{ehi:.0f} % ({ehi - elo:.1f} points): "
@@ -204,9 +211,7 @@ def _hygric(p: ModelProposal, ti, te, rhi, rhe, cal_days: float) -> None:
         return s - s.groupby(s.index.floor("D")).transform("mean")
 
     x, y, z = dep(pi).to_numpy(), dep(ps).to_numpy(), dep(pe).to_numpy()
-    r_t = float(np.corrcoef(x, y)[0, 1])
-    r_e = float(np.corrcoef(x, z)[0, 1])
-    r_ty = float(np.corrcoef(y, z)[0, 1])
+    r_t, r_e, r_ty = _corr(x, y), _corr(x, z), _corr(y, z)
     partial = (r_t - r_e * r_ty) / np.sqrt(max((1 - r_e**2) * (1 - r_ty**2), 1e-12))
     swing = _daily_range(ti)
     sorption = partial >= SORPTION_R and swing >= SORPTION_SWING_K

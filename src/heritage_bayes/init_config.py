@@ -25,8 +25,10 @@ and ``tests/test_init.py``):
   validate), else its first whole 12 months, else 2/3 and 1/3 of it; never starting or
   ending in a gap. While a clock is an open question they keep 14 h (the largest
   offset) inside the stretch, so that any answer keeps them inside the data.
-* **Models**: thermal_1c and hygric_1c, the smallest of each ladder; the report's
-  ladder fits the larger ones.
+* **Models**: what the data call for (:mod:`heritage_bayes.init_model`): the control
+  (thermostat, humidistat band, a constant gain), the vapour sink or the sorbing buffer
+  each from a measured signature, two thermal nodes from 60 days of calibration data;
+  the evidence is written above the keys.
 * **Irradiance stamps**: the reading of the stamps (interval end, instant, interval
   start) under which the sun confirms the declared clock (FMI: values at the stamp).
 
@@ -62,6 +64,7 @@ from heritage_bayes.init_checks import (
     weather_clock,
 )
 from heritage_bayes.init_columns import fahrenheit_column_check, rh_column_check, usable
+from heritage_bayes.init_model import propose_model
 from heritage_bayes.io import clock as _clock
 from heritage_bayes.io.loggers import TableLayout, inspect_table
 from heritage_bayes.questions import MARK
@@ -474,12 +477,6 @@ def init_config(
         f"{ndays} days while the outdoor air averaged 5 K colder"
         + (": heated (a thermostat's floor)" if heated else ": free-running")
     )
-    if heated:
-        questions.append(
-            f"questions: the room looks heated to about {floor:.0f} °C on {held} of {ndays} "
-            "days; if so, model the heating (thermal.options: {thermostat: true}) or choose "
-            "periods outside the heating season; then delete this question"
-        )
     if any(z and str(z).startswith(MARK) for z in (izone, wzone)):
         # an open clock moves the data by up to 14 h when answered: periods chosen on the
         # file's clock keep that far inside the stretch, so any answer keeps them inside
@@ -496,6 +493,19 @@ def init_config(
     # an RH column that needs an answer keeps the hygric section: answered, it runs
     rhe_open = wlay is not None and str(wcols.get("RHe", "")).startswith(MARK)
     hygric = "RHi" in icols and ("RHe" in dw.columns or rhe_open)
+    rhi_utc = to_utc(din["RHi"], izone) if "RHi" in din else None
+    rhe_utc = (to_utc(dw["RHe"], wzone) if wlay is not None else dw["RHe"]) if "RHe" in dw else None
+    prop = propose_model(
+        ti_utc,
+        te_utc,
+        rhi_utc if hygric else None,
+        rhe_utc,
+        start=cs,
+        mid=ce,
+        end=ve,
+        heated=(floor, held, ndays),
+    )
+    findings += [f"model: {x}" for x in prop.thermal_evidence + prop.hygric_evidence]
     name = name or (output.parent.name if output.stem == "config" else output.stem) or "room"
     check_name(name, what="--name" if name_given else "name (from --output)")
 
@@ -504,7 +514,12 @@ def init_config(
         f"#   logger:  {_comment(rel(indoor))}",
         f"#   weather: {_comment(rel(weather))}",
         "# What init found, and why (check each):",
-        *[line for f in findings for line in _wrap(f, "#   - ", "#     ")],
+        *[
+            line
+            for f in findings
+            if not f.startswith("model: ")  # written above the keys they propose
+            for line in _wrap(f, "#   - ", "#     ")
+        ],
         "# Values starting with '??' are open questions: `hbayes calibrate` refuses this file",
         "# until each is answered. Dates are UTC; paths are relative to this file.",
         "",
@@ -547,17 +562,21 @@ def init_config(
         f"  calibration: {{start: {cs}, end: {ce}}}",
         f"  validation: {{start: {vs}, end: {ve}}}",
         "",
-        "# The smallest model of each ladder; the report's ladder fits the larger ones",
-        "# (thermal_2c, thermal_4a; hygric_2c, hygric_2c_fixed) and shows whether they pay.",
+        "# The model the data call for (what init measured over the periods):",
+        *[x for f in prop.thermal_evidence for x in _wrap(f, "#   - ", "#     ")],
         "# Tf, the fixed node, is the outdoor annual cycle 1 m deep in the soil (the ground",
         "# under the floor). A room without a floor on the ground (an attic, an upper storey): set",
         "# options: {ground: false}, or give the neighbouring space's measured temperature",
         "# (data.ground_temperature: {mode: column, column: ..., source: {...}}).",
         "thermal:",
-        "  model: thermal_1c",
+        f"  model: {prop.thermal_model}",
+        *([f"  options: {_yaml_value(prop.thermal_options)}"] if prop.thermal_options else []),
     ]
     if hygric:
-        lines += ["", "hygric:", "  model: hygric_1c"]
+        lines += ["", *[x for f in prop.hygric_evidence for x in _wrap(f, "#   - ", "#     ")]]
+        lines += ["hygric:", f"  model: {prop.hygric_model}"]
+        if prop.hygric_options:
+            lines.append(f"  options: {_yaml_value(prop.hygric_options)}")
     lines += ["", "sampler:", *_doc("sampler.max_time"), "  max_time: 30min", ""]
     extra = [q.split(": ", 1)[1] for q in questions if q.startswith("questions: ")]
     if extra:

@@ -325,7 +325,7 @@ def test_the_same_posterior_prints_the_same_digits_on_every_page(compared):
     import html as html_mod
     import re
 
-    from heritage_bayes.report.format import fmt
+    from heritage_bayes.format import fmt
 
     out, res = compared
     page = html_mod.unescape((out / "comparison.html").read_text(encoding="utf-8"))

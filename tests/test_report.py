@@ -27,7 +27,7 @@ from heritage_bayes.errors import InputError
 from heritage_bayes.report import write_report
 from heritage_bayes.report._diag import acf, cumulative_periodogram, innovations
 from heritage_bayes.report.build import SECTIONS
-from heritage_bayes.report.format import fmt, fmt_int, prior_text
+from heritage_bayes.format import fmt, fmt_int, prior_text
 from heritage_bayes.report.page import Section, render_page, script_hash
 from heritage_bayes.report.sections.identifiability import ladder_metrics
 from heritage_bayes.report.verdict import convergence_verdict, ess_class, rhat_class, run_notes

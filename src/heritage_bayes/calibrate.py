@@ -48,6 +48,7 @@ from heritage_bayes.run import (  # Run, load_run: re-exported
     stamp_provenance,
 )
 from heritage_bayes.rundir import check_name
+from heritage_bayes.rundir.summary import RunSummary
 from heritage_bayes.sources import input_paths
 
 __all__ = [
@@ -389,6 +390,8 @@ def _calibrate_into(
     stamp_provenance(cfg, idata, summary)
     ensure_free_space(out / "posterior.nc", sum(int(idata[g].nbytes) for g in idata.groups()))
     atomic_write(out / "posterior.nc", lambda p: write_inference_data(idata, p))
+    # written through the typed summary every consumer reads (schema version stamped)
+    summary = RunSummary.from_dict(summary, source=out / "summary.json").to_dict()
     dump_json(out / "summary.json", summary)
     say.say(
         f"summary: converged={summary['converged']}, max R-hat "

@@ -106,7 +106,7 @@ class Run:
         The resolved config.
     idata : arviz.InferenceData
     summary : dict
-        ``summary.json``.
+        ``summary.json`` as JSON; :attr:`run_summary` is the same, typed.
     models : dict
         Section name (``thermal``/``hygric``) -> RCModel.
     notes : list of str
@@ -124,6 +124,13 @@ class Run:
     @property
     def sections(self) -> tuple[str, ...]:
         return tuple(self.models)
+
+    @property
+    def run_summary(self):
+        """:attr:`summary` typed (:class:`heritage_bayes.rundir.summary.RunSummary`)."""
+        from heritage_bayes.rundir.summary import RunSummary
+
+        return RunSummary.from_dict(self.summary, source=self.path / "summary.json")
 
     def draws(self, section: str, n: int | None = None, seed: int = 0) -> dict[str, np.ndarray]:
         """Posterior draws of the model parameters: name -> (K,) arrays [SI units].

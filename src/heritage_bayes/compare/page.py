@@ -10,7 +10,7 @@ import math
 from collections.abc import Sequence
 from pathlib import Path
 
-from heritage_bayes.report.format import fmt
+from heritage_bayes.format import fmt
 
 
 def fig_tradeoff(result: dict):

@@ -12,7 +12,7 @@ import pandas as pd
 from heritage_bayes.climate.risk.registry import indicator_info
 from heritage_bayes.errors import InputError
 from heritage_bayes.portfolio.spec import Portfolio
-from heritage_bayes.report.format import fmt_pct
+from heritage_bayes.format import fmt_pct
 
 __all__ = ["render_index"]
 

@@ -30,7 +30,7 @@ import numpy as np
 
 from heritage_bayes.climate.risk.registry import indicator_info
 from heritage_bayes.report.figures.style import RC_PARAMS, _figure, to_png_uri
-from heritage_bayes.report.format import fmt, fmt_interval_html, fmt_pct
+from heritage_bayes.format import fmt, fmt_interval_html, fmt_pct
 
 #: Indicators drawn in the figures (when computed), in this order.
 KEY_INDICATORS = (

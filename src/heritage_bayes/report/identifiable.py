@@ -36,7 +36,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from heritage_bayes.report.format import fmt
+from heritage_bayes.format import fmt
 from heritage_bayes.report.rundata import RunData, section_params
 
 __all__ = [

@@ -9,7 +9,7 @@ search, missing chain files, synthetic data. The verdict itself is
 
 from __future__ import annotations
 
-from heritage_bayes.report.format import prior_text
+from heritage_bayes.format import prior_text
 
 __all__ = ["run_notes"]
 

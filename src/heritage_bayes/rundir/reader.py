@@ -24,6 +24,7 @@ from pathlib import Path
 from heritage_bayes.errors import InputError
 
 __all__ = [
+    "SCHEMA_VERSION",
     "SUMMARY_TYPES",
     "check_run_files",
     "damaged",
@@ -31,6 +32,10 @@ __all__ = [
     "read_posterior",
     "read_summary",
 ]
+
+#: Version of the ``summary.json`` layout this hbayes writes and reads up to (a summary
+#: without ``schema_version`` is version 1: every hbayes before the typed summary).
+SCHEMA_VERSION = 2
 
 #: The files every consumer of a calibration run needs.
 RUN_INPUTS = ("posterior.nc", "summary.json", "config.yaml")
@@ -51,6 +56,7 @@ SUMMARY_TYPES: dict[str, tuple[type, ...]] = {
     "dt": (int, float),
     "init_steps": (int,),
     "config_hash": (str,),
+    "schema_version": (int,),
 }
 
 _JSON_NAMES = {dict: "an object", list: "a list", str: "a text", bool: "true/false",
@@ -134,8 +140,9 @@ def read_summary(run_dir: str | Path) -> dict:
     Raises
     ------
     InputError
-        Not a JSON object, a key of the wrong type (named), or an object with none of
-        the keys of a run summary (another file).
+        Not a JSON object, a key of the wrong type (named), an object with none of
+        the keys of a run summary (another file), or a schema newer than
+        :data:`SCHEMA_VERSION`.
     """
     path = Path(run_dir) / "summary.json"
     s = read_json_object(path, "the object of a run summary")
@@ -147,6 +154,15 @@ def read_summary(run_dir: str | Path) -> dict:
             continue
         want = " or ".join(dict.fromkeys(_JSON_NAMES[t] for t in types))
         raise damaged(path, f"key {key!r}: expected {want}, found {_JSON_NAMES[type(v)]}")
+    version = s.get("schema_version", 1)
+    if version < 1:
+        raise damaged(path, "key 'schema_version': expected a positive whole number")
+    if version > SCHEMA_VERSION:
+        raise damaged(
+            path,
+            f"written with summary schema {version}, this hbayes reads up to "
+            f"{SCHEMA_VERSION} (upgrade heritage_bayes)",
+        )
     models = s.get("models") or {}
     for name, m in models.items():
         if not isinstance(m, dict):

@@ -6,7 +6,7 @@ from functools import lru_cache
 
 from markupsafe import Markup
 
-from heritage_bayes.report.format import fmt
+from heritage_bayes.format import fmt, prose_html
 
 __all__ = ["render_fragment"]
 
@@ -23,6 +23,7 @@ def _env():
         lstrip_blocks=True,
     )
     env.filters["fmt"] = fmt
+    env.filters["prose"] = lambda text: Markup(prose_html(text))
     return env
 
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from heritage_bayes.report.format import fmt_int, fmt_time
+from heritage_bayes.format import fmt_int, fmt_time
 from heritage_bayes.report.page import Section
 from heritage_bayes.report.rundata import RunData, measurement_gaps, time_axis
 from heritage_bayes.report.sections._fragment import render_fragment

@@ -18,7 +18,7 @@ import math
 import numpy as np
 
 from heritage_bayes.errors import InputError
-from heritage_bayes.report.format import OUT_UNITS, fmt_int, fmt_pct
+from heritage_bayes.format import OUT_UNITS, fmt_int, fmt_pct
 from heritage_bayes.report.page import Section
 from heritage_bayes.report.rundata import RunData, parameter_set, section_params
 from heritage_bayes.report.sections._fragment import render_fragment

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from heritage_bayes.report.format import OUT_WORDS
+from heritage_bayes.format import OUT_WORDS
 from heritage_bayes.report.page import Section
 from heritage_bayes.report.rundata import (
     RunData,

@@ -25,7 +25,7 @@ import math
 
 import numpy as np
 
-from heritage_bayes.report.format import fmt, fmt_int, is_log_prior
+from heritage_bayes.format import fmt, fmt_int, is_log_prior
 from heritage_bayes.report.identifiable import (
     identifiable_coordinates,
     identifiable_correlation,

@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-from heritage_bayes.report.format import fmt, fmt_int, fmt_pct, prior_text
+from heritage_bayes.format import fmt, fmt_int, fmt_pct, prior_text
 from heritage_bayes.report.identifiable import mcse_cells, mcse_table, prior_density
 from heritage_bayes.report.page import Section
 from heritage_bayes.report.rundata import RunData, parameter_set, section_params

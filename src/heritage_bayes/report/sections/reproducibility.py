@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from heritage_bayes._version import __version__
-from heritage_bayes.report.format import fmt, fmt_time
+from heritage_bayes.format import fmt, fmt_time
 from heritage_bayes.report.page import Section
 from heritage_bayes.report.rundata import RunData
 from heritage_bayes.report.sections._fragment import render_fragment

@@ -6,7 +6,7 @@ section, above its heading: the first thing a reader sees.
 
 from __future__ import annotations
 
-from heritage_bayes.report.format import fmt_time
+from heritage_bayes.format import fmt_time
 from heritage_bayes.report.page import Section
 from heritage_bayes.report.rundata import RunData
 from heritage_bayes.report.sections._fragment import render_fragment

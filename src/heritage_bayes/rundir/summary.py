@@ -1,0 +1,372 @@
+"""The typed run summary: what a calibration states about its posterior, read once.
+
+``hbayes calibrate`` writes ``summary.json`` through :class:`RunSummary`
+(:meth:`RunSummary.to_dict`, which stamps :data:`SCHEMA_VERSION`); the report, the
+comparison, the portfolio, the projection and the CLI read it through
+:func:`load_summary`, so that the same posterior prints the same figures everywhere and
+no consumer pokes at nested dicts:
+
+- :class:`Estimate` — one parameter or derived quantity: median, 5 % and 95 %
+  quantiles, mean, sd [its unit], its plain-words label, prior, sampler statistics;
+- :class:`FitMetrics` — fit criteria and band coverage of one output over one period;
+- :class:`Convergence` — the criteria the run states (max R-hat, min bulk ESS, chain
+  length in τ), the figures of the draws saved in ``posterior.nc`` and the stopping
+  rule's decision;
+- :class:`ModelInfo` — one section's model, noise model and chain.
+
+Versions: a summary without ``schema_version`` is version 1 (every hbayes before the
+typed summary); its keys are read as they were written, missing ones as absent
+(None). A summary of a newer schema than this hbayes knows is refused with a message
+naming the file. The whole JSON object stays available as :attr:`RunSummary.raw`
+for the parts not typed here (alignment, provenance, ladder).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from types import MappingProxyType
+from typing import Any
+
+from heritage_bayes.format import quantity_label
+from heritage_bayes.rundir.reader import SCHEMA_VERSION, damaged, read_summary
+
+__all__ = [
+    "SCHEMA_VERSION",
+    "Convergence",
+    "Estimate",
+    "FitMetrics",
+    "ModelInfo",
+    "RunSummary",
+    "load_summary",
+]
+
+#: The convergence criteria of runs that did not state them (hbayes before they did).
+_DEFAULT_CRITERIA = {"max_rhat": 1.01, "min_ess_bulk": 400.0, "tau_factor": 50.0}
+
+
+def _num(v) -> float | None:
+    """A finite float, or None (absent, null, NaN, not a number)."""
+    if isinstance(v, bool) or v is None:
+        return None
+    try:
+        f = float(v)
+    except (TypeError, ValueError):
+        return None
+    return f if math.isfinite(f) else None
+
+
+@dataclass(frozen=True)
+class Estimate:
+    """One parameter or derived quantity of a run's posterior.
+
+    ``median``, ``q05``, ``q95`` [``unit``] are the quantiles of the draws saved in
+    ``posterior.nc`` (a reader recomputing them from the file gets the same digits);
+    ``fixed`` holds the value of a parameter the config fixed (no posterior).
+    """
+
+    key: str  # "<section>.<name>"
+    unit: str = ""
+    median: float | None = None
+    q05: float | None = None
+    q95: float | None = None
+    mean: float | None = None
+    sd: float | None = None
+    truth: float | None = None
+    kind: str = ""
+    description: str = ""
+    derived: bool = False
+    fixed: float | None = None
+    prior: str | None = None
+    map: float | None = None
+    r_hat: float | None = None
+    ess_bulk: float | None = None
+    ess_tail: float | None = None
+    tau: float | None = None
+    contraction: float | None = None
+    at_bound: str | None = None
+
+    @property
+    def section(self) -> str:
+        return self.key.split(".", 1)[0]
+
+    @property
+    def name(self) -> str:
+        return self.key.split(".", 1)[-1]
+
+    @property
+    def free(self) -> bool:
+        return self.fixed is None and not self.derived
+
+    @property
+    def label(self) -> str:
+        """Plain words, symbol and unit (``τ₁ [h]``, ``solar aperture, east facade [m²]``)."""
+        return quantity_label(self.name, self.unit, self.description, domain=self.section)
+
+    @property
+    def truth_inside(self) -> bool | None:
+        """Whether a known true value lies inside the 90 % interval (None: no truth)."""
+        if self.truth is None or self.q05 is None or self.q95 is None:
+            return None
+        return self.q05 <= self.truth <= self.q95
+
+    @classmethod
+    def from_dict(cls, key: str, d: dict, *, derived: bool = False) -> Estimate:
+        fixed = d.get("fixed")
+        return cls(
+            key=key,
+            unit=str(d.get("unit") or ""),
+            median=_num(d.get("median")),
+            q05=_num(d.get("q05")),
+            q95=_num(d.get("q95")),
+            mean=_num(d.get("mean")),
+            sd=_num(d.get("sd")),
+            truth=_num(d.get("truth")),
+            kind="derived" if derived else str(d.get("kind") or ""),
+            description=str(d.get("description") or ""),
+            derived=derived,
+            fixed=_num(fixed) if fixed is not None else None,
+            prior=d.get("prior") if isinstance(d.get("prior"), str) else None,
+            map=_num(d.get("map")),
+            r_hat=_num(d.get("r_hat")),
+            ess_bulk=_num(d.get("ess_bulk")),
+            ess_tail=_num(d.get("ess_tail")),
+            tau=_num(d.get("tau")),
+            contraction=_num(d.get("contraction")),
+            at_bound=d.get("at_bound") if isinstance(d.get("at_bound"), str) else None,
+        )
+
+
+@dataclass(frozen=True)
+class FitMetrics:
+    """Fit of the posterior-median simulation of one output over one period.
+
+    ``FIT`` [%] (100 (1 - |y - ŷ| / |y - ȳ|)), ``MSE`` [unit²], ``MAE`` [unit],
+    ``n`` hours; ``coverage50``/``coverage90`` [-]: the share of hours inside the 50 %
+    and 90 % predictive bands.
+    """
+
+    section: str
+    output: str
+    period: str
+    FIT: float | None = None  # noqa: N815 (the criterion's name)
+    MSE: float | None = None  # noqa: N815
+    MAE: float | None = None  # noqa: N815
+    n: int | None = None
+    coverage50: float | None = None
+    coverage90: float | None = None
+
+
+@dataclass(frozen=True)
+class Convergence:
+    """The run's convergence: criteria stated, figures of the saved draws, decision.
+
+    ``max_rhat`` and ``min_ess_bulk`` are those of the draws saved in ``posterior.nc``
+    over the free parameters (what ``arviz.rhat`` / ``arviz.ess`` of the file give);
+    ``converged`` is the sampler's stopping rule (chains of ``tau_factor`` τ with a
+    stable τ, R-hat and ESS on the sampler's retained draws).
+    """
+
+    max_rhat: float | None
+    min_ess_bulk: float | None
+    target_rhat: float
+    target_ess: float
+    tau_factor: float
+    converged: bool
+    converged_tau: bool
+    reasons: tuple[str, ...] = ()
+
+    @property
+    def saved_draws_ok(self) -> bool:
+        """Whether the saved draws meet the stated R-hat and ESS criteria."""
+        return (
+            self.max_rhat is not None
+            and self.min_ess_bulk is not None
+            and self.max_rhat <= self.target_rhat
+            and self.min_ess_bulk >= self.target_ess
+        )
+
+    @property
+    def criteria_text(self) -> str:
+        """The stated criteria in words."""
+        return (
+            f"R-hat ≤ {self.target_rhat:g} and bulk ESS ≥ {self.target_ess:g} on the "
+            f"saved draws, chains of at least {self.tau_factor:g} τ with a stable τ"
+        )
+
+
+@dataclass(frozen=True)
+class ModelInfo:
+    """One section (``thermal``/``hygric``) of a run: its model and chain."""
+
+    section: str
+    model: str
+    noise: str = ""
+    domain: str = ""
+    steps: int | None = None
+    walkers: int | None = None
+    tau_max: float | None = None
+    converged_tau: bool = False
+    likelihood_temperature: float = 1.0
+
+
+@dataclass(frozen=True)
+class RunSummary:
+    """``summary.json`` of a calibration run, typed (see the module docstring)."""
+
+    schema_version: int
+    name: str
+    building: str
+    room: str
+    seed: int | None
+    config_hash: str
+    created_at: str
+    dt: float
+    parameters: MappingProxyType  # key -> Estimate
+    derived: MappingProxyType  # key -> Estimate
+    metrics: tuple[FitMetrics, ...]
+    convergence: Convergence
+    models: MappingProxyType  # section -> ModelInfo
+    timings: MappingProxyType  # what -> seconds
+    wall_seconds: float | None
+    raw: MappingProxyType = field(repr=False)
+
+    # ------------------------------------------------------------------ reading
+    def estimate(self, key: str) -> Estimate | None:
+        """The parameter or derived quantity ``<section>.<name>`` (None if absent)."""
+        return self.parameters.get(key) or self.derived.get(key)
+
+    def estimates(self, section: str | None = None) -> list[Estimate]:
+        """Parameters then derived quantities (of one section)."""
+        out = [*self.parameters.values(), *self.derived.values()]
+        return [e for e in out if section is None or e.section == section]
+
+    def metric(self, section: str, output: str, period: str) -> FitMetrics | None:
+        for m in self.metrics:
+            if (m.section, m.output, m.period) == (section, output, period):
+                return m
+        return None
+
+    @property
+    def seeds(self) -> dict[str, int]:
+        """The seeds that make the run reproducible (calibration; synthetic data)."""
+        out = {"calibration": self.seed} if self.seed is not None else {}
+        demo = (((self.raw.get("provenance") or {}).get("config") or {}).get("data") or {}).get(
+            "demo"
+        )
+        if isinstance(demo, dict) and isinstance(demo.get("seed"), int):
+            out["synthetic data"] = demo["seed"]
+        return out
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON object ``summary.json`` holds (this hbayes's schema version)."""
+        import copy
+
+        d = copy.deepcopy(dict(self.raw))
+        d["schema_version"] = SCHEMA_VERSION
+        return d
+
+    # ------------------------------------------------------------------ building
+    @classmethod
+    def from_dict(cls, d: dict, *, source: str | Path = "summary.json") -> RunSummary:
+        """The typed summary of a ``summary.json`` object (any schema up to
+        :data:`SCHEMA_VERSION`; keys a version lacks read as absent).
+
+        Raises
+        ------
+        InputError
+            A schema newer than this hbayes knows, named with the file.
+        """
+        version = d.get("schema_version", 1)
+        if not isinstance(version, int) or isinstance(version, bool) or not (
+            1 <= version <= SCHEMA_VERSION
+        ):
+            raise damaged(
+                Path(source),
+                f"summary schema {version!r}: this hbayes reads 1 to {SCHEMA_VERSION} "
+                "(a newer one: upgrade heritage_bayes)",
+            )
+        crit = {**_DEFAULT_CRITERIA, **(d.get("criteria") or {})}
+        models = {}
+        for sec, info in (d.get("models") or {}).items():
+            ch = info.get("chain") or {}
+            models[sec] = ModelInfo(
+                section=sec,
+                model=str(info.get("model") or sec),
+                noise=str(info.get("noise") or ""),
+                domain=str(info.get("domain") or sec),
+                steps=ch.get("steps"),
+                walkers=ch.get("walkers"),
+                tau_max=_num(ch.get("tau_max")),
+                converged_tau=bool(ch.get("converged_tau", False)),
+                likelihood_temperature=_num(info.get("likelihood_temperature")) or 1.0,
+            )
+        metrics = []
+        for sec, outs in (d.get("metrics") or {}).items():
+            for out, periods in (outs or {}).items():
+                for per, m in (periods or {}).items():
+                    if not isinstance(m, dict):
+                        continue
+                    metrics.append(
+                        FitMetrics(
+                            section=sec,
+                            output=out,
+                            period=per,
+                            FIT=_num(m.get("FIT")),
+                            MSE=_num(m.get("MSE")),
+                            MAE=_num(m.get("MAE")),
+                            n=m.get("n"),
+                            coverage50=_num(m.get("coverage50")),
+                            coverage90=_num(m.get("coverage90")),
+                        )
+                    )
+        conv = Convergence(
+            max_rhat=_num(d.get("max_rhat")),
+            min_ess_bulk=_num(d.get("min_ess_bulk")),
+            target_rhat=float(crit["max_rhat"]),
+            target_ess=float(crit["min_ess_bulk"]),
+            tau_factor=float(crit["tau_factor"]),
+            converged=bool(d.get("converged", False)),
+            converged_tau=bool(d.get("converged_tau", d.get("converged", False))),
+            reasons=tuple(str(r) for r in d.get("unconverged_reasons") or ()),
+        )
+        return cls(
+            schema_version=version,
+            name=str(d.get("name") or ""),
+            building=str(d.get("building") or ""),
+            room=str(d.get("room") or ""),
+            seed=d.get("seed") if isinstance(d.get("seed"), int) else None,
+            config_hash=str(d.get("config_hash") or ""),
+            created_at=str(d.get("created_at") or ""),
+            dt=_num(d.get("dt")) or 3600.0,
+            parameters=MappingProxyType(
+                {k: Estimate.from_dict(k, v) for k, v in (d.get("parameters") or {}).items()}
+            ),
+            derived=MappingProxyType(
+                {
+                    k: Estimate.from_dict(k, v, derived=True)
+                    for k, v in (d.get("derived") or {}).items()
+                }
+            ),
+            metrics=tuple(metrics),
+            convergence=conv,
+            models=MappingProxyType(models),
+            timings=MappingProxyType(
+                {k: float(v) for k, v in (d.get("timings") or {}).items() if _num(v) is not None}
+            ),
+            wall_seconds=_num(d.get("wall_seconds")),
+            raw=MappingProxyType(d),
+        )
+
+
+def load_summary(run_dir: str | Path) -> RunSummary:
+    """The typed ``summary.json`` of a run directory (:func:`read_summary` checks the
+    file; every schema version up to :data:`SCHEMA_VERSION` loads).
+
+    Raises
+    ------
+    InputError
+        Missing, damaged or foreign file, or a newer schema (named).
+    """
+    return RunSummary.from_dict(read_summary(run_dir), source=Path(run_dir) / "summary.json")

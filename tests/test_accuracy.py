@@ -142,8 +142,8 @@ def test_missing_physics_names_the_ladders_better_rung():
     s = _summary(2.6, ladder=ladder)
     f = accuracy_failures(s)
     words = " ".join(missing_physics(s, f, {}))
-    assert "thermal_4a reproduces Ti with FIT 83.0 % on the validation period" in words
-    assert "calibrate thermal_4a" in words
+    assert "`thermal_4a` reproduces Ti with FIT 83.0 % on the validation period" in words
+    assert "calibrate `thermal_4a`" in words
     # a rung better by less than the margin is not named; one still failing is not advised
     ladder["thermal"][1:] = [
         {"model": "thermal_2c", "fit": {"validation": {"Ti": {"FIT": 2.6 + LADDER_MARGIN}}}}

@@ -225,18 +225,19 @@ def test_recommendation_rule():
     }
     rec = _recommend(models, "elpd_validation")
     assert rec["model"] == "thermal_2c"
-    assert "within 2 SE or 4 nats of thermal_4a (difference -3.0 ± 2.0)" in rec["reason"]
+    assert "within 2 SE or 4 nats of `thermal_4a` (difference -3.0 ± 2.0)" in rec["reason"]
     assert (
-        "thermal_4a is as accurate but its time constants are not identified: τ2" in (rec["reason"])
+        "`thermal_4a` is as accurate but its time constants are not identified: τ₂"
+        in (rec["reason"])
     )
-    assert "thermal_1c is less accurate" in rec["reason"]
+    assert "`thermal_1c` is less accurate" in rec["reason"]
     assert "Not converged" not in rec["reason"]
     models["thermal_4a"]["converged"] = False
-    assert "provisional: thermal_4a" in _recommend(models, "elpd_validation")["reason"]
+    assert "provisional: `thermal_4a`" in _recommend(models, "elpd_validation")["reason"]
     # 2c outside 2 SE: the accurate model is recommended, with its unidentified tau named
     models["thermal_2c"] = model(10, -5.0, 2.0, [])
     rec = _recommend(models, "elpd_validation")
-    assert rec["model"] == "thermal_4a" and "(τ2; no candidate" in rec["reason"]
+    assert rec["model"] == "thermal_4a" and "(τ₂; no candidate" in rec["reason"]
     assert "tau_" not in rec["reason"]  # no code names in the sentence
     # a negligible difference (< 4) counts as equal even with a tiny SE (1c == 2c)
     models["thermal_2c"] = model(10, -0.8, 0.01, [])
@@ -249,9 +250,10 @@ def test_recommendation_rule():
     rec = _recommend(models, "elpd_validation")
     assert rec["model"] == "thermal_2c"
     assert "all its time constants identified" not in rec["reason"]
-    assert "time constants longer than the time step identified (τ2 shorter" in rec["reason"]
+    assert "time constants longer than the time step identified (τ₂ shorter" in rec["reason"]
     assert (
-        "thermal_4a is as accurate, its time constants identified, but has more" in (rec["reason"])
+        "`thermal_4a` is as accurate, its time constants identified, but has more"
+        in (rec["reason"])
     )
     assert "0 of its 13 parameters identified" in rec["reason"]
 
@@ -325,7 +327,7 @@ def test_the_same_posterior_prints_the_same_digits_on_every_page(compared):
     import html as html_mod
     import re
 
-    from heritage_bayes.format import fmt
+    from heritage_bayes.format import fmt, fmt_interval
 
     out, res = compared
     page = html_mod.unescape((out / "comparison.html").read_text(encoding="utf-8"))
@@ -346,9 +348,9 @@ def test_the_same_posterior_prints_the_same_digits_on_every_page(compared):
                     assert e[q] == stated[q], (m, name, q)
                 x = post[f"thermal.{name}"].values.reshape(-1)
                 assert stated["median"] == np.quantile(x, 0.5)
-                cells = next(c for c in rows if c[:2] == [name, label])
+                cells = next(c for c in rows if c[1:3] == [f"<code>{name}</code>", label])
                 assert fmt(stated["median"]) in cells, (m, name, cells)
-                assert f"{fmt(stated['q05'])} … {fmt(stated['q95'])}" in cells, (m, name, cells)
+                assert fmt_interval(stated["q05"], stated["q95"]) in cells, (m, name, cells)
                 checked += 1
     assert checked >= 10
 

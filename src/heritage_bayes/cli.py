@@ -243,10 +243,12 @@ def _cmd_calibrate(args) -> int:
 def _converged_or_3(run_dir) -> int:
     """0 when the run's ``summary.json`` says converged; else name the reasons, return 3."""
     from heritage_bayes.convergence import EXIT_UNCONVERGED
+    from heritage_bayes.format import fmt_int
     from heritage_bayes.report.accuracy import accuracy_failures, resolutions
-    from heritage_bayes.rundir.reader import read_summary
+    from heritage_bayes.rundir.summary import load_summary
 
-    summary = read_summary(run_dir)
+    rs = load_summary(run_dir)
+    summary, conv = dict(rs.raw), rs.convergence
     failures = accuracy_failures(summary, resolutions({}))
     if failures:
         print(
@@ -255,13 +257,22 @@ def _converged_or_3(run_dir) -> int:
             + f". The report's verdict names what is most likely missing: {run_dir}",
             file=sys.stderr,
         )
-    if summary.get("converged"):
+    if conv.converged:
+        if not conv.saved_draws_ok:
+            print(
+                f"hbayes: note: the draws saved in posterior.nc give max R-hat "
+                f"{conv.max_rhat or float('nan'):.3f} and min bulk ESS "
+                f"{fmt_int(conv.min_ess_bulk)} (criteria ≤ {conv.target_rhat:g}, "
+                f"≥ {conv.target_ess:g}): the report's verdict is amber; --resume with a "
+                "larger sampler.max_steps continues the chains",
+                file=sys.stderr,
+            )
         return 0
     print(
         f"hbayes: finished but NOT converged (exit code {EXIT_UNCONVERGED}): {run_dir}",
         file=sys.stderr,
     )
-    for reason in summary.get("unconverged_reasons") or ["see summary.json"]:
+    for reason in conv.reasons or ["see summary.json"]:
         print(f"hbayes:   {reason}", file=sys.stderr)
     print(
         "hbayes: continue the chains with --resume, or raise sampler.max_time",

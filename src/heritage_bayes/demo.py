@@ -496,7 +496,7 @@ def virtual_monument(
         meas = meas[(meas.index < g0) | (meas.index >= g1)]
     meas.index.name = "time"
     meas.attrs = {
-        "source": f"virtual monument (heritage_bayes.demo, seed {int(seed)})",
+        "source": f"virtual monument (the built-in demo, seed {int(seed)})",
         "format": "demo",
         "units": {"Ti": "°C", "RHi": "%"},
         "averaged": (),

@@ -1,9 +1,9 @@
-"""The one formatter: numbers, intervals, times, priors, units and labels as people read them.
+"""The one formatter: numbers, intervals, times, priors, units and labels for people.
 
 Shared by every report section, the other pages (portfolio, projection, comparison)
-and the CLI, so that the same figure prints the same digits everywhere: ``fmt(2.41e6) == "2.41×10⁶"``, ``fmt_time("2019-01-02T00:00Z") ==
-"2019-01-02 00:00 UTC"``, ``prior_text("loguniform[1e+04, 1e+12]") ==
-"loguniform[10000, 10¹²]"``.
+and the CLI, so that the same figure prints the same digits everywhere:
+``fmt(2.41e6) == "2.41×10⁶"``, ``fmt_time("2019-01-02T00:00Z") == "2019-01-02 00:00 UTC"``,
+``prior_text("loguniform[1e+04, 1e+12]") == "loguniform[10000, 10¹²]"``.
 
 Labels: every parameter and derived quantity of a run as people read it, with its
 symbol where it helps and its unit (:func:`quantity_label`: ``tau_1_h`` -> ``τ₁ [h]``,
@@ -22,8 +22,8 @@ __all__ = [
     "OUT_UNITS",
     "OUT_WORDS",
     "fmt",
-    "fmt_interval",
     "fmt_int",
+    "fmt_interval",
     "fmt_interval_html",
     "fmt_pct",
     "fmt_time",

@@ -21,6 +21,7 @@ from heritage_bayes.compare.scores import (
     tempered_loo,
 )
 from heritage_bayes.errors import InputError
+from heritage_bayes.format import quantity_name
 
 #: ELPD differences smaller than this are negligible whatever their SE (two nearly
 #: identical models have a tiny SE of their difference) [nats]; Sivula et al. (2020).
@@ -79,17 +80,17 @@ def compare_runs(
         model = run.models[section]
         var = f"{section}.{model.output_names[0]}"
         acc: dict = {}
-        met = (run.summary.get("metrics") or {}).get(section, {}).get(model.output_names[0], {})
+        rs = run.run_summary
         for period in ("calibration", "validation"):
-            if period in met:
-                acc[period] = {k: met[period].get(k) for k in ("FIT", "MSE", "MAE", "coverage90")}
+            met = rs.metric(section, model.output_names[0], period)
+            if met is not None:
+                acc[period] = {k: getattr(met, k) for k in ("FIT", "MSE", "MAE", "coverage90")}
         ev = elpd_validation(run.idata, var, block_hours)
         if ev is not None:
             acc["elpd_validation"] = {k: ev[k] for k in ("elpd", "se", "n")}
             val_pw[label] = (ev["pointwise"], ev["times"])
-        temperature = float(
-            (run.summary.get("models") or {}).get(section, {}).get("likelihood_temperature") or 1.0
-        )
+        info = rs.models.get(section)
+        temperature = info.likelihood_temperature if info else 1.0
         with warnings.catch_warnings():  # high Pareto k: recorded below, not printed
             warnings.simplefilter("ignore", UserWarning)
             # the draws of a tempered posterior need their own importance weights
@@ -111,11 +112,13 @@ def compare_runs(
         out_models[label] = {
             "model": model.name,
             "run_dir": str(run.path),
-            "noise": (run.summary.get("models") or {}).get(section, {}).get("noise"),
-            "periods": run.summary.get("periods"),
-            "converged": bool(run.summary.get("converged")),
-            "max_rhat": run.summary.get("max_rhat"),
-            "min_ess_bulk": run.summary.get("min_ess_bulk"),
+            "noise": info.noise if info else None,
+            "periods": rs.raw.get("periods"),
+            # the report's rule: the stopping rule met and the saved draws within the
+            # stated criteria
+            "converged": rs.convergence.converged and rs.convergence.saved_draws_ok,
+            "max_rhat": rs.convergence.max_rhat,
+            "min_ess_bulk": rs.convergence.min_ess_bulk,
             "n_draws": int(run.idata.posterior.sizes["chain"] * run.idata.posterior.sizes["draw"]),
             "accuracy": acc,
             "identifiability": ident,
@@ -159,11 +162,11 @@ def compare_runs(
             "practical_ratio": practical_ratio,
             "seed": seed,
             "method": {
-                "calibration": f"blocked PSIS-LOO, blocks of {block_hours:g} h (az.loo over "
-                "block sums of the pointwise log-likelihood; a tempered run's draws weighted "
-                "by p^(-1/T), compare.scores.tempered_loo)",
+                "calibration": f"blocked PSIS-LOO, blocks of {block_hours:g} h (`az.loo` "
+                "over block sums of the pointwise log-likelihood; a tempered run's draws "
+                "weighted by p^(-1/T))",
                 "validation": "sum over validation hours of the log posterior-mean one-step "
-                "predictive density (elpd_val); SE from block sums",
+                "predictive density (the validation ELPD); SE from block sums",
                 "identified": f"90 % interval within a factor {identified_factor:g}",
                 "practical_rank": f"directions with posterior/prior variance < {practical_ratio:g}",
             },
@@ -180,9 +183,8 @@ def _num(x):
 
 
 def _tau_label(key: str) -> str:
-    """``tau_2_h`` -> ``τ2``: a time constant as the pages name it."""
-    core = key.removeprefix("tau_").removesuffix("_h")
-    return f"τ{core}" if core.isdigit() else key
+    """``tau_2_h`` -> ``τ₂``: a time constant as the pages name it."""
+    return quantity_name(key).removeprefix("time constant ")
 
 
 def _recommend(models: dict, score: str) -> dict:
@@ -214,7 +216,7 @@ def _recommend(models: dict, score: str) -> dict:
         parts.append(f"the best {what} of the candidates")
     else:
         parts.append(
-            f"{what} within 2 SE or {NEGLIGIBLE_ELPD:g} nats of {best} "
+            f"{what} within 2 SE or {NEGLIGIBLE_ELPD:g} nats of `{best}` "
             f"(difference {diff:.1f} ± {dse:.1f})"
         )
     if ident["time_constants_identified"]:
@@ -239,27 +241,28 @@ def _recommend(models: dict, score: str) -> dict:
         if m == choice:
             continue
         if not eq:
-            others.append(f"{m} is less accurate ({what} {d:.1f} ± {se:.1f} below the best)")
+            others.append(f"`{m}` is less accurate ({what} {d:.1f} ± {se:.1f} below the best)")
             continue
         bad = idf["time_constants_not_identified"]
         if bad:
             others.append(
-                f"{m} is as accurate but its time constants are not identified: "
+                f"`{m}` is as accurate but its time constants are not identified: "
                 + ", ".join(_tau_label(k) for k in bad)
             )
         else:
             n_ok = idf["n_free_physical"] - len(idf.get("parameters_not_identified", []))
             others.append(
-                f"{m} is as accurate, its time constants identified, but has more "
+                f"`{m}` is as accurate, its time constants identified, but has more "
                 f"parameters ({idf['n_free_physical']} against {ident['n_free_physical']}; "
                 f"{n_ok} of its {idf['n_free_physical']} parameters identified)"
             )
-    text = f"{choice}: " + ", ".join(parts) + "."
+    text = f"`{choice}`: " + ", ".join(parts) + "."
     if others:
         text += " " + "; ".join(others) + "."
     unconverged = [m for m, info in models.items() if info.get("converged") is False]
     if unconverged:
-        text += f" Not converged (R-hat/ESS/τ criteria), so provisional: {', '.join(unconverged)}."
+        names = ", ".join(f"`{m}`" for m in unconverged)
+        text += f" Not converged (R-hat/ESS/τ criteria), so provisional: {names}."
     return {
         "model": choice,
         "reason": text,

@@ -36,12 +36,13 @@ def _contraction(post: np.ndarray, prior: np.ndarray) -> float | None:
     return float(1.0 - np.var(post) / vp)
 
 
-def _interval(x: np.ndarray, stated: dict | None = None) -> dict:
+def _interval(x: np.ndarray, stated=None) -> dict:
     """Median and 90 % interval of the draws ``x``: those the run's summary.json states
-    (``stated``: computed from the same saved draws, so every page prints the same
-    digits), else computed here (a run written before the summary stated them)."""
-    if stated and all(stated.get(k) is not None for k in ("median", "q05", "q95")):
-        q05, q50, q95 = (float(stated[k]) for k in ("q05", "median", "q95"))
+    (``stated``: its :class:`~heritage_bayes.rundir.summary.Estimate`, computed from the
+    same saved draws, so every page prints the same digits), else computed here (a run
+    written before the summary stated them)."""
+    if stated is not None and None not in (stated.median, stated.q05, stated.q95):
+        q05, q50, q95 = stated.q05, stated.median, stated.q95
     else:
         x = x[np.isfinite(x)]
         q05, q50, q95 = np.quantile(x, [0.05, 0.5, 0.95])
@@ -61,6 +62,7 @@ def _practical_rank(post: np.ndarray, prior_var: np.ndarray, ratio: float) -> tu
 
 def _identifiability(run, section: str, *, seed: int, identified_factor: float, ratio: float):
     summ = run.summary
+    rs = run.run_summary
     model = run.models[section]
     idata = run.idata
     P_prior, dq_prior = _prior_pushforward(run, section, 20000, seed)
@@ -68,12 +70,12 @@ def _identifiability(run, section: str, *, seed: int, identified_factor: float, 
     free, prior_var, post_cols = [], [], []
     for j, name in enumerate(model.parameter_names):
         key = f"{section}.{name}"
-        info = summ["parameters"].get(key, {})
+        est = rs.parameters.get(key)
         x = idata.posterior[key].values.reshape(-1)
-        fixed = info.get("fixed") is not None
-        entry = {"unit": info.get("unit", ""), "kind": info.get("kind", ""), "fixed": fixed}
+        fixed = est is not None and est.fixed is not None
+        entry = {"unit": est.unit if est else "", "kind": est.kind if est else "", "fixed": fixed}
         if not fixed:
-            entry.update(_interval(x, info))
+            entry.update(_interval(x, est))
             entry["contraction"] = _contraction(x, P_prior[:, j])
             f = entry["factor90"]
             entry["identified"] = bool(f is not None and f <= identified_factor)
@@ -91,8 +93,10 @@ def _identifiability(run, section: str, *, seed: int, identified_factor: float, 
         x = idata.posterior[key].values.reshape(-1)
         if not np.all(np.isfinite(x)):
             continue
-        stated = summ.get("derived", {}).get(key)
-        entry = {"unit": idata.posterior[key].attrs.get("unit", ""), **_interval(x, stated)}
+        entry = {
+            "unit": idata.posterior[key].attrs.get("unit", ""),
+            **_interval(x, rs.derived.get(key)),
+        }
         entry["contraction"] = _contraction(x, prior)
         f = entry["factor90"]
         entry["identified"] = bool(f is not None and f <= identified_factor)
@@ -112,7 +116,7 @@ def _identifiability(run, section: str, *, seed: int, identified_factor: float, 
                 widest = {"parameter": name, "decades": dec, "q05": e["q05"], "q95": e["q95"]}
     # time constants shorter than the time step act within one step: hourly data see
     # only their static effect, so they neither can nor need to be identified
-    dt_h = float(summ.get("dt", 3600.0)) / 3600.0
+    dt_h = rs.dt / 3600.0
     taus = {k: v for k, v in derived.items() if k.startswith("tau_") and v["median"] >= dt_h}
     fast = sorted(k for k in derived if k.startswith("tau_") and k not in taus)
     contr = [params[n]["contraction"] for n in free if params[n]["contraction"] is not None]

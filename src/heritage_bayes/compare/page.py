@@ -10,7 +10,9 @@ import math
 from collections.abc import Sequence
 from pathlib import Path
 
-from heritage_bayes.format import fmt
+from markupsafe import Markup
+
+from heritage_bayes.format import fmt, fmt_interval, prose_html, quantity_name
 
 
 def fig_tradeoff(result: dict):
@@ -71,17 +73,18 @@ def _f(x, fmt="{:.3g}") -> str:
     return fmt.format(x)
 
 
-def _table(head: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
+def _table(head: Sequence[str], rows: Sequence[Sequence[str]], code: Sequence[int] = (0,)) -> str:
+    """An HTML table; the columns ``code`` hold names the user types (model names,
+    the Python names of quantities) and are set as code."""
+
+    def cell(i: int, c: str) -> str:
+        text = html.escape(c)
+        if i in code and c:
+            text = f"<code>{text}</code>"
+        return f"<td class='num'>{text}</td>" if i and i not in code else f"<td>{text}</td>"
+
     h = "".join(f"<th scope='col'>{html.escape(c)}</th>" for c in head)
-    body = "".join(
-        "<tr>"
-        + "".join(
-            f"<td class='num'>{html.escape(c)}</td>" if i else f"<td>{html.escape(c)}</td>"
-            for i, c in enumerate(r)
-        )
-        + "</tr>"
-        for r in rows
-    )
+    body = "".join("<tr>" + "".join(cell(i, c) for i, c in enumerate(r)) + "</tr>" for r in rows)
     return (
         f"<div class='scroll'><table><thead><tr>{h}</tr></thead><tbody>{body}</tbody></table></div>"
     )
@@ -148,12 +151,13 @@ def identifiability_rows(result: dict) -> tuple[list[str], list[list[str]]]:
                 _f(i["structural_rank"], "{}"),
                 str(i["practical_rank"]),
                 _f(i["contraction_median"], "{:.2f}"),
-                f"{w['parameter']}: {w['decades']:.1f} decades" if w else "–",
+                f"{quantity_name(w['parameter'])}: {w['decades']:.1f} decades" if w else "–",
                 f"{i['n_free_physical'] - len(i['parameters_not_identified'])} of "
                 f"{i['n_free_physical']}",
                 _f(i["time_constants_identified"]),
                 ", ".join(
-                    k + (" (< time step)" if k in i["time_constants_below_step"] else "")
+                    quantity_name(k).removeprefix("time constant ")
+                    + (" (< time step)" if k in i["time_constants_below_step"] else "")
                     for k, e in i["derived"].items()
                     if not e["identified"]
                 )
@@ -164,20 +168,24 @@ def identifiability_rows(result: dict) -> tuple[list[str], list[list[str]]]:
 
 
 def _quantity_rows(info: dict) -> list[list[str]]:
+    """One row per quantity: its label, its Python name, then the run's own figures
+    (the medians and intervals its summary.json states, printed as its report does)."""
     rows = []
     i = info["identifiability"]
     for kind, table in (("parameter", i["parameters"]), ("derived", i["derived"])):
         for name, e in table.items():
+            label = quantity_name(name, domain=info.get("section", ""))
             if e.get("fixed"):
-                rows.append([name, kind, e.get("unit", ""), "fixed", "", "", "", ""])
+                rows.append([label, name, kind, e.get("unit", ""), "fixed", "", "", "", ""])
                 continue
             rows.append(
                 [
+                    label,
                     name,
                     kind,
                     e.get("unit", ""),
                     fmt(e.get("median")),  # the digits of the run's own report
-                    f"{fmt(e.get('q05'))} … {fmt(e.get('q95'))}",
+                    fmt_interval(e.get("q05"), e.get("q95")),
                     _f(e.get("factor90"), "{:.3g}"),
                     _f(e.get("contraction"), "{:.3f}"),
                     _f(e.get("identified")),
@@ -195,16 +203,16 @@ def render_comparison(result: dict) -> str:
     rec = result["recommendation"]
     s = result["settings"]
     lead = (
-        f"<div class='verdict green'><strong>Recommended: {html.escape(rec['model'])}</strong>"
-        f"<p>{html.escape(rec['reason'])}</p></div>"
+        f"<div class='verdict green'><strong>Recommended: <code>{html.escape(rec['model'])}"
+        f"</code></strong><p>{prose_html(rec['reason'])}</p></div>"
     )
     fig = fig_tradeoff(result)
     summary = (
         "<p>Each candidate was calibrated on the same data, noise model and prior "
         "knowledge, with full posteriors (its own run directory and report). Accuracy: "
-        f"{html.escape(s['method']['validation'])}; on the calibration period "
-        f"{html.escape(s['method']['calibration'])}: hourly data are not exchangeable, so "
-        "whole blocks are left out (see heritage_bayes.compare). Identifiability: "
+        f"{prose_html(s['method']['validation'])}; on the calibration period "
+        f"{prose_html(s['method']['calibration'])}: hourly data are not exchangeable, so "
+        "whole blocks are left out. Identifiability: "
         f"a quantity counts as identified when its {html.escape(s['method']['identified'])}; "
         f"practical rank: {html.escape(s['method']['practical_rank'])}.</p>"
         f"<figure id='fig-tradeoff'><img src='{to_png_uri(fig)}' alt='accuracy against "
@@ -227,13 +235,15 @@ def render_comparison(result: dict) -> str:
             f"{k} {v['start'][:10]} – {v['end'][:10]}" for k, v in p.items() if isinstance(v, dict)
         )
         body = (
-            f"<p>Noise model {html.escape(str(info.get('noise')))}; {html.escape(per)}; "
+            f"<p>Noise model <code>{html.escape(str(info.get('noise')))}</code>; "
+            f"{html.escape(per)}; "
             f"{info['n_draws']} posterior draws; max R-hat {_f(info.get('max_rhat'), '{:.3f}')}, "
             f"min bulk ESS {_f(info.get('min_ess_bulk'), '{:.0f}')}. Run directory: "
             f"<code>{html.escape(info['run_dir'])}</code>.</p>"
             + _table(
                 [
                     "quantity",
+                    "name",
                     "kind",
                     "unit",
                     "median",
@@ -243,9 +253,11 @@ def render_comparison(result: dict) -> str:
                     "identified",
                 ],
                 _quantity_rows(info),
+                code=(1,),
             )
         )
-        sections.append(Section(f"Model {m}", body, id=f"model-{m}"))
+        title = Markup(f"Model <code>{html.escape(m)}</code>")  # a name the user types
+        sections.append(Section(title, body, id=f"model-{m}"))
     c = result.get("config") or {}
     return render_page(
         f"Model comparison — {c.get('name') or ''}",

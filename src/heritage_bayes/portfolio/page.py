@@ -11,8 +11,8 @@ import pandas as pd
 
 from heritage_bayes.climate.risk.registry import indicator_info
 from heritage_bayes.errors import InputError
-from heritage_bayes.portfolio.spec import Portfolio
 from heritage_bayes.format import fmt_pct
+from heritage_bayes.portfolio.spec import Portfolio
 
 __all__ = ["render_index"]
 

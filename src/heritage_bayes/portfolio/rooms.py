@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import time
 import traceback
-from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -131,53 +130,51 @@ def _project_room(run_dir: Path, projection: Path, resume: bool) -> dict:
     return row
 
 
-def _get(d: Mapping, *keys, default=float("nan")):
-    for k in keys:
-        if not isinstance(d, Mapping) or k not in d:
-            return default
-        d = d[k]
-    return d
-
-
 def room_row(run_dir: str | Path) -> dict:
     """The portfolio table's row of one finished run directory.
 
-    Columns: convergence (``converged``, ``max_rhat``, ``min_ess_bulk``,
+    Read through the typed summary (:func:`heritage_bayes.rundir.summary.load_summary`).
+    Columns: convergence (``converged``: the stopping rule; ``saved_draws_ok``: the
+    saved draws within the stated R-hat/ESS criteria; ``max_rhat``, ``min_ess_bulk``,
     ``wall_seconds``), per measured output ``<section>.<output>.FIT_cal`` /
     ``FIT_val`` [%] and ``coverage90_val`` [-], the slowest time constant and the
     outdoor-temperature gain of each section, and conservation-risk indicators of the
     *measured* indoor climate over the data period (:func:`measured_risk`).
     """
-    from heritage_bayes.rundir.reader import read_summary
+    from heritage_bayes.rundir.summary import load_summary
 
     run_dir = Path(run_dir)
-    s = read_summary(run_dir)
+    s = load_summary(run_dir)
+    conv = s.convergence
+    nan = float("nan")
     row: dict[str, Any] = {
         "run_dir": str(run_dir),
         "report": str(run_dir / "report.html") if (run_dir / "report.html").is_file() else "",
-        "building": s.get("building", ""),
-        "room_description": s.get("room", ""),
-        "converged": bool(s.get("converged", False)),
-        "unconverged_reasons": "; ".join(s.get("unconverged_reasons") or []),
-        "max_rhat": s.get("max_rhat", float("nan")),
-        "min_ess_bulk": s.get("min_ess_bulk", float("nan")),
-        "wall_seconds": s.get("wall_seconds", float("nan")),
+        "building": s.building,
+        "room_description": s.room,
+        "converged": conv.converged,
+        "saved_draws_ok": conv.saved_draws_ok,
+        "unconverged_reasons": "; ".join(conv.reasons),
+        "max_rhat": nan if conv.max_rhat is None else conv.max_rhat,
+        "min_ess_bulk": nan if conv.min_ess_bulk is None else conv.min_ess_bulk,
+        "wall_seconds": nan if s.wall_seconds is None else s.wall_seconds,
     }
-    for section, outputs in (s.get("metrics") or {}).items():
-        if section == "combined" or not isinstance(outputs, Mapping):
+    for sec, out in dict.fromkeys((m.section, m.output) for m in s.metrics):
+        if sec == "combined":
             continue
-        for out, per in outputs.items():
-            key = f"{section}.{out}"
-            row[f"{key}.FIT_cal"] = _get(per, "calibration", "FIT")
-            row[f"{key}.FIT_val"] = _get(per, "validation", "FIT")
-            row[f"{key}.coverage90_val"] = _get(per, "validation", "coverage90")
-    derived = s.get("derived") or {}
+        cal, val = s.metric(sec, out, "calibration"), s.metric(sec, out, "validation")
+        for col, v in (
+            ("FIT_cal", cal and cal.FIT),
+            ("FIT_val", val and val.FIT),
+            ("coverage90_val", val and val.coverage90),
+        ):
+            row[f"{sec}.{out}.{col}"] = nan if v is None else v
     for section in ("thermal", "hygric"):
         for q, col in ((f"{section}.tau_1_h", "tau_1_h"), (f"{section}.gain_Ti_Te", "gain_Te")):
-            if q in derived:
-                row[f"{section}.{col}"] = derived[q].get("median", float("nan"))
-                row[f"{section}.{col}_q05"] = derived[q].get("q05", float("nan"))
-                row[f"{section}.{col}_q95"] = derived[q].get("q95", float("nan"))
+            e = s.derived.get(q)
+            if e is not None:
+                for suffix, v in (("", e.median), ("_q05", e.q05), ("_q95", e.q95)):
+                    row[f"{section}.{col}{suffix}"] = nan if v is None else v
     row.update(measured_risk(run_dir))
     return row
 

@@ -17,9 +17,9 @@ from html import escape
 import numpy as np
 
 from heritage_bayes.climate.risk.registry import indicator_info
+from heritage_bayes.format import fmt, fmt_interval_html, fmt_pct
 from heritage_bayes.projection.interventions import COSTS
 from heritage_bayes.report.figures.style import RC_PARAMS, _figure, to_png_uri
-from heritage_bayes.format import fmt, fmt_interval_html, fmt_pct
 
 _MARKERS = ("o", "s", "D", "^", "v", "P", "X", "*")
 _COLOURS = ("#1f5fa8", "#c0392b", "#2e8b57", "#e08a00", "#7b3fa0", "#8c564b", "#17becf",

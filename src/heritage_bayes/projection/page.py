@@ -29,8 +29,8 @@ from html import escape
 import numpy as np
 
 from heritage_bayes.climate.risk.registry import indicator_info
+from heritage_bayes.format import fmt, fmt_interval_html, fmt_pct, prose_html
 from heritage_bayes.report.figures.style import RC_PARAMS, _figure, to_png_uri
-from heritage_bayes.format import fmt, fmt_interval_html, fmt_pct
 
 #: Indicators drawn in the figures (when computed), in this order.
 KEY_INDICATORS = (
@@ -291,7 +291,7 @@ def _banner(proj) -> str:
         return ""
     from heritage_bayes.projection import UNCONVERGED_TEXT
 
-    reasons = "".join(f"<li>{escape(str(r))}</li>" for r in s.get("unconverged_reasons") or [])
+    reasons = "".join(f"<li>{prose_html(r)}</li>" for r in s.get("unconverged_reasons") or [])
     return (
         "<div class='note red' id='unconverged'><strong>Calibration not converged</strong>"
         f"<p>{escape(UNCONVERGED_TEXT[:1].upper() + UNCONVERGED_TEXT[1:])}. Continue it "
@@ -431,7 +431,7 @@ def _split_html(proj) -> str:
         "only, for one year's value); <b>scenario</b> — the spread of the scenario means "
         f"at a horizon. {_scenario_caveat(proj)} Where the model "
         "error is correlated with the parameters, the covariance is shared in proportion "
-        "to the two variances (see heritage_bayes.projection.summary).</p>" + note + "".join(out)
+        "to the two variances.</p>" + note + "".join(out)
     )
 
 
@@ -452,6 +452,7 @@ def _registry_html(proj) -> str:
 
 
 def _weather_html(proj) -> str:
+    mode = str(proj.summary["humidity"])
     rows = []
     for c in proj.summary["cases"]:
         w = c["weather"]
@@ -467,14 +468,24 @@ def _weather_html(proj) -> str:
             f"<td class='num'>{c['years']}</td><td class='num'>{c['hours_dropped']}</td></tr>"
         )
     return (
-        f"<p>Humidity under warming: <b>{escape(proj.summary['humidity'])}</b> (see "
-        "heritage_bayes.climate.morph). Every indicator is computed over the complete "
+        f"<p>Humidity under warming: <b>{_HUMIDITY_WORDS.get(mode, escape(mode))}</b> "
+        f"(<code>humidity: {escape(mode)}</code>). Every indicator is computed over the complete "
         "years of the weather (blocks of 8760 h from its start); the hours after the "
         "last complete year are not simulated.</p><div class='scroll'><table><thead><tr>"
         "<th>case</th><th>weather</th><th>details</th><th class='num'>mean Te [°C]</th>"
         "<th class='num'>complete years</th><th class='num'>hours left out</th></tr>"
         f"</thead><tbody>{''.join(rows)}</tbody></table></div>"
     )
+
+
+#: What each ``humidity`` mode of the projection config does, in words.
+_HUMIDITY_WORDS = {
+    "constant_rh": "outdoor relative humidity kept as it was (the vapour pressure rises "
+    "with the warming)",
+    "constant_vapour_pressure": "outdoor vapour pressure kept as it was (the relative "
+    "humidity falls with the warming)",
+    "table": "outdoor relative humidity changed as the KNMI'14 tables give",
+}
 
 
 def render_projection_page(proj, run) -> str:
@@ -485,7 +496,7 @@ def render_projection_page(proj, run) -> str:
     s = proj.summary
     assumptions = "".join(f"<li>{escape(a)}</li>" for a in s["assumptions"])
     noise = s.get("noise")
-    noise_text = ", ".join(f"{k}: {v}" for k, v in (noise or {}).items())
+    noise_text = ", ".join(f"{k}: `{v}`" for k, v in (noise or {}).items())
     lead = (
         _CSS
         + _banner(proj)
@@ -494,7 +505,7 @@ def render_projection_page(proj, run) -> str:
         + f"{s['draws']} posterior draws of the calibrated room, each simulated on the "
         + f"baseline and on {len(proj.labels) - 1} future weather(s)"
         + (
-            f", with a draw of its noise model ({escape(noise_text)})"
+            f", with a draw of its noise model ({prose_html(noise_text)})"
             if noise
             else ", noise-free (parameter uncertainty only)"
         )

@@ -253,11 +253,11 @@ def _better_rung(summary: dict, failure: dict) -> str | None:
     if best is None:
         return None
     text = (
-        f"the model-order ladder's {best} reproduces {o} with FIT {best_fit:.1f} % on the "
+        f"the model-order ladder's `{best}` reproduces {o} with FIT {best_fit:.1f} % on the "
         f"{p} period (its MAP), against {float(own):.1f} %"
     )
     if best_fit >= MIN_FIT:
-        return text + f": calibrate {best}"
+        return text + f": calibrate `{best}`"
     return text + f", still below {MIN_FIT:g} %: it has part of what is missing"
 
 
@@ -312,7 +312,7 @@ def missing_physics(summary: dict, failures: list[dict], shapes: dict | None) ->
             lack = []
             if len(info.get("state_names") or []) < 2:
                 lack.append(
-                    "a second, slower node (" + ("thermal_2c" if o == "Ti" else "hygric_2c") + ")"
+                    "a second, slower node (`" + ("thermal_2c" if o == "Ti" else "hygric_2c") + "`)"
                 )
             if o == "Ti" and "Tset" not in have:
                 lack.append("a control (thermostat, if the room is heated)")
@@ -320,7 +320,7 @@ def missing_physics(summary: dict, failures: list[dict], shapes: dict | None) ->
                 if not {"RH_lo", "RH_hi", "RH_set"} & have:
                     lack.append("a control (humidistat, dehumidifier)")
                 if "Pf" not in have:
-                    lack.append("a sink (hygric_2c_fixed's fixed vapour-pressure node)")
+                    lack.append("a sink (the fixed vapour-pressure node of `hygric_2c_fixed`)")
             found.append(
                 f"a slow drift of the residuals' day means (RMS {sh['drift']:.2g}{u}, against "
                 f"a measured standard deviation of {sh['measured_sd']:.2g}{u}): "

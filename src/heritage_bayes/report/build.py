@@ -153,7 +153,7 @@ def render(ctx: dict) -> str:
         [m.section(ctx) for m in SECTION_MODULES],
         subtitle=h["room"] or "",
         window_title=window,
-        header_note=f"Calibration report of run “{h['name']}” — heritage_bayes {h['version']}",
+        header_note=f"Calibration report of run “{h['name']}” — hbayes {h['version']}",
         generator=f"heritage_bayes {ctx['generated']['version']}",
         footer=_FOOTER.format(version=ctx["generated"]["version"]),
     )

@@ -36,7 +36,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from heritage_bayes.format import fmt
+from heritage_bayes.format import fmt, quantity_label
 from heritage_bayes.report.rundata import RunData, section_params
 
 __all__ = [
@@ -153,8 +153,8 @@ def identifiable_coordinates(rd: RunData, m: str) -> list[Coord]:
         else:
             fin = x[np.isfinite(x)]
             log = bool(name.startswith("gain_") and unit not in ("", "-") and np.all(fin > 0))
-            u = f" [{unit}]" if unit else " [-]"
-            label = f"log10 {name}{u}" if log else f"{name}{u}"
+            words = quantity_label(name, unit or "-", domain=m)
+            label = f"log10 {words}" if log else words
         fin = x[np.isfinite(x)]
         if fin.size and np.ptp(fin) <= 1e-9 * max(1.0, float(np.max(np.abs(fin)))):
             continue  # fixed by the structure (e.g. the gain from a single boundary: 1)

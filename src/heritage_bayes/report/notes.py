@@ -9,7 +9,7 @@ search, missing chain files, synthetic data. The verdict itself is
 
 from __future__ import annotations
 
-from heritage_bayes.format import prior_text
+from heritage_bayes.format import prior_text, quantity_name
 
 __all__ = ["run_notes"]
 
@@ -95,7 +95,8 @@ def run_notes(
             unit = v.get("unit", "")
             unit = f" {unit}" if unit and unit != "-" else ""
             bound.append(
-                f"{k} (at the {v['at_bound']} end of its prior {prior_text(v.get('prior'))}{unit})"
+                f"{quantity_name(k, v.get('description'))} (at the {v['at_bound']} end of its "
+                f"prior {prior_text(v.get('prior'))}{unit})"
             )
     if bound:
         out.append(
@@ -110,7 +111,9 @@ def run_notes(
             }
         )
     for m, i in (s.get("models") or {}).items():
-        on_bound = [f"{n} ({side})" for n, side in i.get("map_at_bound") or []]
+        on_bound = [
+            f"{quantity_name(n, domain=m)} ({side})" for n, side in i.get("map_at_bound") or []
+        ]
         if on_bound:
             out.append(
                 {
@@ -169,8 +172,8 @@ def run_notes(
                 {
                     "level": "amber",
                     "title": f"The {m} model is over-parameterised for these data",
-                    "text": "At the MAP the data leave "
-                    + ", ".join(flagged)
+                    "text": "At the MAP the data leave the "
+                    + ", ".join(quantity_name(n, domain=m) for n in flagged)
                     + " almost as uncertain as their priors (Laplace standard deviation "
                     "above 25 % of the prior range, with the overall scale held fixed): "
                     "their posteriors are mostly prior and slow the chain. Choose: fix "
@@ -186,8 +189,8 @@ def run_notes(
                 {
                     "level": "amber",
                     "title": f"The {m} chain ran out of time",
-                    "text": "The wall-time budget sampler.max_time ended the chain before "
-                    "it converged: raise the budget, or continue it with --resume.",
+                    "text": "The wall-time budget `sampler.max_time` ended the chain before "
+                    "it converged: raise the budget, or continue it with `--resume`.",
                 }
             )
     nulls = [
@@ -216,7 +219,7 @@ def run_notes(
                 "level": "amber",
                 "title": "Chain files missing",
                 "text": "Trace plots are not available: "
-                + ", ".join(chains_missing)
+                + ", ".join(f"`{c}`" for c in chains_missing)
                 + " not found in the run directory.",
             }
         )

@@ -52,7 +52,8 @@ class Section(NamedTuple):
     Attributes
     ----------
     title : str
-        Heading (``<h2>``) and table-of-contents entry; plain text (escaped).
+        Heading (``<h2>``) and table-of-contents entry; plain text (escaped), or
+        ``markupsafe.Markup`` for trusted HTML (a model name set as code).
     body : str
         Trusted HTML under the heading.
     id : str

@@ -17,8 +17,8 @@ from __future__ import annotations
 
 import math
 
+from heritage_bayes.format import fmt, fmt_int, fmt_interval, quantity_name
 from heritage_bayes.report.accuracy import accuracy_failures, missing_physics
-from heritage_bayes.format import fmt, fmt_int, fmt_interval, quantity_label, quantity_name
 from heritage_bayes.report.notes import run_notes
 from heritage_bayes.rundir.summary import RunSummary
 

@@ -150,9 +150,9 @@ class FitMetrics:
     section: str
     output: str
     period: str
-    FIT: float | None = None  # noqa: N815 (the criterion's name)
-    MSE: float | None = None  # noqa: N815
-    MAE: float | None = None  # noqa: N815
+    FIT: float | None = None
+    MSE: float | None = None
+    MAE: float | None = None
     n: int | None = None
     coverage50: float | None = None
     coverage90: float | None = None
@@ -279,8 +279,10 @@ class RunSummary:
             A schema newer than this hbayes knows, named with the file.
         """
         version = d.get("schema_version", 1)
-        if not isinstance(version, int) or isinstance(version, bool) or not (
-            1 <= version <= SCHEMA_VERSION
+        if (
+            not isinstance(version, int)
+            or isinstance(version, bool)
+            or not (1 <= version <= SCHEMA_VERSION)
         ):
             raise damaged(
                 Path(source),

@@ -227,7 +227,7 @@ def _entries() -> dict[str, Indicator]:
             "Share of the hours outside the EN 15757 band computed from the same series "
             "(≈ 14 % by construction for any climate: 7 % below the 7th and above the "
             "93rd percentile). Describes a measured historical climate; for a future "
-            "climate use en15757_outside_baseline.",
+            "climate use the hours outside the baseline EN 15757 band.",
             "EN 15757:2010; Camuffo et al. (2022) doi:10.3390/atmos13091344",
             _YEARS,
             0,

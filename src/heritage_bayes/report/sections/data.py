@@ -242,9 +242,9 @@ def _hold_words(rd: RunData) -> str:
         return (
             "Inputs as they were measured: interval averages constant over the interval "
             "they describe; readings at an instant linear between readings (the exact "
-            f"first-order hold; data.input_hold: exact; inputs {', '.join(slopes)})."
+            f"first-order hold; `data.input_hold: exact`; inputs {', '.join(slopes)})."
         )
-    return "Every input held at its mean over each step (data.input_hold: interval_mean)."
+    return "Every input held at its mean over each step (`data.input_hold: interval_mean`)."
 
 
 def section(ctx: dict) -> Section:

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import math
 
-from heritage_bayes.report.accuracy import NEARLY_CONSTANT_RESOLUTIONS, nearly_constant
 from heritage_bayes.format import OUT_UNITS, fmt, fmt_int, fmt_pct
+from heritage_bayes.report.accuracy import NEARLY_CONSTANT_RESOLUTIONS, nearly_constant
 from heritage_bayes.report.page import Section
 from heritage_bayes.report.rundata import RunData, model_label
 from heritage_bayes.report.sections._fragment import render_fragment

@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-from heritage_bayes.format import fmt, fmt_int, fmt_pct, prior_text
+from heritage_bayes.format import fmt, fmt_int, fmt_interval, fmt_pct, prior_text, quantity_name
 from heritage_bayes.report.identifiable import mcse_cells, mcse_table, prior_density
 from heritage_bayes.report.page import Section
 from heritage_bayes.report.rundata import RunData, parameter_set, section_params
@@ -54,14 +54,14 @@ def parameter_tables(rd: RunData) -> list[dict]:
             rows.append(
                 {
                     "name": name,
-                    "description": v.get("description", ""),
+                    "label": quantity_name(name, v.get("description"), domain=m),
                     "unit": v.get("unit", ""),
                     "prior": "fixed" if fixed is not None else prior_text(v.get("prior")),
                     "map": fmt(v.get("map")),
                     "median": fmt(v.get("median")),
                     "interval": "—"
                     if fixed is not None
-                    else f"{fmt(v.get('q05'))} … {fmt(v.get('q95'))}",
+                    else fmt_interval(v.get("q05"), v.get("q95")),
                     "at_bound": v.get("at_bound"),
                     "truth": fmt(truth) if truth is not None else "—",
                     "inside": inside,

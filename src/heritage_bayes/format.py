@@ -32,6 +32,7 @@ __all__ = [
     "prose_html",
     "quantity_label",
     "quantity_name",
+    "tick_names",
 ]
 
 #: Unit of each model output.
@@ -110,6 +111,16 @@ def prose_html(text) -> str:
     from html import escape
 
     return _TICKS.sub(r"<code>\1</code>", escape(str(text), quote=False))
+
+
+def tick_names(text: str, names) -> str:
+    """``text`` with each whole-word occurrence of one of ``names`` (parameter names of
+    a model) in backticks, for :func:`prose_html` to set as code."""
+    names = sorted({str(n) for n in names if n}, key=len, reverse=True)
+    if not names or not text:
+        return text
+    pattern = re.compile(r"(?<![\w`])(" + "|".join(map(re.escape, names)) + r")(?![\w`])")
+    return pattern.sub(r"`\1`", str(text))
 
 
 def fmt_time(text: str | None) -> str:

@@ -292,7 +292,7 @@ def _scale_hint(model, ref: str) -> str:
         hints = []
         if air:
             hints.append(
-                f"a prior on {air} from the room air volume V (V/(R_v·T) ≈ "
+                f"a prior on {air} from the room air volume V (V/(Rᵥ·T) ≈ "
                 "7.4e-6 kg/(Pa·m³) × V at 20 °C)"
             )
         hints.append("a known moisture source")

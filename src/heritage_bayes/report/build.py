@@ -60,7 +60,7 @@ SECTION_MODULES = (
 SECTIONS = tuple((m.ID, m.TITLE) for m in SECTION_MODULES)
 
 _FOOTER = (
-    "Written by heritage_bayes {version}. This file is self-contained: it needs no "
+    "Written by hbayes {version}. This file is self-contained: it needs no "
     "internet connection and no other file."
 )
 

@@ -306,7 +306,7 @@ def convergence_verdict(
     )
     rule = (
         "Rule applied: green only when the sampler's stopping rule is met (chains of "
-        f"at least {tf:g} τ with a stable τ) and the draws saved in posterior.nc, which "
+        f"at least {tf:g} τ with a stable τ) and the draws saved in `posterior.nc`, which "
         f"every figure on this page uses, meet the stated criteria (R-hat ≤ {r_ok:g}, "
         f"bulk ESS ≥ {e_ok:g}, as arviz recomputes them from the file) and the checks "
         "pass."

@@ -123,7 +123,7 @@ def fit_context(rd: RunData, outputs: list[dict]) -> list[dict]:
         items.append(
             {
                 "id": f"fig-fit-{o['section']}-{o['output']}",
-                "title": f"{what} ({o['output']}) — {o['model']}",
+                "title": f"{what} ({o['output']}) — `{o['model']}`",
                 "figure": fig,
                 "caption": (
                     f"Measured {what} (black) and the model's posterior "
@@ -170,7 +170,7 @@ def _one_step_item(rd: RunData, o: dict, pp, times, y, codes, gaps, what: str) -
             cov.append(f"{period} {100 * c:.0f} %")
     return {
         "id": f"fig-fit-{o['section']}-{o['output']}-1step",
-        "title": f"{what} ({o['output']}), one step ahead — {o['model']}",
+        "title": f"{what} ({o['output']}), one step ahead — `{o['model']}`",
         "figure": fig,
         "caption": (
             f"Measured {what} (black) and the Kalman filter's one-step-ahead prediction "

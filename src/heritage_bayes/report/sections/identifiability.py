@@ -25,7 +25,7 @@ import math
 
 import numpy as np
 
-from heritage_bayes.format import fmt, fmt_int, is_log_prior
+from heritage_bayes.format import fmt, fmt_int, is_log_prior, tick_names
 from heritage_bayes.report.identifiable import (
     identifiable_coordinates,
     identifiable_correlation,
@@ -52,8 +52,8 @@ def identifiability_context(rd: RunData) -> list[dict]:
         nulls = [
             {
                 "label": d.get("label", ""),
-                "description": d.get("description", ""),
-                "pinned_by": ", ".join(d.get("pinned_by") or []),
+                "description": tick_names(d.get("description", ""), params),
+                "pinned_by": ", ".join(f"`{n}`" for n in d.get("pinned_by") or []),
                 "is_scale": bool(d.get("is_scale")),
             }
             for d in idf.get("null_directions") or []

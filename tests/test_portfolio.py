@@ -111,7 +111,7 @@ def test_three_rooms_two_workers_one_bad(finished):
     # room a was projected: the warmer case shortens its chemical lifetime (TWPI)
     assert by.loc["a", "proj.case"] == "warm 2050"
     assert by.loc["a", "proj.twpi.change"] < 0 and by.loc["a", "proj.twpi.p_worse"] > 0.5
-    assert by.loc["a", "proj.statement"] == "P(twpi < 1000)"
+    assert by.loc["a", "proj.statement"] == "P(Time-weighted preservation index < 1000 years)"
     assert 0 <= by.loc["a", "proj.probability"] <= 1
     assert (out / "a" / "projection" / "projection.json").is_file()
     assert pd.isna(by.loc["b", "proj.case"])

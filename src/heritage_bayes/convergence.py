@@ -26,7 +26,7 @@ EXIT_UNCONVERGED = 3
 
 _STOPPED_BY = {
     "max_seconds": "the time budget sampler.max_time ran out",
-    "max_steps": "the step cap sampler.max_steps was reached",
+    "max_steps": "the step cap `sampler.max_steps` was reached",
 }
 
 

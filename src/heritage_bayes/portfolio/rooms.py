@@ -125,7 +125,10 @@ def _project_room(run_dir: Path, projection: Path, resume: bool) -> dict:
     probs = summary.get("probabilities") or []
     if probs:
         p0 = probs[0]
-        row["proj.statement"] = f"P({p0['indicator']} {p0['op']} {p0['value']:g})"
+        # the indicator's name as the projection page prints it, not its key
+        what = p0.get("name") or p0["indicator"]
+        unit = f" {p0['unit']}" if p0.get("unit") else ""
+        row["proj.statement"] = f"P({what} {p0['op']} {p0['value']:g}{unit})"
         row["proj.probability"] = p0["cases"].get(label, {}).get("p", float("nan"))
     return row
 

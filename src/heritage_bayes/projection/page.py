@@ -458,13 +458,13 @@ def _weather_html(proj) -> str:
         w = c["weather"]
         method = w.get("method") or w.get("from", "")
         detail = ", ".join(
-            f"{k}: {v}"
+            f"{k}: `{v}`" if k == "humidity" else f"{k}: {v}".replace("`", "")
             for k, v in w.items()
             if k in ("scenario", "horizon", "region", "humidity", "path")
         )
         rows.append(
             f"<tr><td>{escape(c['label'])}</td><td>{escape(str(method))}</td>"
-            f"<td>{escape(detail)}</td><td class='num'>{fmt(c['mean_Te'])}</td>"
+            f"<td>{prose_html(detail)}</td><td class='num'>{fmt(c['mean_Te'])}</td>"
             f"<td class='num'>{c['years']}</td><td class='num'>{c['hours_dropped']}</td></tr>"
         )
     return (

@@ -25,7 +25,14 @@ import math
 
 import numpy as np
 
-from heritage_bayes.format import fmt, fmt_int, is_log_prior, tick_names
+from heritage_bayes.format import (
+    fmt,
+    fmt_int,
+    fmt_interval,
+    is_log_prior,
+    quantity_name,
+    tick_names,
+)
 from heritage_bayes.report.identifiable import (
     identifiable_coordinates,
     identifiable_correlation,
@@ -59,7 +66,7 @@ def identifiability_context(rd: RunData) -> list[dict]:
             for d in idf.get("null_directions") or []
         ]
         summ_lines = [
-            ln.strip()[:1].upper() + ln.strip()[1:]
+            tick_names(ln.strip()[:1].upper() + ln.strip()[1:], params)
             for ln in str(idf.get("summary", "")).splitlines()[1:]
             if ln.strip() and not ln.strip().startswith("- ")
         ]
@@ -220,7 +227,6 @@ def _derived_keys(s: dict, m: str) -> list[str]:
 
 def _derived_rows(s: dict, m: str, info: dict, mc: dict | None = None) -> dict:
     taus, gains = [], []
-    outs = list(info.get("output_names") or [])
     for key, v in (s.get("derived") or {}).items():
         if not key.startswith(f"{m}."):
             continue
@@ -240,31 +246,21 @@ def _derived_rows(s: dict, m: str, info: dict, mc: dict | None = None) -> dict:
             **mcse_cells((mc or {}).get(key)),
         }
         if name.startswith("tau_") and name.endswith("_h"):
-            k = name[4:-2]
             base.update(
-                label=f"τ{k}",
+                label=quantity_name(name).removeprefix("time constant "),
                 median_h=fmt(v.get("median")),
-                int_h=f"{fmt(v.get('q05'))} … {fmt(v.get('q95'))}",
+                int_h=fmt_interval(v.get("q05"), v.get("q95")),
                 median_d=fmt(_div(v.get("median"), 24)),
-                int_d=f"{fmt(_div(v.get('q05'), 24))} … {fmt(_div(v.get('q95'), 24))}",
+                int_d=fmt_interval(_div(v.get("q05"), 24), _div(v.get("q95"), 24)),
             )
             taus.append(base)
             continue
-        label = name
-        for prefix, words in (
-            ("gain_", "static gain of {o} from {i}"),
-            ("offset_", "steady-state offset of {o} from {i}"),
-        ):
-            if name.startswith(prefix):
-                rest = name[len(prefix) :]
-                o = next((o for o in outs if rest.startswith(o + "_")), None)
-                if o is not None:
-                    label = words.format(o=o, i=rest[len(o) + 1 :])
         base.update(
-            label=label,
+            label=quantity_name(name, domain=m),
+            name=name,
             unit=v.get("unit", ""),
             median=fmt(v.get("median")),
-            interval=f"{fmt(v.get('q05'))} … {fmt(v.get('q95'))}",
+            interval=fmt_interval(v.get("q05"), v.get("q95")),
         )
         gains.append(base)
     return {

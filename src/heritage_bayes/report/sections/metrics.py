@@ -23,7 +23,7 @@ def metrics_context(rd: RunData, resolutions: dict | None = None) -> dict:
             u = OUT_UNITS.get(o, "")
             groups.append(
                 {
-                    "label": f"{model_label(rd.summary, m)} — {o}",
+                    "label": f"`{model_label(rd.summary, m)}` — {o}",
                     "output": o,
                     "unit": u,
                     "per": per,

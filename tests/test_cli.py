@@ -158,13 +158,13 @@ def test_an_unconverged_run_exits_3_with_its_reasons(tiny_run, tmp_path, capsys)
     assert s["converged"] is False
     reasons = s["unconverged_reasons"]
     assert any(
-        r.startswith("thermal: the step cap sampler.max_steps was reached after 400 steps; τmax ")
+        r.startswith("thermal: the step cap `sampler.max_steps` was reached after 400 steps; τmax ")
         for r in reasons
     ), reasons
     assert main(["calibrate", str(cfg), "--out", str(tmp_path / "r"), "--no-report"]) == 3
     err = capsys.readouterr().err
     assert "hbayes: finished but NOT converged (exit code 3)" in err
-    assert "thermal: the step cap sampler.max_steps was reached after 400 steps" in err
+    assert "thermal: the step cap `sampler.max_steps` was reached after 400 steps" in err
     assert "Traceback" not in err
 
 

@@ -342,7 +342,7 @@ def test_a_converged_run_has_no_reasons_even_when_its_saved_draws_scatter():
     }
     assert unconverged_reasons(summary) == []
     reasons = unconverged_reasons({**summary, "converged": False})
-    assert reasons == ["max R-hat 1.018 (thermal.phi_Ti) > 1.01"]
+    assert reasons == ["max R-hat 1.018 (thermal model: model-error autocorrelation of Ti) > 1.01"]
 
 
 def test_report_notes_name_separate_optima():

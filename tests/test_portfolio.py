@@ -148,7 +148,7 @@ def test_batch_counts_unconverged_rooms_and_exits_3(finished, capsys):
     df = pd.read_csv(d / "out" / "portfolio.csv").set_index("room")
     for room in ("a", "b"):
         assert not df.loc[room, "converged"]
-        assert "sampler.max_steps was reached" in df.loc[room, "unconverged_reasons"]
+        assert "`sampler.max_steps` was reached" in df.loc[room, "unconverged_reasons"]
     index = (d / "out" / "index.html").read_text(encoding="utf-8")
     assert "why not converged" in index and "2 finished unconverged" in index
     pf = yaml.safe_load((d / "portfolio.yaml").read_text(encoding="utf-8"))

@@ -19,13 +19,15 @@ import math
 from collections.abc import Mapping
 from typing import Any
 
+from heritage_bayes.format import quantity_name
+
 __all__ = ["EXIT_UNCONVERGED", "unconverged_reasons"]
 
 #: Exit code of a run that finished but did not converge.
 EXIT_UNCONVERGED = 3
 
 _STOPPED_BY = {
-    "max_seconds": "the time budget sampler.max_time ran out",
+    "max_seconds": "the time budget `sampler.max_time` ran out",
     "max_steps": "the step cap `sampler.max_steps` was reached",
 }
 
@@ -35,6 +37,12 @@ def _num(value: Any) -> float:
         return float(value)
     except (TypeError, ValueError):
         return math.nan
+
+
+def _words(key: str) -> str:
+    """``thermal.phi_Ti`` -> ``thermal model: model-error autocorrelation of Ti``."""
+    section = key.split(".", 1)[0] if "." in key else ""
+    return f"{section} model: {quantity_name(key)}" if section else quantity_name(key)
 
 
 def _grouped(n: float) -> str:
@@ -60,9 +68,9 @@ def unconverged_reasons(summary: Mapping[str, Any]) -> list[str]:
     Returns
     -------
     list of str
-        E.g. ``"hygric: the time budget sampler.max_time ran out after 68 000 steps;
+        E.g. ``"hygric: the time budget `sampler.max_time` ran out after 68 000 steps;
         τmax 1311 asks for about 65 550 steps (50 τ) with a stable τ"``, ``"max R-hat
-        1.034 (hygric.Cw) > 1.01"``.
+        1.034 (hygric model: moisture capacity of the buffering surfaces Cw) > 1.01"``.
     """
     if summary.get("converged") is True:
         return []
@@ -89,10 +97,10 @@ def unconverged_reasons(summary: Mapping[str, Any]) -> list[str]:
     ess = {k: _num(v.get("ess_bulk")) for k, v in params.items() if "ess_bulk" in v}
     worst = max(rhat, key=lambda k: rhat[k] if math.isfinite(rhat[k]) else math.inf, default=None)
     if worst is not None and not rhat[worst] <= max_rhat:
-        reasons.append(f"max R-hat {rhat[worst]:.3f} ({worst}) > {max_rhat:g}")
+        reasons.append(f"max R-hat {rhat[worst]:.3f} ({_words(worst)}) > {max_rhat:g}")
     least = min(ess, key=lambda k: ess[k] if math.isfinite(ess[k]) else -math.inf, default=None)
     if least is not None and not ess[least] >= min_ess:
-        reasons.append(f"min bulk ESS {ess[least]:.0f} ({least}) < {min_ess:g}")
+        reasons.append(f"min bulk ESS {ess[least]:.0f} ({_words(least)}) < {min_ess:g}")
     if not reasons and not summary.get("converged", True):
         reasons.append("the convergence criteria did not hold (see summary.json: criteria)")
     return reasons

@@ -243,7 +243,6 @@ def _cmd_calibrate(args) -> int:
 def _converged_or_3(run_dir) -> int:
     """0 when the run's ``summary.json`` says converged; else name the reasons, return 3."""
     from heritage_bayes.convergence import EXIT_UNCONVERGED
-    from heritage_bayes.format import fmt_int
     from heritage_bayes.report.accuracy import accuracy_failures, resolutions
     from heritage_bayes.rundir.summary import load_summary
 
@@ -258,15 +257,8 @@ def _converged_or_3(run_dir) -> int:
             file=sys.stderr,
         )
     if conv.converged:
-        if not conv.saved_draws_ok:
-            print(
-                f"hbayes: note: the draws saved in posterior.nc give max R-hat "
-                f"{conv.max_rhat or float('nan'):.3f} and min bulk ESS "
-                f"{fmt_int(conv.min_ess_bulk)} (criteria ≤ {conv.target_rhat:g}, "
-                f"≥ {conv.target_ess:g}): the report's verdict is amber; --resume with a "
-                "larger sampler.max_steps continues the chains",
-                file=sys.stderr,
-            )
+        if not conv.saved_draws_ok:  # the report's verdict is amber
+            print(f"hbayes: note: {conv.saved_draws_text}", file=sys.stderr)
         return 0
     print(
         f"hbayes: finished but NOT converged (exit code {EXIT_UNCONVERGED}): {run_dir}",

@@ -316,11 +316,9 @@ def convergence_verdict(
     if rule_ok and not saved_ok:
         level, title = "amber", "Stopping rule met, but the saved draws miss the criteria"
         text = (
-            "The sampler's stopping rule was met on its retained draws, but the draws "
-            "saved in posterior.nc give "
-            f"max R-hat {max_rhat:.3f} and min bulk ESS {fmt_int(min_ess)} against the "
-            f"criteria R-hat ≤ {r_ok:g} and ESS ≥ {e_ok:g}. Medians are usable; treat the "
-            "intervals, bands and tail values as approximate."
+            f"The sampler's stopping rule was met on its retained draws, but "
+            f"{conv.saved_draws_text}. Medians are usable; treat the intervals, bands and "
+            "tail values as approximate."
         )
         advice = (
             "Continue the chains: raise `sampler.max_steps` in the config and run "

@@ -29,7 +29,7 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Any
 
-from heritage_bayes.format import quantity_label
+from heritage_bayes.format import fmt_int, quantity_label
 from heritage_bayes.rundir.reader import SCHEMA_VERSION, damaged, read_summary
 
 __all__ = [
@@ -185,6 +185,16 @@ class Convergence:
             and self.min_ess_bulk is not None
             and self.max_rhat <= self.target_rhat
             and self.min_ess_bulk >= self.target_ess
+        )
+
+    @property
+    def saved_draws_text(self) -> str:
+        """The saved draws' R-hat and ESS against the criteria, in words."""
+        r = "—" if self.max_rhat is None else f"{self.max_rhat:.3f}"
+        return (
+            f"the draws saved in posterior.nc give max R-hat {r} and min bulk ESS "
+            f"{fmt_int(self.min_ess_bulk)} against the criteria R-hat ≤ {self.target_rhat:g} "
+            f"and ESS ≥ {self.target_ess:g}"
         )
 
     @property

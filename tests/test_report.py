@@ -24,7 +24,7 @@ from heritage_bayes.calibrate import run_calibration
 from heritage_bayes.cli import main
 from heritage_bayes.config import parse_config
 from heritage_bayes.errors import InputError
-from heritage_bayes.format import fmt, fmt_int, prior_text
+from heritage_bayes.format import fmt, fmt_int, prior_text, prose_html, tick_names
 from heritage_bayes.report import write_report
 from heritage_bayes.report._diag import acf, cumulative_periodogram, innovations
 from heritage_bayes.report.build import SECTIONS
@@ -138,7 +138,10 @@ def test_data_section_says_how_the_inputs_were_held(report):
     default, its generator's hold); the data section says so."""
     _, html = report
     data = html.split('<section id="data">', 1)[1].split("</section>", 1)[0]
-    assert "Every input held at its mean over each step (data.input_hold: interval_mean)" in data
+    assert (
+        "Every input held at its mean over each step (<code>data.input_hold: interval_mean"
+        "</code>)" in data
+    )
 
 
 def test_every_figure_is_an_embedded_png(report):
@@ -268,7 +271,10 @@ def test_identifiability_and_derived(report, run_dir):
         idf = summary["models"][m]["identifiability"]
         assert f"rank {idf['rank']} of {idf['n_params']}" in sec
         for d in idf["null_directions"]:
-            assert d["description"].split(":")[0] in sec
+            # the words of the analysis, its parameter names set as code
+            names = summary["models"][m]["identifiability"]["parameters"]
+            words = prose_html(tick_names(d["description"], names))
+            assert words.split(":")[0] in sec
         assert f'id="table-tau-{m}"' in sec and f'id="table-gains-{m}"' in sec
     assert "[d]" in sec and "[h]" in sec
     # the model-order ladder (MAP fits of thermal 1c/2c/4a, hygric 1c/2c/2c_fixed)
@@ -276,10 +282,10 @@ def test_identifiability_and_derived(report, run_dir):
     for m in ("thermal", "hygric"):
         rows = summary["ladder"][m]
         for r in rows:
-            assert f"<td>{r['model']}</td>" in sec
+            assert f"<td><code>{r['model']}</code></td>" in sec
         sampled = [r["model"] for r in rows if r["sampled"]]
         assert sampled == [summary["models"][m]["model"]]
-        assert f'<tr class="sampled"><td>{sampled[0]}</td>' in sec
+        assert f'<tr class="sampled"><td><code>{sampled[0]}</code></td>' in sec
         fit = rows[0]["fit"]["validation"]
         ((out, v),) = fit.items()
         assert f"{v['FIT']:.1f}".replace("-", "−") in sec
@@ -304,7 +310,7 @@ def test_diagnostics_and_reproducibility(report, run_dir):
         "pvlib",
         "heritage_bayes",
     ):
-        assert f"<td>{lib}</td>" in repro, lib
+        assert f"<td><code>{lib}</code></td>" in repro, lib
     assert "max_steps: 600" in repro  # the resolved config, verbatim
     assert "thermal map" in repro and "this report" in repro
 
@@ -490,7 +496,7 @@ def test_the_verdict_names_the_scale_parameters_the_priors_pin():
     s["models"]["thermal"]["identifiability"]["parameters"]["Ci"]["identifiable"] = True
     v = convergence_verdict(s, ok)
     assert v["level"] == "amber" and len(v["checks"]) == 1
-    assert v["checks"][0].startswith("heat capacity of the air and fast contents Ci [")
+    assert v["checks"][0].startswith("heat capacity of the air and fast contents Ci: the true")
 
 
 def test_verdict_classes_and_notes():
@@ -542,7 +548,7 @@ def test_house_page_builder():
     assert re.findall(r'<section id="([^"]+)">', html) == ["plain-simple", "two"]
     assert '<a href="#two">Second</a>' in html
     assert html.index("<div id='lead'>L</div>") < html.index("<h2>Second</h2>")
-    assert "<footer>heritage_bayes test</footer>" in html
+    assert "<footer><code>heritage_bayes test</code></footer>" in html
     assert "--red-bg" in html  # the house CSS, shared with report.html
     js = "document.title = 'x';"
     html = render_page("t", [("s", "")], script=js, footer="done")
@@ -708,7 +714,7 @@ def test_mcse_columns_equal_arviz(report, run_dir):
         tau = html[html.index(f'id="table-tau-{m}"') :]
         tau = tau[: tau.index("</table>")]
         med, q = cells(f"{m}.tau_1_h")
-        row = _row(tau, "<td>τ1</td>")
+        row = _row(tau, "<td>τ₁</td>")
         assert f'<td class="num">{med}</td>' in row and q in row
         assert "MCSE median [h]" in tau
 

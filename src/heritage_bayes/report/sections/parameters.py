@@ -24,58 +24,49 @@ ID, TITLE = "parameters", "5. Parameters"
 
 
 def parameter_tables(rd: RunData) -> list[dict]:
+    """One table per model, every figure from the typed run summary."""
     s = rd.summary
-    crit = s.get("criteria") or {}
-    r_ok = float(crit.get("max_rhat", 1.01))
-    e_ok = float(crit.get("min_ess_bulk", 400.0))
+    rs = rd.run.run_summary
+    r_ok, e_ok = rs.convergence.target_rhat, rs.convergence.target_ess
     tables = []
     for m, info in (s.get("models") or {}).items():
         ident = (info.get("identifiability") or {}).get("parameters") or {}
-        params = section_params(s, m)
-        has_truth = any(v.get("truth") is not None for v in params.values())
-        mc = mcse_table(rd, [f"{m}.{n}" for n, v in params.items() if v.get("fixed") is None])
+        params = [e for e in rs.parameters.values() if e.section == m]
+        has_truth = any(e.truth is not None for e in params)
+        mc = mcse_table(rd, [e.key for e in params if e.fixed is None])
         rows = []
-        for name, v in params.items():
-            fixed = v.get("fixed")
-            r, e = v.get("r_hat"), v.get("ess_bulk")
-            idf = ident.get(name)
+        for e in params:
+            idf = ident.get(e.name)
             if idf is None:
-                id_text = "noise" if v.get("kind") in ("sigma", "phi", "sigma_meas") else "—"
+                id_text = "noise" if e.kind in ("sigma", "phi", "sigma_meas") else "—"
             elif idf.get("identifiable"):
                 id_text = "yes"
             elif idf.get("identifiable_given_scale"):
                 id_text = "if scale pinned"
             else:
                 id_text = "no"
-            truth = v.get("truth")
-            inside = None
-            if truth is not None and v.get("q05") is not None:
-                inside = v["q05"] <= truth <= v["q95"]
+            fixed = e.fixed is not None
             rows.append(
                 {
-                    "name": name,
-                    "label": quantity_name(name, v.get("description"), domain=m),
-                    "unit": v.get("unit", ""),
-                    "prior": "fixed" if fixed is not None else prior_text(v.get("prior")),
-                    "map": fmt(v.get("map")),
-                    "median": fmt(v.get("median")),
-                    "interval": "—"
-                    if fixed is not None
-                    else fmt_interval(v.get("q05"), v.get("q95")),
-                    "at_bound": v.get("at_bound"),
-                    "truth": fmt(truth) if truth is not None else "—",
-                    "inside": inside,
-                    "contraction": "—"
-                    if v.get("contraction") is None
-                    else fmt_pct(v["contraction"]),
-                    "r_hat": "—" if r is None else f"{r:.3f}",
-                    "r_cls": "" if r is None else rhat_class(r, r_ok),
-                    "ess_bulk": fmt_int(e),
-                    "ess_tail": fmt_int(v.get("ess_tail")),
-                    "e_cls": "" if e is None else ess_class(e, e_ok),
-                    "tau": fmt_int(v.get("tau")),
+                    "name": e.name,
+                    "label": quantity_name(e.name, e.description, domain=m),
+                    "unit": e.unit,
+                    "prior": "fixed" if fixed else prior_text(e.prior),
+                    "map": fmt(e.map),
+                    "median": fmt(e.median),
+                    "interval": "—" if fixed else fmt_interval(e.q05, e.q95),
+                    "at_bound": e.at_bound,
+                    "truth": fmt(e.truth) if e.truth is not None else "—",
+                    "inside": e.truth_inside,
+                    "contraction": "—" if e.contraction is None else fmt_pct(e.contraction),
+                    "r_hat": "—" if e.r_hat is None else f"{e.r_hat:.3f}",
+                    "r_cls": "" if e.r_hat is None else rhat_class(e.r_hat, r_ok),
+                    "ess_bulk": fmt_int(e.ess_bulk),
+                    "ess_tail": fmt_int(e.ess_tail),
+                    "e_cls": "" if e.ess_bulk is None else ess_class(e.ess_bulk, e_ok),
+                    "tau": fmt_int(e.tau),
                     "ident": id_text,
-                    **mcse_cells(mc.get(f"{m}.{name}")),
+                    **mcse_cells(mc.get(e.key)),
                 }
             )
         mp = info.get("map") or {}

@@ -199,7 +199,7 @@ def test_comparison_json(compared):
     assert 1.0 <= p2["Gw"]["q05"] and p2["Gw"]["q95"] <= 1.0e4
     assert "Gw" not in res["models"]["thermal_1c"]["identifiability"]["parameters"]
     rec = res["recommendation"]
-    assert rec["model"] in MODELS and rec["reason"].startswith(rec["model"] + ":")
+    assert rec["model"] in MODELS and rec["reason"].startswith(f"`{rec['model']}`:")
     assert rec["best_accuracy"] in rec["equivalent"]
     assert (out / "comparison.html").is_file()
 

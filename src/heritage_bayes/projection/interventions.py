@@ -230,6 +230,14 @@ class Measure:
                 f"(air exchange), which none of the run's models {names} has"
             )
         heat = self.heating or self.thermostat
+        hyg = run.models.get("hygric")
+        if self.controlled and getattr(hyg, "time_varying", False):
+            raise ConfigError(
+                f"interventions: {self.name!r}: heating and dehumidifier controllers are "
+                f"stepped on a constant modal form, which the hygric model {hyg.name!r} "
+                "(coupled to the temperature) does not have; project this measure with a "
+                "run calibrated with hygric_2c, or keep to ventilation measures"
+            )
         for s, on in (("thermal", heat), ("hygric", self.dehumidifier or self.humidistat)):
             m = run.models[s]
             if (

@@ -44,10 +44,19 @@ def run_dir(tmp_path_factory):
 
 def test_projection_gives_rh_draws(run_dir, tmp_path):
     vent = {"name": "half the ventilation", "ventilation": {"factor": 0.5}}
-    p = project(run_dir, {**PROJ, "draws": DRAWS, "interventions": [vent]}, out=tmp_path / "p")
+    heat = {"name": "heat", "heating": {"t_set": 12}}
+    cfg = {**PROJ, "draws": DRAWS, "interventions": [vent, heat]}
+    p = project(run_dir, cfg, out=tmp_path / "p")
     ds = p.dataset
-    (res,) = p.interventions.values()
-    assert all(np.isfinite(r.RHi_month).all() for r in res)
+    for res in p.interventions.values():
+        assert all(np.isfinite(r.RHi_month).all() for r in res)
+    # heating to 12 °C: a warmer room in winter and, the buffer sorbing at that Ti, a
+    # lower RH than doing nothing; a heating energy for every draw
+    nothing, heated = p.results[0], p.interventions["heat"][0]
+    winter = np.isin(heated.months.month, [12, 1, 2])
+    assert heated.Ti_month[:, winter].mean() >= 11.5
+    assert heated.RHi_month[:, winter].mean() < nothing.RHi_month[:, winter].mean() - 5
+    assert np.isfinite(heated.costs["heating_energy"]).all()
     assert ds.sizes["draw"] == DRAWS
     rh = ds["RHi_monthly"].values
     assert np.isfinite(rh).all() and (rh > 5).all() and (rh <= 100).all()
@@ -132,3 +141,14 @@ def test_controlled_measure_is_refused_with_its_name(run_dir, tmp_path):
     cfg = {**PROJ, "draws": 4, "interventions": [dry]}
     with pytest.raises(ConfigError, match=r"'dry'.*hygric_2c_sorption"):
         project(run_dir, cfg, out=tmp_path / "p")
+
+
+def test_sink_at_the_ground_temperature_projects(tmp_path):
+    """A sorbing buffer and a vapour sink at the ground temperature: the sink's ``Tf``
+    is the thermal side's ground temperature projection, ``Ti`` each draw's own."""
+    out = tmp_path / "run"
+    raw = _raw({"model": "hygric_2c_sorption", "options": {"sink": "temperature"}})
+    run_calibration(parse_config(raw), out_dir=out, report=False, quiet=True)
+    p = project(out, {**PROJ, "draws": 4}, out=tmp_path / "p")
+    rh = p.dataset["RHi_monthly"].values
+    assert np.isfinite(rh).all() and (rh <= 100).all()

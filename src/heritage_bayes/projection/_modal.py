@@ -148,23 +148,31 @@ def case_inputs(run, inp) -> dict:
 def coupled_pair(run, P: dict, c, rows, dt: float, w: int) -> dict:
     """Noise-free ``Ti``, ``Pi`` (section -> (k, N)) of draws ``rows`` when the hygric
     model sorbs at the indoor temperature: the thermal model first (all draws at once),
-    then the hygric model of each draw on its own simulated ``Ti``, each from the steady
-    state of the mean of its first ``w`` rows (as the free-running pass). Empty when the
-    hygric model takes no simulated column."""
+    then the hygric model of each draw on its own simulated ``Ti``
+    (:func:`hygric_on`), each from the steady state of the mean of its first ``w``
+    rows (as the free-running pass). Empty when the hygric model takes no simulated
+    column."""
     from heritage_bayes.projection.weather import coupled_columns
 
     if "hygric" not in run.models or not coupled_columns(run, "hygric"):
         return {}
-    mT, mH = run.models["thermal"], run.models["hygric"]
+    mT = run.models["thermal"]
     U = c.U["thermal"]
     T = mT.forward(P["thermal"][rows], U, dt, u_init=U[: max(1, w)].mean(axis=0))[0]
     T = np.ascontiguousarray(T[..., list(mT.output_names).index("Ti")])
-    UH = c.U["hygric"].copy()
-    ti = list(mH.input_names).index("Ti")
-    PH = P["hygric"][rows]
+    return {"thermal": T, "hygric": hygric_on(run, P["hygric"][rows], c.U["hygric"], T, dt, w)}
+
+
+def hygric_on(run, P: np.ndarray, U: np.ndarray, T: np.ndarray, dt: float, w: int):
+    """Noise-free ``Pi`` (k, N) [Pa] of the hygric draws ``P`` (k, p), draw ``j`` with
+    its input ``Ti`` set to ``T[j]`` [°C] (a simulated indoor temperature), from the
+    steady state of the mean of its first ``w`` rows."""
+    m = run.models["hygric"]
+    UH = np.array(U, dtype=float)
+    ti = list(m.input_names).index("Ti")
     H = np.empty_like(T)
     for j in range(T.shape[0]):
         UH[:, ti] = T[j]
         u0 = UH[: max(1, w)].mean(axis=0)
-        H[j] = mH.forward(PH[j : j + 1], UH, dt, u_init=u0)[0][0, :, 0]
-    return {"thermal": T, "hygric": H}
+        H[j] = m.forward(P[j : j + 1], UH, dt, u_init=u0)[0][0, :, 0]
+    return H

@@ -353,7 +353,7 @@ def _simulate(
                 ahead = pool.submit(draw_noise, i + 1)
             for v, Pv, outs, sv in zip(variants, params, out, sigs, strict=True):
                 t0 = time.perf_counter()
-                ctl = v is not None and v.controlled
+                ctl = v is not None and v.controlled and v.stepped_together(run)
                 free = {"free": True} if ctl and compiled else {}  # the measure's networks
                 modal = {s: _modal_form(m, Pv[s][sl], dt, **free) for s, m in run.models.items()}
                 ctrl = None

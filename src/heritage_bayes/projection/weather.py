@@ -270,7 +270,7 @@ def coupled_columns(run, section: str, where: str = "projection") -> tuple[str, 
         Such a hygric model in a run without a thermal model: nothing can give the
         future indoor temperature.
     """
-    m = run.models[section]
+    m = run.models.get(section)
     if section != "hygric" or not getattr(m, "time_varying", False) or "Ti" not in m.input_names:
         return ()
     if "Ti" not in getattr(run.models.get("thermal"), "output_names", ()):

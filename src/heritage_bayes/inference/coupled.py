@@ -31,13 +31,11 @@ __all__ = ["coupled_filter_stats"]
 _LOG2PI = math.log(2.0 * math.pi)
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
-def _coupled_kf(
-    kp, pe, dpe, rs, ps, slope, dt, x0, yobs, sigma, phi, w, nb, acc
-):  # pragma: no cover - compiled
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath={"contract"})
+def _coupled_kf(kp, sb, slope, dt, x0, yobs, sigma, phi, w, nb, acc):  # pragma: no cover
     """Recursion + residual filter + initial-state statistics of every walker.
 
-    kp (K, 7) kernel parameters; pe, dpe, rs, ps, slope: the step series of
+    kp (K, 7) kernel parameters; sb, slope: the step series of
     :meth:`~heritage_bayes.rc.sorption.CoupledHygricModel.series`; x0 (K, 2) initial
     states [Pa]; yobs (N,) observed ``Pi`` (NaN = excluded); sigma, phi, w (K,) noise
     parameters; nb: 2 (basis of both nodes) or 0; acc (3 + nb + nb², K), zeros, as
@@ -45,7 +43,7 @@ def _coupled_kf(
     triangle of H), in physical coordinates.
     """
     K = kp.shape[0]
-    N = pe.size
+    N = sb.shape[1]
     Mf = np.empty((6, BLOCK))
     for p in range(K):
         s2 = sigma[p] * sigma[p]
@@ -74,7 +72,7 @@ def _coupled_kf(
         alive = nb > 0
         for k0 in range(0, N, BLOCK):
             B = min(BLOCK, N - k0)
-            coupled_block(kp[p], pe, dpe, rs, ps, dt, slope, k0, B, Mf)
+            coupled_block(kp[p], sb, dt, slope, k0, B, Mf)
             # a free response that has decayed below 1e-280 Pa adds nothing: stop it
             # (else it sticks at the smallest subnormal, 20x slower arithmetic)
             if alive and max(abs(uw), abs(ui), abs(vw), abs(vi), abs(mu), abs(mv)) < 1e-280:

@@ -127,3 +127,52 @@ def _controlled(run, P, c: _Case, o: _CaseOut | None, rows, dt, w, measure) -> d
     if o is not None:
         o.cost[rows] = measure.cost_sums(costs, dt, c.N / _HOURS_YEAR)
     return Y
+
+
+def case_inputs(run, inp) -> dict:
+    """Section -> (hours, inputs) array of the run's models on one case's weather, the
+    columns taken from another model's simulation
+    (:func:`~heritage_bayes.projection.weather.coupled_columns`) NaN until
+    :func:`coupled_pair` fills them draw by draw."""
+    from heritage_bayes.projection.weather import coupled_columns
+
+    out = {}
+    for s, m in run.models.items():
+        sim = set(coupled_columns(run, s)) - set(inp.columns)
+        cols = [np.full(len(inp), np.nan) if c in sim else inp[c].to_numpy(dtype=float)
+                for c in m.input_names]  # fmt: skip
+        out[s] = np.ascontiguousarray(np.column_stack(cols))
+    return out
+
+
+def coupled_pair(run, P: dict, c, rows, dt: float, w: int) -> dict:
+    """Noise-free ``Ti``, ``Pi`` (section -> (k, N)) of draws ``rows`` when the hygric
+    model sorbs at the indoor temperature: the thermal model first (all draws at once),
+    then the hygric model of each draw on its own simulated ``Ti``
+    (:func:`hygric_on`), each from the steady state of the mean of its first ``w``
+    rows (as the free-running pass). Empty when the hygric model takes no simulated
+    column."""
+    from heritage_bayes.projection.weather import coupled_columns
+
+    if "hygric" not in run.models or not coupled_columns(run, "hygric"):
+        return {}
+    mT = run.models["thermal"]
+    U = c.U["thermal"]
+    T = mT.forward(P["thermal"][rows], U, dt, u_init=U[: max(1, w)].mean(axis=0))[0]
+    T = np.ascontiguousarray(T[..., list(mT.output_names).index("Ti")])
+    return {"thermal": T, "hygric": hygric_on(run, P["hygric"][rows], c.U["hygric"], T, dt, w)}
+
+
+def hygric_on(run, P: np.ndarray, U: np.ndarray, T: np.ndarray, dt: float, w: int):
+    """Noise-free ``Pi`` (k, N) [Pa] of the hygric draws ``P`` (k, p), draw ``j`` with
+    its input ``Ti`` set to ``T[j]`` [°C] (a simulated indoor temperature), from the
+    steady state of the mean of its first ``w`` rows."""
+    m = run.models["hygric"]
+    UH = np.array(U, dtype=float)
+    ti = list(m.input_names).index("Ti")
+    H = np.empty_like(T)
+    for j in range(T.shape[0]):
+        UH[:, ti] = T[j]
+        u0 = UH[: max(1, w)].mean(axis=0)
+        H[j] = m.forward(P[j : j + 1], UH, dt, u_init=u0)[0][0, :, 0]
+    return H

@@ -43,6 +43,8 @@ from heritage_bayes.projection._modal import (
     _modal_form,
     _noise,
     _work,
+    case_inputs,
+    coupled_pair,
 )
 from heritage_bayes.rc.control import N_COST, N_CP
 
@@ -311,10 +313,7 @@ def _simulate(
     cases = []
     for inp in inputs:
         inp = inp.iloc[: complete_year_hours(len(inp))]  # the indicators' complete years
-        U = {
-            s: np.ascontiguousarray(inp[list(m.input_names)].to_numpy(dtype=float))
-            for s, m in run.models.items()
-        }
+        U = case_inputs(run, inp)  # a column simulated by another model: NaN here
         starts, months = _month_starts(inp.index)
         plan = fused_plan(len(inp), func="assess_batch", **plan_opts)  # checks options
         Ut = {s: np.ascontiguousarray(u.T) for s, u in U.items()}
@@ -354,7 +353,7 @@ def _simulate(
                 ahead = pool.submit(draw_noise, i + 1)
             for v, Pv, outs, sv in zip(variants, params, out, sigs, strict=True):
                 t0 = time.perf_counter()
-                ctl = v is not None and v.controlled
+                ctl = v is not None and v.controlled and v.stepped_together(run)
                 free = {"free": True} if ctl and compiled else {}  # the measure's networks
                 modal = {s: _modal_form(m, Pv[s][sl], dt, **free) for s, m in run.models.items()}
                 ctrl = None
@@ -504,6 +503,7 @@ def _run_chunk(
     Y, M, U = {}, {}, {}
     if ctrl is None and measure is not None and measure.controlled:  # the reference
         Y = _controlled(run, P, c, o, sl, dt, w, measure)
+    Y = Y or coupled_pair(run, P, c, sl, dt, w)  # hygric sorbing at the simulated Ti
     for s, m in run.models.items():
         u0 = c.U[s][: max(1, w)].mean(axis=0)  # steady state of the first window
         if s in Y:
@@ -556,6 +556,7 @@ def _recompute(
     ys = {} if ctrl is None else _coupled_series(c, modal, ctrl, sig, bad, w)
     if ctrl is None and measure is not None and measure.controlled:
         ys = _controlled(run, P, c, None, rows, dt, w, measure)
+    ys = ys or coupled_pair(run, P, c, rows, dt, w)
     for s, m in run.models.items():
         u0 = c.U[s][: max(1, w)].mean(axis=0)
         if s not in ys:

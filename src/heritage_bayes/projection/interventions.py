@@ -132,6 +132,13 @@ class Measure:
             for x in (self.heating, self.dehumidifier, self.thermostat, self.humidistat)
         )
 
+    def stepped_together(self, run) -> bool:
+        """Both models stepped together with the controllers in the compiled pass; False
+        for a hygric model coupled to the temperature (time-varying): a thermostat's
+        room is then simulated first and the hygric model on its ``Ti``
+        (:meth:`simulate`)."""
+        return not getattr(run.models.get("hygric"), "time_varying", False)
+
     def controller_arrays(self, k: int, modal: dict, run, P: dict) -> tuple:
         """The compiled pass's controllers for ``k`` draws: ``(cp (k, N_CP), bdT (k, nT),
         bdP (k, nP), spin, sources)`` (:func:`heritage_bayes.rc.control.coupled_draw`;
@@ -230,6 +237,18 @@ class Measure:
                 f"(air exchange), which none of the run's models {names} has"
             )
         heat = self.heating or self.thermostat
+        hyg = run.models.get("hygric")
+        if not self.stepped_together(run) and (
+            self.heating or self.dehumidifier or self.humidistat
+        ):
+            raise ConfigError(
+                f"interventions: {self.name!r}: conservation heating and (de)humidifiers "
+                "read the other model's air and are stepped together with it on a "
+                f"constant modal form, which the hygric model {hyg.name!r} (coupled to "
+                "the temperature) does not have; project this measure with a run "
+                "calibrated with hygric_2c, or keep to heating to a set-point and "
+                "ventilation measures"
+            )
         for s, on in (("thermal", heat), ("hygric", self.dehumidifier or self.humidistat)):
             m = run.models[s]
             if (
@@ -280,7 +299,9 @@ class Measure:
     def simulate(self, run, model: dict, U: dict, u0: dict, dt: float, index=None):
         """Noise-free outputs of a chunk of draws with the controllers, through
         ``ControlledModel.forward`` (the reference implementation: each controller
-        against the other model's free-running series, no humidistat band).
+        against the other model's free-running series, no humidistat band). A hygric
+        model coupled to the temperature is simulated last, each draw on its own
+        controlled ``Ti`` (from the steady state of the run's initial window).
 
         Parameters
         ----------
@@ -303,6 +324,8 @@ class Measure:
         costs : dict
             :data:`COSTS` name -> (k,) values of the measure's controllers.
         """
+        from heritage_bayes.projection._modal import hygric_on
+        from heritage_bayes.projection.weather import coupled_columns
         from heritage_bayes.rc.control import Control, ControlledModel
 
         if self.humidistat is not None or any(
@@ -313,9 +336,11 @@ class Measure:
                 "(hysteresis) and takes free-running networks only; it is simulated by "
                 "the compiled pass"
             )
+        sim = coupled_columns(run, "hygric")  # a hygric model on the simulated Ti: last
         Y = {
             s: np.ascontiguousarray(m.forward(model[s], U[s], dt, u_init=u0[s])[0][..., 0])
             for s, m in run.models.items()
+            if not (s == "hygric" and sim)
         }
         k, N = Y["thermal"].shape
         years = N / _HOURS_YEAR
@@ -337,6 +362,9 @@ class Measure:
             Y["thermal"], Q = self._thermostat(run, model["thermal"], U["thermal"],
                                                u0["thermal"], dt, spin, index)  # fmt: skip
             costs.update(_heating_costs(Q, dt, years))
+        if sim:
+            w = int(run.summary.get("init_steps", 720))
+            Y["hygric"] = hygric_on(run, model["hygric"], U["hygric"], Y["thermal"], dt, w)
         if self.dehumidifier is not None:
             rh, cap, e_kg = self.dehumidifier
             m = run.models["hygric"]

@@ -488,6 +488,20 @@ _HUMIDITY_WORDS = {
 }
 
 
+def _models_text(run) -> str:
+    """`` (models a, b ...)`` of the run, and what a hygric model sorbing at the indoor
+    temperature is driven by in a projection."""
+    models = getattr(run, "models", None) or {}
+    if not models:
+        return ""
+    text = " (models " + ", ".join(f"<code>{escape(m.name)}</code>" for m in models.values())
+    from heritage_bayes.projection.weather import coupled_columns
+
+    if "hygric" in models and "thermal" in models and coupled_columns(run, "hygric"):
+        text += "; the hygric buffer sorbs at each draw's simulated indoor temperature"
+    return text + ")"
+
+
 def render_projection_page(proj, run) -> str:
     """The HTML page of a projection (see the module docstring)."""
     from heritage_bayes._version import __version__
@@ -502,7 +516,8 @@ def render_projection_page(proj, run) -> str:
         + _banner(proj)
         + _verdict_html(proj)
         + "<div class='note info'><p>"
-        + f"{s['draws']} posterior draws of the calibrated room, each simulated on the "
+        + f"{s['draws']} posterior draws of the calibrated room{_models_text(run)}, each "
+        + "simulated on the "
         + f"baseline and on {len(proj.labels) - 1} future weather(s)"
         + (
             f", with a draw of its noise model ({prose_html(noise_text)})"

@@ -217,7 +217,7 @@ def model_inputs(run, pcfg, weather: pd.DataFrame, site: dict | None, where: str
     except (DataError, InputError) as exc:
         raise DataError(f"{where}: putting the weather on the run's grid: {exc}") from None
     frame = aligned.frame.copy()
-    if thermal:
+    if thermal or any("Tf" in m.input_names for m in run.models.values()):
         gt = pcfg.ground_temperature or data.ground_temperature
         if gt.mode == "constant":
             frame["Tf"] = float(gt.value)
@@ -240,7 +240,8 @@ def model_inputs(run, pcfg, weather: pd.DataFrame, site: dict | None, where: str
     # first-order hold (readings at an instant), zeros for interval means
     add_slope_columns(frame, run.models.values(), aligned.slopes)
     for section, model in run.models.items():
-        missing = [c for c in model.input_names if c not in frame.columns]
+        simulated = coupled_columns(run, section, where)  # another model's output
+        missing = [c for c in model.input_names if c not in frame.columns and c not in simulated]
         if missing:
             raise DataError(
                 f"{where}: the {section} model needs {missing}, which this weather does "
@@ -256,3 +257,28 @@ def model_inputs(run, pcfg, weather: pd.DataFrame, site: dict | None, where: str
     out = frame.iloc[:n].copy()
     out.attrs["hours_dropped"] = len(frame) - n
     return out
+
+
+def coupled_columns(run, section: str, where: str = "projection") -> tuple[str, ...]:
+    """Input columns of ``section``'s model that a projection takes from another model's
+    simulation of the same draw: ``Ti`` of a hygric model whose buffer sorbs at the
+    indoor temperature (the thermal model's noise-free ``Ti``).
+
+    Raises
+    ------
+    DataError
+        Such a hygric model in a run without a thermal model: nothing can give the
+        future indoor temperature.
+    """
+    m = run.models.get(section)
+    if section != "hygric" or not getattr(m, "time_varying", False) or "Ti" not in m.input_names:
+        return ()
+    if "Ti" not in getattr(run.models.get("thermal"), "output_names", ()):
+        raise DataError(
+            f"{where}: the hygric model {m.name!r} couples its buffer to the indoor "
+            "temperature Ti, which was measured in the calibration but has no future: the "
+            f"run {run.path} has no thermal model to simulate it. Calibrate the room with "
+            "a thermal model too (a 'thermal:' section beside 'hygric:'), or project a "
+            "hygric model that does not take Ti (e.g. hygric_2c)"
+        )
+    return ("Ti",)

@@ -34,8 +34,9 @@ convention for instantaneous readings). With :math:`r` held at the step's mean
 two-node network with capacities :math:`(C_w/\\bar r_k, C_i)` and the symmetric
 conductance matrix :math:`\\mathbf G`, whose zero-order hold is the modal solution of
 :mod:`heritage_bayes.rc.discretize`. Per step, the 2×2 symmetric
-:math:`S = C^{-1/2}\\mathbf G C^{-1/2}` is diagonalised in closed form (one Jacobi
-rotation, :math:`S = V\\Lambda V^T`), and
+:math:`S = C^{-1/2}\\mathbf G C^{-1/2}` is diagonalised in closed form (a plane
+rotation, :math:`S = V\\Lambda V^T`; the smaller eigenvalue as the determinant over the
+larger, so that a stiff pair loses no digits), and
 
 .. math::
 
@@ -58,7 +59,10 @@ constant over the step; otherwise the error is of second order in the step's cha
 materials"). ``Tf`` (a sink's temperature, slow) is held over the step at its row's
 value. The output is linear in the initial state given the temperatures (the
 transitions do not depend on it), so the initial state is integrated out as for the
-linear models. Compiled (numba), batched over parameter sets.
+linear models. Compiled (numba), batched over parameter sets: ``p_sat`` of the
+temperatures is evaluated once per reading (once per data set in the likelihood), the
+transitions of a block of steps in one vectorised loop (two divisions, a square root
+and two exponentials per step), then the recursion.
 
 With :math:`r \\equiv 1` (``Tw`` constant at :math:`T_{ref}`) the model is exactly the
 linear two-node network (hygric model 3 of Kramer et al. [1]_ without its buffer's link
@@ -93,6 +97,7 @@ __all__ = [
     "CoupledHygricModel",
     "coupled_block",
     "coupled_network",
+    "fill_series",
 ]
 
 #: Reference temperature [°C] at which the buffer's state is expressed in [Pa].
@@ -290,42 +295,33 @@ class CoupledHygricModel(RCModel):
         out[~self.valid_mask(P)] = _PLACEHOLDER
         return out
 
-    def series(self, U: np.ndarray) -> tuple:
-        """Per-step series of the compiled step from the input columns ``U`` (N, m).
-
-        ``pe`` [Pa]; ``dpe`` its change over the step [Pa] (the ``Pe_slope`` column;
-        without one, ``pe``, unused); ``rs`` (4, N): the step mean of
-        ``r = p_sat(Ti)/p_sat(T_ref)`` [-] (linear between the readings), its square
-        root, the inverse of that and r's change over the step (ones and zero without
-        sorption, :func:`temperature_ratio`); ``ps``: the
-        sink's ``p_sat(Tf)`` [Pa] (``[1.0]`` without a sink at a temperature);
-        ``slope``: whether there is a ``Pe_slope`` column."""
-        U = np.asarray(U, dtype=float)
+    def input_columns(self) -> np.ndarray:
+        """Column indices of ``Pe``, ``Pe_slope``, ``Ti`` and ``Tf`` in the inputs (-1:
+        absent), as :func:`fill_series` reads them."""
         names = self.input_names
-        N = U.shape[0]
-        pe = np.ascontiguousarray(U[:, 0])
-        slope = "Pe" + SLOPE_SUFFIX in names
-        dpe = np.ascontiguousarray(U[:, names.index("Pe" + SLOPE_SUFFIX)]) if slope else pe
-        if self.sorption:
-            ratio = np.empty((4, N))
-            temperature_ratio(np.ascontiguousarray(U[:, names.index("Ti")]), ratio)
-        else:
-            ratio = np.ones((4, N))
-            ratio[3] = 0.0
-        if self.sink == "temperature":
-            ps = np.empty(N)
-            saturation_series(np.ascontiguousarray(U[:, names.index("Tf")]), ps)
-        else:
-            ps = np.ones(1)
-        return pe, dpe, ratio, ps, slope
+        cols = ("Pe", "Pe" + SLOPE_SUFFIX, "Ti", "Tf")
+        return np.array([names.index(c) if c in names else -1 for c in cols], dtype=np.int64)
+
+    def series(self, U: np.ndarray) -> tuple:
+        """Per-step series of the compiled step from the input columns ``U`` (N, m):
+        ``(sb, slope)``, ``sb`` (7, N) the rows of :func:`fill_series` (``Pe``, its
+        change over the step, the step mean of ``r = p_sat(Ti)/p_sat(T_ref)`` [-], its
+        square root and the inverse of that, r's change over the step, the sink's
+        ``p_sat(Tf)`` [Pa] or 1), ``slope``: whether there is a ``Pe_slope`` column.
+        Computed once per data set (the temperatures are data)."""
+        U = np.ascontiguousarray(U, dtype=float)
+        cols = self.input_columns()
+        sb = np.empty((N_SERIES, U.shape[0]))
+        fill_series(U, cols, 0, U.shape[0], sb)
+        return sb, bool(cols[1] >= 0)
 
     def steady_state(self, P: np.ndarray, u0: np.ndarray) -> np.ndarray:
         """(K, 2) steady state (Pw, Pi) [Pa] of constant inputs ``u0`` (m,) (the
         temperatures included): the solution of G y = β in the variables
         (v = r Pw, Pi), then Pw = v / r."""
         kp = self.kernel_parameters(P)
-        pe, _, rs, ps, _ = self.series(np.atleast_2d(u0))
-        pe, r, ps = pe[0], rs[0, 0], ps[0]  # ps: p_sat(Tf) or 1
+        sb, _ = self.series(np.atleast_2d(u0))
+        pe, r, ps = sb[0, 0], sb[2, 0], sb[6, 0]  # ps: p_sat(Tf) or 1
         _, _, gw, gi, gfast, gf, sink = kp.T
         b1, b2 = gw * pe, gfast * pe + gf * sink * ps
         a11, a22 = gw + gi, gi + gfast + gf
@@ -353,79 +349,144 @@ class CoupledHygricModel(RCModel):
             x = np.broadcast_to(np.asarray(x0, dtype=float), (K, 2))
         x = np.ascontiguousarray(np.where(np.isfinite(x), x, 0.0))
         out = np.empty((K, U.shape[0], 1))
-        _simulate(kp, *self.series(U), float(dt), x, out[:, :, 0])
+        cols = self.input_columns()
+        _simulate(kp, U, cols, bool(cols[1] >= 0), float(dt), x, out[:, :, 0])
         valid &= np.isfinite(out[:, -1, 0]) if U.shape[0] else valid
         return out, valid
 
 
 #: Kernel parameters of an invalid walker (a harmless stable network).
 _PLACEHOLDER = np.array([1e-3, 1e-3, 0.0, 1e-8, 1e-8, 0.0, 0.0])
+#: Rows of the step series (:func:`fill_series`).
+N_SERIES = 7
+_IREF = 1.0 / P_REF
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath={"contract"})
+def fill_series(U, cols, k0, B, sb):  # pragma: no cover - compiled
+    """Step series of rows ``k0 .. k0 + B - 1`` of the inputs ``U`` (N, m) into
+    ``sb[:, :B]`` (7, >= B): ``Pe`` [Pa]; its change over the step (the ``Pe_slope``
+    column, 0 without one); from the readings ``T`` = ``Ti`` [°C] at the step
+    boundaries, ``ρ = p_sat(T)/p_sat(T_ref)`` linear between them: its step mean
+    ``r = (ρ[k] + ρ[k+1])/2`` [-], ``sqrt(r)``, ``1/sqrt(r)`` and the change
+    ``ρ[k+1] - ρ[k]`` (zero on the last row, whose next reading is unknown; 1, 1, 1, 0
+    without ``Ti``); the sink's ``p_sat(Tf)`` [Pa] (1 without ``Tf``). ``cols``: the
+    columns of ``Pe``, ``Pe_slope``, ``Ti``, ``Tf`` (-1: absent). The columns are
+    copied first, so that each loop vectorises; ``p_sat`` is evaluated once per
+    reading."""
+    N = U.shape[0]
+    ipe, idpe, iti, itf = cols[0], cols[1], cols[2], cols[3]
+    for b in range(B):
+        sb[0, b] = U[k0 + b, ipe]
+    if idpe >= 0:
+        for b in range(B):
+            sb[1, b] = U[k0 + b, idpe]
+    else:
+        sb[1, :B] = 0.0
+    if itf >= 0:
+        for b in range(B):
+            sb[6, b] = U[k0 + b, itf]
+        for b in range(B):
+            sb[6, b] = psat_water(sb[6, b])
+    else:
+        sb[6, :B] = 1.0
+    if iti < 0:
+        sb[2:5, :B] = 1.0
+        sb[5, :B] = 0.0
+        return
+    rho = np.empty(B + 1)
+    for b in range(B + 1):
+        rho[b] = U[min(k0 + b, N - 1), iti]
+    for b in range(B + 1):
+        rho[b] = psat_water(rho[b]) * _IREF
+    for b in range(B):
+        v = 0.5 * (rho[b] + rho[b + 1])
+        q = math.sqrt(v)
+        sb[2, b] = v
+        sb[3, b] = q
+        sb[4, b] = 1.0 / q
+        sb[5, b] = rho[b + 1] - rho[b]
 
 
 @numba.njit(inline="always", cache=True, nogil=True, error_model="numpy")
-def _gains(lam, dt, slope):  # pragma: no cover - compiled
+def _gains(lam, il, dt, idt, slope):  # pragma: no cover - compiled
     """Pole ``a = exp(-lam dt)``, ZOH gain ``(1 - a)/lam`` [s] and with ``slope`` the
     FOH slope gain ``(w+ - w-)/2`` [s] (:func:`heritage_bayes.rc.discretize.foh_weights`,
-    else 0) of a mode with decay rate ``lam`` [1/s]; series below ``lam dt = 1e-2`` (no
-    cancellation: relative error below 1e-12). Branch-free in the step, so that a loop
-    over steps vectorises."""
+    else 0) of a mode with decay rate ``lam`` [1/s] and its inverse ``il`` [s]; series
+    below ``lam dt = 1e-2`` (no cancellation: relative error below 1e-12). Branch-free
+    and without a division (the other side of a selection may be inf or NaN, unused),
+    so that a loop over steps vectorises."""
     x = lam * dt
     a = vexp(-x)
-    xs = min(x, 1e-2)
-    xl = max(x, 1e-2)
-    ixl = 1.0 / xl
-    ps = 1.0 + xs * (-0.5 + xs * (1 / 6 + xs * (-1 / 24 + xs * (1 / 120 - xs / 720))))
-    p = dt * (ps if x < 1e-2 else (1.0 - a) * ixl)
+    small = x < 1e-2
+    p = dt * (1.0 + x * (-0.5 + x * (1 / 6 + x * (-1 / 24 + x * (1 / 120 - x * (1 / 720))))))
+    p = p if small else (1.0 - a) * il
     g = 0.0
     if slope:
-        ws = 0.5 + xs * (-1 / 3 + xs * (1 / 8 + xs * (-1 / 30 + xs * (1 / 144 - xs / 840))))
-        wl = (1.0 - a * (1.0 + xl)) * ixl * ixl
-        g = 0.5 * p - dt * (ws if x < 1e-2 else wl)
+        ws = 0.5 + x * (-1 / 3 + x * (1 / 8 + x * (-1 / 30 + x * (1 / 144 - x * (1 / 840)))))
+        ix = il * idt
+        wl = (1.0 - a * (1.0 + x)) * ix * ix
+        g = 0.5 * p - dt * (ws if small else wl)
     return a, p, g
 
 
 @numba.njit(inline="always", cache=True, nogil=True, error_model="numpy")
-def walker_constants(kp, each, ps0):  # pragma: no cover - compiled
+def walker_constants(kp):  # pragma: no cover - compiled
     """The per-parameter-set constants of :func:`step_coefficients` (a tuple) from one
-    row ``kp`` of :meth:`CoupledHygricModel.kernel_parameters`; ``each``: the sink's
-    ``p_sat(Tf)`` is a series, else the constant ``ps0`` (1 for a constant node)."""
+    row ``kp`` of :meth:`CoupledHygricModel.kernel_parameters`: with the capacities'
+    scalings ``iw = Cw^-1/2``, ``s2 = Ci^-1/2``, the symmetric
+    ``S = [[A11 r, -A12 sqrt(r)], [-A12 sqrt(r), S22]]`` and its determinant ``r D``
+    (``D`` from the conductances, without cancellation)."""
     cw, ci, gw, gi, gfast, gf, sink = kp[0], kp[1], kp[2], kp[3], kp[4], kp[5], kp[6]
     iw = 1.0 / math.sqrt(cw)
     s2 = 1.0 / math.sqrt(ci)
     S22 = (gi + gfast + gf) * s2 * s2
-    A11 = (gw + gi) * iw * iw  # S11 = A11 r
-    A12 = gi * iw * s2  # S12 = -A12 sqrt(r)
-    iA12 = 0.5 / A12 if A12 > 0.0 else 1e300  # zeta huge or 0: t = 0 or 1, same M
-    # the sink's flow gf·sink·ps[k]: a series, or a constant (a series read with weight
-    # 0 in the constant case keeps the step branch-free)
-    gfs = gf * sink if each else 0.0
-    const = 0.0 if each else gf * sink * ps0
-    return (iw, s2, S22, A11, A12, iA12, gw, gi, gfast, gfs, const)
+    A11 = (gw + gi) * iw * iw
+    A12 = gi * iw * s2
+    D = (gw * (gi + gfast + gf) + gi * (gfast + gf)) * (iw * iw) * (s2 * s2)
+    iD = 1.0 / D if D > 0.0 else math.inf
+    return (iw, s2, S22, A11, A12, D, iD, iw / s2, s2 / iw, gw, gi, gfast, gf * sink)
 
 
 @numba.njit(inline="always", cache=True, nogil=True, error_model="numpy")
-def step_coefficients(c, r, sr, isr, dr, pe, dpe, xs, dt, slope):  # pragma: no cover
+def step_coefficients(c, r, sr, isr, dr, pe, dpe, xs, dt, idt, slope):  # pragma: no cover
     """Transition ``(M0, M1, M2, M3)`` and forcing ``(f0, f1)`` of one step:
     ``(Pw, Pi)[k+1] = [[M0, M1], [M2, M3]] (Pw, Pi)[k] + (f0, f1)`` (module docstring).
     ``c``: :func:`walker_constants`; ``r``, ``sr``, ``isr``, ``dr``: the step mean of
     ``r = p_sat(Tw)/p_sat(T_ref)``, its square root, the inverse of that and r's change
     over the step; ``pe``, ``dpe`` the vapour pressure's mean and change (the latter
-    used with ``slope``); ``xs`` the sink's ``p_sat(Tf)``. Branch-free."""
-    iw, s2, S22, A11, A12, iA12, gw, gi, gfast, gfs, const = c
+    used with ``slope``); ``xs`` the sink's ``p_sat(Tf)`` (1 for a constant node);
+    ``idt = 1/dt``. Branch-free, two divisions and one square root.
+
+    The eigen-decomposition of the 2×2 symmetric ``S`` in closed form: with
+    ``δ = (S11 - S22)/2``, ``b = -S12 >= 0``, ``h = sqrt(δ² + b²)``, the eigenvalue
+    that continues ``S11`` is ``l1 = (S11 + S22)/2 + sign(δ) h``, and
+    ``V = [[c, s], [-s, c]]`` with ``c² = (1 + |δ|/h)/2``, ``s² = 1 - c²``,
+    ``cs = sign(δ) b/(2h)``; the smaller eigenvalue is the determinant over the larger
+    (no cancellation), and ``1/l`` of each follows from ``1/det``."""
+    iw, s2, S22, A11, A12, D, iD, w_s, s_w, gw, gi, gfast, gfs = c
     S11 = A11 * r
-    S12 = -A12 * sr
-    # one Jacobi rotation: V = [[c, s], [-s, c]], columns the eigenvectors of S (l1, l2);
-    # an uncoupled buffer (S12 = 0, zeta infinite) gives t = 0
-    zeta = (S11 - S22) * iA12 * isr
-    t = 1.0 / (abs(zeta) + math.sqrt(1.0 + zeta * zeta))
-    t = t if zeta >= 0.0 else -t
-    l1 = S11 - t * S12
-    l2 = S22 + t * S12
-    a1, p1, g1 = _gains(l1, dt, True)
-    a2, p2, g2 = _gains(l2, dt, True)
-    # cos² = 1/(1 + t²), t = sin/cos: only the products of cos and sin enter
-    cc = 1.0 / (1.0 + t * t)
-    ss, cs = t * t * cc, t * cc
+    b = A12 * sr
+    dl = 0.5 * (S11 - S22)
+    h = math.sqrt(dl * dl + b * b)
+    ih = 1.0 / max(h, 1e-300)  # h = 0: S a multiple of I, any rotation (cs = 0)
+    q = abs(dl) * ih
+    cc = 0.5 + 0.5 * q
+    ss = 0.5 - 0.5 * q
+    cs = 0.5 * b * ih
+    cs = cs if dl >= 0.0 else -cs
+    lb = 0.5 * (S11 + S22) + h
+    ilb = 1.0 / lb
+    ir = isr * isr
+    ls = r * D * ilb
+    ils = lb * ir * iD
+    up = dl >= 0.0
+    l1 = lb if up else ls
+    l2 = ls if up else lb
+    il1 = ilb if up else ils
+    il2 = ils if up else ilb
+    a1, p1, g1 = _gains(l1, il1, dt, idt, True)
+    a2, p2, g2 = _gains(l2, il2, dt, idt, True)
     h11 = cc * g1 + ss * g2
     h22 = ss * g1 + cc * g2
     h12 = cs * (g2 - g1)
@@ -436,11 +497,11 @@ def step_coefficients(c, r, sr, isr, dr, pe, dpe, xs, dt, slope):  # pragma: no 
     gdr = gi * dr
     m12 = cs * (a2 - a1)
     M0 = cc * a1 + ss * a2 + iw * isr * (h12 * s2 - h11 * s1) * gdr
-    M1 = m12 * (iw / s2) * isr
-    M2 = m12 * (s2 / iw) * sr + s2 * (h22 * s2 - h12 * s1) * gdr
+    M1 = m12 * w_s * isr
+    M2 = m12 * s_w * sr + s2 * (h22 * s2 - h12 * s1) * gdr
     M3 = ss * a1 + cc * a2
     b1 = s1 * gw * pe
-    b2 = s2 * (gfast * pe + gfs * xs + const)
+    b2 = s2 * (gfast * pe + gfs * xs)
     k12 = cs * (p2 - p1)
     f1 = (cc * p1 + ss * p2) * b1 + k12 * b2
     f2 = k12 * b1 + (ss * p1 + cc * p2) * b2
@@ -452,24 +513,22 @@ def step_coefficients(c, r, sr, isr, dr, pe, dpe, xs, dt, slope):  # pragma: no 
     return M0, M1, M2, M3, iw * isr * f1, s2 * f2  # f0 = s1 f1 / r
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
-def coupled_block(kp, pe, dpe, rs, ps, dt, slope, k0, B, Mf):  # pragma: no cover - compiled
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath={"contract"})
+def coupled_block(kp, sb, dt, slope, k0, B, Mf):  # pragma: no cover - compiled
     """Transitions and forcings of steps ``k0 .. k0 + B - 1`` for one parameter set
     (:func:`step_coefficients`), into ``Mf[:, :B]`` (``Mf`` (6, >= B), C-contiguous).
 
-    ``kp``: one row of :meth:`CoupledHygricModel.kernel_parameters`; ``rs`` (4, N): the
-    step mean of ``r = p_sat(Tw)/p_sat(T_ref)``, its square root, the inverse of that
-    and r's change over the step; ``ps`` the sink's ``p_sat(Tf)`` (N,) (or ``[1.0]``: a
-    constant node); ``dpe`` the change of ``pe`` over the step, used with ``slope``. No
-    dependency between steps: the loop vectorises."""
-    each = ps.size > 1
-    c = walker_constants(kp, each, ps[0])
-    xs = ps if each else pe
+    ``kp``: one row of :meth:`CoupledHygricModel.kernel_parameters`; ``sb`` (7, N): the
+    step series of :func:`fill_series`; the change of ``Pe`` over the step is used with
+    ``slope``. No dependency between steps: the loop vectorises."""
+    c = walker_constants(kp)
+    idt = 1.0 / dt
     for b in range(B):
         k = k0 + b
         m0, m1, m2, m3, f0, f1 = step_coefficients(
-            c, rs[0, k], rs[1, k], rs[2, k], rs[3, k], pe[k], dpe[k], xs[k], dt, slope
-        )
+            c, sb[2, k], sb[3, k], sb[4, k], sb[5, k], sb[0, k], sb[1, k], sb[6, k], dt, idt,
+            slope,
+        )  # fmt: skip
         Mf[0, b] = m0
         Mf[1, b] = m1
         Mf[2, b] = m2
@@ -478,59 +537,33 @@ def coupled_block(kp, pe, dpe, rs, ps, dt, slope, k0, B, Mf):  # pragma: no cove
         Mf[5, b] = f1
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
-def temperature_ratio(T, out):  # pragma: no cover - compiled
-    """From readings ``T`` [°C] at the step boundaries, ``ρ = p_sat(T)/p_sat(T_ref)``
-    linear between them: ``out[0]`` its step mean ``(ρ[k] + ρ[k+1])/2`` [-], ``out[1]``
-    the square root of that, ``out[2]`` the inverse of ``out[1]``, ``out[3]`` the change
-    ``ρ[k+1] - ρ[k]`` (zero on the last row, whose next reading is unknown) (4, N)."""
-    N = T.size
-    if N == 0:
-        return
-    rho = np.empty(N + 1)
-    for k in range(N):  # two passes: each loop vectorises
-        rho[k] = psat_water(T[k]) / P_REF
-    rho[N] = rho[N - 1]
-    for k in range(N):
-        v = 0.5 * (rho[k] + rho[k + 1])
-        q = math.sqrt(v)
-        out[0, k] = v
-        out[1, k] = q
-        out[2, k] = 1.0 / q
-        out[3, k] = rho[k + 1] - rho[k]
-
-
-@numba.njit(cache=True, nogil=True, error_model="numpy")
-def saturation_series(T, out):  # pragma: no cover - compiled
-    """``out = p_sat(T)`` [Pa] over water (N,)."""
-    for k in range(T.size):
-        out[k] = psat_water(T[k])
-
-
 #: Steps per block of :func:`coupled_block` (its (6, BLOCK) array stays in cache).
 BLOCK = 2048
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
-def _simulate(kp, pe, dpe, rs, ps, slope, dt, x, out):  # pragma: no cover - compiled
-    """Outputs ``out[p, k] = Pi[k]`` of every walker (``x`` (K, 2) start, in place)."""
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath={"contract"})
+def _simulate(kp, U, cols, slope, dt, x, out):  # pragma: no cover - compiled
+    """Outputs ``out[p, k] = Pi[k]`` of every walker (``x`` (K, 2) start, in place),
+    the step series of each block of inputs computed once for all walkers."""
     K = kp.shape[0]
-    N = pe.size
+    N = U.shape[0]
     Mf = np.empty((6, BLOCK))
-    for p in range(K):
-        xw = x[p, 0]
-        xi = x[p, 1]
-        for k0 in range(0, N, BLOCK):
-            B = min(BLOCK, N - k0)
-            coupled_block(kp[p], pe, dpe, rs, ps, dt, slope, k0, B, Mf)
+    sb = np.empty((N_SERIES, BLOCK))
+    for k0 in range(0, N, BLOCK):
+        B = min(BLOCK, N - k0)
+        fill_series(U, cols, k0, B, sb)
+        for p in range(K):
+            coupled_block(kp[p], sb, dt, slope, 0, B, Mf)
+            xw = x[p, 0]
+            xi = x[p, 1]
             for b in range(B):
                 out[p, k0 + b] = xi
                 xw, xi = (
                     Mf[0, b] * xw + Mf[1, b] * xi + Mf[4, b],
                     Mf[2, b] * xw + Mf[3, b] * xi + Mf[5, b],
                 )
-        x[p, 0] = xw
-        x[p, 1] = xi
+            x[p, 0] = xw
+            x[p, 1] = xi
 
 
 stamp_cache(globals(), _vecmath)

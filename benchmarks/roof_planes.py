@@ -1,0 +1,118 @@
+"""The sun on an attic's roof: solar apertures on the two roof slopes (``data.roof``)
+against one horizontal aperture and the four vertical facades, on the TRH-1 attics.
+
+For each attic (``trh1-espoo-attic/`` as R2, ``trh1-more-attics/R3`` ... ``R7``):
+``hbayes init`` on the logger file and the FMI weather as published (measured ``Rglob``,
+``Rdif``) and on a copy without those two columns (``data.irradiance: estimated``); then
+the thermal section's MAP validation FIT of Ti [%] (100 generations, 2 starts, as
+``benchmarks/init_without_radiation.py``) with init's model and each set of solar
+surfaces:
+
+* ``H``: one aperture on the horizontal (what init wrote before ``data.roof``);
+* ``facades``: the four vertical facades N, E, S, W;
+* ``roof 45 E-W``: ``roof: {pitch: 45, ridge_azimuth: 90}``, init's default for an attic
+  (slopes facing north and south);
+* ``roof 45 N-S``: ``roof: {pitch: 45, ridge_azimuth: 0}`` (slopes east and west);
+* ``roof 30 notes``: the ridge read from the data set's notes (the long sides, where
+  the eave vents are), pitch 30° (a Finnish tile roof, 1:2 to 1:1.5); R3's mono-pitch
+  roof, high side south, as one slope facing north, 10°.
+
+R3, R5 and R7 are held out: no choice (init's default, the priors) was made on them.
+Sites at the towns' positions (the houses' are not published).
+
+Usage (from the repository root)::
+
+    python benchmarks/roof_planes.py [R2 R3 R4 R5 R6 R7] [--data ../shared/data]
+        [--cases H facades "roof 45 E-W" ...]
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import tempfile
+from pathlib import Path
+
+import pandas as pd
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "benchmarks"))
+
+from heritage_bayes.config import load_config  # noqa: E402
+from heritage_bayes.config.data import DEFAULT_SURFACES  # noqa: E402
+from heritage_bayes.init_config import init_config  # noqa: E402
+from init_without_radiation import SITES, map_fit  # noqa: E402
+
+#: the ridge's direction [°] from the data set's notes (*_YP*_tiedot.txt): the long sides
+#: with the eave vents. R2: eave vents on the west side; R4, R5: north and south long
+#: sides; R6: north-west and south-east; R7: east and west. R3: a mono-pitch roof.
+NOTES_RIDGE = {"R2": 0.0, "R4": 90.0, "R5": 90.0, "R6": 45.0, "R7": 0.0}
+
+CASES = ("H", "facades", "roof 45 E-W", "roof 45 N-S", "roof 30 notes")
+
+
+def solar(cfg, site: str, case: str):
+    """``cfg`` with the solar surfaces of ``case`` (validated as a config would be)."""
+    raw = cfg.data.model_dump(exclude={"surfaces", "roof"}, exclude_unset=True)
+    if case == "H":
+        raw["surfaces"] = {"H": (0.0, 0.0)}
+    elif case == "facades":
+        raw["surfaces"] = dict(DEFAULT_SURFACES)
+    elif case == "roof 30 notes" and site == "R3":
+        raw["surfaces"] = {"roof_N": (10.0, 0.0)}
+    else:
+        pitch, ridge = {
+            "roof 45 E-W": (45.0, 90.0),
+            "roof 45 N-S": (45.0, 0.0),
+            "roof 30 notes": (30.0, NOTES_RIDGE.get(site)),
+        }[case]
+        raw["roof"] = {"pitch": pitch, "ridge_azimuth": ridge}
+    data = type(cfg.data).model_validate(raw)
+    return cfg.model_copy(update={"data": data})
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("sites", nargs="*", help=f"default: all of {list(SITES)}")
+    ap.add_argument("--data", type=Path, default=ROOT.parent / "shared" / "data")
+    ap.add_argument("--cases", nargs="+", default=list(CASES), choices=CASES)
+    args = ap.parse_args(argv)
+    args.sites = args.sites or list(SITES)
+    if set(args.sites) - set(SITES):
+        ap.error(
+            f"unknown site(s) {sorted(set(args.sites) - set(SITES))}; choose from {list(SITES)}"
+        )
+    print("validation FIT of Ti [%] of the thermal MAP, by solar surfaces and irradiance")
+    with tempfile.TemporaryDirectory() as tmp:
+        for name in args.sites:
+            folder, lat, lon = SITES[name]
+            d = args.data / folder
+            work = Path(tmp) / name
+            (work / "data").mkdir(parents=True)
+            bare = work / "data" / "fmi.csv"
+            pd.read_csv(d / "fmi.csv").drop(columns=["Rglob", "Rdif"]).to_csv(bare, index=False)
+            for label, weather in (("measured", d / "fmi.csv"), ("estimated", bare)):
+                out = work / label / "config.yaml"
+                out.parent.mkdir()
+                init_config(
+                    d / "roofmiddle_airmiddle.csv", weather, output=out, latitude=lat, longitude=lon
+                )
+                cfg = load_config(out)
+                row = []
+                for case in args.cases:
+                    ti, p = map_fit(solar(cfg, name, case), "thermal")
+                    apertures = " ".join(
+                        f"{k[3:]} {v:.3g}" for k, v in p.items() if k.startswith("fI_")
+                    )
+                    row.append(f"{case}: {ti:.1f}")
+                    print(
+                        f"{name} {label:<9} ({cfg.thermal.model}) {case:<14} FIT Ti {ti:5.1f} %"
+                        f"   apertures [m²] {apertures}",
+                        flush=True,
+                    )
+                print(f"{name} {label}: " + " | ".join(row), flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -28,20 +28,20 @@ Usage (from the repository root)::
 
 from __future__ import annotations
 
-import argparse
 import sys
 import tempfile
 from pathlib import Path
 
-import pandas as pd
-
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
-from heritage_bayes.config import load_config  # noqa: E402
 from heritage_bayes.config.data import DEFAULT_SURFACES  # noqa: E402
-from heritage_bayes.init_config import init_config  # noqa: E402
-from init_without_radiation import SITES, map_fit  # noqa: E402
+from init_without_radiation import (  # noqa: E402
+    checked_sites,
+    init_both,
+    map_fit,
+    site_parser,
+)
 
 #: the ridge's direction [°] from the data set's notes (*_YP*_tiedot.txt): the long sides
 #: with the eave vents. R2: eave vents on the west side; R4, R5: north and south long
@@ -72,32 +72,14 @@ def solar(cfg, site: str, case: str):
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("sites", nargs="*", help=f"default: all of {list(SITES)}")
-    ap.add_argument("--data", type=Path, default=ROOT.parent / "shared" / "data")
+    ap = site_parser(__doc__)
     ap.add_argument("--cases", nargs="+", default=list(CASES), choices=CASES)
-    args = ap.parse_args(argv)
-    args.sites = args.sites or list(SITES)
-    if set(args.sites) - set(SITES):
-        ap.error(
-            f"unknown site(s) {sorted(set(args.sites) - set(SITES))}; choose from {list(SITES)}"
-        )
+    args = checked_sites(ap, argv)
     print("validation FIT of Ti [%] of the thermal MAP, by solar surfaces and irradiance")
     with tempfile.TemporaryDirectory() as tmp:
         for name in args.sites:
-            folder, lat, lon = SITES[name]
-            d = args.data / folder
-            work = Path(tmp) / name
-            (work / "data").mkdir(parents=True)
-            bare = work / "data" / "fmi.csv"
-            pd.read_csv(d / "fmi.csv").drop(columns=["Rglob", "Rdif"]).to_csv(bare, index=False)
-            for label, weather in (("measured", d / "fmi.csv"), ("estimated", bare)):
-                out = work / label / "config.yaml"
-                out.parent.mkdir()
-                init_config(
-                    d / "roofmiddle_airmiddle.csv", weather, output=out, latitude=lat, longitude=lon
-                )
-                cfg = load_config(out)
+            cfgs = init_both(name, args.data, Path(tmp))
+            for label, cfg in (("measured", cfgs["measured"]), ("estimated", cfgs["none"])):
                 row = []
                 for case in args.cases:
                     ti, p = map_fit(solar(cfg, name, case), "thermal")

@@ -48,7 +48,44 @@ from init_without_radiation import (  # noqa: E402
 #: sides; R6: north-west and south-east; R7: east and west. R3: a mono-pitch roof.
 NOTES_RIDGE = {"R2": 0.0, "R4": 90.0, "R5": 90.0, "R6": 45.0, "R7": 0.0}
 
-CASES = ("H", "facades", "roof 45 E-W", "roof 45 N-S", "roof 30 notes")
+CASES = (
+    "H",
+    "facades",
+    "roof 45 E-W",
+    "roof 45 N-S",
+    "roof 30 notes",
+    "roof 45 E-W on Tw",
+    "roof 45 E-W shared",
+)
+
+
+def sun_on_the_roof(cfg, node: str = "Tw", shared: bool = False):
+    """``cfg`` with init's two thermal nodes (thermal_2c's links, the ground's too) and the
+    slopes' sun on ``node``: ``Tw``, the envelope node (the roof; as
+    ``benchmarks/configs/trh1_attic_2c_roof.yaml``), or ``Ti``, the air; ``shared``: one
+    aperture ``fI_roof`` for both slopes (same area, same covering)."""
+    planes = list(cfg.data.surfaces)
+    spec = {
+        "name": "thermal_2c_sun_on_roof",
+        "domain": "thermal",
+        "nodes": {"Tw": "Cw", "Ti": "Ci"},
+        "links": [
+            ["Tw", "Te", "Gw"],
+            ["Tw", "Ti", "Gi"],
+            ["Ti", "Te", "Gfast"],
+            ["Ti", "Tf", "Gf"],
+        ],
+        "inputs": ["Te", *[f"I_{s}" for s in planes], "Tf"],
+        "outputs": ["Ti"],
+        "sources": [
+            {"input": f"I_{s}", "node": node, "gain": "fI_roof" if shared else f"fI_{s}"}
+            for s in planes
+        ],
+    }
+    sec = type(cfg.thermal).model_validate(
+        {**cfg.thermal.model_dump(exclude_unset=True, exclude={"model", "options"}), "model": spec}
+    )
+    return cfg.model_copy(update={"thermal": sec})
 
 
 def solar(cfg, site: str, case: str):
@@ -63,12 +100,17 @@ def solar(cfg, site: str, case: str):
     else:
         pitch, ridge = {
             "roof 45 E-W": (45.0, 90.0),
+            "roof 45 E-W on Tw": (45.0, 90.0),
+            "roof 45 E-W shared": (45.0, 90.0),
             "roof 45 N-S": (45.0, 0.0),
             "roof 30 notes": (30.0, NOTES_RIDGE.get(site)),
         }[case]
         raw["roof"] = {"pitch": pitch, "ridge_azimuth": ridge}
     data = type(cfg.data).model_validate(raw)
-    return cfg.model_copy(update={"data": data})
+    cfg = cfg.model_copy(update={"data": data})
+    if case.endswith("on Tw"):
+        return sun_on_the_roof(cfg)
+    return sun_on_the_roof(cfg, "Ti", shared=True) if case.endswith("shared") else cfg
 
 
 def main(argv=None) -> int:

@@ -3,20 +3,19 @@ slopes of a roof for a room that looks like an attic, else one horizontal apertu
 
 A room looks like an attic or loft when a name says so (the logger file's, the run's:
 *attic*, *loft*, *roof*, *garret* and their Dutch, German, Finnish, Swedish, French,
-Italian and Polish words) or when its median daily temperature range is at least the outdoor one
-(:data:`SWING_RATIO`): only the sun on a thin envelope heats a room faster than the
-weather, and a roof takes the sun's full height. Such a room gets ``data.roof`` with
-:data:`DEFAULT_PITCH` and :data:`DEFAULT_RIDGE_AZIMUTH` and a comment asking for its
-real pitch and ridge direction.
+Italian and Polish words) or when its median daily temperature range is at least the
+outdoor one (:data:`SWING_RATIO`, the ratio at which :mod:`heritage_bayes.init_model`
+says the sun heats the room). Such a room gets ``data.roof`` with :data:`DEFAULT_PITCH`
+and :data:`DEFAULT_RIDGE_AZIMUTH` and a comment asking for its real pitch and ridge
+direction.
 
 Why these defaults. *Pitch 45°*: the roofs of historic buildings lie between about 30°
-(Nordic and Mediterranean tile roofs, 1:2 to 1:1.5) and 60° (Gothic churches, Dutch and
-German steep roofs); 45° is the middle, and within ±15° the slopes' daily irradiance
-changes little against the orientation's effect. *Ridge east-west* (slopes facing north
-and south): the orientation that the south-facing slope, whose sun is the strongest,
-makes the default for; two slopes with their own apertures also fit a roof turned from
-it, the north slope taking the diffuse part. The measured comparison with a north-south
-ridge and the roofs' real orientations is in ``docs/science/inputs.md`` ("Roofs").
+(Nordic and Mediterranean tile roofs, 1:2 to 1:1.5) and 60° (Gothic churches, steep
+northern European roofs); 45° is the middle. *Ridge east-west* (slopes facing north and
+south): of the two main orientations it fitted the attics it was chosen on better
+(validation FIT of Ti, ``benchmarks/roof_planes.py``, measured and estimated radiation);
+the comparison, with held-out attics, is in ``docs/science/inputs.md`` ("Roofs as solar
+surfaces").
 """
 
 from __future__ import annotations

@@ -88,8 +88,9 @@ def sun_on_the_roof(cfg, node: str = "Tw", shared: bool = False):
     return cfg.model_copy(update={"thermal": sec})
 
 
-def solar(cfg, site: str, case: str):
-    """``cfg`` with the solar surfaces of ``case`` (validated as a config would be)."""
+def solar(cfg, site: str, case: str, area: float | None = None):
+    """``cfg`` with the solar surfaces of ``case`` (validated as a config would be);
+    ``area`` [m²]: the roof's, for the prior on its apertures (``data.roof.area``)."""
     raw = cfg.data.model_dump(exclude={"surfaces", "roof"}, exclude_unset=True)
     if case == "H":
         raw["surfaces"] = {"H": (0.0, 0.0)}
@@ -106,6 +107,8 @@ def solar(cfg, site: str, case: str):
             "roof 30 notes": (30.0, NOTES_RIDGE.get(site)),
         }[case]
         raw["roof"] = {"pitch": pitch, "ridge_azimuth": ridge}
+        if area is not None:
+            raw["roof"]["area"] = area
     data = type(cfg.data).model_validate(raw)
     cfg = cfg.model_copy(update={"data": data})
     if case.endswith("on Tw"):
@@ -116,6 +119,7 @@ def solar(cfg, site: str, case: str):
 def main(argv=None) -> int:
     ap = site_parser(__doc__)
     ap.add_argument("--cases", nargs="+", default=list(CASES), choices=CASES)
+    ap.add_argument("--area", type=float, help="data.roof.area [m²] of the roof cases")
     args = checked_sites(ap, argv)
     print("validation FIT of Ti [%] of the thermal MAP, by solar surfaces and irradiance")
     with tempfile.TemporaryDirectory() as tmp:
@@ -124,7 +128,7 @@ def main(argv=None) -> int:
             for label, cfg in (("measured", cfgs["measured"]), ("estimated", cfgs["none"])):
                 row = []
                 for case in args.cases:
-                    ti, p = map_fit(solar(cfg, name, case), "thermal")
+                    ti, p = map_fit(solar(cfg, name, case, args.area), "thermal")
                     apertures = " ".join(
                         f"{k[3:]} {v:.3g}" for k, v in p.items() if k.startswith("fI_")
                     )

@@ -115,7 +115,8 @@ def test_a_sunlit_attic_with_sorption(tmp_path):
     _, cfg, text = _init(tmp_path, ti, rhi, w)
     assert cfg.thermal.model == "thermal_2c" and "thermostat" not in cfg.thermal.options
     assert "(ratio 1.55): larger indoors: the sun heats the room" in text
-    assert cfg.data.surfaces == {"H": (0.0, 0.0)}
+    # a swing larger than outdoors: the roof's two slopes at init's default (45°, E-W ridge)
+    assert cfg.data.surfaces == {"roof_N": (45.0, 0.0), "roof_S": (45.0, 180.0)}
     assert cfg.hygric.model == "hygric_2c_sorption"
     assert "it follows the room's temperature: sorption" in text
 

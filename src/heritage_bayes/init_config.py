@@ -19,7 +19,8 @@ and ``tests/test_init.py``):
   facades: the data pin one aperture; with four, thermal_1c put fI_E on its bound and
   left fI_N unidentified, and its MAP validation FIT of Ti was 76.7 % against 78.0 % with
   H (calibration Dec 2010-Aug 2011, validation Aug-Dec 2011; 4 facades also sampled
-  slowly: τmax 141 after 13 000 steps, stopped).
+  slowly: τmax 141 after 13 000 steps, stopped). A room that looks like an attic gets
+  its roof's two slopes instead (``data.roof``, :mod:`heritage_bayes.init_roof`).
 * **Periods**: chosen after the clocks, on UTC: the first whole calendar year of the
   longest stretch without a gap over 6 h (all seasons; 8 months to calibrate, 4 to
   validate), else its first whole 12 months, else 2/3 and 1/3 of it; never starting or
@@ -65,6 +66,7 @@ from heritage_bayes.init_checks import (
 )
 from heritage_bayes.init_columns import fahrenheit_column_check, rh_column_check, usable
 from heritage_bayes.init_model import propose_model
+from heritage_bayes.init_roof import attic_evidence, roof_finding, solar_surface_lines
 from heritage_bayes.io import clock as _clock
 from heritage_bayes.io.loggers import TableLayout, inspect_table
 from heritage_bayes.questions import MARK
@@ -509,6 +511,9 @@ def init_config(
     name = name or (output.parent.name if output.stem == "config" else output.stem) or "room"
     check_name(name, what="--name" if name_given else "name (from --output)")
 
+    sunlit = irr == "measured" or lat is not None  # a solar input: the surfaces it falls on
+    attic = attic_evidence((indoor.stem, name), ti_utc[cs:ve], te_utc[cs:ve]) if sunlit else None
+    findings += [roof_finding(attic)] if attic else []
     lines = [
         f"# Written by `hbayes init` on {_dt.date.today():%Y-%m-%d} from",
         f"#   logger:  {_comment(rel(indoor))}",
@@ -539,19 +544,12 @@ def init_config(
     else:
         lines += ["  weather:", f"    format: {wfmt}", f"    path: {_yaml_value(rel(weather))}"]
     lines += _source_lines("measurements", lay, rel(indoor), izone, icols, iunits, None, idropped)
-    if irr == "measured":
+    if sunlit:
         lines += [
-            "  irradiance: measured",
-            "  # One solar aperture on the horizontal (tilt, azimuth from north) [°]: the",
-            "  # sun on the building as a whole, which the data can pin. Name the facades",
-            "  # or roof planes that matter when you know them (e.g. S: [90, 180], roof_E:",
-            "  # [30, 90]); each adds an aperture to estimate.",
-            "  surfaces: {H: [0, 0]}",
-        ]
-    elif lat is not None:
-        lines += [
-            "  irradiance: estimated   # no measured irradiance: from the daily Te range",
-            "  surfaces: {H: [0, 0]}   # one aperture on the horizontal (see above)",
+            "  irradiance: measured"
+            if irr == "measured"
+            else "  irradiance: estimated   # no measured irradiance: from the daily Te range",
+            *solar_surface_lines(attic),
         ]
     else:
         lines += ["  irradiance: none"]

@@ -200,9 +200,10 @@ def describe_model(name: str, noise: str = "ar1_white") -> str:
         *(
             [
                 "glazing_area {surface: m²} sets log-normal priors on the apertures fI "
-                "(median 0.4 × the glazed area).",
+                "(median 0.4 × the glazed area); data.roof.area [m²] on a roof's two "
+                "slopes' (median 0.07 × each slope's area).",
                 "Options (under options:): ground (true | false | estimate), heating; the "
-                "solar surfaces come from data.surfaces.",
+                "solar surfaces come from data.surfaces (and data.roof: an attic's slopes).",
             ]
             if net.domain == "thermal"
             else [

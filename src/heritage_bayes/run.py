@@ -88,6 +88,7 @@ def section_parameters(cfg: CalibrationConfig, section: str, model: RCModel, pri
         envelope_area=cfg.envelope_area,
         interior_area=cfg.interior_area,
         glazing_area=cfg.glazing_area,
+        roof_area=cfg.data.roof.plane_areas() if cfg.data.roof else None,
         fixed_node_temperature=cfg.fixed_node_temperature,
         where=f"{section}.priors",
         dt=cfg.data.step.total_seconds(),

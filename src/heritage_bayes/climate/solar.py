@@ -56,6 +56,7 @@ __all__ = [
     "clear_sky_weather",
     "extraterrestrial_radiation_daily",
     "hargreaves_samani",
+    "roof_planes",
     "surface_irradiance",
     "temperature_range_weather",
 ]
@@ -67,6 +68,54 @@ DEFAULT_SURFACES: dict[str, tuple[float, float]] = {
     "S": (90.0, 180.0),
     "W": (90.0, 270.0),
 }
+
+_COMPASS = ("N", "NE", "E", "SE", "S", "SW", "W", "NW")
+
+
+def roof_planes(pitch: float, ridge_azimuth: float) -> dict[str, tuple[float, float]]:
+    """The two slopes of a gable roof as solar surfaces ``{name: (tilt, azimuth)}`` [°].
+
+    Parameters
+    ----------
+    pitch : float
+        Tilt of each slope from the horizontal [°], in (0, 90).
+    ridge_azimuth : float
+        Direction in which the ridge runs [°] clockwise from north, in [0, 360]; a line,
+        so 90 and 270 (an east-west ridge) are the same roof.
+
+    Returns
+    -------
+    dict
+        Two surfaces whose outward normals face away from the ridge on either side,
+        azimuths ``ridge_azimuth ± 90`` (modulo 360), in increasing azimuth. Names are
+        ``roof_<compass point>`` (``roof_N``, ``roof_SE``) when the azimuth is a
+        multiple of 45°, else ``roof_<azimuth rounded to a degree>`` (``roof_120``).
+
+    Examples
+    --------
+    >>> roof_planes(45, 90)
+    {'roof_N': (45.0, 0.0), 'roof_S': (45.0, 180.0)}
+    """
+    try:
+        pitch, ridge = float(pitch), float(ridge_azimuth)
+    except (TypeError, ValueError) as exc:
+        raise InputError(
+            f"roof: pitch and ridge_azimuth must be numbers in degrees (got {pitch!r}, "
+            f"{ridge_azimuth!r})"
+        ) from exc
+    if not 0.0 < pitch < 90.0:
+        raise InputError(f"roof: pitch must be in (0, 90) ° from the horizontal (got {pitch:g})")
+    if not 0.0 <= ridge <= 360.0:
+        raise InputError(
+            f"roof: ridge_azimuth must be in [0, 360] ° clockwise from north (got {ridge:g})"
+        )
+    out = {}
+    for az in sorted(round((ridge + side) % 360.0, 9) for side in (90.0, 270.0)):
+        point = az / 45.0
+        label = _COMPASS[round(point) % 8] if point == round(point) else f"{round(az) % 360:d}"
+        out[f"roof_{label}"] = (pitch, az)
+    return out
+
 
 _TRANSPOSITION = ("isotropic", "haydavies", "perez", "klucher", "reindl")
 _DECOMPOSITION = ("erbs", "dirint")

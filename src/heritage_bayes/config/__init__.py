@@ -42,6 +42,9 @@ Layout (see ``configs/demo.yaml`` for a complete, commented example)::
       irradiance: measured         # measured | estimated | clear_sky | none (default:
                                    # measured if the weather has it, else estimated)
       surfaces: {N: [90, 0], E: [90, 90], S: [90, 180], W: [90, 270]}  # (tilt, azimuth)
+      roof: {pitch: 45, ridge_azimuth: 90, area: 220}   # an attic: its two slopes
+                        # roof_N, roof_S as surfaces (in place of the facades if
+                        # 'surfaces' is not given); area [m²]: prior on their fI
       ground_temperature: {mode: seasonal, depth: 1}   # or {mode: annual_mean},
                         # {mode: constant, value: 10},
                         # {mode: column, column: T, source: {format: csv, path: ...}}

@@ -162,6 +162,13 @@ class CalibrationConfig(_Strict):
                     "glazing_area: given, but data.irradiance is 'none' (no solar input); "
                     "remove 'glazing_area' or set data.irradiance"
                 )
+            roof = self.data.roof.plane_areas() if self.data.roof else {}
+            both = sorted(set(self.glazing_area) & set(roof))
+            if both:
+                raise ValueError(
+                    f"glazing_area: {both} are roof slopes whose aperture prior comes from "
+                    "data.roof.area; give one of the two"
+                )
             stray = sorted(set(self.glazing_area) - set(self.data.surfaces))
             if stray:
                 raise ValueError(

@@ -20,7 +20,7 @@ from heritage_bayes.config._base import (
 )
 from heritage_bayes.config.sources import DemoData, Source
 
-__all__ = ["DEFAULT_SURFACES", "Data", "GroundTemperature"]
+__all__ = ["DEFAULT_SURFACES", "Data", "GroundTemperature", "Roof"]
 
 
 class GroundTemperature(_Strict):
@@ -80,6 +80,53 @@ class GroundTemperature(_Strict):
         return self
 
 
+class Roof(_Strict):
+    """A gable roof over the room (an attic, a loft): its two slopes become solar surfaces.
+
+    The slopes face away from the ridge on either side, azimuths ``ridge_azimuth ± 90``,
+    each tilted by ``pitch`` (:func:`heritage_bayes.climate.solar.roof_planes`); their
+    irradiance is transposed from the same global (measured or estimated) irradiance and
+    sky model as any surface. ``area`` sets the prior of their apertures
+    (:func:`heritage_bayes.inference.parameters.roof_aperture_prior`).
+    """
+
+    pitch: float = key(
+        unit="°",
+        description="tilt of each slope from the horizontal, e.g. 45 (steep old roofs "
+        "45-60, Nordic tile roofs about 30)",
+        gt=0,
+        lt=90,
+    )
+    ridge_azimuth: float = key(
+        unit="°",
+        description="direction the ridge runs, clockwise from north: 90 (or 270) an "
+        "east-west ridge, slopes facing north and south; 0 (or 180) a north-south ridge, "
+        "slopes facing east and west",
+        ge=0,
+        le=360,
+    )
+    area: float | None = key(
+        None,
+        unit="m²",
+        description="area of the two slopes together, measured along the slope (about "
+        "the floor area / cos(pitch)): a log-normal prior on each slope's aperture, median "
+        "0.07 × its half; without it the wide default prior",
+        gt=0,
+    )
+
+    def planes(self) -> dict[str, tuple[float, float]]:
+        """The two slopes, ``{name: (tilt, azimuth)}`` [°]."""
+        from heritage_bayes.climate.solar import roof_planes
+
+        return roof_planes(self.pitch, self.ridge_azimuth)
+
+    def plane_areas(self) -> dict[str, float]:
+        """Each slope's area [m²] (half of ``area``); empty without ``area``."""
+        if self.area is None:
+            return {}
+        return dict.fromkeys(self.planes(), self.area / 2.0)
+
+
 #: The four vertical facades (the paper's N, E, S, W): name -> (tilt, azimuth) [°].
 DEFAULT_SURFACES = {
     "N": (90.0, 0.0),
@@ -121,6 +168,13 @@ class Data(_Strict):
         description="name -> (tilt, azimuth; 0 = N, 90 = E) of the sunlit surfaces",
         default_factory=lambda: dict(DEFAULT_SURFACES),
     )
+    roof: Roof | None = key(
+        None,
+        unit=None,
+        description="a gable roof over the room (attic, loft), e.g. {pitch: 45, "
+        "ridge_azimuth: 90}: its two slopes become solar surfaces roof_<direction>, in "
+        "place of the four facades when 'surfaces' is not given, else beside them",
+    )
     ground_temperature: GroundTemperature = key(
         unit=None,
         description="the fixed (ground) temperature input of the thermal models",
@@ -158,12 +212,35 @@ class Data(_Strict):
             )
         if self.demo is not None and "mode" not in self.ground_temperature.model_fields_set:
             self.ground_temperature.mode = "annual_mean"  # the demo generator's Tf
+        if self.roof is not None:
+            self._add_roof()
         if self.irradiance == "none" and self.surfaces != DEFAULT_SURFACES:
             raise ValueError(
                 "surfaces: given, but irradiance is 'none' (no solar input); remove "
                 "'surfaces' or 'irradiance: none'"
             )
         return self
+
+    def _add_roof(self) -> None:
+        if self.irradiance == "none":
+            raise ValueError(
+                "roof: given, but irradiance is 'none' (no solar input); remove 'roof' or "
+                "'irradiance: none'"
+            )
+        planes = self.roof.planes()
+        if "surfaces" not in self.model_fields_set:  # the roof replaces the four facades
+            self.surfaces = planes
+            return
+        merged = dict(self.surfaces)
+        for name, (tilt, az) in planes.items():
+            if name in merged and tuple(merged[name]) != (tilt, az):
+                raise ValueError(
+                    f"surfaces.{name}: {list(merged[name])}, but the roof's plane of that name "
+                    f"is [{tilt:g}, {az:g}] (roof: pitch {self.roof.pitch:g}°, ridge_azimuth "
+                    f"{self.roof.ridge_azimuth:g}°); rename the surface or remove it"
+                )
+            merged[name] = (tilt, az)
+        self.surfaces = merged
 
     @field_validator("surfaces")
     @classmethod

@@ -49,6 +49,7 @@ __all__ = [
     "default_prior",
     "interior_prior",
     "parameters_for",
+    "roof_aperture_prior",
     "ventilation_prior",
 ]
 
@@ -510,6 +511,47 @@ def aperture_prior(
     return _lognormal(median, sigma)
 
 
+#: Effective solar aperture per m² of a ventilated roof's slope [-]: the share of the sun
+#: on the covering that reaches the attic air, EN ISO 13790:2008 11.3.4 for an opaque
+#: element, A_sol = α × R_se × U × A: α ≈ 0.65 (red clay tile; 0.3-0.9 from light to
+#: dark sheet), R_se = 0.04 m²K/W (EN ISO 6946, Table 7), U ≈ 2.6 W/(m²·K) from the
+#: covering to the attic air (radiation across the ventilated gap, 4.7 W/(m²·K) for
+#: emissivities 0.9, EN ISO 6946 Annex D, in series with R_si = 0.17 m²K/W, heat flow
+#: downward): 0.65 × 0.04 × 2.6 ≈ 0.07.
+ROOF_APERTURE_PER_AREA = 0.07
+
+
+def roof_aperture_prior(
+    plane_area: float, *, factor: float = ROOF_APERTURE_PER_AREA, sigma: float = 0.7
+) -> Prior:
+    """Log-normal prior on a roof slope's effective solar aperture ``fI_roof_<...>``
+    [m²] from the slope's area [m²].
+
+    Median ``factor × plane_area`` (:data:`ROOF_APERTURE_PER_AREA`: absorbed fraction ×
+    the share of the absorbed heat that reaches the attic air, EN ISO 13790's opaque
+    element [1]_), width σ_log = 0.7 (a factor 2: the covering's absorptance, the gap's
+    ventilation and the wind, all uncertain).
+
+    Parameters
+    ----------
+    plane_area : float
+        Area of the slope [m²] (> 0), along the slope.
+    factor : float
+        Median effective aperture per m² of slope [-].
+    sigma : float
+        sd of log(fI).
+
+    References
+    ----------
+    .. [1] EN ISO 13790:2008, Energy performance of buildings - Calculation of energy
+       use for space heating and cooling, 11.3.4 (the effective collecting area of
+       opaque building parts).
+    """
+    if not (isinstance(plane_area, (int, float)) and plane_area > 0):
+        raise ConfigError(f"roof area must be > 0 m² (got {plane_area!r})")
+    return _lognormal(factor * plane_area, sigma)
+
+
 #: Exterior surface heat transfer coefficient [W/(m²·K)]: 1 / R_se, R_se = 0.04 m²K/W
 #: (EN ISO 6946:2017, Table 7): nothing outside the envelope node couples it to the
 #: outdoor air better than the film on its outer face.
@@ -843,6 +885,7 @@ def parameters_for(
     envelope_area: float | None = None,
     interior_area: float | None = None,
     glazing_area: Mapping[str, float] | None = None,
+    roof_area: Mapping[str, float] | None = None,
     fixed_node_temperature: float | None = None,
     where: str = "priors",
     dt: float = 3600.0,
@@ -880,6 +923,9 @@ def parameters_for(
         listed surface's aperture ``fI_<surface>`` (see :func:`aperture_prior`); the
         other surfaces keep the default. Ignored by a model without solar inputs; a
         surface the model does not have is an error.
+    roof_area : mapping surface -> float, optional
+        Area [m²] of each roof slope (``data.roof``'s planes): a log-normal prior on its
+        aperture (see :func:`roof_aperture_prior`). A model without the surface ignores it.
     fixed_node_temperature : float, optional
         Temperature [°C] of the ground or space behind a fixed vapour-pressure node: a
         log-normal prior on ``Pf`` (see :func:`fixed_vapour_pressure_prior`).
@@ -956,6 +1002,8 @@ def parameters_for(
         if envelope_area is not None and name in ("Gw", "Cw"):
             prior = envelope_priors(envelope_area, domain)[name]
         surface = name.removeprefix("fI_")
+        if surface in (roof_area or {}) and kind == "gain" and name.startswith("fI_"):
+            prior = roof_aperture_prior(roof_area[surface])
         if surface in glazing and kind == "gain":
             try:
                 prior = aperture_prior(glazing[surface])

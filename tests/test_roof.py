@@ -1,0 +1,158 @@
+"""Roofs as solar surfaces: ``data.roof``'s two slopes, their irradiance, their aperture
+prior, and ``hbayes init`` writing the key for an attic."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pvlib
+import pytest
+
+from heritage_bayes.climate.solar import roof_planes, surface_irradiance
+from heritage_bayes.config import load_config, parse_config
+from heritage_bayes.errors import ConfigError, InputError
+from heritage_bayes.inference.parameters import ROOF_APERTURE_PER_AREA
+from heritage_bayes.init_config import init_config
+from heritage_bayes.inputs import solar_inputs
+from heritage_bayes.models import build_model
+from heritage_bayes.run import section_parameters
+
+SITE = {"latitude": 60.21, "longitude": 24.66, "altitude": 30.0}
+
+
+def _config(roof, **data):
+    return parse_config(
+        {
+            "name": "x",
+            "data": {"demo": {}, "roof": roof, **data},
+            "thermal": {"model": "thermal_1c"},
+        }
+    )
+
+
+def test_the_slopes_face_away_from_the_ridge():
+    assert roof_planes(45, 90) == {"roof_N": (45.0, 0.0), "roof_S": (45.0, 180.0)}
+    assert roof_planes(30, 0) == roof_planes(30, 180) == roof_planes(30, 360)
+    assert roof_planes(30, 0) == {"roof_E": (30.0, 90.0), "roof_W": (30.0, 270.0)}
+    assert roof_planes(35, 45) == {"roof_SE": (35.0, 135.0), "roof_NW": (35.0, 315.0)}
+    assert roof_planes(20, 30) == {"roof_120": (20.0, 120.0), "roof_300": (20.0, 300.0)}
+    for pitch, ridge in ((0, 90), (90, 90), (45, -1), (45, 361)):
+        with pytest.raises(InputError, match=r"roof: (pitch|ridge_azimuth) must be in"):
+            roof_planes(pitch, ridge)
+
+
+def test_roof_plane_irradiance_is_pvlibs_transposition():
+    """Instantaneous readings with all three components: each slope's irradiance is
+    pvlib's Perez transposition for its tilt and azimuth, computed here directly."""
+    idx = pd.date_range("2011-06-21 04:00", "2011-06-21 17:00", freq="1h", tz="UTC")
+    loc = pvlib.location.Location(SITE["latitude"], SITE["longitude"], altitude=30.0)
+    weather = loc.get_clearsky(idx)[["ghi", "dni", "dhi"]] * 0.8  # a hazy clear day
+    planes = roof_planes(40, 90)
+    got = surface_irradiance(weather, SITE, planes, averaged=False)
+    sun = pvlib.solarposition.get_solarposition(idx, SITE["latitude"], SITE["longitude"], 30.0)
+    assert sun["zenith"].max() < 87  # no low-sun special case in this window
+    for name, (tilt, az) in planes.items():
+        want = pvlib.irradiance.get_total_irradiance(
+            tilt,
+            az,
+            sun["apparent_zenith"],
+            sun["azimuth"],
+            weather["dni"],
+            weather["ghi"],
+            weather["dhi"],
+            dni_extra=pvlib.irradiance.get_extra_radiation(idx.day_of_year),
+            airmass=pvlib.atmosphere.get_relative_airmass(sun["apparent_zenith"]),
+            albedo=0.2,
+            model="perez",
+        )["poa_global"]
+        np.testing.assert_allclose(got[name], want.clip(lower=0), rtol=1e-9, atol=1e-9)
+    # the south slope takes more sun than the north one, and at noon more than the horizontal
+    assert got["roof_S"].sum() > 1.5 * got["roof_N"].sum()
+    noon = got.index[np.argmax(got["roof_S"])]
+    assert got.loc[noon, "roof_S"] > weather.loc[noon, "ghi"]
+
+
+def test_config_roof_replaces_the_facades_and_feeds_the_inputs():
+    cfg = _config({"pitch": 45, "ridge_azimuth": 90})
+    assert cfg.data.surfaces == {"roof_N": (45.0, 0.0), "roof_S": (45.0, 180.0)}
+    # beside facades given explicitly; the resolved config reads back the same
+    cfg = _config({"pitch": 30, "ridge_azimuth": 0}, surfaces={"S": [90, 180]})
+    assert list(cfg.data.surfaces) == ["S", "roof_E", "roof_W"]
+    again = parse_config(cfg.resolved())
+    assert again.data.surfaces == cfg.data.surfaces and again.data.roof == cfg.data.roof
+    # the model's apertures and the inputs I_<slope>
+    model = build_model(_config({"pitch": 45, "ridge_azimuth": 90}), "thermal")
+    assert {"fI_roof_N", "fI_roof_S"} <= set(model.parameter_names)
+    idx = pd.date_range("2011-06-01", periods=72, freq="1h", tz="UTC")
+    ghi = pvlib.location.Location(60.21, 24.66).get_clearsky(idx)["ghi"]
+    weather = pd.DataFrame({"ghi": ghi, "Te": 15.0}, index=idx)
+    irr, _, _ = solar_inputs(weather, SITE, cfg.data.surfaces, "measured")
+    assert list(irr.columns) == ["I_S", "I_roof_E", "I_roof_W"]
+
+
+@pytest.mark.parametrize(
+    ("roof", "extra", "message"),
+    [
+        ({"pitch": 90, "ridge_azimuth": 90}, {}, r"data\.roof\.pitch: outside the allowed range"),
+        ({"pitch": 0, "ridge_azimuth": 90}, {}, r"data\.roof\.pitch: outside the allowed range"),
+        ({"pitch": 45, "ridge_azimuth": 400}, {}, r"data\.roof\.ridge_azimuth: outside"),
+        ({"pitch": 45}, {}, r"data\.roof\.ridge_azimuth: required"),
+        ({"pitch": 45, "ridge_azimuth": 90, "area": 0}, {}, r"data\.roof\.area: outside"),
+        ({"pitch": 45, "ridge_azimuth": 90, "tilt": 3}, {}, r"data\.roof\.tilt"),
+        (
+            {"pitch": 45, "ridge_azimuth": 90},
+            {"irradiance": "none"},
+            "roof: given, but irradiance is 'none'",
+        ),
+        (
+            {"pitch": 45, "ridge_azimuth": 90},
+            {"surfaces": {"roof_S": [90, 180]}},
+            r"surfaces\.roof_S: \[90\.0, 180\.0\], but the roof's plane of that name is "
+            r"\[45, 180\]",
+        ),
+    ],
+)
+def test_config_errors_name_the_key(roof, extra, message):
+    with pytest.raises(ConfigError, match=message):
+        _config(roof, **extra)
+
+
+def test_roof_area_sets_the_aperture_prior():
+    cfg = _config({"pitch": 45, "ridge_azimuth": 90, "area": 200})
+    model = build_model(cfg, "thermal")
+    _, params = section_parameters(cfg, "thermal", model)
+    for name in ("fI_roof_N", "fI_roof_S"):
+        prior = params[name].prior
+        assert prior.dist == "lognormal"
+        assert prior.mu == pytest.approx(ROOF_APERTURE_PER_AREA * 100.0)
+    without = _config({"pitch": 45, "ridge_azimuth": 90})
+    _, wide = section_parameters(without, "thermal", build_model(without, "thermal"))
+    assert wide["fI_roof_N"].prior.dist == "loguniform"
+    with pytest.raises(ConfigError, match=r"glazing_area: \['roof_S'\] are roof slopes"):
+        parse_config(
+            {
+                "name": "x",
+                "data": {"demo": {}, "roof": {"pitch": 45, "ridge_azimuth": 90, "area": 90}},
+                "glazing_area": {"roof_S": 2},
+                "thermal": {"model": "thermal_1c"},
+            }
+        )
+
+
+@pytest.mark.shared_data
+def test_init_writes_the_roof_for_an_attic_and_not_for_the_room_below(shared_data, tmp_path):
+    d = shared_data / "trh1-espoo-attic"
+    site = {"latitude": 60.21, "longitude": 24.66}
+    res = init_config(
+        d / "roofmiddle_airmiddle.csv", d / "fmi.csv", output=tmp_path / "a.yaml", **site
+    )
+    assert res.questions == []
+    assert "  roof: {pitch: 45, ridge_azimuth: 90}" in res.text.splitlines()
+    assert "CHECK the pitch" in res.text and "init's defaults" in res.text
+    assert any(f.startswith("roof: the room looks like an attic") for f in res.findings)
+    cfg = load_config(tmp_path / "a.yaml")
+    assert cfg.data.surfaces == {"roof_N": (45.0, 0.0), "roof_S": (45.0, 180.0)}
+    # the heated room below: neither its name nor its daily swing (0.2 of outdoors') says roof
+    res = init_config(d / "indoor1.csv", d / "fmi.csv", output=tmp_path / "b.yaml", **site)
+    assert "roof:" not in res.text
+    assert load_config(tmp_path / "b.yaml").data.surfaces == {"H": (0.0, 0.0)}

@@ -222,7 +222,7 @@ def screen(
         )
     out.choice = choose([r for r in out.rows if "error" not in r], margin)
     for r in out.rows:
-        r["chosen"] = r["model"] == out.choice["choice"]
+        r["chosen"] = r["sampled"] = r["model"] == out.choice["choice"]
     say(f"[{section}] chosen: {out.choice['choice']}: {out.choice['reason']}")
     return out
 

@@ -51,16 +51,17 @@ MARGIN_FIT = 2.0
 _CARRY = {"Gfast": "Ge"}
 
 
-def row_score(row: Mapping) -> tuple[float, str]:
-    """(score [%], what it is) of a ladder row: the validation FIT (the mean over the
-    outputs), else the calibration FIT; NaN when the row has neither."""
-    for period in ("validation", "calibration"):
-        per = (row.get("fit") or {}).get(period) or {}
+def row_score(row: Mapping, period: str | None = None) -> tuple[float, str]:
+    """(score [%], what it is) of a ladder row: the FIT of ``period`` (the mean over the
+    outputs); by default the validation FIT where the row has one, else the calibration
+    FIT. NaN when the row has none."""
+    for p in (period,) if period else ("validation", "calibration"):
+        per = (row.get("fit") or {}).get(p) or {}
         vals = [v.get("FIT") for v in per.values() if isinstance(v, Mapping)]
         vals = [float(v) for v in vals if v is not None and math.isfinite(float(v))]
         if vals:
-            return sum(vals) / len(vals), f"{period} FIT"
-    return math.nan, "no FIT"
+            return sum(vals) / len(vals), f"{p} FIT"
+    return math.nan, f"{period or 'no'} FIT"
 
 
 def choose(rows: Sequence[Mapping], margin: float = MARGIN_FIT) -> dict:
@@ -80,7 +81,10 @@ def choose(rows: Sequence[Mapping], margin: float = MARGIN_FIT) -> dict:
     InputError
         No row has a finite score (every rung failed).
     """
-    scored = [(i, r, *row_score(r)) for i, r in enumerate(rows)]
+    # one period for every row: the validation FIT when any row has one
+    has_val = any((r.get("fit") or {}).get("validation") for r in rows)
+    period = "validation" if has_val else "calibration"
+    scored = [(i, r, *row_score(r, period)) for i, r in enumerate(rows)]
     scored = [t for t in scored if math.isfinite(t[2])]
     if not scored:
         raise InputError("model: auto: no model of the ladder could be fitted and scored")
@@ -212,7 +216,7 @@ def screen(
             continue
         row.update(parent=parent, seeded_from=parent if start is not None else None)
         row["map_seconds"] = time.perf_counter() - t0
-        row["score"] = row_score(row)[0]
+        row["score"] = row_score(row, _period(prep))[0]
         out.rows.append(row)
         out.models[label], out.logposts[label], out.maps[label] = model, lp, mp
         out.options[label] = own[label]
@@ -253,3 +257,8 @@ def chosen_section(cfg, section: str, scr: Screen):
     }
     new = sec.model_copy(update={"model": name, "options": options, "priors": priors})
     return cfg.model_copy(update={section: new})
+
+
+def _period(prep) -> str:
+    """The period whose FIT scores a rung: validation, else calibration."""
+    return "validation" if prep.validation is not None else "calibration"

@@ -65,7 +65,7 @@ def screen_candidates(
     from heritage_bayes.ladder import ladder_row
     from heritage_bayes.models import build_model
     from heritage_bayes.prepare import prepare
-    from heritage_bayes.selection import row_score
+    from heritage_bayes.selection import _period, row_score
 
     parents = {n: p for n, _, p in AUTO_LADDERS.get(section, ())}
     preps: dict = {}
@@ -106,7 +106,7 @@ def screen_candidates(
             tell(f"screen {k}/{n}: {label}: no MAP ({exc})")
             continue
         row["map_seconds"] = time.perf_counter() - t0
-        row["score"] = scores[label] = row_score(row)[0]
+        row["score"] = scores[label] = row_score(row, _period(prep))[0]
         rows[label], maps[label], lps[label] = row, mp, lp
         tell(
             f"screen {k}/{n}: {label}: {lp.ndim} free parameters, MAP validation FIT "

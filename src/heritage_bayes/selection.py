@@ -174,7 +174,7 @@ def screen(
     margin : float
         :data:`MARGIN_FIT`.
     """
-    from heritage_bayes.inference.optimize import BudgetError, find_map, unit_point
+    from heritage_bayes.inference.optimize import BudgetError, find_map
 
     say = say or (lambda msg: None)
     sec = getattr(cfg, section)
@@ -192,10 +192,7 @@ def screen(
             lp = rung_log_posterior(cfg, prep, section, model, sec.initial_state)
             start = None
             if parent in out.maps:
-                plp, pmp = out.logposts[parent], out.maps[parent]
-                values = dict(zip(plp.params.names, map(float, pmp.theta), strict=True))
-                values.update({a: values[b] for a, b in _CARRY.items() if b in values})
-                start = unit_point(lp, values)
+                start = carried_start(lp, out.logposts[parent], out.maps[parent])
             mp = find_map(
                 lp,
                 seed=seed,
@@ -229,6 +226,17 @@ def screen(
         r["chosen"] = r["sampled"] = r["model"] == out.choice["choice"]
     say(f"[{section}] chosen: {out.choice['choice']}: {out.choice['reason']}")
     return out
+
+
+def carried_start(lp, parent_lp, parent_map):
+    """A nested simpler model's MAP as a start of ``lp``'s search (the unit-cube point of
+    :func:`~heritage_bayes.inference.optimize.unit_point`): its parameters by name, one
+    node's total conductance as the fast path's; the others at mid-range."""
+    from heritage_bayes.inference.optimize import unit_point
+
+    values = dict(zip(parent_lp.params.names, map(float, parent_map.theta), strict=True))
+    values.update({a: values[b] for a, b in _CARRY.items() if b in values and a not in values})
+    return unit_point(lp, values)
 
 
 def _fit_text(row: Mapping) -> str:

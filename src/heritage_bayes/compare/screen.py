@@ -61,11 +61,11 @@ def screen_candidates(
     why)."""
     from heritage_bayes.calibrate import _log_posterior
     from heritage_bayes.errors import ConfigError, InputError
-    from heritage_bayes.inference.optimize import find_map, unit_point
+    from heritage_bayes.inference.optimize import find_map
     from heritage_bayes.ladder import ladder_row
     from heritage_bayes.models import build_model
     from heritage_bayes.prepare import prepare
-    from heritage_bayes.selection import _period, row_score
+    from heritage_bayes.selection import _period, carried_start, row_score
 
     parents = {n: p for n, _, p in AUTO_LADDERS.get(section, ())}
     preps: dict = {}
@@ -81,14 +81,8 @@ def screen_candidates(
             prep = preps[key]
             sec = getattr(cand, section)
             lp = _log_posterior(cand, prep, section, model, sec.priors)
-            start = None
             parent = parents.get(label)
-            if parent in maps:
-                values = dict(
-                    zip(lps[parent].params.names, map(float, maps[parent].theta), strict=True)
-                )
-                values.setdefault("Gfast", values.get("Ge", math.nan))
-                start = unit_point(lp, values)
+            start = carried_start(lp, lps[parent], maps[parent]) if parent in maps else None
             opt = cand.optimizer
             mp = find_map(
                 lp,

@@ -57,10 +57,19 @@ def test_the_choice_is_by_parameters_not_ladder_order_and_skips_unscored_rungs()
 
 
 def test_compare_samples_those_within_reach_and_at_least_two():
-    v = within_reach({"thermal_1c": 40.0, "thermal_2c": 80.0, "thermal_4a": 83.0})
+    n = {"thermal_1c": 7, "thermal_2c": 10, "thermal_4a": 13}
+    v = within_reach({"thermal_1c": 40.0, "thermal_2c": 80.0, "thermal_4a": 83.0}, n)
     assert v["thermal_2c"] is None and v["thermal_4a"] is None
     assert v["thermal_1c"].startswith("screened out: MAP validation FIT 40.0 %, 43.0 points")
     assert f"reach {REACH_FIT:g} points" in v["thermal_1c"]
+    # a richer model that adds nothing over a simpler one within reach is not sampled
+    # (TRH-1's attic: 2c collapses onto 1c, 80.4 % each, 4a 84.1 %)
+    v = within_reach({"thermal_1c": 80.4, "thermal_2c": 80.4, "thermal_4a": 84.1}, n)
+    assert v["thermal_1c"] is None and v["thermal_4a"] is None
+    assert v["thermal_2c"] == (
+        f"screened out: MAP validation FIT 80.4 %, not more than {MARGIN_FIT:g} points "
+        "above the simpler thermal_1c (80.4 %)"
+    )
     # one far ahead: the runner-up is still sampled (a comparison needs two)
     v = within_reach({"a": 10.0, "b": 90.0, "c": 20.0, "d": math.nan})
     assert [m for m, why in v.items() if why is None] == ["b", "c"]

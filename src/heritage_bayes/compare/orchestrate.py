@@ -13,6 +13,7 @@ from heritage_bayes.compare.core import DEFAULT_MODELS, compare_runs
 from heritage_bayes.compare.page import write_comparison
 from heritage_bayes.compare.screen import REACH_FIT, screen_candidates, within_reach
 from heritage_bayes.errors import ConfigError
+from heritage_bayes.selection import MARGIN_FIT
 
 
 def _section_of(cfg, models: Sequence[str] | None) -> tuple[str, list[str]]:
@@ -243,12 +244,15 @@ def run_compare(
 
     First every candidate's MAP and its validation FIT
     (:mod:`heritage_bayes.compare.screen`: seconds each); then only the candidates
-    within :data:`~heritage_bayes.compare.screen.REACH_FIT` points of the best (at least
-    the best two) are calibrated, each chain started at its screened MAP, and compared
-    by their posteriors (blocked LOO, validation ELPD). The others are in
-    ``comparison.json`` (``screened_out``, ``screen``) and the page with their MAP score
-    and the reason. Ctrl-C or SIGTERM stops every worker at once (exit 130): their
-    staging folders removed, no candidate started after.
+    within :data:`~heritage_bayes.compare.screen.REACH_FIT` points of the best, each
+    beating the simpler ones sampled by more than
+    :data:`~heritage_bayes.selection.MARGIN_FIT` points (at least the best two:
+    :func:`~heritage_bayes.compare.screen.within_reach`) are calibrated, each chain
+    started at its screened MAP, and compared by their posteriors (blocked LOO,
+    validation ELPD). The others are in ``comparison.json`` (``screened_out``,
+    ``screen``) and the page with their MAP score and the reason. Ctrl-C or SIGTERM
+    stops every worker at once (exit 130): no run written, the chains so far kept in
+    the staging folders for ``--resume``, no candidate started after.
 
     Parameters
     ----------
@@ -322,7 +326,7 @@ def run_compare(
             RunWriter(out / n, force=force, resume=resume).check()
         tell(f"screening {', '.join(names)} by their MAP (validation FIT)")
         rows, maps, scores = screen_candidates(cands, section, tell=tell)
-        verdicts = within_reach(scores)
+        verdicts = within_reach(scores, {n: r.get("n_params", 0) for n, r in rows.items()})
         keep = [n for n in names if verdicts[n] is None]
         for n in names:
             if verdicts[n] is not None:
@@ -344,8 +348,9 @@ def run_compare(
         tell("comparing the posteriors (blocked LOO, validation ELPD)")
         result = compare_runs(dirs, section, seed=cfg.seed if seed is None else int(seed))
         result["screen"] = {
-            "rule": f"each candidate's MAP scored by its validation FIT; sampled: those within "
-            f"{REACH_FIT:g} points of the best, at least the best two",
+            "rule": f"each candidate's MAP scored by its validation FIT; sampled, simplest "
+            f"first: those within {REACH_FIT:g} points of the best that beat every simpler "
+            f"one sampled by more than {MARGIN_FIT:g} points; at least the best two",
             "reach_fit": REACH_FIT,
             "rows": [rows[n] for n in names],
             "sampled": keep,

@@ -16,41 +16,62 @@ import time
 from collections.abc import Callable, Mapping
 
 from heritage_bayes.models import AUTO_LADDERS
+from heritage_bayes.selection import MARGIN_FIT
 
 __all__ = ["REACH_FIT", "screen_candidates", "within_reach"]
 
 #: [percentage points of validation FIT] candidates whose MAP scores within this of the
-#: best are sampled (at least the best two: a comparison needs two posteriors). Wider
-#: than :data:`heritage_bayes.selection.MARGIN_FIT`: the ELPD of the posteriors, not the
+#: best may be sampled (:func:`within_reach`). Wider than
+#: :data:`heritage_bayes.selection.MARGIN_FIT`: the ELPD of the posteriors, not the
 #: MAP's FIT, decides between those sampled.
 REACH_FIT = 5.0
 
 
-def within_reach(scores: Mapping[str, float], reach: float = REACH_FIT) -> dict[str, str | None]:
+def within_reach(
+    scores: Mapping[str, float],
+    n_params: Mapping[str, int] | None = None,
+    reach: float = REACH_FIT,
+    margin: float = MARGIN_FIT,
+) -> dict[str, str | None]:
     """Candidate -> None when it is sampled, else why it is screened out.
 
-    ``scores``: candidate -> MAP validation score [%] (NaN: not scored, screened out).
-    Sampled: every candidate within ``reach`` points of the best score, and at least the
-    best two scored.
+    ``scores``: candidate -> MAP validation score [%] (NaN: not scored, screened out);
+    ``n_params``: candidate -> free parameters (default: all equal). Sampled, simplest
+    first: a candidate within ``reach`` points of the best that beats every simpler
+    candidate sampled by more than ``margin`` points (a richer model that adds nothing
+    over a simpler one is not worth its posterior); then, were fewer than two taken,
+    the best-scoring others (a comparison needs two posteriors).
     """
+    n_params = n_params or {}
     ok = {m: s for m, s in scores.items() if math.isfinite(s)}
     if not ok:
-        return {m: "no MAP score" for m in scores}
+        return {m: "screened out: no MAP score" for m in scores}
     best = max(ok.values())
     ranked = sorted(ok, key=lambda m: -ok[m])
-    keep = {m for m in ok if ok[m] >= best - reach} | set(ranked[:2])
-    out: dict[str, str | None] = {}
-    for m, s in scores.items():
-        if m in keep:
-            out[m] = None
-        elif not math.isfinite(s):
-            out[m] = "screened out: no MAP score"
-        else:
-            out[m] = (
-                f"screened out: MAP validation FIT {s:.1f} %, {best - s:.1f} points below "
-                f"the best ({ranked[0]}: {best:.1f} %; reach {reach:g} points)"
+    keep: list[str] = []
+    why: dict[str, str] = {}
+    for m in sorted(ok, key=lambda m: (n_params.get(m, 0), list(scores).index(m))):
+        if ok[m] < best - reach:
+            why[m] = (
+                f"screened out: MAP validation FIT {ok[m]:.1f} %, {best - ok[m]:.1f} points "
+                f"below the best ({ranked[0]}: {best:.1f} %; reach {reach:g} points)"
             )
-    return out
+            continue
+        simpler = [k for k in keep if n_params.get(k, 0) < n_params.get(m, 0)]
+        top = max(simpler, key=lambda k: ok[k]) if simpler else None
+        if top is not None and ok[m] <= ok[top] + margin:
+            why[m] = (
+                f"screened out: MAP validation FIT {ok[m]:.1f} %, not more than {margin:g} "
+                f"points above the simpler {top} ({ok[top]:.1f} %)"
+            )
+            continue
+        keep.append(m)
+    for m in ranked:
+        if len(keep) >= 2:
+            break
+        if m not in keep:
+            keep.append(m)
+    return {m: None if m in keep else why.get(m, "screened out: no MAP score") for m in scores}
 
 
 def screen_candidates(

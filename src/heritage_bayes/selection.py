@@ -3,7 +3,7 @@
 ``model: auto`` in a config section (and ``hbayes compare``'s first step) screens the
 rungs of :data:`heritage_bayes.models.AUTO_LADDERS`, simplest first: each rung's MAP on
 the calibration period (the MAP of its nested simpler rung carried over as one of the
-starts of the search, :func:`heritage_bayes.inference.optimize.unit_point`), then the
+starts of the search, :func:`unit_point`), then the
 simulation from the MAP scored on the validation period by the paper's FIT [%]
 (Kramer, van Schijndel & Schellen 2013). A MAP costs seconds where a posterior costs
 minutes: only the model chosen is sampled.
@@ -35,6 +35,8 @@ import math
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
+
+import numpy as np
 
 from heritage_bayes.errors import ConfigError, InputError
 from heritage_bayes.ladder import ladder_row, rung_log_posterior
@@ -228,12 +230,27 @@ def screen(
     return out
 
 
+def unit_point(logpost, values: dict[str, float]) -> np.ndarray:
+    """The unit-cube point of the free parameters (the search's coordinates) for the
+    values given by name; a parameter not given, or outside its prior range, sits at the
+    middle of its range [-]."""
+    ps = logpost.params
+    out = np.full(ps.ndim, 0.5)
+    for j, name in enumerate(ps.free_names):
+        v = values.get(name)
+        if v is None or not np.isfinite(v) or (ps._log[j] and v <= 0):
+            continue
+        y = np.log(v) if ps._log[j] else v
+        u = (y - ps._a[j]) / ps._w[j]
+        if 0.0 < u < 1.0:
+            out[j] = u
+    return np.clip(out, 0.01, 0.99)
+
+
 def carried_start(lp, parent_lp, parent_map):
     """A nested simpler model's MAP as a start of ``lp``'s search (the unit-cube point of
-    :func:`~heritage_bayes.inference.optimize.unit_point`): its parameters by name, one
+    :func:`unit_point`): its parameters by name, one
     node's total conductance as the fast path's; the others at mid-range."""
-    from heritage_bayes.inference.optimize import unit_point
-
     values = dict(zip(parent_lp.params.names, map(float, parent_map.theta), strict=True))
     values.update({a: values[b] for a, b in _CARRY.items() if b in values and a not in values})
     return unit_point(lp, values)

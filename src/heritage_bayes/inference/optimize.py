@@ -56,7 +56,6 @@ __all__ = [
     "parameters_apart",
     "seconds_left",
     "share_deadline",
-    "unit_point",
 ]
 
 _EPS = 1e-9
@@ -282,9 +281,8 @@ def find_map(logpost, **kwargs) -> MAPResult:
     budget : str
         Names the budget in the message, e.g. ``"sampler.max_time = 30s"``.
     start : (d,) array, optional
-        A point of the unit cube (:func:`unit_point`) put into the first global search's
-        population and polished as one of the starts: the MAP of a nested simpler model
-        carried over (the search still explores; the start only adds a candidate).
+        A point of the unit cube put into the first search's population and polished as
+        one more start (a nested simpler model's MAP: it adds a candidate, no more).
 
     Raises
     ------
@@ -373,23 +371,6 @@ def _with_modes(found: list[MAPResult], objective) -> MAPResult:
     )
 
 
-def unit_point(logpost, values: dict[str, float]) -> np.ndarray:
-    """The unit-cube point of the free parameters (the search's coordinates) for the
-    values given by name; a parameter not given, or outside its prior range, sits at the
-    middle of its range [-]."""
-    ps = logpost.params
-    out = np.full(ps.ndim, 0.5)
-    for j, name in enumerate(ps.free_names):
-        v = values.get(name)
-        if v is None or not np.isfinite(v) or (ps._log[j] and v <= 0):
-            continue
-        y = np.log(v) if ps._log[j] else v
-        u = (y - ps._a[j]) / ps._w[j]
-        if 0.0 < u < 1.0:
-            out[j] = u
-    return np.clip(out, 0.01, 0.99)
-
-
 def _search(logpost, obj, seed, method, popsize, maxiter, starts, start=None) -> MAPResult:
     d = logpost.params.ndim
     rng = np.random.default_rng(seed)
@@ -430,9 +411,7 @@ def _search(logpost, obj, seed, method, popsize, maxiter, starts, start=None) ->
         if x0 is not None and min(np.abs(x0 - c).max() for c in cands) > 0.02:
             cands.append(x0)
     elif method == "multistart":
-        cands = list(rng.uniform(0.02, 0.98, (max(starts, 1), d)))
-        if x0 is not None:
-            cands.append(x0)
+        cands = list(rng.uniform(0.02, 0.98, (max(starts, 1), d))) + ([] if x0 is None else [x0])
     else:
         raise ValueError(
             f"optimizer.method must be 'differential_evolution' or 'multistart' (got {method!r})"

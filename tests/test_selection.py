@@ -13,6 +13,7 @@ from heritage_bayes.cli import main
 from heritage_bayes.compare.screen import REACH_FIT, within_reach
 from heritage_bayes.errors import InputError
 from heritage_bayes.selection import MARGIN_FIT, choose, row_score
+from test_compare import TINY
 
 
 def _row(model: str, n: int, val: float | None, cal: float = 80.0) -> dict:
@@ -76,17 +77,11 @@ def test_compare_samples_those_within_reach_and_at_least_two():
     assert v["d"] == "screened out: no MAP score"
 
 
+#: test_compare's tiny demo room (its periods, room volume, seed), both sections auto
 AUTO = {
+    **TINY,
     "name": "auto",
-    "seed": 3,
     "data": {"demo": {"seed": 7}},
-    "periods": {
-        "calibration": {"start": "2019-02-01", "end": "2019-02-11"},
-        "validation": {"start": "2019-02-11", "end": "2019-02-16"},
-        "warmup": "2d",
-        "init_window": "2d",
-    },
-    "room_volume": 400,
     "thermal": {"model": "auto"},
     "hygric": {"model": "auto", "noise": "ar1"},
     "sampler": {"max_steps": 200, "check_every": 100, "max_draws": 100, "n_predictive": 10},

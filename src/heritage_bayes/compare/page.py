@@ -241,7 +241,7 @@ def render_comparison(result: dict) -> str:
     if result.get("screen"):
         hs, rs = screen_rows(result)
         body = f"<p>{html.escape(result['screen']['rule'])}.</p>" + _table(hs, rs)
-        sections.insert(1, Section("Screen (MAP)", body, id="screen"))
+        sections.append(Section("Screen (MAP)", body, id="screen"))
     for m, info in result["models"].items():
         p = info.get("periods") or {}
         per = "; ".join(

@@ -67,6 +67,20 @@ def compared(cfg_path, tmp_path_factory):
     return out, json.loads((out / "comparison.json").read_text())
 
 
+def test_the_screen_is_recorded(compared):
+    """Every candidate's MAP screened before sampling: its row (free parameters, FIT,
+    score) in comparison.json; two candidates are both sampled (a comparison needs two),
+    each chain started at its screened MAP."""
+    out, res = compared
+    screen = res["screen"]
+    assert screen["sampled"] == list(MODELS) and res["screened_out"] == {}
+    assert [r["model"] for r in screen["rows"]] == list(MODELS)
+    for r in screen["rows"]:
+        assert {"n_params", "fit", "score", "map_seconds"} <= set(r), r
+        assert r["score"] == pytest.approx(r["fit"]["validation"]["Ti"]["FIT"])
+    assert "within 5 points of the best" in screen["rule"]
+
+
 def test_results_do_not_depend_on_where_a_candidate_ran(compared, cfg_path, tmp_path):
     """The parent calibrates the largest candidate itself, a worker the other (issue 28):
     each candidate's chain is its seed's, so one after the other in this process gives
@@ -367,8 +381,10 @@ def test_comparison_page_in_headless_chromium(compared):
     external = [u for u in page.requests[1:] if not u.startswith("data:")]
     assert external == [], external
     dom = page.dom
-    assert dom["sections"][:3] == ["summary", "accuracy", "identifiability"]
-    assert [f"model-{m}" for m in MODELS] == dom["sections"][3:]
+    # the screen's table (every candidate's MAP score, sampled or why not) before the
+    # sampled models' own sections
+    assert dom["sections"][:4] == ["summary", "accuracy", "identifiability", "screen"]
+    assert [f"model-{m}" for m in MODELS] == dom["sections"][4:]
     assert dom["figures"] == ["fig-tradeoff"] and dom["scripts"] == 0
     assert all(i["complete"] and i["w"] > 400 for i in dom["images"])
     import matplotlib.image as mpimg

@@ -25,6 +25,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -678,28 +679,46 @@ def test_a_second_run_while_the_first_makes_its_staging_folder(tmp_path, capsys,
     assert sorted(p.name for p in work.iterdir()) == ["c.yaml"]
 
 
-#: the signal as the parent's own candidate starts (its workers just submitted)
-_PARENT_STARTS = """
-import heritage_bayes.calibrate as _c
-_orig = _c.run_calibration
-def _rc(*a, **k):
+#: the signal once a worker samples: its chain's first checkpoint in a staging folder
+_WORKERS_SAMPLE = """
+import threading, time
+from pathlib import Path
+import heritage_bayes.compare.orchestrate as _o
+_orig = _o._start_worker
+def _watch(root):
+    while not any(Path(root).rglob("*.partial/chain_*.h5")):
+        time.sleep(0.2)
     os.kill(os.getpid(), SIG)
-    return _orig(*a, **k)
-_c.run_calibration = _rc
+def _sw(ctx, name, cand, run_dir, kwargs, results):
+    proc = _orig(ctx, name, cand, run_dir, kwargs, results)
+    threading.Thread(target=_watch, args=(Path(run_dir).parent,), daemon=True).start()
+    return proc
+_o._start_worker = _sw
 """
 
 
-def test_an_interrupted_compare_stops_its_workers(tmp_path):
-    """SIGTERM to ``hbayes compare --workers 2`` (the parent only, as ``kill PID``
-    sends it) ends the workers too: exit 130 without the worker's candidate calibrated
-    to its end while the parent waited (it was, and the run went on)."""
+@pytest.mark.parametrize("sig", ["SIGTERM", "SIGINT"])
+def test_an_interrupted_compare_stops_its_workers(tmp_path, sig):
+    """SIGTERM or SIGINT to ``hbayes compare --workers 2`` (the parent only, as ``kill
+    PID`` sends it) while its workers sample ends the workers at once: exit 130, every
+    worker process gone, no candidate's run, staging folder or lock left, and no
+    candidate started after (the chains are set to run far longer than the test)."""
     work = tmp_path / "w"
     work.mkdir()
-    cfg = _cfg(work)
+    cfg = work / "c.yaml"
+    long = {**TINY_CFG["sampler"], "max_steps": 10**6, "max_time": "1h"}
+    cfg.write_text(yaml.safe_dump({**TINY_CFG, "sampler": long}), encoding="utf-8")
     argv = ["compare", cfg, "--models", "thermal_1c,thermal_2c", "--workers", "2"]
-    rc, err = _spawn(_PARENT_STARTS, "SIGTERM", *argv, "--out", work / "cmp")
-    assert rc == 130 and "terminated (SIGTERM)" in err and _clean(err), err
-    assert not (work / "cmp" / "thermal_1c").exists()
+    rc, err = _spawn(_WORKERS_SAMPLE, sig, *argv, "--out", work / "cmp")
+    told = "terminated (SIGTERM)" if sig == "SIGTERM" else "interrupted"
+    assert rc == 130 and told in err and _clean(err), err
+    pids = [int(x) for x in re.findall(r"\(worker (\d+)\)", err)]
+    assert len(pids) == 2, err  # both were sampling
+    for pid in pids:
+        with pytest.raises(ProcessLookupError):
+            os.kill(pid, 0)
+    assert not list((work / "cmp").glob("thermal_*")), sorted(work.rglob("*"))
+    # a worker's staging folder keeps its chains so far (--resume), never a posterior
     assert not list(work.rglob("*.lock")) and not list(work.rglob("*.partial/posterior.nc"))
 
 

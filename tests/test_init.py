@@ -82,8 +82,9 @@ def test_init_synthetic_measures_an_undeclared_weather_clock(tmp_path):
     assert cfg.data.weather.columns == {"Te": "T_out", "RHe": "RH_out", "ghi": "global_rad"}
     assert timezone_text(cfg.data.measurements[0].timezone) == "UTC+01:00"  # HOBO's header
     assert cfg.data.measurements[0].time_format == "%m/%d/%y %I:%M:%S %p"
-    # 80 days to calibrate: two thermal nodes (a short record keeps one: test_init_model.py)
-    assert cfg.name == "room" and cfg.thermal.model == "thermal_2c"
+    # 80 days to calibrate: two thermal nodes or three, screened (model: auto; a short
+    # record keeps one: test_init_model.py)
+    assert cfg.name == "room" and cfg.thermal.model == "auto"
     assert cfg.data.surfaces == {"H": (0.0, 0.0)}
     # paths relative to the config; 120 days: 2/3 to calibrate, the rest to validate
     assert cfg.data.weather.path == "../data/weather.csv"
@@ -189,7 +190,7 @@ def test_init_trh1(shared_data, tmp_path):
     )
     # a year's data; the timber's vapour follows the attic's temperature (partial
     # correlation 0.71 under an 8.1 K daily swing): the sorbing buffer
-    assert (cfg.thermal.model, cfg.hygric.model) == ("thermal_2c", "hygric_2c_sorption")
+    assert (cfg.thermal.model, cfg.hygric.model) == ("auto", "hygric_2c_sorption")
     assert any("0.71 with psat(Ti) once the outdoor one" in f for f in res.findings)
 
 

@@ -14,7 +14,6 @@ for climate-change projections).
 from __future__ import annotations
 
 import time
-from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -36,7 +35,13 @@ from heritage_bayes.inference.results import (
     ensure_free_space,
     write_inference_data,
 )
-from heritage_bayes.models import SECTIONS, _catalog_options, build_model, initial_state_of
+from heritage_bayes.ladder import (  # structural_at_map: re-exported
+    ladder_row,
+    rung_log_posterior,
+    section_log_posterior,
+    structural_at_map,
+)
+from heritage_bayes.models import AUTO, SECTIONS, _catalog_options, build_model, initial_state_of
 from heritage_bayes.rc.catalog import model as catalog_model
 from heritage_bayes.rc.model import RCModel
 from heritage_bayes.run import (  # Run, load_run: re-exported
@@ -59,6 +64,7 @@ __all__ = [
     "load_run",
     "model_ladder",
     "run_calibration",
+    "structural_at_map",
 ]
 
 
@@ -77,33 +83,8 @@ def check_models(cfg: CalibrationConfig) -> None:
             initial_state_of(cfg, section, model)
 
 
-def _log_posterior(
-    cfg, prep, section: str, model: RCModel, priors: Mapping, initial_state=None
-) -> LogPosterior:
-    """The log-posterior of ``model`` on the calibration period of a config section
-    (initial state as configured unless ``initial_state`` is given)."""
-    noise, params = _parameters(cfg, section, model, priors)
-    if initial_state is None:
-        initial_state = initial_state_of(cfg, section, model)
-    cal = prep.calibration
-    try:
-        return LogPosterior(
-            model,
-            params,
-            noise,
-            prep.model_inputs(section, model)[cal],
-            prep.observed(section, model)[cal],
-            dt=prep.dt,
-            warmup=prep.warmup_steps,
-            init_window=prep.init_steps,
-            initial_state=initial_state,
-            initial_state_sd=getattr(cfg, section).initial_state_sd,
-            initial_state_horizon=getattr(cfg, section).horizon_seconds,
-            time_constant_cap=getattr(cfg, section).cap_seconds(model.domain),
-            temperature=getattr(cfg, section).temperature(model.domain, model.n_states),
-        )
-    except ValueError as exc:
-        raise InputError(f"{section}: {exc}") from None
+#: The log-posterior of a config section's model (:mod:`heritage_bayes.ladder`).
+_log_posterior = section_log_posterior
 
 
 @dataclass
@@ -125,17 +106,6 @@ class _Section:
     lp: np.ndarray | None = None
     timings: dict = field(default_factory=dict)
     deadline: float | None = None  # time.perf_counter() end of the run's time budget
-
-
-def structural_at_map(model: RCModel, logpost: LogPosterior, map_result, dt: float):
-    """Structural identifiability of ``model`` at a MAP (its fixed parameters held):
-    :func:`heritage_bayes.rc.identify.structural_identifiability`."""
-    from heritage_bayes.rc.identify import structural_identifiability
-
-    n = logpost.n_model
-    fixed = tuple(p.name for p in logpost.params.parameters[:n] if not p.free)
-    point = dict(zip(model.parameter_names, map_result.theta[:n], strict=True))
-    return structural_identifiability(model, point, dt=dt, fixed=fixed)
 
 
 def identifiability_at_map(model: RCModel, logpost: LogPosterior, map_result, dt: float):
@@ -160,6 +130,7 @@ def run_calibration(
     quiet: bool = False,
     report: bool | None = None,
     force: bool = False,
+    start_maps: dict | None = None,
 ) -> Path:
     """Calibrate the configured models and write the run directory; return its path.
 
@@ -179,6 +150,14 @@ def run_calibration(
     force : bool
         Write the run beside the files of a folder hbayes did not make, replacing none
         (:class:`~heritage_bayes.rundir.writer.RunWriter`: output-path policy, marker).
+    start_maps : dict, optional
+        Section -> MAP (:class:`~heritage_bayes.inference.optimize.MAPResult`) of its
+        model on these data, found beforehand: the chain starts there, no new search.
+
+    A section with ``model: auto`` is chosen first by the screen of its model ladder
+    (:mod:`heritage_bayes.selection`), inside the time budget; the run records the
+    screen (``summary.json``: ``selection``; its rows are the section's ladder) and its
+    ``config.yaml`` names the model chosen.
 
     Notes
     -----
@@ -190,7 +169,14 @@ def run_calibration(
 
     with threadpool_limits(limits=1, user_api="blas"):
         return _run_calibration(
-            cfg, out_dir, seed=seed, resume=resume, quiet=quiet, report=report, force=force
+            cfg,
+            out_dir,
+            seed=seed,
+            resume=resume,
+            quiet=quiet,
+            report=report,
+            force=force,
+            start_maps=start_maps,
         )
 
 
@@ -203,6 +189,7 @@ def _run_calibration(
     quiet: bool = False,
     report: bool | None = None,
     force: bool = False,
+    start_maps: dict | None = None,
 ) -> Path:
     """Implementation of :func:`run_calibration` (same parameters)."""
     if seed is not None:
@@ -217,7 +204,15 @@ def _run_calibration(
     check_models(cfg)
     with writer:
         try:
-            _calibrate_into(writer.staging, cfg, out, resume=resume, quiet=quiet, report=report)
+            _calibrate_into(
+                writer.staging,
+                cfg,
+                out,
+                resume=resume,
+                quiet=quiet,
+                report=report,
+                start_maps=start_maps,
+            )
             writer.commit()
         except BaseException as exc:
             exc.add_note(writer.left_behind())
@@ -233,15 +228,19 @@ def _calibrate_into(
     resume: bool,
     quiet: bool,
     report: bool | None,
+    start_maps: dict | None = None,
 ) -> None:
-    """Calibrate and write every output into ``out`` (the staging folder of ``final``)."""
+    """Calibrate and write every output into ``out`` (the staging folder of ``final``);
+    ``start_maps``: section -> a MAP found beforehand (``hbayes compare``'s screen) that
+    starts the chain instead of a new search."""
     t_start = time.perf_counter()
     say = _Progress(quiet)
+    start_maps = start_maps or {}
     # the heavy imports (arviz, scipy.optimize, emcee) only once the config is valid
     from heritage_bayes.inference.coordinates import sampling_coordinates
     from heritage_bayes.inference.idata import CONVERGENCE, build_run_outputs
     from heritage_bayes.inference.moves import unidentified_block
-    from heritage_bayes.inference.optimize import find_map, seconds_left, share_deadline
+    from heritage_bayes.inference.optimize import seconds_left, share_deadline
     from heritage_bayes.inference.sampler import run_sampler
     from heritage_bayes.inference.start import start_hessian
     from heritage_bayes.prepare import prepare
@@ -261,6 +260,11 @@ def _calibrate_into(
         f"{prep.frame.index[0]} to {prep.frame.index[-1]} "
         f"(irradiance: {prep.irradiance_source})"
     )
+    end = None if cfg.sampler.max_seconds is None else t_start + cfg.sampler.max_seconds
+    # model: auto: the ladder's MAP screen chooses the model sampled (heritage_bayes.selection)
+    cfg, screens = _select_models(cfg, prep, say, end)
+    maps = dict(start_maps or {})
+    maps.update({k: v.maps[v.choice["choice"]] for k, v in screens.items()})
     atomic_write_text(out / "config.yaml", config_yaml(cfg))
     if cfg.source_text is not None:  # the user's own file, comments and all
         atomic_write_text(out / "config.original.yaml", cfg.source_text)
@@ -274,26 +278,18 @@ def _calibrate_into(
         sections.append(_Section(name, model, lp))
     ndims = [s.logpost.ndim for s in sections]
     nwalkers = cfg.sampler.walkers or max(32, 2 * max(ndims) + 2)
-    end = None if cfg.sampler.max_seconds is None else t_start + cfg.sampler.max_seconds
     for i, s in enumerate(sections):  # one budget: MAP search and sampling, all sections
         t0, deadline = time.perf_counter(), share_deadline(end, len(sections) - i)
-        say.say(
-            f"[{s.name}] {s.model.name}: {s.logpost.ndim} free parameters, MAP search "
-            f"({cfg.optimizer.method})"
-        )
-        s.map = find_map(
-            s.logpost,
-            seed=cfg.seed + 101 * i,
-            method=cfg.optimizer.method,
-            popsize=cfg.optimizer.popsize,
-            maxiter=cfg.optimizer.maxiter,
-            starts=cfg.optimizer.starts,
-            restarts=cfg.optimizer.restarts_for(s.model.n_states),
-            deadline=deadline,
-            budget=f"the time budget sampler.max_time = "
-            f"{format_timedelta(cfg.sampler.max_time or 0)} ({len(sections) - i} section(s) "
-            f"left: {(deadline or t0) - t0:.0f} s for this one)",
-        )
+        known = maps.get(s.name)
+        if known is not None and known.x.size == s.logpost.ndim:
+            s.map = known  # the screen's MAP starts the chain
+            say.say(f"[{s.name}] {s.model.name}: the screen's MAP starts the sampler")
+        else:
+            say.say(
+                f"[{s.name}] {s.model.name}: {s.logpost.ndim} free parameters, MAP search "
+                f"({cfg.optimizer.method})"
+            )
+            s.map = _section_map(cfg, s, i, deadline, t0, len(sections))
         s.timings["map_seconds"] = time.perf_counter() - t0
         say.say(
             f"[{s.name}] MAP log-posterior {s.map.log_post:.1f}; "
@@ -368,9 +364,11 @@ def _calibrate_into(
     for s in sections:
         s.X, s.lp = s.X[:, -n_draw:], s.lp[:, -n_draw:]
         s.theta = s.theta_kept[:, -n_draw:]
-    ladder = {}
+    ladder = {k: v.rows for k, v in screens.items()}  # model: auto: the screen is the ladder
     if cfg.ladder:
         for i, s in enumerate(sections):
+            if s.name in ladder:
+                continue
             t0 = time.perf_counter()
             say.say(f"[{s.name}] model-order ladder (MAP fits)")
             s.deadline = end  # the ladder stops where the budget does
@@ -381,6 +379,7 @@ def _calibrate_into(
     summary["unconverged_reasons"] = unconverged_reasons(summary)  # [] when converged
     t_out = time.perf_counter() - t0
     summary["ladder"] = ladder or None
+    summary["selection"] = {k: v.record() for k, v in screens.items()} or None
     summary["timings"] = {
         "prepare_seconds": t_prep,
         **{f"{s.name}_{k}": v for s in sections for k, v in s.timings.items()},
@@ -411,6 +410,58 @@ def _calibrate_into(
         say.say(f"report: {final / 'report.html'}")
 
 
+def _section_map(cfg: CalibrationConfig, s: _Section, i: int, deadline, t0, n: int):
+    """The MAP search of section ``s`` (the ``i``-th of ``n``) within its deadline."""
+    from heritage_bayes.inference.optimize import find_map
+
+    return find_map(
+        s.logpost,
+        seed=cfg.seed + 101 * i,
+        method=cfg.optimizer.method,
+        popsize=cfg.optimizer.popsize,
+        maxiter=cfg.optimizer.maxiter,
+        starts=cfg.optimizer.starts,
+        restarts=cfg.optimizer.restarts_for(s.model.n_states),
+        deadline=deadline,
+        budget=f"the time budget sampler.max_time = "
+        f"{format_timedelta(cfg.sampler.max_time or 0)} ({n - i} section(s) "
+        f"left: {(deadline or t0) - t0:.0f} s for this one)",
+    )
+
+
+def _select_models(cfg: CalibrationConfig, prep, say, end) -> tuple[CalibrationConfig, dict]:
+    """Every ``model: auto`` section screened and replaced by its choice: (the config
+    with the models chosen, section -> :class:`~heritage_bayes.selection.Screen`).
+    Each screen may use a share of the time budget (``end``) of its own and of the
+    sections still to sample."""
+    from heritage_bayes.inference.optimize import share_deadline
+    from heritage_bayes.selection import chosen_section, screen
+
+    auto = [n for n in SECTIONS if getattr(cfg, n) is not None and getattr(cfg, n).model == AUTO]
+    n_sections = sum(getattr(cfg, n) is not None for n in SECTIONS)
+    screens = {}
+    for i, name in enumerate(auto):
+        say.say(f"[{name}] model: auto: screening the model ladder (MAP and validation FIT)")
+        t0 = time.perf_counter()
+        scr = screen(
+            cfg,
+            prep,
+            name,
+            seed=cfg.seed + 101 * SECTIONS.index(name),
+            deadline=share_deadline(end, 2 * (n_sections - i)),
+            say=say.say,
+        )
+        scr.choice["screen_seconds"] = time.perf_counter() - t0
+        if scr.choice.get("runner_up"):
+            say.say(
+                f"[{name}] {scr.choice['runner_up']} is within {scr.choice['margin']:g} points "
+                f"of it: `hbayes compare --models` weighs the two by their posteriors"
+            )
+        cfg = chosen_section(cfg, name, scr)
+        screens[name] = scr
+    return cfg, screens
+
+
 def model_ladder(cfg: CalibrationConfig, prep, section: _Section, *, seed: int) -> list[dict]:
     """Accuracy versus identifiability over model orders (the paper's trade-off).
 
@@ -423,7 +474,6 @@ def model_ladder(cfg: CalibrationConfig, prep, section: _Section, *, seed: int) 
     budget (``section.deadline``) leaves no time for are left out.
     """
     from heritage_bayes.inference.optimize import BudgetError, find_map
-    from heritage_bayes.inference.results import fit_metrics
 
     sec_cfg = getattr(cfg, section.name)
     names = list(LADDERS[section.name]) if isinstance(sec_cfg.model, str) else []
@@ -441,17 +491,7 @@ def model_ladder(cfg: CalibrationConfig, prep, section: _Section, *, seed: int) 
                 continue
             if model.output_names != out:
                 continue
-            # the configured priors whose parameters exist in this model order
-            priors = {
-                k: v
-                for k, v in sec_cfg.priors.items()
-                if k in model.parameter_names or k.split("_")[0] in ("sigma", "phi")
-            }
-            mode = section.logpost.initial_state
-            if isinstance(mode, Mapping) or model.control is not None:
-                # fixed nodes belong to the configured model: the others estimate theirs
-                mode = "steady" if model.control is not None else "estimate"
-            lp = _log_posterior(cfg, prep, section.name, model, priors, initial_state=mode)
+            lp = rung_log_posterior(cfg, prep, section.name, model, section.logpost.initial_state)
             try:
                 mp = find_map(
                     lp,
@@ -464,38 +504,7 @@ def model_ladder(cfg: CalibrationConfig, prep, section: _Section, *, seed: int) 
                 )
             except BudgetError:  # sampler.max_time is spent: the ladder ends here
                 break
-        ident = structural_at_map(model, lp, mp, prep.dt)
-        U = prep.model_inputs(section.name, model)
-        ysim = lp.simulate_frame(mp.theta[None], U, prep.calibration.start)[0][0]
-        obs = prep.observed(section.name, model)
-        fit = {}
-        for period in ("calibration", "validation"):
-            sl = getattr(prep, period)
-            if sl is None:
-                continue
-            start = sl.start + (prep.warmup_steps if period == "calibration" else 0)
-            fit[period] = {
-                o: fit_metrics(obs[start : sl.stop, k], ysim[start : sl.stop, k])
-                for k, o in enumerate(out)
-            }
-        ll = float(lp.log_likelihood(mp.theta[None])[0])
-        n_obs = int(np.isfinite(lp.observed).sum())
-        k = lp.ndim
-        rows.append(
-            {
-                "model": model.name,
-                "n_params": int(k),
-                "n_model_params": len(model.parameter_names),
-                "fit": fit,
-                "log_likelihood": ll,
-                "aic": 2 * k - 2 * ll,
-                "bic": k * float(np.log(max(n_obs, 1))) - 2 * ll,
-                "rank": int(ident.rank),
-                "n_null": len(ident.directions),
-                "null_directions": [d.label for d in ident.directions],
-                "condition_number_identifiable": float(ident.condition_number_identifiable),
-                "map_agreed": f"{mp.n_agreed}/{mp.n_starts}",
-                "sampled": model.name == section.model.name,
-            }
-        )
+        row = ladder_row(prep, section.name, model, lp, mp)
+        row["sampled"] = model.name == section.model.name
+        rows.append(row)
     return rows

@@ -394,6 +394,8 @@ def _cmd_compare(args) -> int:
             for r in rows:
                 print(" | ".join(r))
             print()
+        for m, info in (res.get("screened_out") or {}).items():
+            print(f"{m}: {info['reason']}")
         print("recommendation:", res["recommendation"]["reason"])
         print(out / "comparison.html")
     return 0

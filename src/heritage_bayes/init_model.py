@@ -28,8 +28,11 @@ written as comments above them:
   ``hygric_2c_sorption`` (with ``sink: temperature`` when a sink shows too).
 
 The starting order: a calibration period of :data:`LONG_DAYS` days or more of hourly
-data pins two thermal nodes (``thermal_2c``; Kramer et al.'s ``thermal_4a`` is the next
-rung, for ``hbayes compare``); shorter records keep the one-node models.
+data pins two thermal nodes or more, and which of ``thermal_2c`` and Kramer et al.'s
+``thermal_4a`` the room calls for is not a signature init can measure: it writes
+``model: auto`` (:mod:`heritage_bayes.selection`: the ladder screened by MAP and
+validation FIT, the winner sampled), and so for the hygric model where no signature
+names one; shorter records keep the one-node models.
 
 References
 ----------
@@ -146,11 +149,12 @@ def _thermal(p: ModelProposal, ti, te, heated: tuple[float, int, int], cal_days:
             )
         )
     if cal_days >= LONG_DAYS:
-        p.thermal_model = "thermal_2c"
+        p.thermal_model = "auto"
         p.thermal_evidence.append(
-            f"{cal_days:.0f} days of calibration data (>= {LONG_DAYS}) pin two nodes: "
-            "thermal_2c (envelope, air); thermal_4a (Kramer et al., the paper's model) is "
-            "the next rung to try with `hbayes compare`"
+            f"{cal_days:.0f} days of calibration data (>= {LONG_DAYS}) pin two nodes or "
+            "more: thermal_2c (envelope, air) or thermal_4a (Kramer et al., the paper's "
+            "model, with an interior mass): model: auto screens thermal_1c, thermal_2c and "
+            "thermal_4a (MAP, validation FIT) and samples the one the data call for"
         )
     else:
         p.thermal_evidence.append(
@@ -239,6 +243,13 @@ def _hygric(p: ModelProposal, ti, te, rhi, rhe, cal_days: float) -> None:
                 "model first; try the two-node model the signature names with `hbayes compare`"
             )
         return
+    if not (sorption or sink):
+        p.hygric_model = "auto"
+        p.hygric_evidence.append(
+            f"{cal_days:.0f} days of calibration data (>= {LONG_DAYS}) and no signature "
+            "that names a model: model: auto screens the hygric ladder (1c, 2c, the fixed "
+            "node, sorption; MAP, validation FIT) and samples the one the data call for"
+        )
     if sorption:
         p.hygric_model = "hygric_2c_sorption"
         if sink:

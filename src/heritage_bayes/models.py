@@ -18,9 +18,57 @@ from heritage_bayes.rc.catalog import model as catalog_model
 from heritage_bayes.rc.model import RCModel
 from heritage_bayes.rc.network import Network
 
-__all__ = ["SECTIONS", "build_model", "describe_model", "input_hold_of"]
+__all__ = [
+    "AUTO",
+    "AUTO_LADDERS",
+    "SECTIONS",
+    "auto_rungs",
+    "build_model",
+    "describe_model",
+    "input_hold_of",
+]
 
 SECTIONS = ("thermal", "hygric")
+
+#: ``model:`` value that screens the section's :data:`AUTO_LADDERS` (MAP and validation
+#: score, :mod:`heritage_bayes.selection`) and samples the model chosen.
+AUTO = "auto"
+#: The rungs ``model: auto`` screens, simplest first: (catalogue name, the rung's own
+#: options, the nested simpler rung whose MAP seeds this one's search). The configured
+#: ``options`` (control, sources, surfaces) apply to every rung; ``sink`` is the rung's.
+#: The last rung's inputs cover every rung's: the data are prepared for it.
+AUTO_LADDERS: dict[str, tuple[tuple[str, dict, str | None], ...]] = {
+    "thermal": (
+        ("thermal_1c", {}, None),
+        ("thermal_2c", {}, "thermal_1c"),
+        ("thermal_4a", {}, "thermal_2c"),
+    ),
+    "hygric": (
+        ("hygric_1c", {}, None),
+        ("hygric_2c", {}, "hygric_1c"),
+        ("hygric_2c_fixed", {"sink": "constant"}, "hygric_2c"),
+        ("hygric_2c_fixed", {"sink": "temperature"}, "hygric_2c"),
+        ("hygric_2c_sorption", {}, "hygric_1c"),
+        ("hygric_2c_sorption", {"sink": "temperature"}, "hygric_2c_sorption"),
+    ),
+}
+
+
+def rung_label(name: str, own: Mapping) -> str:
+    """A rung as the console, summary and report name it: ``hygric_2c_fixed``, or with
+    its own options ``hygric_2c_fixed (sink: temperature)``; the constant sink, the
+    default, is not named."""
+    extra = {k: v for k, v in own.items() if not (k == "sink" and v in ("constant", "none"))}
+    return name + (" (" + ", ".join(f"{k}: {v}" for k, v in extra.items()) + ")" if extra else "")
+
+
+def rung_options(cfg: CalibrationConfig, section: str, name: str, own: Mapping) -> dict:
+    """Options of a rung: the configured ones without ``sink``, the rung's own, and the
+    solar surfaces (:func:`_catalog_options`)."""
+    opts = {k: v for k, v in _catalog_options(cfg, section, name).items() if k != "sink"}
+    return {**opts, **own}
+
+
 _SOLAR = {"thermal_1c", "thermal_2c", "thermal_4a"}
 
 
@@ -57,6 +105,8 @@ def build_model(cfg: CalibrationConfig, section: str) -> RCModel:
             m = RCModel(Network.from_dict(sec.model, where=where))
             _check_names(m, where)
         else:
+            if sec.model == AUTO:  # the richest rung: its inputs cover every rung's
+                return auto_rungs(cfg, section)[-1][1]
             if sec.model not in CATALOG:
                 raise ConfigError(
                     f"{where}: unknown model {sec.model!r}; available: {sorted(CATALOG)}"
@@ -76,6 +126,32 @@ def build_model(cfg: CalibrationConfig, section: str) -> RCModel:
         # change over the step for instantaneous readings, zeros for interval means
         m = m.with_slopes(m.network.inputs)
     return m
+
+
+def auto_rungs(cfg: CalibrationConfig, section: str) -> list[tuple[str, RCModel, str | None]]:
+    """The rungs of :data:`AUTO_LADDERS` that the configured options allow, built:
+    (label, model, label of the nested simpler rung or None). A rung whose catalogue
+    model refuses the options (e.g. a control it does not take) is left out; none
+    left: :class:`ConfigError` naming ``<section>.options``."""
+    rungs, refused = [], []
+    labels = {}
+    for name, own, parent in AUTO_LADDERS[section]:
+        label = rung_label(name, own)
+        labels.setdefault(name, label)  # a parent is named by its first rung
+        try:
+            m = catalog_model(name, **rung_options(cfg, section, name, own))
+        except ValueError as exc:
+            refused.append(f"{label}: {exc}")
+            continue
+        if input_hold_of(cfg) == "exact":
+            m = m.with_slopes(m.network.inputs)
+        rungs.append((label, m, labels.get(parent) if parent else None))
+    if not rungs:
+        raise ConfigError(
+            f"{section}.model: auto: no model of the ladder takes the configured "
+            f"{section}.options ({'; '.join(refused)})"
+        )
+    return rungs
 
 
 def input_hold_of(cfg: CalibrationConfig) -> str:

@@ -11,7 +11,9 @@ from pathlib import Path
 from heritage_bayes._memory import release_memory
 from heritage_bayes.compare.core import DEFAULT_MODELS, compare_runs
 from heritage_bayes.compare.page import write_comparison
+from heritage_bayes.compare.screen import REACH_FIT, screen_candidates, within_reach
 from heritage_bayes.errors import ConfigError
+from heritage_bayes.selection import MARGIN_FIT
 
 
 def _section_of(cfg, models: Sequence[str] | None) -> tuple[str, list[str]]:
@@ -49,6 +51,10 @@ def _section_of(cfg, models: Sequence[str] | None) -> tuple[str, list[str]]:
     return section, names
 
 
+#: Catalogue models that take the option ``sink``.
+_SINK_MODELS = ("hygric_2c_fixed", "hygric_2c_sorption")
+
+
 def _candidate_config(cfg, section: str, name: str):
     """The config calibrating only ``name`` in ``section`` (same data, noise, knowledge)."""
     from heritage_bayes.models import SECTIONS
@@ -59,6 +65,11 @@ def _candidate_config(cfg, section: str, name: str):
     from heritage_bayes.models import _catalog_options
     from heritage_bayes.rc.catalog import model as catalog_model
 
+    if "sink" in sec.options and name not in _SINK_MODELS:  # (a rung's own, as in auto)
+        sec = sec.model_copy(
+            update={"options": {k: v for k, v in sec.options.items() if k != "sink"}}
+        )
+        cfg = cfg.model_copy(update={section: sec})
     try:
         model = catalog_model(name, **_catalog_options(cfg, section, name))
     except ValueError as exc:
@@ -79,8 +90,7 @@ def _candidate_config(cfg, section: str, name: str):
 
 
 def _calibrate_candidate(cand, run_dir: str, kwargs: dict) -> tuple[str, float, float]:
-    """One candidate's calibration in a worker process: (run directory, wall [s], CPU
-    [s] of the worker)."""
+    """One candidate's calibration: (run directory, wall [s], CPU [s] of the process)."""
     import time
 
     from heritage_bayes.calibrate import run_calibration
@@ -90,30 +100,118 @@ def _calibrate_candidate(cand, run_dir: str, kwargs: dict) -> tuple[str, float, 
     return str(out), time.perf_counter() - t0, time.process_time() - c0
 
 
-def _worker_candidate(cand, run_dir: str, kwargs: dict) -> tuple[str, float, float]:
-    """:func:`_calibrate_candidate` in a worker process, where SIGTERM (sent by the
-    parent when it is interrupted or fails) ends the calibration as Ctrl-C does: the
-    chains saved for ``--resume``, the lock released."""
+def _worker_candidate(name: str, cand, run_dir: str, kwargs: dict, results) -> None:
+    """:func:`_calibrate_candidate` in a worker process, its outcome put on ``results``
+    as ``(name, "done", (run_dir, wall, cpu))`` or ``(name, "failed", message)``.
+    SIGTERM (sent by the parent when it is interrupted or a candidate failed) and
+    SIGINT (Ctrl-C reaches the whole process group) end the calibration at once, as
+    Ctrl-C does: the staging folder removed, the chains saved for ``--resume``, the
+    lock released."""
     import signal
 
     def stop(signum, frame):
         raise KeyboardInterrupt
 
     signal.signal(signal.SIGTERM, stop)
-    return _calibrate_candidate(cand, run_dir, kwargs)
+    signal.signal(signal.SIGINT, stop)
+    try:
+        results.put((name, "done", _calibrate_candidate(cand, run_dir, kwargs)))
+    except KeyboardInterrupt:
+        results.put((name, "stopped", None))
+    except Exception as exc:  # told to the parent, which stops the others and raises
+        results.put((name, "failed", f"{type(exc).__name__}: {exc}"))
 
 
-def _stop_workers(pool) -> None:
-    """Cancel the candidates not started; SIGTERM to the running workers, then wait for
-    them to save their chains and end (a parent that is interrupted must not wait for
-    their whole calibrations)."""
-    procs = list((getattr(pool, "_processes", None) or {}).values())
-    pool.shutdown(wait=False, cancel_futures=True)
-    for proc in procs:
+def _start_worker(ctx, name: str, cand, run_dir: str, kwargs: dict, results):
+    """A started worker process calibrating candidate ``name``."""
+    proc = ctx.Process(
+        target=_worker_candidate,
+        args=(name, cand, run_dir, kwargs, results),
+        name=f"hbayes-compare-{name}",
+    )
+    proc.start()
+    return proc
+
+
+def _stop_workers(procs: dict, grace: float = 60.0) -> None:
+    """SIGTERM to every running worker, then wait (at most ``grace`` seconds in all)
+    for them to save their chains, remove their staging folders and end; a worker still
+    running then is killed."""
+    import time
+
+    for proc in procs.values():
         if proc.is_alive():
             proc.terminate()
-    for proc in procs:
-        proc.join()
+    end = time.monotonic() + grace
+    for proc in procs.values():
+        proc.join(max(0.0, end - time.monotonic()))
+        if proc.is_alive():
+            proc.kill()
+            proc.join()
+
+
+def _sample_parallel(cands: dict, out: Path, kwargs_of: dict, n_workers: int, tell) -> dict:
+    """Calibrate the candidates in ``n_workers`` worker processes (largest first, a new
+    one started as soon as one ends; ``kwargs_of``: name -> keywords of
+    :func:`~heritage_bayes.calibrate.run_calibration`), with a progress line per start
+    and end and every :data:`HEARTBEAT` seconds; return name -> run directory. Interrupted (Ctrl-C,
+    SIGTERM) or a candidate failing: every worker stopped at once, none started."""
+    import multiprocessing
+    import queue
+    import time
+
+    from heritage_bayes.errors import InputError
+
+    ctx = multiprocessing.get_context("spawn")  # no forked numba/BLAS threads
+    results = ctx.Queue()
+    todo = sorted(cands, key=lambda n: -_n_free(cands[n], _section_name(cands[n])))
+    running: dict = {}
+    started: dict[str, float] = {}
+    dirs: dict[str, Path] = {}
+    last = time.monotonic()
+    try:
+        while todo or running:
+            while todo and len(running) < n_workers:
+                n = todo.pop(0)
+                kw = {**kwargs_of[n], "quiet": True}
+                running[n] = _start_worker(ctx, n, cands[n], str(out / n), kw, results)
+                started[n] = time.monotonic()
+                tell(f"sampling {n} (worker {running[n].pid})")
+            try:
+                name, status, value = results.get(timeout=1.0)
+            except queue.Empty:
+                for n, proc in list(running.items()):
+                    if not proc.is_alive() and proc.exitcode not in (0, None):
+                        raise InputError(
+                            f"{n}: its worker ended with code {proc.exitcode}"
+                        ) from None
+                if time.monotonic() - last >= HEARTBEAT:
+                    last = time.monotonic()
+                    tell(
+                        "still sampling: "
+                        + ", ".join(f"{n} ({last - started[n]:.0f} s)" for n in running)
+                        + (f"; waiting: {', '.join(todo)}" if todo else "")
+                    )
+                continue
+            running.pop(name).join()
+            if status == "done":
+                run_dir, wall, cpu = value
+                dirs[name] = Path(run_dir)
+                tell(f"{name} done ({wall:.0f} s wall, {cpu:.0f} s CPU)")
+            elif status == "stopped":
+                raise KeyboardInterrupt
+            else:
+                raise InputError(f"{name}: {value}")
+    except BaseException:  # Ctrl-C, SIGTERM, a failed candidate: stop them all
+        _stop_workers(running)
+        raise
+    return dirs
+
+
+def _section_name(cand) -> str:
+    from heritage_bayes.models import SECTIONS
+
+    return next(s for s in SECTIONS if getattr(cand, s) is not None)
 
 
 def _n_free(cand, section: str) -> int:
@@ -123,6 +221,10 @@ def _n_free(cand, section: str) -> int:
 
     model = build_model(cand, section)
     return section_parameters(cand, section, model)[1].ndim
+
+
+#: [s] between the progress lines of candidates still sampling.
+HEARTBEAT = 60.0
 
 
 def run_compare(
@@ -137,7 +239,20 @@ def run_compare(
     force: bool = False,
     workers: int | None = None,
 ) -> Path:
-    """Calibrate each candidate model and write the comparison; return its folder.
+    """Screen the candidate models by their MAP, sample those within reach of the best,
+    and write the comparison; return its folder.
+
+    First every candidate's MAP and its validation FIT
+    (:mod:`heritage_bayes.compare.screen`: seconds each); then only the candidates
+    within :data:`~heritage_bayes.compare.screen.REACH_FIT` points of the best, each
+    beating the simpler ones sampled by more than
+    :data:`~heritage_bayes.selection.MARGIN_FIT` points (at least the best two:
+    :func:`~heritage_bayes.compare.screen.within_reach`) are calibrated, each chain
+    started at its screened MAP, and compared by their posteriors (blocked LOO,
+    validation ELPD). The others are in ``comparison.json`` (``screened_out``,
+    ``screen``) and the page with their MAP score and the reason. Ctrl-C or SIGTERM
+    stops every worker at once (exit 130): no run written, the chains so far kept in
+    the staging folders for ``--resume``, no candidate started after.
 
     Parameters
     ----------
@@ -159,13 +274,12 @@ def run_compare(
         :class:`~heritage_bayes.rundir.folder.OutputFolder`).
     workers : int, optional
         Candidates calibrated at the same time (default: one per core, at most one per
-        candidate; 1: one after the other in this process). This process calibrates
-        the largest model, which starts first so that the longest chain does not wait,
-        and ``workers - 1`` worker processes the others, each calibrating one
-        candidate and exiting: memory holds one model's calibration per process, and
-        no idle parent holds a copy of the libraries. The comparison then reads the
-        runs one at a time. Every candidate has its own seed-determined chain, so the
-        results do not depend on ``workers``.
+        candidate sampled; 1: one after the other in this process). Each runs in a
+        worker process of its own, the largest first, the next started as soon as one
+        ends; this process prints a line as each starts and ends and every minute
+        meanwhile. The comparison then reads the runs one at a time. Every candidate
+        has its own seed-determined chain from its screened MAP, so the results do not
+        depend on ``workers``.
 
     Raises
     ------
@@ -181,7 +295,7 @@ def run_compare(
     from heritage_bayes.errors import InputError
     from heritage_bayes.rundir import check_name
     from heritage_bayes.rundir.folder import OutputFolder
-    from heritage_bayes.rundir.writer import is_run_directory
+    from heritage_bayes.rundir.writer import RunWriter, is_run_directory
     from heritage_bayes.sources import input_paths
 
     section, names = _section_of(cfg, models)
@@ -190,61 +304,66 @@ def run_compare(
         out_dir = Path("reports") / check_name(f"{cfg.name or 'run'}-compare", what="name")
     if workers is not None and (isinstance(workers, bool) or int(workers) < 1):
         raise InputError(f"--workers: expected a whole number >= 1 (got {workers})")
-    n_workers = min(len(cands), int(workers) if workers else (os.cpu_count() or 1))
-    kwargs = dict(seed=seed, quiet=quiet, report=report, resume=resume, force=force)
+    kwargs = dict(quiet=quiet, report=report, resume=resume, force=force)
 
     def tell(msg: str) -> None:
         if not quiet:
             print(f"hbayes compare: {msg}", file=sys.stderr, flush=True)
 
+    if seed is not None:  # the screen's MAPs and the chains: the same seed
+        from heritage_bayes.config import MAX_SEED
+
+        if not 0 <= int(seed) <= MAX_SEED:
+            raise InputError(f"--seed: must be within 0..{MAX_SEED} (got {seed})")
+        cands = {n: c.model_copy(update={"seed": int(seed)}) for n, c in cands.items()}
     folder = OutputFolder(out_dir, kind="comparison", protect=input_paths(cfg), force=force)
     with folder:
         out = folder.path
         # a candidate's folder: new, its own run, or (--force) one the run writes beside
         folder.claim(*names, folders_from=lambda q: force or is_run_directory(q))
         folder.claim("comparison.json", "comparison.html")
+        for n in names:  # refuse a bad folder before any candidate starts
+            RunWriter(out / n, force=force, resume=resume).check()
+        tell(f"screening {', '.join(names)} by their MAP (validation FIT)")
+        rows, maps, scores = screen_candidates(cands, section, tell=tell)
+        verdicts = within_reach(scores, {n: r.get("n_params", 0) for n, r in rows.items()})
+        keep = [n for n in names if verdicts[n] is None]
+        for n in names:
+            if verdicts[n] is not None:
+                tell(f"{n}: {verdicts[n]}")
+        n_workers = min(len(keep), int(workers) if workers else (os.cpu_count() or 1))
         dirs = {}
         if n_workers <= 1:
-            for n, c in cands.items():
-                tell(f"calibrating {n}")
-                dirs[n] = run_calibration(c, out / n, **kwargs)
+            for n in keep:
+                tell(f"sampling {n}")
+                dirs[n] = run_calibration(
+                    cands[n], out / n, **kwargs, start_maps={section: maps[n]}
+                )
         else:
-            import multiprocessing
-            from concurrent.futures import ProcessPoolExecutor, as_completed
-
-            from heritage_bayes.run import RunWriter
-
-            for n in names:  # refuse a bad folder before any candidate starts
-                RunWriter(out / n, force=force, resume=resume).check()
-            order = sorted(cands, key=lambda n: -_n_free(cands[n], section))
-            # this process calibrates the largest candidate itself, and n_workers - 1
-            # worker processes the others: n_workers calibrations at once, as before,
-            # without a waiting parent that holds the libraries of a calibration (about
-            # 0.3 GB resident) on top of those of the workers (issue 28)
-            own, rest = order[0], order[1:]
-            tell(f"calibrating {', '.join(order)}, {n_workers} at a time ({own} in this process)")
-            ctx = multiprocessing.get_context("spawn")  # no forked numba/BLAS threads
-            pool_size = min(n_workers - 1, len(rest))
-            with ProcessPoolExecutor(pool_size, mp_context=ctx, max_tasks_per_child=1) as pool:
-                quiet_kw = {**kwargs, "quiet": True}
-                try:
-                    futs = {
-                        pool.submit(_worker_candidate, cands[n], str(out / n), quiet_kw): n
-                        for n in rest
-                    }
-                    run_dir, wall, cpu = _calibrate_candidate(cands[own], str(out / own), quiet_kw)
-                    dirs[own] = Path(run_dir)
-                    tell(f"{own} done ({wall:.0f} s wall, {cpu:.0f} s CPU)")
-                    release_memory()  # while the workers run on
-                    for f in as_completed(futs):
-                        run_dir, wall, cpu = f.result()
-                        dirs[futs[f]] = Path(run_dir)
-                        tell(f"{futs[f]} done ({wall:.0f} s wall, {cpu:.0f} s CPU)")
-                except BaseException:  # Ctrl-C, SIGTERM, a failed candidate: stop them all
-                    _stop_workers(pool)
-                    raise
-            dirs = {n: dirs[n] for n in names}
+            tell(f"sampling {', '.join(keep)}, {n_workers} at a time")
+            per = {n: {**kwargs, "start_maps": {section: maps[n]}} for n in keep}
+            dirs = _sample_parallel({n: cands[n] for n in keep}, out, per, n_workers, tell)
+        dirs = {n: dirs[n] for n in keep}
+        release_memory()
+        tell("comparing the posteriors (blocked LOO, validation ELPD)")
         result = compare_runs(dirs, section, seed=cfg.seed if seed is None else int(seed))
+        result["screen"] = {
+            "rule": f"each candidate's MAP scored by its validation FIT; sampled, simplest "
+            f"first: those within {REACH_FIT:g} points of the best that beat every simpler "
+            f"one sampled by more than {MARGIN_FIT:g} points; at least the best two",
+            "reach_fit": REACH_FIT,
+            "rows": [rows[n] for n in names],
+            "sampled": keep,
+        }
+        result["screened_out"] = {
+            n: {"model": n, "map_validation_fit": _finite(scores[n]), "reason": verdicts[n]}
+            for n in names
+            if verdicts[n] is not None
+        }
         result["config"] = {"name": cfg.name, "building": cfg.building, "room": cfg.room}
         write_comparison(result, out)
     return out
+
+
+def _finite(x: float) -> float | None:
+    return float(x) if x == x else None

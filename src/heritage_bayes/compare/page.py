@@ -194,6 +194,23 @@ def _quantity_rows(info: dict) -> list[list[str]]:
     return rows
 
 
+def screen_rows(result: dict) -> tuple[list[str], list[list[str]]]:
+    """The screen's table: each candidate's free parameters, calibration and validation
+    FIT of the simulation from its MAP, and whether it was sampled or why not."""
+    out = result.get("screened_out") or {}
+    rows = []
+    for r in (result.get("screen") or {}).get("rows", []):
+        fit = r.get("fit") or {}
+        cells = [
+            _f(next(iter((fit.get(p) or {}).values()), {}).get("FIT"), "{:.1f}")
+            for p in ("calibration", "validation")
+        ]
+        m = r.get("model", "?")
+        what = (out.get(m) or {}).get("reason") or r.get("error") or "sampled"
+        rows.append([m, _f(r.get("n_params"), "{:.0f}"), *cells, what])
+    return ["model", "free parameters", "MAP FIT cal [%]", "MAP FIT val [%]", "outcome"], rows
+
+
 def render_comparison(result: dict) -> str:
     """``comparison.html``: the house page with the trade-off figure and the tables."""
     from heritage_bayes._version import __version__
@@ -229,6 +246,10 @@ def render_comparison(result: dict) -> str:
         Section("Accuracy", _table(ha, ra), id="accuracy"),
         Section("Identifiability", _table(hi, ri), id="identifiability"),
     ]
+    if result.get("screen"):
+        hs, rs = screen_rows(result)
+        body = f"<p>{html.escape(result['screen']['rule'])}.</p>" + _table(hs, rs)
+        sections.append(Section("Screen (MAP)", body, id="screen"))
     for m, info in result["models"].items():
         p = info.get("periods") or {}
         per = "; ".join(

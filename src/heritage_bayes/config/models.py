@@ -66,7 +66,9 @@ class ModelSection(_Strict):
     model: str | dict[str, Any] = key(
         unit=None,
         description="a catalogue model (hbayes models lists them, e.g. thermal_2c, "
-        "hygric_2c) or an RC network given as a mapping",
+        "hygric_2c), 'auto' (the model ladder screened by MAP and validation FIT, the "
+        "simplest within 2 FIT points of the best sampled) or an RC network given as a "
+        "mapping",
     )
     options: dict[str, Any] = key(
         unit=None,

@@ -280,6 +280,9 @@ def find_map(logpost, **kwargs) -> MAPResult:
         every :data:`CHUNK` evaluations, a population of any size included).
     budget : str
         Names the budget in the message, e.g. ``"sampler.max_time = 30s"``.
+    start : (d,) array, optional
+        A point of the unit cube put into the first search's population and polished as
+        one more start (a nested simpler model's MAP: it adds a candidate, no more).
 
     Raises
     ------
@@ -305,13 +308,14 @@ def _find_map(
     restarts: int = 1,
     deadline: float | None = None,
     budget: str = "the time budget",
+    start: np.ndarray | None = None,
 ) -> MAPResult:
     """Implementation of :func:`find_map` (same parameters)."""
     if restarts < 1:
         raise ValueError(f"optimizer.restarts must be at least 1 (got {restarts})")
     obj = _Objective(logpost, deadline)
     try:
-        first = _search(logpost, obj, seed, method, popsize, maxiter, starts)
+        first = _search(logpost, obj, seed, method, popsize, maxiter, starts, start)
     except _OutOfTimeError as exc:
         d = logpost.params.ndim
         pop = f"a population of {popsize} × {d} = {popsize * d}" if method != "multistart" else ""
@@ -367,9 +371,10 @@ def _with_modes(found: list[MAPResult], objective) -> MAPResult:
     )
 
 
-def _search(logpost, obj, seed, method, popsize, maxiter, starts) -> MAPResult:
+def _search(logpost, obj, seed, method, popsize, maxiter, starts, start=None) -> MAPResult:
     d = logpost.params.ndim
     rng = np.random.default_rng(seed)
+    x0 = None if start is None else np.clip(np.asarray(start, dtype=float), 0.01, 0.99)
     if method == "differential_evolution":
         if obj.deadline is not None:  # a generation cannot be stopped once started
             gen = _generation_seconds(popsize * d)
@@ -390,6 +395,7 @@ def _search(logpost, obj, seed, method, popsize, maxiter, starts) -> MAPResult:
             updating="deferred",
             polish=False,
             init="latinhypercube",
+            x0=x0,
         )
         pop = np.asarray(res.population)
         energies = np.asarray(res.population_energies)
@@ -402,8 +408,10 @@ def _search(logpost, obj, seed, method, popsize, maxiter, starts) -> MAPResult:
                 cands.append(pop[i])
         while len(cands) < starts:  # population collapsed: perturb the best
             cands.append(np.clip(pop[order[0]] + rng.normal(0, 0.05, d), 0.01, 0.99))
+        if x0 is not None and min(np.abs(x0 - c).max() for c in cands) > 0.02:
+            cands.append(x0)
     elif method == "multistart":
-        cands = list(rng.uniform(0.02, 0.98, (max(starts, 1), d)))
+        cands = list(rng.uniform(0.02, 0.98, (max(starts, 1), d))) + ([] if x0 is None else [x0])
     else:
         raise ValueError(
             f"optimizer.method must be 'differential_evolution' or 'multistart' (got {method!r})"

@@ -315,7 +315,7 @@ def ladder_context(s: dict) -> dict | None:
             labels = ", ".join(map(str, r.get("null_directions") or []))
             out.append(
                 {
-                    "model": r.get("model", "?"),
+                    "model": r.get("model", "?") + (f" ({r['error']})" if r.get("error") else ""),
                     "n_params": n_text,
                     "rank": fmt_int(r.get("rank")),
                     "n_null": fmt_int(r.get("n_null")) + (f" ({labels})" if labels else ""),
@@ -333,8 +333,24 @@ def ladder_context(s: dict) -> dict | None:
                     "sampled": bool(r.get("sampled")),
                 }
             )
-        tables.append({"domain": domain, "rows": out})
+        tables.append({"domain": domain, "rows": out, "selection": _selection_text(s, domain)})
     return {"tables": tables, "figure": fig_ladder(ladder)}
+
+
+def _selection_text(s: dict, domain: str) -> str | None:
+    """``model: auto``: the model the screen chose, why, and the rule (None otherwise)."""
+    sel = (s.get("selection") or {}).get(domain)
+    if not sel:
+        return None
+    text = (
+        f"model: auto — {sel['choice']} chosen by the screen: {sel['reason']}. Rule: {sel['rule']}."
+    )
+    if sel.get("runner_up"):
+        text += (
+            f" {sel['runner_up']} is within the margin of it: `hbayes compare --models` "
+            "weighs the two by their posteriors."
+        )
+    return text
 
 
 def _fit_txt(v) -> str:

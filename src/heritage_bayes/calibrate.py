@@ -85,8 +85,14 @@ def _log_posterior(
     if initial_state is None:
         initial_state = initial_state_of(cfg, section, model)
     cal = prep.calibration
+    kind, extra = LogPosterior, {}
+    if prep.breaks is not None:  # input gaps too long to bridge: one start per segment
+        from heritage_bayes.inference.segments import SegmentedLogPosterior, calibration_segments
+
+        kind = SegmentedLogPosterior
+        extra = {"segments": tuple(calibration_segments(prep)[0]), "frame_breaks": prep.breaks}
     try:
-        return LogPosterior(
+        return kind(
             model,
             params,
             noise,
@@ -100,9 +106,32 @@ def _log_posterior(
             initial_state_horizon=getattr(cfg, section).horizon_seconds,
             time_constant_cap=getattr(cfg, section).cap_seconds(model.domain),
             temperature=getattr(cfg, section).temperature(model.domain, model.n_states),
+            **extra,
         )
     except ValueError as exc:
         raise InputError(f"{section}: {exc}") from None
+
+
+def _say_segments(say, prep) -> None:
+    """Console note on input gaps too long to bridge: the calibration's segments and
+    those dropped as too short."""
+    if prep.breaks is None:
+        return
+    from heritage_bayes.inference.segments import MIN_SEGMENT_HOURS, calibration_segments
+
+    kept, dropped = calibration_segments(prep)
+    idx, h = prep.frame.index[prep.calibration], prep.dt / 3600.0
+    say.say(
+        f"data: {int(prep.breaks.sum())} step(s) inside input gaps longer than data.max_gap "
+        f"are not simulated; the calibration is fitted over {len(kept)} segment(s) of "
+        + ", ".join(f"{(b - a) * h / 24:.1f} d" for a, b in kept)
+        + " (each with its own initial state)"
+    )
+    for a, b in dropped:
+        say.say(
+            f"data: calibration segment {idx[a]} to {idx[b - 1]} dropped: shorter than the "
+            f"warm-up plus {MIN_SEGMENT_HOURS:g} h between input gaps"
+        )
 
 
 @dataclass
@@ -260,6 +289,7 @@ def _calibrate_into(
         f"{prep.frame.index[0]} to {prep.frame.index[-1]} "
         f"(irradiance: {prep.irradiance_source})"
     )
+    _say_segments(say, prep)
     atomic_write_text(out / "config.yaml", config_yaml(cfg))
     if cfg.source_text is not None:  # the user's own file, comments and all
         atomic_write_text(out / "config.original.yaml", cfg.source_text)

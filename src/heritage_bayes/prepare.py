@@ -24,13 +24,12 @@ Conventions (those of :func:`~heritage_bayes.io.align`)
 Periods
 -------
 Dates in the config are UTC unless they carry an offset. The frame spans the earliest
-start to the latest end of the calibration and validation periods; the simulation runs
-continuously over the whole frame, except across input gaps longer than ``data.max_gap``
-(:attr:`Prepared.breaks`: the record splits there into segments). Without ``periods``, the frame is the common period of
-all inputs and measurements, its first 2/3 (rounded to whole rows) the calibration period
-and the rest the validation period. Period boundaries that do not fall on the grid are
-rounded up to the next row. ``warmup_steps`` (from ``periods.warmup``) are the first rows
-of the calibration period, simulated but excluded from the likelihood by the caller.
+start to the latest end of the periods; the simulation runs over the whole frame except
+inside input gaps longer than ``data.max_gap`` (:attr:`Prepared.breaks`: the record splits
+there into segments). Without ``periods``: the common period of all inputs and
+measurements, its first 2/3 (whole rows) for calibration, the rest for validation. Period
+bounds off the grid are rounded up to the next row. ``warmup_steps`` (``periods.warmup``):
+the first rows of the calibration period, simulated but not fitted.
 
 Ground temperature ``Tf``
 -------------------------
@@ -472,6 +471,7 @@ def prepare(cfg) -> Prepared:
         period_note = "default: first 2/3 of the common period of all data, then the rest"
     dt = float(step.total_seconds())
     from heritage_bayes.models import default_warmup
+
     warmup = per.warmup if per.warmup is not None else default_warmup(cfg)
     warmup_steps = math.ceil(warmup / step - 1e-9)
     init_steps = math.ceil(per.init_window / step - 1e-9)

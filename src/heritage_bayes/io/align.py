@@ -481,7 +481,6 @@ def align(
     return Aligned(frame, flags, report, in_names, out_names, slopes, breaks)
 
 
-
 def _slopes(series: _Input, values: np.ndarray, edges: np.ndarray) -> np.ndarray:
     """Change of an instantaneous input over each bin, ``u(edges[k+1]) - u(edges[k])``,
     on its linear interpolation between samples; zero for an interval mean (constant

@@ -12,7 +12,6 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-
 from heritage_bayes.io._common import format_timedelta, to_jsonable
 
 __all__ = ["Aligned", "AlignmentReport", "Gap"]

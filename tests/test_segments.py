@@ -154,3 +154,47 @@ def test_prepare_splits_a_long_weather_gap(tmp_path):
     assert [(g["column"], g["n_missing"]) for g in gaps] == [("Te", 35), ("Pe", 35)]
     kept, dropped = calibration_segments(prep)
     assert len(kept) == 2 and not dropped
+
+
+def test_init_proposes_the_year_across_an_outage(tmp_path):
+    """A year of an FMI-style weather file with a 35-hour outage in April and a HOBO
+    export with the logger silent for 35 hours in June: init proposes the calendar year
+    (8 months to calibrate, 4 to validate, the coverage in the comment), not the longest
+    stretch without a gap (April to February), and calibrate's data layer accepts it."""
+    import sys
+
+    import yaml
+
+    sys.path.insert(0, str(Path(__file__).parent))
+    from test_init_detect import _climate, _data, _hobo
+
+    from heritage_bayes.init_config import init_config
+
+    utc, te, ti, rh, ghi = _climate("2021-01-01", "2022-02-01", 25.0)
+    wall = utc.tz_localize(None) + pd.Timedelta(hours=2)
+    out_w = (utc >= "2021-04-12 07:00") & (
+        utc < pd.Timestamp("2021-04-12 07:00", tz="UTC") + pd.Timedelta(hours=35)
+    )
+    wp = _data(tmp_path) / "fmi.csv"
+    pd.DataFrame(
+        {"t_UTC+2": wall.strftime("%Y-%m-%d %H:%M:%S"), "Te": te.round(2), "RHe": rh.round(1),
+         "Rglob": ghi}
+    )[~out_w].to_csv(wp, index=False)  # fmt: skip
+    out_l = (utc >= "2021-06-20 00:00") & (utc < "2021-06-21 11:00")
+    lp = _hobo(_data(tmp_path) / "logger.csv", wall[~out_l], ti[~out_l], rh[~out_l], "+02:00")
+    out = tmp_path / "room" / "config.yaml"
+    res = init_config(lp, wp, output=out, latitude=60.0, longitude=25.0)
+    assert res.questions == []
+    raw = yaml.safe_load(out.read_text(encoding="utf-8"))
+    per = {k: (str(v["start"]), str(v["end"])) for k, v in raw["periods"].items() if k != "warmup"}
+    assert per == {
+        "calibration": ("2021-01-01", "2021-09-01"),
+        "validation": ("2021-09-01", "2022-01-01"),
+    }, per
+    text = out.read_text(encoding="utf-8")
+    assert "a logger reading in 99.6% of the hours, a weather reading in 99.6%" in text
+    raw.pop("hygric", None)  # the periods are what is tested here
+    cfg = parse_config(raw, base_dir=str(out.parent), name="room")
+    prep = prepare(cfg)
+    kept, dropped = calibration_segments(prep)
+    assert len(kept) == 2 and not dropped  # split at the weather's outage

@@ -57,10 +57,10 @@ from heritage_bayes.init_checks import (
     clock_step,
     heating_floor,
     logger_clock,
-    longest_stretch,
     marked,
     present_hours,
     to_utc,
+    usable_span,
     weather_clock,
 )
 from heritage_bayes.init_columns import fahrenheit_column_check, rh_column_check, usable
@@ -456,7 +456,7 @@ def init_config(
             "altitude": 0,
         }
     try:
-        s, e, gap_notes = longest_stretch(ti_utc, te_utc)
+        s, e, span, gap_notes = usable_span(ti_utc, te_utc)
     except DataError as exc:
         typical = (
             " (a typical year cannot calibrate a room: use the weather measured over "
@@ -465,10 +465,7 @@ def init_config(
             else ""
         )
         raise DataError(f"{indoor.name}, {weather.name}: {exc}{typical}") from None
-    findings.append(
-        f"overlap: longest stretch without a gap over {MAX_GAP_H} h: "
-        f"{s:%Y-%m-%d %H:%M} to {e:%Y-%m-%d %H:%M} UTC"
-    )
+    findings.append(f"overlap: {span}: {s:%Y-%m-%d %H:%M} to {e:%Y-%m-%d %H:%M} UTC")
     findings += [f"overlap: {g}" for g in gap_notes]
     floor, held, ndays = heating_floor(ti_utc, te_utc)
     heated = held >= max(20, 0.05 * ndays)
@@ -488,7 +485,7 @@ def init_config(
             "`hbayes init` again (--timezone, --weather-timezone) chooses them on UTC"
         )
     # the inputs must hold a reading at both ends of the periods (the outputs need not)
-    cs, ce, vs, ve, why = choose_periods(s, e, present_hours(te_utc, te_utc))
+    cs, ce, vs, ve, why = choose_periods(s, e, present_hours(te_utc, te_utc), span)
     findings.append(f"periods: {why}")
     # an RH column that needs an answer keeps the hygric section: answered, it runs
     rhe_open = wlay is not None and str(wcols.get("RHe", "")).startswith(MARK)

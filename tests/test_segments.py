@@ -187,3 +187,30 @@ def test_init_proposes_the_year_across_an_outage(tmp_path):
     prep = prepare(cfg)
     kept, dropped = calibration_segments(prep)
     assert len(kept) == 2 and not dropped  # split at the weather's outage
+
+
+def test_a_short_segment_is_dropped_with_a_note(tmp_path):
+    """A calibration that starts 43 hours before a weather outage: that piece (shorter
+    than the 2-day warm-up plus 48 h) is dropped, the console says so, and the
+    calibration is fitted over the rest."""
+    from heritage_bayes.calibrate import _say_segments
+
+    _write_files(tmp_path, weather_gap=35)
+    raw = _csv_config(tmp_path)
+    raw["periods"]["calibration"]["start"] = "2020-01-20"
+    prep = prepare(_load(tmp_path, raw))
+    kept, dropped = calibration_segments(prep)
+    assert len(kept) == 1 and dropped == [(0, 43)]
+    lines = []
+
+    class Say:
+        def say(self, text):
+            lines.append(text)
+
+    _say_segments(Say(), prep)
+    assert "1 segment(s) of 8.7 d" in lines[0]
+    assert lines[1].startswith("data: calibration segment 2020-01-20 00:00 to 2020-01-21 18:00")
+    cfg = _load(tmp_path, raw)
+    lp = _log_posterior(cfg, prep, "thermal", build_model(cfg, "thermal"), cfg.thermal.priors)
+    assert lp.segments == tuple(kept)
+    assert np.isnan(lp.observed[:43]).all()

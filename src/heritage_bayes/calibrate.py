@@ -129,8 +129,8 @@ def _say_segments(say, prep) -> None:
     )
     for a, b in dropped:
         say.say(
-            f"data: calibration segment {idx[a]} to {idx[b - 1]} dropped: shorter than the "
-            f"warm-up plus {MIN_SEGMENT_HOURS:g} h between input gaps"
+            f"data: calibration segment {idx[a]:%Y-%m-%d %H:%M} to {idx[b - 1]:%Y-%m-%d %H:%M} "
+            f"UTC dropped: shorter than the warm-up plus {MIN_SEGMENT_HOURS:g} h between gaps"
         )
 
 

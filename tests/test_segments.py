@@ -109,6 +109,7 @@ def test_segments_likelihood_is_the_sum_of_single_segment_likelihoods(demo):
         for a, b in lp.segments
     ]  # fmt: skip
     total = singles[0].log_likelihood(theta) + singles[1].log_likelihood(theta)
+    assert np.isfinite(total).all()
     np.testing.assert_allclose(lp.log_likelihood(theta), total, rtol=1e-12)
     # the frame's simulation: nothing inside the gap, each segment from its own start
     Ys = lp.simulate_frame(theta[:1], gp.model_inputs("thermal", model), gp.calibration.start)[0]
@@ -214,3 +215,37 @@ def test_a_short_segment_is_dropped_with_a_note(tmp_path):
     lp = _log_posterior(cfg, prep, "thermal", build_model(cfg, "thermal"), cfg.thermal.priors)
     assert lp.segments == tuple(kept)
     assert np.isnan(lp.observed[:43]).all()
+
+
+def test_a_controlled_room_restarts_steady_after_a_gap():
+    """A thermostat (nonlinear, ``initial_state: steady`` with a warm-up): each segment
+    its own warm-up and steady start; the sum of the segments' likelihoods."""
+    import heritage_bayes as hb
+    from heritage_bayes.inference.likelihoods import get_noise_model
+    from heritage_bayes.inference.parameters import parameters_for
+
+    rng = np.random.default_rng(5)
+    N = 24 * 40
+    k = np.arange(N)
+    te = 2 + 6 * np.sin(2 * np.pi * k / 24) + 3 * np.sin(2 * np.pi * k / 240)
+    m = hb.model("thermal_2c", surfaces=(), ground=False, thermostat=True)
+    truth = {"Cw": 5e7, "Ci": 5e6, "Gw": 150.0, "Gi": 400.0, "Gfast": 60.0, "Tset": 12.0}
+    truth = {n: truth.get(n, 1000.0) for n in m.parameter_names}
+    y = hb.simulate(m, truth, te[:, None])[:, 0] + 0.1 * rng.standard_normal(N)
+    noise = get_noise_model("iid")
+    ps = parameters_for(m, noise, {n: {"fixed": v} for n, v in truth.items()})
+    segs = ((0, 400), (440, N))
+    lp = SegmentedLogPosterior(
+        m, ps, noise, te[:, None], y[:, None], warmup=48, init_window=24, segments=segs
+    )
+    theta = np.array([[*truth.values(), 0.1]])
+    single = [
+        LogPosterior(m, ps, noise, te[a:b, None], y[a:b, None], warmup=48, init_window=24)
+        for a, b in segs
+    ]
+    total = sum(p.log_likelihood(theta) for p in single)
+    assert np.isfinite(total).all()
+    np.testing.assert_allclose(lp.log_likelihood(theta), total, rtol=1e-12)
+    Y = lp.simulate_frame(theta, te[:, None], 0)[0][0, :, 0]
+    assert np.isnan(Y[400:440]).all() and np.isfinite(Y[:400]).all()
+    assert np.nanmax(np.abs(Y[488:] - y[488:])) < 1.0  # after its warm-up: on the room

@@ -5,7 +5,7 @@ with :func:`~heritage_bayes.io.loggers.inspect_table`, the clocks with
 :mod:`heritage_bayes.io.clock`), decides what it can — time column and format, the clock
 of each file checked against the sun and the outdoor daily cycle, the columns of
 temperature, relative humidity and irradiance and their units, the step, the gaps, the
-longest stretch of overlapping data for the calibration and validation periods, the
+usable span of overlapping data for the calibration and validation periods, the
 models to start with — and writes a ``config.yaml`` whose comments say what was guessed
 and why. What it cannot decide becomes a marked question (a value starting with ``??``,
 see :mod:`heritage_bayes.questions`) that ``hbayes calibrate`` refuses until answered.
@@ -20,11 +20,14 @@ and ``tests/test_init.py``):
   left fI_N unidentified, and its MAP validation FIT of Ti was 76.7 % against 78.0 % with
   H (calibration Dec 2010-Aug 2011, validation Aug-Dec 2011; 4 facades also sampled
   slowly: τmax 141 after 13 000 steps, stopped).
-* **Periods**: chosen after the clocks, on UTC: the first whole calendar year of the
-  longest stretch without a gap over 6 h (all seasons; 8 months to calibrate, 4 to
-  validate), else its first whole 12 months, else 2/3 and 1/3 of it; never starting or
-  ending in a gap. While a clock is an open question they keep 14 h (the largest
-  offset) inside the stretch, so that any answer keeps them inside the data.
+* **Periods**: chosen after the clocks, on UTC, in the usable span
+  (:func:`~heritage_bayes.init_checks.usable_span`: the overlap of the files, else its
+  most recent 12 months, with readings in 70 % of the hours from each file): its first
+  whole calendar year (all seasons; 8 months to calibrate, 4 to validate), else its
+  first whole 12 months, else 2/3 and 1/3 of it; spanning gaps (the calibration splits
+  at those over ``data.max_gap``) but never starting or ending in one. While a clock is
+  an open question they keep 14 h (the largest offset) inside the span, so that any
+  answer keeps them inside the data.
 * **Models**: what the data call for (:mod:`heritage_bayes.init_model`): the control
   (thermostat, humidistat band, a constant gain), the vapour sink or the sorbing buffer
   each from a measured signature, two thermal nodes from 60 days of calibration data;

@@ -94,7 +94,12 @@ class SegmentedLogPosterior(LogPosterior):
                 segs.append((int(a), int(b)))
                 fitted[a + self.warmup : b] = True
         if not segs:
-            raise ValueError("no observations left in any segment after the warm-up")
+            raise ValueError(
+                "no part of the calibration period between input gaps longer than "
+                f"data.max_gap is long enough (the warm-up plus {MIN_SEGMENT_HOURS:g} h) and "
+                "holds observations: choose a calibration period with fewer gaps, or raise "
+                "data.max_gap to bridge them by interpolation"
+            )
         self.segments = tuple(segs)
         self.parts = [
             LogPosterior(

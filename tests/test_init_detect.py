@@ -183,7 +183,8 @@ def _hobo(path: Path, stamps, ti, rh, gmt: str) -> Path:
 def test_periods_stay_inside_the_data_whatever_the_answer_to_an_open_clock(tmp_path):
     """A weather file that names no clock (kept on UTC-2, no irradiance) with a 35-hour
     outage: its clock is a question, and the periods init proposes stay inside the data
-    once it is answered (they used to start inside the outage: calibrate refused)."""
+    once it is answered (they used to start inside the outage: calibrate refused; now they
+    span it)."""
     import yaml
 
     from heritage_bayes.config import parse_config
@@ -202,11 +203,13 @@ def test_periods_stay_inside_the_data_whatever_the_answer_to_an_open_clock(tmp_p
     assert [q.split(":")[0] for q in res.questions] == ["data.weather.timezone"]
     assert any("a clock is still an open question" in f for f in res.findings)
     raw = yaml.safe_load(out.read_text(encoding="utf-8"))
-    # the outage ends 2021-03-07 00:00 on the file's clock: 14 h margin, next midnight
-    assert str(raw["periods"]["calibration"]["start"]) == "2021-03-08"
+    # the data start 2021-03-01 00:00 on the file's clock: 14 h margin, next midnight;
+    # the periods span the outage (a gap splits the record into segments)
+    assert str(raw["periods"]["calibration"]["start"]) == "2021-03-02"
     for answer in ("UTC-2", "UTC+12", "UTC-12"):
         raw["data"]["weather"]["timezone"] = answer
-        prepare(parse_config(raw, base_dir=str(out.parent), name="room"))  # no DataError
+        prep = prepare(parse_config(raw, base_dir=str(out.parent), name="room"))
+        assert prep.breaks.sum() >= 35  # the outage: not simulated, no DataError
 
 
 def test_periods_never_start_in_a_short_gap():

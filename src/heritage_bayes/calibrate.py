@@ -87,6 +87,28 @@ def check_models(cfg: CalibrationConfig) -> None:
 _log_posterior = section_log_posterior
 
 
+def _say_segments(say, prep) -> None:
+    """Console note on input gaps too long to bridge: the calibration's segments and
+    those dropped as too short."""
+    if prep.breaks is None:
+        return
+    from heritage_bayes.inference.segments import MIN_SEGMENT_HOURS, calibration_segments
+
+    kept, dropped = calibration_segments(prep)
+    idx, h = prep.frame.index[prep.calibration], prep.dt / 3600.0
+    say.say(
+        f"data: {int(prep.breaks.sum())} step(s) inside input gaps longer than data.max_gap "
+        f"are not simulated; the calibration is fitted over {len(kept)} segment(s) of "
+        + ", ".join(f"{(b - a) * h / 24:.1f} d" for a, b in kept)
+        + " (each with its own initial state)"
+    )
+    for a, b in dropped:
+        say.say(
+            f"data: calibration segment {idx[a]:%Y-%m-%d %H:%M} to {idx[b - 1]:%Y-%m-%d %H:%M} "
+            f"UTC dropped: shorter than the warm-up plus {MIN_SEGMENT_HOURS:g} h between gaps"
+        )
+
+
 @dataclass
 class _Section:
     name: str
@@ -260,6 +282,7 @@ def _calibrate_into(
         f"{prep.frame.index[0]} to {prep.frame.index[-1]} "
         f"(irradiance: {prep.irradiance_source})"
     )
+    _say_segments(say, prep)
     end = None if cfg.sampler.max_seconds is None else t_start + cfg.sampler.max_seconds
     # model: auto: the ladder's MAP screen chooses the model sampled (heritage_bayes.selection)
     cfg, screens = _select_models(cfg, prep, say, end)

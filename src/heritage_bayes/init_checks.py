@@ -1,5 +1,5 @@
 """The checks behind ``hbayes init`` (:mod:`heritage_bayes.init_config`): the clocks of
-the two files, the longest stretch of overlapping data, the periods, a heating floor.
+the two files, the usable span of overlapping data, the periods, a heating floor.
 
 Each returns what it found and, when it cannot decide, a question (text; the writer marks
 it with :data:`heritage_bayes.questions.MARK`).
@@ -29,11 +29,15 @@ __all__ = [
     "present_hours",
     "raw_table",
     "to_utc",
+    "usable_span",
     "weather_clock",
 ]
 
 #: Longest gap [h] bridged inside a period (the config's ``data.max_gap``).
 MAX_GAP_H = 6
+#: Least share of the hours with a reading, of the logger and of the weather each, in the
+#: span init proposes: gaps inside it split the record (each segment its own start).
+MIN_COVERAGE = 0.7
 #: A stretch this long [days] or longer is split 8 months / 4 months (a year); shorter
 #: ones 2/3 / 1/3.
 YEAR_DAYS = 365
@@ -242,6 +246,56 @@ def longest_stretch(ti: pd.Series, te: pd.Series) -> tuple[pd.Timestamp, pd.Time
     return both[starts[k]], both[ends[k]] + pd.Timedelta(hours=1), notes
 
 
+def usable_span(ti: pd.Series, te: pd.Series) -> tuple[pd.Timestamp, pd.Timestamp, str, list]:
+    """The span ``[start, end)`` [UTC] init proposes periods in (:func:`choose_periods`)
+    and what it is, with the share of the hours with a reading of the logger (``ti``) and
+    of the weather (``te``) over those periods: the whole overlap of the files when the
+    periods chosen in it have at least :data:`MIN_COVERAGE` of each; else the most recent
+    12 months that have; else the longest stretch without a gap over :data:`MAX_GAP_H`
+    hours (:func:`longest_stretch`). Gaps inside are normal: the calibration splits the
+    record at those too long to bridge. Returns (start, end, what, notes on the gaps).
+
+    Raises
+    ------
+    DataError
+        The files overlap in fewer than 48 hours (see :func:`longest_stretch`).
+    """
+    s, e, notes = longest_stretch(ti, te)
+    hi_t, hi_e = ti.dropna().index.floor("h"), te.dropna().index.floor("h")
+    lo = max(hi_t.min(), hi_e.min()).ceil("D")
+    hi = (min(hi_t.max(), hi_e.max()) + pd.Timedelta(hours=1)).floor("D")
+    if hi - lo < pd.Timedelta(days=2):
+        return s, e, f"the longest stretch without a gap over {MAX_GAP_H} h", notes
+    hours = pd.date_range(lo, hi, freq="h", inclusive="left")
+    cum = [np.r_[0, np.cumsum(hours.isin(h))] for h in (hi_t.unique(), hi_e.unique())]
+
+    def coverage(start, end) -> list[float]:
+        i, j = hours.searchsorted(start), hours.searchsorted(end)
+        return [(c[j] - c[i]) / max(j - i, 1) for c in cum]
+
+    def what(label, cov):
+        return (
+            f"{label} (a logger reading in {cov[0]:.1%} of the hours, a weather reading in "
+            f"{cov[1]:.1%}; a gap over {MAX_GAP_H} h splits the record, each part with its "
+            "own initial state)"
+        )
+
+    cs, _, _, ve, _ = choose_periods(lo, hi)
+    cov = coverage(pd.Timestamp(cs, tz="UTC"), pd.Timestamp(ve, tz="UTC"))
+    if min(cov) >= MIN_COVERAGE:
+        return lo, hi, what("the overlap of the files", cov), notes
+    for end in pd.date_range(lo, hi, freq="D")[::-1]:  # the latest 12 months first
+        start = end - pd.DateOffset(years=1)
+        if start < lo:
+            break
+        if min(cov := coverage(start, end)) >= MIN_COVERAGE:
+            return start, end, what("the most recent 12 months with data", cov), notes
+    return s, e, (
+        f"the longest stretch without a gap over {MAX_GAP_H} h (no year with "
+        f"{MIN_COVERAGE:.0%} of the hours from both files)"
+    ), notes  # fmt: skip
+
+
 def present_hours(ti: pd.Series, te: pd.Series) -> pd.DatetimeIndex:
     """The hours [UTC] in which both ``ti`` and ``te`` have a value, sorted."""
     a = ti.dropna().index.floor("h").unique()
@@ -269,7 +323,10 @@ def heating_floor(ti: pd.Series, te: pd.Series) -> tuple[float, int, int]:
 
 
 def choose_periods(
-    s: pd.Timestamp, e: pd.Timestamp, present: pd.DatetimeIndex | None = None
+    s: pd.Timestamp,
+    e: pd.Timestamp,
+    present: pd.DatetimeIndex | None = None,
+    span: str = "the longest stretch",
 ) -> tuple[str, str, str, str, str]:
     """Calibration ``[start, mid)`` and validation ``[mid, end)`` in whole UTC days
     within the stretch ``[s, e)``, and why: the first whole calendar year (8 months to
@@ -277,7 +334,8 @@ def choose_periods(
     stretch's first 2/3 and the rest. With ``present`` (the hours with an input
     reading), the start and the end are midnights with a reading: a period never starts
     or ends inside an input gap (or after the last reading), which the simulation
-    cannot bridge. Returns ``(start, mid, mid, end, why)`` as text."""
+    cannot bridge. ``span`` says what ``[s, e)`` is, for ``why``. Returns ``(start, mid,
+    mid, end, why)`` as text."""
     day = pd.Timedelta(days=1)
     s0 = s.ceil("D")
     e0 = e.floor("D")
@@ -292,13 +350,14 @@ def choose_periods(
         mid = s0 + pd.DateOffset(months=8)
         what = "calendar year" if (s0.month, s0.day) == (1, 1) else "year"
         why = (
-            f"the first whole {what} of the longest stretch (all seasons): 8 months to "
-            "calibrate, 4 to validate"
+            f"the first whole {what} of {span}: 8 months to calibrate, 4 to validate (all seasons)"
+            if not span.startswith("the most recent")
+            else f"{span}: 8 months to calibrate, the next 4 to validate (all seasons)"
         )
     else:
         end = e0
         mid = s0 + day * round((e0 - s0).days * 2 / 3)
-        why = "the longest stretch: its first 2/3 to calibrate, the rest to validate"
+        why = f"{span}: its first 2/3 to calibrate, the rest to validate"
     if present is not None and len(present):  # no start or end inside a short gap
         have = set(present)
         moved = s0

@@ -5,7 +5,7 @@ with :func:`~heritage_bayes.io.loggers.inspect_table`, the clocks with
 :mod:`heritage_bayes.io.clock`), decides what it can — time column and format, the clock
 of each file checked against the sun and the outdoor daily cycle, the columns of
 temperature, relative humidity and irradiance and their units, the step, the gaps, the
-longest stretch of overlapping data for the calibration and validation periods, the
+usable span of overlapping data for the calibration and validation periods, the
 models to start with — and writes a ``config.yaml`` whose comments say what was guessed
 and why. What it cannot decide becomes a marked question (a value starting with ``??``,
 see :mod:`heritage_bayes.questions`) that ``hbayes calibrate`` refuses until answered.
@@ -21,11 +21,14 @@ and ``tests/test_init.py``):
   H (calibration Dec 2010-Aug 2011, validation Aug-Dec 2011; 4 facades also sampled
   slowly: τmax 141 after 13 000 steps, stopped). A room that looks like an attic gets
   its roof's two slopes instead (``data.roof``, :mod:`heritage_bayes.init_roof`).
-* **Periods**: chosen after the clocks, on UTC: the first whole calendar year of the
-  longest stretch without a gap over 6 h (all seasons; 8 months to calibrate, 4 to
-  validate), else its first whole 12 months, else 2/3 and 1/3 of it; never starting or
-  ending in a gap. While a clock is an open question they keep 14 h (the largest
-  offset) inside the stretch, so that any answer keeps them inside the data.
+* **Periods**: chosen after the clocks, on UTC, in the usable span
+  (:func:`~heritage_bayes.init_checks.usable_span`: the overlap of the files, else its
+  most recent 12 months, with readings in 70 % of the hours from each file): its first
+  whole calendar year (all seasons; 8 months to calibrate, 4 to validate), else its
+  first whole 12 months, else 2/3 and 1/3 of it; spanning gaps (the calibration splits
+  at those over ``data.max_gap``) but never starting or ending in one. While a clock is
+  an open question they keep 14 h (the largest offset) inside the span, so that any
+  answer keeps them inside the data.
 * **Models**: what the data call for (:mod:`heritage_bayes.init_model`): the control
   (thermostat, humidistat band, a constant gain), the vapour sink or the sorbing buffer
   each from a measured signature, two thermal nodes from 60 days of calibration data;
@@ -58,10 +61,10 @@ from heritage_bayes.init_checks import (
     clock_step,
     heating_floor,
     logger_clock,
-    longest_stretch,
     marked,
     present_hours,
     to_utc,
+    usable_span,
     weather_clock,
 )
 from heritage_bayes.init_columns import fahrenheit_column_check, rh_column_check, usable
@@ -458,7 +461,7 @@ def init_config(
             "altitude": 0,
         }
     try:
-        s, e, gap_notes = longest_stretch(ti_utc, te_utc)
+        s, e, span, gap_notes = usable_span(ti_utc, te_utc)
     except DataError as exc:
         typical = (
             " (a typical year cannot calibrate a room: use the weather measured over "
@@ -467,10 +470,7 @@ def init_config(
             else ""
         )
         raise DataError(f"{indoor.name}, {weather.name}: {exc}{typical}") from None
-    findings.append(
-        f"overlap: longest stretch without a gap over {MAX_GAP_H} h: "
-        f"{s:%Y-%m-%d %H:%M} to {e:%Y-%m-%d %H:%M} UTC"
-    )
+    findings.append(f"overlap: {span}: {s:%Y-%m-%d %H:%M} to {e:%Y-%m-%d %H:%M} UTC")
     findings += [f"overlap: {g}" for g in gap_notes]
     floor, held, ndays = heating_floor(ti_utc, te_utc)
     heated = held >= max(20, 0.05 * ndays)
@@ -490,7 +490,7 @@ def init_config(
             "`hbayes init` again (--timezone, --weather-timezone) chooses them on UTC"
         )
     # the inputs must hold a reading at both ends of the periods (the outputs need not)
-    cs, ce, vs, ve, why = choose_periods(s, e, present_hours(te_utc, te_utc))
+    cs, ce, vs, ve, why = choose_periods(s, e, present_hours(te_utc, te_utc), span)
     findings.append(f"periods: {why}")
     # an RH column that needs an answer keeps the hygric section: answered, it runs
     rhe_open = wlay is not None and str(wcols.get("RHe", "")).startswith(MARK)

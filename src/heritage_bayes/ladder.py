@@ -32,8 +32,14 @@ def section_log_posterior(
     if initial_state is None:
         initial_state = initial_state_of(cfg, section, model)
     cal = prep.calibration
+    kind, extra = LogPosterior, {}
+    if getattr(prep, "breaks", None) is not None:  # gaps too long to bridge: one start each
+        from heritage_bayes.inference.segments import SegmentedLogPosterior, calibration_segments
+
+        kind = SegmentedLogPosterior
+        extra = {"segments": tuple(calibration_segments(prep)[0]), "frame_breaks": prep.breaks}
     try:
-        return LogPosterior(
+        return kind(
             model,
             params,
             noise,
@@ -47,6 +53,7 @@ def section_log_posterior(
             initial_state_horizon=getattr(cfg, section).horizon_seconds,
             time_constant_cap=getattr(cfg, section).cap_seconds(model.domain),
             temperature=getattr(cfg, section).temperature(model.domain, model.n_states),
+            **extra,
         )
     except ValueError as exc:
         raise InputError(f"{section}: {exc}") from None

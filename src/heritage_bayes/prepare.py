@@ -24,12 +24,12 @@ Conventions (those of :func:`~heritage_bayes.io.align`)
 Periods
 -------
 Dates in the config are UTC unless they carry an offset. The frame spans the earliest
-start to the latest end of the calibration and validation periods; the simulation runs
-continuously over the whole frame. Without ``periods``, the frame is the common period of
-all inputs and measurements, its first 2/3 (rounded to whole rows) the calibration period
-and the rest the validation period. Period boundaries that do not fall on the grid are
-rounded up to the next row. ``warmup_steps`` (from ``periods.warmup``) are the first rows
-of the calibration period, simulated but excluded from the likelihood by the caller.
+start to the latest end of the periods; the simulation runs over the whole frame except
+inside input gaps longer than ``data.max_gap`` (:attr:`Prepared.breaks`: the record splits
+there into segments). Without ``periods``: the common period of all inputs and
+measurements, its first 2/3 (whole rows) for calibration, the rest for validation. Period
+bounds off the grid are rounded up to the next row. ``warmup_steps`` (``periods.warmup``):
+the first rows of the calibration period, simulated but not fitted.
 
 Ground temperature ``Tf``
 -------------------------
@@ -76,9 +76,7 @@ __all__ = [
 _SECTIONS = ("thermal", "hygric")
 
 
-# ---------------------------------------------------------------------------------------
-# The result
-# ---------------------------------------------------------------------------------------
+# -- the result -------------------------------------------------------------------------
 
 
 @dataclass
@@ -107,6 +105,9 @@ class Prepared:
     irradiance_source : str
         ``"measured"``, ``"estimated from the daily Te range (Hargreaves-Samani)"``,
         ``"clear-sky proxy (pvlib Ineichen)"``, ``"none"``, or the demo's description.
+    breaks : numpy.ndarray or None
+        (N,) bool: rows inside an input gap longer than ``data.max_gap``, where the record
+        splits into segments (:mod:`heritage_bayes.inference.segments`); None: no such gap.
     truth : dict or None
         Demo only: ``{"thermal": {name: value}, "hygric": {...}}``, the true parameters
         and the **nominal** noise parameters (``sigma_Ti``, ``phi_Ti``, ``sigma_Pi``,
@@ -128,6 +129,7 @@ class Prepared:
     irradiance_source: str
     truth: dict | None = None
     sources: dict = field(default_factory=dict)
+    breaks: np.ndarray | None = None
 
     @property
     def n_rows(self) -> int:
@@ -242,7 +244,6 @@ def _output_hint(missing: Sequence[str]) -> str:
     return "; ".join(hints) or "unknown output"
 
 
-# ---------------------------------------------------------------------------------------
 def _extra_inputs(cfg) -> list[str]:
     """Model inputs beyond those built here (Te, Pe, Tf, I_<surface>), in model order."""
     from heritage_bayes.models import build_model  # the models decide their inputs
@@ -262,8 +263,7 @@ def _extra_inputs(cfg) -> list[str]:
     return extra
 
 
-# Periods
-# ---------------------------------------------------------------------------------------
+# -- periods ----------------------------------------------------------------------------
 
 
 def _utc(text: str) -> pd.Timestamp:
@@ -276,9 +276,7 @@ def _rows(t: pd.Timestamp, start: pd.Timestamp, step: pd.Timedelta) -> int:
     return math.ceil((t - start) / step - 1e-9)
 
 
-# ---------------------------------------------------------------------------------------
-# prepare
-# ---------------------------------------------------------------------------------------
+# -- prepare ----------------------------------------------------------------------------
 
 
 def _check_models_vs_irradiance(cfg) -> None:
@@ -384,6 +382,7 @@ def prepare(cfg) -> Prepared:
             max_gap=data.max_gap,
             start=start,
             end=end,
+            long_gaps="split",
         )
     except DataError as exc:
         what = (
@@ -530,6 +529,7 @@ def prepare(cfg) -> Prepared:
         irradiance_source=irradiance_source,
         truth=truth,
         sources=to_jsonable(sources),
+        breaks=aligned.breaks if aligned.breaks.any() else None,
     )
 
 

@@ -189,7 +189,8 @@ class Data(_Strict):
     max_gap: NonNegativeDuration = key(
         "6h",
         unit=DURATION_UNIT,
-        description="longest input gap filled by interpolation",
+        description="longest input gap filled by interpolation; a longer one splits the "
+        "record into segments, each simulated from its own initial state",
         validate_default=True,
     )
     input_hold: Literal["exact", "interval_mean"] | None = key(

@@ -34,13 +34,17 @@ class Periods(_Strict):
     """Calibration and validation periods, warm-up and initial-state window.
 
     Default (no periods): the common period of all data, its first 2/3 for calibration
-    and the rest for validation. ``warmup``: the first part of the calibration period
-    simulated but excluded from the likelihood. Default: none when every model estimates
-    its initial state (``initial_state: estimate``, the default of linear models), 14
-    days when one starts from the steady state (a controlled room, or
-    ``initial_state: steady``). ``init_window``: the mean inputs over the first
-    ``init_window`` give the steady state that is the initial state's prior mean (or the
-    initial state itself with ``steady``); default 30 days.
+    and the rest for validation. A period may span gaps in the data: an input gap longer
+    than ``data.max_gap`` splits the calibration into segments, each with its own
+    initial state, and nothing is simulated inside it.
+
+    ``warmup``: the first part of the calibration period simulated but excluded from the
+    likelihood. Default: none when every model estimates its initial state
+    (``initial_state: estimate``, the default of linear models), 14 days when one starts
+    from the steady state (a controlled room, or ``initial_state: steady``).
+    ``init_window``: the mean inputs over the first ``init_window`` give the steady state
+    that is the initial state's prior mean (or the initial state itself with ``steady``);
+    default 30 days.
     """
 
     calibration: Period | None = key(

@@ -110,6 +110,8 @@ def _validation_pointwise(s, prep, Ysim, tn, th=None) -> np.ndarray:
     Yobs = np.full_like(obs, np.nan)
     if prep.validation is not None:
         Yobs[prep.validation] = obs[prep.validation]
+    if prep.breaks is not None:  # no prediction inside an input gap
+        Yobs[prep.breaks] = np.nan
     Yobs = np.ascontiguousarray(Yobs)
     lp = s.logpost
     if getattr(lp.noise, "statespace", False) and th is not None:
@@ -139,6 +141,8 @@ def _one_step_sample(s, prep, th, rng) -> np.ndarray:
     with np.errstate(all="ignore"):
         _, _, mean, var = lp.noise.filter(s.model, mf, U, obs, tn, *lp._x0_prior(mf), True)
     mean[~mf.valid], var[~mf.valid] = np.nan, np.nan
+    if prep.breaks is not None:  # no prediction inside an input gap
+        mean[:, prep.breaks] = np.nan
     return mean + np.sqrt(np.maximum(var, 0.0)) * rng.standard_normal(mean.shape)
 
 

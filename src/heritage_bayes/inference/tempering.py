@@ -56,6 +56,11 @@ def innovations_at(logpost, theta: np.ndarray) -> np.ndarray:
     through :func:`ar1_white_innovations`.
     """
     theta = np.atleast_2d(np.asarray(theta, dtype=float))
+    if hasattr(logpost, "parts"):  # segments between input gaps: each its own filter
+        out = np.full(logpost.observed.shape, np.nan)
+        for (a, b), part in zip(logpost.segments, logpost.parts, strict=True):
+            out[a:b] = innovations_at(part, theta)
+        return out
     if getattr(logpost.noise, "statespace", False):
         mean, var = logpost.noise.one_step(logpost, theta)
         return ((logpost.observed - mean[0]) / np.sqrt(var[0])).astype(float)

@@ -20,9 +20,12 @@ Gap policy
 Input gaps (missing samples of the native series) up to ``max_gap`` are filled by
 linear interpolation in time and every grid row that depends on a filled sample is
 flagged in :attr:`Aligned.flags`. Longer input gaps inside the period raise a
-:class:`~heritage_bayes.errors.DataError` listing them; restrict the period with
-``start``/``end`` to avoid them. Measurement gaps stay NaN (the likelihood masks them)
-and are listed in the report.
+:class:`~heritage_bayes.errors.DataError` listing them (restrict the period with
+``start``/``end`` to avoid them), unless ``long_gaps="split"``: then they are filled
+the same way only to keep the arrays finite, and every grid row that depends on one of
+their samples is marked in :attr:`Aligned.breaks`; the caller splits the record there
+into segments (no simulated value inside, a fresh initial state after). Measurement
+gaps stay NaN (the likelihood masks them) and are listed in the report.
 """
 
 from __future__ import annotations
@@ -233,6 +236,7 @@ def align(
     start=None,
     end=None,
     averaged: Iterable[str] | None = None,
+    long_gaps: str = "raise",
 ) -> Aligned:
     """Put weather (inputs) and measurements (outputs) on one regular UTC grid.
 
@@ -258,6 +262,9 @@ def align(
     averaged : iterable of str, optional
         Override the interval-average columns of all tables (names of input or output
         columns); the other columns are instantaneous.
+    long_gaps : {"raise", "split"}, default "raise"
+        Input gaps longer than ``max_gap``: an error, or bridged by interpolation and
+        marked as breaks (:attr:`Aligned.breaks`) where the record splits into segments.
 
     Returns
     -------
@@ -280,6 +287,8 @@ def align(
     """
     step = _duration(step, "step", allow_zero=False)
     max_gap = _duration(max_gap, "max_gap", allow_zero=True)
+    if long_gaps not in ("raise", "split"):
+        raise InputError(f"long_gaps must be 'raise' or 'split' (got {long_gaps!r})")
     override = None
     if averaged is not None:
         override = {averaged} if isinstance(averaged, str) else set(averaged)
@@ -363,9 +372,11 @@ def align(
     flag_cols: dict[str, np.ndarray] = {}
     interpolated: dict[str, int] = {}
     slope_cols: dict[str, np.ndarray] = {}
+    breaks = np.zeros(n_rows, dtype=bool)
     for s in inputs:
         values = s.values.copy()
         filled = np.zeros(values.size)
+        bridged = np.zeros(values.size)
         for a, b in s.runs():
             if not s.affects(a, b, s0, e0):
                 continue
@@ -378,13 +389,15 @@ def align(
                 pd.Timedelta(n * s.delta, unit="ns"),
                 n * s.delta <= max_gap.value,
             )
-            if not gap.filled:
+            if not gap.filled and long_gaps == "raise":
                 too_long.append(gap)
                 continue
             gaps.append(gap)
             x = s.times[a - 1 : b + 2].astype(float)
             values[a : b + 1] = np.interp(x[1:-1], x[[0, -1]], values[[a - 1, b + 1]])
-            filled[a : b + 1] = 1.0
+            (filled if gap.filled else bridged)[a : b + 1] = 1.0
+        if bridged.any():
+            breaks |= _bin_integrals(s, bridged, edges) > 1e-9
         interpolated[s.name] = int(filled.sum())
         frame_cols[s.name] = _bin_integrals(s, values, edges) / (step_ns / _NS)
         slope_cols[s.name] = _slopes(s, values, edges)
@@ -465,7 +478,7 @@ def align(
         sources=sources,
     )
     slopes = pd.DataFrame({k: slope_cols[k] for k in in_names}, index=index)
-    return Aligned(frame, flags, report, in_names, out_names, slopes)
+    return Aligned(frame, flags, report, in_names, out_names, slopes, breaks)
 
 
 def _slopes(series: _Input, values: np.ndarray, edges: np.ndarray) -> np.ndarray:

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+import numpy as np
 import pandas as pd
 
 from heritage_bayes.io._common import format_timedelta, to_jsonable
@@ -87,7 +88,8 @@ class AlignmentReport:
     flagged_rows : dict
         Per input column, grid rows that depend on a filled sample (``flags`` True).
     input_gaps, measurement_gaps : list of Gap
-        Gaps inside the period: native input gaps (all filled) and runs of NaN rows of
+        Gaps inside the period: native input gaps (``filled`` False: longer than
+        ``max_gap``, a break between segments) and runs of NaN rows of
         each measurement column.
     measurement_missing : dict
         Per output column, NaN rows in the aligned frame.
@@ -157,6 +159,9 @@ class Aligned:
         :math:`u(t_{k+1}) - u(t_k)` of the linear interpolation between the samples of
         an instantaneous input, zero for an interval mean (the first-order hold's
         second input, see :meth:`heritage_bayes.rc.RCModel.with_slopes`).
+    breaks : numpy.ndarray or None
+        (n_rows,) bool: True where an input value depends on a sample of an input gap
+        longer than ``max_gap`` (``long_gaps="split"``): the record is split there.
     """
 
     frame: pd.DataFrame
@@ -165,6 +170,7 @@ class Aligned:
     inputs: tuple[str, ...]
     outputs: tuple[str, ...]
     slopes: pd.DataFrame | None = None
+    breaks: np.ndarray | None = None
 
     @property
     def step(self) -> pd.Timedelta:

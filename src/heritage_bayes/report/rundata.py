@@ -138,10 +138,14 @@ def parameter_set(rd: RunData, m: str):
 
 
 def measurement_gaps(rd: RunData, dt: np.timedelta64, column: str | None = None) -> list[tuple]:
-    """Measurement gaps as (start, end) datetime64 pairs (of one column, or of all)."""
+    """Measurement gaps as (start, end) datetime64 pairs (of one column, or of all), and
+    the input gaps too long to bridge (nothing is simulated there: a gap in every
+    output)."""
     out = []
-    for g in (rd.summary.get("alignment") or {}).get("measurement_gaps") or []:
-        if column is not None and g.get("column") != column:
+    al = rd.summary.get("alignment") or {}
+    long_inputs = [g for g in al.get("input_gaps") or [] if not g.get("filled", True)]
+    for g in (al.get("measurement_gaps") or []) + long_inputs:
+        if column is not None and g.get("column") != column and g.get("filled", True):
             continue
         try:
             out.append((utc64(g["start"]), utc64(g["end"]) + dt))

@@ -121,7 +121,7 @@ def _shade_gaps(
     for t0, t1 in gaps:
         lab = None
         if labelled is not None and not labelled[0]:
-            lab = "measurement gap"
+            lab = "gap in the data"
             labelled[0] = True
         ax.axvspan(
             t0, t1, facecolor="none", edgecolor=C_GAP, hatch="///", lw=0, zorder=0.5, label=lab

@@ -165,9 +165,10 @@ def data_context(rd: RunData) -> dict:
         ("measurement", "measurement_gaps"),
     ):
         for g in al.get(key) or []:
+            long = key == "input_gaps" and not g.get("filled")
             gaps.append(
                 {
-                    "kind": kind,
+                    "kind": "input (too long: not simulated, the record splits)" if long else kind,
                     "column": g.get("column", "?"),
                     "start": fmt_time(g.get("start")),
                     "end": fmt_time(g.get("end")),

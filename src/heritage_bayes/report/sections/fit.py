@@ -130,7 +130,8 @@ def fit_context(rd: RunData, outputs: list[dict]) -> list[dict]:
                     "median (blue line) with the 50 % and 90 % posterior-"
                     "predictive bands (model and noise). Shading: warm-up "
                     "(grey, simulated but not fitted), calibration (green), "
-                    "validation (orange); hatched: measurement gaps. Bottom: "
+                    "validation (orange); hatched: gaps in the data (no simulated value where an "
+                    "input was missing too long to bridge). Bottom: "
                     "two-week details."
                 )
                 + band_note,

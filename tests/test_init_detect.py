@@ -365,3 +365,36 @@ def test_an_rh_column_out_of_range_or_empty_is_a_question_not_a_silent_drop(tmp_
     assert ("holds no value" if fault == "empty" else "above 100 %") in q
     assert "hygric:" in res.text  # the hygric model waits for the answer
     assert main(["calibrate", str(out)]) == 2  # calibrate refuses, naming the key
+
+
+def test_a_logger_whose_clock_was_changed_keeps_one_part(tmp_path):
+    """A logger on Finnish local time (DST) in 2010-2011 whose DST was switched off for
+    2012-2013 (the stamps then keep UTC+2: the spring hour stamped, no autumn repeat),
+    as the Ørholm store's logger did: init names the change, keeps one clock and chooses
+    the periods within its part; a declared DST zone keeps the DST part."""
+    utc, te, ti, rh, ghi = _climate("2010-02-01", "2013-12-01", HELSINKI["longitude"])
+    switch = utc < pd.Timestamp("2012-01-01", tz="UTC")
+    wall = (
+        utc.tz_convert("Europe/Helsinki")
+        .tz_localize(None)
+        .where(switch, utc.tz_localize(None) + pd.Timedelta(hours=2))
+    )
+    rows = ["DATE AND TIME; TEMP C; %RH"] + [
+        f"{t:%d-%m-%Y %H:%M};{a:.1f};{b:.0f}" for t, a, b in zip(wall, ti, rh, strict=True)
+    ]
+    lp = _data(tmp_path) / "logger.csv"
+    lp.write_text("\r\n".join(rows) + "\r\n", encoding="utf-8")
+    assert "27-03-2011 03:00" not in lp.read_text() and "25-03-2012 03:00" in lp.read_text()
+    wp = _fmi(tmp_path, utc, te, rh, ghi)
+    out = tmp_path / "room" / "config.yaml"
+    res = init_config(lp, wp, output=out, **HELSINKI)
+    assert res.questions == []
+    cfg = load_config(out)
+    assert timezone_text(cfg.data.measurements[0].timezone) == "UTC+02:00"
+    assert pd.Timestamp(cfg.periods.calibration.start) >= pd.Timestamp("2012-01-01")
+    (f,) = [f for f in res.findings if "the logger's clock was changed" in f]
+    assert "Europe/Helsinki in 2010-2011 and a fixed clock in 2012-2013" in f
+    res = init_config(lp, wp, output=out, force=True, timezone="Europe/Helsinki", **HELSINKI)
+    assert res.questions == []
+    cfg = load_config(out)
+    assert pd.Timestamp(cfg.periods.validation.end) <= pd.Timestamp("2012-01-01")

@@ -8,6 +8,7 @@ it with :data:`heritage_bayes.questions.MARK`).
 from __future__ import annotations
 
 import datetime as _dt
+from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
@@ -20,8 +21,10 @@ from heritage_bayes.questions import MARK
 __all__ = [
     "MAX_GAP_H",
     "YEAR_DAYS",
+    "ClockSwitch",
     "choose_periods",
     "clock_step",
+    "clock_switch",
     "heating_floor",
     "logger_clock",
     "longest_stretch",
@@ -397,6 +400,91 @@ def logger_clock(layout, df_naive, declared, lon, findings, where, lat=None):
                     "outdoor air do; is the logger's clock ahead of the declared one?"
                 )
     return question or declared
+
+
+@dataclass
+class ClockSwitch:
+    """A logger whose stamps follow the DST changes of its site's zone in some years and
+    keep a fixed clock in others (a setting changed once): the part init keeps.
+
+    ``zone``: the clock of the part kept (the DST zone, or its standard offset such as
+    ``UTC+1``); ``start``, ``end``: the part's bounds on the file's clock (naive; None:
+    open); ``why``: the evidence, in words.
+    """
+
+    zone: str
+    start: pd.Timestamp | None
+    end: pd.Timestamp | None
+    why: str
+
+    def keep(self, series):
+        """``series`` (a Series or DataFrame on the file's clock, stamps as if UTC)
+        within the part kept."""
+        t = series.index.tz_localize(None) if series.index.tz is not None else series.index
+        ok = np.ones(len(series), bool)
+        if self.start is not None:
+            ok &= t >= self.start
+        if self.end is not None:
+            ok &= t < self.end
+        return series[ok]
+
+
+def clock_switch(
+    times: pd.DatetimeIndex, lat, lon, prefer: str | None = None
+) -> ClockSwitch | None:
+    """A change of clock within a logger file, from its stamps alone.
+
+    Each calendar year's stamps are compared with the DST changes of the site's zone
+    (:func:`~heritage_bayes.io.clock.dst_structure`): a year whose spring hour is
+    skipped is on DST, a year with stamps inside the skipped hour on a fixed clock. When
+    the years fall in two runs (DST, then fixed, or the reverse) the run of ``prefer``
+    (``"dst"`` or ``"fixed"``: the kind of clock declared) is kept, else the longer run
+    (the later on a tie), bounded at the 1st of January of the later run's first year
+    (in winter the two clocks agree). The fixed clock is taken as the zone's standard
+    offset (the logger's DST switched off). None without a site, for a zone without DST,
+    or when the years do not fall in two runs. Measured: the Ørholm store's logger
+    follows Europe/Copenhagen's changes 2009-2011 and keeps a fixed clock 2012-2021.
+    """
+    if lat is None or lon is None or len(times) < 3:
+        return None
+    zone = _clock.site_zone(float(lat), float(lon))
+    years = range(times.min().year, times.max().year + 1)
+    if not zone or not _clock.keeps_dst(zone, years):
+        return None
+    verdicts = {}
+    for y in years:
+        v = _clock.dst_structure(times[times.year == y], zone).verdict
+        if v is not None:
+            verdicts[y] = v
+    runs: list[list] = []  # [verdict, first year, last year]
+    for y, v in verdicts.items():
+        if runs and runs[-1][0] == v:
+            runs[-1][2] = y
+        else:
+            runs.append([v, y, y])
+    if len(runs) != 2:
+        return None
+    (v0, a0, b0), (v1, a1, b1) = runs
+    kept = runs[0] if b0 - a0 > b1 - a1 else runs[1]
+    if prefer in (v0, v1):
+        kept = runs[0] if v0 == prefer else runs[1]
+    cut = pd.Timestamp(year=a1, month=1, day=1)
+    std = min(
+        pd.Timestamp(year=a0, month=m, day=15, tz="UTC").tz_convert(zone).utcoffset()
+        / pd.Timedelta(hours=1)
+        for m in (1, 7)
+    )
+    kz = zone if kept[0] == "dst" else _fmt_h(std)
+    words = {"dst": f"the DST changes of {zone}", "fixed": "a fixed clock"}
+    why = (
+        f"the stamps follow {words[v0]} in {a0}-{b0} and {words[v1]} in {a1}-{b1} (each "
+        f"year's spring and autumn changes): the logger's clock was changed; the "
+        f"{kept[1]}-{kept[2]} part is kept, on {kz}"
+        + (" (the zone's standard offset)" if kept[0] == "fixed" else "")
+        + f", from {cut:%Y-%m-%d}" * (kept is runs[1])
+        + f", until {cut:%Y-%m-%d}" * (kept is runs[0])
+    )
+    return ClockSwitch(kz, cut if kept is runs[1] else None, cut if kept is runs[0] else None, why)
 
 
 def _dst_rules(layout) -> str | None:

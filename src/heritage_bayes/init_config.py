@@ -55,11 +55,13 @@ from heritage_bayes.init_checks import (
     MAX_GAP_H,
     choose_periods,
     clock_step,
+    clock_switch,
     heating_floor,
     logger_clock,
     longest_stretch,
     marked,
     present_hours,
+    raw_table,
     to_utc,
     weather_clock,
 )
@@ -120,6 +122,20 @@ def _weather_format(path: Path, given: str | None) -> str:
     if head.startswith("# STN") or "YYYYMMDD" in head[:2000]:
         return "knmi"
     return "csv"
+
+
+def _clock_kind(zone: str | None) -> str | None:
+    """``"fixed"`` for a fixed offset, ``"dst"`` for a zone with rules, None when not
+    given or not readable (the reader's own message comes later)."""
+    if not zone:
+        return None
+    from heritage_bayes.io import parse_timezone
+
+    try:
+        tz = parse_timezone(zone)
+    except (ValueError, TypeError):
+        return None
+    return "fixed" if isinstance(tz, _dt.timezone) else "dst"
 
 
 def _read_naive(layout: TableLayout, columns: dict[str, str], units: dict) -> pd.DataFrame:
@@ -438,7 +454,13 @@ def init_config(
         izone = None
         findings.append("logger: time stamps carry their UTC offset")
     else:
-        izone = logger_clock(lay, din, timezone or lay.timezone, lon, findings, "logger", lat)
+        declared = timezone or lay.timezone
+        switch = clock_switch(raw_table(lay).index, lat, lon, _clock_kind(declared))
+        if switch is not None:  # the clock changed within the file: one part is kept
+            findings.append(f"logger: {switch.why}")
+            din = switch.keep(din)
+            declared = declared or switch.zone
+        izone = logger_clock(lay, din, declared, lon, findings, "logger", lat)
     if izone and izone.startswith(MARK):
         questions.append(f"data.measurements.timezone: {izone[len(MARK) :].strip()}")
     ti_utc = to_utc(din["Ti"], izone)

@@ -100,6 +100,25 @@ def run_init(room: str, data: Path, work: Path, weather: Path | None = None) -> 
     return out, res.questions, given
 
 
+def room_below(config: Path, logger: Path) -> Path:
+    """init's config with its written advice for a room without a floor on the ground
+    followed: the neighbouring space's measured temperature as ``Tf`` (the TRH-1 attics:
+    ``indoor1.csv``, the heated room below, beside the attic's logger file)."""
+    import yaml
+
+    raw = yaml.safe_load(config.read_text(encoding="utf-8"))
+    house = logger.parent / "indoor1.csv"
+    rel = Path(os.path.relpath(house.resolve(), config.parent.resolve())).as_posix()
+    raw["data"]["ground_temperature"] = {
+        "mode": "column",
+        "column": "T",
+        "source": {"format": "csv", "path": rel, "time_column": "t_UTC+2", "timezone": "UTC+2"},
+    }
+    out = config.with_name("config_room_below.yaml")
+    out.write_text(yaml.safe_dump(raw, sort_keys=False, allow_unicode=True), encoding="utf-8")
+    return out
+
+
 def map_fits(cfg, maxiter: int, starts: int) -> dict:
     """Validation FIT [%] of the MAP simulations: Ti, Pi and RH (Pi over psat(Ti)), and
     the models."""
@@ -208,6 +227,11 @@ def main(argv=None) -> int:
     ap.add_argument("--calibrate", action="store_true", help="also a short hbayes calibrate")
     ap.add_argument("--max-steps", type=int, default=1500, help="emcee cap with --calibrate")
     ap.add_argument("--no-bare", action="store_true", help="skip the attics without radiation")
+    ap.add_argument(
+        "--room-below",
+        action="store_true",
+        help="attics: also with init's advice followed (the room below's measured T as Tf)",
+    )
     ap.add_argument("--json", type=Path, help="write the rows here")
     args = ap.parse_args(argv)
     rooms = args.rooms or TUNING + (HELD_OUT if args.held_out else [])
@@ -241,6 +265,11 @@ def main(argv=None) -> int:
             row = one(room, variant, config, args, w, {"answers": given, **init_s})
             rows.append(row)
             _print(row)
+            if args.room_below and logger.startswith("trh1"):
+                below = room_below(config, args.data / logger)
+                row = one(room, variant + ", room below", below, args, w, {"answers": given})
+                rows.append(row)
+                _print(row)
         if room == "annisse":
             row = one(room, "hand config", ROOT / "configs" / "annisse.yaml", args,
                       work / room / "hand", {})  # fmt: skip

@@ -398,3 +398,17 @@ def test_a_logger_whose_clock_was_changed_keeps_one_part(tmp_path):
     assert res.questions == []
     cfg = load_config(out)
     assert pd.Timestamp(cfg.periods.validation.end) <= pd.Timestamp("2012-01-01")
+
+
+def test_a_validation_warmer_than_the_calibration_is_named():
+    """Eight months from November split in time: a winter to calibrate, a summer to
+    validate (the TRH-1 R5 attic's record); a whole year split 8/4 months is not."""
+    from heritage_bayes.init_checks import extrapolated_seasons
+
+    utc, te, *_ = _climate("2010-11-15", "2011-07-26", HELSINKI["longitude"])
+    s = pd.Series(te, index=utc)
+    note = extrapolated_seasons(s, "2010-11-15", "2011-05-02", "2011-07-26")
+    assert note is not None and "the calibration holds no summer" in note
+    utc, te, *_ = _climate("2011-01-01", "2012-01-01", HELSINKI["longitude"])
+    s = pd.Series(te, index=utc)
+    assert extrapolated_seasons(s, "2011-01-01", "2011-09-01", "2012-01-01") is None

@@ -25,6 +25,7 @@ __all__ = [
     "choose_periods",
     "clock_step",
     "clock_switch",
+    "extrapolated_seasons",
     "heating_floor",
     "logger_clock",
     "longest_stretch",
@@ -315,6 +316,38 @@ def choose_periods(
         s0, end = moved, end_moved
     f = "%Y-%m-%d"
     return s0.strftime(f), mid.strftime(f), mid.strftime(f), end.strftime(f), why
+
+
+#: Validation's warm days [K] (95th percentile of the daily mean outdoor temperature)
+#: beyond the calibration's: the validation tests an extrapolation.
+WARMER_K = 3.0
+
+
+def extrapolated_seasons(te: pd.Series, cs, ce, ve) -> str | None:
+    """A note when the validation ``[ce, ve)`` holds warmer weather than any in the
+    calibration ``[cs, ce)`` (a record shorter than a year, split in time: a winter to
+    calibrate, a summer to validate): the 95th percentile of the daily mean outdoor
+    temperature [°C] higher by :data:`WARMER_K` or more. The sun's gain and the summer's
+    conditions (a roof free of snow) are then learned from a season they do not hold;
+    None otherwise. Measured: the TRH-1 R4 attic cut to 8 months (2010-11-15 to
+    2011-07-26, a winter to calibrate) validated at 61 % FIT Ti against 80 % with a year.
+    """
+    d = te.resample("1D").mean().dropna()
+    d.index = d.index.tz_localize(None) if d.index.tz is not None else d.index
+    cal = d[(d.index >= pd.Timestamp(cs)) & (d.index < pd.Timestamp(ce))]
+    val = d[(d.index >= pd.Timestamp(ce)) & (d.index < pd.Timestamp(ve))]
+    if len(cal) < 10 or len(val) < 10:
+        return None
+    c95, v95 = float(np.percentile(cal, 95)), float(np.percentile(val, 95))
+    if v95 - c95 < WARMER_K:
+        return None
+    return (
+        f"the validation is warmer than any of the calibration (95th percentile of the daily "
+        f"mean outdoor temperature {v95:.1f} °C against {c95:.1f} °C): the calibration holds "
+        "no summer, so the sun's gain and summer conditions (a roof free of snow) are "
+        "extrapolated and the validation FIT measures that; a record of a year or more "
+        "calibrates all seasons"
+    )
 
 
 def logger_clock(layout, df_naive, declared, lon, findings, where, lat=None):

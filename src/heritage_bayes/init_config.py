@@ -56,6 +56,7 @@ from heritage_bayes.init_checks import (
     choose_periods,
     clock_step,
     clock_switch,
+    extrapolated_seasons,
     heating_floor,
     logger_clock,
     longest_stretch,
@@ -512,6 +513,9 @@ def init_config(
     # the inputs must hold a reading at both ends of the periods (the outputs need not)
     cs, ce, vs, ve, why = choose_periods(s, e, present_hours(te_utc, te_utc))
     findings.append(f"periods: {why}")
+    if season := extrapolated_seasons(te_utc, cs, ce, ve):
+        findings.append(f"periods: {season}")
+        why = f"{why}. Note: {season}"
     # an RH column that needs an answer keeps the hygric section: answered, it runs
     rhe_open = wlay is not None and str(wcols.get("RHe", "")).startswith(MARK)
     hygric = "RHi" in icols and ("RHe" in dw.columns or rhe_open)

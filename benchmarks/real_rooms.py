@@ -51,27 +51,29 @@ from _common import config_map  # noqa: E402
 
 DMI = "orholm/DMI_outdoor-climate-data_2009-2021.csv"
 
-#: room -> logger, weather (under the data root), site [° N, ° E], held out, the answers
-#: to init's questions (init_config keyword arguments) and why. The TRH-1 houses'
+#: room -> logger, weather (under the data root), site [° N, ° E], held out, and the
+#: answers to init's questions in turn (init_config keyword arguments; each used only
+#: while init still asks). The TRH-1 houses'
 #: positions are not published: the towns'.
 ROOMS = {
     "R2": ("trh1-espoo-attic/roofmiddle_airmiddle.csv", "trh1-espoo-attic/fmi.csv",
-           (60.21, 24.66), False, {}),
+           (60.21, 24.66), False, []),
     "R3": ("trh1-more-attics/R3/roofmiddle_airmiddle.csv", "trh1-more-attics/R3/fmi.csv",
-           (60.21, 24.66), True, {}),
+           (60.21, 24.66), True, []),
     "R4": ("trh1-more-attics/R4/roofmiddle_airmiddle.csv", "trh1-more-attics/R4/fmi.csv",
-           (61.50, 23.76), False, {}),
+           (61.50, 23.76), False, []),
     "R5": ("trh1-more-attics/R5/roofmiddle_airmiddle.csv", "trh1-more-attics/R5/fmi.csv",
-           (61.50, 23.76), True, {}),
+           (61.50, 23.76), True, []),
     "R6": ("trh1-more-attics/R6/roofmiddle_airmiddle.csv", "trh1-more-attics/R6/fmi.csv",
-           (61.26, 24.03), False, {}),
+           (61.26, 24.03), False, []),
     "R7": ("trh1-more-attics/R7/roofmiddle_airmiddle.csv", "trh1-more-attics/R7/fmi.csv",
-           (60.29, 25.04), True, {}),
-    # the data set's description: Ørholm and Annisse loggers in Danish local time
+           (60.29, 25.04), True, []),
+    # the clock question, when init asks it: init names the stamps' fixed clock and the
+    # zone's standard time UTC+1 (the data set's description says nothing of the clock)
     "orholm": ("orholm/oerholm-indoor-climate-data_2009-2021.csv", DMI, (55.79, 12.50), False,
-               {"timezone": "Europe/Copenhagen"}),
+               [{"timezone": "UTC+1"}]),
     "annisse": ("orholm/annisse-indoor-climate-data_2014-2018.csv", DMI, (56.03, 12.17), True,
-                {"timezone": "Europe/Copenhagen"}),
+                [{"timezone": "UTC+1"}]),
 }  # fmt: skip
 TUNING = ["R2", "R4", "R6", "orholm"]
 HELD_OUT = ["R3", "R5", "R7", "annisse"]
@@ -84,18 +86,19 @@ def _cpu() -> float:
 
 
 def run_init(room: str, data: Path, work: Path, weather: Path | None = None) -> tuple:
-    """init on a room's raw files; init again with the recorded answers when it asks.
-    Returns (config path, questions left, answers given)."""
+    """init on a room's raw files; while it asks, init again with the next recorded
+    answer. Returns (config path, questions left, answers given)."""
     from heritage_bayes.init_config import init_config
 
     logger, wfile, (lat, lon), _, answers = ROOMS[room]
     out = work / "config.yaml"
     kw = {"latitude": lat, "longitude": lon, "output": out, "force": True}
     res = init_config(data / logger, weather or data / wfile, **kw)
-    given = {}
-    if res.questions:
-        given = {k: v for k, v in answers.items() if any(k in q for q in res.questions)}
-        given = given or answers
+    given: dict = {}
+    for answer in answers:
+        if not res.questions:
+            break
+        given = answer
         res = init_config(data / logger, weather or data / wfile, **kw, **given)
     return out, res.questions, given
 

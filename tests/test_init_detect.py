@@ -412,3 +412,20 @@ def test_a_validation_warmer_than_the_calibration_is_named():
     utc, te, *_ = _climate("2011-01-01", "2012-01-01", HELSINKI["longitude"])
     s = pd.Series(te, index=utc)
     assert extrapolated_seasons(s, "2011-01-01", "2011-09-01", "2012-01-01") is None
+
+
+def test_a_logger_on_a_fixed_clock_is_asked_which_fixed_clock(tmp_path):
+    """Stamps through the spring change of the site's zone without a jump (the hour
+    Europe/Helsinki skips is stamped): the question names a fixed clock and the zone's
+    standard offset, not a zone with daylight-saving time."""
+    utc, te, ti, rh, ghi = _climate("2013-03-01", "2013-12-01", HELSINKI["longitude"])
+    wall = utc.tz_localize(None) + pd.Timedelta(hours=2)
+    rows = ["DATE AND TIME; TEMP C; %RH"] + [
+        f"{t:%d-%m-%Y %H:%M};{a:.1f};{b:.0f}" for t, a, b in zip(wall, ti, rh, strict=True)
+    ]
+    lp = _data(tmp_path) / "logger.csv"
+    lp.write_text("\n".join(rows) + "\n", encoding="utf-8")
+    res = init_config(lp, _fmi(tmp_path, utc, te, rh, ghi), output=tmp_path / "r" / "c.yaml",
+                      **HELSINKI)  # fmt: skip
+    (q,) = [q for q in res.questions if q.startswith("data.measurements.timezone")]
+    assert "keep a fixed clock, not Europe/Helsinki" in q and "standard time UTC+2" in q

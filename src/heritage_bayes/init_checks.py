@@ -376,6 +376,9 @@ def logger_clock(layout, df_naive, declared, lon, findings, where, lat=None):
                 "or give --latitude and --longitude to have it looked up"
             )
         example = (site and _clock.site_zone(lat, lon)) or "Europe/Amsterdam"
+        fixed = _fixed_stamps(layout, example) if site else None
+        if fixed:
+            return marked(fixed)
         return marked(
             "the logger's clock: UTC, a fixed offset such as UTC+1, or a zone with "
             f"daylight-saving time such as {example} (see its settings or the software it "
@@ -518,6 +521,25 @@ def clock_switch(
         + f", until {cut:%Y-%m-%d}" * (kept is runs[0])
     )
     return ClockSwitch(kz, cut if kept is runs[1] else None, cut if kept is runs[0] else None, why)
+
+
+def _fixed_stamps(layout, zone: str) -> str | None:
+    """The clock question for stamps that keep a fixed clock through the DST changes of
+    the site's zone (the spring hour it skips is stamped): which fixed clock, naming the
+    zone's standard offset; None when the stamps do not tell."""
+    times = _raw_times(layout)
+    if not len(times) or not _clock.keeps_dst(zone, range(times.min().year, times.max().year + 1)):
+        return None
+    st = _clock.dst_structure(times, zone)
+    if st.verdict != "fixed":
+        return None
+    t = pd.Timestamp(year=int(times.min().year), month=1, day=15, tz="UTC").tz_convert(zone)
+    std = _fmt_h(t.utcoffset() / pd.Timedelta(hours=1))
+    return (
+        f"the logger's stamps keep a fixed clock, not {zone}'s daylight-saving time "
+        f"({st.describe()}): which one, UTC or {zone}'s standard time {std}? (see its "
+        "settings or the software it was read out with)"
+    )
 
 
 def _dst_rules(layout) -> str | None:

@@ -78,10 +78,9 @@ def main(argv=None) -> int:
     print("weekly mean daily range [K], March-May 2011")
     print(rng.loc["2011-03-01":"2011-05-31"].round(2).to_string())
     if args.split:
-        from real_rooms import map_fits
-
         from heritage_bayes.config import load_config
         from heritage_bayes.init_config import init_config
+        from real_rooms import map_fits
 
         with tempfile.TemporaryDirectory() as tmp:
             cut = Path(tmp) / "data"

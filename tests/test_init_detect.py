@@ -222,6 +222,20 @@ def test_periods_never_start_in_a_short_gap():
     assert (s, end) == ("2021-01-01", "2021-04-01") and "moved" not in why
 
 
+def test_periods_are_the_most_recent_whole_calendar_year():
+    """Four years without a long gap (the Ørholm store's 2012-01 to 2015-12-18): the
+    last whole calendar year, the room as it is now; one whole year: that one."""
+    from heritage_bayes.init_checks import choose_periods
+
+    s, e = pd.Timestamp("2012-01-01", tz="UTC"), pd.Timestamp("2015-12-18", tz="UTC")
+    cs, ce, _, ve, why = choose_periods(s, e)
+    assert (cs, ce, ve) == ("2014-01-01", "2014-09-01", "2015-01-01")
+    assert "most recent whole calendar year" in why
+    s, e = pd.Timestamp("2010-11-15", tz="UTC"), pd.Timestamp("2012-05-19", tz="UTC")
+    cs, ce, _, ve, why = choose_periods(s, e)
+    assert (cs, ce, ve) == ("2011-01-01", "2011-09-01", "2012-01-01") and "first" in why
+
+
 def test_overlapping_downloads_get_a_sort_setting_that_exists(tmp_path):
     """Two HOBO downloads joined in one file, the second starting ten days before the
     first ended: init writes `sort: true` (a real key) and a question that can be

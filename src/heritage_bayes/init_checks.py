@@ -276,8 +276,9 @@ def choose_periods(
     s: pd.Timestamp, e: pd.Timestamp, present: pd.DatetimeIndex | None = None
 ) -> tuple[str, str, str, str, str]:
     """Calibration ``[start, mid)`` and validation ``[mid, end)`` in whole UTC days
-    within the stretch ``[s, e)``, and why: the first whole calendar year (8 months to
-    calibrate, 4 to validate: all seasons), else the first 12 whole months, else the
+    within the stretch ``[s, e)``, and why: the most recent whole calendar year (8 months
+    to calibrate, 4 to validate: all seasons; the room as it is now, which a model for
+    projections and interventions describes), else the first 12 whole months, else the
     stretch's first 2/3 and the rest. With ``present`` (the hours with an input
     reading), the start and the end are midnights with a reading: a period never starts
     or ends inside an input gap (or after the last reading), which the simulation
@@ -289,15 +290,18 @@ def choose_periods(
     jan = pd.Timestamp(year=s0.year + int((s0.month, s0.day) > (1, 1)), month=1, day=1, tz=s0.tz)
     if s0.day != 1 and (e - s0).days >= YEAR_DAYS + 31:
         s0 = (s0 + pd.offsets.MonthBegin(1)).normalize()
+    which = "first"
     if e0 >= jan + pd.DateOffset(years=1):  # a whole calendar year: the reporting year
-        s0 = jan
+        last = pd.Timestamp(year=e0.year - 1, month=1, day=1, tz=s0.tz)  # the most recent
+        which = "most recent" if last > jan else which
+        s0 = last
     if (e0 - s0).days >= YEAR_DAYS:
         end = s0 + pd.DateOffset(months=12)
         mid = s0 + pd.DateOffset(months=8)
         what = "calendar year" if (s0.month, s0.day) == (1, 1) else "year"
         why = (
-            f"the first whole {what} of the longest stretch (all seasons): 8 months to "
-            "calibrate, 4 to validate"
+            f"the {which} whole {what} of the longest stretch (all seasons; the most recent: "
+            "the room as it is now): 8 months to calibrate, 4 to validate"
         )
     else:
         end = e0

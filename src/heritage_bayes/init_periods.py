@@ -1,0 +1,142 @@
+"""The periods ``hbayes init`` proposes (:mod:`heritage_bayes.init_config`): the longest
+stretch of overlapping data, the calibration and validation periods in it, and a note
+when the validation holds weather the calibration does not.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from heritage_bayes.errors import DataError
+
+__all__ = [
+    "MAX_GAP_H",
+    "WARMER_K",
+    "YEAR_DAYS",
+    "choose_periods",
+    "extrapolated_seasons",
+    "longest_stretch",
+    "present_hours",
+]
+
+#: Longest gap [h] bridged inside a period (the config's ``data.max_gap``).
+MAX_GAP_H = 6
+#: A stretch this long [days] or longer is split 8 months / 4 months (a year); shorter
+#: ones 2/3 / 1/3.
+YEAR_DAYS = 365
+
+
+def longest_stretch(ti: pd.Series, te: pd.Series) -> tuple[pd.Timestamp, pd.Timestamp, list[str]]:
+    """The longest run of hours with both ``Ti`` and ``Te`` [°C], gaps of up to
+    :data:`MAX_GAP_H` hours bridged: (start, end) [UTC] and notes on the gaps found.
+
+    Raises
+    ------
+    DataError
+        The files overlap in fewer than 48 hours (the message gives both spans).
+    """
+    both = present_hours(ti, te)
+    if len(both) < 48:
+        raise DataError(
+            f"the logger and weather files overlap in {len(both)} hour(s) only "
+            f"(logger {ti.index[0]} to {ti.index[-1]}, weather {te.index[0]} to {te.index[-1]})"
+        )
+    gap_h = np.diff(both) / pd.Timedelta(hours=1)
+    gaps = np.flatnonzero(gap_h > MAX_GAP_H)
+    starts = np.r_[0, gaps + 1]
+    ends = np.r_[gaps, len(both) - 1]
+    k = int(np.argmax(both[ends] - both[starts]))
+    notes = [f"gap of {gap_h[g]:.0f} h from {both[g]:%Y-%m-%d %H:%M} UTC" for g in gaps[:5]] + (
+        [f"... {len(gaps) - 5} more"] if len(gaps) > 5 else []
+    )
+    return both[starts[k]], both[ends[k]] + pd.Timedelta(hours=1), notes
+
+
+def present_hours(ti: pd.Series, te: pd.Series) -> pd.DatetimeIndex:
+    """The hours [UTC] in which both ``ti`` and ``te`` have a value, sorted."""
+    a = ti.dropna().index.floor("h").unique()
+    b = te.dropna().index.floor("h").unique()
+    return a.intersection(b).sort_values()
+
+
+def choose_periods(
+    s: pd.Timestamp, e: pd.Timestamp, present: pd.DatetimeIndex | None = None
+) -> tuple[str, str, str, str, str]:
+    """Calibration ``[start, mid)`` and validation ``[mid, end)`` in whole UTC days
+    within the stretch ``[s, e)``, and why: the most recent whole calendar year (8 months
+    to calibrate, 4 to validate: all seasons; the room as it is now, which a model for
+    projections and interventions describes), else the first 12 whole months, else the
+    stretch's first 2/3 and the rest. With ``present`` (the hours with an input
+    reading), the start and the end are midnights with a reading: a period never starts
+    or ends inside an input gap (or after the last reading), which the simulation
+    cannot bridge. Returns ``(start, mid, mid, end, why)`` as text."""
+    day = pd.Timedelta(days=1)
+    s0 = s.ceil("D")
+    e0 = e.floor("D")
+
+    jan = pd.Timestamp(year=s0.year + int((s0.month, s0.day) > (1, 1)), month=1, day=1, tz=s0.tz)
+    if s0.day != 1 and (e - s0).days >= YEAR_DAYS + 31:
+        s0 = (s0 + pd.offsets.MonthBegin(1)).normalize()
+    which = "first"
+    if e0 >= jan + pd.DateOffset(years=1):  # a whole calendar year: the reporting year
+        last = pd.Timestamp(year=e0.year - 1, month=1, day=1, tz=s0.tz)  # the most recent
+        which = "most recent" if last > jan else which
+        s0 = last
+    if (e0 - s0).days >= YEAR_DAYS:
+        end = s0 + pd.DateOffset(months=12)
+        mid = s0 + pd.DateOffset(months=8)
+        what = "calendar year" if (s0.month, s0.day) == (1, 1) else "year"
+        why = (
+            f"the {which} whole {what} of the longest stretch (all seasons; the most recent: "
+            "the room as it is now): 8 months to calibrate, 4 to validate"
+        )
+    else:
+        end = e0
+        mid = s0 + day * round((e0 - s0).days * 2 / 3)
+        why = "the longest stretch: its first 2/3 to calibrate, the rest to validate"
+    if present is not None and len(present):  # no start or end inside a short gap
+        have = set(present)
+        moved = s0
+        while moved < mid and moved not in have:
+            moved += day
+        end_moved = end
+        while end_moved > mid and end_moved not in have:
+            end_moved -= day
+        if (moved, end_moved) != (s0, end):
+            why += "; start and end moved off gaps in the data"
+        s0, end = moved, end_moved
+    f = "%Y-%m-%d"
+    return s0.strftime(f), mid.strftime(f), mid.strftime(f), end.strftime(f), why
+
+
+#: Validation's warm days [K] (95th percentile of the daily mean outdoor temperature)
+#: beyond the calibration's: the validation tests an extrapolation.
+WARMER_K = 3.0
+
+
+def extrapolated_seasons(te: pd.Series, cs, ce, ve) -> str | None:
+    """A note when the validation ``[ce, ve)`` holds warmer weather than any in the
+    calibration ``[cs, ce)`` (a record shorter than a year, split in time: a winter to
+    calibrate, a summer to validate): the 95th percentile of the daily mean outdoor
+    temperature [°C] higher by :data:`WARMER_K` or more. The sun's gain and the summer's
+    conditions (a roof free of snow) are then learned from a season they do not hold;
+    None otherwise. Measured: the TRH-1 R4 attic cut to 8 months (2010-11-15 to
+    2011-07-26, a winter to calibrate) validated at 61 % FIT Ti against 80 % with a year.
+    """
+    d = te.resample("1D").mean().dropna()
+    d.index = d.index.tz_localize(None) if d.index.tz is not None else d.index
+    cal = d[(d.index >= pd.Timestamp(cs)) & (d.index < pd.Timestamp(ce))]
+    val = d[(d.index >= pd.Timestamp(ce)) & (d.index < pd.Timestamp(ve))]
+    if len(cal) < 10 or len(val) < 10:
+        return None
+    c95, v95 = float(np.percentile(cal, 95)), float(np.percentile(val, 95))
+    if v95 - c95 < WARMER_K:
+        return None
+    return (
+        f"the validation is warmer than any of the calibration (95th percentile of the daily "
+        f"mean outdoor temperature {v95:.1f} °C against {c95:.1f} °C): the calibration holds "
+        "no summer, so the sun's gain and summer conditions (a roof free of snow) are "
+        "extrapolated and the validation FIT measures that; a record of a year or more "
+        "calibrates all seasons"
+    )

@@ -224,13 +224,17 @@ def test_periods_never_start_in_a_short_gap():
 
 def test_periods_are_the_most_recent_whole_calendar_year():
     """Four years without a long gap (the Ørholm store's 2012-01 to 2015-12-18): the
-    last whole calendar year, the room as it is now; one whole year: that one."""
+    most recent whole calendar year with 8 months or more after it calibrates, what
+    follows validates; one whole year and 4.5 months: that year, 8 and 4 months."""
     from heritage_bayes.init_checks import choose_periods
 
     s, e = pd.Timestamp("2012-01-01", tz="UTC"), pd.Timestamp("2015-12-18", tz="UTC")
     cs, ce, _, ve, why = choose_periods(s, e)
-    assert (cs, ce, ve) == ("2014-01-01", "2014-09-01", "2015-01-01")
+    assert (cs, ce, ve) == ("2014-01-01", "2015-01-01", "2015-12-18")
     assert "most recent whole calendar year" in why
+    e = pd.Timestamp("2015-07-01", tz="UTC")  # 6 months after 2014: 2013 calibrates
+    cs, ce, _, ve, why = choose_periods(s, e)
+    assert (cs, ce, ve) == ("2013-01-01", "2014-01-01", "2015-01-01")
     s, e = pd.Timestamp("2010-11-15", tz="UTC"), pd.Timestamp("2012-05-19", tz="UTC")
     cs, ce, _, ve, why = choose_periods(s, e)
     assert (cs, ce, ve) == ("2011-01-01", "2011-09-01", "2012-01-01") and "first" in why

@@ -12,6 +12,7 @@ from heritage_bayes.errors import DataError
 
 __all__ = [
     "MAX_GAP_H",
+    "VALIDATION_MONTHS",
     "WARMER_K",
     "YEAR_DAYS",
     "choose_periods",
@@ -25,6 +26,9 @@ MAX_GAP_H = 6
 #: A stretch this long [days] or longer is split 8 months / 4 months (a year); shorter
 #: ones 2/3 / 1/3.
 YEAR_DAYS = 365
+#: Months of data after a whole calendar year from which that year calibrates and what
+#: follows (up to a year) validates, rather than 8 and 4 months of one year.
+VALIDATION_MONTHS = 8
 
 
 def longest_stretch(ti: pd.Series, te: pd.Series) -> tuple[pd.Timestamp, pd.Timestamp, list[str]]:
@@ -64,9 +68,11 @@ def choose_periods(
     s: pd.Timestamp, e: pd.Timestamp, present: pd.DatetimeIndex | None = None
 ) -> tuple[str, str, str, str, str]:
     """Calibration ``[start, mid)`` and validation ``[mid, end)`` in whole UTC days
-    within the stretch ``[s, e)``, and why: the most recent whole calendar year (8 months
-    to calibrate, 4 to validate: all seasons; the room as it is now, which a model for
-    projections and interventions describes), else the first 12 whole months, else the
+    within the stretch ``[s, e)``, and why: the most recent whole calendar year followed
+    by :data:`VALIDATION_MONTHS` or more to calibrate, and up to a year after it to
+    validate (every season in both; the room as it is now, which a model for projections
+    and interventions describes); else the most recent whole calendar year (8 months to
+    calibrate, 4 to validate), else the first 12 whole months, else the
     stretch's first 2/3 and the rest. With ``present`` (the hours with an input
     reading), the start and the end are midnights with a reading: a period never starts
     or ends inside an input gap (or after the last reading), which the simulation
@@ -79,22 +85,36 @@ def choose_periods(
     if s0.day != 1 and (e - s0).days >= YEAR_DAYS + 31:
         s0 = (s0 + pd.offsets.MonthBegin(1)).normalize()
     which = "first"
-    if e0 >= jan + pd.DateOffset(years=1):  # a whole calendar year: the reporting year
-        last = pd.Timestamp(year=e0.year - 1, month=1, day=1, tz=s0.tz)  # the most recent
-        which = "most recent" if last > jan else which
-        s0 = last
-    if (e0 - s0).days >= YEAR_DAYS:
-        end = s0 + pd.DateOffset(months=12)
-        mid = s0 + pd.DateOffset(months=8)
-        what = "calendar year" if (s0.month, s0.day) == (1, 1) else "year"
+    # a whole calendar year to calibrate and VALIDATION_MONTHS or more after it: the
+    # most recent such year; every season in both periods
+    cal_year = pd.Timestamp(year=e0.year - 1, month=1, day=1, tz=s0.tz)
+    if cal_year + pd.DateOffset(years=1, months=VALIDATION_MONTHS) > e0:
+        cal_year -= pd.DateOffset(years=1)
+    if cal_year >= jan:
+        mid = cal_year + pd.DateOffset(years=1)
+        end = min(mid + pd.DateOffset(years=1), e0)
+        s0 = cal_year
         why = (
-            f"the {which} whole {what} of the longest stretch (all seasons; the most recent: "
-            "the room as it is now): 8 months to calibrate, 4 to validate"
+            f"the most recent whole calendar year of the longest stretch with "
+            f"{VALIDATION_MONTHS} months or more after it to calibrate (all seasons; the "
+            "room as it is now), up to a year after it to validate"
         )
     else:
-        end = e0
-        mid = s0 + day * round((e0 - s0).days * 2 / 3)
-        why = "the longest stretch: its first 2/3 to calibrate, the rest to validate"
+        if e0 >= jan + pd.DateOffset(years=1):  # a whole calendar year: the reporting year
+            s0 = pd.Timestamp(year=e0.year - 1, month=1, day=1, tz=s0.tz)  # the most recent
+            which = "most recent" if s0 > jan else which
+        if (e0 - s0).days >= YEAR_DAYS:
+            end = s0 + pd.DateOffset(months=12)
+            mid = s0 + pd.DateOffset(months=8)
+            what = "calendar year" if (s0.month, s0.day) == (1, 1) else "year"
+            why = (
+                f"the {which} whole {what} of the longest stretch (all seasons): 8 months to "
+                "calibrate, 4 to validate"
+            )
+        else:
+            end = e0
+            mid = s0 + day * round((e0 - s0).days * 2 / 3)
+            why = "the longest stretch: its first 2/3 to calibrate, the rest to validate"
     if present is not None and len(present):  # no start or end inside a short gap
         have = set(present)
         moved = s0

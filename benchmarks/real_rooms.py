@@ -151,6 +151,31 @@ def map_fits(cfg, maxiter: int, starts: int) -> dict:
     return out
 
 
+def monthly_residuals(cfg, maxiter: int, starts: int) -> pd.DataFrame:
+    """The thermal MAP's validation residual (measured - simulated Ti) by month: bias
+    and RMSE [K], and the mean daily range [K] measured and simulated."""
+    opt = cfg.optimizer.model_copy(update={"maxiter": maxiter, "starts": starts})
+    prep, model, lp, mp = config_map(cfg.model_copy(update={"optimizer": opt}), "thermal")
+    y = lp.simulate_frame(mp.theta[None], prep.model_inputs("thermal", model),
+                          prep.calibration.start)[0][0][:, 0]  # fmt: skip
+    v = prep.validation
+    r = pd.DataFrame(
+        {"obs": prep.observed("thermal", model)[v.start : v.stop, 0], "sim": y[v.start : v.stop]},
+        index=prep.period_index("validation"),
+    )
+    e = r.obs - r.sim
+    day = r.resample("1D")
+    rng = (day.max() - day.min()).resample("MS").mean()
+    return pd.DataFrame(
+        {
+            "bias_K": e.resample("MS").mean(),
+            "rmse_K": np.sqrt((e**2).resample("MS").mean()),
+            "range_measured_K": rng.obs,
+            "range_simulated_K": rng.sim,
+        }
+    ).round(2)
+
+
 def calibrate_fits(cfg, work: Path, max_steps: int) -> dict:
     """`hbayes calibrate` (no ladder, no report) with emcee capped at ``max_steps``:
     posterior-predictive validation FIT [%] and convergence."""
@@ -235,6 +260,9 @@ def main(argv=None) -> int:
         action="store_true",
         help="attics: also with init's advice followed (the room below's measured T as Tf)",
     )
+    ap.add_argument(
+        "--monthly", action="store_true", help="also the thermal MAP's residual by month"
+    )
     ap.add_argument("--json", type=Path, help="write the rows here")
     args = ap.parse_args(argv)
     rooms = args.rooms or TUNING + (HELD_OUT if args.held_out else [])
@@ -268,6 +296,10 @@ def main(argv=None) -> int:
             row = one(room, variant, config, args, w, {"answers": given, **init_s})
             rows.append(row)
             _print(row)
+            if args.monthly:
+                from heritage_bayes.config import load_config
+
+                print(monthly_residuals(load_config(config), args.maxiter, args.starts))
             if args.room_below and logger.startswith("trh1"):
                 below = room_below(config, args.data / logger)
                 row = one(room, variant + ", room below", below, args, w, {"answers": given})

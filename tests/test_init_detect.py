@@ -225,6 +225,24 @@ def test_periods_never_start_in_a_short_gap():
     assert (s, end) == ("2021-01-01", "2021-04-01") and "moved" not in why
 
 
+def test_periods_are_the_most_recent_whole_calendar_year():
+    """Four years without a long gap (the Ørholm store's 2012-01 to 2015-12-18): the
+    most recent whole calendar year with 8 months or more after it calibrates, what
+    follows validates; one whole year and 4.5 months: that year, 8 and 4 months."""
+    from heritage_bayes.init_checks import choose_periods
+
+    s, e = pd.Timestamp("2012-01-01", tz="UTC"), pd.Timestamp("2015-12-18", tz="UTC")
+    cs, ce, _, ve, why = choose_periods(s, e)
+    assert (cs, ce, ve) == ("2014-01-01", "2015-01-01", "2015-12-18")
+    assert "most recent whole calendar year" in why
+    e = pd.Timestamp("2015-07-01", tz="UTC")  # 6 months after 2014: 2013 calibrates
+    cs, ce, _, ve, why = choose_periods(s, e)
+    assert (cs, ce, ve) == ("2013-01-01", "2014-01-01", "2015-01-01")
+    s, e = pd.Timestamp("2010-11-15", tz="UTC"), pd.Timestamp("2012-05-19", tz="UTC")
+    cs, ce, _, ve, why = choose_periods(s, e)
+    assert (cs, ce, ve) == ("2011-01-01", "2011-09-01", "2012-01-01") and "first" in why
+
+
 def test_overlapping_downloads_get_a_sort_setting_that_exists(tmp_path):
     """Two HOBO downloads joined in one file, the second starting ten days before the
     first ended: init writes `sort: true` (a real key) and a question that can be
@@ -368,3 +386,67 @@ def test_an_rh_column_out_of_range_or_empty_is_a_question_not_a_silent_drop(tmp_
     assert ("holds no value" if fault == "empty" else "above 100 %") in q
     assert "hygric:" in res.text  # the hygric model waits for the answer
     assert main(["calibrate", str(out)]) == 2  # calibrate refuses, naming the key
+
+
+def test_a_logger_whose_clock_was_changed_keeps_one_part(tmp_path):
+    """A logger on Finnish local time (DST) in 2010-2011 whose DST was switched off for
+    2012-2013 (the stamps then keep UTC+2: the spring hour stamped, no autumn repeat),
+    as the Ørholm store's logger did: init names the change, keeps one clock and chooses
+    the periods within its part; a declared DST zone keeps the DST part."""
+    utc, te, ti, rh, ghi = _climate("2010-02-01", "2013-12-01", HELSINKI["longitude"])
+    switch = utc < pd.Timestamp("2012-01-01", tz="UTC")
+    wall = (
+        utc.tz_convert("Europe/Helsinki")
+        .tz_localize(None)
+        .where(switch, utc.tz_localize(None) + pd.Timedelta(hours=2))
+    )
+    rows = ["DATE AND TIME; TEMP C; %RH"] + [
+        f"{t:%d-%m-%Y %H:%M};{a:.1f};{b:.0f}" for t, a, b in zip(wall, ti, rh, strict=True)
+    ]
+    lp = _data(tmp_path) / "logger.csv"
+    lp.write_text("\r\n".join(rows) + "\r\n", encoding="utf-8")
+    assert "27-03-2011 03:00" not in lp.read_text() and "25-03-2012 03:00" in lp.read_text()
+    wp = _fmi(tmp_path, utc, te, rh, ghi)
+    out = tmp_path / "room" / "config.yaml"
+    res = init_config(lp, wp, output=out, **HELSINKI)
+    assert res.questions == []
+    cfg = load_config(out)
+    assert timezone_text(cfg.data.measurements[0].timezone) == "UTC+02:00"
+    assert pd.Timestamp(cfg.periods.calibration.start) >= pd.Timestamp("2012-01-01")
+    (f,) = [f for f in res.findings if "the logger's clock was changed" in f]
+    assert "Europe/Helsinki in 2010-2011 and a fixed clock in 2012-2013" in f
+    res = init_config(lp, wp, output=out, force=True, timezone="Europe/Helsinki", **HELSINKI)
+    assert res.questions == []
+    cfg = load_config(out)
+    assert pd.Timestamp(cfg.periods.validation.end) <= pd.Timestamp("2012-01-01")
+
+
+def test_a_validation_warmer_than_the_calibration_is_named():
+    """Eight months from November split in time: a winter to calibrate, a summer to
+    validate (the TRH-1 R5 attic's record); a whole year split 8/4 months is not."""
+    from heritage_bayes.init_checks import extrapolated_seasons
+
+    utc, te, *_ = _climate("2010-11-15", "2011-07-26", HELSINKI["longitude"])
+    s = pd.Series(te, index=utc)
+    note = extrapolated_seasons(s, "2010-11-15", "2011-05-02", "2011-07-26")
+    assert note is not None and "the calibration holds no summer" in note
+    utc, te, *_ = _climate("2011-01-01", "2012-01-01", HELSINKI["longitude"])
+    s = pd.Series(te, index=utc)
+    assert extrapolated_seasons(s, "2011-01-01", "2011-09-01", "2012-01-01") is None
+
+
+def test_a_logger_on_a_fixed_clock_is_asked_which_fixed_clock(tmp_path):
+    """Stamps through the spring change of the site's zone without a jump (the hour
+    Europe/Helsinki skips is stamped): the question names a fixed clock and the zone's
+    standard offset, not a zone with daylight-saving time."""
+    utc, te, ti, rh, ghi = _climate("2013-03-01", "2013-12-01", HELSINKI["longitude"])
+    wall = utc.tz_localize(None) + pd.Timedelta(hours=2)
+    rows = ["DATE AND TIME; TEMP C; %RH"] + [
+        f"{t:%d-%m-%Y %H:%M};{a:.1f};{b:.0f}" for t, a, b in zip(wall, ti, rh, strict=True)
+    ]
+    lp = _data(tmp_path) / "logger.csv"
+    lp.write_text("\n".join(rows) + "\n", encoding="utf-8")
+    res = init_config(lp, _fmi(tmp_path, utc, te, rh, ghi), output=tmp_path / "r" / "c.yaml",
+                      **HELSINKI)  # fmt: skip
+    (q,) = [q for q in res.questions if q.startswith("data.measurements.timezone")]
+    assert "keep a fixed clock, not Europe/Helsinki" in q and "standard time UTC+2" in q

@@ -1,5 +1,6 @@
 """The checks behind ``hbayes init`` (:mod:`heritage_bayes.init_config`): the clocks of
-the two files, the usable span of overlapping data, the periods, a heating floor.
+the two files (a clock changed within a logger file too), a heating floor; the usable
+span and the periods are :mod:`heritage_bayes.init_periods`' (re-exported here).
 
 Each returns what it found and, when it cannot decide, a question (text; the writer marks
 it with :data:`heritage_bayes.questions.MARK`).
@@ -8,20 +9,34 @@ it with :data:`heritage_bayes.questions.MARK`).
 from __future__ import annotations
 
 import datetime as _dt
+from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
 
-from heritage_bayes.errors import DataError
+from heritage_bayes.init_periods import (
+    MAX_GAP_H,
+    MIN_COVERAGE,
+    YEAR_DAYS,
+    choose_periods,
+    extrapolated_seasons,
+    longest_stretch,
+    present_hours,
+    usable_span,
+)
 from heritage_bayes.io import clock as _clock
 from heritage_bayes.io.loggers import TableLayout
 from heritage_bayes.questions import MARK
 
 __all__ = [
     "MAX_GAP_H",
+    "MIN_COVERAGE",
     "YEAR_DAYS",
+    "ClockSwitch",
     "choose_periods",
     "clock_step",
+    "clock_switch",
+    "extrapolated_seasons",
     "heating_floor",
     "logger_clock",
     "longest_stretch",
@@ -32,15 +47,6 @@ __all__ = [
     "usable_span",
     "weather_clock",
 ]
-
-#: Longest gap [h] bridged inside a period (the config's ``data.max_gap``).
-MAX_GAP_H = 6
-#: Least share of the hours with a reading, of the logger and of the weather each, in the
-#: span init proposes: gaps inside it split the record (each segment its own start).
-MIN_COVERAGE = 0.7
-#: A stretch this long [days] or longer is split 8 months / 4 months (a year); shorter
-#: ones 2/3 / 1/3.
-YEAR_DAYS = 365
 
 
 def marked(text: str) -> str:
@@ -220,89 +226,6 @@ def weather_clock(df, lon, declared, findings, where, *, lat=None, layout=None):
     return zone, lab, None
 
 
-def longest_stretch(ti: pd.Series, te: pd.Series) -> tuple[pd.Timestamp, pd.Timestamp, list[str]]:
-    """The longest run of hours with both ``Ti`` and ``Te`` [°C], gaps of up to
-    :data:`MAX_GAP_H` hours bridged: (start, end) [UTC] and notes on the gaps found.
-
-    Raises
-    ------
-    DataError
-        The files overlap in fewer than 48 hours (the message gives both spans).
-    """
-    both = present_hours(ti, te)
-    if len(both) < 48:
-        raise DataError(
-            f"the logger and weather files overlap in {len(both)} hour(s) only "
-            f"(logger {ti.index[0]} to {ti.index[-1]}, weather {te.index[0]} to {te.index[-1]})"
-        )
-    gap_h = np.diff(both) / pd.Timedelta(hours=1)
-    gaps = np.flatnonzero(gap_h > MAX_GAP_H)
-    starts = np.r_[0, gaps + 1]
-    ends = np.r_[gaps, len(both) - 1]
-    k = int(np.argmax(both[ends] - both[starts]))
-    notes = [f"gap of {gap_h[g]:.0f} h from {both[g]:%Y-%m-%d %H:%M} UTC" for g in gaps[:5]] + (
-        [f"... {len(gaps) - 5} more"] if len(gaps) > 5 else []
-    )
-    return both[starts[k]], both[ends[k]] + pd.Timedelta(hours=1), notes
-
-
-def usable_span(ti: pd.Series, te: pd.Series) -> tuple[pd.Timestamp, pd.Timestamp, str, list]:
-    """The span ``[start, end)`` [UTC] init proposes periods in (:func:`choose_periods`)
-    and what it is, with the share of the hours with a reading of the logger (``ti``) and
-    of the weather (``te``) over those periods: the whole overlap of the files when the
-    periods chosen in it have at least :data:`MIN_COVERAGE` of each; else the most recent
-    12 months that have; else the longest stretch without a gap over :data:`MAX_GAP_H`
-    hours (:func:`longest_stretch`). Gaps inside are normal: the calibration splits the
-    record at those too long to bridge. Returns (start, end, what, notes on the gaps).
-
-    Raises
-    ------
-    DataError
-        The files overlap in fewer than 48 hours (see :func:`longest_stretch`).
-    """
-    s, e, notes = longest_stretch(ti, te)
-    hi_t, hi_e = ti.dropna().index.floor("h"), te.dropna().index.floor("h")
-    lo = max(hi_t.min(), hi_e.min()).ceil("D")
-    hi = (min(hi_t.max(), hi_e.max()) + pd.Timedelta(hours=1)).floor("D")
-    if hi - lo < pd.Timedelta(days=2):
-        return s, e, f"the longest stretch without a gap over {MAX_GAP_H} h", notes
-    hours = pd.date_range(lo, hi, freq="h", inclusive="left")
-    cum = [np.r_[0, np.cumsum(hours.isin(h))] for h in (hi_t.unique(), hi_e.unique())]
-
-    def coverage(start, end) -> list[float]:
-        i, j = hours.searchsorted(start), hours.searchsorted(end)
-        return [(c[j] - c[i]) / max(j - i, 1) for c in cum]
-
-    def what(label, cov):
-        return (
-            f"{label} (a logger reading in {cov[0]:.1%} of the hours, a weather reading in "
-            f"{cov[1]:.1%}; a gap over {MAX_GAP_H} h splits the record, each part with its "
-            "own initial state)"
-        )
-
-    cs, _, _, ve, _ = choose_periods(lo, hi)
-    cov = coverage(pd.Timestamp(cs, tz="UTC"), pd.Timestamp(ve, tz="UTC"))
-    if min(cov) >= MIN_COVERAGE:
-        return lo, hi, what("the overlap of the files", cov), notes
-    for end in pd.date_range(lo, hi, freq="D")[::-1]:  # the latest 12 months first
-        start = end - pd.DateOffset(years=1)
-        if start < lo:
-            break
-        if min(cov := coverage(start, end)) >= MIN_COVERAGE:
-            return start, end, what("the most recent 12 months with data", cov), notes
-    return s, e, (
-        f"the longest stretch without a gap over {MAX_GAP_H} h (no year with "
-        f"{MIN_COVERAGE:.0%} of the hours from both files)"
-    ), notes  # fmt: skip
-
-
-def present_hours(ti: pd.Series, te: pd.Series) -> pd.DatetimeIndex:
-    """The hours [UTC] in which both ``ti`` and ``te`` have a value, sorted."""
-    a = ti.dropna().index.floor("h").unique()
-    b = te.dropna().index.floor("h").unique()
-    return a.intersection(b).sort_values()
-
-
 def heating_floor(ti: pd.Series, te: pd.Series) -> tuple[float, int, int]:
     """A thermostat's signature: (floor [°C], days held at it, days with both series).
 
@@ -320,57 +243,6 @@ def heating_floor(ti: pd.Series, te: pd.Series) -> tuple[float, int, int]:
     floor = float(np.percentile(both["ti"], 5))
     held = (both["ti"] - floor).abs().le(0.5) & both["te"].lt(floor - 5)
     return floor, int(held.sum()), len(both)
-
-
-def choose_periods(
-    s: pd.Timestamp,
-    e: pd.Timestamp,
-    present: pd.DatetimeIndex | None = None,
-    span: str = "the longest stretch",
-) -> tuple[str, str, str, str, str]:
-    """Calibration ``[start, mid)`` and validation ``[mid, end)`` in whole UTC days
-    within the stretch ``[s, e)``, and why: the first whole calendar year (8 months to
-    calibrate, 4 to validate: all seasons), else the first 12 whole months, else the
-    stretch's first 2/3 and the rest. With ``present`` (the hours with an input
-    reading), the start and the end are midnights with a reading: a period never starts
-    or ends inside an input gap (or after the last reading), which the simulation
-    cannot bridge. ``span`` says what ``[s, e)`` is, for ``why``. Returns ``(start, mid,
-    mid, end, why)`` as text."""
-    day = pd.Timedelta(days=1)
-    s0 = s.ceil("D")
-    e0 = e.floor("D")
-
-    jan = pd.Timestamp(year=s0.year + int((s0.month, s0.day) > (1, 1)), month=1, day=1, tz=s0.tz)
-    if s0.day != 1 and (e - s0).days >= YEAR_DAYS + 31:
-        s0 = (s0 + pd.offsets.MonthBegin(1)).normalize()
-    if e0 >= jan + pd.DateOffset(years=1):  # a whole calendar year: the reporting year
-        s0 = jan
-    if (e0 - s0).days >= YEAR_DAYS:
-        end = s0 + pd.DateOffset(months=12)
-        mid = s0 + pd.DateOffset(months=8)
-        what = "calendar year" if (s0.month, s0.day) == (1, 1) else "year"
-        why = (
-            f"the first whole {what} of {span}: 8 months to calibrate, 4 to validate (all seasons)"
-            if not span.startswith("the most recent")
-            else f"{span}: 8 months to calibrate, the next 4 to validate (all seasons)"
-        )
-    else:
-        end = e0
-        mid = s0 + day * round((e0 - s0).days * 2 / 3)
-        why = f"{span}: its first 2/3 to calibrate, the rest to validate"
-    if present is not None and len(present):  # no start or end inside a short gap
-        have = set(present)
-        moved = s0
-        while moved < mid and moved not in have:
-            moved += day
-        end_moved = end
-        while end_moved > mid and end_moved not in have:
-            end_moved -= day
-        if (moved, end_moved) != (s0, end):
-            why += "; start and end moved off gaps in the data"
-        s0, end = moved, end_moved
-    f = "%Y-%m-%d"
-    return s0.strftime(f), mid.strftime(f), mid.strftime(f), end.strftime(f), why
 
 
 def logger_clock(layout, df_naive, declared, lon, findings, where, lat=None):
@@ -399,6 +271,9 @@ def logger_clock(layout, df_naive, declared, lon, findings, where, lat=None):
                 "or give --latitude and --longitude to have it looked up"
             )
         example = (site and _clock.site_zone(lat, lon)) or "Europe/Amsterdam"
+        fixed = _fixed_stamps(layout, example) if site else None
+        if fixed:
+            return marked(fixed)
         return marked(
             "the logger's clock: UTC, a fixed offset such as UTC+1, or a zone with "
             f"daylight-saving time such as {example} (see its settings or the software it "
@@ -456,6 +331,110 @@ def logger_clock(layout, df_naive, declared, lon, findings, where, lat=None):
                     "outdoor air do; is the logger's clock ahead of the declared one?"
                 )
     return question or declared
+
+
+@dataclass
+class ClockSwitch:
+    """A logger whose stamps follow the DST changes of its site's zone in some years and
+    keep a fixed clock in others (a setting changed once): the part init keeps.
+
+    ``zone``: the clock of the part kept (the DST zone, or its standard offset such as
+    ``UTC+1``); ``start``, ``end``: the part's bounds on the file's clock (naive; None:
+    open); ``why``: the evidence, in words.
+    """
+
+    zone: str
+    start: pd.Timestamp | None
+    end: pd.Timestamp | None
+    why: str
+
+    def keep(self, series):
+        """``series`` (a Series or DataFrame on the file's clock, stamps as if UTC)
+        within the part kept."""
+        t = series.index.tz_localize(None) if series.index.tz is not None else series.index
+        ok = np.ones(len(series), bool)
+        if self.start is not None:
+            ok &= t >= self.start
+        if self.end is not None:
+            ok &= t < self.end
+        return series[ok]
+
+
+def clock_switch(
+    times: pd.DatetimeIndex, lat, lon, prefer: str | None = None
+) -> ClockSwitch | None:
+    """A change of clock within a logger file, from its stamps alone.
+
+    Each calendar year's stamps are compared with the DST changes of the site's zone
+    (:func:`~heritage_bayes.io.clock.dst_structure`): a year whose spring hour is
+    skipped is on DST, a year with stamps inside the skipped hour on a fixed clock. When
+    the years fall in two runs (DST, then fixed, or the reverse) the run of ``prefer``
+    (``"dst"`` or ``"fixed"``: the kind of clock declared) is kept, else the longer run
+    (the later on a tie), bounded at the 1st of January of the later run's first year
+    (in winter the two clocks agree). The fixed clock is taken as the zone's standard
+    offset (the logger's DST switched off). None without a site, for a zone without DST,
+    or when the years do not fall in two runs. Measured: the Ørholm store's logger
+    follows Europe/Copenhagen's changes 2009-2011 and keeps a fixed clock 2012-2021.
+    """
+    if lat is None or lon is None or len(times) < 3:
+        return None
+    zone = _clock.site_zone(float(lat), float(lon))
+    years = range(times.min().year, times.max().year + 1)
+    if not zone or not _clock.keeps_dst(zone, years):
+        return None
+    verdicts = {}
+    for y in years:
+        v = _clock.dst_structure(times[times.year == y], zone).verdict
+        if v is not None:
+            verdicts[y] = v
+    runs: list[list] = []  # [verdict, first year, last year]
+    for y, v in verdicts.items():
+        if runs and runs[-1][0] == v:
+            runs[-1][2] = y
+        else:
+            runs.append([v, y, y])
+    if len(runs) != 2:
+        return None
+    (v0, a0, b0), (v1, a1, b1) = runs
+    kept = runs[0] if b0 - a0 > b1 - a1 else runs[1]
+    if prefer in (v0, v1):
+        kept = runs[0] if v0 == prefer else runs[1]
+    cut = pd.Timestamp(year=a1, month=1, day=1)
+    std = min(
+        pd.Timestamp(year=a0, month=m, day=15, tz="UTC").tz_convert(zone).utcoffset()
+        / pd.Timedelta(hours=1)
+        for m in (1, 7)
+    )
+    kz = zone if kept[0] == "dst" else _fmt_h(std)
+    words = {"dst": f"the DST changes of {zone}", "fixed": "a fixed clock"}
+    why = (
+        f"the stamps follow {words[v0]} in {a0}-{b0} and {words[v1]} in {a1}-{b1} (each "
+        f"year's spring and autumn changes): the logger's clock was changed; the "
+        f"{kept[1]}-{kept[2]} part is kept, on {kz}"
+        + (" (the zone's standard offset)" if kept[0] == "fixed" else "")
+        + f", from {cut:%Y-%m-%d}" * (kept is runs[1])
+        + f", until {cut:%Y-%m-%d}" * (kept is runs[0])
+    )
+    return ClockSwitch(kz, cut if kept is runs[1] else None, cut if kept is runs[0] else None, why)
+
+
+def _fixed_stamps(layout, zone: str) -> str | None:
+    """The clock question for stamps that keep a fixed clock through the DST changes of
+    the site's zone (the spring hour it skips is stamped): which fixed clock, naming the
+    zone's standard offset; None when the stamps do not tell."""
+    times = _raw_times(layout)
+    if not len(times) or not _clock.keeps_dst(zone, range(times.min().year, times.max().year + 1)):
+        return None
+    st = _clock.dst_structure(times, zone)
+    if st.verdict != "fixed":
+        return None
+    t = pd.Timestamp(year=int(times.min().year), month=1, day=15, tz="UTC").tz_convert(zone)
+    std = _fmt_h(t.utcoffset() / pd.Timedelta(hours=1))
+    return (
+        f"the logger's stamps keep a fixed clock, not {zone}'s daylight-saving time "
+        f"({st.describe()}): which one, UTC or {zone}'s standard time {std}? (see its "
+        "settings or the software it was read out with)"
+    )
 
 
 def _dst_rules(layout) -> str | None:

@@ -59,10 +59,13 @@ from heritage_bayes.init_checks import (
     MAX_GAP_H,
     choose_periods,
     clock_step,
+    clock_switch,
+    extrapolated_seasons,
     heating_floor,
     logger_clock,
     marked,
     present_hours,
+    raw_table,
     to_utc,
     usable_span,
     weather_clock,
@@ -70,6 +73,8 @@ from heritage_bayes.init_checks import (
 from heritage_bayes.init_columns import fahrenheit_column_check, rh_column_check, usable
 from heritage_bayes.init_model import propose_model
 from heritage_bayes.init_roof import attic_evidence, roof_finding, solar_surface_lines
+from heritage_bayes.init_sources import source_lines as _source_lines
+from heritage_bayes.init_sources import timing_without_sun as _timing_without_sun
 from heritage_bayes.io import clock as _clock
 from heritage_bayes.io.loggers import TableLayout, inspect_table
 from heritage_bayes.questions import MARK
@@ -127,6 +132,20 @@ def _weather_format(path: Path, given: str | None) -> str:
     return "csv"
 
 
+def _clock_kind(zone: str | None) -> str | None:
+    """``"fixed"`` for a fixed offset, ``"dst"`` for a zone with rules, None when not
+    given or not readable (the reader's own message comes later)."""
+    if not zone:
+        return None
+    from heritage_bayes.io import parse_timezone
+
+    try:
+        tz = parse_timezone(zone)
+    except (ValueError, TypeError):
+        return None
+    return "fixed" if isinstance(tz, _dt.timezone) else "dst"
+
+
 def _read_naive(layout: TableLayout, columns: dict[str, str], units: dict) -> pd.DataFrame:
     """The table on the file's own clock (read as if UTC), for inspection only."""
     from heritage_bayes.io import read_csv
@@ -165,87 +184,6 @@ def _pick(layout: TableLayout, kinds: dict[str, str], findings: list[str], what:
         )
         findings.append(f"{what}: {std} = column {c.name!r}: {c.why}{also}")
     return columns, units
-
-
-def _timing_without_sun(layout: TableLayout, findings: list[str]) -> str:
-    """How a weather CSV without irradiance stamps its values (the sun cannot tell):
-    hour-ending means for a DMI portal export (``Station;Year;Month;Day;Hour (UTC)``,
-    "hourly averages" in its description), readings at the stamp otherwise."""
-    tc = layout.time_column if isinstance(layout.time_column, list) else [layout.time_column]
-    if "Station" in layout.header and "Hour (UTC)" in tc:
-        findings.append(
-            "weather: a DMI export (Station, Year, Month, Day, Hour (UTC)): its values are "
-            "hourly averages, taken as means of the hour ending at the stamp"
-        )
-        return "means_end"
-    findings.append(
-        "weather: no irradiance to time the stamps against the sun: Te and RHe taken as "
-        "readings at the stamp; if the file holds interval means, list them under averaged"
-    )
-    return "instant"
-
-
-def _source_lines(
-    key: str, layout: TableLayout, rel: str, zone, columns, units, label, dropped
-) -> list[str]:
-    out = [f"  {key}:", "    format: csv", f"    path: {_yaml_value(rel)}"]
-    tc = layout.time_column
-    out.append(f"    time_column: {_yaml_value(tc)}")
-    if layout.time_format != "ISO8601":
-        out.append(f"    time_format: {_yaml_value(layout.time_format)}")
-        out.append(f"    timezone: {_yaml_value(zone)}")
-    if layout.sep != ",":
-        out.append(f"    sep: {_yaml_value(layout.sep)}")
-    if layout.decimal != ".":
-        out.append(f"    decimal: {_yaml_value(layout.decimal)}")
-    if layout.skiprows:
-        out.append(f"    skiprows: {_yaml_value(layout.skiprows)}   # {layout.layout} layout")
-    if layout.encoding != "utf-8":
-        out.append(f"    encoding: {layout.encoding}")
-    out.append(f"    columns: {_yaml_value(columns)}")
-    if units:
-        out.append(f"    units: {_yaml_value(units)}   # converted on reading")
-    irr = [c for c in ("ghi", "dni", "dhi") if c in columns]
-    if label == "means_end":
-        out.append(
-            f"    averaged: {_yaml_value(sorted(columns))}   # means of the hour ending at "
-            "the stamp (the file's documentation): constant over their hour"
-        )
-    elif label == "instant" or (label is not None and not irr):
-        out.append(
-            "    averaged: []   # every column read at the stamp (irradiance: see the clock "
-            "check): linear between readings"
-        )
-    elif label in ("end", "start"):
-        out.append(
-            f"    averaged: {_yaml_value(irr)}   # means of the hour "
-            f"{'ending' if label == 'end' else 'starting'} at the stamp (the clock check); "
-            "the others read at the stamp"
-        )
-        if label == "start":
-            out.append("    label: start")
-    out += _policy_lines(dropped)
-    return out
-
-
-#: What the reader dropped while init inspected a file, and the key that lets the
-#: calibration read the file the same way (its default would refuse it).
-_POLICIES = {
-    "duplicates": ("duplicates: first", "stamps repeated with other values: the first kept"),
-    "sorted": ("sort: true", "time stamps going backwards: the rows sorted by time"),
-    "bad_timestamps": ("invalid: nan", "unreadable time stamps: those rows dropped"),
-    "unparseable_values": ("invalid: nan", "unreadable values: left out"),
-    "out_of_range": ("invalid: nan", "values outside the physical range: left out"),
-}
-
-
-def _policy_lines(dropped: dict) -> list[str]:
-    lines: dict[str, list[str]] = {}
-    for what, n in (dropped or {}).items():
-        if what in _POLICIES and n:
-            setting, why = _POLICIES[what]
-            lines.setdefault(setting, []).append(f"{n} {why}")
-    return [f"    {k}   # {'; '.join(v)}" for k, v in lines.items()]
 
 
 def _dropped_findings(df: pd.DataFrame, where: str, findings: list[str], questions: list[str]):
@@ -443,7 +381,13 @@ def init_config(
         izone = None
         findings.append("logger: time stamps carry their UTC offset")
     else:
-        izone = logger_clock(lay, din, timezone or lay.timezone, lon, findings, "logger", lat)
+        declared = timezone or lay.timezone
+        switch = clock_switch(raw_table(lay).index, lat, lon, _clock_kind(declared))
+        if switch is not None:  # the clock changed within the file: one part is kept
+            findings.append(f"logger: {switch.why}")
+            din = switch.keep(din)
+            declared = declared or switch.zone
+        izone = logger_clock(lay, din, declared, lon, findings, "logger", lat)
     if izone and izone.startswith(MARK):
         questions.append(f"data.measurements.timezone: {izone[len(MARK) :].strip()}")
     ti_utc = to_utc(din["Ti"], izone)
@@ -492,6 +436,9 @@ def init_config(
     # the inputs must hold a reading at both ends of the periods (the outputs need not)
     cs, ce, vs, ve, why = choose_periods(s, e, present_hours(te_utc, te_utc), span)
     findings.append(f"periods: {why}")
+    if season := extrapolated_seasons(te_utc, cs, ce, ve):
+        findings.append(f"periods: {season}")
+        why = f"{why}. Note: {season}"
     # an RH column that needs an answer keeps the hygric section: answered, it runs
     rhe_open = wlay is not None and str(wcols.get("RHe", "")).startswith(MARK)
     hygric = "RHi" in icols and ("RHe" in dw.columns or rhe_open)

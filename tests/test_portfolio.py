@@ -104,6 +104,14 @@ def test_three_rooms_two_workers_one_bad(finished):
         )
         assert by.loc[room, "converged"] == summary["converged"]
         assert (out / room / "report.html").is_file()
+        # the run is the room: its summary and report carry the room's name, not the
+        # shared config's ("tiny")
+        assert summary["name"] == room
+        report = (out / room / "report.html").read_text(encoding="utf-8")
+        assert f"run “{room}”" in report and "“tiny”" not in report
+        # the status is the report's verdict (these tiny runs stop at their step cap)
+        assert by.loc[room, "verdict"] == "not converged"
+        assert f'class="verdict {by.loc[room, "verdict_level"]}"' in report
         # risk of the measured climate: less than a year logged, so only what does not
         # depend on the season covered, and the page says why
         assert by.loc[room, "emc_range_pct"] > 0 and pd.isna(by.loc[room, "twpi_years"])
@@ -150,7 +158,7 @@ def test_batch_counts_unconverged_rooms_and_exits_3(finished, capsys):
         assert not df.loc[room, "converged"]
         assert "sampler.max_steps was reached" in df.loc[room, "unconverged_reasons"]
     index = (d / "out" / "index.html").read_text(encoding="utf-8")
-    assert "why not converged" in index and "2 finished unconverged" in index
+    assert "why not converged" in index and "2 not converged" in index
     pf = yaml.safe_load((d / "portfolio.yaml").read_text(encoding="utf-8"))
     pf["rooms"] = pf["rooms"][:2]
     two = _write(d / "two.yaml", pf)
@@ -221,15 +229,17 @@ def test_index_sorts_in_headless_chromium(finished):
     d, _, _ = finished
     # click "room" twice (ascending, then descending) and read the first column of rooms
     js = """(() => {
-      const ths = Array.from(document.querySelectorAll('table.sortable th'));
+      const table = document.getElementById('table-calibration');
+      const ths = Array.from(table.querySelectorAll('th'));
       const th = ths.find(h => h.textContent.trim() === 'room');
       const col = ths.indexOf(th);
-      const rooms = () => Array.from(document.querySelectorAll('table.sortable tbody tr'))
+      const rooms = () => Array.from(table.querySelectorAll('tbody tr'))
         .map(r => r.cells[col].textContent.trim());
       const before = rooms();
       th.click(); const asc = rooms();
       th.click(); const desc = rooms();
-      return {before, asc, desc, links: document.querySelectorAll('a[href$="report.html"]').length};
+      return {before, asc, desc,
+              links: table.querySelectorAll('a[href$="report.html"]').length};
     })()"""
     res = open_page(d / "out" / "index.html", chromium=chromium, extra_js=js)
     assert res.errors == [], res.errors  # CSP: the hashed sort script is allowed
@@ -270,3 +280,23 @@ def test_index_speaks_in_percent_and_names_the_indicators_at_risk(tmp_path):
     flagged = next(c for c in cells if c.startswith("2: "))
     assert "mould" in flagged.lower() and "EN 15757" in flagged
     assert "vtt_mould_index_max" not in flagged
+
+
+@pytest.mark.browser
+@pytest.mark.parametrize("width", [1280, 390])
+def test_index_fits_the_screen_with_its_projection_columns(finished, width):
+    """At 1280 px the three tables fit the page (the projection columns on screen, no
+    sideways scroll); at 390 px each room is a card: nothing wider than the screen."""
+    from _report_browser import phone_layout
+
+    d, _, _ = finished
+    lay = phone_layout(d / "out" / "index.html", width=width, extra="""
+      (() => { const t = document.getElementById('table-projection');
+               const r = t.getBoundingClientRect();
+               return {right: r.right, height: r.height,
+                       text: t.innerText, status: document.getElementById(
+                         'table-calibration').innerText}; })()""")  # fmt: skip
+    proj = lay["extra"]
+    assert proj["right"] <= lay["W"] and proj["height"] > 0, proj
+    assert "warm 2050" in proj["text"] and "P(TWPI" in proj["text"]
+    assert "not converged" in proj["status"] and "failed" in proj["status"]

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import time
 import traceback
 from collections.abc import Mapping
@@ -14,7 +15,7 @@ import pandas as pd
 from heritage_bayes.errors import InputError
 from heritage_bayes.portfolio.spec import RoomSpec
 
-__all__ = ["measured_risk", "room_row"]
+__all__ = ["STATUSES", "measured_risk", "report_status", "room_row"]
 
 
 def _is_done(run_dir: Path, chash: str) -> bool:
@@ -127,8 +128,20 @@ def _project_room(run_dir: Path, projection: Path, resume: bool) -> dict:
     if probs:
         p0 = probs[0]
         row["proj.statement"] = f"P({p0['indicator']} {p0['op']} {p0['value']:g})"
+        row["proj.statement_text"] = _statement_text(p0)
         row["proj.probability"] = p0["cases"].get(label, {}).get("p", float("nan"))
     return row
+
+
+def _statement_text(p: Mapping) -> str:
+    """``P(TWPI < 25 years)``: a probability statement in the indicator's name and unit."""
+    from heritage_bayes.climate.risk.registry import indicator_info
+
+    try:
+        info = indicator_info(p["indicator"])
+    except InputError:  # an indicator this version does not know: its code
+        return f"P({p['indicator']} {p['op']} {p['value']:g})"
+    return f"P({info.name} {p['op']} {p['value']:g} {info.unit})".replace(" )", ")")
 
 
 def _get(d: Mapping, *keys, default=float("nan")):
@@ -143,10 +156,11 @@ def room_row(run_dir: str | Path) -> dict:
     """The portfolio table's row of one finished run directory.
 
     Columns: convergence (``converged``, ``max_rhat``, ``min_ess_bulk``,
-    ``wall_seconds``), per measured output ``<section>.<output>.FIT_cal`` /
-    ``FIT_val`` [%] and ``coverage90_val`` [-], the slowest time constant and the
-    outdoor-temperature gain of each section, and conservation-risk indicators of the
-    *measured* indoor climate over the data period (:func:`measured_risk`).
+    ``wall_seconds``), the report's verdict (:func:`report_status`), per measured
+    output ``<section>.<output>.FIT_cal`` / ``FIT_val`` [%] and ``coverage90_val`` [-],
+    the slowest time constant and the outdoor-temperature gain of each section, and
+    conservation-risk indicators of the *measured* indoor climate over the data period
+    (:func:`measured_risk`).
     """
     from heritage_bayes.rundir.reader import read_summary
 
@@ -178,8 +192,56 @@ def room_row(run_dir: str | Path) -> dict:
                 row[f"{section}.{col}"] = derived[q].get("median", float("nan"))
                 row[f"{section}.{col}_q05"] = derived[q].get("q05", float("nan"))
                 row[f"{section}.{col}_q95"] = derived[q].get("q95", float("nan"))
+    row.update(report_status(run_dir, s))
     row.update(measured_risk(run_dir))
     return row
+
+
+#: The statuses of the overview, most urgent first (failed rooms come before them).
+STATUSES = ("not converged", "checks failed", "converged")
+_VERDICT = re.compile(
+    r"<div id=\"verdict\" class=\"verdict (?P<level>\w+)\"[^>]*>\s*<h2>(?P<title>.*?)</h2>", re.S
+)
+
+
+def report_status(run_dir: Path, summary: Mapping) -> dict:
+    """The room's status as its report's verdict gives it: ``verdict_level`` (green,
+    amber, red), ``verdict_title`` (the verdict's heading) and ``verdict`` — one of
+    :data:`STATUSES`: *converged* (green), *checks failed* (the sampler converged but
+    the report's residual, coverage, truth or accuracy checks fail) or *not converged*.
+
+    Read from ``report.html`` (the package wrote it; its verdict box is the page's
+    contract), so the overview never contradicts the report it links. Without a report
+    the run's own decision (``summary.json``) gives *converged* or *not converged*, and
+    ``verdict_title`` says that no report was checked.
+    """
+    import html as html_mod
+
+    converged = bool(summary.get("converged")) and bool(summary.get("converged_tau", True))
+    path = run_dir / "report.html"
+    m = None
+    if path.is_file():
+        try:
+            with path.open(encoding="utf-8") as fh:
+                m = _VERDICT.search(fh.read(200_000))  # the verdict leads the page
+        except (OSError, UnicodeDecodeError):
+            m = None
+    if m is None:
+        return {
+            "verdict": "converged" if converged else "not converged",
+            "verdict_level": "",
+            "verdict_title": "no report: the residual and coverage checks were not run",
+        }
+    level = m["level"]
+    title = re.sub(r"\s+", " ", html_mod.unescape(re.sub(r"<[^>]+>", "", m["title"]))).strip()
+    title = title.lstrip("✔⚠✖ ")
+    if level == "green":
+        status = "converged"
+    elif converged and not re.search(r"not (fully )?converged", title, re.I):
+        status = "checks failed"
+    else:
+        status = "not converged"
+    return {"verdict": status, "verdict_level": level, "verdict_title": title}
 
 
 def measured_risk(run_dir: str | Path) -> dict:
@@ -246,11 +308,14 @@ def measured_risk(run_dir: str | Path) -> dict:
 
 
 def _attention_order(df: pd.DataFrame) -> pd.DataFrame:
-    """Rooms that need attention first: failed or unconverged calibrations (their
-    figures cannot be trusted), then the most indicators rated "risk", then the
-    shortest preservation index (TWPI)."""
+    """Rooms that need attention first: failed calibrations, then those not converged,
+    then those whose report's checks fail (their figures cannot be trusted yet), then
+    the most indicators rated "risk", then the shortest preservation index (TWPI)."""
     status_rank = df["status"].map({"failed": 0, "error": 0}).fillna(1)
     conv = df.get("converged", pd.Series(True, index=df.index)).fillna(False).astype(bool)
+    if "verdict" in df:  # the report's verdict: not converged, checks failed, converged
+        rank = {v: i for i, v in enumerate(STATUSES)}
+        conv = df["verdict"].map(rank).fillna(conv.astype(int) * (len(STATUSES) - 1))
     flags = df.get("risk_flags", pd.Series(0, index=df.index)).fillna(0)
     twpi = df.get("twpi_years", pd.Series(np.inf, index=df.index)).fillna(np.inf)
     key = pd.DataFrame({"s": status_rank, "c": conv.astype(int), "f": -flags, "t": twpi})

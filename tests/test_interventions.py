@@ -604,3 +604,16 @@ def test_tradeoff_labels_do_not_overlap_when_measures_cluster():
         for j, (x, y) in enumerate(px):
             if i != j:
                 assert not (b.x0 < x < b.x1 and b.y0 < y < b.y1), (texts[i], j)
+
+
+@pytest.mark.browser
+def test_measures_section_on_a_phone_has_no_horizontal_scroll(projected):
+    """At 390 px the page with its measures section (decision table, trade-off figure,
+    per-case tables) is no wider than the screen, and no cell cuts a word or number."""
+    from _report_browser import phone_layout
+
+    lay = phone_layout(Path(projected.paths["html"]), extra="""
+      (() => { const s = document.getElementById('interventions');
+               return s ? s.getBoundingClientRect().right : null; })()""")  # fmt: skip
+    assert lay["extra"] is not None and lay["extra"] <= lay["W"]
+    assert lay["broken"] == [], lay["broken"]

@@ -300,3 +300,35 @@ def test_index_fits_the_screen_with_its_projection_columns(finished, width):
     assert proj["right"] <= lay["W"] and proj["height"] > 0, proj
     assert "warm 2050" in proj["text"] and "P(TWPI" in proj["text"]
     assert "not converged" in proj["status"] and "failed" in proj["status"]
+
+
+@pytest.mark.parametrize(
+    ("level", "title", "converged", "status"),
+    [
+        ("green", "Converged", True, "converged"),
+        ("amber", "Converged, but the checks below fail", True, "checks failed"),
+        ("red", "This model does not reproduce the room", True, "checks failed"),
+        ("red", "This model does not reproduce the room — and NOT CONVERGED", False,
+         "not converged"),
+        ("amber", "Nearly converged — use with care", False, "not converged"),
+        ("red", "NOT CONVERGED — do not use these results yet", True, "not converged"),
+    ],
+)  # fmt: skip
+def test_a_rooms_status_is_its_reports_verdict(tmp_path, level, title, converged, status):
+    """The verdict box as the report's own template renders it, read back: the status
+    never contradicts the report the row links (a run that met its stopping rule but
+    whose saved draws fail is 'not converged' when its report says so)."""
+    from heritage_bayes.portfolio.rooms import report_status
+    from heritage_bayes.report.sections._fragment import render_fragment
+
+    verdict = {"level": level, "title": title, "text": "t", "models": [], "advice": "",
+               "stats": "s"}  # fmt: skip
+    box = render_fragment("verdict.html", {"verdict": verdict, "warnings": []})
+    (tmp_path / "report.html").write_text(f"<html><body>{box}</body></html>", encoding="utf-8")
+    got = report_status(tmp_path, {"converged": converged, "converged_tau": converged})
+    assert got["verdict"] == status and got["verdict_level"] == level
+    assert got["verdict_title"] == title
+    (tmp_path / "report.html").unlink()  # no report: the run's own decision, said so
+    got = report_status(tmp_path, {"converged": converged, "converged_tau": converged})
+    assert got["verdict"] == ("converged" if converged else "not converged")
+    assert "no report" in got["verdict_title"]

@@ -165,7 +165,7 @@ def _status(r) -> tuple[str, str, str]:
     if not isinstance(status, str) or not status:  # a row of an older version
         status = "converged" if bool(r.get("converged")) else "not converged"
     title = r.get("verdict_title")
-    title = title if isinstance(title, str) and status != "converged" else ""
+    title = title if isinstance(title, str) and status == "checks failed" else ""
     return status, title, _STATUS_CLASS.get(status, "")
 
 
@@ -198,7 +198,8 @@ def _row_cells(r, cols, out: Path) -> str:
                 text = html.escape(_flagged_text(r.get(key), r["risk_flagged"]))
             if key == "message":
                 cls = "msg"
-                text = f"<span class='pre-wrap'>{html.escape(str(value or '')[:600])}</span>"
+                msg = html.escape(str(value or "")[:600]).replace("/", "/<wbr>")  # paths
+                text = f"<span class='pre-wrap'>{msg}</span>"
         attr = f" class='{cls}'" if cls else ""
         cells.append(
             f"<td{attr} data-label='{html.escape(header)}' data-v='{html.escape(sort)}'>"

@@ -298,7 +298,8 @@ def test_index_fits_the_screen_with_its_projection_columns(finished, width):
                          'table-calibration').innerText}; })()""")  # fmt: skip
     proj = lay["extra"]
     assert proj["right"] <= lay["W"] and proj["height"] > 0, proj
-    assert "warm 2050" in proj["text"] and "P(TWPI" in proj["text"]
+    assert "warm 2050" in proj["text"]  # the case and the statement in words
+    assert "P(Time-weighted preservation index < 1000 years)" in proj["text"]
     assert "not converged" in proj["status"] and "failed" in proj["status"]
 
 

@@ -546,7 +546,10 @@ def test_tradeoff_figure_has_one_labelled_marker_per_measure(projected, monkeypa
     monkeypatch.setattr(interventions_page, "to_png_uri", lambda fig: figs.append(fig) or "x")
     interventions_page.fig_tradeoff(projected, KEY_INDICATORS)
     (fig,) = figs
-    names = sorted(projected.summary["interventions"])
+    # each label: the measure's rank in the decision table and its name
+    ranked = projected.summary["decision"]["measures"]
+    names = sorted(f"{i}. {m['name']}" for i, m in enumerate(ranked, 1))
+    assert len(names) == len(projected.summary["interventions"])
     for ax in fig.axes:
         assert len(ax.containers) == len(names)  # one errorbar (marker) per measure
         assert sorted(t.get_text() for t in ax.texts) == names

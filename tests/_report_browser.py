@@ -8,6 +8,8 @@ Debian's ``chromium`` package (or the executable named by ``HB_CHROMIUM``).
 :func:`open_page` loads the file, waits for the load event, and returns the console
 messages, uncaught exceptions, browser log entries (CSP violations, failed loads), every
 network request the page made, the result of a few DOM queries and a PNG screenshot.
+:func:`phone_layout` checks a page for horizontal overflow (the browser tests);
+:func:`screenshot_figure` embeds a page's first screen in the manual (the docs build).
 """
 
 from __future__ import annotations
@@ -24,7 +26,15 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-__all__ = ["BROKEN_WORDS", "PHONE_OVERFLOW_JS", "PageResult", "find_chromium", "open_page"]
+__all__ = [
+    "BROKEN_WORDS",
+    "PHONE_OVERFLOW_JS",
+    "PageResult",
+    "find_chromium",
+    "open_page",
+    "phone_layout",
+    "screenshot_figure",
+]
 
 _FLAGS = [
     "--headless",
@@ -315,3 +325,68 @@ def open_page(
             proc.wait(timeout=10)
         shutil.rmtree(profile, ignore_errors=True)
     return res
+
+
+def phone_layout(path: str | Path, *, width: int = 390, height: int = 844, extra: str = ""):
+    """Open ``path`` at ``width`` px and check that the page has no horizontal scroll:
+    the document no wider than the screen, no element outside the sideways-scrolling
+    tables and code sticking out (:data:`PHONE_OVERFLOW_JS`), no console error. Skips
+    the calling test when Chromium is not installed. Returns the layout dict, with the
+    value of the JavaScript expression ``extra`` under ``"extra"``."""
+    import pytest
+
+    chromium = find_chromium()
+    if chromium is None:
+        pytest.skip("chromium not installed: the page was not opened in a real browser")
+    js = PHONE_OVERFLOW_JS
+    if extra:
+        js = f"Object.assign({PHONE_OVERFLOW_JS}, {{extra: {extra}}})"
+    res = open_page(path, chromium=chromium, width=width, height=height, extra_js=js)
+    assert res.errors == [], res.errors
+    lay = res.dom["extra"]
+    assert lay["docw"] <= lay["W"] <= width, (Path(path).name, lay)
+    assert lay["wide"] == [], (Path(path).name, lay["wide"])
+    return lay
+
+
+def screenshot_figure(
+    path: str | Path,
+    caption: str,
+    *,
+    section: str | None = None,
+    width: int = 1280,
+    height: int = 800,
+) -> str:
+    """HTML of a ``<figure>``: the first screen of the page ``path`` (scrolled to the
+    element with id ``section``, if given) at ``width`` × ``height`` px, a PNG embedded
+    as a data URI, for the manual's build. Without Chromium: a visible placeholder
+    saying that the screenshot needs it, and a note on stderr (the build log) — never
+    a silent gap."""
+    import html
+    import sys
+
+    name = Path(path).name + (f"#{section}" if section else "")
+    if find_chromium() is None:
+        print(f"docs: chromium not found: the screenshot of {name} needs it", file=sys.stderr)
+        return (
+            f'<div class="admonition note"><p class="admonition-title">Screenshot of '
+            f"{html.escape(name)} not built</p><p>This screenshot is taken with headless "
+            "Chromium (the <code>chromium</code> package) when the site is built; the "
+            "machine that built this site did not have it. The page itself is "
+            f"<code>{html.escape(str(path))}</code>.</p></div>"
+        )
+    scroll = None
+    if section:
+        scroll = (
+            f"(() => {{ const e = document.getElementById({json.dumps(section)}); "
+            "if (!e) return null; e.scrollIntoView(); return window.scrollY; })()"
+        )
+    shot = open_page(path, width=width, height=height, extra_js=scroll)
+    if section and shot.dom.get("extra") is None:
+        raise ValueError(f"{path}: no element with id {section!r} to scroll to")
+    data = base64.b64encode(shot.screenshot).decode("ascii")
+    return (
+        f'<figure><img src="data:image/png;base64,{data}" width="{width}" '
+        f'alt="first screen of {html.escape(name)}" style="border:1px solid #ccc">'
+        f"<figcaption>{html.escape(caption)}</figcaption></figure>"
+    )

@@ -546,7 +546,10 @@ def test_tradeoff_figure_has_one_labelled_marker_per_measure(projected, monkeypa
     monkeypatch.setattr(interventions_page, "to_png_uri", lambda fig: figs.append(fig) or "x")
     interventions_page.fig_tradeoff(projected, KEY_INDICATORS)
     (fig,) = figs
-    names = sorted(projected.summary["interventions"])
+    # each label: the measure's rank in the decision table and its name
+    ranked = projected.summary["decision"]["measures"]
+    names = sorted(f"{i}. {m['name']}" for i, m in enumerate(ranked, 1))
+    assert len(names) == len(projected.summary["interventions"])
     for ax in fig.axes:
         assert len(ax.containers) == len(names)  # one errorbar (marker) per measure
         assert sorted(t.get_text() for t in ax.texts) == names
@@ -569,3 +572,51 @@ def test_rank_by_and_tariffs_are_validated(run):
     for name, needle in (("mould", "unknown indicator"), ("en15757_upper_offset", "direction")):
         with pytest.raises(ConfigError, match=needle):
             project(run, {**PROJ, "interventions_rank_by": name}, write=False)
+
+
+def test_tradeoff_labels_do_not_overlap_when_measures_cluster():
+    """Five measures within a few pixels of each other (the demo's cluster near zero
+    energy) and one apart: every label drawn inside the axes, no two labels and no
+    label and another measure's marker overlapping."""
+    import itertools
+
+    from heritage_bayes.projection.interventions_page import place_labels
+    from heritage_bayes.report.figures.style import _figure
+
+    fig = _figure(9.5, 4.4)
+    ax = fig.subplots()
+    pts = [(0.0, 1.0), (0.5, 1.02), (1.0, 0.98), (0.2, 1.01), (0.8, 0.99), (4000.0, 3.0)]
+    texts = [f"{i + 1}. measure number {i + 1}" for i in range(len(pts))]
+    for x, y in pts:
+        ax.plot([x], [y], "o")
+    ax.margins(x=0.25, y=0.15)
+    labels = place_labels(ax, pts, texts, ["k"] * len(pts))
+    fig.draw_without_rendering()
+    r = fig.canvas.get_renderer()
+    from matplotlib.text import Text
+
+    boxes = [Text.get_window_extent(a, r) for a in labels]  # the text, not its leader
+    frame = ax.get_window_extent(r)
+    for b in boxes:
+        assert frame.x0 - 1 <= b.x0 and b.x1 <= frame.x1 + 1, (b, frame)
+        assert frame.y0 - 1 <= b.y0 and b.y1 <= frame.y1 + 1, (b, frame)
+    for a, b in itertools.combinations(boxes, 2):
+        assert not a.overlaps(b), (a, b)
+    px = [ax.transData.transform(p) for p in pts]
+    for i, b in enumerate(boxes):
+        for j, (x, y) in enumerate(px):
+            if i != j:
+                assert not (b.x0 < x < b.x1 and b.y0 < y < b.y1), (texts[i], j)
+
+
+@pytest.mark.browser
+def test_measures_section_on_a_phone_has_no_horizontal_scroll(projected):
+    """At 390 px the page with its measures section (decision table, trade-off figure,
+    per-case tables) is no wider than the screen, and no cell cuts a word or number."""
+    from _report_browser import phone_layout
+
+    lay = phone_layout(Path(projected.paths["html"]), extra="""
+      (() => { const s = document.getElementById('interventions');
+               return s ? s.getBoundingClientRect().right : null; })()""")  # fmt: skip
+    assert lay["extra"] is not None and lay["extra"] <= lay["W"]
+    assert lay["broken"] == [], lay["broken"]

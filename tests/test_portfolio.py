@@ -104,6 +104,14 @@ def test_three_rooms_two_workers_one_bad(finished):
         )
         assert by.loc[room, "converged"] == summary["converged"]
         assert (out / room / "report.html").is_file()
+        # the run is the room: its summary and report carry the room's name, not the
+        # shared config's ("tiny")
+        assert summary["name"] == room
+        report = (out / room / "report.html").read_text(encoding="utf-8")
+        assert f"run “{room}”" in report and "“tiny”" not in report
+        # the status is the report's verdict (these tiny runs stop at their step cap)
+        assert by.loc[room, "verdict"] == "not converged"
+        assert f'class="verdict {by.loc[room, "verdict_level"]}"' in report
         # risk of the measured climate: less than a year logged, so only what does not
         # depend on the season covered, and the page says why
         assert by.loc[room, "emc_range_pct"] > 0 and pd.isna(by.loc[room, "twpi_years"])
@@ -150,7 +158,7 @@ def test_batch_counts_unconverged_rooms_and_exits_3(finished, capsys):
         assert not df.loc[room, "converged"]
         assert "`sampler.max_steps` was reached" in df.loc[room, "unconverged_reasons"]
     index = (d / "out" / "index.html").read_text(encoding="utf-8")
-    assert "why not converged" in index and "2 finished unconverged" in index
+    assert "why not converged" in index and "2 not converged" in index
     pf = yaml.safe_load((d / "portfolio.yaml").read_text(encoding="utf-8"))
     pf["rooms"] = pf["rooms"][:2]
     two = _write(d / "two.yaml", pf)
@@ -221,15 +229,17 @@ def test_index_sorts_in_headless_chromium(finished):
     d, _, _ = finished
     # click "room" twice (ascending, then descending) and read the first column of rooms
     js = """(() => {
-      const ths = Array.from(document.querySelectorAll('table.sortable th'));
+      const table = document.getElementById('table-calibration');
+      const ths = Array.from(table.querySelectorAll('th'));
       const th = ths.find(h => h.textContent.trim() === 'room');
       const col = ths.indexOf(th);
-      const rooms = () => Array.from(document.querySelectorAll('table.sortable tbody tr'))
+      const rooms = () => Array.from(table.querySelectorAll('tbody tr'))
         .map(r => r.cells[col].textContent.trim());
       const before = rooms();
       th.click(); const asc = rooms();
       th.click(); const desc = rooms();
-      return {before, asc, desc, links: document.querySelectorAll('a[href$="report.html"]').length};
+      return {before, asc, desc,
+              links: table.querySelectorAll('a[href$="report.html"]').length};
     })()"""
     res = open_page(d / "out" / "index.html", chromium=chromium, extra_js=js)
     assert res.errors == [], res.errors  # CSP: the hashed sort script is allowed
@@ -264,9 +274,62 @@ def test_index_speaks_in_percent_and_names_the_indicators_at_risk(tmp_path):
     )
     pf = SimpleNamespace(rooms=[object()], name="p", notes="")
     page = render_index(pf, df, tmp_path)
-    cells = re.findall(r"<td[^>]*>(.*?)</td>", page)
+    cells = [re.sub(r"<[^>]+>", "", c) for c in re.findall(r"<td[^>]*>(.*?)</td>", page)]
     assert "91 %" in cells and "100 %" in cells and "25 %" in cells
     assert "0.91" not in cells and "1.00" not in cells
     flagged = next(c for c in cells if c.startswith("2: "))
     assert "mould" in flagged.lower() and "EN 15757" in flagged
     assert "vtt_mould_index_max" not in flagged
+
+
+@pytest.mark.browser
+@pytest.mark.parametrize("width", [1280, 390])
+def test_index_fits_the_screen_with_its_projection_columns(finished, width):
+    """At 1280 px the three tables fit the page (the projection columns on screen, no
+    sideways scroll); at 390 px each room is a card: nothing wider than the screen."""
+    from _report_browser import phone_layout
+
+    d, _, _ = finished
+    lay = phone_layout(d / "out" / "index.html", width=width, extra="""
+      (() => { const t = document.getElementById('table-projection');
+               const r = t.getBoundingClientRect();
+               return {right: r.right, height: r.height,
+                       text: t.innerText, status: document.getElementById(
+                         'table-calibration').innerText}; })()""")  # fmt: skip
+    proj = lay["extra"]
+    assert proj["right"] <= lay["W"] and proj["height"] > 0, proj
+    assert "warm 2050" in proj["text"]  # the case and the statement in words
+    assert "P(Time-weighted preservation index < 1000 years)" in proj["text"]
+    assert "not converged" in proj["status"] and "failed" in proj["status"]
+
+
+@pytest.mark.parametrize(
+    ("level", "title", "converged", "status"),
+    [
+        ("green", "Converged", True, "converged"),
+        ("amber", "Converged, but the checks below fail", True, "checks failed"),
+        ("red", "This model does not reproduce the room", True, "checks failed"),
+        ("red", "This model does not reproduce the room — and NOT CONVERGED", False,
+         "not converged"),
+        ("amber", "Nearly converged — use with care", False, "not converged"),
+        ("red", "NOT CONVERGED — do not use these results yet", True, "not converged"),
+    ],
+)  # fmt: skip
+def test_a_rooms_status_is_its_reports_verdict(tmp_path, level, title, converged, status):
+    """The verdict box as the report's own template renders it, read back: the status
+    never contradicts the report the row links (a run that met its stopping rule but
+    whose saved draws fail is 'not converged' when its report says so)."""
+    from heritage_bayes.portfolio.rooms import report_status
+    from heritage_bayes.report.sections._fragment import render_fragment
+
+    verdict = {"level": level, "title": title, "text": "t", "models": [], "advice": "",
+               "stats": "s"}  # fmt: skip
+    box = render_fragment("verdict.html", {"verdict": verdict, "warnings": []})
+    (tmp_path / "report.html").write_text(f"<html><body>{box}</body></html>", encoding="utf-8")
+    got = report_status(tmp_path, {"converged": converged, "converged_tau": converged})
+    assert got["verdict"] == status and got["verdict_level"] == level
+    assert got["verdict_title"] == title
+    (tmp_path / "report.html").unlink()  # no report: the run's own decision, said so
+    got = report_status(tmp_path, {"converged": converged, "converged_tau": converged})
+    assert got["verdict"] == ("converged" if converged else "not converged")
+    assert "no report" in got["verdict_title"]

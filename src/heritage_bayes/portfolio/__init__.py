@@ -15,7 +15,8 @@ Portfolio file (YAML)::
     defaults:                         # deep-merged into every room's config (optional)
       sampler: {max_steps: 40000}
     rooms:
-      - name: nave                    # run directory <out>/nave/ (letters, digits, _ . -)
+      - name: nave                    # run directory <out>/nave/ and the run's name in its
+                                      # report (letters, digits, _ . -)
         config: rooms/nave.yaml       # relative to the portfolio file
       - name: crypt
         config: rooms/crypt.yaml

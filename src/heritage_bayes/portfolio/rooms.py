@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import re
 import time
 import traceback
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -13,7 +15,7 @@ import pandas as pd
 from heritage_bayes.errors import InputError
 from heritage_bayes.portfolio.spec import RoomSpec
 
-__all__ = ["measured_risk", "room_row"]
+__all__ = ["STATUSES", "measured_risk", "report_status", "room_row"]
 
 
 def _is_done(run_dir: Path, chash: str) -> bool:
@@ -129,8 +131,20 @@ def _project_room(run_dir: Path, projection: Path, resume: bool) -> dict:
         what = p0.get("name") or p0["indicator"]
         unit = f" {p0['unit']}" if p0.get("unit") else ""
         row["proj.statement"] = f"P({what} {p0['op']} {p0['value']:g}{unit})"
+        row["proj.statement_text"] = _statement_text(p0)
         row["proj.probability"] = p0["cases"].get(label, {}).get("p", float("nan"))
     return row
+
+
+def _statement_text(p: Mapping) -> str:
+    """``P(TWPI < 25 years)``: a probability statement in the indicator's name and unit."""
+    from heritage_bayes.climate.risk.registry import indicator_info
+
+    try:
+        info = indicator_info(p["indicator"])
+    except InputError:  # an indicator this version does not know: its code
+        return f"P({p['indicator']} {p['op']} {p['value']:g})"
+    return f"P({info.name} {p['op']} {p['value']:g} {info.unit})".replace(" )", ")")
 
 
 def room_row(run_dir: str | Path) -> dict:
@@ -142,7 +156,8 @@ def room_row(run_dir: str | Path) -> dict:
     ``wall_seconds``), per measured output ``<section>.<output>.FIT_cal`` /
     ``FIT_val`` [%] and ``coverage90_val`` [-], the slowest time constant and the
     outdoor-temperature gain of each section, and conservation-risk indicators of the
-    *measured* indoor climate over the data period (:func:`measured_risk`).
+    *measured* indoor climate over the data period (:func:`measured_risk`), and the
+    report's verdict (:func:`report_status`).
     """
     from heritage_bayes.rundir.summary import load_summary
 
@@ -178,8 +193,57 @@ def room_row(run_dir: str | Path) -> dict:
             if e is not None:
                 for suffix, v in (("", e.median), ("_q05", e.q05), ("_q95", e.q95)):
                     row[f"{section}.{col}{suffix}"] = nan if v is None else v
+    row.update(report_status(run_dir, s))
     row.update(measured_risk(run_dir))
     return row
+
+
+#: The statuses of the overview, most urgent first (failed rooms come before them).
+STATUSES = ("not converged", "checks failed", "converged")
+_VERDICT = re.compile(
+    r"<div id=\"verdict\" class=\"verdict (?P<level>\w+)\"[^>]*>\s*<h2>(?P<title>.*?)</h2>", re.S
+)
+
+
+def report_status(run_dir: Path, summary) -> dict:
+    """The room's status as its report's verdict gives it: ``verdict_level`` (green,
+    amber, red), ``verdict_title`` (the verdict's heading) and ``verdict`` — one of
+    :data:`STATUSES`: *converged* (green), *checks failed* (the sampler converged but
+    the report's residual, coverage, truth or accuracy checks fail) or *not converged*.
+
+    Read from ``report.html`` (the package wrote it; its verdict box is the page's
+    contract), so the overview never contradicts the report it links. Without a report
+    the run's own decision (``summary.json``) gives *converged* or *not converged*, and
+    ``verdict_title`` says that no report was checked.
+    """
+    import html as html_mod
+
+    raw = summary.raw  # a RunSummary (heritage_bayes.rundir.summary)
+    converged = summary.convergence.converged and bool(raw.get("converged_tau", True))
+    path = run_dir / "report.html"
+    m = None
+    if path.is_file():
+        try:
+            with path.open(encoding="utf-8") as fh:
+                m = _VERDICT.search(fh.read(200_000))  # the verdict leads the page
+        except (OSError, UnicodeDecodeError):
+            m = None
+    if m is None:
+        return {
+            "verdict": "converged" if converged else "not converged",
+            "verdict_level": "",
+            "verdict_title": "no report: the residual and coverage checks were not run",
+        }
+    level = m["level"]
+    title = re.sub(r"\s+", " ", html_mod.unescape(re.sub(r"<[^>]+>", "", m["title"]))).strip()
+    title = title.lstrip("✔⚠✖ ")
+    if level == "green":
+        status = "converged"
+    elif converged and not re.search(r"not (fully )?converged", title, re.I):
+        status = "checks failed"
+    else:
+        status = "not converged"
+    return {"verdict": status, "verdict_level": level, "verdict_title": title}
 
 
 def measured_risk(run_dir: str | Path) -> dict:
@@ -246,11 +310,14 @@ def measured_risk(run_dir: str | Path) -> dict:
 
 
 def _attention_order(df: pd.DataFrame) -> pd.DataFrame:
-    """Rooms that need attention first: failed or unconverged calibrations (their
-    figures cannot be trusted), then the most indicators rated "risk", then the
-    shortest preservation index (TWPI)."""
+    """Rooms that need attention first: failed calibrations, then those not converged,
+    then those whose report's checks fail (their figures cannot be trusted yet), then
+    the most indicators rated "risk", then the shortest preservation index (TWPI)."""
     status_rank = df["status"].map({"failed": 0, "error": 0}).fillna(1)
     conv = df.get("converged", pd.Series(True, index=df.index)).fillna(False).astype(bool)
+    if "verdict" in df:  # the report's verdict: not converged, checks failed, converged
+        rank = {v: i for i, v in enumerate(STATUSES)}
+        conv = df["verdict"].map(rank).fillna(conv.astype(int) * (len(STATUSES) - 1))
     flags = df.get("risk_flags", pd.Series(0, index=df.index)).fillna(0)
     twpi = df.get("twpi_years", pd.Series(np.inf, index=df.index)).fillna(np.inf)
     key = pd.DataFrame({"s": status_rank, "c": conv.astype(int), "f": -flags, "t": twpi})

@@ -134,7 +134,9 @@ def load_portfolio(path: str | Path) -> Portfolio:
             if not isinstance(room_raw, dict):
                 raise ConfigError(f"{where}.config: {cfile} is not a YAML mapping")
             merged = _deep_merge(_deep_merge(room_raw, defaults), overrides)
-            merged.setdefault("name", rname)
+            # the run is the room: its reports and summary carry the room's name, not
+            # the shared config's (several rooms often share one config)
+            merged["name"] = overrides.get("name", rname)
             cfg = parse_config(
                 merged, source=f"{where} ({cfile})", base_dir=str(cfile.parent), name=rname
             )

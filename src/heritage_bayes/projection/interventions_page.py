@@ -93,6 +93,90 @@ def _improvement(info, d: dict) -> list[float]:
     return [y[0], -info.worse * d["q50"], y[1]]
 
 
+#: Candidate label offsets from a marker [pt], in order of preference: the diagonals
+#: (clear of the marker's own error bars), right, left, above, below, then the same
+#: farther out (with a leader line).
+_OFFSETS = [
+    (dx * r, dy * r)
+    for r in (1.0, 2.2, 3.6, 5.2)
+    for dx, dy in ((5, 4), (5, -13), (-5, 4), (-5, -13), (7, -4), (-7, -4), (0, 8), (0, -16))
+]
+
+
+def _overlap(a, b) -> float:
+    """Overlap area of two display boxes ``(x0, y0, x1, y1)`` [px²]."""
+    w = min(a[2], b[2]) - max(a[0], b[0])
+    h = min(a[3], b[3]) - max(a[1], b[1])
+    return w * h if w > 0 and h > 0 else 0.0
+
+
+def place_labels(ax, points, texts, colours) -> list:
+    """Label each marker of ``ax`` without two labels overlapping.
+
+    ``points`` are the markers in data coordinates. The figure is drawn once and its
+    layout frozen; then, marker by marker from the most crowded, each label takes the
+    first of :data:`_OFFSETS` whose box lies inside the axes and overlaps no placed
+    label and no marker (a box of ±5 px around it); where none is free, the candidate
+    with the least overlap. A label moved farther than the first ring is tied to its
+    marker by a thin leader line. Returns the annotations (their boxes in display
+    pixels are final: the layout does not move after this).
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    fig = ax.figure
+    if not hasattr(fig.canvas, "get_renderer"):
+        FigureCanvasAgg(fig)
+    fig.draw_without_rendering()
+    fig.set_layout_engine("none")  # the axes stay where the layout put them
+    renderer = fig.canvas.get_renderer()
+    to_px = ax.transData.transform
+    pts = [tuple(to_px(p)) for p in points]
+    frame = ax.get_window_extent(renderer)
+    frame = (frame.x0, frame.y0, frame.x1, frame.y1)
+    markers = [(x - 5, y - 5, x + 5, y + 5) for x, y in pts]
+    scale = fig.dpi / 72.0
+    # the most crowded marker first: it has the fewest free places
+    crowd = [sum(np.hypot(x - u, y - v) < 60 for u, v in pts) for x, y in pts]
+    order = sorted(range(len(pts)), key=lambda i: -crowd[i])
+    placed: list[tuple] = []
+    labels: list = [None] * len(pts)
+    for i in order:
+        probe = ax.text(0, 0, texts[i], fontsize=8, transform=None)
+        ext = probe.get_window_extent(renderer)
+        probe.remove()
+        w, h = ext.width + 4, ext.height + 4  # with the label's white backing
+        best, best_cost = None, float("inf")
+        for k, (dx, dy) in enumerate(_OFFSETS):
+            x0 = pts[i][0] + dx * scale - (w if dx < 0 else w / 2 if dx == 0 else 0)
+            y0 = pts[i][1] + dy * scale
+            box = (x0, y0, x0 + w, y0 + h)
+            outside = (max(0.0, frame[0] - box[0]) + max(0.0, box[2] - frame[2])
+                       + max(0.0, frame[1] - box[1]) + max(0.0, box[3] - frame[3]))  # fmt: skip
+            cost = (sum(_overlap(box, b) for b in placed)
+                    + sum(_overlap(box, m) for j, m in enumerate(markers) if j != i)
+                    + outside * h)  # fmt: skip
+            if cost < best_cost - 1e-9:
+                best, best_cost = (k, box, dx, dy), cost
+            if cost == 0.0:
+                break
+        k, box, dx, dy = best
+        leader = (
+            {"arrowstyle": "-", "color": colours[i], "lw": 0.6, "shrinkA": 0, "shrinkB": 3}
+            if k >= 8  # beyond the first ring: a leader line to the marker
+            else None
+        )
+        ann = ax.annotate(
+            texts[i], points[i], xytext=(dx, dy), textcoords="offset points", fontsize=8,
+            color=colours[i], annotation_clip=False, arrowprops=leader,
+            bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.8},
+            ha="right" if dx < 0 else "center" if dx == 0 else "left", va="bottom",
+        )  # fmt: skip
+        ann.set_in_layout(False)
+        placed.append(box)
+        labels[i] = ann
+    return labels
+
+
 def fig_tradeoff(proj, page_key: tuple) -> str:
     """Risk reduction vs annual energy at the decision table's case: one panel per
     indicator (the ranking one, then the first other of :data:`_TRADEOFF` computed),
@@ -110,8 +194,10 @@ def fig_tradeoff(proj, page_key: tuple) -> str:
     with matplotlib.rc_context(RC_PARAMS):
         fig = _figure(9.5, 4.4)
         axes = np.atleast_1d(fig.subplots(1, len(names)))
+        all_marks = []
         for ax, n in zip(axes, names, strict=True):
             info = indicator_info(n)
+            marks = []
             for j, row in enumerate(dec["measures"]):
                 d = iv[row["name"]]["cases"][case]["indicators"].get(n)
                 if not d or d.get("q50") is None:
@@ -123,10 +209,10 @@ def fig_tradeoff(proj, page_key: tuple) -> str:
                             yerr=[[y[1] - y[0]], [y[2] - y[1]]],
                             fmt=_MARKERS[j % len(_MARKERS)], color=_COLOURS[j % len(_COLOURS)],
                             ms=6, capsize=2, elinewidth=0.8, alpha=0.9)  # fmt: skip
-                ax.annotate(row["name"], (x["q50"], y[1]), xytext=(5, 4),
-                            textcoords="offset points", fontsize=8,
-                            color=_COLOURS[j % len(_COLOURS)])  # fmt: skip
-            ax.margins(x=0.25)  # room for the labels right of the markers
+                marks.append(((x["q50"], y[1]), f"{j + 1}. {row['name']}",
+                              _COLOURS[j % len(_COLOURS)]))  # fmt: skip
+            ax.margins(x=0.25, y=0.15)  # room for the labels around the markers
+            all_marks.append(marks)
             ax.axhline(0.0, color="#888888", lw=0.8)
             ax.set_xlabel("running energy of the measure [kWh/a]")
             ax.set_ylabel(f"improvement [{info.unit}]")
@@ -135,6 +221,10 @@ def fig_tradeoff(proj, page_key: tuple) -> str:
             f"{case}: improvement against doing nothing vs running energy (median and "
             "5–95 % of the draws; above 0: better)"
         )
+        for ax, marks in zip(axes, all_marks, strict=True):
+            if marks:  # after the layout: the labels placed in the axes' final pixels
+                pts, texts, colours = zip(*marks, strict=True)
+                place_labels(ax, pts, texts, colours)
         return to_png_uri(fig)
 
 

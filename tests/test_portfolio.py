@@ -323,13 +323,13 @@ def test_a_rooms_status_is_its_reports_verdict(tmp_path, level, title, converged
     from heritage_bayes.report.sections._fragment import render_fragment
 
     verdict = {"level": level, "title": title, "text": "t", "models": [], "advice": "",
-               "stats": "s"}  # fmt: skip
+               "stats": "s", "rule": "r"}  # fmt: skip
     box = render_fragment("verdict.html", {"verdict": verdict, "warnings": []})
     (tmp_path / "report.html").write_text(f"<html><body>{box}</body></html>", encoding="utf-8")
-    got = report_status(tmp_path, {"converged": converged, "converged_tau": converged})
+    got = report_status(tmp_path, converged)
     assert got["verdict"] == status and got["verdict_level"] == level
     assert got["verdict_title"] == title
     (tmp_path / "report.html").unlink()  # no report: the run's own decision, said so
-    got = report_status(tmp_path, {"converged": converged, "converged_tau": converged})
+    got = report_status(tmp_path, converged)
     assert got["verdict"] == ("converged" if converged else "not converged")
     assert "no report" in got["verdict_title"]

@@ -266,10 +266,7 @@ def _converged_or_3(run_dir) -> int:
     )
     for reason in conv.reasons or ["see summary.json"]:
         print(f"hbayes:   {reason}", file=sys.stderr)
-    print(
-        "hbayes: continue the chains with --resume, or raise sampler.max_time",
-        file=sys.stderr,
-    )
+    print("hbayes: continue the chains with --resume, or raise sampler.max_time", file=sys.stderr)
     return EXIT_UNCONVERGED
 
 

@@ -193,7 +193,7 @@ def room_row(run_dir: str | Path) -> dict:
             if e is not None:
                 for suffix, v in (("", e.median), ("_q05", e.q05), ("_q95", e.q95)):
                     row[f"{section}.{col}{suffix}"] = nan if v is None else v
-    row.update(report_status(run_dir, s))
+    row.update(report_status(run_dir, conv.converged and bool(s.raw.get("converged_tau", True))))
     row.update(measured_risk(run_dir))
     return row
 
@@ -205,7 +205,7 @@ _VERDICT = re.compile(
 )
 
 
-def report_status(run_dir: Path, summary) -> dict:
+def report_status(run_dir: Path, converged: bool) -> dict:
     """The room's status as its report's verdict gives it: ``verdict_level`` (green,
     amber, red), ``verdict_title`` (the verdict's heading) and ``verdict`` — one of
     :data:`STATUSES`: *converged* (green), *checks failed* (the sampler converged but
@@ -213,13 +213,12 @@ def report_status(run_dir: Path, summary) -> dict:
 
     Read from ``report.html`` (the package wrote it; its verdict box is the page's
     contract), so the overview never contradicts the report it links. Without a report
-    the run's own decision (``summary.json``) gives *converged* or *not converged*, and
+    the run's own decision (``converged``: its stopping rule, ``summary.json``) gives
+    *converged* or *not converged*, and
     ``verdict_title`` says that no report was checked.
     """
     import html as html_mod
 
-    raw = summary.raw  # a RunSummary (heritage_bayes.rundir.summary)
-    converged = summary.convergence.converged and bool(raw.get("converged_tau", True))
     path = run_dir / "report.html"
     m = None
     if path.is_file():

@@ -270,7 +270,8 @@ def generate(
     ``seed``: anything :func:`numpy.random.default_rng` takes. ``without``: parts left
     out (diagnosis): ``"isotherm"`` (a linear isotherm through the GAB's 65 % RH point:
     the fitted model's own buffer), ``"source"`` (no moisture source), ``"noise"`` (no
-    sensor noise, rounding or lost readings; the outage stays).
+    sensor noise, rounding or lost readings; the outage stays), ``"outage"`` (no
+    outage). Leaving parts out keeps every random draw of the room.
 
     Returns a dict: ``truth`` (the fit's parameters by name, the buffer's capacity
     averaged over the calibration period), ``generator`` (the drawn physical
@@ -319,8 +320,9 @@ def generate(
         rhi_obs[lost] = np.nan
     g_len = int(rng.integers(2 * 24, 7 * 24 + 1))
     g0 = rows.start + int(rng.integers(7 * 24, cal_days * 24 - g_len - 7 * 24))
-    ti_obs[g0 : g0 + g_len] = np.nan
-    rhi_obs[g0 : g0 + g_len] = np.nan
+    if "outage" not in without:
+        ti_obs[g0 : g0 + g_len] = np.nan
+        rhi_obs[g0 : g0 + g_len] = np.nan
     te = w["Te"][at]
     hourly = {
         "Te": np.round(te, 1),

@@ -28,7 +28,7 @@ model's temperature input with its gaps interpolated linearly, the survey's room
 Each replicate is a function of ``(seed, room, replicate)``; one JSON line per replicate
 is appended to ``--log`` as soon as it is done, ``--first-rep`` extends a study, and
 ``--table`` merges logs. ``--without`` leaves parts of the generator out (diagnosis:
-``isotherm``, ``source``, ``noise``; :func:`coupled_rooms.generate`).
+``isotherm``, ``source``, ``noise``, ``outage``; :func:`coupled_rooms.generate`).
 """
 
 from __future__ import annotations
@@ -64,7 +64,7 @@ IDENTIFIABLE = {
 OTHERS = {"attic": ("Cm",), "cellar": ("tau2_h",)}
 VARIANT = "ar1_white:estimate"
 SEED = 2049
-CAL_DAYS = 90
+CAL_DAYS = 60
 
 
 def fit_inputs(room: dict, fit_model):
@@ -302,16 +302,16 @@ def main(argv=None) -> int:
     ap.add_argument("--rooms", default=",".join(rooms.ROOMS))
     ap.add_argument("--jobs", type=int, default=1)
     ap.add_argument("--seed", type=int, default=SEED)
-    ap.add_argument("--max-steps", type=int, default=6000)
+    ap.add_argument("--max-steps", type=int, default=4000)
     ap.add_argument("--cal-days", type=int, default=CAL_DAYS)
     ap.add_argument("--log", help="append each replicate's result as a JSON line")
     ap.add_argument("--without", default="", help="parts of the generator left out: "
-                    "isotherm, source, noise (coupled_rooms.generate)")  # fmt: skip
+                    "isotherm, source, noise, outage (coupled_rooms.generate)")  # fmt: skip
     ap.add_argument("--table", nargs="+", metavar="LOG", help="only tabulate logs")
     ap.add_argument("--markdown", action="store_true", help="with --table: markdown")
     args = ap.parse_args(argv)
     without = tuple(w for w in args.without.split(",") if w)
-    bad = set(without) - {"isotherm", "source", "noise"}
+    bad = set(without) - {"isotherm", "source", "noise", "outage"}
     if bad:
         ap.error(f"--without: unknown {sorted(bad)}")
     room_types = [r for r in args.rooms.split(",") if r]

@@ -304,7 +304,7 @@ def generate(
     hours = sim["pi"].size // PER_HOUR
     sub_h = int(3600 / DT_W)
     at = np.arange(hours) * sub_h  # weather grid index of every full hour
-    pi_true = sim["pi"][:: PER_HOUR][:hours]
+    pi_true = sim["pi"][::PER_HOUR][:hours]
     ti_true = ti[at]
     rows = slice(spin * 24, (spin + cal_days) * 24)
     quiet = "noise" in without

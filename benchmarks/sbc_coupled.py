@@ -51,7 +51,10 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import coupled_rooms as rooms  # the generator (no heritage_bayes inside)
 
 #: the fitted model of each room type: (catalogue name, options)
-MODELS = {"attic": ("hygric_2c_sorption", {}), "cellar": ("hygric_2c_fixed", {"sink": "temperature"})}
+MODELS = {
+    "attic": ("hygric_2c_sorption", {}),
+    "cellar": ("hygric_2c_fixed", {"sink": "temperature"}),
+}
 #: quantities whose truths the data determine (scale-free: every quantity here is
 #: unchanged when all capacities and conductances are multiplied by one factor, the
 #: direction hourly data cannot see; :func:`coupled_rooms.network_quantities`)
@@ -174,7 +177,6 @@ def misfit(fit_model, room: dict, U: np.ndarray) -> dict:
     model has to take up: the isotherm's curvature, sub-hourly weather, p_sat
     formulas, and the source when it is on)."""
     import heritage_bayes as hb
-
     from heritage_bayes.rc.sorption import P_REF
 
     rows = room["rows"]
@@ -184,6 +186,39 @@ def misfit(fit_model, room: dict, U: np.ndarray) -> dict:
     d = (room["hourly"]["Pi_true"][: sim.size] - sim)[rows]
     days = d[: d.size // 24 * 24].reshape(-1, 24).mean(axis=1)
     return {"mean": float(d.mean()), "sd": float(d.std()), "daily_sd": float(days.std())}
+
+
+def misfit_lines(room_types, reps, seed: int, cal_days: int) -> list[str]:
+    """``--misfit``: the structural error (:func:`misfit`, no fit) of rooms ``reps``
+    with every part of the generator and with each part left out (the same rooms and
+    draws): medians over the rooms of its |mean|, sd and sd of daily means [Pa]."""
+    import heritage_bayes as hb
+
+    cases = {
+        "every part": (),
+        "without outage": ("outage",),
+        "without isotherm": ("isotherm",),
+        "without source": ("source",),
+        "without isotherm, source, outage": ("isotherm", "source", "outage"),
+    }
+    lines = [
+        f"noise-free generator - fitted model with the true parameters, {len(reps)} rooms "
+        "each (medians): |mean|, sd, sd of daily means [Pa]"
+    ]
+    for room_type in room_types:
+        name, opts = MODELS[room_type]
+        model = hb.model(name, **opts).with_slopes(("Pe",))
+        for label, without in cases.items():
+            m = []
+            for rep in reps:
+                room = rooms.generate(
+                    room_type, [seed, rooms.ROOMS.index(room_type), rep], cal_days,
+                    without=without,
+                )  # fmt: skip
+                m.append(misfit(model, room, fit_inputs(room, model)[0]))
+            med = [np.median([abs(x[k]) for x in m]) for k in ("mean", "sd", "daily_sd")]
+            lines.append(f"  {room_type:7s} {label:34s} {med[0]:6.1f} {med[1]:6.1f} {med[2]:6.1f}")
+    return lines
 
 
 # --------------------------------------------------------------------------- tables
@@ -309,6 +344,8 @@ def main(argv=None) -> int:
                     "isotherm, source, noise, outage (coupled_rooms.generate)")  # fmt: skip
     ap.add_argument("--table", nargs="+", metavar="LOG", help="only tabulate logs")
     ap.add_argument("--markdown", action="store_true", help="with --table: markdown")
+    ap.add_argument("--misfit", action="store_true", help="no fit: the structural error "
+                    "of rooms --first-rep.. with each part of the generator left out")  # fmt: skip
     args = ap.parse_args(argv)
     without = tuple(w for w in args.without.split(",") if w)
     bad = set(without) - {"isotherm", "source", "noise", "outage"}
@@ -323,6 +360,11 @@ def main(argv=None) -> int:
         for line in table_lines(results, args.markdown):
             print(line)
         return 0
+    if args.misfit:
+        reps = range(args.first_rep, args.first_rep + args.reps)
+        for line in misfit_lines(room_types, reps, args.seed, args.cal_days):
+            print(line, flush=True)
+        return 0
     from bench_sbc import run_tasks
 
     tasks = [
@@ -330,7 +372,7 @@ def main(argv=None) -> int:
         for rep in range(args.first_rep, args.first_rep + args.reps)
         for room in room_types
     ]
-    t0, c0 = time.perf_counter(), time.process_time()
+    t0 = time.perf_counter()
     results = run_tasks(replicate, tasks, args.jobs, args.log)
     print(
         f"SBC of the coupled models: {len(results)} rooms, {time.perf_counter() - t0:.0f} s "

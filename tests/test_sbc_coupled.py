@@ -78,9 +78,7 @@ def test_small_study_ranks_every_quantity_and_a_wrong_truth_fails():
     ten times too long is outside every 90 % interval, a coverage the table calls
     low beyond the binomial noise of four rooms."""
     tasks = [
-        (room, rep, 5, 600, 30, (), {"tau1_h": 10.0})
-        for rep in range(2)
-        for room in rooms.ROOMS
+        (room, rep, 5, 600, 30, (), {"tau1_h": 10.0}) for rep in range(2) for room in rooms.ROOMS
     ]
     results = [sbc.replicate(t) for t in tasks]
     for r in results:

@@ -108,4 +108,29 @@ def test_verdict_and_binomial_interval():
     s = {**base, "c90": 20 / 40, "c90_ci": sbc.coverage_interval(20, 40)}
     assert sbc.verdict(s) == "low"
     s = {**base, "c90": 1.0, "c90_ci": sbc.coverage_interval(40, 40)}
+    assert sbc.verdict(s) == "high (within noise)"  # 40 of 40 happens at 0.90 (p 0.015)
+    s = {**base, "c90": 1.0, "c90_ci": sbc.coverage_interval(100, 100)}
     assert sbc.verdict(s) == "high"
+
+
+def test_simulate_runs_a_coupled_model_through_its_recursion():
+    """``hb.simulate`` of a model coupled to a temperature is its exact recursion
+    (``forward``), not the constant modal form of its network at the reference
+    temperature; the balance equations name the buffer's own vapour pressure."""
+    import heritage_bayes as hb
+
+    rng = np.random.default_rng(2)
+    n = 96
+    pe = 1000 + 50 * rng.standard_normal(n)
+    ti = 15 + 8 * np.sin(2 * np.pi * np.arange(n) / 24)
+    m = hb.model("hygric_2c_sorption")
+    p = {"Cm": 50.0, "Ci": 0.02, "Gi": 1e-6, "Gfast": 5e-7}
+    U = np.column_stack([pe, ti])
+    x0 = np.array([900.0, 1000.0])
+    y = hb.simulate(m, p, U, 3600.0, x0)
+    P = np.array([[p[k] for k in m.parameter_names]])
+    np.testing.assert_allclose(y, m.forward(P, U, 3600.0, x0=x0)[0][0], rtol=1e-12)
+    flat = hb.simulate(m, p, np.column_stack([pe, np.full(n, 15.0)]), 3600.0, x0)
+    assert np.abs(y - flat).max() > 10.0  # the temperature acts
+    eq = hb.model("hygric_2c_fixed", sink="temperature").equations()[0]
+    assert eq == "Cw·dPw/dt = Gw·(Pe − Pw) + Gi·(Pi − Pw)", eq

@@ -23,7 +23,8 @@ model's temperature input with its gaps interpolated linearly, the survey's room
 
     python benchmarks/sbc_coupled.py --reps 40 --jobs 2 --log coupled.jsonl
     python benchmarks/sbc_coupled.py --table coupled.jsonl [--markdown]
-    python benchmarks/sbc_coupled.py --reps 10 --rooms attic --without isotherm,source
+    python benchmarks/sbc_coupled.py --reps 10 --rooms attic --without outage --log no.jsonl
+    python benchmarks/sbc_coupled.py --paired coupled.jsonl no.jsonl
 
 Each replicate is a function of ``(seed, room, replicate)``; one JSON line per replicate
 is appended to ``--log`` as soon as it is done, ``--first-rep`` extends a study, and
@@ -330,6 +331,38 @@ def table_lines(results: list[dict], markdown: bool = False) -> list[str]:
     return lines
 
 
+def paired_lines(a: list[dict], b: list[dict]) -> list[str]:
+    """Two logs of the same rooms (e.g. every part, and ``--without outage``): per room
+    type and quantity over the replicates in both, mean z in each, the mean and sd of
+    z_a - z_b (z = (posterior median - truth)/posterior sd) and the 90 % coverage in
+    each: what the part left out moves, in the posterior's own sd."""
+    lines = []
+    for room in rooms.ROOMS:
+        ra = {r["rep"]: r for r in a if r["room"] == room}
+        rb = {r["rep"]: r for r in b if r["room"] == room}
+        reps = sorted(set(ra) & set(rb))
+        if not reps:
+            continue
+        lines.append(f"{room}: {len(reps)} rooms in both (replicates {reps})")
+        for q in IDENTIFIABLE[room] + OTHERS[room]:
+            za, zb, ia, ib = [], [], 0, 0
+            for r in reps:
+                xa = ra[r]["variants"][VARIANT]["ranks"].get(q)
+                xb = rb[r]["variants"][VARIANT]["ranks"].get(q)
+                if xa is None or xb is None:
+                    continue
+                za.append((xa["median"] - ra[r]["truth"][q]) / xa["sd"])
+                zb.append((xb["median"] - rb[r]["truth"][q]) / xb["sd"])
+                ia, ib = ia + xa["in90"], ib + xb["in90"]
+            d = np.subtract(za, zb)
+            sd = f"{d.std(ddof=1):.2f}" if d.size > 1 else "—"
+            lines.append(
+                f"  {q:14s} mean z {np.mean(za):+.2f} / {np.mean(zb):+.2f}; z_a - z_b mean "
+                f"{d.mean():+.2f}, sd {sd}; in 90 %: {ia} / {ib} of {d.size}"
+            )
+    return lines
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--reps", type=int, default=40)
@@ -344,6 +377,8 @@ def main(argv=None) -> int:
                     "isotherm, source, noise, outage (coupled_rooms.generate)")  # fmt: skip
     ap.add_argument("--table", nargs="+", metavar="LOG", help="only tabulate logs")
     ap.add_argument("--markdown", action="store_true", help="with --table: markdown")
+    ap.add_argument("--paired", nargs=2, metavar="LOG", help="two logs of the same rooms: "
+                    "what a part left out moves (paired_lines)")  # fmt: skip
     ap.add_argument("--misfit", action="store_true", help="no fit: the structural error "
                     "of rooms --first-rep.. with each part of the generator left out")  # fmt: skip
     args = ap.parse_args(argv)
@@ -354,6 +389,10 @@ def main(argv=None) -> int:
     room_types = [r for r in args.rooms.split(",") if r]
     if set(room_types) - set(rooms.ROOMS):
         ap.error(f"--rooms: expected some of {list(rooms.ROOMS)}")
+    if args.paired:
+        for line in paired_lines(*(read_logs([p]) for p in args.paired)):
+            print(line)
+        return 0
     if args.table:
         results = read_logs(args.table)
         print(f"SBC of the coupled models, {' '.join(args.table)}: {len(results)} rooms")

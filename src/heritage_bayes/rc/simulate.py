@@ -180,7 +180,9 @@ def iter_simulate(
         x0s = x0
         if x0 is not None and np.ndim(x0) == 2:
             x0s = np.asarray(x0)[sl]
-        if model.control is not None:  # a controlled room (heating, humidistat, sources)
+        # a controlled room (heating, humidistat, sources) or one coupled to a
+        # temperature (heritage_bayes.rc.sorption): no constant modal recursion
+        if model.control is not None or getattr(model, "time_varying", False):
             yield sl, model.forward(P[sl], U, dt, x0=x0s)[0]
             continue
         z0 = _initial_modal(mf, U, x0s)

@@ -209,6 +209,7 @@ class CoupledHygricModel(RCModel):
         """The balance equations in words (for ``hbayes models``)."""
         cap = "(Cm/psat(T_ref))" if self.sorption else "Cw"
         r = "r" if self.sorption else ""
+        rw = "r·Pw" if self.sorption else "Pw"  # the buffer's surface vapour pressure
         out = "Gw·(Pe − Pw) + " if "Gw" in self.parameter_names else ""
         sink = {
             "none": "",
@@ -216,7 +217,7 @@ class CoupledHygricModel(RCModel):
             "temperature": " + Gf·(phi_f·psat(Tf) − Pi)",
         }[self.sink]
         lines = [
-            f"{cap}·dPw/dt = {out.replace('Pw', r + '·Pw')}Gi·(Pi − {r + '·' if r else ''}Pw)",
+            f"{cap}·dPw/dt = {out.replace('Pw', rw)}Gi·(Pi − {rw})",
             f"Ci·dPi/dt = Gfast·(Pe − Pi) + Gi·({r + '·' if r else ''}Pw − Pi){sink}",
         ]
         if self.sorption:

@@ -1,0 +1,136 @@
+"""The simulation-based calibration of the coupled hygric models, in small (the study:
+``benchmarks/sbc_coupled.py``, its table in docs/science/sbc.md).
+
+The generator (``benchmarks/coupled_rooms.py``) must share no code with the package and
+agree with it where their physics is the same; the runner must rank every quantity, and
+a deliberately wrong truth must fail the coverage check.
+"""
+
+from __future__ import annotations
+
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+BENCH = ROOT / "benchmarks"
+sys.path.insert(0, str(BENCH))
+
+rooms = pytest.importorskip("coupled_rooms")
+sbc = pytest.importorskip("sbc_coupled")
+
+
+def test_generator_imports_nothing_of_the_package():
+    code = (
+        f"import sys; sys.path.insert(0, {str(BENCH)!r}); import coupled_rooms as r; "
+        "[r.generate(t, 3, cal_days=30, max_spin_days=7) for t in r.ROOMS]; "
+        "bad = [m for m in sys.modules if m.startswith('heritage_bayes')]; "
+        "assert not bad, bad"
+    )
+    subprocess.run([sys.executable, "-c", code], check=True)
+    src = (BENCH / "coupled_rooms.py").read_text()
+    assert not re.search(r"^\s*(from|import)\s+(heritage_bayes|bench_sbc|sbc_)", src, re.M)
+
+
+def test_gab_isotherm_inverse_and_slope():
+    phi = np.linspace(0.05, 0.95, 19)
+    um, c, k = 0.06, 7.0, 0.78
+    u = rooms.gab(phi, um, c, k)
+    assert np.all(np.diff(u) > 0) and 0.08 < rooms.gab(0.65, um, c, k) < 0.13  # softwood
+    back = [rooms.gab_inverse(x, um, c, k) for x in u]
+    np.testing.assert_allclose(back, phi, rtol=1e-10)
+    h = 1e-6
+    num = (rooms.gab(phi + h, um, c, k) - rooms.gab(phi - h, um, c, k)) / (2 * h)
+    np.testing.assert_allclose(rooms.gab_slope(phi, um, c, k), num, rtol=1e-6)
+    # nonlinear: the capacity at 85 % RH is well above that at 45 %
+    assert rooms.gab_slope(0.85, um, c, k) > 1.5 * rooms.gab_slope(0.45, um, c, k)
+
+
+@pytest.mark.parametrize("room_type", rooms.ROOMS)
+def test_generator_and_package_agree_where_their_physics_is_the_same(room_type):
+    """With a linear isotherm, no moisture source and the true indoor temperature as
+    input, the package's model with the room's parameters follows the independent
+    Runge-Kutta room within a few Pa (what is left: sub-hourly weather and the two
+    p_sat formulas); a buffer twice as large does not."""
+    import heritage_bayes as hb
+
+    room = rooms.generate(room_type, 11, cal_days=30, without=("isotherm", "source", "noise"))
+    name, opts = sbc.MODELS[room_type]
+    model = hb.model(name, **opts).with_slopes(("Pe",))
+    U, _ = sbc.fit_inputs(room, model)
+    if "Ti" in model.input_names:
+        U[:, model.input_names.index("Ti")] = room["hourly"]["Ti_true"][: len(U)]
+    err = sbc.misfit(model, room, U)
+    assert abs(err["mean"]) < 6.0 and err["sd"] < 4.0, err
+    cap = "Cm" if "Cm" in room["truth"] else "Cw"
+    wrong = {**room, "truth": {**room["truth"], cap: 2 * room["truth"][cap]}}
+    bad = sbc.misfit(model, wrong, U)
+    assert bad["sd"] > 3 * max(err["sd"], 1.0), (bad, err)
+
+
+def test_small_study_ranks_every_quantity_and_a_wrong_truth_fails():
+    """Two attics and two cellars (30 days, short chains): every quantity ranked with
+    finite statistics, the table printed; and the slow time constant's truth taken
+    ten times too long is outside every 90 % interval, a coverage the table calls
+    low beyond the binomial noise of four rooms."""
+    tasks = [
+        (room, rep, 5, 600, 30, (), {"tau1_h": 10.0}) for rep in range(2) for room in rooms.ROOMS
+    ]
+    results = [sbc.replicate(t) for t in tasks]
+    for r in results:
+        ranks = r["variants"][sbc.VARIANT]["ranks"]
+        wanted = sbc.IDENTIFIABLE[r["room"]] + sbc.OTHERS[r["room"]]
+        assert set(wanted) <= set(ranks), (r["room"], sorted(ranks))
+        for q in wanted:
+            assert np.isfinite(ranks[q]["median"]) and ranks[q]["sd"] > 0, q
+        assert np.isfinite(r["misfit_Pa"]["sd"])
+    for room in rooms.ROOMS:
+        s = sbc.summary(results, room, "tau1_h")
+        assert s["n"] == 2 and s["in90"] == 0, s
+    pooled = [dict(r, room="attic") for r in results]  # four rooms of one kind
+    s = sbc.summary(pooled, "attic", "tau1_h")
+    assert s["c90"] == 0.0 and s["c90_ci"][1] < 0.85 and sbc.verdict(s) == "low"
+    lines = sbc.table_lines(results, markdown=True)
+    assert any("tau1_h" in line and "low" in line for line in lines)
+
+
+def test_verdict_and_binomial_interval():
+    lo, hi = sbc.coverage_interval(36, 40)
+    assert lo < 0.9 < hi and 0.75 < lo < 0.8
+    base = {"c50": 0.5, "z_mean": 0.0, "z_sd": 1.0, "rank_p": 0.5, "width": 0.1}
+    assert sbc.verdict({**base, "c90": 0.9, "c90_ci": sbc.coverage_interval(36, 40)}) == "met"
+    s = {**base, "c90": 32 / 40, "c90_ci": sbc.coverage_interval(32, 40)}
+    assert sbc.verdict(s) == "low (within noise)"
+    s = {**base, "c90": 20 / 40, "c90_ci": sbc.coverage_interval(20, 40)}
+    assert sbc.verdict(s) == "low"
+    s = {**base, "c90": 1.0, "c90_ci": sbc.coverage_interval(40, 40)}
+    assert sbc.verdict(s) == "high (within noise)"  # 40 of 40 happens at 0.90 (p 0.015)
+    s = {**base, "c90": 1.0, "c90_ci": sbc.coverage_interval(100, 100)}
+    assert sbc.verdict(s) == "high"
+
+
+def test_simulate_runs_a_coupled_model_through_its_recursion():
+    """``hb.simulate`` of a model coupled to a temperature is its exact recursion
+    (``forward``), not the constant modal form of its network at the reference
+    temperature; the balance equations name the buffer's own vapour pressure."""
+    import heritage_bayes as hb
+
+    rng = np.random.default_rng(2)
+    n = 96
+    pe = 1000 + 50 * rng.standard_normal(n)
+    ti = 15 + 8 * np.sin(2 * np.pi * np.arange(n) / 24)
+    m = hb.model("hygric_2c_sorption")
+    p = {"Cm": 50.0, "Ci": 0.02, "Gi": 1e-6, "Gfast": 5e-7}
+    U = np.column_stack([pe, ti])
+    x0 = np.array([900.0, 1000.0])
+    y = hb.simulate(m, p, U, 3600.0, x0)
+    P = np.array([[p[k] for k in m.parameter_names]])
+    np.testing.assert_allclose(y, m.forward(P, U, 3600.0, x0=x0)[0][0], rtol=1e-12)
+    flat = hb.simulate(m, p, np.column_stack([pe, np.full(n, 15.0)]), 3600.0, x0)
+    assert np.abs(y - flat).max() > 10.0  # the temperature acts
+    eq = hb.model("hygric_2c_fixed", sink="temperature").equations()[0]
+    assert eq == "Cw·dPw/dt = Gw·(Pe − Pw) + Gi·(Pi − Pw)", eq

@@ -177,3 +177,20 @@ def test_sink_and_source_from_the_mean_vapour_pressure(offset_pa, key):
     # the sink names its model; a source names none: 78 days to calibrate, the ladder's
     # screen chooses (model: auto); the RH held near the outdoors' reads as a band
     assert p.hygric_model == {"sink": "hygric_2c_fixed", "source": "auto"}.get(key, "hygric_1c")
+
+
+def test_sorption_with_a_wet_offset_writes_no_source_the_model_cannot_take(tmp_path):
+    # the attic above, 150 Pa wetter than outdoors: both signatures; the sorbing buffer has
+    # no source term, so init writes none (the loader would refuse it) and says why
+    w = _weather(240)
+    utc, te, rhe, ghi = w
+    ti = _smooth(te, 2) + 0.03 * _smooth(ghi, 1.5)
+    ps = saturation_vapour_pressure(ti)
+    pe = rhe / 100 * saturation_vapour_pressure(te)
+    pi = _smooth(pe, 24) + 150 + 0.12 * (ps - _smooth(ps, 24))
+    rhi = np.clip(relative_humidity(ti, pi), 1, 99)
+    _, cfg, text = _init(tmp_path, ti, rhi, w)
+    assert cfg.hygric.model == "hygric_2c_sorption"
+    assert "source" not in cfg.hygric.options
+    assert "a moisture source (source: true" in text
+    assert "the sorbing buffer has no moisture source term" in text

@@ -254,6 +254,11 @@ def _hygric(p: ModelProposal, ti, te, rhi, rhe, cal_days: float) -> None:
         p.hygric_model = "hygric_2c_sorption"
         if sink:
             p.hygric_options["sink"] = "temperature"
+        if p.hygric_options.pop("source", None):  # the sorbing buffer has no source term
+            p.hygric_evidence.append(
+                "the sorbing buffer has no moisture source term: the source is left out; "
+                "`hbayes compare` weighs it (hygric_2c with source: true) against sorption"
+            )
     elif sink:
         p.hygric_model = "hygric_2c_fixed"
         p.hygric_options["sink"] = "temperature"

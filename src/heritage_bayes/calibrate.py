@@ -176,13 +176,13 @@ def run_calibration(
         Section -> MAP (:class:`~heritage_bayes.inference.optimize.MAPResult`) of its
         model on these data, found beforehand: the chain starts there, no new search.
 
+    Notes
+    -----
     A section with ``model: auto`` is chosen first by the screen of its model ladder
     (:mod:`heritage_bayes.selection`), inside the time budget; the run records the
     screen (``summary.json``: ``selection``; its rows are the section's ladder) and its
     ``config.yaml`` names the model chosen.
 
-    Notes
-    -----
     BLAS is limited to one thread for the duration: the hot loops multiply many small
     matrices, where OpenBLAS worker threads spin-wait; on a busy 2-core machine that
     made the MAP search 8x slower (measured: 37 s against 4.5 s).

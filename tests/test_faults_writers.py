@@ -216,7 +216,8 @@ def test_init_output(box, capsys, case):
     before = tree(box)
     rc, err = run_cli(_init_argv(work, out, *extra), capsys)
     assert rc == code, err
-    assert message in err and _clean(err), err
+    # init's findings are long by design (each with its evidence): no traceback is the check
+    assert message in err and "Traceback" not in err and "internal error" not in err, err
     if written is None:
         assert_only(box, before)
         return

@@ -122,6 +122,35 @@ def room_below(config: Path, logger: Path) -> Path:
     return out
 
 
+def screen_auto(cfg) -> tuple:
+    """Each ``model: auto`` section replaced by the model its ladder screen chooses, as
+    ``hbayes calibrate`` does (:mod:`heritage_bayes.selection`, same seeds); returns the
+    config and the screen's rows in words (``<section>_screen``)."""
+    from threadpoolctl import threadpool_limits
+
+    from heritage_bayes.models import AUTO, SECTIONS
+    from heritage_bayes.prepare import prepare
+    from heritage_bayes.selection import chosen_section, screen
+
+    out = {}
+    auto = [
+        n for n in SECTIONS if getattr(cfg, n, None) is not None and getattr(cfg, n).model == AUTO
+    ]
+    if not auto:
+        return cfg, out
+    with threadpool_limits(limits=1, user_api="blas"):
+        prep = prepare(cfg)
+        for name in auto:
+            scr = screen(cfg, prep, name, seed=cfg.seed + 101 * SECTIONS.index(name))
+            out[f"{name}_screen"] = "; ".join(
+                f"{r['model']} {r.get('score', float('nan')):.1f}"
+                for r in scr.rows
+                if "error" not in r
+            )
+            cfg = chosen_section(cfg, name, scr)
+    return cfg, out
+
+
 def map_fits(cfg, maxiter: int, starts: int) -> dict:
     """Validation FIT [%] of the MAP simulations: Ti, Pi and RH (Pi over psat(Ti)), and
     the models."""
@@ -130,7 +159,8 @@ def map_fits(cfg, maxiter: int, starts: int) -> dict:
 
     opt = cfg.optimizer.model_copy(update={"maxiter": maxiter, "starts": starts})
     cfg = cfg.model_copy(update={"optimizer": opt})
-    out, sims = {}, {}
+    cfg, out = screen_auto(cfg)
+    sims = {}
     for sec, name in (("thermal", "Ti"), ("hygric", "Pi")):
         if getattr(cfg, sec, None) is None:
             continue
@@ -222,6 +252,12 @@ def one(room, variant, config: Path, args, work: Path, extra: dict) -> dict:
         f"|..{cfg.periods.validation.end}"
     )
     row.update(map_fits(cfg, args.maxiter, args.starts))
+    secs = [sec for sec in ("thermal", "hygric") if getattr(cfg, sec, None) is not None]
+    parts = row["models"].split("; ")
+    for i, sec in enumerate(secs):  # model: auto: the screen's choice beside it
+        if f"{sec}_screen" in row:
+            parts[i] = parts[i].replace("auto", f"auto → {row[f'{sec}_model']}", 1)
+    row["models"] = "; ".join(parts)
     if args.calibrate:
         row.update(calibrate_fits(cfg, work, args.max_steps))
     row["wall_s"], row["cpu_s"] = time.perf_counter() - t0, _cpu() - c0

@@ -124,30 +124,26 @@ def room_below(config: Path, logger: Path) -> Path:
 
 def screen_auto(cfg) -> tuple:
     """Each ``model: auto`` section replaced by the model its ladder screen chooses, as
-    ``hbayes calibrate`` does (:mod:`heritage_bayes.selection`, same seeds); returns the
+    ``hbayes calibrate`` does (its own screen, same seeds, no time budget); returns the
     config and the screen's rows in words (``<section>_screen``)."""
+    from types import SimpleNamespace
+
     from threadpoolctl import threadpool_limits
 
+    from heritage_bayes.calibrate import _select_models
     from heritage_bayes.models import AUTO, SECTIONS
     from heritage_bayes.prepare import prepare
-    from heritage_bayes.selection import chosen_section, screen
 
-    out = {}
-    auto = [
-        n for n in SECTIONS if getattr(cfg, n, None) is not None and getattr(cfg, n).model == AUTO
-    ]
-    if not auto:
-        return cfg, out
+    if not any(getattr(getattr(cfg, n, None), "model", None) == AUTO for n in SECTIONS):
+        return cfg, {}
     with threadpool_limits(limits=1, user_api="blas"):
-        prep = prepare(cfg)
-        for name in auto:
-            scr = screen(cfg, prep, name, seed=cfg.seed + 101 * SECTIONS.index(name))
-            out[f"{name}_screen"] = "; ".join(
-                f"{r['model']} {r.get('score', float('nan')):.1f}"
-                for r in scr.rows
-                if "error" not in r
-            )
-            cfg = chosen_section(cfg, name, scr)
+        cfg, screens = _select_models(cfg, prepare(cfg), SimpleNamespace(say=lambda m: None), None)
+    out = {
+        f"{name}_screen": "; ".join(
+            f"{r['model']} {r.get('score', float('nan')):.1f}" for r in scr.rows if "error" not in r
+        )
+        for name, scr in screens.items()
+    }
     return cfg, out
 
 

@@ -10,7 +10,7 @@ import pandas as pd
 import pytest
 import yaml
 
-from heritage_bayes.calibrate import _log_posterior, build_model
+from heritage_bayes.calibrate import build_model
 from heritage_bayes.config import parse_config
 from heritage_bayes.inference.optimize import find_map
 from heritage_bayes.inference.posterior import LogPosterior
@@ -21,6 +21,7 @@ from heritage_bayes.inference.segments import (
     segments_of,
 )
 from heritage_bayes.init_config import init_config
+from heritage_bayes.ladder import section_log_posterior as _log_posterior
 from heritage_bayes.prepare import prepare
 from test_init_detect import _climate, _data, _hobo
 from test_prepare import _csv_config, _load, _write_files

@@ -68,10 +68,6 @@ __all__ = [
 ]
 
 
-#: Noise model and parameter set (priors validated) of a config section.
-_parameters = section_parameters
-
-
 def check_models(cfg: CalibrationConfig) -> None:
     """Build every configured model and its priors without reading any data, so that a
     wrong model name, option or prior fails at once (:class:`ConfigError` naming the key)."""
@@ -79,12 +75,8 @@ def check_models(cfg: CalibrationConfig) -> None:
         sec_cfg = getattr(cfg, section)
         if sec_cfg is not None:
             model = build_model(cfg, section)
-            _parameters(cfg, section, model, sec_cfg.priors)
+            section_parameters(cfg, section, model, sec_cfg.priors)
             initial_state_of(cfg, section, model)
-
-
-#: The log-posterior of a config section's model (:mod:`heritage_bayes.ladder`).
-_log_posterior = section_log_posterior
 
 
 def _say_segments(say, prep) -> None:
@@ -297,7 +289,7 @@ def _calibrate_into(
         if sec_cfg is None:
             continue
         model = build_model(cfg, name)
-        lp = _log_posterior(cfg, prep, name, model, sec_cfg.priors)
+        lp = section_log_posterior(cfg, prep, name, model, sec_cfg.priors)
         sections.append(_Section(name, model, lp))
     ndims = [s.logpost.ndim for s in sections]
     nwalkers = cfg.sampler.walkers or max(32, 2 * max(ndims) + 2)

@@ -61,9 +61,9 @@ def _candidate_config(cfg, section: str, name: str):
 
     sec = getattr(cfg, section)
     # the configured priors whose parameters exist in this model (as the ladder does)
-    from heritage_bayes.calibrate import _parameters
     from heritage_bayes.models import _catalog_options
     from heritage_bayes.rc.catalog import model as catalog_model
+    from heritage_bayes.run import section_parameters
 
     if "sink" in sec.options and name not in _SINK_MODELS:  # (a rung's own, as in auto)
         sec = sec.model_copy(
@@ -85,7 +85,7 @@ def _candidate_config(cfg, section: str, name: str):
             "name": f"{cfg.name or 'run'}-{name}",
         }
     )
-    _parameters(cand, section, model, priors)  # a prior that does not fit fails now
+    section_parameters(cand, section, model, priors)  # a prior that does not fit fails now
     return cand
 
 

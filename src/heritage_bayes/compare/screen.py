@@ -80,10 +80,9 @@ def screen_candidates(
     """MAP and ladder row of every candidate config: (label -> row, label -> MAP result,
     label -> score [%]). A candidate whose MAP cannot be found scores NaN (its row says
     why)."""
-    from heritage_bayes.calibrate import _log_posterior
     from heritage_bayes.errors import ConfigError, InputError
     from heritage_bayes.inference.optimize import find_map
-    from heritage_bayes.ladder import ladder_row
+    from heritage_bayes.ladder import ladder_row, section_log_posterior
     from heritage_bayes.models import build_model
     from heritage_bayes.prepare import prepare
     from heritage_bayes.selection import _period, carried_start, row_score
@@ -101,7 +100,7 @@ def screen_candidates(
                 preps[key] = prepare(cand)
             prep = preps[key]
             sec = getattr(cand, section)
-            lp = _log_posterior(cand, prep, section, model, sec.priors)
+            lp = section_log_posterior(cand, prep, section, model, sec.priors)
             parent = parents.get(label)
             start = carried_start(lp, lps[parent], maps[parent]) if parent in maps else None
             opt = cand.optimizer

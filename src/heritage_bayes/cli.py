@@ -33,6 +33,7 @@ from heritage_bayes._terminal import reader_gone as _reader_gone
 from heritage_bayes._terminal import tolerant_streams as _tolerant_streams
 from heritage_bayes._version import __version__
 from heritage_bayes.errors import InputError
+from heritage_bayes.names import NOISE_MODELS
 
 __all__ = ["main"]
 
@@ -105,7 +106,7 @@ def _build_parser() -> argparse.ArgumentParser:
     mod.add_argument(
         "--noise",
         default="ar1_white",
-        choices=["ar1_white", "ar1", "iid", "kalman"],
+        choices=list(NOISE_MODELS),
         help="noise model (default ar1_white)",
     )
     mod.set_defaults(func=_cmd_models)

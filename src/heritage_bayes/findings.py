@@ -13,16 +13,16 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from heritage_bayes.names import noise_traits
+from heritage_bayes.rc.catalog import DomainView, model_ladder
 from heritage_bayes.rc.derived import frozen_time_constant
 
 __all__ = ["LADDERS", "modes_finding", "say_findings"]
 
 #: The model-order ladder of each section, smallest first (the report's ladder, the
-#: candidates of ``hbayes compare``, the smaller model a finding suggests).
-LADDERS = {
-    "thermal": ("thermal_1c", "thermal_2c", "thermal_4a"),
-    "hygric": ("hygric_1c", "hygric_2c", "hygric_2c_fixed"),
-}
+#: candidates of ``hbayes compare``, the smaller model a finding suggests): the
+#: catalogue entries marked ``ladder`` (:func:`heritage_bayes.rc.catalog.model_ladder`).
+LADDERS: Mapping[str, tuple[str, ...]] = DomainView(model_ladder)
 
 
 def say_findings(say, s, priors: Mapping | tuple = ()) -> None:
@@ -34,7 +34,9 @@ def say_findings(say, s, priors: Mapping | tuple = ()) -> None:
     """
     s.map_at_bound = s.logpost.params.at_bound(s.map.x)
     capped = [n for n, side in s.map_at_bound if n.startswith("phi_") and side == "upper"]
-    told = {(n, "upper") for n in capped} if s.logpost.noise.name == "ar1_white" else set()
+    told = (
+        {(n, "upper") for n in capped} if noise_traits(s.logpost.noise.name).capped_phi else set()
+    )
     if told:
         ph = s.logpost.params.parameters[s.logpost.params.names.index(capped[0])].prior.upper
         hours = -s.logpost.dt / 3600.0 / np.log(ph)

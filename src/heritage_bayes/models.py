@@ -13,7 +13,7 @@ import pandas as pd
 
 from heritage_bayes.config import CalibrationConfig
 from heritage_bayes.errors import ConfigError
-from heritage_bayes.rc.catalog import CATALOG
+from heritage_bayes.rc.catalog import CATALOG, DomainView, auto_ladder
 from heritage_bayes.rc.catalog import model as catalog_model
 from heritage_bayes.rc.model import RCModel
 from heritage_bayes.rc.network import Network
@@ -34,24 +34,11 @@ SECTIONS = ("thermal", "hygric")
 #: score, :mod:`heritage_bayes.selection`) and samples the model chosen.
 AUTO = "auto"
 #: The rungs ``model: auto`` screens, simplest first: (catalogue name, the rung's own
-#: options, the nested simpler rung whose MAP seeds this one's search). The configured
-#: ``options`` (control, sources, surfaces) apply to every rung; ``sink`` is the rung's.
-#: The last rung's inputs cover every rung's: the data are prepared for it.
-AUTO_LADDERS: dict[str, tuple[tuple[str, dict, str | None], ...]] = {
-    "thermal": (
-        ("thermal_1c", {}, None),
-        ("thermal_2c", {}, "thermal_1c"),
-        ("thermal_4a", {}, "thermal_2c"),
-    ),
-    "hygric": (
-        ("hygric_1c", {}, None),
-        ("hygric_2c", {}, "hygric_1c"),
-        ("hygric_2c_fixed", {"sink": "constant"}, "hygric_2c"),
-        ("hygric_2c_fixed", {"sink": "temperature"}, "hygric_2c"),
-        ("hygric_2c_sorption", {}, "hygric_1c"),
-        ("hygric_2c_sorption", {"sink": "temperature"}, "hygric_2c_sorption"),
-    ),
-}
+#: options, the nested simpler rung whose MAP seeds this one's search), read from the
+#: catalogue entries' ``rungs`` (:func:`heritage_bayes.rc.catalog.auto_ladder`). The
+#: configured ``options`` (control, sources, surfaces) apply to every rung; ``sink`` is
+#: the rung's. The last rung's inputs cover every rung's: the data are prepared for it.
+AUTO_LADDERS: Mapping[str, tuple[tuple[str, dict, str | None], ...]] = DomainView(auto_ladder)
 
 
 def rung_label(name: str, own: Mapping) -> str:
@@ -67,9 +54,6 @@ def rung_options(cfg: CalibrationConfig, section: str, name: str, own: Mapping) 
     solar surfaces (:func:`_catalog_options`)."""
     opts = {k: v for k, v in _catalog_options(cfg, section, name).items() if k != "sink"}
     return {**opts, **own}
-
-
-_SOLAR = {"thermal_1c", "thermal_2c", "thermal_4a"}
 
 
 #: Names that become variable names in posterior.nc (NetCDF) and input columns.
@@ -202,7 +186,7 @@ def _catalog_options(cfg: CalibrationConfig, section: str, name: str) -> dict:
     """Options of catalogue model ``name`` in a section: the configured ones, plus the
     solar surfaces from ``data.surfaces`` (none when ``data.irradiance: none``)."""
     options = dict(getattr(cfg, section).options)
-    if name in _SOLAR and "surfaces" not in options:
+    if CATALOG[name].solar and "surfaces" not in options:
         options["surfaces"] = tuple(cfg.data.surfaces) if cfg.data.irradiance != "none" else ()
     return options
 
@@ -224,7 +208,11 @@ def describe_model(name: str, noise: str = "ar1_white") -> str:
     m = catalog_model(name)
     net = m.network
     pot = "T" if net.domain == "thermal" else "P"
-    lines = [f"{name}: {CATALOG[name][1]}", "", "Equations (one balance per capacity node):"]
+    lines = [
+        f"{name}: {CATALOG[name].description}",
+        "",
+        "Equations (one balance per capacity node):",
+    ]
     for node in () if hasattr(m, "equations") else net.nodes:
         terms = []
         for lk in net.links:

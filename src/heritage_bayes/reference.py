@@ -179,7 +179,10 @@ def schema_reference(model: type[BaseModel], *, title: str | None = None, level:
                 type_text = f"[section](#{_anchor(model, k.path)})"
                 default = "see section" if not k.required else "**required**"
             else:
-                type_text = _cell(_type_text(field.annotation))
+                choices = next((m.names for m in field.metadata if hasattr(m, "names")), None)
+                type_text = _cell(
+                    _type_text(typing.Literal[choices] if choices else field.annotation)
+                )
                 default = "**required**" if k.required else _value_text(k.default)
             out.append(
                 f"| `{k.path}` | {type_text} | {default} | {_bounds_text(field)} "

@@ -22,16 +22,15 @@ from heritage_bayes.compare.scores import (
 )
 from heritage_bayes.errors import InputError
 from heritage_bayes.format import quantity_name
+from heritage_bayes.rc.catalog import DomainView, model_ladder
 
 #: ELPD differences smaller than this are negligible whatever their SE (two nearly
 #: identical models have a tiny SE of their difference) [nats]; Sivula et al. (2020).
 NEGLIGIBLE_ELPD = 4.0
 
-#: Candidates when ``--models`` is not given: the model orders of each section.
-DEFAULT_MODELS = {
-    "thermal": ("thermal_1c", "thermal_2c", "thermal_4a"),
-    "hygric": ("hygric_1c", "hygric_2c", "hygric_2c_fixed"),
-}
+#: Candidates when ``--models`` is not given: the model-order ladder of each section
+#: (the catalogue entries marked ``ladder``, :func:`heritage_bayes.rc.catalog.model_ladder`).
+DEFAULT_MODELS: Mapping[str, tuple[str, ...]] = DomainView(model_ladder)
 
 
 def compare_runs(

@@ -35,7 +35,7 @@ def _section_of(cfg, models: Sequence[str] | None) -> tuple[str, list[str]]:
         raise ConfigError(f"--models: {dup} given more than once")
     if len(names) < 2:
         raise ConfigError(f"--models: give at least two models to compare (got {names})")
-    domains = {m: m.split("_")[0] for m in names}
+    domains = {m: CATALOG[m].domain for m in names}
     section = domains[names[0]]
     wrong = [m for m in names if domains[m] != section]
     if wrong:

@@ -9,6 +9,7 @@ configuration reference and ``hbayes init`` read them (:mod:`heritage_bayes.conf
 from __future__ import annotations
 
 import datetime as _dt
+from collections.abc import Mapping
 from typing import Annotated, Any
 
 import pandas as pd
@@ -21,13 +22,14 @@ from pydantic import (
     PlainValidator,
     WithJsonSchema,
 )
-from pydantic_core import PydanticUndefined
+from pydantic_core import PydanticCustomError, PydanticUndefined, core_schema
 
 from heritage_bayes.convert import format_timedelta, parse_duration, parse_timezone, timezone_text
 from heritage_bayes.errors import InputError
 
 __all__ = [
     "MAX_SEED",
+    "Choices",
     "DateText",
     "Duration",
     "NonNegativeDuration",
@@ -44,6 +46,37 @@ MAX_SEED = 2**31 - 1
 
 #: The unit of duration keys in the schema: the value carries its own unit.
 DURATION_UNIT = "duration"
+
+
+class Choices:
+    """A key whose value is a name of a registry (a mapping, read at each validation, so
+    that a name registered after this module's import is accepted): the type of
+    ``noise:`` and ``sampler.moves``, e.g. ``Annotated[str, Choices(NOISE_MODELS)]``.
+
+    A wrong name gets pydantic's own message for a ``Literal`` (``Input should be 'a',
+    'b' or 'c'``); the JSON schema and the generated reference list the names."""
+
+    def __init__(self, registry: Mapping[str, Any]):
+        self.registry = registry
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        return tuple(self.registry)
+
+    def _check(self, value: Any) -> str:
+        if isinstance(value, str) and value in self.registry:
+            return value
+        quoted = [repr(n) for n in self.names]
+        expected = " or ".join([", ".join(quoted[:-1]), quoted[-1]] if len(quoted) > 1 else quoted)
+        raise PydanticCustomError(
+            "literal_error", "Input should be {expected}", {"expected": expected}
+        )
+
+    def __get_pydantic_core_schema__(self, source: Any, handler: Any) -> Any:
+        return core_schema.no_info_plain_validator_function(self._check)
+
+    def __get_pydantic_json_schema__(self, schema: Any, handler: Any) -> dict:
+        return {"enum": list(self.names), "type": "string"}
 
 
 class _Strict(BaseModel):

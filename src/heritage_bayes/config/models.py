@@ -14,8 +14,9 @@ from typing import Annotated, Any, Literal
 import pandas as pd
 from pydantic import PlainSerializer, PlainValidator, WithJsonSchema
 
-from heritage_bayes.config._base import DURATION_UNIT, _duration, _Strict, key
+from heritage_bayes.config._base import DURATION_UNIT, Choices, _duration, _Strict, key
 from heritage_bayes.convert import format_timedelta
+from heritage_bayes.names import NOISE_MODELS
 
 __all__ = [
     "DEFAULT_LIKELIHOOD_TEMPERATURE",
@@ -76,7 +77,7 @@ class ModelSection(_Strict):
         "humidistat, source (hbayes models)",
         default_factory=dict,
     )
-    noise: Literal["ar1_white", "ar1", "iid", "kalman"] = key(
+    noise: Annotated[str, Choices(NOISE_MODELS)] = key(
         "ar1_white",
         unit=None,
         description="noise model: AR(1) model error + white sensor noise, a single AR(1), "

@@ -7,8 +7,9 @@ from typing import Annotated, Any, Literal
 import pandas as pd
 from pydantic import PlainSerializer, PlainValidator, WithJsonSchema
 
-from heritage_bayes.config._base import DURATION_UNIT, _duration, _Strict, key
+from heritage_bayes.config._base import DURATION_UNIT, Choices, _duration, _Strict, key
 from heritage_bayes.convert import format_timedelta
+from heritage_bayes.names import MOVES
 
 #: ``optimizer.restarts`` of networks of :data:`BLOCK_MIN_NODES` or more capacity nodes
 #: where the config does not set it: on the demo's data thermal_4a has two optima of
@@ -93,7 +94,7 @@ class SamplerSettings(_Strict):
         ge=0,
         lt=1,
     )
-    moves: Literal["de_snooker", "de_snooker_50", "de", "stretch", "de_global", "dime"] = key(
+    moves: Annotated[str, Choices(MOVES)] = key(
         "de_snooker",
         unit=None,
         description="emcee's proposal moves: de_snooker (differential evolution 80 %, "

@@ -41,6 +41,7 @@ import numba
 import numpy as np
 
 from heritage_bayes.inference.parameters import Prior
+from heritage_bayes.names import NOISE_MODELS as DECLARED
 
 __all__ = [
     "NOISE_MODELS",
@@ -51,6 +52,7 @@ __all__ = [
     "ar1_white_innovations",
     "fit_free_run_error",
     "get_noise_model",
+    "register_noise",
 ]
 
 _LOG2PI = math.log(2.0 * math.pi)
@@ -481,11 +483,32 @@ def ar1_white_innovations(e: np.ndarray, sigma: float, phi: float, w: float) -> 
     return out
 
 
-NOISE_MODELS: dict[str, type[NoiseModel]] = {
-    "iid": IIDNoise,
-    "ar1": AR1Noise,
-    "ar1_white": AR1WhiteNoise,
-}
+#: The implementations of the noise models declared in
+#: :data:`heritage_bayes.names.NOISE_MODELS` (name -> class), filled by
+#: :func:`register_noise`.
+NOISE_MODELS: dict[str, type[NoiseModel]] = {}
+
+
+def register_noise(cls: type[NoiseModel]) -> type[NoiseModel]:
+    """Register a noise model class under its declared ``name`` (a class decorator).
+
+    Raises
+    ------
+    ValueError
+        ``cls.name`` is not declared in :data:`heritage_bayes.names.NOISE_MODELS`
+        (:func:`heritage_bayes.names.declare_noise`), or already has a class.
+    """
+    if cls.name not in DECLARED or cls.name in NOISE_MODELS:
+        raise ValueError(
+            f"noise model {cls.name!r}: declare its name first "
+            "(heritage_bayes.names.declare_noise), once"
+        )
+    NOISE_MODELS[cls.name] = cls
+    return cls
+
+
+for _cls in (IIDNoise, AR1Noise, AR1WhiteNoise):
+    register_noise(_cls)
 
 
 def fit_free_run_error(residual: np.ndarray, phi_max: float = 0.999) -> dict[str, float]:

@@ -45,7 +45,7 @@ import math
 import numba
 import numpy as np
 
-from heritage_bayes.inference.likelihoods import NOISE_MODELS, NoiseModel
+from heritage_bayes.inference.likelihoods import NoiseModel, register_noise
 from heritage_bayes.rc.discretize import modal_form
 
 __all__ = ["KalmanNoise", "modal_process_noise"]
@@ -264,4 +264,4 @@ class KalmanNoise(NoiseModel):
         return out + np.sqrt(R)[:, None, :] * rng.standard_normal((K, N, n_out))
 
 
-NOISE_MODELS["kalman"] = KalmanNoise  # get_noise_model("kalman")
+register_noise(KalmanNoise)  # get_noise_model("kalman")

@@ -61,14 +61,25 @@ Control of the air node (a heated, humidity-controlled or occupied room; see
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from typing import NamedTuple
 
 from heritage_bayes.rc.control import _parse_control, controlled
 from heritage_bayes.rc.model import RCModel
 from heritage_bayes.rc.network import Link, Network, Node, Source
 from heritage_bayes.rc.sorption import CoupledHygricModel, coupled_network
 
-__all__ = ["CATALOG", "available_models", "model"]
+__all__ = [
+    "CATALOG",
+    "DOMAINS",
+    "CatalogModel",
+    "DomainView",
+    "auto_ladder",
+    "available_models",
+    "model",
+    "model_ladder",
+    "register",
+]
 
 DEFAULT_SURFACES = ("N", "E", "S", "W")
 
@@ -215,48 +226,195 @@ def _sorption_factory(name: str) -> Callable[..., RCModel]:
     return build
 
 
-#: Catalogue: name -> (factory of the Network, one-line description).
-CATALOG: dict[str, tuple[Callable[..., Network], str]] = {
-    "thermal_1c": (
-        _thermal_factory("1c", True, "thermal_1c"),
-        "thermal, 1 capacity (air + contents), solar, ground",
+class CatalogModel(NamedTuple):
+    """One catalogue model: everything the package reads about it, in one entry.
+
+    The CLI (``hbayes models``), the config's ``model:`` names, the solar surfaces a
+    section's model receives, the model-order ladder (the run's ladder, the candidates
+    of ``hbayes compare``, the smaller model a finding suggests) and the rungs that
+    ``model: auto`` screens are all read from :data:`CATALOG`; :func:`register` adds one.
+    """
+
+    #: Builds the model from its options: a :class:`Network` (compiled and given its
+    #: control by :func:`model`) or a compiled :class:`RCModel` (a time-varying model).
+    factory: Callable[..., Network | RCModel]
+    #: One line for ``hbayes models``.
+    description: str
+    #: ``"thermal"`` or ``"hygric"``: the config section it calibrates, and the control
+    #: it takes (``thermostat`` or ``humidistat``).
+    domain: str
+    #: Takes solar surfaces: the option ``surfaces`` is filled from ``data.surfaces``.
+    solar: bool = False
+    #: On its section's model-order ladder (smallest first, in catalogue order).
+    ladder: bool = False
+    #: Rungs of ``model: auto``'s screen (in catalogue order): per rung, the rung's own
+    #: options and the catalogue name of the nested simpler rung whose MAP seeds it.
+    rungs: tuple[tuple[dict, str | None], ...] = ()
+
+
+#: Sections a catalogue model belongs to.
+DOMAINS = ("thermal", "hygric")
+
+#: Catalogue: name -> :class:`CatalogModel`, in ladder order within each domain.
+CATALOG: dict[str, CatalogModel] = {}
+
+
+def register(name: str, entry: CatalogModel) -> CatalogModel:
+    """Add a model to :data:`CATALOG` (after the others of its domain's ladder).
+
+    Raises
+    ------
+    ValueError
+        A name taken or not a lowercase identifier, an unknown domain, or a rung whose
+        parent is not a catalogue model of the same domain.
+    """
+    if name in CATALOG or not name.isidentifier() or name != name.lower():
+        raise ValueError(f"model name {name!r}: taken, or not a lowercase identifier")
+    if entry.domain not in DOMAINS:
+        raise ValueError(f"model {name!r}: domain must be one of {DOMAINS} (got {entry.domain!r})")
+    for _, parent in entry.rungs:
+        if (
+            parent is not None
+            and parent != name
+            and (parent not in CATALOG or CATALOG[parent].domain != entry.domain)
+        ):
+            raise ValueError(
+                f"model {name!r}: rung parent {parent!r} is not a {entry.domain} model"
+            )
+    CATALOG[name] = entry
+    return entry
+
+
+def model_ladder(domain: str) -> tuple[str, ...]:
+    """The model-order ladder of a domain, smallest first: the catalogue models marked
+    ``ladder``."""
+    return tuple(n for n, e in CATALOG.items() if e.domain == domain and e.ladder)
+
+
+def auto_ladder(domain: str) -> tuple[tuple[str, dict, str | None], ...]:
+    """The rungs ``model: auto`` screens in a domain, simplest first: (catalogue name,
+    the rung's own options, the nested simpler rung's name or None)."""
+    return tuple(
+        (n, own, parent)
+        for n, e in CATALOG.items()
+        if e.domain == domain
+        for own, parent in e.rungs
+    )
+
+
+class DomainView(Mapping):
+    """A read-only ``{domain: value}`` mapping computed from :data:`CATALOG` on each
+    look-up, so that a model registered later shows in it."""
+
+    def __init__(self, of: Callable[[str], tuple]):
+        self._of = of
+
+    def __getitem__(self, domain: str) -> tuple:
+        if domain not in DOMAINS:
+            raise KeyError(domain)
+        return self._of(domain)
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(DOMAINS)
+
+    def __len__(self) -> int:
+        return len(DOMAINS)
+
+    def __repr__(self) -> str:
+        return repr(dict(self))
+
+
+for _name, _entry in (
+    (
+        "thermal_1c",
+        CatalogModel(
+            _thermal_factory("1c", True, "thermal_1c"),
+            "thermal, 1 capacity (air + contents), solar, ground",
+            "thermal",
+            solar=True,
+            ladder=True,
+            rungs=(({}, None),),
+        ),
     ),
-    "thermal_2c": (
-        _thermal_factory("2c", True, "thermal_2c"),
-        "thermal, 2 capacities (envelope, air), solar, ground",
+    (
+        "thermal_2c",
+        CatalogModel(
+            _thermal_factory("2c", True, "thermal_2c"),
+            "thermal, 2 capacities (envelope, air), solar, ground",
+            "thermal",
+            solar=True,
+            ladder=True,
+            rungs=(({}, "thermal_1c"),),
+        ),
     ),
-    "thermal_4a": (
-        _thermal_factory("3c", True, "thermal_4a"),
-        "thermal model 4a of Kramer et al.: envelope, air, interior mass, solar on facades, ground",
+    (
+        "thermal_4a",
+        CatalogModel(
+            _thermal_factory("3c", True, "thermal_4a"),
+            "thermal model 4a of Kramer et al.: envelope, air, interior mass, solar on "
+            "facades, ground",
+            "thermal",
+            solar=True,
+            ladder=True,
+            rungs=(({}, "thermal_2c"),),
+        ),
     ),
-    "thermal_4a_nosolar": (
-        _thermal_factory("3c", False, "thermal_4a_nosolar"),
-        "thermal model 4a without solar input",
+    (
+        "thermal_4a_nosolar",
+        CatalogModel(
+            _thermal_factory("3c", False, "thermal_4a_nosolar"),
+            "thermal model 4a without solar input",
+            "thermal",
+        ),
     ),
-    "hygric_1c": (
-        _hygric_factory("1c", False, "hygric_1c"),
-        "hygric, 1 capacity (air + fast buffer)",
+    (
+        "hygric_1c",
+        CatalogModel(
+            _hygric_factory("1c", False, "hygric_1c"),
+            "hygric, 1 capacity (air + fast buffer)",
+            "hygric",
+            ladder=True,
+            rungs=(({}, None),),
+        ),
     ),
-    "hygric_2c": (
-        _hygric_factory("2c", False, "hygric_2c"),
-        "hygric model 3 of Kramer et al.: buffer, air",
+    (
+        "hygric_2c",
+        CatalogModel(
+            _hygric_factory("2c", False, "hygric_2c"),
+            "hygric model 3 of Kramer et al.: buffer, air",
+            "hygric",
+            ladder=True,
+            rungs=(({}, "hygric_1c"),),
+        ),
     ),
-    "hygric_2c_fixed": (
-        _hygric_factory("2c", True, "hygric_2c_fixed"),
-        "hygric model 3 with a fixed vapour-pressure node (Gf, Pf; or sink: temperature, "
-        "a vapour sink at phi_f·psat(Tf))",
+    (
+        "hygric_2c_fixed",
+        CatalogModel(
+            _hygric_factory("2c", True, "hygric_2c_fixed"),
+            "hygric model 3 with a fixed vapour-pressure node (Gf, Pf; or sink: "
+            "temperature, a vapour sink at phi_f·psat(Tf))",
+            "hygric",
+            ladder=True,
+            rungs=(({"sink": "constant"}, "hygric_2c"), ({"sink": "temperature"}, "hygric_2c")),
+        ),
     ),
-    "hygric_2c_sorption": (
-        _sorption_factory("hygric_2c_sorption"),
-        "hygric, air and a sorbing buffer whose surface vapour pressure is "
-        "φ_w·psat(Ti) (thermo-hygric coupling)",
+    (
+        "hygric_2c_sorption",
+        CatalogModel(
+            _sorption_factory("hygric_2c_sorption"),
+            "hygric, air and a sorbing buffer whose surface vapour pressure is "
+            "φ_w·psat(Ti) (thermo-hygric coupling)",
+            "hygric",
+            rungs=(({}, "hygric_1c"), ({"sink": "temperature"}, "hygric_2c_sorption")),
+        ),
     ),
-}
+):
+    register(_name, _entry)
 
 
 def available_models() -> dict[str, str]:
     """Catalogue names and descriptions."""
-    return {k: v[1] for k, v in CATALOG.items()}
+    return {k: v.description for k, v in CATALOG.items()}
 
 
 def model(name: str, **options) -> RCModel:
@@ -278,16 +436,17 @@ def model(name: str, **options) -> RCModel:
     """
     if name not in CATALOG:
         raise ValueError(f"unknown model {name!r}; available: {sorted(CATALOG)}")
-    factory = CATALOG[name][0]
+    entry = CATALOG[name]
+    factory = entry.factory
     options = dict(options)
-    control = _parse_control(name.split("_")[0], name, options)
+    control = _parse_control(entry.domain, name, options)
     try:
         net = factory(**options)
     except TypeError as exc:
         import inspect
 
         allowed = [*inspect.signature(factory).parameters, "source"]
-        allowed += ["thermostat"] if name.startswith("thermal") else ["humidistat"]
+        allowed += ["thermostat"] if entry.domain == "thermal" else ["humidistat"]
         raise ValueError(
             f"model {name!r}: unknown option(s) in {sorted(options)}; allowed: {allowed}"
         ) from exc

@@ -19,6 +19,7 @@ import numpy as np
 
 from heritage_bayes.errors import InputError
 from heritage_bayes.format import OUT_UNITS, fmt_int, fmt_pct
+from heritage_bayes.names import noise_traits
 from heritage_bayes.report.page import Section
 from heritage_bayes.report.rundata import RunData, parameter_set, section_params
 from heritage_bayes.report.sections._fragment import render_fragment
@@ -216,9 +217,10 @@ def diagnostics_context(rd: RunData, fits: list[dict]) -> dict:
             continue
         phi, white = None, None
         pars = s.get("parameters") or {}
-        if info.get("noise") in ("ar1", "ar1_white"):
+        traits = noise_traits(info.get("noise"))
+        if traits.ar1:
             phi = (pars.get(f"{m}.phi_{o}") or {}).get("median")
-        if info.get("noise") == "ar1_white":
+        if traits.white:
             white = tuple(
                 (pars.get(f"{m}.{k}_{o}") or {}).get("median", 0.0)
                 for k in ("sigma", "phi", "sigma_meas")

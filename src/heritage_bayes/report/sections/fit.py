@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from heritage_bayes.format import OUT_WORDS
+from heritage_bayes.names import noise_traits
 from heritage_bayes.report.page import Section
 from heritage_bayes.report.rundata import (
     RunData,
@@ -90,7 +91,7 @@ def fit_context(rd: RunData, outputs: list[dict]) -> list[dict]:
         pred = ((models.get(o["section"]) or {}).get("predictive_noise") or {}).get(o["output"])
         band_note = ""
         if pred:
-            kalman = (models.get(o["section"]) or {}).get("noise") == "kalman"
+            kalman = noise_traits((models.get(o["section"]) or {}).get("noise")).state_space
             band_note = (
                 (
                     " The process noise is estimated for one-step prediction (the "

@@ -1,0 +1,81 @@
+"""The name lists a user chooses from, declared once: noise models and sampler moves.
+
+Layer 0, imported by the settings (the ``Literal`` choices of ``noise:`` and
+``sampler.moves``), by the command line (``hbayes models --noise``'s choices, without
+importing the numerics), by the generated references and by the report; the
+implementations register under a declared name (:func:`heritage_bayes.inference.
+likelihoods.register_noise`, :data:`heritage_bayes.inference.monitor.MOVES`), and a
+name declared here without an implementation, or the other way round, fails the tests.
+
+The catalogue of RC models is :data:`heritage_bayes.rc.catalog.CATALOG` (one entry
+per model, its ladder position and solar capability included).
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+__all__ = ["MOVES", "NOISE_MODELS", "NoiseName", "declare_noise", "noise_traits"]
+
+
+class NoiseName(NamedTuple):
+    """What the package knows of a noise model without importing its numerics."""
+
+    #: One line for the references.
+    description: str
+    #: Its model error is an AR(1) process with coefficient ``phi_<output>``: the
+    #: report shows the error's correlation time.
+    ar1: bool = False
+    #: Besides the AR(1) error, white sensor noise ``sigma_meas_<output>``.
+    white: bool = False
+    #: ``phi`` has a cap per time (the prior's upper bound from the time step): a
+    #: ``phi`` at its cap is a finding, not a prior bound.
+    capped_phi: bool = False
+    #: A state-space model (a Kalman filter on the stochastic RC model): the fit
+    #: figure shows its one-step-ahead band.
+    state_space: bool = False
+
+
+#: ``noise:`` choices, the default first.
+NOISE_MODELS: dict[str, NoiseName] = {}
+
+
+def declare_noise(name: str, entry: NoiseName) -> NoiseName:
+    """Declare a noise model's name (then its class registers under it).
+
+    Raises
+    ------
+    ValueError
+        The name is taken or not a lowercase identifier.
+    """
+    if name in NOISE_MODELS or not name.isidentifier() or name != name.lower():
+        raise ValueError(f"noise model name {name!r}: taken, or not a lowercase identifier")
+    NOISE_MODELS[name] = entry
+    return entry
+
+
+def noise_traits(name: str | None) -> NoiseName:
+    """The declaration of a noise model by name; a name not declared (a run written by
+    another version) has none of the traits."""
+    return NOISE_MODELS.get(name or "", NoiseName(""))
+
+
+declare_noise(
+    "ar1_white",
+    NoiseName("AR(1) model error + white sensor noise", ar1=True, white=True, capped_phi=True),
+)
+declare_noise("ar1", NoiseName("a single AR(1) error", ar1=True))
+declare_noise("iid", NoiseName("independent errors"))
+declare_noise("kalman", NoiseName("a Kalman filter on the stochastic RC model", state_space=True))
+
+#: ``sampler.moves`` choices, the default first (name -> description); the emcee
+#: mixtures are :data:`heritage_bayes.inference.monitor.MOVES`.
+MOVES: dict[str, str] = {
+    "de_snooker": "differential evolution 80 %, snooker 20 %",
+    "de_snooker_50": "differential evolution 50 %, snooker 50 %",
+    "de": "differential evolution",
+    "stretch": "the affine-invariant stretch move",
+    "de_global": "de_snooker whose DE part is replaced, for a walker in ten, by an "
+    "independent draw from a Student-t fitted to the chain so far",
+    "dime": "DE with those independent draws, no snooker",
+}

@@ -1,0 +1,120 @@
+"""One registry per name list: a model or a noise model registered in one place shows up
+everywhere a user meets the list (the CLI, the config, ``hbayes models``, the ladders)."""
+
+from __future__ import annotations
+
+import pytest
+import yaml
+
+from heritage_bayes import names
+from heritage_bayes.calibrate import check_models
+from heritage_bayes.cli import main
+from heritage_bayes.compare import DEFAULT_MODELS
+from heritage_bayes.config import parse_config
+from heritage_bayes.errors import ConfigError
+from heritage_bayes.findings import LADDERS
+from heritage_bayes.inference import likelihoods, monitor
+from heritage_bayes.models import AUTO_LADDERS, auto_rungs, build_model
+from heritage_bayes.rc import catalog
+from heritage_bayes.rc.network import Link, Network, Node, Source
+
+DEMO = "configs/demo.yaml"
+
+
+@pytest.fixture
+def restore_registries():
+    """Whatever a test registers is gone after it."""
+    saved = [(d, dict(d)) for d in (catalog.CATALOG, names.NOISE_MODELS, likelihoods.NOISE_MODELS)]
+    yield
+    for d, before in saved:
+        d.clear()
+        d.update(before)
+
+
+def _toy_network(surfaces=None, ground: bool = True) -> Network:
+    """One air node [°C] with a conductance Ge [W/K] to outdoors and solar apertures."""
+    surfaces = tuple(surfaces) if surfaces is not None else ("S",)
+    return Network(
+        name="thermal_toy",
+        domain="thermal",
+        nodes=(Node("Ti", "Ci"),),
+        links=(Link("Ti", "Te", "Ge"),),
+        inputs=("Te", *(f"I_{s}" for s in surfaces)),
+        outputs=("Ti",),
+        sources=tuple(Source(f"I_{s}", "Ti", f"fI_{s}") for s in surfaces),
+    )
+
+
+class _ToyNoise(likelihoods.IIDNoise):
+    name = "iid_toy"
+
+
+def _register_toys() -> None:
+    catalog.register(
+        "thermal_toy",
+        catalog.CatalogModel(
+            _toy_network,
+            "a toy: one air node",
+            "thermal",
+            solar=True,
+            ladder=True,
+            rungs=(({}, "thermal_4a"),),
+        ),
+    )
+    names.declare_noise("iid_toy", names.NoiseName("a toy: independent errors"))
+    likelihoods.register_noise(_ToyNoise)
+
+
+def _config(**section):
+    raw = yaml.safe_load(open(DEMO, encoding="utf-8"))
+    raw["thermal"].update(section)
+    return parse_config(raw, source="test")
+
+
+def test_a_registered_model_and_noise_model_show_up_everywhere(restore_registries, capsys):
+    _register_toys()
+    # the ladders: the model-order ladder (run ladder, compare, findings) and auto's rungs
+    assert LADDERS["thermal"][-1] == DEFAULT_MODELS["thermal"][-1] == "thermal_toy"
+    assert AUTO_LADDERS["thermal"][-1] == ("thermal_toy", {}, "thermal_4a")
+    cfg = _config(model="auto", noise="iid_toy")
+    labels = [(label, parent) for label, _, parent in auto_rungs(cfg, "thermal")]
+    assert labels[-1] == ("thermal_toy", "thermal_4a")
+    # the config takes both names; the solar surfaces come from data.surfaces
+    cfg = _config(model="thermal_toy", noise="iid_toy")
+    check_models(cfg)
+    m = build_model(cfg, "thermal")
+    assert [f"fI_{s}" for s in cfg.data.surfaces] == [
+        n for n in m.parameter_names if n.startswith("fI_")
+    ]
+    # the CLI: the --noise choices and `hbayes models`
+    assert main(["models", "--help"]) == 0
+    assert "--noise {ar1_white,ar1,iid,kalman,iid_toy}" in capsys.readouterr().out
+    assert main(["models"]) == 0
+    assert "thermal_toy" in capsys.readouterr().out
+    assert main(["models", "thermal_toy", "--noise", "iid_toy"]) == 0
+    out = capsys.readouterr().out
+    assert "thermal_toy: a toy: one air node" in out and "Ge " in out
+
+
+def test_an_unregistered_name_is_refused_with_the_registry_s_names():
+    with pytest.raises(ConfigError, match=r"thermal\.noise: Input should be 'ar1_white', 'ar1'"):
+        _config(noise="iid_toy")
+    with pytest.raises(ConfigError, match=r"thermal\.model: unknown model 'thermal_toy'"):
+        build_model(_config(model="thermal_toy"), "thermal")
+    with pytest.raises(ValueError, match="declare its name first"):
+        likelihoods.register_noise(_ToyNoise)
+    with pytest.raises(ValueError, match="rung parent 'thermal_nope'"):
+        catalog.register(
+            "thermal_toy",
+            catalog.CatalogModel(_toy_network, "toy", "thermal", rungs=(({}, "thermal_nope"),)),
+        )
+    assert "thermal_toy" not in catalog.CATALOG
+
+
+def test_every_declared_name_has_its_implementation_and_no_other():
+    assert set(likelihoods.NOISE_MODELS) == set(names.NOISE_MODELS)
+    assert list(monitor.MOVES) == list(names.MOVES)
+    for name, cls in likelihoods.NOISE_MODELS.items():
+        assert cls.name == name
+    for name, entry in catalog.CATALOG.items():
+        assert catalog.model(name).domain == entry.domain

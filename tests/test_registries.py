@@ -118,3 +118,34 @@ def test_every_declared_name_has_its_implementation_and_no_other():
         assert cls.name == name
     for name, entry in catalog.CATALOG.items():
         assert catalog.model(name).domain == entry.domain
+
+
+def test_a_model_s_own_parameter_roles_take_the_room_s_priors(restore_registries):
+    """The room's description sets priors by role: a model naming its air capacity
+    ``Ca`` declares the role and gets ``room_volume``'s prior on it."""
+    from heritage_bayes.inference.parameters import air_capacity_prior, parameters_for
+
+    def network() -> Network:
+        return Network(
+            name="thermal_ca",
+            domain="thermal",
+            nodes=(Node("Ti", "Ca"),),
+            links=(Link("Ti", "Te", "Ge"),),
+            inputs=("Te",),
+            outputs=("Ti",),
+        )
+
+    catalog.register(
+        "thermal_ca",
+        catalog.CatalogModel(network, "toy", "thermal", roles={"Ca": "air_capacity"}),
+    )
+    ps = parameters_for(
+        catalog.model("thermal_ca"), likelihoods.get_noise_model("iid"), room_volume=80.0
+    )
+    assert ps.parameters[ps.names.index("Ca")].prior == air_capacity_prior("thermal", 80.0)
+    default = parameters_for(
+        catalog.model("thermal_1c"), likelihoods.get_noise_model("iid"), room_volume=80.0
+    )
+    assert default.parameters[default.names.index("Ci")].prior == air_capacity_prior(
+        "thermal", 80.0
+    )

@@ -38,6 +38,7 @@ import numpy as np
 from scipy.special import expit, logit
 
 from heritage_bayes.errors import ConfigError
+from heritage_bayes.rc.catalog import roles_of
 
 __all__ = [
     "RHO_CP_AIR",
@@ -974,33 +975,43 @@ def parameters_for(
     ]
     noise_names = {n for n, _, _ in noise_specs}
     overrides = noise.priors_for(dt) if hasattr(noise, "priors_for") else {}
+    roles = roles_of(model.name)
     for name, kind, unit, desc in entries:
         prior = default_prior(domain, kind)
+        role = roles.get(name) if name not in noise_names else None
         if name in noise_names and (domain, kind) in overrides:
             prior = overrides[(domain, kind)]
-        if name == "Ci" and room_volume is not None and kind == "capacity":
+        if role == "air_capacity" and room_volume is not None and kind == "capacity":
             prior = air_capacity_prior(domain, room_volume)
-        if name == "Gfast" and air_change_rate is not None and kind == "conductance":
+        if role == "ventilation" and air_change_rate is not None and kind == "conductance":
             if room_volume is None:
                 raise ConfigError(
                     "air_change_rate: needs room_volume (the ventilation "
                     "conductance is volume × air change rate)"
                 )
             prior = ventilation_prior(domain, room_volume, air_change_rate, sigma=air_change_sigma)
-        if name == "Gf" and floor_area is not None and (domain, kind) == ("thermal", "conductance"):
+        if (
+            role == "ground"
+            and floor_area is not None
+            and (domain, kind) == ("thermal", "conductance")
+        ):
             prior = ground_prior(floor_area)
-        if name == "Gf" and floor_area is not None and (domain, kind) == ("hygric", "conductance"):
+        if (
+            role == "ground"
+            and floor_area is not None
+            and (domain, kind) == ("hygric", "conductance")
+        ):
             prior = vapour_ground_prior(floor_area)
-        if name == "Pf" and fixed_node_temperature is not None and kind == "constant":
+        if role == "fixed_potential" and fixed_node_temperature is not None and kind == "constant":
             prior = fixed_vapour_pressure_prior(fixed_node_temperature)
-        if interior_area is not None and (name, domain, kind) == (
-            "Gint",
+        if interior_area is not None and (role, domain, kind) == (
+            "interior_mass",
             "thermal",
             "conductance",
         ):
             prior = interior_prior(interior_area)
-        if envelope_area is not None and name in ("Gw", "Cw"):
-            prior = envelope_priors(envelope_area, domain)[name]
+        if envelope_area is not None and role == "envelope":
+            prior = envelope_priors(envelope_area, domain)["Gw" if kind == "conductance" else "Cw"]
         surface = name.removeprefix("fI_")
         if surface in (roof_area or {}) and kind == "gain" and name.startswith("fI_"):
             prior = roof_aperture_prior(roof_area[surface])

@@ -72,6 +72,7 @@ from heritage_bayes.rc.sorption import CoupledHygricModel, coupled_network
 __all__ = [
     "CATALOG",
     "DOMAINS",
+    "ROLES",
     "CatalogModel",
     "DomainView",
     "auto_ladder",
@@ -79,6 +80,7 @@ __all__ = [
     "model",
     "model_ladder",
     "register",
+    "roles_of",
 ]
 
 DEFAULT_SURFACES = ("N", "E", "S", "W")
@@ -250,6 +252,33 @@ class CatalogModel(NamedTuple):
     #: Rungs of ``model: auto``'s screen (in catalogue order): per rung, the rung's own
     #: options and the catalogue name of the nested simpler rung whose MAP seeds it.
     rungs: tuple[tuple[dict, str | None], ...] = ()
+    #: Parameter name -> role, for a model that names its parameters otherwise than
+    #: the catalogue (:data:`ROLES`, the default).
+    roles: Mapping[str, str] | None = None
+
+
+#: The roles of a network's parameters that a description of the room sets a prior on
+#: (:func:`heritage_bayes.inference.parameters.parameters_for`): parameter name -> role,
+#: by the catalogue's names. ``air_capacity`` (``room_volume``), ``ventilation``
+#: (``air_change_rate``), ``ground`` (``floor_area``), ``interior_mass``
+#: (``interior_area``), ``envelope`` (a conductance and a capacity: ``envelope_area``),
+#: ``fixed_potential`` (``fixed_node_temperature``).
+ROLES: Mapping[str, str] = {
+    "Ci": "air_capacity",
+    "Gfast": "ventilation",
+    "Gf": "ground",
+    "Gint": "interior_mass",
+    "Gw": "envelope",
+    "Cw": "envelope",
+    "Pf": "fixed_potential",
+}
+
+
+def roles_of(name: str) -> Mapping[str, str]:
+    """The parameter roles of a model by name: its catalogue entry's, else :data:`ROLES`
+    (a custom network named by the catalogue's conventions)."""
+    entry = CATALOG.get(name)
+    return entry.roles if entry is not None and entry.roles is not None else ROLES
 
 
 #: Sections a catalogue model belongs to.

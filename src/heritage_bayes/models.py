@@ -13,7 +13,7 @@ import pandas as pd
 
 from heritage_bayes.config import CalibrationConfig
 from heritage_bayes.errors import ConfigError
-from heritage_bayes.rc.catalog import CATALOG, DomainView, auto_ladder
+from heritage_bayes.rc.catalog import CATALOG, DomainView, auto_ladder, takes_option
 from heritage_bayes.rc.catalog import model as catalog_model
 from heritage_bayes.rc.model import RCModel
 from heritage_bayes.rc.network import Network
@@ -275,7 +275,7 @@ def describe_model(name: str, noise: str = "ar1_white") -> str:
                 "hygric_2c_sorption: none | constant | temperature); a sink at a temperature "
                 "reads Tf, the thermal section's ground temperature (data.ground_temperature)."
             ]
-            if name in ("hygric_2c_fixed", "hygric_2c_sorption")
+            if takes_option(name, "sink")
             else []
         ),
     ]

@@ -51,10 +51,6 @@ def _section_of(cfg, models: Sequence[str] | None) -> tuple[str, list[str]]:
     return section, names
 
 
-#: Catalogue models that take the option ``sink``.
-_SINK_MODELS = ("hygric_2c_fixed", "hygric_2c_sorption")
-
-
 def _candidate_config(cfg, section: str, name: str):
     """The config calibrating only ``name`` in ``section`` (same data, noise, knowledge)."""
     from heritage_bayes.models import SECTIONS
@@ -63,9 +59,10 @@ def _candidate_config(cfg, section: str, name: str):
     # the configured priors whose parameters exist in this model (as the ladder does)
     from heritage_bayes.models import _catalog_options
     from heritage_bayes.rc.catalog import model as catalog_model
+    from heritage_bayes.rc.catalog import takes_option
     from heritage_bayes.run import section_parameters
 
-    if "sink" in sec.options and name not in _SINK_MODELS:  # (a rung's own, as in auto)
+    if "sink" in sec.options and not takes_option(name, "sink"):  # (a rung's own, as in auto)
         sec = sec.model_copy(
             update={"options": {k: v for k, v in sec.options.items() if k != "sink"}}
         )

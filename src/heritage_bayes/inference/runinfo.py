@@ -23,6 +23,7 @@ def _truth_for(cfg, prep, section) -> tuple[dict, dict]:
     gen = (((prep.sources or {}).get("demo") or {}).get("models") or {}).get(section.name)
     if not truth or gen is None:
         return {}, {}
+    from heritage_bayes.rc.catalog import CATALOG
     from heritage_bayes.rc.catalog import model as catalog_model
 
     if gen == section.model.name:
@@ -31,7 +32,7 @@ def _truth_for(cfg, prep, section) -> tuple[dict, dict]:
     else:
         try:
             opts = {}
-            if section.model.domain == "thermal" and gen != "thermal_4a_nosolar":
+            if section.model.domain == "thermal" and gen in CATALOG and CATALOG[gen].solar:
                 opts["surfaces"] = tuple(cfg.data.surfaces)
             gen_model = catalog_model(gen, **opts)
         except ValueError:

@@ -81,6 +81,7 @@ __all__ = [
     "model_ladder",
     "register",
     "roles_of",
+    "takes_option",
 ]
 
 DEFAULT_SURFACES = ("N", "E", "S", "W")
@@ -312,6 +313,13 @@ def register(name: str, entry: CatalogModel) -> CatalogModel:
             )
     CATALOG[name] = entry
     return entry
+
+
+def takes_option(name: str, option: str) -> bool:
+    """Whether catalogue model ``name``'s factory takes ``option`` (e.g. ``sink``)."""
+    import inspect
+
+    return option in inspect.signature(CATALOG[name].factory).parameters
 
 
 def model_ladder(domain: str) -> tuple[str, ...]:

@@ -302,14 +302,13 @@ def test_every_moves_choice_of_the_config_builds_emcee_moves_and_samples():
     """``sampler.moves``: the schema's choices are the sampler's, each an emcee move
     mixture whose weights sum to 1; an unknown name is refused; each samples a
     Gaussian (the mean within 4 standard errors of the ESS the rule guarantees)."""
-    import typing
-
     import emcee
 
     from heritage_bayes.config.sampler import SamplerSettings
     from heritage_bayes.inference.monitor import MOVES, make_moves
 
-    choices = typing.get_args(SamplerSettings.model_fields["moves"].annotation)
+    field = SamplerSettings.model_fields["moves"]
+    choices = next(m.names for m in field.metadata if hasattr(m, "names"))
     assert set(choices) == set(MOVES)
     f = _BoxGauss(mu=[1.0, -2.0, 0.5], sd=[1.0, 2.0, 0.5], lo=[-np.inf] * 3, hi=[np.inf] * 3)
     for name in choices:

@@ -1,11 +1,12 @@
 """The name lists a user chooses from, declared once: noise models and sampler moves.
 
-Layer 0, imported by the settings (the ``Literal`` choices of ``noise:`` and
-``sampler.moves``), by the command line (``hbayes models --noise``'s choices, without
-importing the numerics), by the generated references and by the report; the
-implementations register under a declared name (:func:`heritage_bayes.inference.
-likelihoods.register_noise`, :data:`heritage_bayes.inference.monitor.MOVES`), and a
-name declared here without an implementation, or the other way round, fails the tests.
+Layer 0, imported by the settings (the choices of ``noise:`` and ``sampler.moves``,
+:class:`heritage_bayes.config._base.Choices`), by the command line (``hbayes models
+--noise``'s choices, without importing the numerics), by the generated references and
+by the report; the implementations register under a declared name
+(:func:`heritage_bayes.inference.likelihoods.register_noise`,
+:data:`heritage_bayes.inference.monitor.MOVES`), and a name declared here without an
+implementation, or the other way round, fails the tests.
 
 The catalogue of RC models is :data:`heritage_bayes.rc.catalog.CATALOG` (one entry
 per model, its ladder position and solar capability included).

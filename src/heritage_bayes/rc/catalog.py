@@ -40,6 +40,11 @@ vapour pressure [Pa]), output ``Pi``:
   ``temperature``) adds the fixed node of ``hygric_2c_fixed``. Linear time-varying given
   the temperature, simulated by an exact per-step recursion.
 
+Each model is one :class:`CatalogModel` entry of :data:`CATALOG` (its network factory,
+description, domain, solar surfaces, place on the model-order ladder, rungs of ``model:
+auto`` and parameter roles), from which the command line, the settings, the ladders and
+the priors read; :func:`register` adds one.
+
 Options (keywords of :func:`model`): ``surfaces`` (sequence of surface names for the
 thermal models with solar), ``ground`` (default True: ``Gf`` to the input column ``Tf``;
 False: no fixed node; ``"estimate"``: ``Tf`` [°C] is a constant to estimate, like the

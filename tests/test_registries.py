@@ -113,6 +113,7 @@ def test_an_unregistered_name_is_refused_with_the_registry_s_names():
 
 def test_every_declared_name_has_its_implementation_and_no_other():
     assert set(likelihoods.NOISE_MODELS) == set(names.NOISE_MODELS)
+    assert next(iter(names.NOISE_MODELS)) == names.DEFAULT_NOISE
     assert list(monitor.MOVES) == list(names.MOVES)
     for name, cls in likelihoods.NOISE_MODELS.items():
         assert cls.name == name

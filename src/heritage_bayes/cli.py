@@ -33,7 +33,7 @@ from heritage_bayes._terminal import reader_gone as _reader_gone
 from heritage_bayes._terminal import tolerant_streams as _tolerant_streams
 from heritage_bayes._version import __version__
 from heritage_bayes.errors import InputError
-from heritage_bayes.names import NOISE_MODELS
+from heritage_bayes.names import DEFAULT_NOISE, NOISE_MODELS
 
 __all__ = ["main"]
 
@@ -105,9 +105,9 @@ def _build_parser() -> argparse.ArgumentParser:
     mod.add_argument("name", nargs="?", help="a catalogue model, e.g. thermal_2c")
     mod.add_argument(
         "--noise",
-        default="ar1_white",
+        default=DEFAULT_NOISE,
         choices=list(NOISE_MODELS),
-        help="noise model (default ar1_white)",
+        help=f"noise model (default {DEFAULT_NOISE})",
     )
     mod.set_defaults(func=_cmd_models)
 

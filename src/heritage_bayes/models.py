@@ -13,6 +13,7 @@ import pandas as pd
 
 from heritage_bayes.config import CalibrationConfig
 from heritage_bayes.errors import ConfigError
+from heritage_bayes.names import DEFAULT_NOISE
 from heritage_bayes.rc.catalog import CATALOG, DomainView, auto_ladder, takes_option
 from heritage_bayes.rc.catalog import model as catalog_model
 from heritage_bayes.rc.model import RCModel
@@ -191,7 +192,7 @@ def _catalog_options(cfg: CalibrationConfig, section: str, name: str) -> dict:
     return options
 
 
-def describe_model(name: str, noise: str = "ar1_white") -> str:
+def describe_model(name: str, noise: str = DEFAULT_NOISE) -> str:
     """A catalogue model in words: balance equations, parameters with units and default
     priors (the names ``priors:`` accepts), inputs and outputs (``hbayes models NAME``).
 

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from typing import NamedTuple
 
-__all__ = ["MOVES", "NOISE_MODELS", "NoiseName", "declare_noise", "noise_traits"]
+__all__ = ["DEFAULT_NOISE", "MOVES", "NOISE_MODELS", "NoiseName", "declare_noise", "noise_traits"]
 
 
 class NoiseName(NamedTuple):
@@ -39,6 +39,8 @@ class NoiseName(NamedTuple):
 
 #: ``noise:`` choices, the default first.
 NOISE_MODELS: dict[str, NoiseName] = {}
+#: The noise model of a section that does not choose one.
+DEFAULT_NOISE = "ar1_white"
 
 
 def declare_noise(name: str, entry: NoiseName) -> NoiseName:

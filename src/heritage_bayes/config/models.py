@@ -16,7 +16,7 @@ from pydantic import PlainSerializer, PlainValidator, WithJsonSchema
 
 from heritage_bayes.config._base import DURATION_UNIT, Choices, _duration, _Strict, key
 from heritage_bayes.convert import format_timedelta
-from heritage_bayes.names import NOISE_MODELS
+from heritage_bayes.names import DEFAULT_NOISE, NOISE_MODELS
 
 __all__ = [
     "DEFAULT_LIKELIHOOD_TEMPERATURE",
@@ -78,7 +78,7 @@ class ModelSection(_Strict):
         default_factory=dict,
     )
     noise: Annotated[str, Choices(NOISE_MODELS)] = key(
-        "ar1_white",
+        DEFAULT_NOISE,
         unit=None,
         description="noise model: AR(1) model error + white sensor noise, a single AR(1), "
         "iid, or a Kalman filter on the stochastic RC model",

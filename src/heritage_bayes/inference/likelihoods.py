@@ -561,7 +561,8 @@ def fit_free_run_error(residual: np.ndarray, phi_max: float = 0.999) -> dict[str
 
 
 def get_noise_model(name: str) -> NoiseModel:
-    """Noise model by name (``"ar1_white"``, ``"ar1"``, ``"iid"`` or ``"kalman"``)."""
+    """Noise model by name (:data:`NOISE_MODELS`: ``"ar1_white"``, ``"ar1"``, ``"iid"``,
+    ``"kalman"``, and any registered with :func:`register_noise`)."""
     # "kalman" (inference/statespace.py) registers itself in NOISE_MODELS; the package
     # imports that module, so no import back from here (no import cycle)
     try:

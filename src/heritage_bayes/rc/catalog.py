@@ -66,6 +66,7 @@ Control of the air node (a heated, humidity-controlled or occupied room; see
 
 from __future__ import annotations
 
+import inspect
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from typing import NamedTuple
 
@@ -322,8 +323,6 @@ def register(name: str, entry: CatalogModel) -> CatalogModel:
 
 def takes_option(name: str, option: str) -> bool:
     """Whether catalogue model ``name``'s factory takes ``option`` (e.g. ``sink``)."""
-    import inspect
-
     return option in inspect.signature(CATALOG[name].factory).parameters
 
 
@@ -485,8 +484,6 @@ def model(name: str, **options) -> RCModel:
     try:
         net = factory(**options)
     except TypeError as exc:
-        import inspect
-
         allowed = [*inspect.signature(factory).parameters, "source"]
         allowed += ["thermostat"] if entry.domain == "thermal" else ["humidistat"]
         raise ValueError(

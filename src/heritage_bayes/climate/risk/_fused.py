@@ -39,6 +39,9 @@ from numba import njit
 
 from heritage_bayes.climate import _vecmath
 from heritage_bayes.climate._vecmath import stamp_cache, vcosh, vexp, vlog
+from heritage_bayes.climate.risk import _vtt, indicators
+from heritage_bayes.climate.risk._vtt import vtt_hours
+from heritage_bayes.climate.risk.indicators import LAYOUT
 
 #: Hours processed together by the vectorised loops.
 BLOCK = 512
@@ -47,15 +50,24 @@ N_BINS = 4096
 _EPS = 1e-9  # as heritage_bayes.climate.risk.standards._EPS (tolerance on limits)
 _T0 = 273.15
 
-# integer parameters (ipar)
-(I_CHEM, I_MECH, I_MOULD, I_ASHRAE, I_EN, I_NEA, I_HALF_A, I_WRAP_A, I_HALF_E, I_WRAP_E,
- I_SHARED, I_METHOD, I_NESTED, I_NCLS, I_EN_WIDTH, I_FROZEN, I_HAS_TSP,
- I_HAS_RHSP) = range(18)  # fmt: skip
-N_IPAR = 18
-# float parameters (fpar)
-(F_TREF_INV, F_RHREF, F_N, F_COEF, F_K1LO, F_K1HI, F_A, F_B, F_C, F_RHMIN, F_CMAT, F_W,
- F_SQ, F_M0, F_LIMC, F_THR, F_TSP, F_RHSP, F_QLO, F_QHI, F_MINBAND) = range(21)  # fmt: skip
-N_FPAR = 21
+# positions in the parameter arrays, derived from the families' parameter names
+_L = LAYOUT
+I_CHEM, I_MECH, I_MOULD, I_ASHRAE, I_EN = (_L.i(f) for f in ("chemical", "mechanical", "mould",
+                                                             "ashrae", "en15757"))  # fmt: skip
+I_NEA = _L.i("chemical.nea")
+I_FROZEN = _L.i("mould.frozen_decline")
+I_HALF_A, I_WRAP_A, I_METHOD, I_NESTED, I_NCLS, I_HAS_TSP, I_HAS_RHSP = (
+    _L.i(f"ashrae.{p}") for p in ("half", "wrap", "setpoint", "nested", "n_classes",
+                                  "has_T_setpoint", "has_RH_setpoint")
+)  # fmt: skip
+I_HALF_E, I_WRAP_E, I_SHARED, I_EN_WIDTH = (
+    _L.i(f"en15757.{p}") for p in ("half", "wrap", "shared", "width")
+)
+F_TREF_INV, F_RHREF, F_N = (_L.f(f"chemical.{p}") for p in ("tref_inv", "rh_ref", "n"))
+F_COEF = _L.f("mechanical.coefficient")
+F_VTT, F_M0, F_LIMC = _L.f("mould.k1_lo"), _L.f("mould.M0"), _L.f("mould.lim_c")
+F_THR, F_TSP, F_RHSP = (_L.f(f"ashrae.{p}") for p in ("threshold", "T_setpoint", "RH_setpoint"))
+F_QLO, F_QHI, F_MINBAND = (_L.f(f"en15757.{p}") for p in ("q_lo", "q_hi", "min_band"))
 # columns of the class table (cls): raw ClimateClass values, NaN for None
 C_TS, C_TDOWN, C_TUP, C_TSMAX, C_TMAX, C_RS, C_RDOWN, C_RUP, C_RLO, C_RHI = range(10)
 N_CLS = 10
@@ -174,6 +186,20 @@ def _bad_hours(T, RH, n):  # pragma: no cover - compiled
     return bad, above1, above0
 
 
+@njit(inline="always", cache=True, error_model="numpy")
+def inv_pi(inv_TK, r):  # pragma: no cover - compiled
+    """1 / PI(T, RH) [1/years] of ``chemical._pi`` from ``1 / (T + 273.15)`` [1/K] and
+    RH [%]: ``PI = exp(a) / 365`` inverted as ``365 exp(-a)`` (vectorised exp)."""
+    return 365.0 * vexp(-((95220.0 - 134.9 * r) * (inv_TK / 8.314) + 0.0284 * r - 28.023))
+
+
+@njit(inline="always", cache=True, error_model="numpy")
+def lim_rh(x, c):  # pragma: no cover - compiled
+    """The lowest isopleth for mould [%] at ``x`` [°C] (``biological._lim``, constant
+    ``c`` of the growth rate)."""
+    return 100.0 * (0.02633 * vcosh(0.10083 * (x - 30.0)) + c)
+
+
 @njit(cache=True, error_model="numpy")
 def _pointwise(T, RH, b0, m, fpar, ipar, ea_r, tmp, sums):  # pragma: no cover - compiled
     """Chemical and mechanical indicators and the isopleth count of one block.
@@ -198,8 +224,7 @@ def _pointwise(T, RH, b0, m, fpar, ipar, ea_r, tmp, sums):  # pragma: no cover -
             inv_TK = 1.0 / (x + _T0)  # the one division (products below)
             u[t] = inv_TK - tref_inv
             lr[t] = n_exp * (log_ref - vlog(r))  # n log(RH_ref / RH)
-            # 1 / PI with PI = exp(a) / 365 (chemical._pi)
-            w[t] = 365.0 * vexp(-((95220.0 - 134.9 * r) * (inv_TK / 8.314) + 0.0284 * r - 28.023))
+            w[t] = inv_pi(inv_TK, r)
         sums[nea] += _bsum(w, m)
         wet = 0
         for t in range(m):  # ISO 9223 time of wetness: RH > 80 % and T > 0 °C
@@ -230,60 +255,8 @@ def _pointwise(T, RH, b0, m, fpar, ipar, ea_r, tmp, sums):  # pragma: no cover -
         cnt = 0
         for t in range(m):
             x = Tb[t]
-            cnt += 1 if RHb[t] > 100.0 * (0.02633 * vcosh(0.10083 * (x - 30.0)) + c) else 0
+            cnt += 1 if RHb[t] > lim_rh(x, c) else 0
         sums[nea + 3] += cnt
-
-
-@njit(cache=True, error_model="numpy")
-def _vtt_block(T, RH, m, fpar, frozen_decline, state):  # pragma: no cover - compiled
-    """The VTT mould-index recursion (of ``_vtt``) over the hours ``T[:m]``, ``RH[:m]``
-    of a complete series, carrying ``state`` = [M, hours of the dry spell, max M]."""
-    k1_lo, k1_hi = fpar[F_K1LO], fpar[F_K1HI]
-    A, B, C, RH_min, C_mat = fpar[F_A], fpar[F_B], fpar[F_C], fpar[F_RHMIN], fpar[F_CMAT]
-    W, SQ = fpar[F_W], fpar[F_SQ]
-    M = state[0]
-    dry = np.int64(state[1])
-    mx = state[2]
-    for t in range(m):
-        Ti = T[t]
-        Ri = RH[t]
-        grow = Ti > 0.0 and Ti < 50.0
-        RHc = RH_min
-        if grow:
-            if Ti <= 20.0:
-                RHc = -0.00267 * Ti**3 + 0.160 * Ti**2 - 3.13 * Ti + 100.0
-                if RHc < RH_min:
-                    RHc = RH_min
-            grow = Ri >= RHc
-        if grow:
-            x = (RHc - Ri) / (RHc - 100.0)
-            M_max = A + B * x - C * x * x
-            k1 = k1_lo if M < 1.0 else k1_hi
-            k2 = 1.0 - math.exp(2.3 * (M - M_max))
-            if k2 < 0.0:
-                k2 = 0.0
-            M += (
-                k1
-                * k2
-                * math.exp(0.68 * math.log(Ti) + 13.9 * math.log(Ri) - 0.14 * W + 0.33 * SQ - 66.02)
-                / 168.0
-            )
-            dry = 0
-        elif Ti <= 0.0 and not frozen_decline:
-            pass
-        else:
-            dry += 1
-            if dry <= 6:
-                M -= 0.00133 * C_mat
-            elif dry > 24:
-                M -= 0.000667 * C_mat
-            if M < 0.0:
-                M = 0.0
-        if M > mx:
-            mx = M
-    state[0] = M
-    state[1] = dry
-    state[2] = mx
 
 
 @njit(cache=True, error_model="numpy")
@@ -566,6 +539,7 @@ def series_indicators(
     vtt[0] = fpar[F_M0]
     vtt[1] = 0.0
     vtt[2] = -1.0
+    vtt_p = fpar[F_VTT : F_VTT + 9]  # k1_lo, k1_hi, A, B, C, RH_min, C_mat, W, SQ
     csT, csRH, csE, f, sel = ws[0], ws[1], ws[2], ws[3], ws[4]
     half_a, wrap_a = ipar[I_HALF_A], ipar[I_WRAP_A] != 0
     half_e, wrap_e = ipar[I_HALF_E], ipar[I_WRAP_E] != 0
@@ -590,7 +564,7 @@ def series_indicators(
         above0 += a0
         _pointwise(T, RH, b0, m, fpar, ipar, ea_r, tmp, sums)
         if mould:
-            _vtt_block(Tb, RHb, m, fpar, frozen, vtt)
+            vtt_hours(Tb, RHb, m, vtt_p, frozen, vtt)
         if sum_T:
             _cumsum_block(Tb, m, csT[b0 : b0 + m + 1])
         if sum_RH:
@@ -685,4 +659,4 @@ def series_indicators(
     return 0
 
 
-stamp_cache(globals(), _vecmath)
+stamp_cache(globals(), _vecmath, _vtt, indicators)

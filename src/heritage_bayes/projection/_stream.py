@@ -26,7 +26,7 @@ from numba import njit, prange
 
 from heritage_bayes.climate import _vecmath
 from heritage_bayes.climate._vecmath import psat_water, stamp_cache
-from heritage_bayes.climate.risk import _fused, _vtt, indicators
+from heritage_bayes.climate.risk import _fused, _sums, _vtt, indicators
 from heritage_bayes.climate.risk._fused import (
     BLOCK,
     _bsum,
@@ -334,4 +334,4 @@ def chunk_kernel(
             _monthly(RHx, starts, RHm[i])
 
 
-stamp_cache(globals(), _fused, _vecmath, _control, _vtt, indicators)
+stamp_cache(globals(), _fused, _vecmath, _control, _sums, _vtt, indicators)

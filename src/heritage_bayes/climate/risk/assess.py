@@ -34,6 +34,13 @@ INDICATOR_GROUPS = {f.name: f.yearly for f in FAMILIES}
 def _resolve_options(func, given: Mapping[str, Mapping | None]):
     """Merge user options with the defaults of each family's target function; reject
     unknowns; then let each family check its own."""
+    known = [k for fam in FAMILIES for k in fam.options]
+    unknown = [k for k in given if k not in known]
+    if unknown:
+        raise InputError(
+            f"{func}: unknown option group(s) {unknown}; expected some of {known} (the "
+            "option keywords of the indicator families)"
+        )
     opts = {}
     for fam in FAMILIES:
         for key, target in fam.options.items():
@@ -146,6 +153,7 @@ def assess(
     isopleth=None,
     ashrae=None,
     en15757=None,
+    **more,
 ):
     r"""All conservation-risk indicators of one hourly series, as a tidy table.
 
@@ -179,6 +187,9 @@ def assess(
         Options of :func:`ashrae_classes`.
     en15757 : dict, optional
         Options of :func:`en15757_band`.
+    **more : dict, optional
+        Options of a family added with
+        :func:`~heritage_bayes.climate.risk.registry.register`, by its option keyword.
 
     Returns
     -------
@@ -246,7 +257,9 @@ def assess(
     'B'
     """
     func = "assess"
-    options = dict(lm=lm, emc=emc, vtt=vtt, isopleth=isopleth, ashrae=ashrae, en15757=en15757)
+    options = dict(
+        lm=lm, emc=emc, vtt=vtt, isopleth=isopleth, ashrae=ashrae, en15757=en15757, **more
+    )
     h, groups, opts = _prepare_assess(func, T, RH, indicators, nan_policy, options)
     if h.ndim != 1:
         raise InputError(
@@ -282,6 +295,7 @@ def assess_batch(
     isopleth=None,
     ashrae=None,
     en15757=None,
+    **more,
 ):
     r"""All indicators for many series at once (posterior draws × hours).
 
@@ -292,7 +306,7 @@ def assess_batch(
         ``RH``. [°C]
     RH : array_like
         Hourly relative humidity, shape (draws, hours), or (hours,) shared. [%]
-    indicators, nan_policy, lm, emc, vtt, isopleth, ashrae, en15757
+    indicators, nan_policy, lm, emc, vtt, isopleth, ashrae, en15757, **more
         As in :func:`assess`.
     chunk_size : int, default 128
         Draws processed together (bounds the memory of the temporaries). [-]
@@ -318,7 +332,9 @@ def assess_batch(
     See :func:`assess`.
     """
     func = "assess_batch"
-    options = dict(lm=lm, emc=emc, vtt=vtt, isopleth=isopleth, ashrae=ashrae, en15757=en15757)
+    options = dict(
+        lm=lm, emc=emc, vtt=vtt, isopleth=isopleth, ashrae=ashrae, en15757=en15757, **more
+    )
     h, groups, opts = _prepare_assess(func, T, RH, indicators, nan_policy, options)
     bad = isinstance(chunk_size, bool) or not isinstance(chunk_size, int | np.integer)
     if bad or chunk_size < 1:

@@ -36,6 +36,7 @@ from numba import njit, prange
 from heritage_bayes.climate import _vecmath
 from heritage_bayes.climate._vecmath import stamp_cache
 from heritage_bayes.climate.risk import _fused as k
+from heritage_bayes.climate.risk._inputs import Hourly
 from heritage_bayes.climate.risk.assess import (
     _check_year,
     _prepare_assess,
@@ -47,6 +48,7 @@ from heritage_bayes.climate.risk.assess import (
 from heritage_bayes.climate.risk.chemical import R_GAS
 from heritage_bayes.climate.risk.indicators import FAMILIES, LAYOUT, shared_seasonal
 from heritage_bayes.climate.risk.standards import _window_half
+from heritage_bayes.errors import InputError
 
 __all__ = ["FusedPlan", "assess_fused", "fused_plan"]
 
@@ -161,7 +163,7 @@ def _plan(func, n, groups, opts) -> FusedPlan:
     cols: list[str] = []
     pad = 0
     for fam in FAMILIES:  # each family's parameters, by name
-        if fam.name not in groups:
+        if fam.name not in groups or not fam.compiled:
             continue
         ints, floats, fam_pad = fam.plan(opts, n, shared)
         ipar[LAYOUT.i(fam.name)] = 1
@@ -195,6 +197,7 @@ def fused_plan(
     ashrae=None,
     en15757=None,
     func: str = "assess_fused",
+    **more,
 ) -> FusedPlan:
     """Resolve and check the options of :func:`assess` for series of ``n_hours`` hours.
 
@@ -202,8 +205,10 @@ def fused_plan(
     ----------
     n_hours : int
         Length of the series. [h]
-    indicators, lm, emc, vtt, isopleth, ashrae, en15757
-        As in :func:`assess` (defaults resolved the same way, unknown keys rejected).
+    indicators, lm, emc, vtt, isopleth, ashrae, en15757, **more
+        As in :func:`assess` (defaults resolved the same way, unknown keys rejected);
+        by default the compiled families only, and a family without a compiled pass is
+        refused by name.
     func : str
         Name used in error messages.
 
@@ -217,10 +222,24 @@ def fused_plan(
         As :func:`assess_batch`: bad options, a series shorter than a year for the
         yearly groups, a moving-average window longer than the series.
     """
-    options = dict(lm=lm, emc=emc, vtt=vtt, isopleth=isopleth, ashrae=ashrae, en15757=en15757)
+    options = dict(
+        lm=lm, emc=emc, vtt=vtt, isopleth=isopleth, ashrae=ashrae, en15757=en15757, **more
+    )
     groups = _resolve_groups(func, indicators)
+    numpy_only = [g for g in groups if g not in _compiled()]
+    if indicators is None:
+        groups = tuple(g for g in groups if g not in numpy_only)
+    elif numpy_only:
+        raise InputError(
+            f"{func}: the indicators {numpy_only} have no compiled pass (numpy only: "
+            f"assess, assess_batch, assess_fused); compiled: {_compiled()}"
+        )
     opts = _resolve_options(func, options)
     return _plan(func, int(n_hours), groups, opts)
+
+
+def _compiled() -> list[str]:
+    return [f.name for f in FAMILIES if f.compiled]
 
 
 @njit(parallel=True, cache=True)
@@ -252,6 +271,7 @@ def assess_fused(
     isopleth=None,
     ashrae=None,
     en15757=None,
+    **more,
 ):
     r"""All indicators for many series at once, one compiled pass per series.
 
@@ -262,7 +282,7 @@ def assess_fused(
         ``RH``. [°C]
     RH : array_like
         Hourly relative humidity, shape (draws, hours), or (hours,) shared. [%]
-    indicators, nan_policy, lm, emc, vtt, isopleth, ashrae, en15757
+    indicators, nan_policy, lm, emc, vtt, isopleth, ashrae, en15757, **more
         As in :func:`assess`.
 
     Returns
@@ -284,7 +304,9 @@ def assess_fused(
     thread, whatever the number of draws.
     """
     func = "assess_fused"
-    options = dict(lm=lm, emc=emc, vtt=vtt, isopleth=isopleth, ashrae=ashrae, en15757=en15757)
+    options = dict(
+        lm=lm, emc=emc, vtt=vtt, isopleth=isopleth, ashrae=ashrae, en15757=en15757, **more
+    )
     h, groups, opts = _prepare_assess(func, T, RH, indicators, nan_policy, options)
     Tc = np.ascontiguousarray(h.T, dtype=float)
     RHc = np.ascontiguousarray(h.RH, dtype=float)
@@ -300,4 +322,10 @@ def assess_fused(
                            **options)  # fmt: skip
         values[redo] = plan.values(ref)
     df = plan.frame(values)
+    for fam in FAMILIES:  # families without a compiled pass: numpy, on the same series
+        if fam.name in groups and not fam.compiled:
+            h = Hourly(T=Tc, RH=RHc, index=None, ndim=2)
+            for key, v in fam.compute(h, opts, nan_policy, None).items():
+                df[key] = v
+                df.attrs["units"][key] = _unit(key)
     return df

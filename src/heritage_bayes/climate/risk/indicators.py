@@ -20,8 +20,8 @@ terms — the groups of :func:`~heritage_bayes.climate.risk.assess`: ``chemical`
 fused pass, the projection and the pages read (through
 :mod:`heritage_bayes.climate.risk.registry`). Adding an indicator to an existing family
 is an entry here (its value in ``compute`` and in the compiled pass); a new family is a
-:class:`Family` appended to :data:`FAMILIES` (the docs' contributor page walks through
-one).
+:class:`Family` added with :func:`heritage_bayes.climate.risk.registry.register` (numpy
+only; the docs' page "Extending the package" walks through one).
 """
 
 from __future__ import annotations
@@ -155,6 +155,11 @@ class Family:
         periodic padding [h] its moving averages need.
     defaults : dict
         Defaults that differ from the target function's (keyword → {option: value}).
+    compiled : bool
+        The compiled pass (:mod:`heritage_bayes.climate.risk._fused`) computes it: the
+        projection and :func:`~heritage_bayes.climate.risk.assess_fused` use the kernel.
+        Otherwise :func:`~heritage_bayes.climate.risk.assess_fused` computes it with
+        ``compute`` and a projection does not offer it.
     """
 
     name: str
@@ -168,6 +173,7 @@ class Family:
     floats: tuple[str, ...] = ()
     plan: Callable = field(default=lambda opts, n, shared: ({}, {}, 0), repr=False)
     defaults: dict = field(default_factory=dict)
+    compiled: bool = False
 
     def option_defaults(self, keyword: str) -> dict:
         """Resolved defaults of the options ``keyword``."""
@@ -240,6 +246,7 @@ def _chem_plan(opts, n, shared):
 
 CHEMICAL = Family(
     name="chemical",
+    compiled=True,
     yearly=True,
     indicators=(
         Indicator(
@@ -291,6 +298,7 @@ def _mech_compute(h, opts, nan_policy, seasonal):
 
 MECHANICAL = Family(
     name="mechanical",
+    compiled=True,
     yearly=False,
     indicators=(
         Indicator(
@@ -356,6 +364,7 @@ def _mould_plan(opts, n, shared):
 
 MOULD = Family(
     name="mould",
+    compiled=True,
     yearly=True,
     indicators=(
         Indicator(
@@ -430,6 +439,7 @@ def _ashrae_plan(opts, n, shared):
 
 ASHRAE = Family(
     name="ashrae",
+    compiled=True,
     yearly=True,
     indicators=(
         Indicator(
@@ -485,6 +495,7 @@ def _en_plan(opts, n, shared):
 
 EN15757 = Family(
     name="en15757",
+    compiled=True,
     yearly=True,
     indicators=(
         Indicator(
@@ -519,8 +530,9 @@ EN15757 = Family(
     plan=_en_plan,
 )  # fmt: skip
 
-#: Every family, in the order of the columns.
-FAMILIES: tuple[Family, ...] = (CHEMICAL, MECHANICAL, MOULD, ASHRAE, EN15757)
+#: Every family, in the order of the columns (:func:`heritage_bayes.climate.risk.registry.register`
+#: appends one).
+FAMILIES: list[Family] = [CHEMICAL, MECHANICAL, MOULD, ASHRAE, EN15757]
 
 #: Indicators of a projection that need a baseline (not computed by ``assess``).
 PROJECTION_INDICATORS = (
@@ -540,10 +552,12 @@ class Layout:
     """Positions of the compiled pass's parameters, derived from :data:`FAMILIES`.
 
     ``ipar``: one switch per family (its name), then each family's ``ints`` as
-    ``"<family>.<name>"``; ``fpar``: each family's ``floats`` the same way.
+    ``"<family>.<name>"``; ``fpar``: each family's ``floats`` the same way (compiled
+    families only).
     """
 
     def __init__(self, families):
+        families = [f for f in families if f.compiled]
         names = [f.name for f in families]
         self.ints = (*names, *(f"{f.name}.{p}" for f in families for p in f.ints))
         self.floats = tuple(f"{f.name}.{p}" for f in families for p in f.floats)

@@ -30,7 +30,12 @@ import re
 from dataclasses import replace
 
 from heritage_bayes.climate.risk._inputs import HOURS_PER_YEAR, MIN_YEAR_HOURS
-from heritage_bayes.climate.risk.indicators import FAMILIES, PROJECTION_INDICATORS, Indicator
+from heritage_bayes.climate.risk.indicators import (
+    FAMILIES,
+    PROJECTION_INDICATORS,
+    Family,
+    Indicator,
+)
 from heritage_bayes.errors import InputError
 
 __all__ = [
@@ -41,7 +46,13 @@ __all__ = [
     "check_indicator_names",
     "complete_year_hours",
     "indicator_info",
+    "register",
+    "unregister",
 ]
+
+
+def _pattern(key: str):
+    return re.compile("^" + r"(.+)".join(map(re.escape, key.split("{}"))) + "$")
 
 
 def _entries() -> dict[str, Indicator]:
@@ -55,11 +66,53 @@ INDICATORS: dict[str, Indicator] = _entries()
 #: prefix, e.g. ``hours_above_LIM``), in registry order.
 ANNUAL: tuple[str, ...] = tuple(i.key.replace("{}", "") for i in INDICATORS.values() if i.per_year)
 #: (pattern, family key) of the parameterised families: ``{}`` matches the parameter.
-_PATTERNS = [
-    (re.compile("^" + r"(.+)".join(map(re.escape, key.split("{}"))) + "$"), key)
-    for key in INDICATORS
-    if "{}" in key
-]
+_PATTERNS = [(_pattern(key), key) for key in INDICATORS if "{}" in key]
+
+
+def register(family: Family) -> None:
+    """Add an indicator family: its columns join :func:`~heritage_bayes.climate.risk.assess`,
+    :func:`~heritage_bayes.climate.risk.assess_batch`,
+    :func:`~heritage_bayes.climate.risk.assess_fused` (with its ``compute``), this
+    registry and the generated reference.
+
+    Raises
+    ------
+    heritage_bayes.errors.InputError
+        A family or option keyword of that name exists already, an indicator key is
+        taken, or the family says it is compiled (the compiled pass is code of
+        :mod:`heritage_bayes.climate.risk._fused`, not registered at run time).
+    """
+    from heritage_bayes.climate.risk.assess import INDICATOR_GROUPS
+
+    taken = {o for f in FAMILIES for o in f.options}
+    clash = [k for k in family.options if k in taken]
+    keys = [i.key for i in family.indicators if i.key in INDICATORS]
+    if family.name in INDICATOR_GROUPS or clash or keys or family.compiled:
+        raise InputError(
+            f"register: family {family.name!r} clashes with the registry (known families "
+            f"{list(INDICATOR_GROUPS)}, option keywords taken {clash}, keys taken {keys}, "
+            f"compiled {family.compiled}: a compiled family is part of the compiled pass)"
+        )
+    FAMILIES.append(family)
+    INDICATOR_GROUPS[family.name] = family.yearly
+    for i in family.indicators:
+        INDICATORS[i.key] = i
+        if "{}" in i.key:
+            _PATTERNS.append((_pattern(i.key), i.key))
+
+
+def unregister(name: str) -> None:
+    """Remove a family added by :func:`register` (the built-in ones stay)."""
+    from heritage_bayes.climate.risk.assess import INDICATOR_GROUPS
+
+    fam = next((f for f in FAMILIES if f.name == name and not f.compiled), None)
+    if fam is None:
+        raise InputError(f"unregister: no registered family {name!r}")
+    FAMILIES.remove(fam)
+    del INDICATOR_GROUPS[name]
+    for i in fam.indicators:
+        del INDICATORS[i.key]
+    _PATTERNS[:] = [(p, k) for p, k in _PATTERNS if k in INDICATORS]
 
 
 def indicator_info(key: str) -> Indicator:

@@ -100,6 +100,9 @@ class Indicator:
         (:func:`heritage_bayes.projection._stream.annual_values`).
     rating : callable or None
         value → rating on the field's published scale (``""`` where none applies).
+    headline : int
+        Place among the key indicators of a projection's figures and first screen
+        (1 first; 0: not among them).
     """
 
     key: str
@@ -113,6 +116,7 @@ class Indicator:
     annual: bool = True
     per_year: bool = field(default=False, compare=False)
     rating: Callable[[float], str] | None = field(default=None, compare=False, repr=False)
+    headline: int = field(default=0, compare=False)
 
     def label(self) -> str:
         """``name [unit]`` (the unit left out for dimensionless ``-``)."""
@@ -121,7 +125,7 @@ class Indicator:
     def as_dict(self) -> dict:
         """JSON-ready entry (the descriptive fields)."""
         d = asdict(self)
-        del d["per_year"], d["rating"]
+        del d["per_year"], d["rating"], d["headline"]
         return d
 
 
@@ -261,7 +265,7 @@ CHEMICAL = Family(
             "Harmonic mean over the hours of the preservation index PI(T, RH) of "
             "cellulose-acetate/paper (IPI); < 45 years rated 'risk', ≥ 75 'good'.",
             "Sebera (1994) Isoperms; Reilly, Nishimura & Zinn (1995) New Tools for Preservation",
-            _YEARS, -1, "chemical", per_year=True,
+            _YEARS, -1, "chemical", per_year=True, headline=1,
             rating=_scale((lambda v: v >= 75.0, "good"), (lambda v: v >= 45.0, "OK"), last="risk"),
         ),
         Indicator(
@@ -270,7 +274,7 @@ CHEMICAL = Family(
             "ISO 9223 (categories τ1 ≤ 10, τ2 ≤ 250, τ3 ≤ 2500, τ4 ≤ 5500, τ5 > 5500 "
             "h/year).",
             "ISO 9223:2012 (annex C, time of wetness)", _YEARS, 1, "chemical",
-            per_year=True, rating=_TOW,
+            per_year=True, rating=_TOW, headline=2,
         ),
     ),
     options={"lm": twlm},
@@ -316,7 +320,7 @@ MECHANICAL = Family(
         Indicator(
             "emc_range", "Range of wood moisture content", "% MC",
             "Maximum minus minimum EMC over the period.", _HH, _SERIES, 1, "mechanical",
-            annual=False,
+            annual=False, headline=5,
         ),
         Indicator(
             "dimensional_change", "Dimensional change of wood (tangential)", "%",
@@ -372,7 +376,7 @@ MOULD = Family(
             "Maximum of the VTT mould index M (0 no growth, 1 microscopic, 3 visible) "
             "over the period; ≥ 1 rated 'risk'.",
             "Hukka & Viitanen (1999) doi:10.1007/s002260050131; Ojanen et al. (2010)",
-            _SERIES, 1, "mould", annual=False,
+            _SERIES, 1, "mould", annual=False, headline=3,
             rating=_scale((lambda v: v < 1.0, "good"), last="risk"),
         ),
         Indicator(
@@ -380,7 +384,7 @@ MOULD = Family(
             "Hours per year with RH above the lowest isopleth for mould growth at the "
             "hour's temperature.",
             "Sedlbauer (2001); Zeng et al. (2023) doi:10.1177/01436244221137846", _YEARS, 1,
-            "mould", per_year=True,
+            "mould", per_year=True, headline=4,
         ),
     ),
     options={"vtt": vtt_mould_index, "isopleth": hours_above_isopleth},
@@ -543,7 +547,7 @@ PROJECTION_INDICATORS = (
         "by hour of the year) plus its 7th/93rd percentile offsets (at least the "
         "minimum band), both from the same posterior draw's baseline simulation.",
         "EN 15757:2010, clause 5 (historical climate as the target)", _YEARS, 1, "projection",
-        per_year=True,
+        per_year=True, headline=6,
     ),
 )  # fmt: skip
 

@@ -45,6 +45,7 @@ __all__ = [
     "as_markdown",
     "check_indicator_names",
     "complete_year_hours",
+    "headline_indicators",
     "indicator_info",
     "register",
     "unregister",
@@ -141,6 +142,24 @@ def indicator_info(key: str) -> Indicator:
             base = INDICATORS[fam]
             return replace(base, key=key, name=base.name.format(m.group(1)))
     raise InputError(f"unknown indicator {key!r}; known: {', '.join(INDICATORS)}")
+
+
+def headline_indicators() -> tuple[str, ...]:
+    """The key indicators of a projection's figures and first screen, in their order
+    (``Indicator.headline``): parameterised ones by their column under the default
+    options (e.g. ``hours_above_LIM0``)."""
+    from heritage_bayes.climate.risk.assess import _resolve_options
+
+    opts = _resolve_options("headline_indicators", {})
+    default_cols = [c for f in FAMILIES for c in f.columns(opts)]
+    out = []
+    for i in sorted((i for i in INDICATORS.values() if i.headline), key=lambda i: i.headline):
+        if "{}" in i.key:
+            pat = _pattern(i.key)
+            out += [c for c in default_cols if pat.match(c)][:1]
+        else:
+            out.append(i.key)
+    return tuple(out)
 
 
 def check_indicator_names(names, available, where: str) -> None:

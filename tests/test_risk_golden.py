@@ -102,27 +102,16 @@ def outputs_fused() -> dict[str, str]:
 
 def outputs_projection() -> dict[str, str]:
     import heritage_bayes as hb
-    from heritage_bayes.demo import TRUE_HYGRIC, TRUE_THERMAL, _inputs
-    from heritage_bayes.inference.likelihoods import get_noise_model
+    from heritage_bayes.demo import _inputs
     from heritage_bayes.projection import engine
-    from heritage_bayes.projection.engine import Draws
+    from test_projection_stream import demo_draws
 
     models = {"thermal": hb.model("thermal_2c"), "hygric": hb.model("hygric_2c")}
     run = SimpleNamespace(models=models, summary={"dt": 3600.0, "init_steps": 720}, path="t")
     _, inp, _, _, _ = _inputs("greensboro_tmy3")  # 8759 h
     warm = inp.copy()
     warm[["Te", "Tf"]] += 3.0
-    rng = np.random.default_rng(0)
-    K = 4
-    truth = {"thermal": TRUE_THERMAL, "hygric": TRUE_HYGRIC}
-    model, noise, nms = {}, {}, {}
-    for s, m in models.items():
-        jit = {p: truth[s][p] * np.exp(rng.normal(0, 0.05, K)) for p in m.parameter_names}
-        model[s], _ = m.param_array(jit)
-        sig = (0.3, 30.0)[s == "hygric"]
-        noise[s] = np.column_stack([sig * np.exp(rng.normal(0, 0.1, K)), np.full(K, 0.9)])
-        nms[s] = get_noise_model("ar1")
-    draws = Draws(index=np.arange(K), model=model, noise=noise, noise_models=nms)
+    draws = demo_draws(models, 4)
     got = engine.simulate_cases(run, draws, [inp, warm], seed=4, chunk=2)
     out = {}
     for i, g in enumerate(got):

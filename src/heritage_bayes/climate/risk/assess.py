@@ -10,7 +10,6 @@ with units and IPI-style ratings.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
 
 import numpy as np
 import pandas as pd
@@ -22,47 +21,14 @@ from heritage_bayes.climate.risk._inputs import (
     hourly,
 )
 from heritage_bayes.climate.risk.indicators import FAMILIES, shared_seasonal
+from heritage_bayes.climate.risk.registry import (
+    INDICATOR_GROUPS,
+    complete_year_hours,
+    indicator_info,
+    resolve_options,
+)
 from heritage_bayes.climate.risk.standards import _window_half
 from heritage_bayes.errors import InputError
-
-#: Indicator groups of :func:`assess` (the families of
-#: :mod:`~heritage_bayes.climate.risk.indicators`); those marked True need at least a
-#: year of data.
-INDICATOR_GROUPS = {f.name: f.yearly for f in FAMILIES}
-
-
-def _resolve_options(func, given: Mapping[str, Mapping | None]):
-    """Merge user options with the defaults of each family's target function; reject
-    unknowns; then let each family check its own."""
-    known = [k for fam in FAMILIES for k in fam.options]
-    unknown = [k for k in given if k not in known]
-    if unknown:
-        raise InputError(
-            f"{func}: unknown option group(s) {unknown}; expected some of {known} (the "
-            "option keywords of the indicator families)"
-        )
-    opts = {}
-    for fam in FAMILIES:
-        for key, target in fam.options.items():
-            d = fam.option_defaults(key)
-            fname = target.__name__
-            user = given.get(key) or {}
-            if not isinstance(user, Mapping):
-                raise InputError(
-                    f"{func}: {key} must be a dict of options for {fname}(); got "
-                    f"{type(user).__name__}"
-                )
-            unknown = sorted(set(user) - set(d))
-            if unknown:
-                raise InputError(
-                    f"{func}: unknown option(s) {unknown} in {key}=...; expected some of "
-                    f"{sorted(d)} (the keywords of {fname}())"
-                )
-            d.update(user)
-            opts[key] = d
-    for fam in FAMILIES:  # validate each family's options once, before any work
-        fam.check(func, opts)
-    return opts
 
 
 def _resolve_groups(func, indicators):
@@ -106,15 +72,11 @@ def _assess_core(h: Hourly, groups, opts, nan_policy) -> dict[str, np.ndarray]:
 
 
 def _unit(name: str) -> str:
-    from heritage_bayes.climate.risk.registry import indicator_info
-
     return indicator_info(name).unit
 
 
 def _rating(name: str, v) -> str:
     """Rating of one indicator value on its published scale ('' where none applies)."""
-    from heritage_bayes.climate.risk.registry import indicator_info
-
     if v is None or (isinstance(v, float) and math.isnan(v)):
         return ""
     rate = indicator_info(name).rating
@@ -128,10 +90,8 @@ def _prepare_assess(func, T, RH, indicators, nan_policy, options):
     (:func:`~heritage_bayes.climate.risk.registry.complete_year_hours`): the hours after
     the last complete year are not used (``Hourly.dropped`` counts them).
     """
-    from heritage_bayes.climate.risk.registry import complete_year_hours
-
     groups = _resolve_groups(func, indicators)
-    opts = _resolve_options(func, options)
+    opts = resolve_options(func, options)
     h = hourly(func, T=T, RH=RH, nan_policy=nan_policy)
     _check_year(func, groups, h.n_hours)
     n = complete_year_hours(h.n_hours)

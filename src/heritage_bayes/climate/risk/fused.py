@@ -41,12 +41,12 @@ from heritage_bayes.climate.risk.assess import (
     _check_year,
     _prepare_assess,
     _resolve_groups,
-    _resolve_options,
     _unit,
     assess_batch,
 )
 from heritage_bayes.climate.risk.chemical import R_GAS
 from heritage_bayes.climate.risk.indicators import FAMILIES, LAYOUT, shared_seasonal
+from heritage_bayes.climate.risk.registry import resolve_options
 from heritage_bayes.climate.risk.standards import _window_half
 from heritage_bayes.errors import InputError
 
@@ -234,7 +234,7 @@ def fused_plan(
             f"{func}: the indicators {numpy_only} have no compiled pass (numpy only: "
             f"assess, assess_batch, assess_fused); compiled: {_compiled()}"
         )
-    opts = _resolve_options(func, options)
+    opts = resolve_options(func, options)
     return _plan(func, int(n_hours), groups, opts)
 
 

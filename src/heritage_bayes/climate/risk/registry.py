@@ -27,6 +27,7 @@ unit the scale of a difference.
 from __future__ import annotations
 
 import re
+from collections.abc import Mapping
 from dataclasses import replace
 
 from heritage_bayes.climate.risk._inputs import HOURS_PER_YEAR, MIN_YEAR_HOURS
@@ -41,6 +42,7 @@ from heritage_bayes.errors import InputError
 __all__ = [
     "ANNUAL",
     "INDICATORS",
+    "INDICATOR_GROUPS",
     "Indicator",
     "as_markdown",
     "check_indicator_names",
@@ -48,6 +50,7 @@ __all__ = [
     "headline_indicators",
     "indicator_info",
     "register",
+    "resolve_options",
     "unregister",
 ]
 
@@ -63,6 +66,48 @@ def _entries() -> dict[str, Indicator]:
 
 #: Every indicator family by key (parameterised ones with ``{}``).
 INDICATORS: dict[str, Indicator] = _entries()
+#: Indicator groups of :func:`~heritage_bayes.climate.risk.assess` (the families of
+#: :mod:`~heritage_bayes.climate.risk.indicators`); those marked True need at least a
+#: year of data.
+INDICATOR_GROUPS = {f.name: f.yearly for f in FAMILIES}
+
+
+def resolve_options(func, given: Mapping[str, Mapping | None]):
+    """The options of every family: the user's (``given``: option keyword → dict or None)
+    merged with the defaults of each family's target function, unknown keywords and keys
+    refused (:class:`~heritage_bayes.errors.InputError` naming ``func``), then checked by
+    each family."""
+    known = [k for fam in FAMILIES for k in fam.options]
+    unknown = [k for k in given if k not in known]
+    if unknown:
+        raise InputError(
+            f"{func}: unknown option group(s) {unknown}; expected some of {known} (the "
+            "option keywords of the indicator families)"
+        )
+    opts = {}
+    for fam in FAMILIES:
+        for key, target in fam.options.items():
+            d = fam.option_defaults(key)
+            fname = target.__name__
+            user = given.get(key) or {}
+            if not isinstance(user, Mapping):
+                raise InputError(
+                    f"{func}: {key} must be a dict of options for {fname}(); got "
+                    f"{type(user).__name__}"
+                )
+            unknown = sorted(set(user) - set(d))
+            if unknown:
+                raise InputError(
+                    f"{func}: unknown option(s) {unknown} in {key}=...; expected some of "
+                    f"{sorted(d)} (the keywords of {fname}())"
+                )
+            d.update(user)
+            opts[key] = d
+    for fam in FAMILIES:  # validate each family's options once, before any work
+        fam.check(func, opts)
+    return opts
+
+
 #: Columns the projection also reports per complete year (a parameterised family by its
 #: prefix, e.g. ``hours_above_LIM``), in registry order.
 ANNUAL: tuple[str, ...] = tuple(i.key.replace("{}", "") for i in INDICATORS.values() if i.per_year)
@@ -83,8 +128,6 @@ def register(family: Family) -> None:
         taken, or the family says it is compiled (the compiled pass is code of
         :mod:`heritage_bayes.climate.risk._fused`, not registered at run time).
     """
-    from heritage_bayes.climate.risk.assess import INDICATOR_GROUPS
-
     taken = {o for f in FAMILIES for o in f.options}
     clash = [k for k in family.options if k in taken]
     keys = [i.key for i in family.indicators if i.key in INDICATORS]
@@ -104,8 +147,6 @@ def register(family: Family) -> None:
 
 def unregister(name: str) -> None:
     """Remove a family added by :func:`register` (the built-in ones stay)."""
-    from heritage_bayes.climate.risk.assess import INDICATOR_GROUPS
-
     fam = next((f for f in FAMILIES if f.name == name and not f.compiled), None)
     if fam is None:
         raise InputError(f"unregister: no registered family {name!r}")
@@ -148,9 +189,7 @@ def headline_indicators() -> tuple[str, ...]:
     """The key indicators of a projection's figures and first screen, in their order
     (``Indicator.headline``): parameterised ones by their column under the default
     options (e.g. ``hours_above_LIM0``)."""
-    from heritage_bayes.climate.risk.assess import _resolve_options
-
-    opts = _resolve_options("headline_indicators", {})
+    opts = resolve_options("headline_indicators", {})
     default_cols = [c for f in FAMILIES for c in f.columns(opts)]
     out = []
     for i in sorted((i for i in INDICATORS.values() if i.headline), key=lambda i: i.headline):

@@ -34,6 +34,7 @@ from heritage_bayes.climate.risk._fused import (
     lim_rh,
     pairwise_sum,
     series_indicators,
+    wet,
 )
 from heritage_bayes.climate.risk.registry import ANNUAL
 from heritage_bayes.rc import control as _control
@@ -193,7 +194,7 @@ def annual_values(T, RH, N, hoy, mode, en, band, out, ma, cnt):  # pragma: no co
     w = np.empty(BLOCK)
     for y in range(ny):
         inv_pi_sum = 0.0
-        wet = 0
+        n_wet = 0
         lim = 0
         out_band = 0
         for b0 in range(y * L, (y + 1) * L, BLOCK):  # blocks: the loops vectorise
@@ -206,7 +207,7 @@ def annual_values(T, RH, N, hoy, mode, en, band, out, ma, cnt):  # pragma: no co
                 w[t] = inv_pi(1.0 / (x + 273.15), r)
             inv_pi_sum += _bsum(w, m)
             for t in range(m):  # ISO 9223 time of wetness
-                wet += 1 if (RHb[t] > 80.0) and (Tb[t] > 0.0) else 0
+                n_wet += wet(Tb[t], RHb[t])
             if has_lim:
                 for t in range(m):  # lowest isopleth for mould (biological._lim)
                     lim += 1 if RHb[t] > lim_rh(Tb[t], limc) else 0
@@ -217,7 +218,7 @@ def annual_values(T, RH, N, hoy, mode, en, band, out, ma, cnt):  # pragma: no co
                     r = RHb[t]
                     out_band += 1 if (r < c + lo_off) or (r > c + hi_off) else 0
         out[y, A_TWPI] = L / inv_pi_sum
-        out[y, A_TOW] = wet / L * 8760.0
+        out[y, A_TOW] = n_wet / L * 8760.0
         out[y, A_LIM] = lim / L * 8760.0 if has_lim else math.nan
         out[y, A_BAND] = 100.0 * out_band / L if mode != 0 else math.nan
 

@@ -101,6 +101,12 @@ def inv_pi(inv_TK, r):  # pragma: no cover - compiled
 
 
 @njit(inline="always", cache=True, error_model="numpy")
+def wet(x, r):  # pragma: no cover - compiled
+    """1 for an hour of ISO 9223 time of wetness (RH > 80 % and T > 0 °C), else 0."""
+    return 1 if (r > 80.0) and (x > 0.0) else 0
+
+
+@njit(inline="always", cache=True, error_model="numpy")
 def lim_rh(x, c):  # pragma: no cover - compiled
     """The lowest isopleth for mould [%] at ``x`` [°C] (``biological._lim``, constant
     ``c`` of the growth rate)."""
@@ -133,10 +139,10 @@ def _pointwise(T, RH, b0, m, fpar, ipar, ea_r, tmp, sums):  # pragma: no cover -
             lr[t] = n_exp * (log_ref - vlog(r))  # n log(RH_ref / RH)
             w[t] = inv_pi(inv_TK, r)
         sums[nea] += _bsum(w, m)
-        wet = 0
-        for t in range(m):  # ISO 9223 time of wetness: RH > 80 % and T > 0 °C
-            wet += 1 if (RHb[t] > 80.0) and (Tb[t] > 0.0) else 0
-        sums[nea + 4] += wet
+        n_wet = 0
+        for t in range(m):  # ISO 9223 time of wetness
+            n_wet += wet(Tb[t], RHb[t])
+        sums[nea + 4] += n_wet
         for k in range(nea):
             e = ea_r[k]
             for t in range(m):

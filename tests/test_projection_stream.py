@@ -45,8 +45,12 @@ def setup():
     two.index = pd.date_range(inp.index[0], periods=len(two), freq="h")
     warm = two.copy()
     warm[["Te", "Tf"]] += 3.0
+    return run, demo_draws(models, 7), [two, warm]
+
+
+def demo_draws(models, K: int) -> Draws:
+    """``K`` seeded draws around the demo's true parameters, AR(1) noise."""
     rng = np.random.default_rng(0)
-    K = 7
     truth = {"thermal": TRUE_THERMAL, "hygric": TRUE_HYGRIC}
     model, noise, nms = {}, {}, {}
     for s, m in models.items():
@@ -55,8 +59,7 @@ def setup():
         sig = (0.3, 30.0)[s == "hygric"]
         noise[s] = np.column_stack([sig * np.exp(rng.normal(0, 0.1, K)), np.full(K, 0.9)])
         nms[s] = get_noise_model("ar1")
-    draws = Draws(index=np.arange(K), model=model, noise=noise, noise_models=nms)
-    return run, draws, [two, warm]
+    return Draws(index=np.arange(K), model=model, noise=noise, noise_models=nms)
 
 
 def reference(run, draws, inputs, noise=True):

@@ -25,9 +25,18 @@ import numpy as np
 from numba import njit, prange
 
 from heritage_bayes.climate import _vecmath
-from heritage_bayes.climate._vecmath import psat_water, stamp_cache, vcosh, vexp
-from heritage_bayes.climate.risk import _fused
-from heritage_bayes.climate.risk._fused import BLOCK, _bsum, pairwise_sum, series_indicators
+from heritage_bayes.climate._vecmath import psat_water, stamp_cache
+from heritage_bayes.climate.risk import _fused, _sums, _vtt, indicators
+from heritage_bayes.climate.risk._fused import (
+    BLOCK,
+    _bsum,
+    inv_pi,
+    lim_rh,
+    pairwise_sum,
+    series_indicators,
+    wet,
+)
+from heritage_bayes.climate.risk.registry import ANNUAL
 from heritage_bayes.rc import control as _control
 from heritage_bayes.rc.control import coupled_draw
 
@@ -97,8 +106,11 @@ def _monthly(x, starts, out):  # pragma: no cover - compiled
         out[j] = (x[a] + pairwise_sum(x, a + 1, b - a - 1)) / (b - a)
 
 
-#: Per-year columns of :func:`annual_values` (index in its ``out`` rows).
-ANNUAL = ("twpi", "time_of_wetness", "hours_above_LIM", "en15757_outside_baseline")
+#: Per-year columns of :func:`annual_values` (index in its ``out`` rows): the registry's
+#: ``per_year`` indicators (:data:`heritage_bayes.climate.risk.registry.ANNUAL`).
+A_TWPI, A_TOW, A_LIM, A_BAND = (ANNUAL.index(k) for k in ("twpi", "time_of_wetness",
+                                                          "hours_above_LIM",
+                                                          "en15757_outside_baseline"))  # fmt: skip
 #: Hour-of-year bins of the baseline seasonal cycle (365 days × 24 h; 29 February is
 #: read as 28 February).
 HOY = 8760
@@ -181,8 +193,8 @@ def annual_values(T, RH, N, hoy, mode, en, band, out, ma, cnt):  # pragma: no co
     hi_off = band[HOY + 1] if mode != 0 else 0.0
     w = np.empty(BLOCK)
     for y in range(ny):
-        inv_pi = 0.0
-        wet = 0
+        inv_pi_sum = 0.0
+        n_wet = 0
         lim = 0
         out_band = 0
         for b0 in range(y * L, (y + 1) * L, BLOCK):  # blocks: the loops vectorise
@@ -192,26 +204,23 @@ def annual_values(T, RH, N, hoy, mode, en, band, out, ma, cnt):  # pragma: no co
             for t in range(m):  # 1 / PI (chemical._pi), as in the fused pass
                 x = Tb[t]
                 r = RHb[t]
-                w[t] = 365.0 * vexp(
-                    -((95220.0 - 134.9 * r) * (1.0 / (x + 273.15) / 8.314) + 0.0284 * r - 28.023)
-                )
-            inv_pi += _bsum(w, m)
+                w[t] = inv_pi(1.0 / (x + 273.15), r)
+            inv_pi_sum += _bsum(w, m)
             for t in range(m):  # ISO 9223 time of wetness
-                wet += 1 if (RHb[t] > 80.0) and (Tb[t] > 0.0) else 0
+                n_wet += wet(Tb[t], RHb[t])
             if has_lim:
                 for t in range(m):  # lowest isopleth for mould (biological._lim)
-                    lim_t = 100.0 * (0.02633 * vcosh(0.10083 * (Tb[t] - 30.0)) + limc)
-                    lim += 1 if RHb[t] > lim_t else 0
+                    lim += 1 if RHb[t] > lim_rh(Tb[t], limc) else 0
             if mode != 0:
                 hb = hoy[b0 : b0 + m]
                 for t in range(m):
                     c = band[hb[t]]
                     r = RHb[t]
                     out_band += 1 if (r < c + lo_off) or (r > c + hi_off) else 0
-        out[y, 0] = L / inv_pi
-        out[y, 1] = wet / L * 8760.0
-        out[y, 2] = lim / L * 8760.0 if has_lim else math.nan
-        out[y, 3] = 100.0 * out_band / L if mode != 0 else math.nan
+        out[y, A_TWPI] = L / inv_pi_sum
+        out[y, A_TOW] = n_wet / L * 8760.0
+        out[y, A_LIM] = lim / L * 8760.0 if has_lim else math.nan
+        out[y, A_BAND] = 100.0 * out_band / L if mode != 0 else math.nan
 
 
 @njit(cache=True, error_model="numpy")
@@ -326,4 +335,4 @@ def chunk_kernel(
             _monthly(RHx, starts, RHm[i])
 
 
-stamp_cache(globals(), _fused, _vecmath, _control)
+stamp_cache(globals(), _fused, _vecmath, _control, _sums, _vtt, indicators)

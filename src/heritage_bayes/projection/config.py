@@ -87,6 +87,7 @@ from typing import Any, Literal
 from pydantic import Field, ValidationError, field_validator, model_validator
 
 from heritage_bayes.climate.morph import KNMI14_SCENARIOS
+from heritage_bayes.climate.risk.indicators import FAMILIES
 from heritage_bayes.config import (
     MAX_SEED,
     GroundTemperature,
@@ -150,10 +151,14 @@ class FutureFile(_Strict):
     weather: Source
 
 
+#: The indicator groups a projection computes (the compiled families).
+_GROUPS = tuple(f.name for f in FAMILIES if f.compiled)
+
+
 class RiskOptions(_Strict):
     """Options of :func:`heritage_bayes.climate.risk.assess_batch` (see there)."""
 
-    indicators: list[Literal["chemical", "mechanical", "mould", "ashrae", "en15757"]] | None = None
+    indicators: list[Literal[_GROUPS]] | None = None
     chunk_draws: int = Field(default=50, ge=1, description="draws simulated together")
 
 

@@ -229,7 +229,7 @@ def simulate_cases(
     -------
     list of CaseResult
         In the order of ``inputs``, with the per-complete-year values of
-        :data:`heritage_bayes.projection._stream.ANNUAL` (``annual_*``) and, when the
+        :data:`heritage_bayes.climate.risk.registry.ANNUAL` (``annual_*``) and, when the
         EN 15757 group is computed and ``baseline``, the column
         ``en15757_outside_baseline`` (mean over the years). ``seconds``: ``simulate``
         (modal forms, and
@@ -410,15 +410,14 @@ class _Case:
 
     def en_params(self) -> tuple[np.ndarray, int]:
         """(en, en_col) of :func:`heritage_bayes.projection._stream.chunk_kernel`."""
-        from heritage_bayes.climate.risk import _fused as k
+        from heritage_bayes.climate.risk.indicators import LAYOUT as L
 
         _, fpar, ipar, _, _ = self.plan.arrays
         cols = self.plan.columns
         en_col = cols.index("en15757_lower_offset") if "en15757_lower_offset" in cols else -1
-        shared = ipar[k.I_SHARED] != 0
-        half = ipar[k.I_HALF_A] if shared else ipar[k.I_HALF_E]
-        wrap = ipar[k.I_WRAP_A] if shared else ipar[k.I_WRAP_E]
-        limc = fpar[k.F_LIMC] if ipar[k.I_MOULD] else np.nan
+        fam = "ashrae" if ipar[L.i("en15757.shared")] != 0 else "en15757"
+        half, wrap = ipar[L.i(f"{fam}.half")], ipar[L.i(f"{fam}.wrap")]
+        limc = fpar[L.f("mould.lim_c")] if ipar[L.i("mould")] else np.nan
         return np.array([self.mode, half, wrap, 0.0, 0.0, limc], float), en_col
 
 
@@ -462,7 +461,7 @@ class _CaseOut:
         )
 
     def result(self, c: _Case, measure=None, dt: float = 3600.0, years: float = 1.0) -> CaseResult:
-        from heritage_bayes.projection._stream import ANNUAL
+        from heritage_bayes.projection._stream import A_BAND, ANNUAL
 
         names = tuple(ANNUAL)
         if "hours_above_LIM" in names:  # the isopleth's own column name
@@ -473,7 +472,7 @@ class _CaseOut:
             df = c.plan.frame(vals)
             if c.mode and "en15757_lower_offset" in df.columns:
                 pos = list(df.columns).index("en15757_upper_offset") + 1
-                df.insert(pos, "en15757_outside_baseline", ann[:, :, 3].mean(axis=1))
+                df.insert(pos, "en15757_outside_baseline", ann[:, :, A_BAND].mean(axis=1))
                 df.attrs["units"]["en15757_outside_baseline"] = "% of hours"
             frames.append(df)
         return CaseResult(

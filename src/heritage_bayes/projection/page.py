@@ -28,19 +28,13 @@ from html import escape
 
 import numpy as np
 
-from heritage_bayes.climate.risk.registry import indicator_info
+from heritage_bayes.climate.risk.registry import headline_indicators, indicator_info
 from heritage_bayes.format import fmt, fmt_interval_html, fmt_pct, prose_html
 from heritage_bayes.report.figures.style import RC_PARAMS, _figure, to_png_uri
 
-#: Indicators drawn in the figures (when computed), in this order.
-KEY_INDICATORS = (
-    "twpi",
-    "time_of_wetness",
-    "vtt_mould_index_max",
-    "hours_above_LIM0",
-    "emc_range",
-    "en15757_outside_baseline",
-)
+#: Indicators drawn in the figures (when computed), in this order (the registry's
+#: ``headline`` entries).
+KEY_INDICATORS = headline_indicators()
 _CASE_COLOURS = ("#222222", "#1f5fa8", "#2e8b57", "#e08a00", "#c0392b", "#7b3fa0", "#8c564b",
                  "#17becf", "#bcbd22", "#e377c2")  # fmt: skip
 _COMPONENT_COLOURS = {"parameter": "#1f5fa8", "noise": "#9aa5b1", "weather_year": "#2e8b57",

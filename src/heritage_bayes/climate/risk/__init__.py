@@ -42,8 +42,11 @@ Layout (one module per mechanism, :func:`assess` on top; every name below is imp
 from this package): :mod:`~heritage_bayes.climate.risk.chemical`,
 :mod:`~heritage_bayes.climate.risk.mechanical`, :mod:`~heritage_bayes.climate.risk.biological`,
 :mod:`~heritage_bayes.climate.risk.standards` and :mod:`~heritage_bayes.climate.risk.assess`;
-input checking in ``_inputs``, the compiled VTT recursion in ``_vtt``, the fused pass in
-:mod:`~heritage_bayes.climate.risk.fused` (kernel in ``_fused``).
+one object per indicator family (its registry entries, options, numpy computation and
+compiled parameters) in :mod:`~heritage_bayes.climate.risk.indicators`, gathered by
+:mod:`~heritage_bayes.climate.risk.registry`; input checking in ``_inputs``, the VTT
+recursion (once) in ``_vtt``, the fused pass in :mod:`~heritage_bayes.climate.risk.fused`
+(kernel in ``_fused``, sums in ``_sums``).
 
 Where the formulas or limits were not read in a primary source (ASHRAE compliance
 algorithm and table, EN 15757 minimum band), the function says so and the choice is a

@@ -23,11 +23,13 @@ Bit for bit the same as numpy: the moving averages (sequential cumulative sums, 
 and EN 15757 comparisons, the EMC, the VTT recursion and the percentiles (exact order
 statistics found by a histogram of the values, then numpy's linear interpolation).
 
-Why one module: :func:`series_indicators` and its block helpers are one compiled
-algorithm over shared parameter layouts (the ``I_``/``F_``/``C_`` indices of the plan's
-arrays), and numba caches a compiled function by its own source file: a helper moved to
-another file is a dependency whose edits the cache of this one would not see (see
-:func:`heritage_bayes.climate._vecmath.stamp_cache`).
+Layout: :func:`series_indicators` and its block helpers are one compiled algorithm over
+the plan's parameter arrays, whose positions (the ``I_``/``F_`` names below) are derived
+from the parameter names each family of :mod:`heritage_bayes.climate.risk.indicators`
+declares (:data:`~heritage_bayes.climate.risk.indicators.LAYOUT`). The VTT recursion is
+:func:`heritage_bayes.climate.risk._vtt.vtt_hours`, the sums are in ``_sums``. numba
+caches a compiled function by its own source file, so this module's cache is stamped
+with the files it reads (:func:`heritage_bayes.climate._vecmath.stamp_cache`).
 """
 
 from __future__ import annotations
@@ -39,6 +41,10 @@ from numba import njit
 
 from heritage_bayes.climate import _vecmath
 from heritage_bayes.climate._vecmath import stamp_cache, vcosh, vexp, vlog
+from heritage_bayes.climate.risk import _sums, _vtt, indicators
+from heritage_bayes.climate.risk._sums import _bminmax, _bsum, pairwise_sum
+from heritage_bayes.climate.risk._vtt import vtt_hours
+from heritage_bayes.climate.risk.indicators import LAYOUT
 
 #: Hours processed together by the vectorised loops.
 BLOCK = 512
@@ -47,116 +53,29 @@ N_BINS = 4096
 _EPS = 1e-9  # as heritage_bayes.climate.risk.standards._EPS (tolerance on limits)
 _T0 = 273.15
 
-# integer parameters (ipar)
-(I_CHEM, I_MECH, I_MOULD, I_ASHRAE, I_EN, I_NEA, I_HALF_A, I_WRAP_A, I_HALF_E, I_WRAP_E,
- I_SHARED, I_METHOD, I_NESTED, I_NCLS, I_EN_WIDTH, I_FROZEN, I_HAS_TSP,
- I_HAS_RHSP) = range(18)  # fmt: skip
-N_IPAR = 18
-# float parameters (fpar)
-(F_TREF_INV, F_RHREF, F_N, F_COEF, F_K1LO, F_K1HI, F_A, F_B, F_C, F_RHMIN, F_CMAT, F_W,
- F_SQ, F_M0, F_LIMC, F_THR, F_TSP, F_RHSP, F_QLO, F_QHI, F_MINBAND) = range(21)  # fmt: skip
-N_FPAR = 21
+# positions in the parameter arrays, derived from the families' parameter names
+_L = LAYOUT
+I_CHEM, I_MECH, I_MOULD, I_ASHRAE, I_EN = (_L.i(f) for f in ("chemical", "mechanical", "mould",
+                                                             "ashrae", "en15757"))  # fmt: skip
+I_NEA = _L.i("chemical.nea")
+I_FROZEN = _L.i("mould.frozen_decline")
+I_HALF_A, I_WRAP_A, I_METHOD, I_NESTED, I_NCLS, I_HAS_TSP, I_HAS_RHSP = (
+    _L.i(f"ashrae.{p}") for p in ("half", "wrap", "setpoint", "nested", "n_classes",
+                                  "has_T_setpoint", "has_RH_setpoint")
+)  # fmt: skip
+I_HALF_E, I_WRAP_E, I_SHARED, I_EN_WIDTH = (
+    _L.i(f"en15757.{p}") for p in ("half", "wrap", "shared", "width")
+)
+F_TREF_INV, F_RHREF, F_N = (_L.f(f"chemical.{p}") for p in ("tref_inv", "rh_ref", "n"))
+F_COEF = _L.f("mechanical.coefficient")
+F_VTT, F_M0, F_LIMC = _L.f("mould.k1_lo"), _L.f("mould.M0"), _L.f("mould.lim_c")
+F_THR, F_TSP, F_RHSP = (_L.f(f"ashrae.{p}") for p in ("threshold", "T_setpoint", "RH_setpoint"))
+F_QLO, F_QHI, F_MINBAND = (_L.f(f"en15757.{p}") for p in ("q_lo", "q_hi", "min_band"))
 # columns of the class table (cls): raw ClimateClass values, NaN for None
 C_TS, C_TDOWN, C_TUP, C_TSMAX, C_TMAX, C_RS, C_RDOWN, C_RUP, C_RLO, C_RHI = range(10)
 N_CLS = 10
 # kinds of set-point check (see standards._setpoint_ok)
 K_NONE, K_MEAN, K_SEASON, K_SETPOINT = range(4)
-
-
-@njit(cache=True, error_model="numpy")
-def _pairwise_leaf(a, lo, n):  # pragma: no cover - compiled
-    """numpy's pairwise summation of ``a[lo:lo + n]`` for ``n <= 128`` (no split)."""
-    if n < 8:
-        res = 0.0
-        for i in range(n):
-            res += a[lo + i]
-        return res
-    r0, r1, r2, r3 = a[lo], a[lo + 1], a[lo + 2], a[lo + 3]
-    r4, r5, r6, r7 = a[lo + 4], a[lo + 5], a[lo + 6], a[lo + 7]
-    i = 8
-    while i < n - (n % 8):
-        r0 += a[lo + i]
-        r1 += a[lo + i + 1]
-        r2 += a[lo + i + 2]
-        r3 += a[lo + i + 3]
-        r4 += a[lo + i + 4]
-        r5 += a[lo + i + 5]
-        r6 += a[lo + i + 6]
-        r7 += a[lo + i + 7]
-        i += 8
-    res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
-    while i < n:
-        res += a[lo + i]
-        i += 1
-    return res
-
-
-@njit(cache=True, error_model="numpy")
-def pairwise_sum(a, lo, n):  # pragma: no cover - compiled
-    """numpy's pairwise summation of ``a[lo:lo + n]`` (the same result, bit for bit).
-
-    numpy splits a sum of more than 128 terms at ``n2 = n // 2 - (n // 2) % 8`` and adds
-    the two halves; the recursion is unrolled here onto an explicit stack (a cached
-    numba function that calls a recursive one does not load from the cache).
-    """
-    if n <= 128:
-        return _pairwise_leaf(a, lo, n)
-    depth = 64
-    s_lo = np.empty(depth, np.int64)
-    s_n = np.empty(depth, np.int64)
-    s_phase = np.zeros(depth, np.int64)  # 0: not split yet, 1: left pending, 2: right
-    s_left = np.empty(depth)
-    sp = 0
-    s_lo[0] = lo
-    s_n[0] = n
-    while True:
-        cn = s_n[sp]
-        if cn > 128 and s_phase[sp] == 0:
-            n2 = cn // 2
-            n2 -= n2 % 8
-            s_phase[sp] = 1
-            sp += 1
-            s_lo[sp] = s_lo[sp - 1]
-            s_n[sp] = n2
-            s_phase[sp] = 0
-            continue
-        r = _pairwise_leaf(a, s_lo[sp], cn)
-        sp -= 1
-        while sp >= 0:  # hand the result to the parents
-            if s_phase[sp] == 1:
-                s_left[sp] = r
-                s_phase[sp] = 2
-                pn = s_n[sp]
-                n2 = pn // 2
-                n2 -= n2 % 8
-                sp += 1
-                s_lo[sp] = s_lo[sp - 1] + n2
-                s_n[sp] = pn - n2
-                s_phase[sp] = 0
-                break
-            r = s_left[sp] + r
-            sp -= 1
-        if sp < 0:
-            return r
-
-
-@njit(cache=True, fastmath={"reassoc", "nsz"})
-def _bsum(a, m):  # pragma: no cover - compiled
-    """Sum of ``a[:m]`` (vectorised: the order of the additions is the compiler's)."""
-    s = 0.0
-    for t in range(m):
-        s += a[t]
-    return s
-
-
-@njit(cache=True, fastmath={"nnan", "nsz"})
-def _bminmax(a, m, lo, hi):  # pragma: no cover - compiled
-    """(min, max) of ``a[:m]`` and the running ``lo``, ``hi`` (finite values: exact)."""
-    for t in range(m):
-        v = a[t]
-        lo = v if v < lo else lo
-        hi = v if v > hi else hi
-    return lo, hi
 
 
 @njit(cache=True, error_model="numpy")
@@ -172,6 +91,26 @@ def _bad_hours(T, RH, n):  # pragma: no cover - compiled
         above1 += 1 if r > 1.0 else 0
         above0 += 1 if r > 0.0 else 0
     return bad, above1, above0
+
+
+@njit(inline="always", cache=True, error_model="numpy")
+def inv_pi(inv_TK, r):  # pragma: no cover - compiled
+    """1 / PI(T, RH) [1/years] of ``chemical._pi`` from ``1 / (T + 273.15)`` [1/K] and
+    RH [%]: ``PI = exp(a) / 365`` inverted as ``365 exp(-a)`` (vectorised exp)."""
+    return 365.0 * vexp(-((95220.0 - 134.9 * r) * (inv_TK / 8.314) + 0.0284 * r - 28.023))
+
+
+@njit(inline="always", cache=True, error_model="numpy")
+def wet(x, r):  # pragma: no cover - compiled
+    """1 for an hour of ISO 9223 time of wetness (RH > 80 % and T > 0 °C), else 0."""
+    return 1 if (r > 80.0) and (x > 0.0) else 0
+
+
+@njit(inline="always", cache=True, error_model="numpy")
+def lim_rh(x, c):  # pragma: no cover - compiled
+    """The lowest isopleth for mould [%] at ``x`` [°C] (``biological._lim``, constant
+    ``c`` of the growth rate)."""
+    return 100.0 * (0.02633 * vcosh(0.10083 * (x - 30.0)) + c)
 
 
 @njit(cache=True, error_model="numpy")
@@ -198,13 +137,12 @@ def _pointwise(T, RH, b0, m, fpar, ipar, ea_r, tmp, sums):  # pragma: no cover -
             inv_TK = 1.0 / (x + _T0)  # the one division (products below)
             u[t] = inv_TK - tref_inv
             lr[t] = n_exp * (log_ref - vlog(r))  # n log(RH_ref / RH)
-            # 1 / PI with PI = exp(a) / 365 (chemical._pi)
-            w[t] = 365.0 * vexp(-((95220.0 - 134.9 * r) * (inv_TK / 8.314) + 0.0284 * r - 28.023))
+            w[t] = inv_pi(inv_TK, r)
         sums[nea] += _bsum(w, m)
-        wet = 0
-        for t in range(m):  # ISO 9223 time of wetness: RH > 80 % and T > 0 °C
-            wet += 1 if (RHb[t] > 80.0) and (Tb[t] > 0.0) else 0
-        sums[nea + 4] += wet
+        n_wet = 0
+        for t in range(m):  # ISO 9223 time of wetness
+            n_wet += wet(Tb[t], RHb[t])
+        sums[nea + 4] += n_wet
         for k in range(nea):
             e = ea_r[k]
             for t in range(m):
@@ -230,60 +168,8 @@ def _pointwise(T, RH, b0, m, fpar, ipar, ea_r, tmp, sums):  # pragma: no cover -
         cnt = 0
         for t in range(m):
             x = Tb[t]
-            cnt += 1 if RHb[t] > 100.0 * (0.02633 * vcosh(0.10083 * (x - 30.0)) + c) else 0
+            cnt += 1 if RHb[t] > lim_rh(x, c) else 0
         sums[nea + 3] += cnt
-
-
-@njit(cache=True, error_model="numpy")
-def _vtt_block(T, RH, m, fpar, frozen_decline, state):  # pragma: no cover - compiled
-    """The VTT mould-index recursion (of ``_vtt``) over the hours ``T[:m]``, ``RH[:m]``
-    of a complete series, carrying ``state`` = [M, hours of the dry spell, max M]."""
-    k1_lo, k1_hi = fpar[F_K1LO], fpar[F_K1HI]
-    A, B, C, RH_min, C_mat = fpar[F_A], fpar[F_B], fpar[F_C], fpar[F_RHMIN], fpar[F_CMAT]
-    W, SQ = fpar[F_W], fpar[F_SQ]
-    M = state[0]
-    dry = np.int64(state[1])
-    mx = state[2]
-    for t in range(m):
-        Ti = T[t]
-        Ri = RH[t]
-        grow = Ti > 0.0 and Ti < 50.0
-        RHc = RH_min
-        if grow:
-            if Ti <= 20.0:
-                RHc = -0.00267 * Ti**3 + 0.160 * Ti**2 - 3.13 * Ti + 100.0
-                if RHc < RH_min:
-                    RHc = RH_min
-            grow = Ri >= RHc
-        if grow:
-            x = (RHc - Ri) / (RHc - 100.0)
-            M_max = A + B * x - C * x * x
-            k1 = k1_lo if M < 1.0 else k1_hi
-            k2 = 1.0 - math.exp(2.3 * (M - M_max))
-            if k2 < 0.0:
-                k2 = 0.0
-            M += (
-                k1
-                * k2
-                * math.exp(0.68 * math.log(Ti) + 13.9 * math.log(Ri) - 0.14 * W + 0.33 * SQ - 66.02)
-                / 168.0
-            )
-            dry = 0
-        elif Ti <= 0.0 and not frozen_decline:
-            pass
-        else:
-            dry += 1
-            if dry <= 6:
-                M -= 0.00133 * C_mat
-            elif dry > 24:
-                M -= 0.000667 * C_mat
-            if M < 0.0:
-                M = 0.0
-        if M > mx:
-            mx = M
-    state[0] = M
-    state[1] = dry
-    state[2] = mx
 
 
 @njit(cache=True, error_model="numpy")
@@ -566,6 +452,7 @@ def series_indicators(
     vtt[0] = fpar[F_M0]
     vtt[1] = 0.0
     vtt[2] = -1.0
+    vtt_p = fpar[F_VTT : F_VTT + 9]  # k1_lo, k1_hi, A, B, C, RH_min, C_mat, W, SQ
     csT, csRH, csE, f, sel = ws[0], ws[1], ws[2], ws[3], ws[4]
     half_a, wrap_a = ipar[I_HALF_A], ipar[I_WRAP_A] != 0
     half_e, wrap_e = ipar[I_HALF_E], ipar[I_WRAP_E] != 0
@@ -590,7 +477,7 @@ def series_indicators(
         above0 += a0
         _pointwise(T, RH, b0, m, fpar, ipar, ea_r, tmp, sums)
         if mould:
-            _vtt_block(Tb, RHb, m, fpar, frozen, vtt)
+            vtt_hours(Tb, RHb, m, vtt_p, frozen, vtt)
         if sum_T:
             _cumsum_block(Tb, m, csT[b0 : b0 + m + 1])
         if sum_RH:
@@ -685,4 +572,4 @@ def series_indicators(
     return 0
 
 
-stamp_cache(globals(), _vecmath)
+stamp_cache(globals(), _vecmath, _sums, _vtt, indicators)

@@ -1,142 +1,34 @@
 """Every indicator at once: :func:`assess`, :func:`assess_batch`, :func:`summarize`.
 
-Sits on top of the mechanism modules (:mod:`~heritage_bayes.climate.risk.chemical`,
-:mod:`~heritage_bayes.climate.risk.mechanical`, :mod:`~heritage_bayes.climate.risk.biological`,
-:mod:`~heritage_bayes.climate.risk.standards`): it resolves the indicator groups and the
-per-group options (defaults are the keyword defaults of the target functions, looked up
-by name), computes all selected indicators in one pass per draw, and returns tidy tables
+Reads the indicator families of :mod:`~heritage_bayes.climate.risk.indicators` (each
+holds its options, its numpy computation and its registry entries): it resolves the
+selected groups and each family's options (defaults are the keyword defaults of the
+target functions), computes all selected indicators per draw, and returns tidy tables
 with units and IPI-style ratings.
 """
 
 from __future__ import annotations
 
-import inspect
 import math
-from collections.abc import Mapping
 
 import numpy as np
 import pandas as pd
 
 from heritage_bayes.climate.risk._inputs import (
-    HOURS_PER_YEAR,
     MIN_YEAR_HOURS,
     Hourly,
     centred_mean,
-    check_positive,
-    harmonic_mean,
     hourly,
-    share_percent,
 )
-
-# The functions named in _OPTION_TARGETS are imported for _defaults(), which reads their
-# keyword defaults by name from this module's globals ("noqa: F401" below).
-from heritage_bayes.climate.risk.biological import (
-    _hours_above,
-    _lim_c,
-    _vtt_args,
-    _vtt_run,
-    hours_above_isopleth,  # noqa: F401
-    vtt_mould_index,  # noqa: F401
+from heritage_bayes.climate.risk.indicators import FAMILIES, shared_seasonal
+from heritage_bayes.climate.risk.registry import (
+    INDICATOR_GROUPS,
+    complete_year_hours,
+    indicator_info,
+    resolve_options,
 )
-from heritage_bayes.climate.risk.chemical import (
-    _T0,
-    R_GAS,
-    _check_lm,
-    _pi,
-    twlm,  # noqa: F401
-)
-from heritage_bayes.climate.risk.mechanical import (
-    _emc,
-    _minmax,
-    dimensional_change,  # noqa: F401
-)
-from heritage_bayes.climate.risk.standards import (
-    _ashrae_check,
-    _ashrae_core,
-    _en_check,
-    _en_core,
-    _window_half,
-    ashrae_classes,  # noqa: F401
-    en15757_band,  # noqa: F401
-)
+from heritage_bayes.climate.risk.standards import _window_half
 from heritage_bayes.errors import InputError
-
-#: Indicator groups of :func:`assess`; those marked True need at least a year of data.
-INDICATOR_GROUPS = {
-    "chemical": True,
-    "mechanical": False,
-    "mould": True,
-    "ashrae": True,
-    "en15757": True,
-}
-
-_OPTION_TARGETS = {
-    "lm": "twlm",
-    "emc": "dimensional_change",
-    "vtt": "vtt_mould_index",
-    "isopleth": "hours_above_isopleth",
-    "ashrae": "ashrae_classes",
-    "en15757": "en15757_band",
-}
-_NOT_OPTIONS = {"T", "RH", "nan_policy", "per_year"}
-_DEFAULT_EA = {"paper": 100e3, "varnish": 70e3}
-
-
-def _defaults(fname):
-    sig = inspect.signature(globals()[fname])
-    return {
-        k: p.default
-        for k, p in sig.parameters.items()
-        if k not in _NOT_OPTIONS and p.default is not inspect.Parameter.empty
-    }
-
-
-def _resolve_options(func, given: Mapping[str, Mapping | None]):
-    """Merge user options with the defaults of each target function; reject unknowns."""
-    opts = {}
-    for key, fname in _OPTION_TARGETS.items():
-        d = _defaults(fname)
-        if key == "lm":
-            d["Ea"] = dict(_DEFAULT_EA)
-        user = given.get(key) or {}
-        if not isinstance(user, Mapping):
-            raise InputError(
-                f"{func}: {key} must be a dict of options for {fname}(); got {type(user).__name__}"
-            )
-        unknown = sorted(set(user) - set(d))
-        if unknown:
-            raise InputError(
-                f"{func}: unknown option(s) {unknown} in {key}=...; expected some of "
-                f"{sorted(d)} (the keywords of {fname}())"
-            )
-        d.update(user)
-        opts[key] = d
-    # validate each group's options once, before any work
-    lm = opts["lm"]
-    Ea = lm["Ea"]
-    if not isinstance(Ea, Mapping):
-        Ea = {f"Ea={float(check_positive(func, 'Ea', Ea)) / 1e3:g}kJ/mol": Ea}
-    if not Ea:
-        raise InputError(f"{func}: lm Ea must name at least one material; got {{}}")
-    for Ea_i in Ea.values():
-        _check_lm(func, Ea_i, lm["T_ref"], lm["RH_ref"], lm["n"])
-    lm["Ea"] = {str(k): float(v) for k, v in Ea.items()}
-    opts["emc"]["coefficient"] = check_positive(func, "coefficient", opts["emc"]["coefficient"])
-    v = opts["vtt"]
-    opts["vtt"] = {"args": _vtt_args(func, **v), **v}
-    opts["isopleth"]["c"] = _lim_c(func, opts["isopleth"]["growth_rate"])
-    a = opts["ashrae"]
-    a["threshold"], a["classes"] = _ashrae_check(
-        func, a["method"], a["threshold"], a["classes"], a["edges"], a["T_setpoint"],
-        a["RH_setpoint"],
-    )  # fmt: skip
-    e = opts["en15757"]
-    check_positive(func, "ashrae window_days", a["window_days"])
-    check_positive(func, "en15757 window_days", e["window_days"])
-    e["percentiles"], e["min_band"] = _en_check(
-        func, e["percentiles"], e["min_band"], e["min_band_mode"], e["edges"]
-    )
-    return opts
 
 
 def _resolve_groups(func, indicators):
@@ -166,106 +58,29 @@ def _check_year(func, groups, n):
 
 
 def _assess_core(h: Hourly, groups, opts, nan_policy) -> dict[str, np.ndarray]:
-    """All indicators of the selected groups, one value per draw."""
-    T, RH = h.T, h.RH
+    """All indicators of the selected families, one value per draw."""
+    seasonal = None
+    if shared_seasonal(groups, opts):
+        a = opts["ashrae"]
+        half = _window_half("assess", a["window_days"], h.n_hours)
+        seasonal = centred_mean(h.RH, half, a["edges"], nan_policy)
     out: dict[str, np.ndarray] = {}
-    if "chemical" in groups:
-        lm = opts["lm"]
-        with np.errstate(divide="ignore", over="ignore"):
-            u = 1.0 / (T + _T0) - 1.0 / (lm["T_ref"] + _T0)
-            rh_term = lm["n"] * np.log(lm["RH_ref"] / RH)
-            for label, Ea in lm["Ea"].items():
-                val = np.exp(Ea / R_GAS * u + rh_term)
-                out[f"lifetime_multiplier[{label}]"] = harmonic_mean(val, nan_policy)
-        out["twpi"] = harmonic_mean(_pi(T, RH), nan_policy)
-        out["time_of_wetness"] = time_of_wetness(h, nan_policy)
-    if "mechanical" in groups:
-        lo, hi = _minmax(_emc(T, RH), nan_policy)
-        out["emc_min"] = lo
-        out["emc_max"] = hi
-        out["emc_range"] = hi - lo
-        out["dimensional_change"] = 100.0 * opts["emc"]["coefficient"] * (hi - lo)
-    if "mould" in groups:
-        _, peak = _vtt_run(h, opts["vtt"]["args"], nan_policy, store=False)
-        out["vtt_mould_index_max"] = peak
-        iso = opts["isopleth"]
-        name = f"hours_above_LIM{float(iso['growth_rate']):g}"
-        out[name] = _hours_above(h, iso["c"], True, nan_policy)
-    sRH = None
-    a, e = opts["ashrae"], opts["en15757"]
-    if "ashrae" in groups and "en15757" in groups:
-        if a["window_days"] == e["window_days"] and a["edges"] == e["edges"]:
-            half = _window_half("assess", a["window_days"], h.n_hours)
-            sRH = centred_mean(RH, half, a["edges"], nan_policy)
-    if "ashrae" in groups:
-        sh, _, _, best, _, _ = _ashrae_core(
-            h,
-            window_days=a["window_days"],
-            T_setpoint=a["T_setpoint"],
-            RH_setpoint=a["RH_setpoint"],
-            method=a["method"],
-            threshold=a["threshold"],
-            classes=a["classes"],
-            nested=bool(a["nested"]),
-            edges=a["edges"],
-            nan_policy=nan_policy,
-            sRH=sRH,
-        )
-        for j, c in enumerate(a["classes"]):
-            out[f"ashrae_{c.name}"] = sh[:, j]
-        out["ashrae_best_class"] = np.array(
-            ["none" if b is None else b for b in best], dtype=object
-        )
-    if "en15757" in groups:
-        *_, lo, hi, _, _, share = _en_core(
-            RH,
-            window_days=e["window_days"],
-            percentiles=e["percentiles"],
-            min_band=e["min_band"],
-            min_band_mode=e["min_band_mode"],
-            edges=e["edges"],
-            nan_policy=nan_policy,
-            seasonal=sRH,
-        )
-        out["en15757_outside"] = share
-        out["en15757_lower_offset"] = lo
-        out["en15757_upper_offset"] = hi
+    for fam in FAMILIES:
+        if fam.name in groups:
+            out.update(fam.compute(h, opts, nan_policy, seasonal))
     return out
 
 
 def _unit(name: str) -> str:
-    from heritage_bayes.climate.risk.registry import indicator_info
-
     return indicator_info(name).unit
 
 
 def _rating(name: str, v) -> str:
-    """IPI-style rating of one indicator value ('' where no published scale applies)."""
+    """Rating of one indicator value on its published scale ('' where none applies)."""
     if v is None or (isinstance(v, float) and math.isnan(v)):
         return ""
-    if name == "twpi":
-        return "good" if v >= 75.0 else ("OK" if v >= 45.0 else "risk")
-    if name == "emc_min":
-        return "OK" if v >= 5.0 else "risk"
-    if name == "emc_max":
-        return "OK" if v <= 12.5 else "risk"
-    if name == "time_of_wetness":  # ISO 9223 categories τ1-τ5
-        return next((f"τ{i}" for i, top in enumerate(_TOW_TOPS, 1) if v <= top), "τ5")
-    if name == "vtt_mould_index_max":
-        return "good" if v < 1.0 else "risk"
-    return ""
-
-
-#: Upper limits of the ISO 9223 time-of-wetness categories τ1-τ4. [h/year]
-_TOW_TOPS = (10.0, 250.0, 2500.0, 5500.0)
-
-
-def time_of_wetness(h: Hourly, nan_policy) -> np.ndarray:
-    """Hours per year with RH > 80 % and T > 0 °C (ISO 9223 time of wetness). [h/year]"""
-    valid = np.isfinite(h.T) & np.isfinite(h.RH)
-    with np.errstate(invalid="ignore"):
-        wet = (h.RH > 80.0) & (h.T > 0.0)
-    return share_percent(wet, valid, nan_policy) / 100.0 * HOURS_PER_YEAR
+    rate = indicator_info(name).rating
+    return "" if rate is None else rate(v)
 
 
 def _prepare_assess(func, T, RH, indicators, nan_policy, options):
@@ -275,10 +90,8 @@ def _prepare_assess(func, T, RH, indicators, nan_policy, options):
     (:func:`~heritage_bayes.climate.risk.registry.complete_year_hours`): the hours after
     the last complete year are not used (``Hourly.dropped`` counts them).
     """
-    from heritage_bayes.climate.risk.registry import complete_year_hours
-
     groups = _resolve_groups(func, indicators)
-    opts = _resolve_options(func, options)
+    opts = resolve_options(func, options)
     h = hourly(func, T=T, RH=RH, nan_policy=nan_policy)
     _check_year(func, groups, h.n_hours)
     n = complete_year_hours(h.n_hours)
@@ -300,6 +113,7 @@ def assess(
     isopleth=None,
     ashrae=None,
     en15757=None,
+    **more,
 ):
     r"""All conservation-risk indicators of one hourly series, as a tidy table.
 
@@ -333,6 +147,9 @@ def assess(
         Options of :func:`ashrae_classes`.
     en15757 : dict, optional
         Options of :func:`en15757_band`.
+    **more : dict, optional
+        Options of a family added with
+        :func:`~heritage_bayes.climate.risk.registry.register`, by its option keyword.
 
     Returns
     -------
@@ -400,7 +217,9 @@ def assess(
     'B'
     """
     func = "assess"
-    options = dict(lm=lm, emc=emc, vtt=vtt, isopleth=isopleth, ashrae=ashrae, en15757=en15757)
+    options = dict(
+        lm=lm, emc=emc, vtt=vtt, isopleth=isopleth, ashrae=ashrae, en15757=en15757, **more
+    )
     h, groups, opts = _prepare_assess(func, T, RH, indicators, nan_policy, options)
     if h.ndim != 1:
         raise InputError(
@@ -436,6 +255,7 @@ def assess_batch(
     isopleth=None,
     ashrae=None,
     en15757=None,
+    **more,
 ):
     r"""All indicators for many series at once (posterior draws × hours).
 
@@ -446,7 +266,7 @@ def assess_batch(
         ``RH``. [°C]
     RH : array_like
         Hourly relative humidity, shape (draws, hours), or (hours,) shared. [%]
-    indicators, nan_policy, lm, emc, vtt, isopleth, ashrae, en15757
+    indicators, nan_policy, lm, emc, vtt, isopleth, ashrae, en15757, **more
         As in :func:`assess`.
     chunk_size : int, default 128
         Draws processed together (bounds the memory of the temporaries). [-]
@@ -472,7 +292,9 @@ def assess_batch(
     See :func:`assess`.
     """
     func = "assess_batch"
-    options = dict(lm=lm, emc=emc, vtt=vtt, isopleth=isopleth, ashrae=ashrae, en15757=en15757)
+    options = dict(
+        lm=lm, emc=emc, vtt=vtt, isopleth=isopleth, ashrae=ashrae, en15757=en15757, **more
+    )
     h, groups, opts = _prepare_assess(func, T, RH, indicators, nan_policy, options)
     bad = isinstance(chunk_size, bool) or not isinstance(chunk_size, int | np.integer)
     if bad or chunk_size < 1:

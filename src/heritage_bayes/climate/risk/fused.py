@@ -36,16 +36,19 @@ from numba import njit, prange
 from heritage_bayes.climate import _vecmath
 from heritage_bayes.climate._vecmath import stamp_cache
 from heritage_bayes.climate.risk import _fused as k
+from heritage_bayes.climate.risk._inputs import Hourly
 from heritage_bayes.climate.risk.assess import (
     _check_year,
     _prepare_assess,
     _resolve_groups,
-    _resolve_options,
     _unit,
     assess_batch,
 )
 from heritage_bayes.climate.risk.chemical import R_GAS
+from heritage_bayes.climate.risk.indicators import FAMILIES, LAYOUT, shared_seasonal
+from heritage_bayes.climate.risk.registry import resolve_options
 from heritage_bayes.climate.risk.standards import _window_half
+from heritage_bayes.errors import InputError
 
 __all__ = ["FusedPlan", "assess_fused", "fused_plan"]
 
@@ -153,66 +156,27 @@ def _kinds_and_table(classes, method):
 
 def _plan(func, n, groups, opts) -> FusedPlan:
     _check_year(func, groups, n)
-    ipar = np.zeros(k.N_IPAR, np.int64)
-    fpar = np.zeros(k.N_FPAR)
-    cols: list[str] = []
-    lm = opts["lm"]
-    ea_r = np.array([Ea / R_GAS for Ea in lm["Ea"].values()])
-    ipar[k.I_NEA] = len(ea_r)
-    if "chemical" in groups:
-        ipar[k.I_CHEM] = 1
-        fpar[k.F_TREF_INV] = 1.0 / (lm["T_ref"] + k._T0)
-        fpar[k.F_RHREF] = lm["RH_ref"]
-        fpar[k.F_N] = lm["n"]
-        cols += [f"lifetime_multiplier[{label}]" for label in lm["Ea"]]
-        cols += ["twpi", "time_of_wetness"]
-    if "mechanical" in groups:
-        ipar[k.I_MECH] = 1
-        fpar[k.F_COEF] = opts["emc"]["coefficient"]
-        cols += ["emc_min", "emc_max", "emc_range", "dimensional_change"]
-    if "mould" in groups:
-        ipar[k.I_MOULD] = 1
-        *vals, frozen_decline = opts["vtt"]["args"]
-        fpar[k.F_K1LO : k.F_M0 + 1] = vals
-        ipar[k.I_FROZEN] = int(bool(frozen_decline))
-        iso = opts["isopleth"]
-        fpar[k.F_LIMC] = iso["c"]
-        cols += ["vtt_mould_index_max", f"hours_above_LIM{float(iso['growth_rate']):g}"]
-    a, e = opts["ashrae"], opts["en15757"]
-    both = "ashrae" in groups and "en15757" in groups
-    shared = both and a["window_days"] == e["window_days"] and a["edges"] == e["edges"]
+    ipar, fpar = LAYOUT.arrays()
+    shared = shared_seasonal(groups, opts)
     if shared:
-        _window_half("assess", a["window_days"], n)
+        _window_half("assess", opts["ashrae"]["window_days"], n)
+    cols: list[str] = []
     pad = 0
+    for fam in FAMILIES:  # each family's parameters, by name
+        if fam.name not in groups or not fam.compiled:
+            continue
+        ints, floats, fam_pad = fam.plan(opts, n, shared)
+        ipar[LAYOUT.i(fam.name)] = 1
+        for name, v in ints.items():
+            ipar[LAYOUT.i(f"{fam.name}.{name}")] = v
+        for name, v in floats.items():
+            fpar[LAYOUT.f(f"{fam.name}.{name}")] = v
+        pad = max(pad, fam_pad)
+        cols += fam.columns(opts)
+    ea_r = np.array([Ea / R_GAS for Ea in opts["lm"]["Ea"].values()])
+    a = opts["ashrae"]
     classes = tuple(a["classes"])
     kinds, cls = _kinds_and_table(classes, a["method"])
-    if "ashrae" in groups:
-        half = _window_half("ashrae_classes", a["window_days"], n)
-        ipar[[k.I_ASHRAE, k.I_HALF_A, k.I_WRAP_A]] = 1, half, a["edges"] == "wrap"
-        ipar[[k.I_METHOD, k.I_NESTED, k.I_NCLS]] = (
-            a["method"] == "setpoint", bool(a["nested"]), len(classes),
-        )  # fmt: skip
-        for flag, val, key in (
-            (k.I_HAS_TSP, k.F_TSP, "T_setpoint"),
-            (k.I_HAS_RHSP, k.F_RHSP, "RH_setpoint"),
-        ):
-            if a[key] is not None:
-                ipar[flag] = 1
-                fpar[val] = float(a[key])
-        fpar[k.F_THR] = a["threshold"]
-        pad = max(pad, half if a["edges"] == "wrap" else 0)
-        cols += [f"ashrae_{c.name}" for c in classes] + ["ashrae_best_class"]
-    if "en15757" in groups:
-        half = _window_half("en15757_band", e["window_days"], n)
-        ipar[[k.I_EN, k.I_HALF_E, k.I_WRAP_E, k.I_SHARED]] = (
-            1, half, e["edges"] == "wrap", shared,
-        )  # fmt: skip
-        ipar[k.I_EN_WIDTH] = e["min_band_mode"] == "width"
-        lo, hi = e["percentiles"]
-        fpar[k.F_QLO], fpar[k.F_QHI] = lo / 100, hi / 100  # as np.percentile
-        fpar[k.F_MINBAND] = e["min_band"]
-        pad = max(pad, half if e["edges"] == "wrap" else 0)
-        cols += ["en15757_outside", "en15757_lower_offset", "en15757_upper_offset"]
     return FusedPlan(
         n_hours=int(n),
         columns=tuple(cols),
@@ -233,6 +197,7 @@ def fused_plan(
     ashrae=None,
     en15757=None,
     func: str = "assess_fused",
+    **more,
 ) -> FusedPlan:
     """Resolve and check the options of :func:`assess` for series of ``n_hours`` hours.
 
@@ -240,8 +205,10 @@ def fused_plan(
     ----------
     n_hours : int
         Length of the series. [h]
-    indicators, lm, emc, vtt, isopleth, ashrae, en15757
-        As in :func:`assess` (defaults resolved the same way, unknown keys rejected).
+    indicators, lm, emc, vtt, isopleth, ashrae, en15757, **more
+        As in :func:`assess` (defaults resolved the same way, unknown keys rejected);
+        by default the compiled families only, and a family without a compiled pass is
+        refused by name.
     func : str
         Name used in error messages.
 
@@ -255,10 +222,24 @@ def fused_plan(
         As :func:`assess_batch`: bad options, a series shorter than a year for the
         yearly groups, a moving-average window longer than the series.
     """
-    options = dict(lm=lm, emc=emc, vtt=vtt, isopleth=isopleth, ashrae=ashrae, en15757=en15757)
+    options = dict(
+        lm=lm, emc=emc, vtt=vtt, isopleth=isopleth, ashrae=ashrae, en15757=en15757, **more
+    )
     groups = _resolve_groups(func, indicators)
-    opts = _resolve_options(func, options)
+    numpy_only = [g for g in groups if g not in _compiled()]
+    if indicators is None:
+        groups = tuple(g for g in groups if g not in numpy_only)
+    elif numpy_only:
+        raise InputError(
+            f"{func}: the indicators {numpy_only} have no compiled pass (numpy only: "
+            f"assess, assess_batch, assess_fused); compiled: {_compiled()}"
+        )
+    opts = resolve_options(func, options)
     return _plan(func, int(n_hours), groups, opts)
+
+
+def _compiled() -> list[str]:
+    return [f.name for f in FAMILIES if f.compiled]
 
 
 @njit(parallel=True, cache=True)
@@ -290,6 +271,7 @@ def assess_fused(
     isopleth=None,
     ashrae=None,
     en15757=None,
+    **more,
 ):
     r"""All indicators for many series at once, one compiled pass per series.
 
@@ -300,7 +282,7 @@ def assess_fused(
         ``RH``. [°C]
     RH : array_like
         Hourly relative humidity, shape (draws, hours), or (hours,) shared. [%]
-    indicators, nan_policy, lm, emc, vtt, isopleth, ashrae, en15757
+    indicators, nan_policy, lm, emc, vtt, isopleth, ashrae, en15757, **more
         As in :func:`assess`.
 
     Returns
@@ -322,7 +304,9 @@ def assess_fused(
     thread, whatever the number of draws.
     """
     func = "assess_fused"
-    options = dict(lm=lm, emc=emc, vtt=vtt, isopleth=isopleth, ashrae=ashrae, en15757=en15757)
+    options = dict(
+        lm=lm, emc=emc, vtt=vtt, isopleth=isopleth, ashrae=ashrae, en15757=en15757, **more
+    )
     h, groups, opts = _prepare_assess(func, T, RH, indicators, nan_policy, options)
     Tc = np.ascontiguousarray(h.T, dtype=float)
     RHc = np.ascontiguousarray(h.RH, dtype=float)
@@ -338,4 +322,10 @@ def assess_fused(
                            **options)  # fmt: skip
         values[redo] = plan.values(ref)
     df = plan.frame(values)
+    for fam in FAMILIES:  # families without a compiled pass: numpy, on the same series
+        if fam.name in groups and not fam.compiled:
+            h = Hourly(T=Tc, RH=RHc, index=None, ndim=2)
+            for key, v in fam.compute(h, opts, nan_policy, None).items():
+                df[key] = v
+                df.attrs["units"][key] = _unit(key)
     return df

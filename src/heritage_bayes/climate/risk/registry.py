@@ -1,4 +1,5 @@
-r"""The indicator registry: one entry per conservation-risk indicator, read by
+r"""The indicator registry: one entry per conservation-risk indicator (gathered from the
+families of :mod:`heritage_bayes.climate.risk.indicators`), read by
 :func:`~heritage_bayes.climate.risk.assess` (units), the projection page, its CSV/JSON
 outputs and the documentation.
 
@@ -18,7 +19,7 @@ computes every indicator of a series of a year or more over its **complete years
 a grid, 8736–8759 h, counts as one) and states the hours left out; the yearly groups
 (``chemical``, ``mould``, ``ashrae``, ``en15757``) refuse a series shorter than a year.
 
-An intervention (a change of the calibrated room, issue 29) is compared with the
+An intervention (a change of the calibrated room) is compared with the
 do-nothing case through the same entries: ``worse`` gives the sign of "better" and the
 unit the scale of a difference.
 """
@@ -26,259 +27,134 @@ unit the scale of a difference.
 from __future__ import annotations
 
 import re
-from dataclasses import asdict, dataclass, replace
+from collections.abc import Mapping
+from dataclasses import replace
 
 from heritage_bayes.climate.risk._inputs import HOURS_PER_YEAR, MIN_YEAR_HOURS
+from heritage_bayes.climate.risk.indicators import (
+    FAMILIES,
+    PROJECTION_INDICATORS,
+    Family,
+    Indicator,
+)
 from heritage_bayes.errors import InputError
 
 __all__ = [
+    "ANNUAL",
     "INDICATORS",
+    "INDICATOR_GROUPS",
     "Indicator",
     "as_markdown",
     "check_indicator_names",
     "complete_year_hours",
+    "headline_indicators",
     "indicator_info",
+    "register",
+    "resolve_options",
+    "unregister",
 ]
 
-_YEARS = "per complete year, summarised over the complete years of the series"
-_SERIES = "over the complete years of the series (the whole series if shorter than a year)"
 
-
-@dataclass(frozen=True)
-class Indicator:
-    """One conservation-risk indicator.
-
-    Attributes
-    ----------
-    key : str
-        Column name in :func:`~heritage_bayes.climate.risk.assess_batch` and in the
-        projection outputs.
-    name : str
-        Human name (for pages and tables).
-    unit : str
-        Unit of the value (``"-"`` for a ratio, ``"% of hours"`` for a share in 0–100).
-    definition : str
-        What is computed, in one or two sentences.
-    source : str
-        Standard or paper the definition follows.
-    period : str
-        The period the value is computed over.
-    worse : int
-        +1: a higher value is worse for the collection; -1: a lower value is worse;
-        0: no direction (a band offset, a class).
-    group : str
-        Indicator group of :func:`~heritage_bayes.climate.risk.assess` (or
-        ``"projection"`` for indicators that need a baseline).
-    annual : bool
-        True where the value is a per-year quantity (computed per complete year).
-    """
-
-    key: str
-    name: str
-    unit: str
-    definition: str
-    source: str
-    period: str
-    worse: int
-    group: str
-    annual: bool = True
-
-    def label(self) -> str:
-        """``name [unit]`` (the unit left out for dimensionless ``-``)."""
-        return self.name if self.unit in ("-", "") else f"{self.name} [{self.unit}]"
-
-    def as_dict(self) -> dict:
-        """JSON-ready entry."""
-        return asdict(self)
+def _pattern(key: str):
+    return re.compile("^" + r"(.+)".join(map(re.escape, key.split("{}"))) + "$")
 
 
 def _entries() -> dict[str, Indicator]:
-    e = [
-        Indicator(
-            "lifetime_multiplier[{}]",
-            "Lifetime multiplier ({})",
-            "-",
-            "Time-weighted lifetime multiplier of chemically unstable material relative "
-            "to 20 °C, 50 % RH: harmonic mean over the hours of exp(Ea/R (1/T − 1/Tref)) "
-            "(RHref/RH)^n.",
-            "Michalski (2002), ICOM-CC 13th Triennial Meeting, 66-72",
-            _YEARS,
-            -1,
-            "chemical",
-        ),
-        Indicator(
-            "twpi",
-            "Time-weighted preservation index",
-            "years",
-            "Harmonic mean over the hours of the preservation index PI(T, RH) of "
-            "cellulose-acetate/paper (IPI); < 45 years rated 'risk', ≥ 75 'good'.",
-            "Sebera (1994) Isoperms; Reilly, Nishimura & Zinn (1995) New Tools for Preservation",
-            _YEARS,
-            -1,
-            "chemical",
-        ),
-        Indicator(
-            "time_of_wetness",
-            "Time of wetness (metal corrosion)",
-            "h/year",
-            "Hours per year with RH > 80 % and T > 0 °C, the time of wetness τ of "
-            "ISO 9223 (categories τ1 ≤ 10, τ2 ≤ 250, τ3 ≤ 2500, τ4 ≤ 5500, τ5 > 5500 "
-            "h/year).",
-            "ISO 9223:2012 (annex C, time of wetness)",
-            _YEARS,
-            1,
-            "chemical",
-        ),
-        Indicator(
-            "emc_min",
-            "Lowest equilibrium moisture content of wood",
-            "% MC",
-            "Minimum over the hours of the Hailwood-Horrobin EMC of wood; < 5 % rated "
-            "'risk' (shrinkage, cracking).",
-            "Hailwood & Horrobin (1946); Wood Handbook FPL-GTR-190 (2010)",
-            _SERIES,
-            -1,
-            "mechanical",
-            annual=False,
-        ),
-        Indicator(
-            "emc_max",
-            "Highest equilibrium moisture content of wood",
-            "% MC",
-            "Maximum over the hours of the Hailwood-Horrobin EMC of wood; > 12.5 % rated "
-            "'risk' (swelling).",
-            "Hailwood & Horrobin (1946); Wood Handbook FPL-GTR-190 (2010)",
-            _SERIES,
-            1,
-            "mechanical",
-            annual=False,
-        ),
-        Indicator(
-            "emc_range",
-            "Range of wood moisture content",
-            "% MC",
-            "Maximum minus minimum EMC over the period.",
-            "Hailwood & Horrobin (1946); Wood Handbook FPL-GTR-190 (2010)",
-            _SERIES,
-            1,
-            "mechanical",
-            annual=False,
-        ),
-        Indicator(
-            "dimensional_change",
-            "Dimensional change of wood (tangential)",
-            "%",
-            "Swelling coefficient × EMC range: the tangential dimensional change of "
-            "unrestrained wood over the period.",
-            "Wood Handbook FPL-GTR-190 (2010), ch. 4",
-            _SERIES,
-            1,
-            "mechanical",
-            annual=False,
-        ),
-        Indicator(
-            "vtt_mould_index_max",
-            "Highest VTT mould index",
-            "-",
-            "Maximum of the VTT mould index M (0 no growth, 1 microscopic, 3 visible) "
-            "over the period; ≥ 1 rated 'risk'.",
-            "Hukka & Viitanen (1999) doi:10.1007/s002260050131; Ojanen et al. (2010)",
-            _SERIES,
-            1,
-            "mould",
-            annual=False,
-        ),
-        Indicator(
-            "hours_above_LIM{}",
-            "Hours above the lowest isopleth for mould (LIM{})",
-            "h/year",
-            "Hours per year with RH above the lowest isopleth for mould growth at the "
-            "hour's temperature.",
-            "Sedlbauer (2001); Zeng et al. (2023) doi:10.1177/01436244221137846",
-            _YEARS,
-            1,
-            "mould",
-        ),
-        Indicator(
-            "ashrae_{}",
-            "Hours within ASHRAE class {}",
-            "% of hours",
-            "Share of the hours that meet the short-term and seasonal limits of the "
-            "ASHRAE museum climate class.",
-            "ASHRAE Handbook — HVAC Applications, ch. 24 (museums)",
-            _YEARS,
-            -1,
-            "ashrae",
-        ),
-        Indicator(
-            "ashrae_best_class",
-            "Best ASHRAE class reached",
-            "class",
-            "The strictest class whose share of hours reaches the threshold ('none' if none does).",
-            "ASHRAE Handbook — HVAC Applications, ch. 24 (museums)",
-            _YEARS,
-            0,
-            "ashrae",
-        ),
-        Indicator(
-            "en15757_outside",
-            "Hours outside the series' own EN 15757 band (self-referenced)",
-            "% of hours",
-            "Share of the hours outside the EN 15757 band computed from the same series "
-            "(≈ 14 % by construction for any climate: 7 % below the 7th and above the "
-            "93rd percentile). Describes a measured historical climate; for a future "
-            "climate use the hours outside the baseline EN 15757 band.",
-            "EN 15757:2010; Camuffo et al. (2022) doi:10.3390/atmos13091344",
-            _YEARS,
-            0,
-            "en15757",
-        ),
-        Indicator(
-            "en15757_lower_offset",
-            "EN 15757 band, lower offset",
-            "%RH",
-            "Lower edge of the band relative to the 30-day centred moving average: the "
-            "7th percentile of the short-term fluctuations, widened to the minimum band.",
-            "EN 15757:2010",
-            _YEARS,
-            0,
-            "en15757",
-        ),
-        Indicator(
-            "en15757_upper_offset",
-            "EN 15757 band, upper offset",
-            "%RH",
-            "Upper edge of the band relative to the 30-day centred moving average: the "
-            "93rd percentile of the short-term fluctuations, widened to the minimum band.",
-            "EN 15757:2010",
-            _YEARS,
-            0,
-            "en15757",
-        ),
-        Indicator(
-            "en15757_outside_baseline",
-            "Hours outside the baseline EN 15757 band",
-            "% of hours",
-            "Share of the hours outside the band the collection is acclimatised to: the "
-            "baseline climate's seasonal cycle (30-day centred moving average, averaged "
-            "by hour of the year) plus its 7th/93rd percentile offsets (at least the "
-            "minimum band), both from the same posterior draw's baseline simulation.",
-            "EN 15757:2010, clause 5 (historical climate as the target)",
-            _YEARS,
-            1,
-            "projection",
-        ),
-    ]
+    e = [i for f in FAMILIES for i in f.indicators] + list(PROJECTION_INDICATORS)
     return {i.key: i for i in e}
 
 
 #: Every indicator family by key (parameterised ones with ``{}``).
 INDICATORS: dict[str, Indicator] = _entries()
-_PATTERNS = [
-    (re.compile(r"^lifetime_multiplier\[(.+)\]$"), "lifetime_multiplier[{}]"),
-    (re.compile(r"^hours_above_LIM(.+)$"), "hours_above_LIM{}"),
-    (re.compile(r"^ashrae_(?!best_class$)(.+)$"), "ashrae_{}"),
-]
+#: Indicator groups of :func:`~heritage_bayes.climate.risk.assess` (the families of
+#: :mod:`~heritage_bayes.climate.risk.indicators`); those marked True need at least a
+#: year of data.
+INDICATOR_GROUPS = {f.name: f.yearly for f in FAMILIES}
+
+
+def resolve_options(func, given: Mapping[str, Mapping | None]):
+    """The options of every family: the user's (``given``: option keyword → dict or None)
+    merged with the defaults of each family's target function, unknown keywords and keys
+    refused (:class:`~heritage_bayes.errors.InputError` naming ``func``), then checked by
+    each family."""
+    known = [k for fam in FAMILIES for k in fam.options]
+    unknown = [k for k in given if k not in known]
+    if unknown:
+        raise InputError(
+            f"{func}: unknown option group(s) {unknown}; expected some of {known} (the "
+            "option keywords of the indicator families)"
+        )
+    opts = {}
+    for fam in FAMILIES:
+        for key, target in fam.options.items():
+            d = fam.option_defaults(key)
+            fname = target.__name__
+            user = given.get(key) or {}
+            if not isinstance(user, Mapping):
+                raise InputError(
+                    f"{func}: {key} must be a dict of options for {fname}(); got "
+                    f"{type(user).__name__}"
+                )
+            unknown = sorted(set(user) - set(d))
+            if unknown:
+                raise InputError(
+                    f"{func}: unknown option(s) {unknown} in {key}=...; expected some of "
+                    f"{sorted(d)} (the keywords of {fname}())"
+                )
+            d.update(user)
+            opts[key] = d
+    for fam in FAMILIES:  # validate each family's options once, before any work
+        fam.check(func, opts)
+    return opts
+
+
+#: Columns the projection also reports per complete year (a parameterised family by its
+#: prefix, e.g. ``hours_above_LIM``), in registry order.
+ANNUAL: tuple[str, ...] = tuple(i.key.replace("{}", "") for i in INDICATORS.values() if i.per_year)
+#: (pattern, family key) of the parameterised families: ``{}`` matches the parameter.
+_PATTERNS = [(_pattern(key), key) for key in INDICATORS if "{}" in key]
+
+
+def register(family: Family) -> None:
+    """Add an indicator family: its columns join :func:`~heritage_bayes.climate.risk.assess`,
+    :func:`~heritage_bayes.climate.risk.assess_batch`,
+    :func:`~heritage_bayes.climate.risk.assess_fused` (with its ``compute``), this
+    registry and the generated reference.
+
+    Raises
+    ------
+    heritage_bayes.errors.InputError
+        A family or option keyword of that name exists already, an indicator key is
+        taken, or the family says it is compiled (the compiled pass is code of
+        :mod:`heritage_bayes.climate.risk._fused`, not registered at run time).
+    """
+    taken = {o for f in FAMILIES for o in f.options}
+    clash = [k for k in family.options if k in taken]
+    keys = [i.key for i in family.indicators if i.key in INDICATORS]
+    if family.name in INDICATOR_GROUPS or clash or keys or family.compiled:
+        raise InputError(
+            f"register: family {family.name!r} clashes with the registry (known families "
+            f"{list(INDICATOR_GROUPS)}, option keywords taken {clash}, keys taken {keys}, "
+            f"compiled {family.compiled}: a compiled family is part of the compiled pass)"
+        )
+    FAMILIES.append(family)
+    INDICATOR_GROUPS[family.name] = family.yearly
+    for i in family.indicators:
+        INDICATORS[i.key] = i
+        if "{}" in i.key:
+            _PATTERNS.append((_pattern(i.key), i.key))
+
+
+def unregister(name: str) -> None:
+    """Remove a family added by :func:`register` (the built-in ones stay)."""
+    fam = next((f for f in FAMILIES if f.name == name and not f.compiled), None)
+    if fam is None:
+        raise InputError(f"unregister: no registered family {name!r}")
+    FAMILIES.remove(fam)
+    del INDICATOR_GROUPS[name]
+    for i in fam.indicators:
+        del INDICATORS[i.key]
+    _PATTERNS[:] = [(p, k) for p, k in _PATTERNS if k in INDICATORS]
 
 
 def indicator_info(key: str) -> Indicator:
@@ -307,6 +183,22 @@ def indicator_info(key: str) -> Indicator:
             base = INDICATORS[fam]
             return replace(base, key=key, name=base.name.format(m.group(1)))
     raise InputError(f"unknown indicator {key!r}; known: {', '.join(INDICATORS)}")
+
+
+def headline_indicators() -> tuple[str, ...]:
+    """The key indicators of a projection's figures and first screen, in their order
+    (``Indicator.headline``): parameterised ones by their column under the default
+    options (e.g. ``hours_above_LIM0``)."""
+    opts = resolve_options("headline_indicators", {})
+    default_cols = [c for f in FAMILIES for c in f.columns(opts)]
+    out = []
+    for i in sorted((i for i in INDICATORS.values() if i.headline), key=lambda i: i.headline):
+        if "{}" in i.key:
+            pat = _pattern(i.key)
+            out += [c for c in default_cols if pat.match(c)][:1]
+        else:
+            out.append(i.key)
+    return tuple(out)
 
 
 def check_indicator_names(names, available, where: str) -> None:

@@ -72,6 +72,7 @@ from heritage_bayes.init_checks import (
 )
 from heritage_bayes.init_columns import fahrenheit_column_check, rh_column_check, usable
 from heritage_bayes.init_model import propose_model
+from heritage_bayes.init_regimes import regime_stretch
 from heritage_bayes.init_roof import attic_evidence, roof_finding, solar_surface_lines
 from heritage_bayes.init_sources import source_lines as _source_lines
 from heritage_bayes.init_sources import timing_without_sun as _timing_without_sun
@@ -416,7 +417,23 @@ def init_config(
         raise DataError(f"{indoor.name}, {weather.name}: {exc}{typical}") from None
     findings.append(f"overlap: {span}: {s:%Y-%m-%d %H:%M} to {e:%Y-%m-%d %H:%M} UTC")
     findings += [f"overlap: {g}" for g in gap_notes]
-    floor, held, ndays = heating_floor(ti_utc, te_utc)
+    # an RH column that needs an answer keeps the hygric section: answered, it runs
+    rhe_open = wlay is not None and str(wcols.get("RHe", "")).startswith(MARK)
+    hygric = "RHi" in icols and ("RHe" in dw.columns or rhe_open)
+    rhi_utc = to_utc(din["RHi"], izone) if "RHi" in din else None
+    rhe_utc = (to_utc(dw["RHe"], wzone) if wlay is not None else dw["RHe"]) if "RHe" in dw else None
+    # the room run one way over the periods: the most recent stretch without a change
+    rs, re_, regime_notes = regime_stretch(
+        ti_utc, te_utc, rhi_utc if hygric else None, rhe_utc, s, e
+    )
+    findings += [f"operation: {n}" for n in regime_notes]
+    regime_why = ""
+    if (rs, re_) != (s, e) or len(regime_notes) > 1:  # a change: its evidence by the periods
+        regime_why = ". " + ". ".join(n[0].upper() + n[1:] for n in regime_notes[::-1])
+    if (rs, re_) != (s, e):
+        s, e = rs, re_
+        span = f"the stretch run one way ({s:%Y-%m-%d} to {e:%Y-%m-%d})"
+    floor, held, ndays = heating_floor(ti_utc[s:e], te_utc[s:e])
     heated = held >= max(20, 0.05 * ndays)
     findings.append(
         f"control: the indoor daily minimum sat at {floor:.1f} °C (within 0.5 K) on {held} of "
@@ -436,14 +453,10 @@ def init_config(
     # the inputs must hold a reading at both ends of the periods (the outputs need not)
     cs, ce, vs, ve, why = choose_periods(s, e, present_hours(te_utc, te_utc), span)
     findings.append(f"periods: {why}")
+    why += regime_why
     if season := extrapolated_seasons(te_utc, cs, ce, ve):
         findings.append(f"periods: {season}")
         why = f"{why}. Note: {season}"
-    # an RH column that needs an answer keeps the hygric section: answered, it runs
-    rhe_open = wlay is not None and str(wcols.get("RHe", "")).startswith(MARK)
-    hygric = "RHi" in icols and ("RHe" in dw.columns or rhe_open)
-    rhi_utc = to_utc(din["RHi"], izone) if "RHi" in din else None
-    rhe_utc = (to_utc(dw["RHe"], wzone) if wlay is not None else dw["RHe"]) if "RHe" in dw else None
     prop = propose_model(
         ti_utc,
         te_utc,

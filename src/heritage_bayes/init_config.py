@@ -471,7 +471,8 @@ def init_config(
     name = name or (output.parent.name if output.stem == "config" else output.stem) or "room"
     check_name(name, what="--name" if name_given else "name (from --output)")
 
-    sunlit = irr == "measured" or lat is not None  # a solar input: the surfaces it falls on
+    # a solar input: the surfaces it falls on; an estimate only where the room shows a sun
+    sunlit = irr == "measured" or (lat is not None and prop.daily_sun is not False)
     attic = attic_evidence((indoor.stem, name), ti_utc[cs:ve], te_utc[cs:ve]) if sunlit else None
     findings += [roof_finding(attic)] if attic else []
     lines = [
@@ -512,7 +513,11 @@ def init_config(
             *solar_surface_lines(attic),
         ]
     else:
-        lines += ["  irradiance: none"]
+        no_sun = lat is not None and prop.daily_sun is False
+        lines += [
+            "  irradiance: none"
+            + ("   # no measured irradiance, and no daily sun in the room" if no_sun else "")
+        ]
     lines += [*_doc("data.step"), "  step: 1h", *_doc("data.max_gap"), f"  max_gap: {MAX_GAP_H}h"]
     lines += [*_doc("data.input_hold"), "  input_hold: exact"]
     lines += ["", "periods:", *_wrap(why, "  # ", "  # ")]

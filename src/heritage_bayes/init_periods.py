@@ -120,6 +120,12 @@ def present_hours(ti: pd.Series, te: pd.Series) -> pd.DatetimeIndex:
     return a.intersection(b).sort_values()
 
 
+def _whole_months(s: pd.Timestamp, e: pd.Timestamp) -> int:
+    """Whole calendar months from ``s`` (a month's first day) to ``e``."""
+    n = (e.year - s.year) * 12 + e.month - s.month
+    return n if s + pd.DateOffset(months=n) <= e else n - 1
+
+
 def choose_periods(
     s: pd.Timestamp,
     e: pd.Timestamp,
@@ -130,7 +136,8 @@ def choose_periods(
     within the stretch ``[s, e)``, and why: the most recent whole calendar year followed
     by :data:`VALIDATION_MONTHS` or more to calibrate, and up to a year after it to
     validate (every season in both; the room as it is now, which a model for projections
-    and interventions describes); else the most recent whole calendar year (8 months to
+    and interventions describes); else the most recent 12 whole months followed by as
+    many; else the most recent whole calendar year (8 months to
     calibrate, 4 to validate), else the first 12 whole months, else the
     stretch's first 2/3 and the rest. With ``present`` (the hours with an input
     reading), the start and the end are midnights with a reading: a period never starts
@@ -158,6 +165,17 @@ def choose_periods(
             f"the most recent whole calendar year of {span} with "
             f"{VALIDATION_MONTHS} months or more after it to calibrate (all seasons; the "
             "room as it is now), up to a year after it to validate"
+        )
+    elif (months := _whole_months(s0, e0)) >= 12 + VALIDATION_MONTHS:
+        # no calendar year, but 12 whole months and VALIDATION_MONTHS after them: the
+        # most recent such 12 months (all seasons in both periods, as above)
+        last = s0 + pd.DateOffset(months=months)
+        mid = last - pd.DateOffset(months=min(12, months - 12))
+        s0, end = mid - pd.DateOffset(years=1), min(mid + pd.DateOffset(years=1), e0)
+        why = (
+            f"the most recent 12 whole months of {span} with {VALIDATION_MONTHS} months or "
+            "more after them to calibrate (all seasons; the room as it is now), up to a "
+            "year after them to validate"
         )
     else:
         if e0 >= jan + pd.DateOffset(years=1):  # a whole calendar year: the reporting year

@@ -17,9 +17,8 @@ A calendar year's *regime* is three signatures init also proposes the model from
   outdoor air 5 K or more below the record's floor (a winter).
 * **the summer excess**: the indoor minus the outdoor mean temperature [K] over the
   year's three warmest months (a constant heat gain: a dehumidifier's or a neighbour's
-  heat, lights); a gain at :data:`~heritage_bayes.init_model.GAIN_K` plus
-  :data:`GAIN_MARGIN_K` or more, none at ``GAIN_K`` minus it or less, unclear between.
-  Needs :data:`MIN_MONTHS` months with 20 days of data (a summer).
+  heat, lights); two years differ when their excesses differ by :data:`EXCESS_SHIFT_K`
+  or more. Needs :data:`MIN_MONTHS` months with 20 days of data (a summer).
 
 A signature a year cannot measure, or measures as unclear, agrees with any other.
 Walking back from the most recent year, a year joins the stretch while none of its
@@ -43,7 +42,7 @@ import numpy as np
 import pandas as pd
 
 from heritage_bayes.init_checks import heating_floor
-from heritage_bayes.init_model import BAND_MAX_PCT, BAND_RATIO, GAIN_K
+from heritage_bayes.init_model import BAND_MAX_PCT, BAND_RATIO
 from heritage_bayes.init_periods import VALIDATION_MONTHS
 
 __all__ = ["YearRegime", "regime_stretch", "year_regimes"]
@@ -51,9 +50,9 @@ __all__ = ["YearRegime", "regime_stretch", "year_regimes"]
 #: Points [% RH] above :data:`~heritage_bayes.init_model.BAND_MAX_PCT` at which a band is
 #: clearly free, and below it at which it is clearly held.
 BAND_MARGIN_PCT = 3.0
-#: Kelvin either side of :data:`~heritage_bayes.init_model.GAIN_K` that leave the summer
-#: excess unclear.
-GAIN_MARGIN_K = 0.5
+#: Change of the summer excess [K] between two years that is a gain switched on or off
+#: (Ørholm's years of one regime agree within 0.7 K).
+EXCESS_SHIFT_K = 2.0
 #: Shift of the heating floor [K] between two heated years that is a new set-point.
 FLOOR_SHIFT_K = 2.0
 #: Days of indoor RH a year needs for its band.
@@ -81,8 +80,6 @@ class YearRegime:
         The year's floor [°C] (5th percentile of the daily indoor minima).
     excess : float or None
         Indoor minus outdoor mean temperature over the three warmest months [K].
-    gain : bool or None
-        A constant gain (True), none (False) or unclear (None).
     """
 
     year: int
@@ -91,7 +88,6 @@ class YearRegime:
     heated: bool | None = None
     floor: float | None = None
     excess: float | None = None
-    gain: bool | None = None
 
     def describe(self) -> str:
         """The year in words: ``2019: RH band 23 points (free), floor 10.0 °C, ...``."""
@@ -109,7 +105,7 @@ class YearRegime:
                 f"heating floor {self.floor:.1f} °C" if self.heated else "no heating floor"
             )
         if self.excess is not None:
-            parts.append(f"summer {self.excess:+.1f} K ({cls(self.gain, 'a gain', 'no gain')})")
+            parts.append(f"summer {self.excess:+.1f} K above outdoors")
         return f"{self.year}: " + (", ".join(parts) or "too little data")
 
     def differs(self, other: YearRegime) -> list[str]:
@@ -121,14 +117,15 @@ class YearRegime:
             out.append("the heating floor")
         elif self.heated and other.heated and abs(self.floor - other.floor) >= FLOOR_SHIFT_K:
             out.append("the heating set-point")
-        if None not in (self.gain, other.gain) and self.gain != other.gain:
-            out.append("the summer gain")
+        if None not in (self.excess, other.excess):
+            if abs(self.excess - other.excess) >= EXCESS_SHIFT_K:
+                out.append("the summer gain")
         return out
 
     def merged(self, older: YearRegime) -> YearRegime:
         """This stretch's signatures, those it cannot tell taken from ``older``."""
         kw = {}
-        for a, b in (("rh_held", "rh_width"), ("heated", "floor"), ("gain", "excess")):
+        for a, b in (("rh_held", "rh_width"), ("heated", "floor"), ("excess", "excess")):
             src = self if getattr(self, a) is not None else older
             kw[a], kw[b] = getattr(src, a), getattr(src, b)
         return YearRegime(self.year, **kw)
@@ -186,9 +183,7 @@ def year_regimes(
         months = both.resample("MS").mean()[count >= 24 * 20]
         if len(months) >= MIN_MONTHS:
             warm = months.nlargest(3, "te")
-            excess = float((warm["ti"] - warm["te"]).mean())
-            gain = _unclear(-excess, -(GAIN_K + GAIN_MARGIN_K), -(GAIN_K - GAIN_MARGIN_K))
-            kw.update(excess=excess, gain=gain)
+            kw["excess"] = float((warm["ti"] - warm["te"]).mean())
         out.append(YearRegime(year, **kw))
     return out
 

@@ -430,10 +430,12 @@ def init_config(
     regime_why = ""
     if (rs, re_) != (s, e) or len(regime_notes) > 1:  # a change: its evidence by the periods
         regime_why = ". " + ". ".join(n[0].upper() + n[1:] for n in regime_notes[::-1])
+    floor_ti, floor_te = ti_utc, te_utc  # the floor over the whole overlap, or the stretch
     if (rs, re_) != (s, e):
         s, e = rs, re_
         span = f"the stretch run one way ({s:%Y-%m-%d} to {e:%Y-%m-%d})"
-    floor, held, ndays = heating_floor(ti_utc[s:e], te_utc[s:e])
+        floor_ti, floor_te = ti_utc[s:e], te_utc[s:e]
+    floor, held, ndays = heating_floor(floor_ti, floor_te)
     heated = held >= max(20, 0.05 * ndays)
     findings.append(
         f"control: the indoor daily minimum sat at {floor:.1f} °C (within 0.5 K) on {held} of "

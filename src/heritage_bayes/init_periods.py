@@ -120,12 +120,6 @@ def present_hours(ti: pd.Series, te: pd.Series) -> pd.DatetimeIndex:
     return a.intersection(b).sort_values()
 
 
-def _whole_months(s: pd.Timestamp, e: pd.Timestamp) -> int:
-    """Whole calendar months from ``s`` (a month's first day) to ``e``."""
-    n = (e.year - s.year) * 12 + e.month - s.month
-    return n if s + pd.DateOffset(months=n) <= e else n - 1
-
-
 def choose_periods(
     s: pd.Timestamp,
     e: pd.Timestamp,
@@ -166,11 +160,12 @@ def choose_periods(
             f"{VALIDATION_MONTHS} months or more after it to calibrate (all seasons; the "
             "room as it is now), up to a year after it to validate"
         )
-    elif (months := _whole_months(s0, e0)) >= 12 + VALIDATION_MONTHS:
+    elif (e0 - (s0 + pd.DateOffset(years=1))).days >= 30 * VALIDATION_MONTHS:
         # no calendar year, but 12 whole months and VALIDATION_MONTHS after them: the
-        # most recent such 12 months (all seasons in both periods, as above)
-        last = s0 + pd.DateOffset(months=months)
-        mid = last - pd.DateOffset(months=min(12, months - 12))
+        # most recent such 12 months, a year after them to validate where the data
+        # reach that far (all seasons in both periods, as above)
+        last_year = e0 - pd.DateOffset(years=1)
+        mid = max(s0 + pd.DateOffset(years=1), last_year.normalize().replace(day=1))
         s0, end = mid - pd.DateOffset(years=1), min(mid + pd.DateOffset(years=1), e0)
         why = (
             f"the most recent 12 whole months of {span} with {VALIDATION_MONTHS} months or "

@@ -121,3 +121,21 @@ def test_a_year_near_a_threshold_joins_either_side():
     start, end, notes = regime_stretch(*series, s, e)
     assert (start, end) == (OFF, e)  # 2015 and 2016: a year and 8 months or more
     assert "the most recent stretch run one way" in notes[-1]
+
+
+def test_twenty_months_calibrate_a_whole_year():
+    """A record of 20 months holding no calendar year with 8 months after it (the
+    Ørholm logger file as a user held it, 2013-03 to 2014-10): 12 whole months calibrate,
+    the rest validates; 19 months keep the 8/4 split of the first year."""
+    from heritage_bayes.init_periods import choose_periods
+
+    utc = "UTC"
+    s = pd.Timestamp("2013-03-01", tz=utc)
+    cs, ce, _, ve, why = choose_periods(s, pd.Timestamp("2014-10-31", tz=utc))
+    assert (cs, ce, ve) == ("2013-03-01", "2014-03-01", "2014-10-31")
+    assert why.startswith("the most recent 12 whole months")
+    cs, ce, _, ve, _ = choose_periods(s, pd.Timestamp("2014-10-01", tz=utc))
+    assert (cs, ce, ve) == ("2013-03-01", "2013-11-01", "2014-03-01")
+    # 26 months: the most recent 12 with a year after them
+    cs, ce, _, ve, _ = choose_periods(s, pd.Timestamp("2015-05-01", tz=utc))
+    assert (cs, ce, ve) == ("2013-05-01", "2014-05-01", "2015-05-01")

@@ -23,9 +23,10 @@ and ``tests/test_init.py``):
   its roof's two slopes instead (``data.roof``, :mod:`heritage_bayes.init_roof`).
 * **Periods**: chosen after the clocks, on UTC, in the usable span
   (:func:`~heritage_bayes.init_checks.usable_span`: the overlap of the files, else its
-  most recent 12 months, with readings in 70 % of the hours from each file): its first
-  whole calendar year (all seasons; 8 months to calibrate, 4 to validate), else its
-  first whole 12 months, else 2/3 and 1/3 of it; spanning gaps (the calibration splits
+  most recent 12 months, with readings in 70 % of the hours from each file), within its
+  most recent stretch run one way (:mod:`~heritage_bayes.init_regimes`: the RH band, the
+  heating floor and the summer gain year by year), as
+  :func:`~heritage_bayes.init_periods.choose_periods` says; spanning gaps (the calibration splits
   at those over ``data.max_gap``) but never starting or ending in one. While a clock is
   an open question they keep 14 h (the largest offset) inside the span, so that any
   answer keeps them inside the data.

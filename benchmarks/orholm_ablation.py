@@ -4,9 +4,11 @@ FIT [%] (benchmarks/real_rooms.py's budget: 100 generations, 2 local starts).
 Two families: the hand-written ``configs/orholm.yaml`` on its periods (2015 / 2016) as
 shipped, without its constant gain, and with each of init's choices in turn (two
 nodes, the seasonal ground, the estimated sun on one horizontal aperture); and init's
-config from the raw files (written to a temporary folder) on other periods: 2012 split
-8/4 months without the constant gain (what init proposed when it took the first year),
-2014 split 8/4, and 2014 / 2015 (what init takes now).
+config from the raw files (written to a temporary folder): as written (2019 / 2020, the
+most recent stretch the store was run one way: its dehumidifier and its heat gone from
+2018), with the estimated sun put back, without the constant gain, and on other periods:
+2012 split 8/4 months without the constant gain (what init proposed when it took the
+first year), 2014 split 8/4, and 2014 / 2015 (the dehumidified years).
 
 Usage (from the repository root)::
 
@@ -69,7 +71,14 @@ def variants(init_cfg):
         "init, 2014 8/4": lambda: _with(
             init_cfg, periods=("2014-01-01", "2014-09-01", "2015-01-01")
         ),
-        "init, 2014 / 2015": lambda: _with(init_cfg),
+        "init, 2014 / 2015": lambda: _with(
+            init_cfg, periods=("2014-01-01", "2015-01-01", "2016-01-01")
+        ),
+        "init as written": lambda: _with(init_cfg),
+        "init + estimated sun": lambda: _with(
+            init_cfg, data={"irradiance": "estimated", "surfaces": {"H": (0.0, 0.0)}}
+        ),
+        "init without source": lambda: _with(init_cfg, thermal={"options": no_gain}),
     }
 
 

@@ -23,9 +23,10 @@ and ``tests/test_init.py``):
   its roof's two slopes instead (``data.roof``, :mod:`heritage_bayes.init_roof`).
 * **Periods**: chosen after the clocks, on UTC, in the usable span
   (:func:`~heritage_bayes.init_checks.usable_span`: the overlap of the files, else its
-  most recent 12 months, with readings in 70 % of the hours from each file): its first
-  whole calendar year (all seasons; 8 months to calibrate, 4 to validate), else its
-  first whole 12 months, else 2/3 and 1/3 of it; spanning gaps (the calibration splits
+  most recent 12 months, with readings in 70 % of the hours from each file), within its
+  most recent stretch run one way (:mod:`~heritage_bayes.init_regimes`: the RH band, the
+  heating floor and the summer gain year by year), as
+  :func:`~heritage_bayes.init_periods.choose_periods` says; spanning gaps (the calibration splits
   at those over ``data.max_gap``) but never starting or ending in one. While a clock is
   an open question they keep 14 h (the largest offset) inside the span, so that any
   answer keeps them inside the data.
@@ -72,6 +73,7 @@ from heritage_bayes.init_checks import (
 )
 from heritage_bayes.init_columns import fahrenheit_column_check, rh_column_check, usable
 from heritage_bayes.init_model import propose_model
+from heritage_bayes.init_regimes import regime_stretch
 from heritage_bayes.init_roof import attic_evidence, roof_finding, solar_surface_lines
 from heritage_bayes.init_sources import source_lines as _source_lines
 from heritage_bayes.init_sources import timing_without_sun as _timing_without_sun
@@ -416,7 +418,25 @@ def init_config(
         raise DataError(f"{indoor.name}, {weather.name}: {exc}{typical}") from None
     findings.append(f"overlap: {span}: {s:%Y-%m-%d %H:%M} to {e:%Y-%m-%d %H:%M} UTC")
     findings += [f"overlap: {g}" for g in gap_notes]
-    floor, held, ndays = heating_floor(ti_utc, te_utc)
+    # an RH column that needs an answer keeps the hygric section: answered, it runs
+    rhe_open = wlay is not None and str(wcols.get("RHe", "")).startswith(MARK)
+    hygric = "RHi" in icols and ("RHe" in dw.columns or rhe_open)
+    rhi_utc = to_utc(din["RHi"], izone) if "RHi" in din else None
+    rhe_utc = (to_utc(dw["RHe"], wzone) if wlay is not None else dw["RHe"]) if "RHe" in dw else None
+    # the room run one way over the periods: the most recent stretch without a change
+    rs, re_, regime_notes = regime_stretch(
+        ti_utc, te_utc, rhi_utc if hygric else None, rhe_utc, s, e
+    )
+    findings += [f"operation: {n}" for n in regime_notes]
+    regime_why = ""
+    if (rs, re_) != (s, e) or len(regime_notes) > 1:  # a change: its evidence by the periods
+        regime_why = ". " + ". ".join(n[0].upper() + n[1:] for n in regime_notes[::-1])
+    floor_ti, floor_te = ti_utc, te_utc  # the floor over the whole overlap, or the stretch
+    if (rs, re_) != (s, e):
+        s, e = rs, re_
+        span = f"the stretch run one way ({s:%Y-%m-%d} to {e:%Y-%m-%d})"
+        floor_ti, floor_te = ti_utc[s:e], te_utc[s:e]
+    floor, held, ndays = heating_floor(floor_ti, floor_te)
     heated = held >= max(20, 0.05 * ndays)
     findings.append(
         f"control: the indoor daily minimum sat at {floor:.1f} °C (within 0.5 K) on {held} of "
@@ -436,14 +456,10 @@ def init_config(
     # the inputs must hold a reading at both ends of the periods (the outputs need not)
     cs, ce, vs, ve, why = choose_periods(s, e, present_hours(te_utc, te_utc), span)
     findings.append(f"periods: {why}")
+    why += regime_why
     if season := extrapolated_seasons(te_utc, cs, ce, ve):
         findings.append(f"periods: {season}")
         why = f"{why}. Note: {season}"
-    # an RH column that needs an answer keeps the hygric section: answered, it runs
-    rhe_open = wlay is not None and str(wcols.get("RHe", "")).startswith(MARK)
-    hygric = "RHi" in icols and ("RHe" in dw.columns or rhe_open)
-    rhi_utc = to_utc(din["RHi"], izone) if "RHi" in din else None
-    rhe_utc = (to_utc(dw["RHe"], wzone) if wlay is not None else dw["RHe"]) if "RHe" in dw else None
     prop = propose_model(
         ti_utc,
         te_utc,
@@ -458,7 +474,8 @@ def init_config(
     name = name or (output.parent.name if output.stem == "config" else output.stem) or "room"
     check_name(name, what="--name" if name_given else "name (from --output)")
 
-    sunlit = irr == "measured" or lat is not None  # a solar input: the surfaces it falls on
+    # a solar input: the surfaces it falls on; an estimate only where the room shows a sun
+    sunlit = irr == "measured" or (lat is not None and prop.daily_sun is not False)
     attic = attic_evidence((indoor.stem, name), ti_utc[cs:ve], te_utc[cs:ve]) if sunlit else None
     findings += [roof_finding(attic)] if attic else []
     lines = [
@@ -499,7 +516,11 @@ def init_config(
             *solar_surface_lines(attic),
         ]
     else:
-        lines += ["  irradiance: none"]
+        no_sun = lat is not None and prop.daily_sun is False
+        lines += [
+            "  irradiance: none"
+            + ("   # no measured irradiance, and no daily sun in the room" if no_sun else "")
+        ]
     lines += [*_doc("data.step"), "  step: 1h", *_doc("data.max_gap"), f"  max_gap: {MAX_GAP_H}h"]
     lines += [*_doc("data.input_hold"), "  input_hold: exact"]
     lines += ["", "periods:", *_wrap(why, "  # ", "  # ")]

@@ -11,10 +11,13 @@ written as comments above them:
 * **a heating floor** (thermostat, :func:`heritage_bayes.init_checks.heating_floor`) →
   ``thermal.options: {thermostat: true}``; with it, an indoor air warmer than outdoors by
   :data:`GAIN_K` or more in the warmest month (when no heating runs) → ``source: true``,
-  a constant heat gain;
+  a constant heat gain (the sun's mean gain too, where no irradiance is measured);
 * **the sun on the room**: the median daily indoor temperature range against the
   outdoor one: at least as large, the room gains heat from the sun (a roof, windows):
-  the solar apertures (``data.surfaces``) are kept, and the ratio is noted;
+  the solar apertures (``data.surfaces``) are kept, and the ratio is noted; under
+  :data:`SUNLESS_RATIO` and no irradiance measured, no daily sun shows in the room and
+  the irradiance estimated from the daily outdoor range (a proxy whose daily cycle is the
+  outdoor air's) is left out: ``irradiance: none`` (:attr:`ModelProposal.daily_sun`);
 * **a vapour sink**: indoor vapour pressure below the outdoor one on average, by at
   least :data:`SINK_PA`, in most months (without an RH band, which explains it) →
   ``hygric_2c_fixed`` with ``sink: temperature`` (a sink at ``phi_f·psat(Tf)``, the ground);
@@ -57,8 +60,11 @@ BAND_MAX_PCT = 15.0
 #: ... and at most this fraction of the outdoor band.
 BAND_RATIO = 0.4
 #: Indoor minus outdoor mean temperature [K] in the warmest month of a heated room that
-#: says a constant heat gain.
-GAIN_K = 3.0
+#: says a constant heat gain: a massive room without one sits at the outdoor mean or
+#: under it in its warmest month (it lags the season).
+GAIN_K = 1.5
+#: Median daily indoor over outdoor temperature range under which no daily sun shows.
+SUNLESS_RATIO = 0.3
 #: Mean indoor minus outdoor vapour pressure [Pa] at or below ``-SINK_PA``: a sink.
 SINK_PA = 30.0
 #: Mean indoor minus outdoor vapour pressure [Pa] at or above this: a moisture source.
@@ -83,6 +89,9 @@ class ModelProposal:
     hygric_options: dict = field(default_factory=dict)
     thermal_evidence: list[str] = field(default_factory=list)
     hygric_evidence: list[str] = field(default_factory=list)
+    #: The room's daily swing against the outdoor one: a daily sun (True), none (False)
+    #: or not measured (None).
+    daily_sun: bool | None = None
 
 
 def _hourly(s: pd.Series | None, start, end) -> pd.Series | None:
@@ -138,6 +147,7 @@ def _thermal(p: ModelProposal, ti, te, heated: tuple[float, int, int], cal_days:
     ri, re_ = _daily_range(ti), _daily_range(te)
     if np.isfinite(ri) and np.isfinite(re_) and re_ > 0:
         ratio = ri / re_
+        p.daily_sun = ratio >= SUNLESS_RATIO
         p.thermal_evidence.append(
             f"daily swing: median indoor range {ri:.2f} K against outdoors {re_:.2f} K "
             f"(ratio {ratio:.2f}): "
@@ -146,6 +156,12 @@ def _thermal(p: ModelProposal, ti, te, heated: tuple[float, int, int], cal_days:
                 "apertures (data.surfaces; name roof planes or facades when known)"
                 if ratio >= 1
                 else "smaller indoors: damped by the envelope"
+                + (
+                    f"; under {SUNLESS_RATIO:g}, no daily sun shows in the room: without "
+                    "measured irradiance, none is estimated (irradiance: none)"
+                    if ratio < SUNLESS_RATIO
+                    else ""
+                )
             )
         )
     if cal_days >= LONG_DAYS:

@@ -130,7 +130,8 @@ def choose_periods(
     within the stretch ``[s, e)``, and why: the most recent whole calendar year followed
     by :data:`VALIDATION_MONTHS` or more to calibrate, and up to a year after it to
     validate (every season in both; the room as it is now, which a model for projections
-    and interventions describes); else the most recent whole calendar year (8 months to
+    and interventions describes); else the most recent 12 whole months followed by as
+    many; else the most recent whole calendar year (8 months to
     calibrate, 4 to validate), else the first 12 whole months, else the
     stretch's first 2/3 and the rest. With ``present`` (the hours with an input
     reading), the start and the end are midnights with a reading: a period never starts
@@ -158,6 +159,18 @@ def choose_periods(
             f"the most recent whole calendar year of {span} with "
             f"{VALIDATION_MONTHS} months or more after it to calibrate (all seasons; the "
             "room as it is now), up to a year after it to validate"
+        )
+    elif (e0 - (s0 + pd.DateOffset(years=1))).days >= 30 * VALIDATION_MONTHS:
+        # no calendar year, but 12 whole months and VALIDATION_MONTHS after them: the
+        # most recent such 12 months, a year after them to validate where the data
+        # reach that far (all seasons in both periods, as above)
+        last_year = e0 - pd.DateOffset(years=1)
+        mid = max(s0 + pd.DateOffset(years=1), last_year.normalize().replace(day=1))
+        s0, end = mid - pd.DateOffset(years=1), min(mid + pd.DateOffset(years=1), e0)
+        why = (
+            f"the most recent 12 whole months of {span} with {VALIDATION_MONTHS} months or "
+            "more after them to calibrate (all seasons; the room as it is now), up to a "
+            "year after them to validate"
         )
     else:
         if e0 >= jan + pd.DateOffset(years=1):  # a whole calendar year: the reporting year

@@ -47,8 +47,9 @@ __all__ = [
 REFERENCE_WIND = 4.0
 #: Conductance of a roof's cover to the attic [W/(m² K)], :math:`U_r`: boarding or
 #: sarking (about 0.1 m² K/W) with the underside's surface resistance (0.10, ISO 6946
-#: upward flow) and the cover's contact, about 5 W/(m² K). Chosen from 0, 5, 12 and 30
-#: on the attics it was tuned on (``docs/science/real_rooms.md``, "The wind on the roof").
+#: upward flow) and the cover's contact, about 5 W/(m² K); of 0, 5 and 12 the value
+#: that fitted the attics it was tuned on best (``docs/science/real_rooms.md``, "The wind
+#: on the roof").
 ROOF_INNER_CONDUCTANCE = 5.0
 #: Long-wave emissivity of the roof's outer surface [-] (tile, slate, painted metal).
 _EMISSIVITY = 0.9
@@ -69,9 +70,7 @@ def exterior_surface_coefficient(wind_speed) -> np.ndarray:
     v = np.asarray(wind_speed, dtype=float)
     if not np.isfinite(v).all() or (v < 0).any():
         bad = v[~(np.isfinite(v) & (v >= 0))]
-        raise InputError(
-            f"wind speed: finite values >= 0 m/s expected (found {bad[:3].tolist()})"
-        )
+        raise InputError(f"wind speed: finite values >= 0 m/s expected (found {bad[:3].tolist()})")
     return _EMISSIVITY * _HR0 + 4.0 + 4.0 * v
 
 

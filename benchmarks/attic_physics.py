@@ -23,7 +23,8 @@ variant of the roof planes' irradiance input:
 The three candidates are not in the package (only the wind weight paid, see
 ``docs/science/real_rooms.md``, "The wind on the roof"); they are written here as
 changes of the irradiance table before alignment. ``--hours``: the MAP's residual
-(measured - simulated Ti) by season and hour of day, calibration and validation.
+(measured - simulated Ti) by season and hour of day, calibration and validation, and
+the correlation of its daily mean with FMI's daily mean wind speed.
 
 Usage (from the repository root)::
 
@@ -142,7 +143,8 @@ def run(room, variant, bare, data, work, hours):
     weather = None
     if bare:
         weather = w / "wx" / "fmi.csv"
-        pd.read_csv(data / ROOMS[room][1]).drop(columns=["Rglob", "Rdif"]).to_csv(weather, index=False)
+        bare_fmi = pd.read_csv(data / ROOMS[room][1]).drop(columns=["Rglob", "Rdif"])
+        bare_fmi.to_csv(weather, index=False)
     cfg = load_config(run_init(room, data, w, weather)[0])
     if variant == "none":
         cols = {k: v for k, v in cfg.data.weather.columns.items() if k != "wind"}
@@ -167,6 +169,12 @@ def run(room, variant, bare, data, work, hours):
         season = np.array(["DJF", "DJF", "MAM", "MAM", "MAM", "JJA", "JJA", "JJA", "SON",
                            "SON", "SON", "DJF"])[e.index.month - 1]  # fmt: skip
         print(e.groupby([season, e.index.hour]).mean().unstack(0).iloc[::6].round(2))
+        ws = _fmi(room, data)["ws"].reindex(e.index - pd.Timedelta(hours=2))
+        daily = pd.DataFrame({"e": e.to_numpy(), "ws": ws.to_numpy()}).groupby(
+            np.asarray(e.index.floor("D"))
+        )
+        r = daily.mean().corr().loc["e", "ws"]
+        print(f"correlation of the daily mean residual with the daily mean wind: {r:.2f}")
     return fit
 
 

@@ -152,7 +152,79 @@ def test_init_writes_the_roof_for_an_attic_and_not_for_the_room_below(shared_dat
     assert any(f.startswith("roof: the room looks like an attic") for f in res.findings)
     cfg = load_config(tmp_path / "a.yaml")
     assert cfg.data.surfaces == {"roof_N": (45.0, 0.0), "roof_S": (45.0, 180.0)}
+    assert cfg.data.weather.columns["wind"] == "ws"  # FMI's wind speed: the sun on the roof
     # the heated room below: neither its name nor its daily swing (0.2 of outdoors') says roof
     res = init_config(d / "indoor1.csv", d / "fmi.csv", output=tmp_path / "b.yaml", **site)
     assert "roof:" not in res.text
     assert load_config(tmp_path / "b.yaml").data.surfaces == {"H": (0.0, 0.0)}
+
+
+def test_wind_weight_is_iso_6946s_share_reaching_the_attic():
+    from heritage_bayes.climate.solair import (
+        REFERENCE_WIND,
+        ROOF_INNER_CONDUCTANCE,
+        exterior_surface_coefficient,
+        roof_wind_weight,
+    )
+
+    # R_se 0.04 m² K/W at the standard 4 m/s (ISO 6946 annex C: 4 + 4 v + 0.9 × 4.6)
+    assert 1 / exterior_surface_coefficient(REFERENCE_WIND) == pytest.approx(0.0414, abs=5e-4)
+    assert roof_wind_weight(REFERENCE_WIND) == pytest.approx(1.0)
+    u = ROOF_INNER_CONDUCTANCE
+    calm = (24.14 + u) / (8.14 + u)
+    assert roof_wind_weight([0.0])[0] == pytest.approx(calm, rel=1e-3)
+    w = roof_wind_weight(np.linspace(0, 20, 41))
+    assert (np.diff(w) < 0).all() and w[-1] > 0  # more wind, less of the sun inside
+    # no conductance to the attic: the share goes as 1/h_e
+    assert roof_wind_weight(8.0, 0.0) == pytest.approx(24.14 / 40.14, rel=1e-3)
+    for bad in ([-1.0], [np.nan]):
+        with pytest.raises(InputError, match="wind speed: finite values >= 0 m/s"):
+            roof_wind_weight(bad)
+    with pytest.raises(InputError, match="inner_conductance"):
+        roof_wind_weight(1.0, -2.0)
+
+
+def test_wind_weights_the_roof_planes_only():
+    """The slopes' irradiance times the wind weight, a facade's unchanged; no wind column:
+    nothing changes; gaps in the wind are interpolated."""
+    from heritage_bayes.climate.solair import roof_wind_weight
+    from heritage_bayes.errors import DataError
+
+    cfg = _config({"pitch": 30, "ridge_azimuth": 0}, surfaces={"S": [90, 180]})
+    idx = pd.date_range("2011-06-01", periods=48, freq="1h", tz="UTC")
+    ghi = pvlib.location.Location(60.21, 24.66).get_clearsky(idx)["ghi"]
+    wind = np.where(np.arange(48) < 24, 0.0, 8.0)
+    weather = pd.DataFrame({"ghi": ghi, "Te": 15.0, "wind": wind}, index=idx)
+    roof = ("roof_E", "roof_W")
+    plain, _, _ = solar_inputs(weather.drop(columns="wind"), SITE, cfg.data.surfaces, "measured")
+    got, _, detail = solar_inputs(weather, SITE, cfg.data.surfaces, "measured", roof=roof)
+    w = roof_wind_weight(wind)
+    for c in ("I_roof_E", "I_roof_W"):
+        np.testing.assert_allclose(got[c], plain[c] * w)
+    np.testing.assert_allclose(got["I_S"], plain["I_S"])
+    assert "weighted by the wind" in detail
+    same, _, _ = solar_inputs(weather.drop(columns="wind"), SITE, cfg.data.surfaces, "measured",
+                              roof=roof)  # fmt: skip
+    np.testing.assert_allclose(same["I_roof_E"], plain["I_roof_E"])
+    gappy = weather.assign(wind=np.where(np.arange(48) == 30, np.nan, wind))
+    filled, _, _ = solar_inputs(gappy, SITE, cfg.data.surfaces, "measured", roof=roof)
+    np.testing.assert_allclose(filled["I_roof_E"], got["I_roof_E"])
+    with pytest.raises(DataError, match=r"data\.weather: column 'wind': wind speed"):
+        solar_inputs(weather.assign(wind=-1.0), SITE, cfg.data.surfaces, "measured", roof=roof)
+
+
+def test_init_reads_a_wind_speed_column(tmp_path):
+    """A weather file's wind speed (FMI's 'ws') is mapped to 'wind'; its direction is
+    not."""
+    from heritage_bayes.io.loggers import inspect_table
+
+    idx = pd.date_range("2011-06-01", periods=200, freq="1h")
+    text = "t,Te,RHe,ws,wd\n" + "\n".join(
+        f"{t:%Y-%m-%d %H:%M:%S},{10 + i % 7},{80 - i % 9},{(i % 11) * 0.7:.1f},{i % 360}"
+        for i, t in enumerate(idx)
+    )
+    p = tmp_path / "fmi.csv"
+    p.write_text(text, encoding="utf-8")
+    lay = inspect_table(p)
+    assert lay.first("wind").name == "ws" and lay.first("wind").unit == "m/s"
+    assert [c.name for c in lay.columns if c.kind is None] == ["wd"]

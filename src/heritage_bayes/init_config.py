@@ -332,7 +332,7 @@ def init_config(
         )
         wcols, wunits = _pick(
             wlay,
-            {"Te": "T", "RHe": "RH", "ghi": "ghi", "dhi": "dhi", "dni": "dni"},
+            {"Te": "T", "RHe": "RH", "ghi": "ghi", "dhi": "dhi", "dni": "dni", "wind": "wind"},
             findings,
             "weather",
         )

@@ -121,7 +121,9 @@ def solar_surface_lines(attic: str | None) -> list[str]:
         "facing N and S; 0 north-south, slopes facing E and W]: these are init's defaults "
         f"({DEFAULT_PITCH:g}°, an east-west ridge); give your roof's. Add area: [m², both "
         "slopes along the slope] for a prior on the apertures. A mono-pitch or flat roof, or "
-        "not an attic: replace 'roof' by surfaces (e.g. {H: [0, 0]})."
+        "not an attic: replace 'roof' by surfaces (e.g. {H: [0, 0]}). With a wind speed in "
+        "the weather (weather.columns.wind [m/s]) the slopes' sun is weighted by the wind "
+        "on the roof (a calm day's sun heats the attic more)."
     )
     return [
         *wrap_comment(text, "  # ", "  # "),

@@ -293,6 +293,7 @@ def solar_inputs(
     mode: str,
     *,
     where: str = "data.weather",
+    roof: Sequence[str] = (),
 ) -> tuple[pd.DataFrame, str, str]:
     """Irradiance on each solar surface as model inputs ``I_<surface>`` [W/m²].
 
@@ -309,6 +310,13 @@ def solar_inputs(
         ``Te`` (:func:`heritage_bayes.climate.solar.temperature_range_weather`); or the
         cloudless sky. With the last two, measured columns, if any, are dropped and the
         input is labelled.
+    roof : sequence of str, optional
+        The surfaces that are opaque roof planes: when the weather has a wind speed
+        ``wind`` [m/s], their irradiance is weighted by the share of the absorbed sun
+        that reaches the attic at that wind
+        (:func:`heritage_bayes.climate.solair.roof_wind_weight`; gaps in the wind
+        interpolated in time); without it, or for other surfaces, unweighted (the
+        standard exterior resistance).
 
     Returns
     -------
@@ -373,6 +381,10 @@ def solar_inputs(
     except InputError as exc:
         raise ConfigError(f"{where}: {exc}") from None
     detail = irr.attrs.get("irradiance_source", label)
+    planes = [k for k in roof if k in surfaces]
+    if planes and "wind" in weather.columns:
+        irr = _wind_weighted(irr, weather["wind"], planes, where)
+        detail += f"; roof planes {planes} weighted by the wind on the roof (ISO 6946 h_e)"
     if mode != "measured" and present:
         detail += f"; measured {present} ignored (data.irradiance: {mode})"
     out = irr.rename(columns={k: f"I_{k}" for k in surfaces})
@@ -382,6 +394,24 @@ def solar_inputs(
     out.attrs["irradiance_source"] = detail
     out.attrs["source"] = f"{attrs.get('source', 'weather')} (irradiance on surfaces)"
     return out, label, detail
+
+
+def _wind_weighted(irr: pd.DataFrame, wind: pd.Series, planes, where: str) -> pd.DataFrame:
+    """``irr`` with the ``planes`` columns times the roof's wind weight."""
+    from heritage_bayes.climate.solair import roof_wind_weight
+
+    v = wind.reindex(irr.index).interpolate(limit_direction="both")
+    if not np.isfinite(v.to_numpy(dtype=float)).any():
+        raise DataError(f"{where}: the wind speed column 'wind' has no values")
+    try:
+        w = roof_wind_weight(v.to_numpy(dtype=float))
+    except InputError as exc:
+        raise DataError(f"{where}: column 'wind': {exc}") from None
+    out = irr.copy()
+    for k in planes:
+        out[k] = irr[k].to_numpy(dtype=float) * w
+    out.attrs = dict(irr.attrs)
+    return out
 
 
 def _with_vapour_pressure(df: pd.DataFrame, target: str, where: str) -> pd.DataFrame:
@@ -427,6 +457,7 @@ def weather_inputs(
     surfaces: Mapping[str, Sequence[float]],
     where: str = "data.weather",
     extra: Sequence[str] = (),
+    roof: Sequence[str] = (),
 ) -> tuple[list[pd.DataFrame], dict]:
     """The input tables to align: ``Te`` (thermal), ``Pe`` (hygric), ``I_<surface>``.
 
@@ -434,7 +465,8 @@ def weather_inputs(
     as they are (e.g. a measured heating power ``Ph`` [W] for a heated test cell, or the
     inputs of a custom network); a missing one is reported when the model asks for it.
     ``irradiance`` None (``data.irradiance``'s default) is ``"measured"`` when the weather
-    has ``ghi``, else ``"estimated"``.
+    has ``ghi``, else ``"estimated"``. ``roof``: the surfaces that are roof planes (their
+    sun weighted by the wind, :func:`solar_inputs`).
 
     Returns the tables and a dict ``{"irradiance_source": short, "irradiance": {...}}``.
     """
@@ -465,7 +497,9 @@ def weather_inputs(
                 "site: required (latitude, longitude) to compute solar irradiance on the "
                 "surfaces; or set data.irradiance: none"
             )
-        irr, label, detail = solar_inputs(weather, site, surfaces, irradiance, where=where)
+        irr, label, detail = solar_inputs(
+            weather, site, surfaces, irradiance, where=where, roof=roof
+        )
         tables.append(irr)
         note = {
             "irradiance_source": label,

@@ -319,8 +319,7 @@ def prepare(cfg) -> Prepared:
     if not (thermal or hygric):
         raise ConfigError("give at least one of 'thermal' and 'hygric'")
     _check_models_vs_irradiance(cfg)
-    data = cfg.data
-    step = data.step
+    data, step = cfg.data, cfg.data.step
     surfaces = {k: tuple(v) for k, v in data.surfaces.items()}
     truth = None
 
@@ -339,6 +338,7 @@ def prepare(cfg) -> Prepared:
         surfaces=surfaces,
         where="data.weather",
         extra=_extra_inputs(cfg),
+        roof=tuple(data.roof.planes()) if data.roof is not None else (),
     )
     sources["irradiance"] = note["irradiance"]
     irradiance_source = note["irradiance_source"]

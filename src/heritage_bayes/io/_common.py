@@ -50,6 +50,7 @@ STANDARD_COLUMNS: dict[str, tuple[str, str, tuple[float, float]]] = {
         "the glazing, a test cell's solar sensor)",
         (0.0, 1500.0),
     ),
+    "wind": ("m/s", "wind speed (a weather station's, 10 m above the ground)", (0.0, 75.0)),
 }
 
 #: Columns that are interval averages (stamped at the interval end) unless told otherwise.

@@ -28,7 +28,7 @@ from heritage_bayes.errors import ConfigError, DataError, InputError
 MAX_SITE_DISTANCE_KM = 50.0
 _EARTH_RADIUS_KM = 6371.0
 
-_WEATHER_COLUMNS = ("Te", "RHe", "Pe", "ghi", "dni", "dhi", "Tdew", "Ph")
+_WEATHER_COLUMNS = ("Te", "RHe", "Pe", "ghi", "dni", "dhi", "Tdew", "Ph", "wind")
 
 
 @dataclass
@@ -211,6 +211,7 @@ def model_inputs(run, pcfg, weather: pd.DataFrame, site: dict | None, where: str
         surfaces={k: tuple(v) for k, v in data.surfaces.items()},
         where=where,
         extra=_extra_inputs(cfg),
+        roof=tuple(data.roof.planes()) if data.roof is not None else (),
     )
     try:
         aligned = align(tables, None, step=step, max_gap=data.max_gap)

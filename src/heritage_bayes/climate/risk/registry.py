@@ -18,7 +18,7 @@ computes every indicator of a series of a year or more over its **complete years
 a grid, 8736–8759 h, counts as one) and states the hours left out; the yearly groups
 (``chemical``, ``mould``, ``ashrae``, ``en15757``) refuse a series shorter than a year.
 
-An intervention (a change of the calibrated room, issue 29) is compared with the
+An intervention (a change of the calibrated room) is compared with the
 do-nothing case through the same entries: ``worse`` gives the sign of "better" and the
 unit the scale of a difference.
 """

@@ -30,22 +30,3 @@ def _nothing_left_in_the_checkout():
     yield
     after = sorted(p.name for p in reports.iterdir()) if reports.is_dir() else []
     assert after == before, f"tests left {sorted(set(after) - set(before))} in {reports}"
-
-
-#: Fixture scopes shared by the tests of one module: those tests run on one worker under
-#: ``pytest -n auto --dist loadgroup`` (the README's command), so the fixture (often a
-#: small calibration) is built once; the other tests are spread one by one.
-_SHARED_SCOPES = {"module", "class", "package"}
-
-
-def pytest_collection_modifyitems(config, items):
-    """Group, for pytest-xdist, the tests of a module that has a module-, class- or
-    package-scoped fixture (``xdist_group`` named after the file)."""
-    shared: dict[Path, bool] = {}
-    for item in items:
-        defs = getattr(getattr(item, "_fixtureinfo", None), "name2fixturedefs", {})
-        if any(d.scope in _SHARED_SCOPES for ds in defs.values() for d in ds):
-            shared[item.path] = True
-    for item in items:
-        if shared.get(item.path):
-            item.add_marker(pytest.mark.xdist_group(item.path.stem))

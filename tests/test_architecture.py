@@ -1,13 +1,15 @@
 """The package's shape: data flows one way (no import cycle), rooms of readable size.
 
 The import graph holds every ``import`` of every module in ``src/heritage_bayes``,
-including imports inside functions (a lazy import is still a dependency), and the
-implicit dependency of a module on its parent package's ``__init__``.
+including imports inside functions (a lazy import is still a dependency) and under
+``if TYPE_CHECKING:`` (a type named in a signature is one too), and the implicit
+dependency of a module on its parent package's ``__init__``.
 """
 
 from __future__ import annotations
 
 import ast
+import re
 from pathlib import Path
 
 import pytest
@@ -35,19 +37,6 @@ def _resolve(name: str, modules: dict[str, Path]) -> str | None:
     return name or None
 
 
-def _runtime_nodes(tree: ast.AST):
-    """All nodes except those under ``if TYPE_CHECKING:`` (not imported at run time)."""
-    todo = [tree]
-    while todo:
-        node = todo.pop()
-        yield node
-        for child in ast.iter_child_nodes(node):
-            if isinstance(child, ast.If) and getattr(child.test, "id", None) == "TYPE_CHECKING":
-                todo.extend(child.orelse)
-                continue
-            todo.append(child)
-
-
 def import_graph(modules: dict[str, Path] | None = None) -> dict[str, set[str]]:
     """module -> modules of this package it imports (anywhere in the file)."""
     modules = modules if modules is not None else _modules()
@@ -55,7 +44,7 @@ def import_graph(modules: dict[str, Path] | None = None) -> dict[str, set[str]]:
     for mod, path in modules.items():
         deps: set[str] = set()
         is_pkg = path.name == "__init__.py"
-        for node in _runtime_nodes(ast.parse(path.read_text(encoding="utf-8"))):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
             names: list[str] = []
             if isinstance(node, ast.Import):
                 names = [a.name for a in node.names]
@@ -124,10 +113,14 @@ def test_import_graph_sees_lazy_and_relative_imports(tmp_path):
     (pkg / "sub" / "__init__.py").write_text("from .x import f\n")
     (pkg / "sub" / "x.py").write_text("def f():\n    from heritage_bayes.y import g\n")
     (pkg / "y.py").write_text("from heritage_bayes.sub.x import f\n")
+    (pkg / "z.py").write_text(
+        "from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    from heritage_bayes.y import T\n"
+    )
     mods = {_module_name_in(p, tmp_path): p for p in pkg.rglob("*.py")}
     g = import_graph(mods)
     assert g["heritage_bayes.sub.x"] == {"heritage_bayes.y"}
     assert g["heritage_bayes.sub"] == {"heritage_bayes.sub.x"}
+    assert g["heritage_bayes.z"] == {"heritage_bayes.y"}  # a typing-only import counts
     assert find_cycle(g) == ["heritage_bayes.sub.x", "heritage_bayes.y", "heritage_bayes.sub.x"]
 
 
@@ -144,7 +137,7 @@ def test_no_import_cycle_in_the_package():
 def test_rc_network_is_a_description_the_model_compiles():
     """``rc.network`` imports nothing of the package (not even lazily or for typing);
     ``rc.model`` imports it and its numerics at module level: the cycle the two once
-    hid behind a lazy import and a ``TYPE_CHECKING`` block is gone (issue 28)."""
+    hid behind a lazy import and a ``TYPE_CHECKING`` block is gone."""
     modules = _modules()
     net_tree = ast.parse(modules["heritage_bayes.rc.network"].read_text(encoding="utf-8"))
     assert not [
@@ -165,7 +158,7 @@ def test_rc_network_is_a_description_the_model_compiles():
 def test_lower_layers_do_not_import_higher_ones():
     graph = import_graph()
     layers = {  # lower number = lower layer
-        "rc": 1, "climate": 1, "io": 1, "errors": 0, "_version": 0, "_arviz": 0,
+        "rc": 1, "climate": 1, "io": 1, "rundir": 1, "errors": 0, "_version": 0, "_arviz": 0,
         "convert": 0, "convergence": 0, "format": 0, "names": 0,
         "config": 1, "inputs": 2, "models": 2, "sources": 2, "demo": 2, "inference": 2,
         "prepare": 3, "run": 3, "report": 4, "calibrate": 5, "projection": 5, "portfolio": 6,
@@ -221,3 +214,52 @@ def test_modules_are_of_readable_size(path):
         f"{path.relative_to(SRC)} has {n} lines (> {MAX_LINES}) and no 'Why one module' "
         "paragraph in its docstring: split it by topic or say why it stays whole"
     )
+
+
+#: An issue or a commit cited in prose: "issue 28", "issues 47, 49", "#28" (not a
+#: logger's ``[#1]`` section), "commit ab12cd3" or a bare hash of 7-40 hex digits
+#: holding both a letter and a digit.
+CITATION = re.compile(
+    r"\b[Ii]ssues?\s+#?\d+|(?<![\w&\[])#\d+\b"
+    r"|\b(?=[0-9a-f]*[a-f])(?=[0-9a-f]*\d)[0-9a-f]{7,40}\b"
+)
+
+
+def _prose(tree: ast.AST):
+    """(line, text) of every docstring and every string ``description=`` (a setting's
+    text in the configuration reference, a command's in the CLI reference)."""
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Module | ast.ClassDef | ast.FunctionDef | ast.AsyncFunctionDef):
+            doc = ast.get_docstring(node, clean=False)
+            if doc:
+                yield getattr(node, "lineno", 1), doc
+        elif isinstance(node, ast.Call):
+            for kw in node.keywords:
+                if kw.arg == "description" and isinstance(kw.value, ast.Constant):
+                    if isinstance(kw.value.value, str):
+                        yield node.lineno, kw.value.value
+
+
+def test_the_citation_finder_finds_citations():
+    cited = [
+        "the peak memory (issue 28)", "issues 47, 49", "see #46", "on 84701f4",
+        "at commit 8a2d1f5, before",
+    ]  # fmt: skip
+    plain = [
+        "sections ``[#I]``, ``[#1]``", "1 000 000 steps", "2019-2020", "deadbeef",
+        "sha256 of the rows", "EN 15757", "&#39;",
+    ]  # fmt: skip
+    assert [bool(CITATION.search(s)) for s in cited] == [True] * len(cited)
+    assert [CITATION.search(s) for s in plain] == [None] * len(plain)
+
+
+def test_no_docstring_or_setting_description_cites_an_issue_or_a_commit():
+    """Docstrings hold the science and the contract; an issue number or a commit ages
+    with every commit. Measured notes and their commands live in ``docs/science/``."""
+    bad = [
+        f"{path.relative_to(SRC)}:{line}: {m.group()!r}"
+        for path in sorted(SRC.rglob("*.py"))
+        for line, text in _prose(ast.parse(path.read_text(encoding="utf-8")))
+        for m in CITATION.finditer(text)
+    ]
+    assert bad == [], bad

@@ -301,3 +301,16 @@ def test_the_readmes_python_block_runs(tiny_run):
     res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert res.returncode == 0, res.stderr
     assert res.stdout.strip() == "['Ci', 'Ge', 'Gf', 'fI_E', 'fI_N', 'fI_S', 'fI_W'] False"
+
+
+def test_ci_runs_the_readmes_test_command():
+    """``.ci/run`` prints and runs the README's second command, character for character."""
+    import re
+
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    block = re.search(r"```bash\n(.*?)```", readme, re.S).group(1)
+    commands = [line for line in block.splitlines() if line and not line.startswith("#")]
+    assert len(commands) == 2 and "pytest" in commands[1], commands
+    ci = (ROOT / ".ci" / "run").read_text(encoding="utf-8")
+    assert f"TEST_COMMAND='{commands[1]}'\n" in ci
+    assert 'echo "$TEST_COMMAND"\neval "$TEST_COMMAND"\n' in ci

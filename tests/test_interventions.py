@@ -354,7 +354,7 @@ def _series(run, case, measure):
 
     draws, inputs, _ = case
     P = measure.params(run, draws.model)
-    c = engine._Case(*[None] * 8)
+    c = engine.Case(*[None] * 8)
     c.U = {s: inputs[list(m.input_names)].to_numpy(float) for s, m in run.models.items()}
     c.Ut = {s: np.ascontiguousarray(u.T) for s, u in c.U.items()}
     c.N = len(inputs)

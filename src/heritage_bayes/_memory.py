@@ -1,4 +1,4 @@
-"""Returning freed memory to the system between the stages of a run (issue 28: the
+"""Returning freed memory to the system between the stages of a run (the
 peak memory of ``hbayes compare``)."""
 
 from __future__ import annotations

@@ -15,7 +15,7 @@ sets them side by side:
   noise each term is the one-step-ahead predictive density of the hour given the
   previous residual, from the simulation continued past the calibration period (the
   ``log_predictive_density_validation`` group of ``posterior.nc`` holds each hour's
-  inner term; runs written before issue 28 the terms per draw,
+  inner term; older runs, without that group, the terms per draw,
   ``log_likelihood_validation``);
 - **blocked PSIS-LOO** on the calibration period: the pointwise log-likelihood summed
   over blocks of ``block_hours`` consecutive hours (default one day), then Pareto-smoothed

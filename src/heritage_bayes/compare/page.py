@@ -13,6 +13,7 @@ from pathlib import Path
 from markupsafe import Markup
 
 from heritage_bayes.format import fmt, fmt_interval, prose_html, quantity_name
+from heritage_bayes.rundir.signals import DeferSignals
 
 
 def fig_tradeoff(result: dict):
@@ -292,12 +293,11 @@ def write_comparison(result: dict, out: str | Path) -> tuple[Path, Path]:
     """Write ``comparison.json`` and ``comparison.html`` into ``out`` (each atomically,
     the page rendered first; SIGINT/SIGTERM wait until both are written: never one
     comparison's data beside another's page)."""
-    from heritage_bayes.inference.backend import _DeferSignals
     from heritage_bayes.inference.results import atomic_write_text, dump_json
 
     out = Path(out)
     page = render_comparison(result)
-    with _DeferSignals():
+    with DeferSignals():
         dump_json(out / "comparison.json", result)
         atomic_write_text(out / "comparison.html", page)
     return out / "comparison.json", out / "comparison.html"

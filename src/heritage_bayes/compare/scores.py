@@ -52,8 +52,8 @@ def pointwise_terms(idata, var_name: str | None = None) -> xr.Dataset:
 
     A run with one output keeps them in ``log_likelihood``; a run with several keeps
     their combination there (the default of ``az.loo``), from which the per-output terms
-    are rebuilt (:func:`heritage_bayes.inference.interop.split_outputs`); runs written
-    before issue 28 also hold them in ``log_likelihood_outputs``.
+    are rebuilt (:func:`heritage_bayes.inference.interop.split_outputs`); older runs
+    (without ``log_predictive_density_validation``) also hold them in ``log_likelihood_outputs``.
     """
     if var_name is not None and var_name in idata.log_likelihood:
         return idata.log_likelihood

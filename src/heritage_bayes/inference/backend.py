@@ -19,8 +19,6 @@ from __future__ import annotations
 import hashlib
 import json
 import os
-import signal
-import threading
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -28,6 +26,7 @@ import h5py
 import numpy as np
 
 from heritage_bayes.errors import InputError
+from heritage_bayes.rundir.signals import DeferSignals
 
 
 def _open_for_append(path, tries: int = 60, wait: float = 0.5):
@@ -43,45 +42,6 @@ def _open_for_append(path, tries: int = 60, wait: float = 0.5):
         except BlockingIOError:
             time.sleep(wait)
     return h5py.File(path, "a")
-
-
-class _DeferSignals:
-    """Record SIGINT and SIGTERM instead of acting on them, for a critical section.
-
-    ``received`` is the first signal number seen (or None). On exit the previous handlers
-    come back and, with ``redeliver=True``, a recorded signal is raised again, so an
-    interrupt during a checkpoint commit takes effect right after it. Only the main
-    thread receives signals in Python; elsewhere this does nothing.
-    """
-
-    SIGNALS = (signal.SIGINT, signal.SIGTERM)
-
-    def __init__(self, redeliver: bool = True):
-        self.redeliver = redeliver
-        self.received: int | None = None
-        self._old: dict = {}
-
-    def __enter__(self):
-        self.received = None
-        if threading.current_thread() is threading.main_thread():
-            for s in self.SIGNALS:
-                if signal.getsignal(s) is signal.SIG_IGN:
-                    continue  # ignored on purpose (nohup, a background job): keep it so
-                old = signal.signal(s, self._record)
-                self._old[s] = signal.SIG_DFL if old is None else old
-        return self
-
-    def _record(self, signum, frame):
-        if self.received is None:
-            self.received = signum
-
-    def __exit__(self, *exc):
-        for s, h in self._old.items():
-            signal.signal(s, h)
-        self._old = {}
-        if self.redeliver and self.received is not None and exc[0] is None:
-            signal.raise_signal(self.received)
-        return False
 
 
 @dataclass
@@ -160,7 +120,7 @@ class _Checkpoint:
 
         chunk = 64 * int(np.prod(chain.shape[1:])) * 8  # one HDF5 chunk [bytes]
         ensure_free_space(self.path, chain.nbytes + log_prob.nbytes + 2 * chunk)
-        with _DeferSignals(), _open_for_append(self.path) as f:
+        with DeferSignals(), _open_for_append(self.path) as f:
             n0 = int(json.loads(f.attrs["commit"])["iteration"]) if "commit" in f.attrs else 0
             n = chain.shape[0]
             for name, rows in (("chain", chain), ("log_prob", log_prob)):
@@ -202,7 +162,7 @@ class _Checkpoint:
         tmp = _Checkpoint(self.path.with_name(self.path.name + ".thinning"), self.tag)
         tmp.create(chain.shape[1], chain.shape[2])
         tmp.append(chain, log_prob, accepted, random_state, tau_history, **thinned)
-        with _DeferSignals():
+        with DeferSignals():
             os.replace(tmp.path, self.path)
 
     def _damaged(self, why: str) -> InputError:

@@ -426,8 +426,8 @@ class AR1WhiteNoise(NoiseModel):
     This is the shape of real logs: a slowly varying model error (what the RC model
     does not resolve: an unmodelled heat source, a wrong solar aperture on one day) on
     top of the logger's own noise and rounding. A single AR(1) fitted to such residuals
-    estimates a compromise coefficient (0.4-0.75 where 0.90-0.95 was generated; issue
-    10) and under-weights slow errors: its intervals come out too narrow. The exact
+    estimates a compromise coefficient (0.4-0.75 where 0.90-0.95 was
+    generated) and under-weights slow errors: its intervals come out too narrow. The exact
     likelihood is a scalar Kalman filter on the residual process (ARMA(1,1) in
     disguise [1]_, [3]_), exact across gaps; its cost is one more division and
     logarithm per observation than AR(1).

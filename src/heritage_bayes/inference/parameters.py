@@ -455,7 +455,7 @@ def interior_prior(interior_area: float, *, h: float = H_INTERIOR, sigma: float 
     posterior has an arm in which the interior mass is decoupled (``Gint`` 0.3-3.5 W/K,
     physically a few tenths of a square metre of surface) and the MAP lies there; the
     chain crosses between that arm and a merged mass in rare long excursions (τ of
-    ``Gint`` 3 899 steps after 150 000 steps, not converged, on 84701f4); with the demo's
+    ``Gint`` 3 899 steps after 150 000 steps, not converged); with the demo's
     80 m² it converges in 9 500 steps (docs/science/benchmarks.md, "The interior area
     and several optima").
 
@@ -490,11 +490,8 @@ def aperture_prior(
     shading, and the sun the opaque wall passes on, all uncertain). Why: with the
     default log-uniform prior over five decades a facade whose sun is mostly diffuse
     (north) is hardly told from the others, and the prior's volume pulls its aperture
-    towards zero. Measured on the demo (``python benchmarks/noise_default.py
-    configs/demo.yaml --noise ar1_white --seeds 7 8 ... 30``, 24 logger-noise seeds, at
-    commit 8a2d1f5, before ``configs/demo.yaml`` gave ``glazing_area``): the north
-    aperture's truth (0.5 m²) lay outside its 90 % interval in 7 of 24 seeds, up to 5.6
-    posterior sd from the median, and in 1 of 24 (2.1 sd) with it; a window
+    towards zero (measured on the demo's north facade over 24 logger-noise seeds,
+    with the commands: docs/science/sbc.md, "The demo's solar apertures"); a window
     count is in every building survey.
 
     Parameters

@@ -4,8 +4,7 @@ What :mod:`heritage_bayes.inference.idata` adds to each posterior draw before th
 are drawn: how the initial state was obtained (in words), the noise model of the bands
 (the free-run error when the likelihood's noise model sits at its cap, and always for
 ``kalman``) and the limit of predicted vapour pressure at saturation; then what of the
-predictive is stored: the bands over every saved draw and a bounded subset of the draws
-(issue 28).
+predictive is stored: the bands over every saved draw and a bounded subset of the draws.
 """
 
 from __future__ import annotations

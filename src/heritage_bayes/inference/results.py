@@ -23,8 +23,8 @@ Run directory (``hbayes calibrate``):
   - ``log_predictive_density_validation`` (not an arviz group): per output, the log of
     the posterior-mean predictive density of each validation hour [nats] (over the
     saved draws, from the simulation continued past calibration; their sum is the
-    expected log predictive density of new data). Runs written before issue 28 hold the
-    terms per draw instead (``log_likelihood_validation``); both are read by
+    expected log predictive density of new data). Older runs, without this group, hold
+    the terms per draw instead (``log_likelihood_validation``); both are read by
     ``heritage_bayes.compare.scores.elpd_validation``;
   - ``observed_data``: ``Ti``, ``Pi``, ``RHi`` on the ``time`` axis;
   - ``constant_data``: the model inputs and a ``period`` code (0 warm-up, 1 calibration,
@@ -184,9 +184,8 @@ def write_inference_data(idata, path: str | Path) -> None:
     far less than their Monte Carlo error). Posterior draws and the data keep their
     precision. Not atomic by itself: call it through :func:`atomic_write`.
 
-    Measured on the demo (``hbayes calibrate configs/demo.yaml``, commit c012fcd vs
-    this writer with the bounded predictive): ``posterior.nc`` 89.7 MB → see the
-    closing note of issue 28 in ``benchmarks/README.md``.
+    The demo's file sizes before and after this format, with the command: the
+    run-directory table in ``benchmarks/README.md``.
     """
     mode = "w"
     for group in idata.groups():

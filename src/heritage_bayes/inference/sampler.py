@@ -59,7 +59,7 @@ import emcee
 import numpy as np
 
 from heritage_bayes.errors import InputError
-from heritage_bayes.inference.backend import _Checkpoint, _DeferSignals, read_compact
+from heritage_bayes.inference.backend import _Checkpoint, read_compact
 from heritage_bayes.inference.chainresult import (
     ChainResult,
     _burn_thin,
@@ -77,6 +77,7 @@ from heritage_bayes.inference.monitor import (
 )
 from heritage_bayes.inference.moves import refit_moves
 from heritage_bayes.inference.start import laplace_ensemble
+from heritage_bayes.rundir.signals import DeferSignals
 
 __all__ = [
     "ChainResult",
@@ -399,7 +400,7 @@ def _run_sampler(
     # SIGINT/SIGTERM only set a flag while sampling: the chain stops after the current
     # step, the steps done are committed, then KeyboardInterrupt (never an exception
     # inside emcee's likelihood call, which would print the parameter matrix)
-    with _DeferSignals(redeliver=False) as sig:
+    with DeferSignals(redeliver=False) as sig:
         while done < max_steps and not converged:
             # the budget is checked between chunks (at least one chunk runs)
             spent = time.perf_counter() - t0

@@ -10,7 +10,7 @@ The RC model itself carries the model error: process noise enters every node,
 with :math:`\\Sigma = \\mathrm{diag}(q_j)` (``q_<node>`` [K/√h] or [Pa/√h]) and white
 measurement noise ``sigma_<output>`` [K] or [Pa] (CTSM-R [1]_, pySIP [2]_). The error
 then has the model's own time constants: it cannot carry a slow (seasonal) response the
-model does not have, which is the trap of a free AR(1) residual (issue 10).
+model does not have, which is the trap of a free AR(1) residual.
 
 Discretisation is exact in the modal coordinates :math:`z = T^{-1}x` of
 :mod:`heritage_bayes.rc.discretize`: with :math:`\\tilde\\Sigma = T^{-1}\\Sigma`,

@@ -55,6 +55,7 @@ from heritage_bayes.portfolio.rooms import _attention_order, _room_task, measure
 from heritage_bayes.portfolio.spec import Portfolio, RoomSpec, load_portfolio
 from heritage_bayes.rundir import check_name
 from heritage_bayes.rundir.folder import OutputFolder
+from heritage_bayes.rundir.signals import DeferSignals
 from heritage_bayes.rundir.writer import is_run_directory
 
 __all__ = [
@@ -274,7 +275,6 @@ def _write_outputs(pf: Portfolio, out: Path, rows: list[dict], seconds: float) -
     """``portfolio.csv``, ``portfolio.json`` and ``index.html``, rendered first and
     written as a group (SIGINT/SIGTERM wait until all three are written)."""
     from heritage_bayes.convert import to_jsonable
-    from heritage_bayes.inference.backend import _DeferSignals
     from heritage_bayes.inference.results import atomic_write, atomic_write_text
 
     df = _table(rows, pf)
@@ -288,7 +288,7 @@ def _write_outputs(pf: Portfolio, out: Path, rows: list[dict], seconds: float) -
     }
     text = json.dumps(to_jsonable(meta), indent=1)
     page = render_index(pf, df, out)
-    with _DeferSignals():
+    with DeferSignals():
         atomic_write(out / "portfolio.csv", lambda p: df.to_csv(p, index=False))
         atomic_write_text(out / "portfolio.json", text)
         atomic_write_text(out / "index.html", page)

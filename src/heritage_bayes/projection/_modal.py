@@ -17,7 +17,7 @@ import numpy as np
 from heritage_bayes.rc.control import N_COST
 
 if TYPE_CHECKING:
-    from heritage_bayes.projection.engine import Draws, _Case, _CaseOut
+    from heritage_bayes.projection.cases import Case, CaseOut, Draws
 
 _HOURS_YEAR = 8760
 
@@ -67,7 +67,7 @@ def _work(plan, slots: int, N: int) -> tuple:
     )
 
 
-def _coupled_series(c: _Case, modal: dict, ctrl: tuple, sig, rows, w: int, cost=None):
+def _coupled_series(c: Case, modal: dict, ctrl: tuple, sig, rows, w: int, cost=None):
     """Noise-free ``Ti``, ``Pi`` (section -> (k, N)) of the chunk's draws ``rows``
     (positions in the chunk) with a measure's controllers
     (:func:`heritage_bayes.rc.control.coupled_draw`, the compiled pass's arithmetic)."""
@@ -117,7 +117,7 @@ def _noise(draws: Draws, sl: slice, N: int, seed: int, i: int, models=None, dt=3
     return out
 
 
-def _controlled(run, P, c: _Case, o: _CaseOut | None, rows, dt, w, measure) -> dict:
+def _controlled(run, P, c: Case, o: CaseOut | None, rows, dt, w, measure) -> dict:
     """The reference path: noise-free ``Ti``, ``Pi`` (section -> (k, N)) of draws
     ``rows`` through :meth:`Measure.simulate`; its running costs stored as sums in ``o``
     (the compiled pass's :data:`~heritage_bayes.rc.control.N_COST` columns)."""

@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import time
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
@@ -46,36 +45,8 @@ from heritage_bayes.projection._modal import (
     case_inputs,
     coupled_pair,
 )
-from heritage_bayes.rc.control import N_COST, N_CP
-
-
-@dataclass
-class Draws:
-    """Posterior draws used by the projection: model and noise parameters per section."""
-
-    index: np.ndarray  # (K,) positions in the flattened (chain, draw) posterior
-    model: dict  # section -> (K, p) model parameter array [SI]
-    noise: dict  # section -> (K, q) noise parameters in the noise model's order
-    noise_models: dict  # section -> NoiseModel
-
-
-@dataclass
-class CaseResult:
-    """What is kept of one case."""
-
-    predictive: pd.DataFrame  # draws × indicators (with the noise draw)
-    parametric: pd.DataFrame  # draws × indicators (noise-free: parameter uncertainty only)
-    months: pd.DatetimeIndex
-    Ti_month: np.ndarray  # (K, n_months) [°C]
-    RHi_month: np.ndarray  # (K, n_months) [%]
-    seconds: dict
-    #: (K, years, len(annual_names)) per-complete-year values, predictive and noise-free
-    annual_predictive: np.ndarray | None = None
-    annual_parametric: np.ndarray | None = None
-    annual_names: tuple = ()
-    #: draws × running costs of an intervention
-    #: (:data:`heritage_bayes.projection.interventions.COSTS`), empty for doing nothing
-    costs: pd.DataFrame | None = None
+from heritage_bayes.projection.cases import Case, CaseOut, CaseResult, Draws
+from heritage_bayes.rc.control import N_CP
 
 
 def select_draws(run, n: int | None, seed: int) -> Draws:
@@ -319,9 +290,9 @@ def _simulate(
         Ut = {s: np.ascontiguousarray(u.T) for s, u in U.items()}
         mode = (1 if not cases else 2) if baseline else 0
         hoy = hour_of_year(inp.index)
-        cases.append(_Case(U, Ut, starts, months, plan, len(inp), hoy, mode, inp.index))
+        cases.append(Case(U, Ut, starts, months, plan, len(inp), hoy, mode, inp.index))
     K = draws.index.size
-    out = [[_CaseOut.empty(c, K) for c in cases] for _ in variants]
+    out = [[CaseOut.empty(c, K) for c in cases] for _ in variants]
     sigs = [[_hours_of_use(v, c) for c in cases] for v in variants]
     slots = max(1, min(numba.get_num_threads(), chunk, K))
     from heritage_bayes.projection._stream import HOY
@@ -396,31 +367,6 @@ def _hours_of_use(v, c) -> np.ndarray:
     return v.hours_of_use(c.index, c.N)
 
 
-@dataclass
-class _Case:
-    U: dict  # section -> (hours, inputs)
-    Ut: dict  # section -> (inputs, hours)
-    starts: np.ndarray
-    months: pd.DatetimeIndex
-    plan: object
-    N: int
-    hoy: np.ndarray  # (N,) hour of the year of each hour
-    mode: int  # 1: the baseline (builds each draw's EN 15757 band), 2: judged by it, 0: none
-    index: pd.DatetimeIndex | None = None  # time of each hour (an intervention's calendar)
-
-    def en_params(self) -> tuple[np.ndarray, int]:
-        """(en, en_col) of :func:`heritage_bayes.projection._stream.chunk_kernel`."""
-        from heritage_bayes.climate.risk.indicators import LAYOUT as L
-
-        _, fpar, ipar, _, _ = self.plan.arrays
-        cols = self.plan.columns
-        en_col = cols.index("en15757_lower_offset") if "en15757_lower_offset" in cols else -1
-        fam = "ashrae" if ipar[L.i("en15757.shared")] != 0 else "en15757"
-        half, wrap = ipar[L.i(f"{fam}.half")], ipar[L.i(f"{fam}.wrap")]
-        limc = fpar[L.f("mould.lim_c")] if ipar[L.i("mould")] else np.nan
-        return np.array([self.mode, half, wrap, 0.0, 0.0, limc], float), en_col
-
-
 def hour_of_year(index: pd.DatetimeIndex) -> np.ndarray:
     """Hour of the year (0-8759) of each time stamp [UTC]; 29 February counts as
     28 February (a 365-day year of hours, so that every year maps onto one cycle)."""
@@ -431,69 +377,8 @@ def hour_of_year(index: pd.DatetimeIndex) -> np.ndarray:
     return np.ascontiguousarray(doy * 24 + np.asarray(idx.hour), dtype=np.int64)
 
 
-@dataclass
-class _CaseOut:
-    par: np.ndarray
-    pred: np.ndarray
-    Tm: np.ndarray
-    RHm: np.ndarray
-    seconds: dict
-    apar: np.ndarray
-    apred: np.ndarray
-    cost: np.ndarray  # (K, N_COST) running-cost sums of a measure's controllers
-
-    @classmethod
-    def empty(cls, c: _Case, K: int) -> _CaseOut:
-        from heritage_bayes.climate.risk.registry import years_of
-        from heritage_bayes.projection._stream import ANNUAL
-
-        nm = c.starts.size
-        ny = years_of(c.N)
-        return cls(
-            par=np.empty((K, c.plan.width)),
-            pred=np.empty((K, c.plan.width)),
-            Tm=np.empty((K, nm), np.float32),
-            RHm=np.empty((K, nm), np.float32),
-            seconds={"simulate": 0.0, "noise": 0.0, "risk": 0.0},
-            apar=np.empty((K, ny, len(ANNUAL))),
-            apred=np.empty((K, ny, len(ANNUAL))),
-            cost=np.zeros((K, N_COST)),
-        )
-
-    def result(self, c: _Case, measure=None, dt: float = 3600.0, years: float = 1.0) -> CaseResult:
-        from heritage_bayes.projection._stream import A_BAND, ANNUAL
-
-        names = tuple(ANNUAL)
-        if "hours_above_LIM" in names:  # the isopleth's own column name
-            lim = [n for n in c.plan.columns if n.startswith("hours_above_LIM")]
-            names = tuple(lim[0] if n == "hours_above_LIM" and lim else n for n in names)
-        frames = []
-        for vals, ann in ((self.pred, self.apred), (self.par, self.apar)):
-            df = c.plan.frame(vals)
-            if c.mode and "en15757_lower_offset" in df.columns:
-                pos = list(df.columns).index("en15757_upper_offset") + 1
-                df.insert(pos, "en15757_outside_baseline", ann[:, :, A_BAND].mean(axis=1))
-                df.attrs["units"]["en15757_outside_baseline"] = "% of hours"
-            frames.append(df)
-        return CaseResult(
-            predictive=frames[0],
-            parametric=frames[1],
-            months=c.months,
-            Ti_month=self.Tm,
-            RHi_month=self.RHm,
-            seconds=self.seconds,
-            annual_predictive=self.apred,
-            annual_parametric=self.apar,
-            annual_names=names,
-            costs=pd.DataFrame(
-                {} if measure is None else measure.costs(self.cost, dt, years),
-                index=pd.RangeIndex(self.par.shape[0]),
-            ),
-        )
-
-
 def _run_chunk(
-    run, P, c: _Case, o: _CaseOut, sl, modal, e, dt, w, work, aw, t_modal, opts, measure=None,
+    run, P, c: Case, o: CaseOut, sl, modal, e, dt, w, work, aw, t_modal, opts, measure=None,
     ctrl=None, sig=None,
 ):  # fmt: skip
     from heritage_bayes.projection._stream import chunk_kernel
@@ -545,7 +430,7 @@ def _run_chunk(
 
 
 def _recompute(
-    run, P, c: _Case, o: _CaseOut, sl, bad, e, dt, w, opts, aw, modal, ctrl, sig, measure
+    run, P, c: Case, o: CaseOut, sl, bad, e, dt, w, opts, aw, modal, ctrl, sig, measure
 ):  # fmt: skip
     """Draws the compiled pass handed back (a missing hour, or a series that
     :func:`assess_batch` rejects): the numpy path, with its NaN policy and its errors."""

@@ -168,7 +168,7 @@ def summarize(labels, horizons, results, baseline: str, thresholds, units) -> di
     """The JSON-ready summary (see the module docstring).
 
     ``labels``: case labels, the baseline first; ``horizons``: their horizons (None for
-    the baseline); ``results``: their :class:`~heritage_bayes.projection.engine.CaseResult`.
+    the baseline); ``results``: their :class:`~heritage_bayes.projection.cases.CaseResult`.
     Every share and probability is a fraction in [0, 1]; units are those of the
     indicator registry (:mod:`heritage_bayes.climate.risk.registry`).
     """

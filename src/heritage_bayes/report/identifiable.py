@@ -1,4 +1,4 @@
-"""Posterior diagnostics in identifiable coordinates (issue 11): the numbers behind them.
+"""Posterior diagnostics in identifiable coordinates: the numbers behind them.
 
 With only indoor temperatures (or vapour pressures) measured and no known heat
 (moisture) input, scaling every capacity, conductance and solar aperture together leaves

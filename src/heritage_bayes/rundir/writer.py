@@ -42,6 +42,7 @@ from heritage_bayes.errors import InputError
 from heritage_bayes.rundir.lock import FolderLock, lock_path
 from heritage_bayes.rundir.marker import MARKER, new_marker, read_marker, write_marker
 from heritage_bayes.rundir.policy import resolve_output
+from heritage_bayes.rundir.signals import DeferSignals
 
 __all__ = [
     "RUN_FILES",
@@ -351,12 +352,10 @@ class StagedFolder:
         """Make the staging folder ``out``, keeping every entry of ``out`` its marker
         does not list (moved across by rename, byte for byte). Signals wait until the
         swap is done: ``out`` is the previous output or the new one, never a mix."""
-        from heritage_bayes.inference.backend import _DeferSignals
-
         out, staging, old = self.out, self.staging, _old_path(self.out)
         names = _staged_names(staging)
         marker = read_marker(staging) or new_marker(self.kind)
-        with _DeferSignals():
+        with DeferSignals():
             write_marker(staging, marker.with_files(*names))
             if out.is_dir():
                 prev = read_marker(out)

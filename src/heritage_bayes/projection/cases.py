@@ -1,0 +1,139 @@
+"""What the projection's engine carries: the posterior draws, one case (a weather's
+inputs and its indicator plan), the arrays a case fills chunk by chunk, and what is kept
+of it.
+
+:mod:`heritage_bayes.projection.engine` builds and fills them;
+:mod:`heritage_bayes.projection._modal` reads them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from heritage_bayes.rc.control import N_COST
+
+__all__ = ["Case", "CaseOut", "CaseResult", "Draws"]
+
+
+@dataclass
+class Draws:
+    """Posterior draws used by the projection: model and noise parameters per section."""
+
+    index: np.ndarray  # (K,) positions in the flattened (chain, draw) posterior
+    model: dict  # section -> (K, p) model parameter array [SI]
+    noise: dict  # section -> (K, q) noise parameters in the noise model's order
+    noise_models: dict  # section -> NoiseModel
+
+
+@dataclass
+class CaseResult:
+    """What is kept of one case."""
+
+    predictive: pd.DataFrame  # draws × indicators (with the noise draw)
+    parametric: pd.DataFrame  # draws × indicators (noise-free: parameter uncertainty only)
+    months: pd.DatetimeIndex
+    Ti_month: np.ndarray  # (K, n_months) [°C]
+    RHi_month: np.ndarray  # (K, n_months) [%]
+    seconds: dict
+    #: (K, years, len(annual_names)) per-complete-year values, predictive and noise-free
+    annual_predictive: np.ndarray | None = None
+    annual_parametric: np.ndarray | None = None
+    annual_names: tuple = ()
+    #: draws × running costs of an intervention
+    #: (:data:`heritage_bayes.projection.interventions.COSTS`), empty for doing nothing
+    costs: pd.DataFrame | None = None
+
+
+@dataclass
+class Case:
+    """One weather (the baseline or a scenario) over ``N`` hours: each section's inputs,
+    the months, the hour of the year and the indicator plan."""
+
+    U: dict  # section -> (hours, inputs)
+    Ut: dict  # section -> (inputs, hours)
+    starts: np.ndarray
+    months: pd.DatetimeIndex
+    plan: object
+    N: int
+    hoy: np.ndarray  # (N,) hour of the year of each hour
+    mode: int  # 1: the baseline (builds each draw's EN 15757 band), 2: judged by it, 0: none
+    index: pd.DatetimeIndex | None = None  # time of each hour (an intervention's calendar)
+
+    def en_params(self) -> tuple[np.ndarray, int]:
+        """(en, en_col) of :func:`heritage_bayes.projection._stream.chunk_kernel`."""
+        from heritage_bayes.climate.risk.indicators import LAYOUT as L
+
+        _, fpar, ipar, _, _ = self.plan.arrays
+        cols = self.plan.columns
+        en_col = cols.index("en15757_lower_offset") if "en15757_lower_offset" in cols else -1
+        fam = "ashrae" if ipar[L.i("en15757.shared")] != 0 else "en15757"
+        half, wrap = ipar[L.i(f"{fam}.half")], ipar[L.i(f"{fam}.wrap")]
+        limc = fpar[L.f("mould.lim_c")] if ipar[L.i("mould")] else np.nan
+        return np.array([self.mode, half, wrap, 0.0, 0.0, limc], float), en_col
+
+
+@dataclass
+class CaseOut:
+    """The per-draw values of one case, filled chunk by chunk: indicators (noise-free and
+    predictive), monthly means, per-year values and running costs."""
+
+    par: np.ndarray
+    pred: np.ndarray
+    Tm: np.ndarray
+    RHm: np.ndarray
+    seconds: dict
+    apar: np.ndarray
+    apred: np.ndarray
+    cost: np.ndarray  # (K, N_COST) running-cost sums of a measure's controllers
+
+    @classmethod
+    def empty(cls, c: Case, K: int) -> CaseOut:
+        from heritage_bayes.climate.risk.registry import years_of
+        from heritage_bayes.projection._stream import ANNUAL
+
+        nm = c.starts.size
+        ny = years_of(c.N)
+        return cls(
+            par=np.empty((K, c.plan.width)),
+            pred=np.empty((K, c.plan.width)),
+            Tm=np.empty((K, nm), np.float32),
+            RHm=np.empty((K, nm), np.float32),
+            seconds={"simulate": 0.0, "noise": 0.0, "risk": 0.0},
+            apar=np.empty((K, ny, len(ANNUAL))),
+            apred=np.empty((K, ny, len(ANNUAL))),
+            cost=np.zeros((K, N_COST)),
+        )
+
+    def result(self, c: Case, measure=None, dt: float = 3600.0, years: float = 1.0) -> CaseResult:
+        from heritage_bayes.projection._stream import A_BAND, ANNUAL
+
+        names = tuple(ANNUAL)
+        if "hours_above_LIM" in names:  # the isopleth's own column name
+            lim = [n for n in c.plan.columns if n.startswith("hours_above_LIM")]
+            names = tuple(lim[0] if n == "hours_above_LIM" and lim else n for n in names)
+        frames = []
+        for vals, ann in ((self.pred, self.apred), (self.par, self.apar)):
+            df = c.plan.frame(vals)
+            if c.mode and "en15757_lower_offset" in df.columns:
+                pos = list(df.columns).index("en15757_upper_offset") + 1
+                df.insert(pos, "en15757_outside_baseline", ann[:, :, A_BAND].mean(axis=1))
+                df.attrs["units"]["en15757_outside_baseline"] = "% of hours"
+            frames.append(df)
+        return CaseResult(
+            predictive=frames[0],
+            parametric=frames[1],
+            months=c.months,
+            Ti_month=self.Tm,
+            RHi_month=self.RHm,
+            seconds=self.seconds,
+            annual_predictive=self.apred,
+            annual_parametric=self.apar,
+            annual_names=names,
+            costs=pd.DataFrame(
+                {} if measure is None else measure.costs(self.cost, dt, years),
+                index=pd.RangeIndex(self.par.shape[0]),
+            ),
+        )

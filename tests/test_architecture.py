@@ -225,43 +225,39 @@ def test_modules_are_of_readable_size(path):
 
 MAX_FUNCTION_LINES = 120
 
-# Functions above MAX_FUNCTION_LINES today, each with its present length as a ceiling:
+# Functions above MAX_FUNCTION_LINES code lines today, each with its present length as a ceiling:
 # none may grow, and an entry leaves the list as soon as its function is split (the test
 # below fails while a short function is still listed, so the list stays true).
 LONG_FUNCTIONS = {
-    "calibrate.py::_calibrate_into": 179,
+    "calibrate.py::_calibrate_into": 176,
     "cli.py::_build_parser": 180,
-    "climate/risk/_fused.py::series_indicators": 136,
+    "climate/risk/_fused.py::series_indicators": 127,
     "climate/risk/registry.py::_entries": 177,
-    "climate/solar.py::surface_irradiance": 189,
-    "compare/core.py::compare_runs": 129,
-    "compare/orchestrate.py::run_compare": 124,
-    "demo.py::virtual_monument": 173,
-    "inference/idata.py::build_run_outputs": 343,
-    "inference/likelihoods.py::_fused_kf": 131,
-    "inference/parameters.py::parameters_for": 148,
-    "inference/sampler.py::_run_sampler": 278,
-    "init_checks.py::weather_clock": 133,
-    "init_config.py::init_config": 312,
-    "io/align.py::align": 241,
-    "io/loggers.py::inspect_table": 145,
-    "io/readers/csvfile.py::read_csv": 346,
-    "prepare.py::prepare": 237,
-    "projection/__init__.py::project": 157,
-    "rc/identify.py::structural_identifiability": 183,
-    "report/notes.py::run_notes": 198,
+    "climate/solar.py::surface_irradiance": 134,
+    "demo.py::virtual_monument": 130,
+    "inference/idata.py::build_run_outputs": 342,
+    "inference/sampler.py::_run_sampler": 209,
+    "init_config.py::init_config": 270,
+    "io/align.py::align": 194,
+    "io/loggers.py::inspect_table": 126,
+    "io/readers/csvfile.py::read_csv": 237,
+    "prepare.py::prepare": 218,
+    "projection/__init__.py::project": 123,
+    "rc/identify.py::structural_identifiability": 121,
+    "report/notes.py::run_notes": 181,
     "report/sections/data.py::data_context": 185,
     "report/sections/diagnostics.py::diagnostics_context": 140,
-    "report/verdict.py::convergence_verdict": 217,
+    "report/verdict.py::convergence_verdict": 178,
 }
 
 
 def function_lengths(root: Path = SRC) -> dict[str, int]:
-    """``"path::Qual.name"`` -> body lines of every ``def`` under ``root``.
+    """``"path::Qual.name"`` -> code lines of every ``def`` under ``root``.
 
-    A function's length is the count of lines from the first statement of its body
-    (its docstring, if any) to its last line; nested functions and methods are counted
-    on their own as well, under their qualified name.
+    A function's length is the count of lines from the first statement of its body after
+    the docstring to its last line: the signature and the docstring (the contract, which
+    may be long) do not count, the code does, blank and comment lines included. Nested
+    functions and methods are counted on their own as well, under their qualified name.
     """
     lengths: dict[str, int] = {}
 
@@ -269,7 +265,10 @@ def function_lengths(root: Path = SRC) -> dict[str, int]:
         for child in ast.iter_child_nodes(node):
             if isinstance(child, ast.FunctionDef | ast.AsyncFunctionDef):
                 key = f"{rel}::{prefix}{child.name}"
-                n = child.end_lineno - child.body[0].lineno + 1
+                body = child.body
+                if len(body) > 1 and ast.get_docstring(child, clean=False) is not None:
+                    body = body[1:]
+                n = child.end_lineno - body[0].lineno + 1
                 lengths[key] = max(lengths.get(key, 0), n)
                 walk(child, f"{prefix}{child.name}.", rel)
             elif isinstance(child, ast.ClassDef):
@@ -282,7 +281,7 @@ def function_lengths(root: Path = SRC) -> dict[str, int]:
     return lengths
 
 
-def test_function_lengths_count_body_lines_of_nested_defs(tmp_path):
+def test_function_lengths_count_code_lines_of_nested_defs(tmp_path):
     (tmp_path / "m.py").write_text(
         "class A:\n"
         "    def f(self):\n"
@@ -291,7 +290,7 @@ def test_function_lengths_count_body_lines_of_nested_defs(tmp_path):
         "            return 1\n"
         "        return g()\n"
     )
-    assert function_lengths(tmp_path) == {"m.py::A.f": 4, "m.py::A.f.g": 1}
+    assert function_lengths(tmp_path) == {"m.py::A.f": 3, "m.py::A.f.g": 1}
 
 
 def test_functions_are_of_readable_length():

@@ -240,7 +240,6 @@ LONG_FUNCTIONS = {
     "init_config.py::init_config": 270,
     "io/align.py::align": 194,
     "io/loggers.py::inspect_table": 126,
-    "io/readers/csvfile.py::read_csv": 237,
     "prepare.py::prepare": 218,
     "projection/__init__.py::project": 123,
     "rc/identify.py::structural_identifiability": 121,

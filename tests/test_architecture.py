@@ -238,7 +238,6 @@ LONG_FUNCTIONS = {
     "inference/idata.py::build_run_outputs": 342,
     "inference/sampler.py::_run_sampler": 209,
     "init_config.py::init_config": 270,
-    "io/align.py::align": 194,
     "io/loggers.py::inspect_table": 126,
     "prepare.py::prepare": 218,
     "projection/__init__.py::project": 123,

@@ -263,3 +263,86 @@ def test_no_docstring_or_setting_description_cites_an_issue_or_a_commit():
         for m in CITATION.finditer(text)
     ]
     assert bad == [], bad
+
+
+MAX_FUNCTION_LINES = 120
+
+# Functions above MAX_FUNCTION_LINES code lines today, each with its present length as a ceiling:
+# none may grow, and an entry leaves the list as soon as its function is split (the test
+# below fails while a short function is still listed, so the list stays true).
+LONG_FUNCTIONS = {
+    "calibrate.py::_calibrate_into": 176,
+    "cli.py::_build_parser": 180,
+    "climate/risk/_fused.py::series_indicators": 127,
+    "climate/risk/registry.py::_entries": 177,
+    "climate/solar.py::surface_irradiance": 134,
+    "demo.py::virtual_monument": 130,
+    "inference/idata.py::build_run_outputs": 342,
+    "inference/sampler.py::_run_sampler": 209,
+    "init_config.py::init_config": 270,
+    "io/loggers.py::inspect_table": 126,
+    "prepare.py::prepare": 218,
+    "projection/__init__.py::project": 123,
+    "rc/identify.py::structural_identifiability": 121,
+    "report/notes.py::run_notes": 181,
+    "report/sections/data.py::data_context": 185,
+    "report/sections/diagnostics.py::diagnostics_context": 140,
+    "report/verdict.py::convergence_verdict": 178,
+}
+
+
+def function_lengths(root: Path = SRC) -> dict[str, int]:
+    """``"path::Qual.name"`` -> code lines of every ``def`` under ``root``.
+
+    A function's length is the count of lines from the first statement of its body after
+    the docstring to its last line: the signature and the docstring (the contract, which
+    may be long) do not count, the code does, blank and comment lines included. Nested
+    functions and methods are counted on their own as well, under their qualified name.
+    """
+    lengths: dict[str, int] = {}
+
+    def walk(node: ast.AST, prefix: str, rel: str) -> None:
+        for child in ast.iter_child_nodes(node):
+            if isinstance(child, ast.FunctionDef | ast.AsyncFunctionDef):
+                key = f"{rel}::{prefix}{child.name}"
+                body = child.body
+                if len(body) > 1 and ast.get_docstring(child, clean=False) is not None:
+                    body = body[1:]
+                n = child.end_lineno - body[0].lineno + 1
+                lengths[key] = max(lengths.get(key, 0), n)
+                walk(child, f"{prefix}{child.name}.", rel)
+            elif isinstance(child, ast.ClassDef):
+                walk(child, f"{prefix}{child.name}.", rel)
+            else:
+                walk(child, prefix, rel)
+
+    for path in sorted(root.rglob("*.py")):
+        walk(ast.parse(path.read_text(encoding="utf-8")), "", path.relative_to(root).as_posix())
+    return lengths
+
+
+def test_function_lengths_count_code_lines_of_nested_defs(tmp_path):
+    (tmp_path / "m.py").write_text(
+        "class A:\n"
+        "    def f(self):\n"
+        '        """Doc."""\n'
+        "        def g():\n"
+        "            return 1\n"
+        "        return g()\n"
+    )
+    assert function_lengths(tmp_path) == {"m.py::A.f": 3, "m.py::A.f.g": 1}
+
+
+def test_functions_are_of_readable_length():
+    """No function above ~120 lines; the long ones of today may only shrink."""
+    lengths = function_lengths()
+    too_long = {k: n for k, n in lengths.items() if n > LONG_FUNCTIONS.get(k, MAX_FUNCTION_LINES)}
+    assert too_long == {}, (
+        f"functions over {MAX_FUNCTION_LINES} lines (or over their listed ceiling): "
+        f"{too_long}; split them into named steps"
+    )
+    stale = {k: lengths.get(k) for k in LONG_FUNCTIONS if lengths.get(k, 0) <= MAX_FUNCTION_LINES}
+    assert stale == {}, (
+        f"listed in LONG_FUNCTIONS but now at most {MAX_FUNCTION_LINES} lines or gone: {stale}; "
+        "remove them from the list"
+    )

@@ -31,12 +31,20 @@ gaps stay NaN (the likelihood masks them) and are listed in the report.
 from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
 
-from heritage_bayes.errors import DataError, InputError, quoted
+from heritage_bayes.errors import DataError, InputError
+from heritage_bayes.io._binning import (
+    NS,
+    NativeSeries,
+    bin_integrals,
+    bin_slopes,
+    input_series,
+    nan_runs,
+    sample_at,
+)
 from heritage_bayes.io._common import (
     AVERAGED_BY_DEFAULT,
     format_timedelta,
@@ -46,51 +54,12 @@ from heritage_bayes.io.aligned import Aligned, AlignmentReport, Gap  # re-export
 
 __all__ = ["Aligned", "AlignmentReport", "Gap", "align"]
 
-_NS = 1_000_000_000
 _MAX_LISTED = 12
 
 
 # ---------------------------------------------------------------------------------------
-# Native series
+# Tables
 # ---------------------------------------------------------------------------------------
-
-
-@dataclass
-class _Input:
-    name: str
-    source: str
-    times: np.ndarray  # int64 ns, regular, step delta
-    values: np.ndarray  # float, NaN = missing
-    delta: int  # ns
-    averaged: bool
-
-    @property
-    def first_valid(self) -> int:
-        return int(np.flatnonzero(~np.isnan(self.values))[0])
-
-    @property
-    def last_valid(self) -> int:
-        return int(np.flatnonzero(~np.isnan(self.values))[-1])
-
-    def coverage(self) -> tuple[int, int]:
-        lo = self.times[self.first_valid] - (self.delta if self.averaged else 0)
-        return int(lo), int(self.times[self.last_valid])
-
-    def runs(self) -> list[tuple[int, int]]:
-        """Inclusive index ranges of NaN runs strictly inside the valid span."""
-        missing = np.isnan(self.values)
-        fv, lv = self.first_valid, self.last_valid
-        inner = missing[fv : lv + 1].astype(np.int8)
-        edges = np.diff(np.concatenate([[0], inner, [0]]))
-        starts = np.flatnonzero(edges == 1)
-        ends = np.flatnonzero(edges == -1) - 1
-        return [(int(a) + fv, int(b) + fv) for a, b in zip(starts, ends, strict=True)]
-
-    def affects(self, a: int, b: int, start: int, end: int) -> bool:
-        """Does the missing run a..b change any bin of ``[start, end)``?"""
-        lo = self.times[a] - self.delta
-        hi = self.times[b] + (0 if self.averaged else self.delta)
-        return lo < end and hi > start
 
 
 def _frames(obj, role: str) -> list[pd.DataFrame]:
@@ -129,75 +98,6 @@ def _averaged_columns(df: pd.DataFrame, override: set[str] | None) -> set[str]:
     if "averaged" in df.attrs:
         return {c for c in df.attrs["averaged"] if c in df.columns}
     return {c for c in AVERAGED_BY_DEFAULT if c in df.columns}
-
-
-def _input_series(df: pd.DataFrame, label: str, averaged: set[str]) -> list[_Input]:
-    idx = df.index.asi8
-    step = modal_step(df.index)
-    delta = int(step.value)
-    interval = df.attrs.get("interval")
-    if averaged and interval is not None and pd.Timedelta(interval).value != delta:
-        raise DataError(
-            f"{label}: averaging interval {interval} differs from the spacing of the "
-            f"timestamps {format_timedelta(step)}; resample the table first"
-        )
-    off = (idx - idx[0]) % delta
-    if off.any():
-        i = int(np.flatnonzero(off)[0])
-        raise DataError(
-            f"{label}: weather timestamps must lie on a regular grid of "
-            f"{format_timedelta(step)}; row {i} ({df.index[i]}) is off the grid"
-        )
-    n = int((idx[-1] - idx[0]) // delta) + 1
-    pos = (idx - idx[0]) // delta
-    times = idx[0] + np.arange(n, dtype=np.int64) * delta
-    out = []
-    for col in df.columns:
-        values = np.full(n, np.nan)
-        values[pos] = df[col].to_numpy(dtype=float)
-        if np.isnan(values).all():
-            raise DataError(f"{label}: input column {quoted(col)} has no values")
-        out.append(_Input(col, label, times, values, delta, col in averaged))
-    return out
-
-
-# ---------------------------------------------------------------------------------------
-# Exact bin means
-# ---------------------------------------------------------------------------------------
-
-
-def _bin_integrals(series: _Input, values: np.ndarray, edges: np.ndarray) -> np.ndarray:
-    """Integral of the series over each bin [edges[k], edges[k+1]) [value·s], NaN-aware.
-
-    Averaged: piecewise constant, ``values[j]`` on ``(t_j - delta, t_j]``.
-    Instantaneous: linear interpolation between consecutive samples.
-    """
-    ref = edges[0]
-    t = (series.times - ref) / _NS
-    e = (edges - ref) / _NS
-    d = series.delta / _NS
-    nan = np.isnan(values)
-    v = np.where(nan, 0.0, values)
-    if series.averaged:
-        knots = np.concatenate([[t[0] - d], t])
-        F = np.concatenate([[0.0], np.cumsum(v * d)])
-        G = np.concatenate([[0.0], np.cumsum(nan * d)])
-        Fe = np.interp(e, knots, F)
-        Ge = np.interp(e, knots, G)
-    else:
-        dt = np.diff(t)
-        seg_nan = (nan[:-1] | nan[1:]).astype(float)
-        F = np.concatenate([[0.0], np.cumsum(0.5 * (v[:-1] + v[1:]) * dt)])
-        G = np.concatenate([[0.0], np.cumsum(seg_nan * dt)])
-        j = np.clip(np.searchsorted(t, e, side="right") - 1, 0, t.size - 2)
-        h = e - t[j]
-        slope = (v[j + 1] - v[j]) / dt[j]
-        Fe = F[j] + v[j] * h + 0.5 * slope * h * h
-        Ge = G[j] + seg_nan[j] * h
-    integral = np.diff(Fe)
-    missing = np.diff(Ge) > 1e-9 * d
-    integral[missing] = np.nan
-    return integral
 
 
 # ---------------------------------------------------------------------------------------
@@ -285,156 +185,16 @@ def align(
     :math:`u_k = (F(t_k + \\Delta t) - F(t_k)) / \\Delta t`, exact for any ratio of native
     spacing to ``step`` and any phase. Outputs are sampled at the instants ``t_k``.
     """
-    step = _duration(step, "step", allow_zero=False)
-    max_gap = _duration(max_gap, "max_gap", allow_zero=True)
-    if long_gaps not in ("raise", "split"):
-        raise InputError(f"long_gaps must be 'raise' or 'split' (got {long_gaps!r})")
-    override = None
-    if averaged is not None:
-        override = {averaged} if isinstance(averaged, str) else set(averaged)
-    wframes = _frames(weather, "weather")
-    if not wframes:
-        raise InputError("weather: at least one table of inputs is required")
-    mframes = _frames(measurements, "measurements")
-    names = [c for df in wframes + mframes for c in df.columns]
-    dupes = sorted({c for c in names if names.count(c) > 1})
-    if dupes:
-        raise DataError(f"column(s) {dupes} appear in more than one table; rename them")
-    if override is not None:
-        unknown = sorted(override - set(names))
-        if unknown:
-            raise InputError(f"averaged: unknown column(s) {unknown}; columns are {names}")
-
-    # -- native inputs -------------------------------------------------------------------
-    inputs: list[_Input] = []
-    sources: list[dict] = []
-    for k, df in enumerate(wframes):
-        label = df.attrs.get("source", f"weather[{k}]")
-        avg = _averaged_columns(df, override)
-        inputs.extend(_input_series(df, f"weather {label}", avg))
-        sources.append(_source_note(df, "weather", avg, modal_step(df.index)))
-
-    # -- native outputs ------------------------------------------------------------------
-    outputs: list[tuple[str, np.ndarray, np.ndarray, int]] = []  # name, t ns, v, delta
-    for df in mframes:
-        avg = _averaged_columns(df, override)
-        mstep = modal_step(df.index)
-        interval = pd.Timedelta(df.attrs.get("interval") or mstep)
-        sources.append(_source_note(df, "measurements", avg, mstep))
-        for col in df.columns:
-            s = df[col].dropna()
-            t = s.index.asi8.copy()
-            if col in avg:
-                t = t - interval.value // 2
-            outputs.append((col, t, s.to_numpy(dtype=float), int(mstep.value)))
-
-    # -- period --------------------------------------------------------------------------
-    cov = {s.name: s.coverage() for s in inputs}
-    cov_lo = max(c[0] for c in cov.values())
-    cov_hi = min(c[1] for c in cov.values())
-    step_ns = int(step.value)
-    if start is not None:
-        s0 = _timestamp(start, "start").value
-    else:
-        s0 = cov_lo
-        firsts = [o[1][0] for o in outputs if o[1].size]
-        if firsts:
-            s0 = max(s0, min(firsts))
-        s0 = -((-s0) // step_ns) * step_ns  # ceil to the grid
-    if end is not None:
-        e0 = _timestamp(end, "end").value
-    else:
-        e0 = cov_hi
-        lasts = [o[1][-1] for o in outputs if o[1].size]
-        if lasts:
-            e0 = min(e0, max(lasts) + step_ns)
-    n_rows = (e0 - s0) // step_ns
-    if n_rows < 1:
-        raise DataError(
-            f"empty period: start {_fmt(s0)} is not at least one step ({format_timedelta(step)}) "
-            f"before end {_fmt(e0)}; the inputs cover {_fmt(cov_lo)} to {_fmt(cov_hi)}"
-            + (" and the measurements do not overlap them" if outputs else "")
-        )
-    e0 = s0 + n_rows * step_ns
-    short = [(n, c) for n, c in cov.items() if c[0] > s0 or c[1] < e0]
-    if short:
-        lines = "; ".join(f"{n} covers {_fmt(c[0])} to {_fmt(c[1])}" for n, c in short)
-        raise DataError(
-            f"the period {_fmt(s0)} to {_fmt(e0)} is not covered by every input: {lines}. "
-            f"Choose start/end inside the inputs' coverage"
-        )
-    edges = s0 + np.arange(n_rows + 1, dtype=np.int64) * step_ns
-
-    # -- input gaps, filling, bin means --------------------------------------------------
-    gaps: list[Gap] = []
-    too_long: list[Gap] = []
-    frame_cols: dict[str, np.ndarray] = {}
-    flag_cols: dict[str, np.ndarray] = {}
-    interpolated: dict[str, int] = {}
-    slope_cols: dict[str, np.ndarray] = {}
-    breaks = np.zeros(n_rows, dtype=bool)
-    for s in inputs:
-        values = s.values.copy()
-        filled = np.zeros(values.size)
-        bridged = np.zeros(values.size)
-        for a, b in s.runs():
-            if not s.affects(a, b, s0, e0):
-                continue
-            n = b - a + 1
-            gap = Gap(
-                s.name,
-                pd.Timestamp(s.times[a], tz="UTC"),
-                pd.Timestamp(s.times[b], tz="UTC"),
-                n,
-                pd.Timedelta(n * s.delta, unit="ns"),
-                n * s.delta <= max_gap.value,
-            )
-            if not gap.filled and long_gaps == "raise":
-                too_long.append(gap)
-                continue
-            gaps.append(gap)
-            x = s.times[a - 1 : b + 2].astype(float)
-            values[a : b + 1] = np.interp(x[1:-1], x[[0, -1]], values[[a - 1, b + 1]])
-            (filled if gap.filled else bridged)[a : b + 1] = 1.0
-        if bridged.any():
-            breaks |= _bin_integrals(s, bridged, edges) > 1e-9
-        interpolated[s.name] = int(filled.sum())
-        frame_cols[s.name] = _bin_integrals(s, values, edges) / (step_ns / _NS)
-        slope_cols[s.name] = _slopes(s, values, edges)
-        flag_cols[s.name] = _bin_integrals(s, filled, edges) > 1e-9
-    if too_long:
-        listed = "\n  ".join(str(g) for g in too_long[:_MAX_LISTED])
-        more = (
-            f"\n  ... and {len(too_long) - _MAX_LISTED} more" if len(too_long) > _MAX_LISTED else ""
-        )
-        raise DataError(
-            f"{len(too_long)} input gap(s) longer than max_gap={format_timedelta(max_gap)} in "
-            f"the period {_fmt(s0)} to {_fmt(e0)}:\n  {listed}{more}\nInputs cannot be left "
-            f"missing (the simulation needs every step): restrict the period with start=/end= "
-            f"to avoid the gaps, fill them upstream, or raise max_gap="
-        )
-
-    # -- outputs at the grid instants ----------------------------------------------------
+    step, max_gap, override, wframes, mframes = _check_tables(
+        weather, measurements, step, max_gap, averaged, long_gaps
+    )
+    inputs, outputs, sources = _native_series(wframes, mframes, override)
+    s0, e0, edges = _period(inputs, outputs, start, end, step)
+    n_rows = edges.size - 1
+    columns = _input_columns(inputs, edges, max_gap, long_gaps)
+    frame_cols, flag_cols, interpolated, slope_cols, gaps, breaks = columns
     grid = edges[:-1]
-    measurement_gaps: list[Gap] = []
-    missing: dict[str, int] = {}
-    for name, t, v, delta in outputs:
-        col = _sample(t, v, grid, tol=1.5 * delta)
-        frame_cols[name] = col
-        flag_cols[name] = np.zeros(n_rows, dtype=bool)
-        missing[name] = int(np.isnan(col).sum())
-        for a, b in _nan_runs(col):
-            n = b - a + 1
-            measurement_gaps.append(
-                Gap(
-                    name,
-                    pd.Timestamp(grid[a], tz="UTC"),
-                    pd.Timestamp(grid[b], tz="UTC"),
-                    n,
-                    n * step,
-                    False,
-                )
-            )
+    measurement_gaps, missing = _output_columns(outputs, grid, step, frame_cols, flag_cols)
 
     index = pd.DatetimeIndex(pd.to_datetime(grid, unit="ns", utc=True), freq=step, name="time")
     frame = pd.DataFrame(frame_cols, index=index)
@@ -481,16 +241,240 @@ def align(
     return Aligned(frame, flags, report, in_names, out_names, slopes, breaks)
 
 
-def _slopes(series: _Input, values: np.ndarray, edges: np.ndarray) -> np.ndarray:
-    """Change of an instantaneous input over each bin, ``u(edges[k+1]) - u(edges[k])``,
-    on its linear interpolation between samples; zero for an interval mean (constant
-    over its interval: the zero-order hold of its bin mean is exact)."""
-    n = edges.size - 1
-    if series.averaged:
-        return np.zeros(n)
-    ok = ~np.isnan(values)
-    at = np.interp(edges.astype(float), series.times[ok].astype(float), values[ok])
-    return np.diff(at)
+# The steps of align, in order.
+
+
+def _check_tables(weather, measurements, step, max_gap, averaged, long_gaps):
+    """Validate :func:`align`'s options and tables.
+
+    Returns
+    -------
+    step, max_gap : pandas.Timedelta
+    override : set of str or None
+        The ``averaged`` override as a set.
+    wframes, mframes : list of pandas.DataFrame
+        The weather and measurement tables on UTC nanosecond indexes.
+
+    Raises
+    ------
+    heritage_bayes.errors.InputError
+        Bad durations or ``long_gaps``, no weather table, unknown ``averaged`` columns.
+    heritage_bayes.errors.DataError
+        A column name in more than one table; a table that is not a time series.
+    """
+    step = _duration(step, "step", allow_zero=False)
+    max_gap = _duration(max_gap, "max_gap", allow_zero=True)
+    if long_gaps not in ("raise", "split"):
+        raise InputError(f"long_gaps must be 'raise' or 'split' (got {long_gaps!r})")
+    override = None
+    if averaged is not None:
+        override = {averaged} if isinstance(averaged, str) else set(averaged)
+    wframes = _frames(weather, "weather")
+    if not wframes:
+        raise InputError("weather: at least one table of inputs is required")
+    mframes = _frames(measurements, "measurements")
+    names = [c for df in wframes + mframes for c in df.columns]
+    dupes = sorted({c for c in names if names.count(c) > 1})
+    if dupes:
+        raise DataError(f"column(s) {dupes} appear in more than one table; rename them")
+    if override is not None:
+        unknown = sorted(override - set(names))
+        if unknown:
+            raise InputError(f"averaged: unknown column(s) {unknown}; columns are {names}")
+    return step, max_gap, override, wframes, mframes
+
+
+def _native_series(wframes, mframes, override):
+    """The native input series and output samples, and a note on each source table.
+
+    Returns
+    -------
+    inputs : list of NativeSeries
+        One regular series per weather column (missing rows as NaN).
+    outputs : list of (name, t [ns], values, spacing [ns])
+        The valid samples of each measurement column; an interval-average column is
+        stamped at the middle of its interval.
+    sources : list of dict
+        Weather notes, then measurement notes, for :attr:`AlignmentReport.sources`.
+    """
+    inputs: list[NativeSeries] = []
+    sources: list[dict] = []
+    for k, df in enumerate(wframes):
+        label = df.attrs.get("source", f"weather[{k}]")
+        avg = _averaged_columns(df, override)
+        inputs.extend(input_series(df, f"weather {label}", avg))
+        sources.append(_source_note(df, "weather", avg, modal_step(df.index)))
+    outputs: list[tuple[str, np.ndarray, np.ndarray, int]] = []
+    for df in mframes:
+        avg = _averaged_columns(df, override)
+        mstep = modal_step(df.index)
+        interval = pd.Timedelta(df.attrs.get("interval") or mstep)
+        sources.append(_source_note(df, "measurements", avg, mstep))
+        for col in df.columns:
+            s = df[col].dropna()
+            t = s.index.asi8.copy()
+            if col in avg:
+                t = t - interval.value // 2
+            outputs.append((col, t, s.to_numpy(dtype=float), int(mstep.value)))
+    return inputs, outputs, sources
+
+
+def _period(inputs, outputs, start, end, step) -> tuple[int, int, np.ndarray]:
+    """The grid ``[s0, e0)`` [ns UTC] and its bin edges.
+
+    Default start: the latest first instant covered by every input and the first
+    measurement, rounded up to a multiple of ``step``; default end: the earliest last
+    instant of the inputs and one step after the last measurement.
+
+    Raises
+    ------
+    heritage_bayes.errors.DataError
+        A period shorter than one step, or not covered by every input.
+    """
+    cov = {s.name: s.coverage() for s in inputs}
+    cov_lo = max(c[0] for c in cov.values())
+    cov_hi = min(c[1] for c in cov.values())
+    step_ns = int(step.value)
+    if start is not None:
+        s0 = _timestamp(start, "start").value
+    else:
+        s0 = cov_lo
+        firsts = [o[1][0] for o in outputs if o[1].size]
+        if firsts:
+            s0 = max(s0, min(firsts))
+        s0 = -((-s0) // step_ns) * step_ns  # ceil to the grid
+    if end is not None:
+        e0 = _timestamp(end, "end").value
+    else:
+        e0 = cov_hi
+        lasts = [o[1][-1] for o in outputs if o[1].size]
+        if lasts:
+            e0 = min(e0, max(lasts) + step_ns)
+    n_rows = (e0 - s0) // step_ns
+    if n_rows < 1:
+        raise DataError(
+            f"empty period: start {_fmt(s0)} is not at least one step ({format_timedelta(step)}) "
+            f"before end {_fmt(e0)}; the inputs cover {_fmt(cov_lo)} to {_fmt(cov_hi)}"
+            + (" and the measurements do not overlap them" if outputs else "")
+        )
+    e0 = s0 + n_rows * step_ns
+    short = [(n, c) for n, c in cov.items() if c[0] > s0 or c[1] < e0]
+    if short:
+        lines = "; ".join(f"{n} covers {_fmt(c[0])} to {_fmt(c[1])}" for n, c in short)
+        raise DataError(
+            f"the period {_fmt(s0)} to {_fmt(e0)} is not covered by every input: {lines}. "
+            f"Choose start/end inside the inputs' coverage"
+        )
+    return s0, e0, s0 + np.arange(n_rows + 1, dtype=np.int64) * step_ns
+
+
+def _input_columns(inputs, edges, max_gap, long_gaps):
+    """Fill the input gaps and take each input's exact mean over every bin.
+
+    A gap (missing run of native samples) that changes a bin of the period is filled by
+    linear interpolation in time; up to ``max_gap`` it is a filled gap (its bins
+    flagged), longer it is an error or, with ``long_gaps="split"``, bridged (its bins
+    marked as breaks).
+
+    Returns
+    -------
+    frame_cols, flag_cols, interpolated, slope_cols : dict by input name
+        Bin means, filled-bin flags, count of filled samples, change over each bin.
+    gaps : list of Gap
+        The gaps filled or bridged.
+    breaks : numpy.ndarray of bool
+        Bins that depend on a bridged sample.
+
+    Raises
+    ------
+    heritage_bayes.errors.DataError
+        Gaps longer than ``max_gap`` with ``long_gaps="raise"`` (all listed, up to 12).
+    """
+    s0, e0 = int(edges[0]), int(edges[-1])
+    step_ns = int(edges[1] - edges[0])
+    gaps: list[Gap] = []
+    too_long: list[Gap] = []
+    frame_cols: dict[str, np.ndarray] = {}
+    flag_cols: dict[str, np.ndarray] = {}
+    interpolated: dict[str, int] = {}
+    slope_cols: dict[str, np.ndarray] = {}
+    breaks = np.zeros(edges.size - 1, dtype=bool)
+    for s in inputs:
+        values = s.values.copy()
+        filled = np.zeros(values.size)
+        bridged = np.zeros(values.size)
+        for a, b in s.runs():
+            if not s.affects(a, b, s0, e0):
+                continue
+            n = b - a + 1
+            gap = Gap(
+                s.name,
+                pd.Timestamp(s.times[a], tz="UTC"),
+                pd.Timestamp(s.times[b], tz="UTC"),
+                n,
+                pd.Timedelta(n * s.delta, unit="ns"),
+                n * s.delta <= max_gap.value,
+            )
+            if not gap.filled and long_gaps == "raise":
+                too_long.append(gap)
+                continue
+            gaps.append(gap)
+            x = s.times[a - 1 : b + 2].astype(float)
+            values[a : b + 1] = np.interp(x[1:-1], x[[0, -1]], values[[a - 1, b + 1]])
+            (filled if gap.filled else bridged)[a : b + 1] = 1.0
+        if bridged.any():
+            breaks |= bin_integrals(s, bridged, edges) > 1e-9
+        interpolated[s.name] = int(filled.sum())
+        frame_cols[s.name] = bin_integrals(s, values, edges) / (step_ns / NS)
+        slope_cols[s.name] = bin_slopes(s, values, edges)
+        flag_cols[s.name] = bin_integrals(s, filled, edges) > 1e-9
+    if too_long:
+        listed = "\n  ".join(str(g) for g in too_long[:_MAX_LISTED])
+        more = (
+            f"\n  ... and {len(too_long) - _MAX_LISTED} more" if len(too_long) > _MAX_LISTED else ""
+        )
+        raise DataError(
+            f"{len(too_long)} input gap(s) longer than max_gap={format_timedelta(max_gap)} in "
+            f"the period {_fmt(s0)} to {_fmt(e0)}:\n  {listed}{more}\nInputs cannot be left "
+            f"missing (the simulation needs every step): restrict the period with start=/end= "
+            f"to avoid the gaps, fill them upstream, or raise max_gap="
+        )
+    return frame_cols, flag_cols, interpolated, slope_cols, gaps, breaks
+
+
+def _output_columns(outputs, grid, step, frame_cols, flag_cols):
+    """Sample each output at the grid instants (into ``frame_cols``, unflagged).
+
+    Linear interpolation between the two neighbouring samples when they are at most 1.5
+    native spacings apart; otherwise NaN (a measurement gap).
+
+    Returns
+    -------
+    measurement_gaps : list of Gap
+        The runs of NaN rows of each output.
+    missing : dict of str to int
+        The count of NaN rows of each output.
+    """
+    measurement_gaps: list[Gap] = []
+    missing: dict[str, int] = {}
+    for name, t, v, delta in outputs:
+        col = sample_at(t, v, grid, tol=1.5 * delta)
+        frame_cols[name] = col
+        flag_cols[name] = np.zeros(grid.size, dtype=bool)
+        missing[name] = int(np.isnan(col).sum())
+        for a, b in nan_runs(col):
+            n = b - a + 1
+            measurement_gaps.append(
+                Gap(
+                    name,
+                    pd.Timestamp(grid[a], tz="UTC"),
+                    pd.Timestamp(grid[b], tz="UTC"),
+                    n,
+                    n * step,
+                    False,
+                )
+            )
+    return measurement_gaps, missing
 
 
 def _fmt(ns: int) -> str:
@@ -520,37 +504,3 @@ def _source_note(df: pd.DataFrame, role: str, avg: set[str], spacing) -> dict:
         if key in df.attrs:
             note[key] = df.attrs[key]
     return note
-
-
-def _sample(t: np.ndarray, v: np.ndarray, grid: np.ndarray, tol: float) -> np.ndarray:
-    """Linear interpolation of (t, v) at ``grid`` between neighbours at most ``tol`` apart."""
-    out = np.full(grid.size, np.nan)
-    if t.size == 0:
-        return out
-    pos = np.searchsorted(t, grid, side="left")
-    inside = pos < t.size
-    exact = inside.copy()
-    exact[inside] = t[pos[inside]] == grid[inside]
-    out[exact] = v[pos[exact]]
-    a = pos - 1
-    between = ~exact & (a >= 0) & inside
-    ai, bi = a[between], pos[between]
-    span = (t[bi] - t[ai]).astype(float)
-    ok = span <= tol
-    w = (grid[between] - t[ai]) / span
-    vals = v[ai] + w * (v[bi] - v[ai])
-    idx = np.flatnonzero(between)
-    out[idx[ok]] = vals[ok]
-    return out
-
-
-def _nan_runs(x: np.ndarray) -> list[tuple[int, int]]:
-    nan = np.isnan(x).astype(np.int8)
-    edges = np.diff(np.concatenate([[0], nan, [0]]))
-    return list(
-        zip(
-            np.flatnonzero(edges == 1).tolist(),
-            (np.flatnonzero(edges == -1) - 1).tolist(),
-            strict=True,
-        )
-    )

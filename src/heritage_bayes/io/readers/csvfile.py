@@ -18,20 +18,23 @@ from heritage_bayes.io._common import (
     AVERAGED_BY_DEFAULT,
     DUPLICATE_POLICIES,
     INVALID_POLICIES,
-    READ_ERRORS,
     STANDARD_COLUMNS,
     _quote_list,
     check_choice,
     check_file,
-    damaged,
     finalize,
     localize,
     modal_step,
     order_and_deduplicate,
     parse_timezone,
-    sniff_text,
     source_name,
     validate_ranges,
+)
+from heritage_bayes.io.readers._csvtext import (
+    parse_timestamps,
+    parse_values,
+    read_body,
+    read_header,
 )
 
 __all__ = ["read_csv"]
@@ -171,6 +174,72 @@ def read_csv(
     """
     path = check_file(path)
     name = source_name(path)
+    time_cols, skip_list = _check_options(duplicates, invalid, label, sort, time_column, skiprows)
+    conversions = _unit_conversions(units)
+    tz = parse_timezone(timezone) if timezone is not None else None
+    na_list = list(na_values) if na_values is not None else []
+    na_numeric = [float(v) for v in na_list if isinstance(v, int | float)]
+
+    table, read_kw, stripped = read_header(path, name, sep, decimal, skiprows, encoding)
+    wanted = _wanted_columns(name, columns, stripped)
+    raw, lines, counts = read_body(
+        table, read_kw, name, encoding, stripped, time_cols, wanted, na_list, skiprows, skip_list
+    )
+    raw, text, stamps, lines = parse_timestamps(
+        raw, lines, name, time_cols, time_format, time_origin, invalid, counts
+    )
+    data = parse_values(raw, lines, name, wanted, decimal, na_numeric, conversions, invalid, counts)
+    line_text = dict(zip(lines.tolist(), text.tolist(), strict=True))
+    frame, lines, tz_label = _on_utc(data, stamps, text, lines, name, tz, timezone, counts)
+
+    clipped = validate_ranges(frame, lines, name, wanted, invalid, counts)
+    frame["__line"] = lines
+    frame = order_and_deduplicate(
+        frame,
+        name,
+        duplicates=duplicates,
+        sort=sort,
+        counts=counts,
+        describe=lambda line: quoted(line_text[int(line)]),
+    )
+    frame = frame.drop(columns="__line")
+    frame, averaged_cols, step = _interval_averages(frame, name, averaged, interval, label)
+    return finalize(
+        frame,
+        source=str(path),
+        fmt="csv",
+        averaged=averaged_cols,
+        interval=step,
+        counts=counts,
+        clipped=clipped,
+        extra={"timezone": tz_label, "source_columns": dict(wanted)},
+    )
+
+
+# ---------------------------------------------------------------------------------------
+# The steps of read_csv, in order
+# ---------------------------------------------------------------------------------------
+
+
+def _check_options(
+    duplicates: str, invalid: str, label: str, sort, time_column, skiprows
+) -> tuple[list[str], list[int] | None]:
+    """Validate the policy options of :func:`read_csv` before the file is opened.
+
+    Returns
+    -------
+    time_cols : list of str
+        The time column(s), as a list.
+    skip_list : list of int or None
+        The sorted distinct 0-based line numbers to skip, when ``skiprows`` is a sequence;
+        None when it is a count of lines before the header.
+
+    Raises
+    ------
+    heritage_bayes.errors.InputError
+        An unknown policy, a non-boolean ``sort``, a time column that is not a name or a
+        list of names, a negative or non-integer ``skiprows``.
+    """
     check_choice(duplicates, DUPLICATE_POLICIES, "duplicates")
     check_choice(invalid, INVALID_POLICIES, "invalid")
     check_choice(label, _LABELS, "label")
@@ -188,32 +257,21 @@ def read_csv(
         skip_list = sorted(set(skiprows))
     elif isinstance(skiprows, bool) or not isinstance(skiprows, int) or skiprows < 0:
         raise InputError(f"skiprows must be a non-negative integer (got {skiprows!r})")
-    conversions = _unit_conversions(units)
-    tz = parse_timezone(timezone) if timezone is not None else None
-    na_list = list(na_values) if na_values is not None else []
-    na_numeric = [float(v) for v in na_list if isinstance(v, int | float)]
-    read_kw = {"sep": sep, "skiprows": skiprows, "encoding": encoding}
+    return time_cols, skip_list
 
-    # -- header --------------------------------------------------------------------------
-    from heritage_bayes.io.readers.workbook import is_workbook, table_source
 
-    if is_workbook(path):  # the first sheet as CSV text (see .workbook)
-        if (sep, decimal) != (",", "."):
-            raise InputError(f"{name}: a workbook is read as sep ',' and decimal '.'")
-        read_kw["encoding"] = None
-    else:
-        read_kw["encoding"] = encoding = sniff_text(path, name, encoding=encoding)
-    table = table_source(path)
-    try:
-        header = pd.read_csv(table(), nrows=0, **read_kw)
-    except pd.errors.EmptyDataError as exc:
-        raise DataError(f"{name}: file is empty, expected a header line") from exc
-    except (pd.errors.ParserError, UnicodeDecodeError) as exc:
-        raise DataError(f"{name}: cannot read the header: {exc}") from exc
-    except READ_ERRORS as exc:
-        raise damaged(name, exc) from None
-    stripped = [str(c).strip() for c in header.columns]
+def _wanted_columns(name: str, columns, stripped: list[str]) -> dict[str, str]:
+    """The ``{standard_name: header name}`` mapping to read.
 
+    Default (``columns`` None): the header names that are standard names already.
+
+    Raises
+    ------
+    heritage_bayes.errors.DataError
+        No mapping given and no header name is a standard name.
+    heritage_bayes.errors.InputError
+        An empty or non-mapping ``columns``, an unknown standard name.
+    """
     if columns is None:
         columns = {c: c for c in stripped if c in STANDARD_COLUMNS}
         if not columns:
@@ -230,119 +288,41 @@ def read_csv(
             f"columns: unknown standard name(s) {_quote_list(unknown)}; standard names are "
             f"{_quote_list(STANDARD_COLUMNS)}"
         )
-    wanted = {std: str(src).strip() for std, src in columns.items()}
+    return {std: str(src).strip() for std, src in columns.items()}
 
-    def position(col: str) -> int:
-        hits = [i for i, c in enumerate(stripped) if c == col]
-        if not hits:
-            raise DataError(
-                f"{name}: column {quoted(col)} not found; columns are: {_quote_list(stripped)}"
-            )
-        if len(hits) > 1:
-            raise DataError(
-                f"{name}: column name {quoted(col)} appears {len(hits)} times in the header"
-            )
-        return hits[0]
 
-    time_pos = [position(c) for c in time_cols]
-    value_pos = {std: position(src) for std, src in wanted.items()}
-    usecols = sorted(set(time_pos) | set(value_pos.values()))
+def _on_utc(
+    data: Mapping[str, np.ndarray],
+    stamps,
+    text: pd.Series,
+    lines: np.ndarray,
+    name: str,
+    tz,
+    timezone,
+    counts: dict[str, int],
+) -> tuple[pd.DataFrame, np.ndarray, str]:
+    """Put the values on a UTC index: convert stamps with an offset, localize naive ones.
 
-    # -- body ------------------------------------------------------------------------------
-    try:
-        raw = pd.read_csv(
-            table(),
-            header=0,
-            index_col=False,
-            dtype=str,
-            na_values=[str(v) for v in na_list] or None,
-            skip_blank_lines=False,
-            **read_kw,
-        )
-    except pd.errors.ParserError as exc:
-        raise DataError(f"{name}: malformed table: {exc}") from exc
-    except UnicodeDecodeError as exc:
-        raise DataError(f"{name}: not {encoding}-encoded text ({exc}); pass encoding=") from exc
-    except READ_ERRORS as exc:
-        raise damaged(name, exc) from None
-    if raw.shape[1] != len(stripped):
-        raise DataError(f"{name}: malformed table: rows have more fields than the header")
-    raw = raw.iloc[:, usecols]
-    raw.columns = [stripped[i] for i in usecols]
-    if skip_list is None:
-        lines = np.arange(len(raw)) + skiprows + 2  # 1-based line numbers, header on skiprows+1
-    else:  # the lines pandas kept: header first, then the body
-        kept, skip, i = [], set(skip_list), 0
-        while len(kept) < len(raw) + 1:
-            if i not in skip:
-                kept.append(i + 1)
-            i += 1
-        lines = np.asarray(kept[1:], dtype=int)
-    counts: dict[str, int] = {}
+    Naive stamps are read on the clock ``tz`` (see :func:`read_csv`, Notes, for the
+    daylight-saving policy); rows that cannot be placed are dropped and counted as
+    ``ambiguous_dst`` and ``nonexistent_dst`` in ``counts``.
 
-    blank = raw.isna().all(axis=1).to_numpy()
-    if blank.any():
-        counts["blank_rows"] = int(blank.sum())
-        raw = raw[~blank]
-        lines = lines[~blank]
+    Returns
+    -------
+    frame : pandas.DataFrame
+        The values on their UTC times (not yet sorted or deduplicated).
+    lines : numpy.ndarray of int
+        The line numbers of the rows kept.
+    tz_label : str
+        The clock, for ``attrs["timezone"]``: ``str(timezone)`` or
+        ``"from the timestamps"``.
 
-    # -- timestamps ------------------------------------------------------------------------
-    parts = [raw[c].str.strip() for c in time_cols]
-    text = parts[0]
-    for part in parts[1:]:
-        text = text + " " + part
-    if time_origin is not None:
-        secs = pd.to_numeric(text, errors="coerce")
-        stamps = pd.Timestamp(time_origin) + pd.to_timedelta(secs, unit="s")
-        time_format = "seconds since " + str(time_origin)
-    else:
-        try:
-            stamps = pd.to_datetime(text, format=time_format, errors="coerce")
-        except ValueError:  # mixed UTC offsets
-            stamps = pd.to_datetime(text, format=time_format, errors="coerce", utc=True)
-    bad = stamps.isna().to_numpy()
-    if bad.any():
-        i = int(np.flatnonzero(bad)[0])
-        if invalid == "raise":
-            expected = f"format {time_format!r}" if time_format else "the format of line 2"
-            shown = text.iloc[i] if isinstance(text.iloc[i], str) else ""
-            raise DataError(
-                f"{name}: cannot parse timestamp {quoted(shown)} in column(s) "
-                f"{_quote_list(time_cols)} on line {int(lines[i])} (expected {expected}); "
-                f"{int(bad.sum())} bad timestamp(s). Fix the file or pass invalid='nan' to "
-                f"drop such rows"
-            )
-        counts["bad_timestamps"] = int(bad.sum())
-        raw, text, stamps, lines = raw[~bad], text[~bad], stamps[~bad], lines[~bad]
-
-    # -- values ----------------------------------------------------------------------------
-    data = {}
-    for std, src in wanted.items():
-        cell = raw[src].str.strip()
-        if decimal != ".":
-            cell = cell.str.replace(decimal, ".", regex=False)
-        num = pd.to_numeric(cell, errors="coerce").astype(float)
-        unparsed = (num.isna() & cell.notna() & (cell != "")).to_numpy()
-        if unparsed.any():
-            i = int(np.flatnonzero(unparsed)[0])
-            if invalid == "raise":
-                raise DataError(
-                    f"{name}: column {quoted(src)} line {int(lines[i])}: cannot parse "
-                    f"{quoted(raw[src].iloc[i])} as a number (decimal mark {decimal!r}); "
-                    f"{int(unparsed.sum())} such value(s). Declare missing-value markers "
-                    f"with na_values= or pass invalid='nan'"
-                )
-            counts["unparseable_values"] = counts.get("unparseable_values", 0) + int(unparsed.sum())
-        values = num.to_numpy(copy=True)
-        if na_numeric:
-            values[np.isin(values, na_numeric)] = np.nan
-        if std in conversions:
-            values = conversions[std](values)
-        data[std] = values
-
-    # -- time zone -------------------------------------------------------------------------
+    Raises
+    ------
+    heritage_bayes.errors.DataError
+        Stamps with an offset and a ``timezone`` given, or naive stamps and none given.
+    """
     stamp_index = pd.DatetimeIndex(stamps)
-    line_text = dict(zip(lines.tolist(), text.tolist(), strict=True))
     if stamp_index.tz is not None:
         if tz is not None:
             raise DataError(
@@ -365,21 +345,33 @@ def read_csv(
         counts["nonexistent_dst"] = loc.nonexistent_dropped
         tz_label = str(timezone)
     frame = pd.DataFrame({k: v[keep] for k, v in data.items()}, index=utc)
-    lines = lines[keep]
+    return frame, lines[keep], tz_label
 
-    clipped = validate_ranges(frame, lines, name, wanted, invalid, counts)
-    frame["__line"] = lines
-    frame = order_and_deduplicate(
-        frame,
-        name,
-        duplicates=duplicates,
-        sort=sort,
-        counts=counts,
-        describe=lambda line: quoted(line_text[int(line)]),
-    )
-    frame = frame.drop(columns="__line")
 
-    # -- interval averages -----------------------------------------------------------------
+def _interval_averages(
+    frame: pd.DataFrame, name: str, averaged, interval, label: str
+) -> tuple[pd.DataFrame, tuple[str, ...], pd.Timedelta | None]:
+    """Name the interval-average columns and put them on the interval-end convention.
+
+    Returns
+    -------
+    frame : pandas.DataFrame
+        With ``label="start"``, the averaged columns moved forward by one interval (to
+        the end of the interval they average); otherwise unchanged.
+    averaged_cols : tuple of str
+        The averaged columns: ``averaged``, or by default the irradiance columns present.
+    step : pandas.Timedelta or None
+        The averaging interval: ``interval``, or the modal spacing of the index (None
+        for a single row).
+
+    Raises
+    ------
+    heritage_bayes.errors.InputError
+        An averaged column that was not read, an ``interval`` that is not a positive
+        duration.
+    heritage_bayes.errors.DataError
+        Averaged columns, one row and no ``interval``.
+    """
     if averaged is None:
         averaged_cols = tuple(c for c in AVERAGED_BY_DEFAULT if c in frame.columns)
     else:
@@ -395,17 +387,7 @@ def read_csv(
         raise DataError(f"{name}: cannot infer the averaging interval from one row; pass interval=")
     if label == "start" and averaged_cols:
         frame = _shift_columns(frame, averaged_cols, step)
-
-    return finalize(
-        frame,
-        source=str(path),
-        fmt="csv",
-        averaged=averaged_cols,
-        interval=step,
-        counts=counts,
-        clipped=clipped,
-        extra={"timezone": tz_label, "source_columns": dict(wanted)},
-    )
+    return frame, averaged_cols, step
 
 
 #: Units a column may be declared in (``units=``) and their conversion to the standard

@@ -215,6 +215,42 @@ def _refuse_data_folder(output: Path, inputs: dict[str, Path]) -> None:
             )
 
 
+def _operation(ti_utc, te_utc, rhi_utc, rhe_utc, s, e, span, findings):
+    """The most recent stretch of ``[s, e]`` over which the room was run one way, and its
+    heating floor.
+
+    Returns
+    -------
+    s, e : pandas.Timestamp
+        The stretch [UTC] (the whole overlap when the operation did not change).
+    span : str
+        Its description for the periods' comment.
+    regime_why : str
+        The per-year evidence of a change (empty when none), appended to that comment.
+    floor : tuple
+        ``(floor [°C], held days, days)`` of :func:`heating_floor` over the stretch (the
+        whole overlap when the operation did not change).
+    """
+    rs, re_, regime_notes = regime_stretch(ti_utc, te_utc, rhi_utc, rhe_utc, s, e)
+    findings += [f"operation: {n}" for n in regime_notes]
+    regime_why = ""
+    if (rs, re_) != (s, e) or len(regime_notes) > 1:  # a change: its evidence by the periods
+        regime_why = ". " + ". ".join(n[0].upper() + n[1:] for n in regime_notes[::-1])
+    floor_ti, floor_te = ti_utc, te_utc  # the floor over the whole overlap, or the stretch
+    if (rs, re_) != (s, e):
+        s, e = rs, re_
+        span = f"the stretch run one way ({s:%Y-%m-%d} to {e:%Y-%m-%d})"
+        floor_ti, floor_te = ti_utc[s:e], te_utc[s:e]
+    floor, held, ndays = heating_floor(floor_ti, floor_te)
+    heated = held >= max(20, 0.05 * ndays)
+    findings.append(
+        f"control: the indoor daily minimum sat at {floor:.1f} °C (within 0.5 K) on {held} of "
+        f"{ndays} days while the outdoor air averaged 5 K colder"
+        + (": heated (a thermostat's floor)" if heated else ": free-running")
+    )
+    return s, e, span, regime_why, (floor, held, ndays)
+
+
 def init_config(
     indoor,
     weather,
@@ -423,25 +459,8 @@ def init_config(
     hygric = "RHi" in icols and ("RHe" in dw.columns or rhe_open)
     rhi_utc = to_utc(din["RHi"], izone) if "RHi" in din else None
     rhe_utc = (to_utc(dw["RHe"], wzone) if wlay is not None else dw["RHe"]) if "RHe" in dw else None
-    # the room run one way over the periods: the most recent stretch without a change
-    rs, re_, regime_notes = regime_stretch(
-        ti_utc, te_utc, rhi_utc if hygric else None, rhe_utc, s, e
-    )
-    findings += [f"operation: {n}" for n in regime_notes]
-    regime_why = ""
-    if (rs, re_) != (s, e) or len(regime_notes) > 1:  # a change: its evidence by the periods
-        regime_why = ". " + ". ".join(n[0].upper() + n[1:] for n in regime_notes[::-1])
-    floor_ti, floor_te = ti_utc, te_utc  # the floor over the whole overlap, or the stretch
-    if (rs, re_) != (s, e):
-        s, e = rs, re_
-        span = f"the stretch run one way ({s:%Y-%m-%d} to {e:%Y-%m-%d})"
-        floor_ti, floor_te = ti_utc[s:e], te_utc[s:e]
-    floor, held, ndays = heating_floor(floor_ti, floor_te)
-    heated = held >= max(20, 0.05 * ndays)
-    findings.append(
-        f"control: the indoor daily minimum sat at {floor:.1f} °C (within 0.5 K) on {held} of "
-        f"{ndays} days while the outdoor air averaged 5 K colder"
-        + (": heated (a thermostat's floor)" if heated else ": free-running")
+    s, e, span, regime_why, (floor, held, ndays) = _operation(
+        ti_utc, te_utc, rhi_utc if hygric else None, rhe_utc, s, e, span, findings
     )
     if any(z and str(z).startswith(MARK) for z in (izone, wzone)):
         # an open clock moves the data by up to 14 h when answered: periods chosen on the

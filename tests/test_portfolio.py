@@ -221,7 +221,7 @@ def test_shipped_portfolio_validates():
 
 @pytest.mark.browser
 def test_index_sorts_in_headless_chromium(finished):
-    from _report_browser import find_chromium, open_page
+    from heritage_bayes.report._browser import find_chromium, open_page
 
     chromium = find_chromium()
     if chromium is None:
@@ -287,7 +287,7 @@ def test_index_speaks_in_percent_and_names_the_indicators_at_risk(tmp_path):
 def test_index_fits_the_screen_with_its_projection_columns(finished, width):
     """At 1280 px the three tables fit the page (the projection columns on screen, no
     sideways scroll); at 390 px each room is a card: nothing wider than the screen."""
-    from _report_browser import phone_layout
+    from _browser_checks import phone_layout
 
     d, _, _ = finished
     lay = phone_layout(d / "out" / "index.html", width=width, extra="""

@@ -19,13 +19,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from _report_browser import PHONE_OVERFLOW_JS, find_chromium, open_page
 from heritage_bayes.calibrate import run_calibration
 from heritage_bayes.cli import main
 from heritage_bayes.config import parse_config
 from heritage_bayes.errors import InputError
 from heritage_bayes.format import fmt, fmt_int, prior_text, prose_html, tick_names
 from heritage_bayes.report import write_report
+from heritage_bayes.report._browser import PHONE_OVERFLOW_JS, find_chromium, open_page
 from heritage_bayes.report._diag import acf, cumulative_periodogram, innovations
 from heritage_bayes.report.build import SECTIONS
 from heritage_bayes.report.page import Section, render_page, script_hash

@@ -526,6 +526,11 @@ def test_verdict_classes_and_notes():
     assert [(n["level"], n["title"]) for n in notes] == [
         ("info", "Solar radiation is estimated from the outdoor temperature")
     ]
+    # a roof slope that init wrote (roof_<direction>) is named in words
+    on_roof = {**s, "models": {"thermal": {"map_at_bound": [["fI_roof_E", "upper"]]}}}
+    (note,) = run_notes(on_roof, [])
+    assert note["title"] == "The thermal MAP lies on a prior bound"
+    assert "for solar aperture, east slope of the roof (upper):" in note["text"]
 
 
 def test_house_page_builder():

@@ -28,6 +28,7 @@ from heritage_bayes.cli import main
 from heritage_bayes.climate.risk.registry import INDICATORS
 from heritage_bayes.config import parse_config
 from heritage_bayes.format import fmt, fmt_interval
+from heritage_bayes.portfolio.rooms import room_row
 from heritage_bayes.projection import project
 from heritage_bayes.report import write_report
 from heritage_bayes.rundir.summary import load_summary
@@ -202,3 +203,9 @@ def test_a_run_whose_saved_draws_fail_its_criteria_is_never_green(pages, tmp_pat
     page = write_report(run).read_text(encoding="utf-8")
     assert _verdict_level(page) != "green"
     assert "Rule applied: green only when" in page
+    # summary.json records the verdict the page shows; the portfolio's row reads it
+    v = load_summary(run).verdict
+    assert v.level == _verdict_level(page) and v.title in html_mod.unescape(page)
+    row = room_row(run)
+    assert (row["verdict_level"], row["verdict_title"]) == (v.level, v.title)
+    assert row["verdict"] == v.status

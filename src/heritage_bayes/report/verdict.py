@@ -20,7 +20,7 @@ import math
 from heritage_bayes.format import fmt, fmt_int, fmt_interval, quantity_name
 from heritage_bayes.report.accuracy import accuracy_failures, missing_physics
 from heritage_bayes.report.notes import run_notes
-from heritage_bayes.rundir.summary import RunSummary
+from heritage_bayes.rundir.summary import RunSummary, Verdict
 
 __all__ = [
     "AMBER",
@@ -33,6 +33,7 @@ __all__ = [
     "run_notes",
     "truth_advice",
     "truth_misses",
+    "verdict_record",
 ]
 
 #: "Close to converged" (amber) thresholds; green uses the run's own criteria.
@@ -228,7 +229,10 @@ def convergence_verdict(
         saved in ``posterior.nc`` within the same criteria, and the residual,
         coverage and truth checks pass; ``"amber"``: the rule met but the saved draws
         or a check fail, or close to converged — max R-hat ≤ 1.05 and min bulk ESS ≥
-        100; ``"red"``: not converged), ``title``, ``text``, ``rule`` (the rule
+        100; ``"red"``: not converged), ``status`` (one of
+        :data:`~heritage_bayes.rundir.summary.STATUSES`: *converged* when green,
+        *checks failed* when the stopping rule was met and the headline does not say
+        otherwise, else *not converged*), ``title``, ``text``, ``rule`` (the rule
         applied, in words, for the page), ``models`` (one plain-words line per model,
         per failed check and per model whose scale only the priors pin,
         :func:`prior_pinned_lines`), ``checks``, ``accuracy`` (the failures of the
@@ -387,11 +391,14 @@ def convergence_verdict(
             "room volume (`room_volume`), usually helps."
         )
     failures = accuracy_failures(summary, resolutions)
+    # the headline says the sampling did not converge (the portfolio's "not converged")
+    says_unconverged = level == "red"
     if failures:
         converged = rule_ok and saved_ok
         nearly = level == "amber" and not converged
         level = "red"
         title = "This model does not reproduce the room"
+        says_unconverged = not converged
         if not converged:
             title += " — and " + ("not fully converged" if nearly else "NOT CONVERGED")
         text = (
@@ -412,8 +419,15 @@ def convergence_verdict(
             "diagnostics (section 7), change the model, and calibrate again."
         )
     lines += prior_pinned_lines(summary)
+    if level == "green":
+        status = "converged"
+    elif conv.converged and conv.converged_tau and not says_unconverged:
+        status = "checks failed"
+    else:
+        status = "not converged"
     return {
         "level": level,
+        "status": status,
         "title": title,
         "text": text,
         "rule": rule,
@@ -423,6 +437,20 @@ def convergence_verdict(
         "accuracy": failures,
         "advice": advice.strip(),
     }
+
+
+def verdict_record(verdict: dict) -> Verdict:
+    """What ``summary.json`` records of a :func:`convergence_verdict` (its level,
+    status, headline, text, reasons and advice): the report writes it beside the page
+    it shows it on, and the portfolio reads it from there."""
+    return Verdict(
+        level=verdict["level"],
+        status=verdict["status"],
+        title=verdict["title"],
+        text=verdict["text"],
+        reasons=tuple(verdict["models"]),
+        advice=verdict["advice"],
+    )
 
 
 def _typed(summary) -> RunSummary:

@@ -12,13 +12,18 @@ no consumer pokes at nested dicts:
 - :class:`Convergence` — the criteria the run states (max R-hat, min bulk ESS, chain
   length in τ), the figures of the draws saved in ``posterior.nc`` and the stopping
   rule's decision;
-- :class:`ModelInfo` — one section's model, noise model and chain.
+- :class:`ModelInfo` — one section's model, noise model, chain and MAP findings
+  (:class:`Identifiability`, :class:`FrozenNode`);
+- :class:`Period` — the calibration and validation periods;
+- :class:`Verdict` — the report's verdict (level, status, headline, reasons), written
+  with the report: the portfolio reads the verdict the report shows.
 
 Versions: a summary without ``schema_version`` is version 1 (every hbayes before the
 typed summary); its keys are read as they were written, missing ones as absent
 (None). A summary of a newer schema than this hbayes knows is refused with a message
 naming the file. The whole JSON object stays available as :attr:`RunSummary.raw`
-for the parts not typed here (alignment, provenance, ladder).
+for the parts not typed here (alignment, provenance, ladder, selection, correlation
+matrices).
 """
 
 from __future__ import annotations
@@ -34,11 +39,16 @@ from heritage_bayes.rundir.reader import SCHEMA_VERSION, damaged, read_summary
 
 __all__ = [
     "SCHEMA_VERSION",
+    "STATUSES",
     "Convergence",
     "Estimate",
     "FitMetrics",
+    "FrozenNode",
+    "Identifiability",
     "ModelInfo",
+    "Period",
     "RunSummary",
+    "Verdict",
     "load_summary",
 ]
 
@@ -156,6 +166,8 @@ class FitMetrics:
     n: int | None = None
     coverage50: float | None = None
     coverage90: float | None = None
+    SD: float | None = None
+    coverage90_1step: float | None = None
 
 
 @dataclass(frozen=True)
@@ -176,6 +188,7 @@ class Convergence:
     converged: bool
     converged_tau: bool
     reasons: tuple[str, ...] = ()
+    tau_rtol: float | None = None
 
     @property
     def saved_draws_ok(self) -> bool:
@@ -207,8 +220,67 @@ class Convergence:
 
 
 @dataclass(frozen=True)
+class Identifiability:
+    """A model's structural identifiability at the MAP (what ``summary.json`` records):
+    the rank of the output sensitivities, the non-identifiable combinations
+    (``null_directions``, each with its ``label``, ``description``, ``pinned_by`` and
+    ``is_scale``), and per parameter whether the data identify it
+    (``identifiable``) or only once the scale is pinned (``identifiable_given_scale``)."""
+
+    n_null: int = 0
+    n_params: int | None = None
+    rank: int | None = None
+    has_scale_direction: bool | None = None
+    condition_number_identifiable: float | None = None
+    identifiable: frozenset = frozenset()
+    identifiable_given_scale: frozenset = frozenset()
+    parameters: tuple[str, ...] = ()  # the parameters the analysis covered
+    null_directions: tuple[MappingProxyType, ...] = ()
+    control: MappingProxyType = field(default_factory=lambda: MappingProxyType({}))
+    summary: str = ""
+
+    @classmethod
+    def from_dict(cls, d: dict | None) -> Identifiability:
+        d = d or {}
+        pars = d.get("parameters") or {}
+        has_scale = d.get("has_scale_direction")
+        return cls(
+            n_null=int(d.get("n_null") or 0),
+            n_params=d.get("n_params"),
+            rank=d.get("rank"),
+            has_scale_direction=None if has_scale is None else bool(has_scale),
+            condition_number_identifiable=_num(d.get("condition_number_identifiable")),
+            identifiable=frozenset(n for n, v in pars.items() if v.get("identifiable")),
+            identifiable_given_scale=frozenset(
+                n for n, v in pars.items() if v.get("identifiable_given_scale")
+            ),
+            parameters=tuple(pars),
+            null_directions=tuple(
+                MappingProxyType(dict(n)) for n in d.get("null_directions") or []
+            ),
+            control=MappingProxyType(dict(d.get("control") or {})),
+            summary=str(d.get("summary") or ""),
+        )
+
+    def on_scale(self, name: str) -> bool:
+        """Identifiable only once the scale is pinned (the priors pin it)."""
+        return name not in self.identifiable and name in self.identifiable_given_scale
+
+
+@dataclass(frozen=True)
+class FrozenNode:
+    """A node that barely moves over the record at the MAP: its slowest time constant
+    ``tau_h`` [h], ``records`` times the calibration record; ``start_free``: its start
+    is estimated freely (a free offset)."""
+
+    tau_h: float
+    records: float
+    start_free: bool = False
+
+
+@dataclass(frozen=True)
 class ModelInfo:
-    """One section (``thermal``/``hygric``) of a run: its model and chain."""
+    """One section (``thermal``/``hygric``) of a run: its model, chain and MAP findings."""
 
     section: str
     model: str
@@ -219,6 +291,135 @@ class ModelInfo:
     tau_max: float | None = None
     converged_tau: bool = False
     likelihood_temperature: float = 1.0
+    burn: int | None = None
+    thin: int | None = None
+    draws_per_walker: int | None = None
+    acceptance_mean: float | None = None
+    resumed_from: int | None = None
+    stopped_by: str = ""
+    tau_history: tuple[tuple[float, ...], ...] = ()
+    output_names: tuple[str, ...] = ()
+    input_names: tuple[str, ...] | None = None  # None: not recorded (older runs)
+    state_names: tuple[str, ...] = ()
+    #: the sampled parameters, in the order of the chain and the correlation matrix
+    free_names: tuple[str, ...] = ()
+    #: output -> the AR coefficient φ of the predictive noise
+    predictive_phi: MappingProxyType = field(default_factory=lambda: MappingProxyType({}))
+    saturation: Any = None
+    map_at_bound: tuple[tuple[str, str], ...] = ()
+    map_modes: tuple[MappingProxyType, ...] = ()
+    map_restarts: int | None = None
+    frozen_node: FrozenNode | None = None
+    frozen_share: float | None = None
+    #: parameters the data leave almost as uncertain as their priors (Laplace at the MAP)
+    unidentified: tuple[str, ...] = ()
+    identifiability: Identifiability = field(default_factory=Identifiability)
+
+    @classmethod
+    def from_dict(cls, sec: str, info: dict, free_names=()) -> ModelInfo:
+        ch = info.get("chain") or {}
+        fz = info.get("frozen_node")
+        found = info.get("map") or {}
+        pred = info.get("predictive_noise") or {}
+        names = info.get("input_names")
+        return cls(
+            section=sec,
+            model=str(info.get("model") or sec),
+            noise=str(info.get("noise") or ""),
+            domain=str(info.get("domain") or sec),
+            steps=ch.get("steps"),
+            walkers=ch.get("walkers"),
+            tau_max=_num(ch.get("tau_max")),
+            converged_tau=bool(ch.get("converged_tau", False)),
+            likelihood_temperature=_num(info.get("likelihood_temperature")) or 1.0,
+            burn=ch.get("burn"),
+            thin=ch.get("thin"),
+            draws_per_walker=ch.get("draws_per_walker"),
+            acceptance_mean=_num(ch.get("acceptance_mean")),
+            resumed_from=ch.get("resumed_from"),
+            stopped_by=str(ch.get("stopped_by") or ""),
+            tau_history=tuple(tuple(map(float, r)) for r in ch.get("tau_history") or []),
+            output_names=tuple(info.get("output_names") or ()),
+            input_names=None if names is None else tuple(names),
+            state_names=tuple(info.get("state_names") or ()),
+            free_names=tuple(free_names),
+            predictive_phi=MappingProxyType(
+                {o: v["phi"] for o, v in pred.items() if isinstance(v, dict) and "phi" in v}
+            ),
+            saturation=info.get("saturation"),
+            map_at_bound=tuple((str(n), str(side)) for n, side in info.get("map_at_bound") or []),
+            map_modes=tuple(MappingProxyType(dict(m)) for m in found.get("modes") or []),
+            map_restarts=found.get("restarts"),
+            frozen_node=None
+            if not fz
+            else FrozenNode(
+                tau_h=float(fz["tau_h"]),
+                records=float(fz["records"]),
+                start_free=bool(fz.get("start_free")),
+            ),
+            frozen_share=_num(info.get("frozen_share")),
+            unidentified=tuple(
+                (info.get("practical_identifiability") or {}).get("unidentified") or ()
+            ),
+            identifiability=Identifiability.from_dict(info.get("identifiability")),
+        )
+
+
+@dataclass(frozen=True)
+class Period:
+    """A period of the run: ``calibration``, ``validation``; ``steps`` of ``dt``."""
+
+    name: str
+    start: str | None
+    end: str | None
+    steps: int = 0
+
+
+#: A room's status as its verdict gives it, most urgent first.
+STATUSES = ("not converged", "checks failed", "converged")
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """The report's verdict on the run, recorded when the report is written (the page
+    and ``summary.json`` hold the one verdict computed then).
+
+    ``level``: ``green``, ``amber`` or ``red``; ``status``: one of :data:`STATUSES`
+    (*converged*: green; *checks failed*: the sampler converged but the residual,
+    coverage, truth or accuracy checks fail; else *not converged*); ``title`` the
+    headline, ``text`` its explanation, ``reasons`` one line per model and failed check,
+    ``advice`` what to do.
+    """
+
+    level: str
+    status: str
+    title: str
+    text: str = ""
+    reasons: tuple[str, ...] = ()
+    advice: str = ""
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "level": self.level,
+            "status": self.status,
+            "title": self.title,
+            "text": self.text,
+            "reasons": list(self.reasons),
+            "advice": self.advice,
+        }
+
+    @classmethod
+    def from_dict(cls, d) -> Verdict | None:
+        if not isinstance(d, dict) or d.get("status") not in STATUSES:
+            return None
+        return cls(
+            level=str(d.get("level") or ""),
+            status=str(d["status"]),
+            title=str(d.get("title") or ""),
+            text=str(d.get("text") or ""),
+            reasons=tuple(str(r) for r in d.get("reasons") or ()),
+            advice=str(d.get("advice") or ""),
+        )
 
 
 @dataclass(frozen=True)
@@ -240,6 +441,20 @@ class RunSummary:
     models: MappingProxyType  # section -> ModelInfo
     timings: MappingProxyType  # what -> seconds
     wall_seconds: float | None
+    periods: tuple[Period, ...]
+    warmup_steps: int
+    init_steps: int | None
+    notes: str
+    heritage_bayes_version: str
+    irradiance_source: str
+    #: library versions the run recorded (empty: an older run)
+    versions: MappingProxyType
+    #: synthetic data with known true values
+    has_truth: bool
+    #: the site's longitude [° east] (None: not recorded)
+    longitude: float | None
+    #: the report's verdict (None: no report written since the run, or an older run)
+    verdict: Verdict | None
     raw: MappingProxyType = field(repr=False)
 
     # ------------------------------------------------------------------ reading
@@ -300,20 +515,12 @@ class RunSummary:
                 "(a newer one: upgrade heritage_bayes)",
             )
         crit = {**_DEFAULT_CRITERIA, **(d.get("criteria") or {})}
-        models = {}
-        for sec, info in (d.get("models") or {}).items():
-            ch = info.get("chain") or {}
-            models[sec] = ModelInfo(
-                section=sec,
-                model=str(info.get("model") or sec),
-                noise=str(info.get("noise") or ""),
-                domain=str(info.get("domain") or sec),
-                steps=ch.get("steps"),
-                walkers=ch.get("walkers"),
-                tau_max=_num(ch.get("tau_max")),
-                converged_tau=bool(ch.get("converged_tau", False)),
-                likelihood_temperature=_num(info.get("likelihood_temperature")) or 1.0,
-            )
+        site = (d.get("sources") or {}).get("site") or {}
+        corr = d.get("correlations") or {}
+        models = {
+            sec: ModelInfo.from_dict(sec, info, (corr.get(sec) or {}).get("names") or ())
+            for sec, info in (d.get("models") or {}).items()
+        }
         metrics = []
         for sec, outs in (d.get("metrics") or {}).items():
             for out, periods in (outs or {}).items():
@@ -331,6 +538,8 @@ class RunSummary:
                             n=m.get("n"),
                             coverage50=_num(m.get("coverage50")),
                             coverage90=_num(m.get("coverage90")),
+                            SD=_num(m.get("SD")),
+                            coverage90_1step=_num(m.get("coverage90_1step")),
                         )
                     )
         conv = Convergence(
@@ -342,6 +551,7 @@ class RunSummary:
             converged=bool(d.get("converged", False)),
             converged_tau=bool(d.get("converged_tau", d.get("converged", False))),
             reasons=tuple(str(r) for r in d.get("unconverged_reasons") or ()),
+            tau_rtol=_num(crit.get("tau_rtol")),
         )
         return cls(
             schema_version=version,
@@ -368,6 +578,21 @@ class RunSummary:
                 {k: float(v) for k, v in (d.get("timings") or {}).items() if _num(v) is not None}
             ),
             wall_seconds=_num(d.get("wall_seconds")),
+            periods=tuple(
+                Period(name=k, start=p.get("start"), end=p.get("end"), steps=p.get("steps", 0))
+                for k, p in (d.get("periods") or {}).items()
+            ),
+            warmup_steps=int(d.get("warmup_steps") or 0),
+            init_steps=d.get("init_steps"),
+            notes=str(d.get("notes") or ""),
+            heritage_bayes_version=str(d.get("heritage_bayes_version") or ""),
+            irradiance_source=str(d.get("irradiance_source") or ""),
+            versions=MappingProxyType(
+                dict(d["versions"]) if isinstance(d.get("versions"), dict) else {}
+            ),
+            has_truth=bool(d.get("truth")),
+            longitude=_num(site.get("longitude")),
+            verdict=Verdict.from_dict(d.get("verdict")),
             raw=MappingProxyType(d),
         )
 

@@ -36,6 +36,7 @@ from heritage_bayes.report.sections import (
     summary,
 )
 from heritage_bayes.report.verdict import convergence_verdict, run_notes, verdict_record
+from heritage_bayes.rundir.summary import RunSummary
 
 __all__ = [
     "REQUIRED_FILES",
@@ -82,11 +83,10 @@ def _render_figures(obj, dpi: float | None = None):
     return obj
 
 
-def residual_shapes(summary: dict, fits: list[dict], res: dict) -> dict:
+def residual_shapes(summary: RunSummary, fits: list[dict], res: dict) -> dict:
     """(section, output) -> :func:`~heritage_bayes.report.accuracy.residual_shape` of
     the posterior-median residuals over the validation period (the calibration period
     without one), hours read in the site's solar time when the run knows the site."""
-    site = (summary.get("sources") or {}).get("site") or {}
     out = {}
     for f in fits:
         if f.get("resid") is None:
@@ -97,7 +97,7 @@ def residual_shapes(summary: dict, fits: list[dict], res: dict) -> dict:
             f["resid"][sel],
             f["measured"][sel],
             f["times"][sel],
-            longitude=site.get("longitude"),
+            longitude=summary.longitude,
             resolution=res.get(f["output"]),
         )
         if shape is not None:

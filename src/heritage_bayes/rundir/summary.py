@@ -22,13 +22,13 @@ Versions: a summary without ``schema_version`` is version 1 (every hbayes before
 typed summary); its keys are read as they were written, missing ones as absent
 (None). A summary of a newer schema than this hbayes knows is refused with a message
 naming the file. The whole JSON object stays available as :attr:`RunSummary.raw`
-for the parts not typed here (alignment, provenance, ladder, selection, correlation
-matrices).
+for the parts not typed here (provenance, ladder, selection, correlation matrices);
+:mod:`heritage_bayes.rundir.summary_parts` holds the models', periods', alignment's and
+verdict's types.
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
@@ -36,35 +36,40 @@ from typing import Any
 
 from heritage_bayes.format import fmt_int, quantity_label
 from heritage_bayes.rundir.reader import SCHEMA_VERSION, damaged, read_summary
+from heritage_bayes.rundir.summary_parts import (
+    STATUSES,
+    Alignment,
+    FrozenNode,
+    Gap,
+    Identifiability,
+    ModelInfo,
+    Period,
+    SourceNote,
+    Verdict,
+    finite_float,
+)
 
 __all__ = [
     "SCHEMA_VERSION",
     "STATUSES",
+    "Alignment",
     "Convergence",
     "Estimate",
     "FitMetrics",
     "FrozenNode",
+    "Gap",
     "Identifiability",
     "ModelInfo",
     "Period",
     "RunSummary",
+    "SourceNote",
     "Verdict",
     "load_summary",
+    "typed_summary",
 ]
 
 #: The convergence criteria of runs that did not state them (hbayes before they did).
 _DEFAULT_CRITERIA = {"max_rhat": 1.01, "min_ess_bulk": 400.0, "tau_factor": 50.0}
-
-
-def _num(v) -> float | None:
-    """A finite float, or None (absent, null, NaN, not a number)."""
-    if isinstance(v, bool) or v is None:
-        return None
-    try:
-        f = float(v)
-    except (TypeError, ValueError):
-        return None
-    return f if math.isfinite(f) else None
 
 
 @dataclass(frozen=True)
@@ -127,23 +132,23 @@ class Estimate:
         return cls(
             key=key,
             unit=str(d.get("unit") or ""),
-            median=_num(d.get("median")),
-            q05=_num(d.get("q05")),
-            q95=_num(d.get("q95")),
-            mean=_num(d.get("mean")),
-            sd=_num(d.get("sd")),
-            truth=_num(d.get("truth")),
+            median=finite_float(d.get("median")),
+            q05=finite_float(d.get("q05")),
+            q95=finite_float(d.get("q95")),
+            mean=finite_float(d.get("mean")),
+            sd=finite_float(d.get("sd")),
+            truth=finite_float(d.get("truth")),
             kind="derived" if derived else str(d.get("kind") or ""),
             description=str(d.get("description") or ""),
             derived=derived,
-            fixed=_num(fixed) if fixed is not None else None,
+            fixed=finite_float(fixed) if fixed is not None else None,
             prior=d.get("prior") if isinstance(d.get("prior"), str) else None,
-            map=_num(d.get("map")),
-            r_hat=_num(d.get("r_hat")),
-            ess_bulk=_num(d.get("ess_bulk")),
-            ess_tail=_num(d.get("ess_tail")),
-            tau=_num(d.get("tau")),
-            contraction=_num(d.get("contraction")),
+            map=finite_float(d.get("map")),
+            r_hat=finite_float(d.get("r_hat")),
+            ess_bulk=finite_float(d.get("ess_bulk")),
+            ess_tail=finite_float(d.get("ess_tail")),
+            tau=finite_float(d.get("tau")),
+            contraction=finite_float(d.get("contraction")),
             at_bound=d.get("at_bound") if isinstance(d.get("at_bound"), str) else None,
         )
 
@@ -220,209 +225,6 @@ class Convergence:
 
 
 @dataclass(frozen=True)
-class Identifiability:
-    """A model's structural identifiability at the MAP (what ``summary.json`` records):
-    the rank of the output sensitivities, the non-identifiable combinations
-    (``null_directions``, each with its ``label``, ``description``, ``pinned_by`` and
-    ``is_scale``), and per parameter whether the data identify it
-    (``identifiable``) or only once the scale is pinned (``identifiable_given_scale``)."""
-
-    n_null: int = 0
-    n_params: int | None = None
-    rank: int | None = None
-    has_scale_direction: bool | None = None
-    condition_number_identifiable: float | None = None
-    identifiable: frozenset = frozenset()
-    identifiable_given_scale: frozenset = frozenset()
-    parameters: tuple[str, ...] = ()  # the parameters the analysis covered
-    null_directions: tuple[MappingProxyType, ...] = ()
-    control: MappingProxyType = field(default_factory=lambda: MappingProxyType({}))
-    summary: str = ""
-
-    @classmethod
-    def from_dict(cls, d: dict | None) -> Identifiability:
-        d = d or {}
-        pars = d.get("parameters") or {}
-        has_scale = d.get("has_scale_direction")
-        return cls(
-            n_null=int(d.get("n_null") or 0),
-            n_params=d.get("n_params"),
-            rank=d.get("rank"),
-            has_scale_direction=None if has_scale is None else bool(has_scale),
-            condition_number_identifiable=_num(d.get("condition_number_identifiable")),
-            identifiable=frozenset(n for n, v in pars.items() if v.get("identifiable")),
-            identifiable_given_scale=frozenset(
-                n for n, v in pars.items() if v.get("identifiable_given_scale")
-            ),
-            parameters=tuple(pars),
-            null_directions=tuple(
-                MappingProxyType(dict(n)) for n in d.get("null_directions") or []
-            ),
-            control=MappingProxyType(dict(d.get("control") or {})),
-            summary=str(d.get("summary") or ""),
-        )
-
-    def on_scale(self, name: str) -> bool:
-        """Identifiable only once the scale is pinned (the priors pin it)."""
-        return name not in self.identifiable and name in self.identifiable_given_scale
-
-
-@dataclass(frozen=True)
-class FrozenNode:
-    """A node that barely moves over the record at the MAP: its slowest time constant
-    ``tau_h`` [h], ``records`` times the calibration record; ``start_free``: its start
-    is estimated freely (a free offset)."""
-
-    tau_h: float
-    records: float
-    start_free: bool = False
-
-
-@dataclass(frozen=True)
-class ModelInfo:
-    """One section (``thermal``/``hygric``) of a run: its model, chain and MAP findings."""
-
-    section: str
-    model: str
-    noise: str = ""
-    domain: str = ""
-    steps: int | None = None
-    walkers: int | None = None
-    tau_max: float | None = None
-    converged_tau: bool = False
-    likelihood_temperature: float = 1.0
-    burn: int | None = None
-    thin: int | None = None
-    draws_per_walker: int | None = None
-    acceptance_mean: float | None = None
-    resumed_from: int | None = None
-    stopped_by: str = ""
-    tau_history: tuple[tuple[float, ...], ...] = ()
-    output_names: tuple[str, ...] = ()
-    input_names: tuple[str, ...] | None = None  # None: not recorded (older runs)
-    state_names: tuple[str, ...] = ()
-    #: the sampled parameters, in the order of the chain and the correlation matrix
-    free_names: tuple[str, ...] = ()
-    #: output -> the AR coefficient φ of the predictive noise
-    predictive_phi: MappingProxyType = field(default_factory=lambda: MappingProxyType({}))
-    saturation: Any = None
-    map_at_bound: tuple[tuple[str, str], ...] = ()
-    map_modes: tuple[MappingProxyType, ...] = ()
-    map_restarts: int | None = None
-    frozen_node: FrozenNode | None = None
-    frozen_share: float | None = None
-    #: parameters the data leave almost as uncertain as their priors (Laplace at the MAP)
-    unidentified: tuple[str, ...] = ()
-    identifiability: Identifiability = field(default_factory=Identifiability)
-
-    @classmethod
-    def from_dict(cls, sec: str, info: dict, free_names=()) -> ModelInfo:
-        ch = info.get("chain") or {}
-        fz = info.get("frozen_node")
-        found = info.get("map") or {}
-        pred = info.get("predictive_noise") or {}
-        names = info.get("input_names")
-        return cls(
-            section=sec,
-            model=str(info.get("model") or sec),
-            noise=str(info.get("noise") or ""),
-            domain=str(info.get("domain") or sec),
-            steps=ch.get("steps"),
-            walkers=ch.get("walkers"),
-            tau_max=_num(ch.get("tau_max")),
-            converged_tau=bool(ch.get("converged_tau", False)),
-            likelihood_temperature=_num(info.get("likelihood_temperature")) or 1.0,
-            burn=ch.get("burn"),
-            thin=ch.get("thin"),
-            draws_per_walker=ch.get("draws_per_walker"),
-            acceptance_mean=_num(ch.get("acceptance_mean")),
-            resumed_from=ch.get("resumed_from"),
-            stopped_by=str(ch.get("stopped_by") or ""),
-            tau_history=tuple(tuple(map(float, r)) for r in ch.get("tau_history") or []),
-            output_names=tuple(info.get("output_names") or ()),
-            input_names=None if names is None else tuple(names),
-            state_names=tuple(info.get("state_names") or ()),
-            free_names=tuple(free_names),
-            predictive_phi=MappingProxyType(
-                {o: v["phi"] for o, v in pred.items() if isinstance(v, dict) and "phi" in v}
-            ),
-            saturation=info.get("saturation"),
-            map_at_bound=tuple((str(n), str(side)) for n, side in info.get("map_at_bound") or []),
-            map_modes=tuple(MappingProxyType(dict(m)) for m in found.get("modes") or []),
-            map_restarts=found.get("restarts"),
-            frozen_node=None
-            if not fz
-            else FrozenNode(
-                tau_h=float(fz["tau_h"]),
-                records=float(fz["records"]),
-                start_free=bool(fz.get("start_free")),
-            ),
-            frozen_share=_num(info.get("frozen_share")),
-            unidentified=tuple(
-                (info.get("practical_identifiability") or {}).get("unidentified") or ()
-            ),
-            identifiability=Identifiability.from_dict(info.get("identifiability")),
-        )
-
-
-@dataclass(frozen=True)
-class Period:
-    """A period of the run: ``calibration``, ``validation``; ``steps`` of ``dt``."""
-
-    name: str
-    start: str | None
-    end: str | None
-    steps: int = 0
-
-
-#: A room's status as its verdict gives it, most urgent first.
-STATUSES = ("not converged", "checks failed", "converged")
-
-
-@dataclass(frozen=True)
-class Verdict:
-    """The report's verdict on the run, recorded when the report is written (the page
-    and ``summary.json`` hold the one verdict computed then).
-
-    ``level``: ``green``, ``amber`` or ``red``; ``status``: one of :data:`STATUSES`
-    (*converged*: green; *checks failed*: the sampler converged but the residual,
-    coverage, truth or accuracy checks fail; else *not converged*); ``title`` the
-    headline, ``text`` its explanation, ``reasons`` one line per model and failed check,
-    ``advice`` what to do.
-    """
-
-    level: str
-    status: str
-    title: str
-    text: str = ""
-    reasons: tuple[str, ...] = ()
-    advice: str = ""
-
-    def to_dict(self) -> dict[str, Any]:
-        return {
-            "level": self.level,
-            "status": self.status,
-            "title": self.title,
-            "text": self.text,
-            "reasons": list(self.reasons),
-            "advice": self.advice,
-        }
-
-    @classmethod
-    def from_dict(cls, d) -> Verdict | None:
-        if not isinstance(d, dict) or d.get("status") not in STATUSES:
-            return None
-        return cls(
-            level=str(d.get("level") or ""),
-            status=str(d["status"]),
-            title=str(d.get("title") or ""),
-            text=str(d.get("text") or ""),
-            reasons=tuple(str(r) for r in d.get("reasons") or ()),
-            advice=str(d.get("advice") or ""),
-        )
-
-
-@dataclass(frozen=True)
 class RunSummary:
     """``summary.json`` of a calibration run, typed (see the module docstring)."""
 
@@ -453,8 +255,11 @@ class RunSummary:
     has_truth: bool
     #: the site's longitude [° east] (None: not recorded)
     longitude: float | None
+    #: how the ground temperature was set, in words ("" if not recorded)
+    ground_temperature: str
     #: the report's verdict (None: no report written since the run, or an older run)
     verdict: Verdict | None
+    alignment: Alignment
     raw: MappingProxyType = field(repr=False)
 
     # ------------------------------------------------------------------ reading
@@ -466,6 +271,14 @@ class RunSummary:
         """Parameters then derived quantities (of one section)."""
         out = [*self.parameters.values(), *self.derived.values()]
         return [e for e in out if section is None or e.section == section]
+
+    def metrics_by_output(self) -> dict[tuple[str, str], dict[str, FitMetrics]]:
+        """(section, output) -> period -> its metrics, in the order the run wrote them
+        (``combined``: the relative humidity of the two models)."""
+        out: dict[tuple[str, str], dict[str, FitMetrics]] = {}
+        for m in self.metrics:
+            out.setdefault((m.section, m.output), {})[m.period] = m
+        return out
 
     def metric(self, section: str, output: str, period: str) -> FitMetrics | None:
         for m in self.metrics:
@@ -518,7 +331,7 @@ class RunSummary:
         site = (d.get("sources") or {}).get("site") or {}
         corr = d.get("correlations") or {}
         models = {
-            sec: ModelInfo.from_dict(sec, info, (corr.get(sec) or {}).get("names") or ())
+            sec: ModelInfo.from_dict(sec, info, corr.get(sec))
             for sec, info in (d.get("models") or {}).items()
         }
         metrics = []
@@ -532,26 +345,26 @@ class RunSummary:
                             section=sec,
                             output=out,
                             period=per,
-                            FIT=_num(m.get("FIT")),
-                            MSE=_num(m.get("MSE")),
-                            MAE=_num(m.get("MAE")),
+                            FIT=finite_float(m.get("FIT")),
+                            MSE=finite_float(m.get("MSE")),
+                            MAE=finite_float(m.get("MAE")),
                             n=m.get("n"),
-                            coverage50=_num(m.get("coverage50")),
-                            coverage90=_num(m.get("coverage90")),
-                            SD=_num(m.get("SD")),
-                            coverage90_1step=_num(m.get("coverage90_1step")),
+                            coverage50=finite_float(m.get("coverage50")),
+                            coverage90=finite_float(m.get("coverage90")),
+                            SD=finite_float(m.get("SD")),
+                            coverage90_1step=finite_float(m.get("coverage90_1step")),
                         )
                     )
         conv = Convergence(
-            max_rhat=_num(d.get("max_rhat")),
-            min_ess_bulk=_num(d.get("min_ess_bulk")),
+            max_rhat=finite_float(d.get("max_rhat")),
+            min_ess_bulk=finite_float(d.get("min_ess_bulk")),
             target_rhat=float(crit["max_rhat"]),
             target_ess=float(crit["min_ess_bulk"]),
             tau_factor=float(crit["tau_factor"]),
             converged=bool(d.get("converged", False)),
             converged_tau=bool(d.get("converged_tau", d.get("converged", False))),
             reasons=tuple(str(r) for r in d.get("unconverged_reasons") or ()),
-            tau_rtol=_num(crit.get("tau_rtol")),
+            tau_rtol=finite_float(crit.get("tau_rtol")),
         )
         return cls(
             schema_version=version,
@@ -561,7 +374,7 @@ class RunSummary:
             seed=d.get("seed") if isinstance(d.get("seed"), int) else None,
             config_hash=str(d.get("config_hash") or ""),
             created_at=str(d.get("created_at") or ""),
-            dt=_num(d.get("dt")) or 3600.0,
+            dt=finite_float(d.get("dt")) or 3600.0,
             parameters=MappingProxyType(
                 {k: Estimate.from_dict(k, v) for k, v in (d.get("parameters") or {}).items()}
             ),
@@ -575,9 +388,13 @@ class RunSummary:
             convergence=conv,
             models=MappingProxyType(models),
             timings=MappingProxyType(
-                {k: float(v) for k, v in (d.get("timings") or {}).items() if _num(v) is not None}
+                {
+                    k: float(v)
+                    for k, v in (d.get("timings") or {}).items()
+                    if finite_float(v) is not None
+                }
             ),
-            wall_seconds=_num(d.get("wall_seconds")),
+            wall_seconds=finite_float(d.get("wall_seconds")),
             periods=tuple(
                 Period(name=k, start=p.get("start"), end=p.get("end"), steps=p.get("steps", 0))
                 for k, p in (d.get("periods") or {}).items()
@@ -591,10 +408,20 @@ class RunSummary:
                 dict(d["versions"]) if isinstance(d.get("versions"), dict) else {}
             ),
             has_truth=bool(d.get("truth")),
-            longitude=_num(site.get("longitude")),
+            longitude=finite_float(site.get("longitude")),
+            ground_temperature=str(
+                ((d.get("sources") or {}).get("ground_temperature") or {}).get("method") or ""
+            ),
             verdict=Verdict.from_dict(d.get("verdict")),
+            alignment=Alignment.from_dict(d.get("alignment")),
             raw=MappingProxyType(d),
         )
+
+
+def typed_summary(summary: RunSummary | dict) -> RunSummary:
+    """``summary`` typed: a :class:`RunSummary` as it is, a ``summary.json`` object
+    through :meth:`RunSummary.from_dict` (for callers that hold the JSON)."""
+    return summary if isinstance(summary, RunSummary) else RunSummary.from_dict(summary)
 
 
 def load_summary(run_dir: str | Path) -> RunSummary:

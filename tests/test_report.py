@@ -377,6 +377,8 @@ def test_cli_on_a_run_without_ladder_and_chain_file(run_dir, tmp_path, capsys):
     (d / "chain_hygric.h5").unlink()
     s = json.loads((d / "summary.json").read_text())
     s.pop("ladder", None)
+    s.pop("verdict", None)
+    s.pop("schema_version")  # a version-1 summary (hbayes before the typed summary)
     (d / "summary.json").write_text(json.dumps(s))
     assert main(["report", str(d)]) == 0
     assert capsys.readouterr().out.strip() == str(d / "report.html")
@@ -386,6 +388,13 @@ def test_cli_on_a_run_without_ladder_and_chain_file(run_dir, tmp_path, capsys):
     assert "fig-trace-thermal" in figs
     assert "Not computed for this run." in html
     assert "chain_hygric.h5" in html and "Chain files missing" in html
+    # the verdict shown is recorded; the rest of the file stays as it was (version 1)
+    after = json.loads((d / "summary.json").read_text())
+    level = re.search(r'<div id="verdict" class="verdict (\w+)"', html).group(1)
+    assert after.pop("verdict")["level"] == level and after == s
+    stamp = (d / "summary.json").stat().st_mtime_ns
+    assert main(["report", str(d), "--quiet"]) == 0  # the same verdict: file untouched
+    assert (d / "summary.json").stat().st_mtime_ns == stamp
     assert matplotlib.get_backend() == backend  # Agg canvases only, no backend switch
     if "matplotlib.pyplot" in sys.modules:  # corner imports pyplot: no figure kept open
         assert sys.modules["matplotlib.pyplot"].get_fignums() == []
@@ -743,9 +752,7 @@ def test_identifiable_coordinates_are_tau_gains_and_scale(run_dir):
         # hygric_1c: the gain from its only boundary is 1 by structure, not shown
         assert "gain_Pi_Pe" not in names
         caps = scale_capacities(rd.summary, m)
-        assert caps and all(
-            rd.summary["parameters"][f"{m}.{c}"]["kind"] == "capacity" for c in caps
-        )
+        assert caps and all(rd.summary.parameters[f"{m}.{c}"].kind == "capacity" for c in caps)
         # the matrix from the posterior variables themselves, rebuilt here
         cols = []
         for n in names:

@@ -19,6 +19,7 @@ __all__ = [
     "Gap",
     "Identifiability",
     "ModelInfo",
+    "NullDirection",
     "Period",
     "PredictiveNoise",
     "Saturation",
@@ -40,6 +41,18 @@ def finite_float(v) -> float | None:
 
 
 @dataclass(frozen=True)
+class NullDirection:
+    """A combination of parameters the data cannot determine: its ``label``, its
+    ``description`` in words, the parameters whose prior or value pins it
+    (``pinned_by``) and whether it is the overall scale (``is_scale``)."""
+
+    label: str = ""
+    description: str = ""
+    pinned_by: tuple[str, ...] = ()
+    is_scale: bool = False
+
+
+@dataclass(frozen=True)
 class Identifiability:
     """A model's structural identifiability at the MAP (what ``summary.json`` records):
     the rank of the output sensitivities, the non-identifiable combinations
@@ -55,7 +68,7 @@ class Identifiability:
     identifiable: frozenset = frozenset()
     identifiable_given_scale: frozenset = frozenset()
     parameters: tuple[str, ...] = ()  # the parameters the analysis covered
-    null_directions: tuple[MappingProxyType, ...] = ()
+    null_directions: tuple[NullDirection, ...] = ()
     control: MappingProxyType = field(default_factory=lambda: MappingProxyType({}))
     summary: str = ""
     #: whether the run recorded the analysis (runs before it did not)
@@ -79,7 +92,13 @@ class Identifiability:
             ),
             parameters=tuple(pars),
             null_directions=tuple(
-                MappingProxyType(dict(n)) for n in d.get("null_directions") or []
+                NullDirection(
+                    label=str(n.get("label", "")),
+                    description=str(n.get("description", "")),
+                    pinned_by=tuple(str(p) for p in n.get("pinned_by") or ()),
+                    is_scale=bool(n.get("is_scale")),
+                )
+                for n in d.get("null_directions") or []
             ),
             control=MappingProxyType(dict(d.get("control") or {})),
             summary=str(d.get("summary") or ""),

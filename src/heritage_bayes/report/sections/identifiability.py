@@ -59,10 +59,10 @@ def identifiability_context(rd: RunData) -> list[dict]:
         params = section_params(s, m)
         nulls = [
             {
-                "label": d.get("label", ""),
-                "description": tick_names(d.get("description", ""), params),
-                "pinned_by": ", ".join(f"`{n}`" for n in d.get("pinned_by") or []),
-                "is_scale": bool(d.get("is_scale")),
+                "label": d.label,
+                "description": tick_names(d.description, params),
+                "pinned_by": ", ".join(f"`{n}`" for n in d.pinned_by),
+                "is_scale": d.is_scale,
             }
             for d in idf.null_directions
         ]

@@ -27,7 +27,7 @@ from heritage_bayes.format import fmt, fmt_int, prior_text, prose_html, tick_nam
 from heritage_bayes.report import write_report
 from heritage_bayes.report._browser import PHONE_OVERFLOW_JS, find_chromium, open_page
 from heritage_bayes.report._diag import acf, cumulative_periodogram, innovations
-from heritage_bayes.report.build import SECTIONS
+from heritage_bayes.report.build import SECTIONS, record_verdict
 from heritage_bayes.report.page import Section, render_page, script_hash
 from heritage_bayes.report.sections.identifiability import ladder_metrics
 from heritage_bayes.report.verdict import convergence_verdict, ess_class, rhat_class, run_notes
@@ -390,10 +390,11 @@ def test_cli_on_a_run_without_ladder_and_chain_file(run_dir, tmp_path, capsys):
     assert "chain_hygric.h5" in html and "Chain files missing" in html
     # the verdict shown is recorded; the rest of the file stays as it was (version 1)
     after = json.loads((d / "summary.json").read_text())
-    level = re.search(r'<div id="verdict" class="verdict (\w+)"', html).group(1)
-    assert after.pop("verdict")["level"] == level and after == s
+    v = after.pop("verdict")
+    assert v["level"] == re.search(r'<div id="verdict" class="verdict (\w+)"', html).group(1)
+    assert after == s
     stamp = (d / "summary.json").stat().st_mtime_ns
-    assert main(["report", str(d), "--quiet"]) == 0  # the same verdict: file untouched
+    assert not record_verdict(d, {**v, "models": v["reasons"]})  # the same: file untouched
     assert (d / "summary.json").stat().st_mtime_ns == stamp
     assert matplotlib.get_backend() == backend  # Agg canvases only, no backend switch
     if "matplotlib.pyplot" in sys.modules:  # corner imports pyplot: no figure kept open
@@ -974,18 +975,22 @@ def test_fit_is_flagged_on_a_nearly_constant_series():
     less than the error, FIT says nothing and the table says so; a varying series with
     a good fit is not flagged."""
     from heritage_bayes.report.sections.metrics import _nearly_constant
+    from heritage_bayes.rundir.summary import FitMetrics
+
+    def metrics(**kw) -> FitMetrics:
+        return FitMetrics("hygric", "RHi", "validation", **kw)
 
     mae, fit = 2.1, -98.0
     rmse = 1.25 * mae  # Gaussian errors: RMSE ≈ 1.25 MAE
     # no SD: derived; RH logger resolution 1 %RH
-    words = _nearly_constant({"MAE": mae, "MSE": rmse**2, "FIT": fit}, 1.0)
+    words = _nearly_constant(metrics(MAE=mae, MSE=rmse**2, FIT=fit), 1.0)
     assert "nearly constant" in words and "MAE 2.1" in words
     sd = rmse / (1 - fit / 100)
     assert f"standard deviation {fmt(sd)}" in words
-    assert _nearly_constant({"MAE": 0.2, "MSE": 0.0625, "FIT": 80.0, "SD": 1.25}, 1.0) == ""
+    assert _nearly_constant(metrics(MAE=0.2, MSE=0.0625, FIT=80.0, SD=1.25), 1.0) == ""
     # a poor fit of a series that varies far beyond the sensor's resolution is a poor
     # fit, not a constant series (a °F file read as °C: SD 10.8 K, FIT 1.2 %)
-    assert _nearly_constant({"MAE": 8.0, "MSE": 110.0, "FIT": 1.2, "SD": 10.8}, 0.1) == ""
+    assert _nearly_constant(metrics(MAE=8.0, MSE=110.0, FIT=1.2, SD=10.8), 0.1) == ""
     # the SD stored by fit_metrics is the population standard deviation of the measured
     from heritage_bayes.inference.results import fit_metrics
 

@@ -193,6 +193,8 @@ def test_a_run_whose_saved_draws_fail_its_criteria_is_never_green(pages, tmp_pat
     assert conv.max_rhat == pytest.approx(rhat, rel=1e-6)
     assert not conv.saved_draws_ok
     assert _verdict_level(pages["report"].read_text(encoding="utf-8")) != "green"
+    # calibrate's report recorded its verdict in summary.json
+    assert rs.verdict.level == _verdict_level(pages["report"].read_text(encoding="utf-8"))
     # as if the stopping rule had been met
     raw = json.loads((run / "summary.json").read_text())
     raw.update(converged=True, converged_tau=True, unconverged_reasons=[])

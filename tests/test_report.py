@@ -31,6 +31,7 @@ from heritage_bayes.report.build import SECTIONS, record_verdict
 from heritage_bayes.report.page import Section, render_page, script_hash
 from heritage_bayes.report.sections.identifiability import ladder_metrics
 from heritage_bayes.report.verdict import convergence_verdict, ess_class, rhat_class, run_notes
+from heritage_bayes.rundir.summary import load_summary
 
 ROOM = "<script>alert(1)</script>"
 BUILDING = 'Château "Ter <b>Horst</b>" & Co'
@@ -115,6 +116,10 @@ def test_report_written_atomically(report, run_dir):
     assert path.stat().st_mode & 0o444 == 0o444 or path.stat().st_mode & 0o044, (
         "report must be readable like an ordinary file, not 0600"
     )
+    # summary.json records the verdict the page shows (the portfolio reads it there)
+    v = load_summary(run_dir).verdict
+    assert f'<div id="verdict" class="verdict {v.level}"' in html
+    assert prose_html(v.title) in html and v.status in ("not converged", "checks failed")
 
 
 def test_sections_in_order(report):

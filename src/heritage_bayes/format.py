@@ -205,7 +205,7 @@ _INPUT_WORDS = {
 
 
 _COMPASS = {
-    **{k: v for k, v in _FACADE.items() if k in "NESW"},
+    **{k: _FACADE[k] for k in ("N", "E", "S", "W")},
     "NE": "north-east",
     "SE": "south-east",
     "SW": "south-west",

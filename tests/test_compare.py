@@ -16,7 +16,6 @@ import pytest
 import xarray as xr
 import yaml
 
-from _report_browser import PHONE_OVERFLOW_JS, find_chromium, open_page
 from heritage_bayes._arviz import az
 from heritage_bayes.cli import main
 from heritage_bayes.compare import (
@@ -29,6 +28,7 @@ from heritage_bayes.compare import (
 )
 from heritage_bayes.config.sampler import SamplerSettings
 from heritage_bayes.inference.predictive import PREDICTIVE_DRAWS
+from heritage_bayes.report._browser import PHONE_OVERFLOW_JS, find_chromium, open_page
 
 TINY = {
     "name": "tiny",

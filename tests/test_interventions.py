@@ -271,7 +271,7 @@ def test_shipped_interventions_config_validates():
 def test_measures_section_in_headless_chromium(projected, size):
     """The measures section and its figure sit in the page; no table wider than its
     container at 1280 and 1920 px, and no word or number of a cell cut in two."""
-    from _report_browser import find_chromium, open_page
+    from heritage_bayes.report._browser import find_chromium, open_page
     from test_projection import _LAYOUT_JS
 
     chromium = find_chromium()
@@ -613,7 +613,7 @@ def test_tradeoff_labels_do_not_overlap_when_measures_cluster():
 def test_measures_section_on_a_phone_has_no_horizontal_scroll(projected):
     """At 390 px the page with its measures section (decision table, trade-off figure,
     per-case tables) is no wider than the screen, and no cell cuts a word or number."""
-    from _report_browser import phone_layout
+    from _browser_checks import phone_layout
 
     lay = phone_layout(Path(projected.paths["html"]), extra="""
       (() => { const s = document.getElementById('interventions');

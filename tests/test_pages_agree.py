@@ -28,6 +28,7 @@ from heritage_bayes.cli import main
 from heritage_bayes.climate.risk.registry import INDICATORS
 from heritage_bayes.config import parse_config
 from heritage_bayes.format import fmt, fmt_interval
+from heritage_bayes.portfolio.rooms import room_row
 from heritage_bayes.projection import project
 from heritage_bayes.report import write_report
 from heritage_bayes.rundir.summary import load_summary
@@ -192,6 +193,8 @@ def test_a_run_whose_saved_draws_fail_its_criteria_is_never_green(pages, tmp_pat
     assert conv.max_rhat == pytest.approx(rhat, rel=1e-6)
     assert not conv.saved_draws_ok
     assert _verdict_level(pages["report"].read_text(encoding="utf-8")) != "green"
+    # calibrate's report recorded its verdict in summary.json
+    assert rs.verdict.level == _verdict_level(pages["report"].read_text(encoding="utf-8"))
     # as if the stopping rule had been met
     raw = json.loads((run / "summary.json").read_text())
     raw.update(converged=True, converged_tau=True, unconverged_reasons=[])
@@ -202,3 +205,9 @@ def test_a_run_whose_saved_draws_fail_its_criteria_is_never_green(pages, tmp_pat
     page = write_report(run).read_text(encoding="utf-8")
     assert _verdict_level(page) != "green"
     assert "Rule applied: green only when" in page
+    # summary.json records the verdict the page shows; the portfolio's row reads it
+    v = load_summary(run).verdict
+    assert v.level == _verdict_level(page) and v.title in html_mod.unescape(page)
+    row = room_row(run)
+    assert (row["verdict_level"], row["verdict_title"]) == (v.level, v.title)
+    assert row["verdict"] == v.status

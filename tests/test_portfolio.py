@@ -221,7 +221,7 @@ def test_shipped_portfolio_validates():
 
 @pytest.mark.browser
 def test_index_sorts_in_headless_chromium(finished):
-    from _report_browser import find_chromium, open_page
+    from heritage_bayes.report._browser import find_chromium, open_page
 
     chromium = find_chromium()
     if chromium is None:
@@ -287,7 +287,7 @@ def test_index_speaks_in_percent_and_names_the_indicators_at_risk(tmp_path):
 def test_index_fits_the_screen_with_its_projection_columns(finished, width):
     """At 1280 px the three tables fit the page (the projection columns on screen, no
     sideways scroll); at 390 px each room is a card: nothing wider than the screen."""
-    from _report_browser import phone_layout
+    from _browser_checks import phone_layout
 
     d, _, _ = finished
     lay = phone_layout(d / "out" / "index.html", width=width, extra="""
@@ -303,33 +303,56 @@ def test_index_fits_the_screen_with_its_projection_columns(finished, width):
     assert "not converged" in proj["status"] and "failed" in proj["status"]
 
 
+def _summary(converged: bool, rhat: float, fit: float = 90.0, truth: float | None = None):
+    """A summary with one measured output: FIT on validation, a derived quantity with a
+    known true value (inside its interval unless ``truth`` says otherwise)."""
+    return {
+        "converged": converged,
+        "converged_tau": converged,
+        "max_rhat": rhat,
+        "min_ess_bulk": 500.0,
+        "models": {},
+        "parameters": {},
+        "derived": {"thermal.tau_1_h": {"median": 10.0, "q05": 9.0, "q95": 11.0, "sd": 0.5,
+                                        "unit": "h", "truth": 10.0 if truth is None else truth}},
+        "metrics": {"thermal": {"Ti": {"validation": {"FIT": fit, "n": 100, "coverage90": 0.9}}}},
+    }  # fmt: skip
+
+
 @pytest.mark.parametrize(
-    ("level", "title", "converged", "status"),
+    ("summary", "level", "title", "status"),
     [
-        ("green", "Converged", True, "converged"),
-        ("amber", "Converged, but the checks below fail", True, "checks failed"),
-        ("red", "This model does not reproduce the room", True, "checks failed"),
-        ("red", "This model does not reproduce the room — and NOT CONVERGED", False,
+        (_summary(True, 1.005), "green", "Converged", "converged"),
+        (_summary(True, 1.005, truth=20.0), "amber", "Converged, but the checks below fail",
+         "checks failed"),
+        (_summary(True, 1.03), "amber", "Stopping rule met, but the saved draws miss the "
+         "criteria", "checks failed"),
+        (_summary(True, 1.005, fit=20.0), "red", "This model does not reproduce the room",
+         "checks failed"),
+        (_summary(True, 1.03, fit=20.0), "red", "This model does not reproduce the room — and "
+         "not fully converged", "not converged"),
+        (_summary(False, 1.2, fit=20.0), "red", "This model does not reproduce the room — and "
+         "NOT CONVERGED", "not converged"),
+        (_summary(False, 1.03), "amber", "Nearly converged — use with care", "not converged"),
+        (_summary(False, 1.2), "red", "NOT CONVERGED — do not use these results yet",
          "not converged"),
-        ("amber", "Nearly converged — use with care", False, "not converged"),
-        ("red", "NOT CONVERGED — do not use these results yet", True, "not converged"),
     ],
 )  # fmt: skip
-def test_a_rooms_status_is_its_reports_verdict(tmp_path, level, title, converged, status):
-    """The verdict box as the report's own template renders it, read back: the status
-    never contradicts the report the row links (a run that met its stopping rule but
-    whose saved draws fail is 'not converged' when its report says so)."""
+def test_a_rooms_status_is_its_reports_verdict(summary, level, title, status):
+    """The status is the one verdict the report computes (and records in summary.json
+    when it writes the page), read back typed: it never contradicts the report the row
+    links (a run that met its stopping rule but whose saved draws fail is 'not
+    converged' when its report's headline says so)."""
     from heritage_bayes.portfolio.rooms import report_status
-    from heritage_bayes.report.sections._fragment import render_fragment
+    from heritage_bayes.report.verdict import convergence_verdict, verdict_record
+    from heritage_bayes.rundir.summary import RunSummary
 
-    verdict = {"level": level, "title": title, "text": "t", "models": [], "advice": "",
-               "stats": "s", "rule": "r"}  # fmt: skip
-    box = render_fragment("verdict.html", {"verdict": verdict, "warnings": []})
-    (tmp_path / "report.html").write_text(f"<html><body>{box}</body></html>", encoding="utf-8")
-    got = report_status(tmp_path, converged)
-    assert got["verdict"] == status and got["verdict_level"] == level
-    assert got["verdict_title"] == title
-    (tmp_path / "report.html").unlink()  # no report: the run's own decision, said so
-    got = report_status(tmp_path, converged)
-    assert got["verdict"] == ("converged" if converged else "not converged")
+    verdict = convergence_verdict(summary)
+    assert (verdict["level"], verdict["title"], verdict["status"]) == (level, title, status)
+    recorded = {**summary, "verdict": verdict_record(verdict).to_dict()}
+    got = report_status(RunSummary.from_dict(json.loads(json.dumps(recorded))))
+    assert got == {"verdict": status, "verdict_level": level, "verdict_title": title}
+    # no report written: the run's own decision, said so
+    got = report_status(RunSummary.from_dict(summary))
+    assert got["verdict"] == ("converged" if summary["converged"] else "not converged")
     assert "no report" in got["verdict_title"]

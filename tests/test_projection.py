@@ -16,12 +16,12 @@ import numpy as np
 import pytest
 import yaml
 
-from _report_browser import BROKEN_WORDS, PHONE_OVERFLOW_JS, find_chromium, open_page
 from heritage_bayes.calibrate import run_calibration
 from heritage_bayes.cli import main
 from heritage_bayes.config import parse_config
 from heritage_bayes.errors import ConfigError, DataError, InputError
 from heritage_bayes.projection import parse_projection_config, project
+from heritage_bayes.report._browser import BROKEN_WORDS, PHONE_OVERFLOW_JS, find_chromium, open_page
 from test_report import TINY
 
 DRAWS = 24

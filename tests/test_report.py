@@ -19,18 +19,19 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from _report_browser import PHONE_OVERFLOW_JS, find_chromium, open_page
 from heritage_bayes.calibrate import run_calibration
 from heritage_bayes.cli import main
 from heritage_bayes.config import parse_config
 from heritage_bayes.errors import InputError
 from heritage_bayes.format import fmt, fmt_int, prior_text, prose_html, tick_names
 from heritage_bayes.report import write_report
+from heritage_bayes.report._browser import PHONE_OVERFLOW_JS, find_chromium, open_page
 from heritage_bayes.report._diag import acf, cumulative_periodogram, innovations
-from heritage_bayes.report.build import SECTIONS
+from heritage_bayes.report.build import SECTIONS, record_verdict
 from heritage_bayes.report.page import Section, render_page, script_hash
 from heritage_bayes.report.sections.identifiability import ladder_metrics
 from heritage_bayes.report.verdict import convergence_verdict, ess_class, rhat_class, run_notes
+from heritage_bayes.rundir.summary import load_summary
 
 ROOM = "<script>alert(1)</script>"
 BUILDING = 'Château "Ter <b>Horst</b>" & Co'
@@ -115,6 +116,10 @@ def test_report_written_atomically(report, run_dir):
     assert path.stat().st_mode & 0o444 == 0o444 or path.stat().st_mode & 0o044, (
         "report must be readable like an ordinary file, not 0600"
     )
+    # summary.json records the verdict the page shows (the portfolio reads it there)
+    v = load_summary(run_dir).verdict
+    assert f'<div id="verdict" class="verdict {v.level}"' in html
+    assert prose_html(v.title) in html and v.status in ("not converged", "checks failed")
 
 
 def test_sections_in_order(report):
@@ -377,6 +382,8 @@ def test_cli_on_a_run_without_ladder_and_chain_file(run_dir, tmp_path, capsys):
     (d / "chain_hygric.h5").unlink()
     s = json.loads((d / "summary.json").read_text())
     s.pop("ladder", None)
+    s.pop("verdict", None)
+    s.pop("schema_version")  # a version-1 summary (hbayes before the typed summary)
     (d / "summary.json").write_text(json.dumps(s))
     assert main(["report", str(d)]) == 0
     assert capsys.readouterr().out.strip() == str(d / "report.html")
@@ -386,6 +393,14 @@ def test_cli_on_a_run_without_ladder_and_chain_file(run_dir, tmp_path, capsys):
     assert "fig-trace-thermal" in figs
     assert "Not computed for this run." in html
     assert "chain_hygric.h5" in html and "Chain files missing" in html
+    # the verdict shown is recorded; the rest of the file stays as it was (version 1)
+    after = json.loads((d / "summary.json").read_text())
+    v = after.pop("verdict")
+    assert v["level"] == re.search(r'<div id="verdict" class="verdict (\w+)"', html).group(1)
+    assert after == s
+    stamp = (d / "summary.json").stat().st_mtime_ns
+    assert not record_verdict(d, {**v, "models": v["reasons"]})  # the same: file untouched
+    assert (d / "summary.json").stat().st_mtime_ns == stamp
     assert matplotlib.get_backend() == backend  # Agg canvases only, no backend switch
     if "matplotlib.pyplot" in sys.modules:  # corner imports pyplot: no figure kept open
         assert sys.modules["matplotlib.pyplot"].get_fignums() == []
@@ -526,6 +541,11 @@ def test_verdict_classes_and_notes():
     assert [(n["level"], n["title"]) for n in notes] == [
         ("info", "Solar radiation is estimated from the outdoor temperature")
     ]
+    # a roof slope that init wrote (roof_<direction>) is named in words
+    on_roof = {**s, "models": {"thermal": {"map_at_bound": [["fI_roof_E", "upper"]]}}}
+    (note,) = run_notes(on_roof, [])
+    assert note["title"] == "The thermal MAP lies on a prior bound"
+    assert "for solar aperture, east slope of the roof (upper):" in note["text"]
 
 
 def test_house_page_builder():
@@ -738,9 +758,7 @@ def test_identifiable_coordinates_are_tau_gains_and_scale(run_dir):
         # hygric_1c: the gain from its only boundary is 1 by structure, not shown
         assert "gain_Pi_Pe" not in names
         caps = scale_capacities(rd.summary, m)
-        assert caps and all(
-            rd.summary["parameters"][f"{m}.{c}"]["kind"] == "capacity" for c in caps
-        )
+        assert caps and all(rd.summary.parameters[f"{m}.{c}"].kind == "capacity" for c in caps)
         # the matrix from the posterior variables themselves, rebuilt here
         cols = []
         for n in names:
@@ -962,18 +980,22 @@ def test_fit_is_flagged_on_a_nearly_constant_series():
     less than the error, FIT says nothing and the table says so; a varying series with
     a good fit is not flagged."""
     from heritage_bayes.report.sections.metrics import _nearly_constant
+    from heritage_bayes.rundir.summary import FitMetrics
+
+    def metrics(**kw) -> FitMetrics:
+        return FitMetrics("hygric", "RHi", "validation", **kw)
 
     mae, fit = 2.1, -98.0
     rmse = 1.25 * mae  # Gaussian errors: RMSE ≈ 1.25 MAE
     # no SD: derived; RH logger resolution 1 %RH
-    words = _nearly_constant({"MAE": mae, "MSE": rmse**2, "FIT": fit}, 1.0)
+    words = _nearly_constant(metrics(MAE=mae, MSE=rmse**2, FIT=fit), 1.0)
     assert "nearly constant" in words and "MAE 2.1" in words
     sd = rmse / (1 - fit / 100)
     assert f"standard deviation {fmt(sd)}" in words
-    assert _nearly_constant({"MAE": 0.2, "MSE": 0.0625, "FIT": 80.0, "SD": 1.25}, 1.0) == ""
+    assert _nearly_constant(metrics(MAE=0.2, MSE=0.0625, FIT=80.0, SD=1.25), 1.0) == ""
     # a poor fit of a series that varies far beyond the sensor's resolution is a poor
     # fit, not a constant series (a °F file read as °C: SD 10.8 K, FIT 1.2 %)
-    assert _nearly_constant({"MAE": 8.0, "MSE": 110.0, "FIT": 1.2, "SD": 10.8}, 0.1) == ""
+    assert _nearly_constant(metrics(MAE=8.0, MSE=110.0, FIT=1.2, SD=10.8), 0.1) == ""
     # the SD stored by fit_metrics is the population standard deviation of the measured
     from heritage_bayes.inference.results import fit_metrics
 

@@ -63,6 +63,32 @@ def test_a_version_1_summary_loads_typed(tmp_path):
     assert "schema_version" not in V1  # to_dict copies
 
 
+def test_the_parts_a_version_1_summary_lacks_read_as_absent():
+    s = RunSummary.from_dict(json.loads(json.dumps(V1)))
+    assert s.verdict is None and s.periods == () and s.longitude is None
+    assert s.alignment.measurement_gaps == () and s.alignment.step == "?"
+    info = s.models["thermal"]
+    assert info.input_names is None and info.free_names == () and info.frozen_node is None
+    assert not info.identifiability.recorded and info.identifiability.n_null == 0
+    assert info.predictive_noise == {} and info.saturation is None
+
+
+def test_the_verdict_the_report_records_reads_back_typed():
+    verdict = {
+        "level": "amber",
+        "status": "checks failed",
+        "title": "Converged, but the checks below fail",
+        "text": "t",
+        "reasons": ["thermal model (`thermal_2c`): all criteria met."],
+        "advice": "",
+    }
+    s = RunSummary.from_dict({**V1, "schema_version": SCHEMA_VERSION, "verdict": verdict})
+    assert s.verdict.to_dict() == verdict and s.to_dict()["verdict"] == verdict
+    assert s.verdict.reasons == ("thermal model (`thermal_2c`): all criteria met.",)
+    # a status this hbayes does not know is no verdict (the portfolio says so)
+    assert RunSummary.from_dict({**V1, "verdict": {**verdict, "status": "?"}}).verdict is None
+
+
 def test_a_newer_schema_is_refused_with_the_file_named(tmp_path):
     (tmp_path / "summary.json").write_text(json.dumps({**V1, "schema_version": 99}))
     with pytest.raises(InputError, match=r"summary\.json.*schema 99.*upgrade heritage_bayes"):
@@ -77,6 +103,9 @@ def test_labels_name_every_quantity_in_words():
         ("thermal.gain_Ti_Te", "-"): "gain from outdoor air [-]",
         ("thermal.gain_Ti_I_N", "K/(W/m²)"): "gain from sun on the north facade [K/(W/m²)]",
         ("thermal.fI_E", "m²"): "solar aperture, east facade [m²]",
+        ("thermal.fI_roof_E", "m²"): "solar aperture, east slope of the roof [m²]",
+        ("thermal.gain_Ti_I_roof_SW", "-"): "gain from sun on the south-west slope of the roof [-]",
+        ("thermal.fI_dome", "m²"): "solar aperture, surface dome [m²]",
         ("thermal.sigma_meas_Ti", "K"): "measurement noise of Ti [K]",
         ("hygric.Cw", "kg/Pa"): "moisture capacity of the buffering surfaces Cw [kg/Pa]",
         ("thermal.Cw", "J/K"): "heat capacity of the envelope Cw [J/K]",

@@ -53,6 +53,7 @@ from heritage_bayes.run import (  # Run, load_run: re-exported
     stamp_provenance,
 )
 from heritage_bayes.rundir import check_name
+from heritage_bayes.rundir.marker import read_marker, write_marker
 from heritage_bayes.rundir.summary import RunSummary
 from heritage_bayes.sources import input_paths
 
@@ -407,6 +408,11 @@ def _calibrate_into(
     # written through the typed summary every consumer reads (schema version stamped)
     summary = RunSummary.from_dict(summary, source=out / "summary.json").to_dict()
     dump_json(out / "summary.json", summary)
+    # the staging marker lists it now (not only at the commit): the report records the
+    # verdict it shows in it, and writes only into files the marker lists
+    marker = read_marker(out)
+    if marker is not None:
+        write_marker(out, marker.with_files("summary.json"))
     say.say(
         f"summary: converged={summary['converged']}, max R-hat "
         f"{summary['max_rhat']:.3f}, min bulk ESS {summary['min_ess_bulk']:.0f}, "

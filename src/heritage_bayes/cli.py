@@ -248,8 +248,8 @@ def _converged_or_3(run_dir) -> int:
     from heritage_bayes.rundir.summary import load_summary
 
     rs = load_summary(run_dir)
-    summary, conv = dict(rs.raw), rs.convergence
-    failures = accuracy_failures(summary, resolutions({}))
+    conv = rs.convergence
+    failures = accuracy_failures(rs, resolutions({}))
     if failures:
         print(
             "hbayes: warning: this model does not reproduce the room: "

@@ -32,6 +32,7 @@ __all__ = [
     "prose_html",
     "quantity_label",
     "quantity_name",
+    "surface_words",
     "tick_names",
 ]
 
@@ -203,11 +204,29 @@ _INPUT_WORDS = {
 }
 
 
+_COMPASS = {
+    **{k: _FACADE[k] for k in ("N", "E", "S", "W")},
+    "NE": "north-east",
+    "SE": "south-east",
+    "SW": "south-west",
+    "NW": "north-west",
+}
+
+
+def surface_words(side: str) -> str:
+    """A solar surface in words: ``E`` the east facade, ``roof_SE`` the south-east
+    slope of the roof (the roof planes ``hbayes init`` writes), anything else by its
+    name (``surface dome``)."""
+    if side in _FACADE:
+        return f"{_FACADE[side]} facade"
+    if side.startswith("roof_") and side[5:] in _COMPASS:
+        return f"{_COMPASS[side[5:]]} slope of the roof"
+    return f"surface {side}"
+
+
 def _input_words(u: str) -> str:
     if u.startswith("I_"):
-        side = u[2:]
-        where = f"{_FACADE[side]} facade" if side in _FACADE else f"surface {side}"
-        return f"sun on the {where}"
+        return f"sun on the {surface_words(u[2:])}"
     return _INPUT_WORDS.get(u, u)
 
 
@@ -232,9 +251,7 @@ def quantity_name(name: str, description: str | None = None, *, domain: str = ""
         return f"offset from {_input_words(m.group(2))}"
     m = re.fullmatch(r"fI_(\w+)", name)
     if m:
-        side = m.group(1)
-        where = f"{_FACADE[side]} facade" if side in _FACADE else f"surface {side}"
-        return f"solar aperture, {where}"
+        return f"solar aperture, {surface_words(m.group(1))}"
     m = re.fullmatch(r"x0_(\w+)", name)
     if m:
         return f"initial state of node {m.group(1)}"

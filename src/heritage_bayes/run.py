@@ -15,6 +15,7 @@ projection, comparison, portfolio) and the orchestrator that writes it
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
@@ -25,6 +26,7 @@ from heritage_bayes.errors import ConfigError, InputError
 from heritage_bayes.models import SECTIONS, build_model
 from heritage_bayes.rc.model import RCModel
 from heritage_bayes.rc.simulate import check_inputs
+from heritage_bayes.rundir.summary import RunSummary
 from heritage_bayes.rundir.writer import (  # the writer's side, re-exported
     RUN_FILES,
     RunWriter,
@@ -126,11 +128,9 @@ class Run:
     def sections(self) -> tuple[str, ...]:
         return tuple(self.models)
 
-    @property
-    def run_summary(self):
+    @cached_property
+    def run_summary(self) -> RunSummary:
         """:attr:`summary` typed (:class:`heritage_bayes.rundir.summary.RunSummary`)."""
-        from heritage_bayes.rundir.summary import RunSummary
-
         return RunSummary.from_dict(self.summary, source=self.path / "summary.json")
 
     def draws(self, section: str, n: int | None = None, seed: int = 0) -> dict[str, np.ndarray]:
@@ -222,12 +222,13 @@ class Run:
         """
         model = self._model(section)
         U = check_inputs(model, inputs)
-        dt = float(dt or self.summary.get("dt", 3600.0))
+        rs = self.run_summary
+        dt = float(dt or rs.dt)
         draws = self.draws(section, n_draws, seed)
         P, _ = model.param_array(draws)
         if control is not True:
             model = model.with_control(control)
-        w = init_window or int(self.summary.get("init_steps", 720))
+        w = init_window or (720 if rs.init_steps is None else int(rs.init_steps))
         u0 = U[: max(1, w)].mean(axis=0)
         return model.forward(P, U, dt, u_init=u0, x0=x0)[0]
 
@@ -336,13 +337,15 @@ def load_run(path: str | Path) -> Run:
     return Run(path=p, config=cfg, idata=idata, summary=summary, models=models, notes=notes)
 
 
-def hold_as_recorded(models: dict[str, RCModel], summary: dict) -> dict[str, RCModel]:
+def hold_as_recorded(models: dict[str, RCModel], summary: RunSummary | dict) -> dict[str, RCModel]:
     """The models with the input hold the run was calibrated with: a run made before
     ``data.input_hold`` existed recorded input names without slope columns (every input
     held at its step mean), which its config, read today, would give."""
+    rs = summary if isinstance(summary, RunSummary) else RunSummary.from_dict(summary)
     out = dict(models)
     for s, m in models.items():
-        names = (summary.get("models") or {}).get(s, {}).get("input_names")
+        info = rs.models.get(s)
+        names = None if info is None else info.input_names
         if m.slope_inputs and names is not None and not set(m.slope_columns) & set(names):
             out[s] = m.with_slopes(())
     return out

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import re
 import time
 import traceback
 from collections.abc import Mapping
@@ -14,6 +13,7 @@ import pandas as pd
 
 from heritage_bayes.errors import InputError
 from heritage_bayes.portfolio.spec import RoomSpec
+from heritage_bayes.rundir.summary import STATUSES, RunSummary
 
 __all__ = ["STATUSES", "measured_risk", "report_status", "room_row"]
 
@@ -193,56 +193,32 @@ def room_row(run_dir: str | Path) -> dict:
             if e is not None:
                 for suffix, v in (("", e.median), ("_q05", e.q05), ("_q95", e.q95)):
                     row[f"{section}.{col}{suffix}"] = nan if v is None else v
-    row.update(report_status(run_dir, conv.converged and bool(s.raw.get("converged_tau", True))))
+    row.update(report_status(s))
     row.update(measured_risk(run_dir))
     return row
 
 
-#: The statuses of the overview, most urgent first (failed rooms come before them).
-STATUSES = ("not converged", "checks failed", "converged")
-_VERDICT = re.compile(
-    r"<div id=\"verdict\" class=\"verdict (?P<level>\w+)\"[^>]*>\s*<h2>(?P<title>.*?)</h2>", re.S
-)
-
-
-def report_status(run_dir: Path, converged: bool) -> dict:
+def report_status(s: RunSummary) -> dict:
     """The room's status as its report's verdict gives it: ``verdict_level`` (green,
     amber, red), ``verdict_title`` (the verdict's heading) and ``verdict`` — one of
     :data:`STATUSES`: *converged* (green), *checks failed* (the sampler converged but
     the report's residual, coverage, truth or accuracy checks fail) or *not converged*.
 
-    Read from ``report.html`` (the package wrote it; its verdict box is the page's
-    contract), so the overview never contradicts the report it links. Without a report
-    the run's own decision (``converged``: its stopping rule, ``summary.json``) gives
-    *converged* or *not converged*, and
-    ``verdict_title`` says that no report was checked.
+    Read from the verdict the report recorded in ``summary.json`` when it was written
+    (:attr:`~heritage_bayes.rundir.summary.RunSummary.verdict`, the one the page shows),
+    so the overview never contradicts the report it links. Without one (no report
+    written since the run) the run's own decision (its stopping rule) gives *converged*
+    or *not converged*, and ``verdict_title`` says that no report was checked.
     """
-    import html as html_mod
-
-    path = run_dir / "report.html"
-    m = None
-    if path.is_file():
-        try:
-            with path.open(encoding="utf-8") as fh:
-                m = _VERDICT.search(fh.read(200_000))  # the verdict leads the page
-        except (OSError, UnicodeDecodeError):
-            m = None
-    if m is None:
+    v = s.verdict
+    if v is None:
+        conv = s.convergence
         return {
-            "verdict": "converged" if converged else "not converged",
+            "verdict": "converged" if conv.converged and conv.converged_tau else "not converged",
             "verdict_level": "",
             "verdict_title": "no report: the residual and coverage checks were not run",
         }
-    level = m["level"]
-    title = re.sub(r"\s+", " ", html_mod.unescape(re.sub(r"<[^>]+>", "", m["title"]))).strip()
-    title = title.lstrip("✔⚠✖ ")
-    if level == "green":
-        status = "converged"
-    elif converged and not re.search(r"not (fully )?converged", title, re.I):
-        status = "checks failed"
-    else:
-        status = "not converged"
-    return {"verdict": status, "verdict_level": level, "verdict_title": title}
+    return {"verdict": v.status, "verdict_level": v.level, "verdict_title": v.title}
 
 
 def measured_risk(run_dir: str | Path) -> dict:

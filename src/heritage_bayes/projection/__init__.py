@@ -228,7 +228,8 @@ def project(
         c.inputs = model_inputs(r, pcfg, c.weather, site, where)
     risk_opts = {"indicators": pcfg.risk.indicators} if pcfg.risk.indicators else {}
     _check_thresholds(pcfg, len(cases[0].inputs), risk_opts)
-    converged = bool(r.summary.get("converged", True))
+    conv = r.run_summary.convergence
+    converged = conv.converged
     if not converged and progress is not None:
         progress(f"WARNING: {UNCONVERGED_TEXT} ({r.path})")
     measures = measures_from_config(pcfg)
@@ -272,7 +273,7 @@ def project(
     )
     summary["assumptions"] = list(ASSUMPTIONS)
     summary["converged"] = converged
-    summary["unconverged_reasons"] = list(r.summary.get("unconverged_reasons") or [])
+    summary["unconverged_reasons"] = list(conv.reasons)
     summary["indicator_registry"] = {
         n: indicator_info(n).as_dict() | {"key": n} for n in summary["indicators"]
     }

@@ -32,6 +32,8 @@ import math
 
 import numpy as np
 
+from heritage_bayes.rundir.summary import FitMetrics, RunSummary, typed_summary
+
 __all__ = [
     "DAILY_CYCLE_RATIO",
     "DRIFT_RATIO",
@@ -104,15 +106,15 @@ def nearly_constant(sd, resolution) -> bool:
     return sd <= NEARLY_CONSTANT_RESOLUTIONS * resolution
 
 
-def _judged_period(per: dict) -> str | None:
+def _judged_period(per: dict[str, FitMetrics]) -> str | None:
     """The period whose FIT judges the model: validation, else calibration."""
     for p in ("validation", "calibration"):
-        if (per.get(p) or {}).get("FIT") is not None:
+        if p in per and per[p].FIT is not None:
             return p
     return None
 
 
-def accuracy_failures(summary: dict, resolutions: dict | None = None) -> list[dict]:
+def accuracy_failures(summary: RunSummary | dict, resolutions: dict | None = None) -> list[dict]:
     """The measured outputs the model does not reproduce (empty: all pass).
 
     Returns
@@ -124,35 +126,33 @@ def accuracy_failures(summary: dict, resolutions: dict | None = None) -> list[di
     """
     res = resolutions or {}
     out = []
-    for sec, outs in (summary.get("metrics") or {}).items():
-        for o, per in (outs or {}).items():
-            reasons, fit_bad, cov_bad = [], None, None
-            p = _judged_period(per)
-            if p is not None:
-                m = per[p]
-                fit = float(m["FIT"])
-                flat = nearly_constant(m.get("SD"), res.get(o))
-                if math.isfinite(fit) and fit < MIN_FIT and not flat:
-                    fit_bad = fit
-                    reasons.append(f"FIT {fit:.1f} % on the {p} period (at least {MIN_FIT:g} %)")
-            cov = (per.get("validation") or {}).get("coverage90")
-            if cov is not None and math.isfinite(float(cov)) and float(cov) < MIN_COVERAGE90:
-                cov_bad = float(cov)
-                reasons.append(
-                    f"the 90 % band covers {100 * cov_bad:.1f} % of the validation hours "
-                    f"(at least {100 * MIN_COVERAGE90:.0f} %)"
-                )
-            if reasons:
-                out.append(
-                    {
-                        "section": sec,
-                        "output": o,
-                        "period": p,
-                        "fit": fit_bad,
-                        "coverage90": cov_bad,
-                        "text": f"{o} ({sec}): " + " and ".join(reasons),
-                    }
-                )
+    for (sec, o), per in typed_summary(summary).metrics_by_output().items():
+        reasons, fit_bad, cov_bad = [], None, None
+        p = _judged_period(per)
+        if p is not None:
+            m = per[p]
+            fit = float(m.FIT)
+            if fit < MIN_FIT and not nearly_constant(m.SD, res.get(o)):
+                fit_bad = fit
+                reasons.append(f"FIT {fit:.1f} % on the {p} period (at least {MIN_FIT:g} %)")
+        cov = per["validation"].coverage90 if "validation" in per else None
+        if cov is not None and cov < MIN_COVERAGE90:
+            cov_bad = float(cov)
+            reasons.append(
+                f"the 90 % band covers {100 * cov_bad:.1f} % of the validation hours "
+                f"(at least {100 * MIN_COVERAGE90:.0f} %)"
+            )
+        if reasons:
+            out.append(
+                {
+                    "section": sec,
+                    "output": o,
+                    "period": p,
+                    "fit": fit_bad,
+                    "coverage90": cov_bad,
+                    "text": f"{o} ({sec}): " + " and ".join(reasons),
+                }
+            )
     return out
 
 
@@ -235,12 +235,13 @@ def residual_shape(
     }
 
 
-def _better_rung(summary: dict, failure: dict) -> str | None:
+def _better_rung(summary: RunSummary, failure: dict) -> str | None:
     """A ladder rung whose FIT of the failing output beats the sampled model's by
     :data:`LADDER_MARGIN` points on the judged period, in words (or None)."""
     sec, o, p = failure["section"], failure["output"], failure["period"]
-    rows = (summary.get("ladder") or {}).get(sec) or []
-    own = ((summary.get("metrics") or {}).get(sec) or {}).get(o, {}).get(p or "", {}).get("FIT")
+    rows = (summary.raw.get("ladder") or {}).get(sec) or []  # the ladder is not typed
+    met = None if p is None else summary.metric(sec, o, p)
+    own = None if met is None else met.FIT
     if own is None or p is None:
         return None
     best, best_fit = None, float(own) + LADDER_MARGIN
@@ -261,7 +262,9 @@ def _better_rung(summary: dict, failure: dict) -> str | None:
     return text + f", still below {MIN_FIT:g} %: it has part of what is missing"
 
 
-def missing_physics(summary: dict, failures: list[dict], shapes: dict | None) -> list[str]:
+def missing_physics(
+    summary: RunSummary | dict, failures: list[dict], shapes: dict | None
+) -> list[str]:
     """The most likely missing physics of each failing output, in words.
 
     ``shapes``: (section, output) -> :func:`residual_shape`. A strong daily cycle in
@@ -271,13 +274,12 @@ def missing_physics(summary: dict, failures: list[dict], shapes: dict | None) ->
     A ladder rung that fits clearly better is named with its FIT.
     """
     shapes = shapes or {}
-    models = summary.get("models") or {}
-    params = summary.get("parameters") or {}
+    rs = typed_summary(summary)
     lines = []
     for f in failures:
         sec, o = f["section"], f["output"]
-        info = models.get(sec) or {}
-        have = {k.split(".", 1)[1] for k in params if k.startswith(f"{sec}.")}
+        info = rs.models.get(sec)
+        have = {e.name for e in rs.parameters.values() if e.section == sec}
         found = []
         sh = shapes.get((sec, o))
         u = _DIFF_UNITS.get(o, "")
@@ -290,7 +292,8 @@ def missing_physics(summary: dict, failures: list[dict], shapes: dict | None) ->
                 f"{sh['peak_hour']:02d} h solar time)"
             )
             if o == "Ti" and sh["sunlit"]:
-                solar = any(str(n).startswith("I_") for n in info.get("input_names") or [])
+                names = () if info is None else info.input_names or ()
+                solar = any(str(n).startswith("I_") for n in names)
                 found.append(
                     f"{size}: the sun — "
                     + (
@@ -310,7 +313,7 @@ def missing_physics(summary: dict, failures: list[dict], shapes: dict | None) ->
                 )
         if sh and sh["slow"]:
             lack = []
-            if len(info.get("state_names") or []) < 2:
+            if info is None or len(info.state_names) < 2:
                 lack.append(
                     "a second, slower node (`" + ("thermal_2c" if o == "Ti" else "hygric_2c") + "`)"
                 )
@@ -326,7 +329,7 @@ def missing_physics(summary: dict, failures: list[dict], shapes: dict | None) ->
                 f"a measured standard deviation of {sh['measured_sd']:.2g}{u}): "
                 + (", ".join(lack) if lack else "a node, a control or a sink the model lacks")
             )
-        rung = _better_rung(summary, f)
+        rung = _better_rung(rs, f)
         if rung:
             found.append(rung)
         if found:

@@ -21,6 +21,7 @@ import time
 from pathlib import Path
 
 from heritage_bayes._version import __version__
+from heritage_bayes.errors import InputError
 from heritage_bayes.report.accuracy import residual_shape, resolutions
 from heritage_bayes.report.page import render_page
 from heritage_bayes.report.rundata import REQUIRED_FILES, load_run_data
@@ -34,13 +35,15 @@ from heritage_bayes.report.sections import (
     reproducibility,
     summary,
 )
-from heritage_bayes.report.verdict import convergence_verdict, run_notes
+from heritage_bayes.report.verdict import convergence_verdict, run_notes, verdict_record
+from heritage_bayes.rundir.summary import RunSummary
 
 __all__ = [
     "REQUIRED_FILES",
     "SECTIONS",
     "build_context",
     "convergence_verdict",
+    "record_verdict",
     "render",
     "write_report",
 ]
@@ -80,11 +83,10 @@ def _render_figures(obj, dpi: float | None = None):
     return obj
 
 
-def residual_shapes(summary: dict, fits: list[dict], res: dict) -> dict:
+def residual_shapes(summary: RunSummary, fits: list[dict], res: dict) -> dict:
     """(section, output) -> :func:`~heritage_bayes.report.accuracy.residual_shape` of
     the posterior-median residuals over the validation period (the calibration period
     without one), hours read in the site's solar time when the run knows the site."""
-    site = (summary.get("sources") or {}).get("site") or {}
     out = {}
     for f in fits:
         if f.get("resid") is None:
@@ -95,7 +97,7 @@ def residual_shapes(summary: dict, fits: list[dict], res: dict) -> dict:
             f["resid"][sel],
             f["measured"][sel],
             f["times"][sel],
-            longitude=site.get("longitude"),
+            longitude=summary.longitude,
             resolution=res.get(f["output"]),
         )
         if shape is not None:
@@ -171,7 +173,8 @@ def _umask() -> int:
 
 
 def write_report(run_dir) -> Path:
-    """Write ``RUN_DIR/report.html`` (atomically) and return its path.
+    """Write ``RUN_DIR/report.html`` (atomically) and return its path; the verdict
+    the page shows goes to ``summary.json`` too (:func:`record_verdict`).
 
     Raises
     ------
@@ -194,4 +197,34 @@ def write_report(run_dir) -> Path:
 
     ctx["generated"]["seconds"] = time.perf_counter() - t0
     html_text = render(ctx)
+    record_verdict(run_dir, ctx["verdict"])
     return atomic_write(target, _write)
+
+
+def record_verdict(run_dir, verdict: dict) -> bool:
+    """Record the page's verdict in ``RUN_DIR/summary.json`` (``verdict``: its level,
+    status, headline, text, reasons and advice, :func:`verdict_record`), so that the
+    portfolio reads the verdict the report shows. The rest of the file is written back
+    as it was; an unchanged verdict leaves the file untouched. A ``summary.json`` the
+    run's marker does not list (a folder hbayes did not make) is not touched.
+
+    Returns
+    -------
+    bool
+        Whether the file was written.
+    """
+    from heritage_bayes.inference.results import dump_json
+    from heritage_bayes.rundir.folder import claim_file
+    from heritage_bayes.rundir.reader import read_summary
+
+    record = verdict_record(verdict).to_dict()
+    summary = read_summary(run_dir)
+    if summary.get("verdict") == record:
+        return False
+    try:
+        target = claim_file(run_dir, "summary.json")
+    except InputError:
+        return False
+    summary["verdict"] = record
+    dump_json(target, summary)
+    return True

@@ -38,6 +38,7 @@ import numpy as np
 
 from heritage_bayes.format import fmt, quantity_label
 from heritage_bayes.report.rundata import RunData, section_params
+from heritage_bayes.rundir.summary import RunSummary
 
 __all__ = [
     "N_PRIOR",
@@ -85,12 +86,10 @@ class Coord:
     prior: np.ndarray | None
 
 
-def scale_capacities(summary: dict, m: str) -> list[str]:
+def scale_capacities(summary: RunSummary, m: str) -> list[str]:
     """Names of the free capacities of section ``m`` (the terms of the scale ΣC)."""
     return [
-        n
-        for n, v in section_params(summary, m).items()
-        if v.get("kind") == "capacity" and v.get("fixed") is None
+        n for n, e in section_params(summary, m).items() if e.kind == "capacity" and e.fixed is None
     ]
 
 
@@ -102,7 +101,7 @@ def _log10(x):
 def _derived_names(rd: RunData, m: str) -> list[str]:
     post = rd.idata.posterior
     out = []
-    for key in (rd.summary.get("derived") or {}).keys():
+    for key in rd.summary.derived:
         sec, _, name = key.partition(".")
         if sec == m and key in post and name.startswith(("tau_", "gain_", "offset_")):
             out.append(name)
@@ -136,16 +135,15 @@ def identifiable_coordinates(rd: RunData, m: str) -> list[Coord]:
     key = ("coords", m)
     if key in rd.cache:
         return rd.cache[key]
-    s = rd.summary
     post = rd.idata.posterior
-    derived = s.get("derived") or {}
+    derived = rd.summary.derived
     push = _prior_pushforward(rd, m)
     coords: list[Coord] = []
     for name in _derived_names(rd, m):
         x = np.asarray(post[f"{m}.{name}"].values, dtype=float)
-        info = derived.get(f"{m}.{name}") or {}
-        truth = info.get("truth")
-        unit = info.get("unit") or post[f"{m}.{name}"].attrs.get("unit", "")
+        e = derived.get(f"{m}.{name}")
+        truth = None if e is None else e.truth
+        unit = (e and e.unit) or post[f"{m}.{name}"].attrs.get("unit", "")
         prior = None if push is None else push[1].get(name)
         if name.startswith("tau_"):
             log = True
@@ -181,7 +179,7 @@ def _scale_coord(rd: RunData, m: str, push) -> Coord | None:
         return None
     params = section_params(rd.summary, m)
     total = sum(np.asarray(post[f"{m}.{c}"].values, dtype=float) for c in caps)
-    truths = [(params.get(c) or {}).get("truth") for c in caps]
+    truths = [params[c].truth for c in caps]
     truth = math.log10(sum(truths)) if all(t is not None for t in truths) else None
     prior = None
     if push is not None:
@@ -189,7 +187,7 @@ def _scale_coord(rd: RunData, m: str, push) -> Coord | None:
         idx = [list(model.parameter_names).index(c) for c in caps]
         prior = _log10(push[0][:, idx].sum(axis=1))
         prior = prior[np.isfinite(prior)]
-    unit = (params.get(caps[0]) or {}).get("unit", "")
+    unit = params[caps[0]].unit
     return Coord("scale", f"log10 ΣC [{unit}]", True, _log10(total), truth, prior)
 
 

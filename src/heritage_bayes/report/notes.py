@@ -1,6 +1,7 @@
 """The notes on a run shown under its verdict (amber or info), before its results.
 
-Pure functions on the run's ``summary.json`` (a dict): a solar input that was not
+Pure functions on the run's typed summary
+(:class:`~heritage_bayes.rundir.summary.RunSummary`): a solar input that was not
 measured (a cloudless sky, or the estimate from the daily temperature range),
 parameters at a prior bound, non-identifiable directions, separate optima of the MAP
 search, missing chain files, synthetic data. The verdict itself is
@@ -10,11 +11,12 @@ search, missing chain files, synthetic data. The verdict itself is
 from __future__ import annotations
 
 from heritage_bayes.format import prior_text, quantity_name
+from heritage_bayes.rundir.summary import RunSummary, typed_summary
 
 __all__ = ["run_notes"]
 
 
-def _modes_note(m: str, modes: list[dict], restarts) -> dict:
+def _modes_note(m: str, modes, restarts) -> dict:
     """The note of a MAP search whose restarts found separate optima (``summary.json``'s
     ``models.<m>.map.modes``, the chain's start first): their heights and the
     parameters in which they differ most (a factor of 3 or more, or 0.1 for
@@ -44,14 +46,17 @@ def _modes_note(m: str, modes: list[dict], restarts) -> dict:
 
 
 def run_notes(
-    summary: dict, chains_missing: list[str], *, irradiance_setting: str | None = None
+    summary: RunSummary | dict,
+    chains_missing: list[str],
+    *,
+    irradiance_setting: str | None = None,
 ) -> list[dict]:
     """Notes on the run to read before its results (under the verdict).
 
     Parameters
     ----------
-    summary : dict
-        The run's ``summary.json``.
+    summary : RunSummary or dict
+        The run's summary (or its ``summary.json`` object).
     chains_missing : list of str
         Chain files (``chain_<model>.h5``) not found in the run directory.
     irradiance_setting : str, optional
@@ -63,9 +68,9 @@ def run_notes(
     list of dict
         ``level`` (``"amber"`` or ``"info"``), ``title`` and ``text`` (plain text) per note.
     """
-    s = summary
+    s = typed_summary(summary)
     out = []
-    irr = str(s.get("irradiance_source", ""))
+    irr = s.irradiance_source
     if "clear" in irr.lower() or irradiance_setting == "clear_sky":
         out.append(
             {
@@ -90,13 +95,12 @@ def run_notes(
             }
         )
     bound = []
-    for k, v in (s.get("parameters") or {}).items():
-        if v.get("at_bound"):
-            unit = v.get("unit", "")
-            unit = f" {unit}" if unit and unit != "-" else ""
+    for e in s.parameters.values():
+        if e.at_bound:
+            unit = f" {e.unit}" if e.unit and e.unit != "-" else ""
             bound.append(
-                f"{quantity_name(k, v.get('description'))} (at the {v['at_bound']} end of its "
-                f"prior {prior_text(v.get('prior'))}{unit})"
+                f"{quantity_name(e.key, e.description or None)} (at the {e.at_bound} end of "
+                f"its prior {prior_text(e.prior)}{unit})"
             )
     if bound:
         out.append(
@@ -110,10 +114,8 @@ def run_notes(
                 "the prior if the bound is not physical.",
             }
         )
-    for m, i in (s.get("models") or {}).items():
-        on_bound = [
-            f"{quantity_name(n, domain=m)} ({side})" for n, side in i.get("map_at_bound") or []
-        ]
+    for m, i in s.models.items():
+        on_bound = [f"{quantity_name(n, domain=m)} ({side})" for n, side in i.map_at_bound]
         if on_bound:
             out.append(
                 {
@@ -126,7 +128,7 @@ def run_notes(
                     "bounds regardless.",
                 }
             )
-        fz, share = i.get("frozen_node"), i.get("frozen_share")
+        fz, share = i.frozen_node, i.frozen_share
         branch = (
             f" {share:.0%} of the posterior draws lie on this branch (the slowest time "
             "constant beyond ten records), the rest on one where every node moves: the "
@@ -139,15 +141,15 @@ def run_notes(
                 {
                     "level": "amber",
                     "title": f"A {m} node barely moves over the record",
-                    "text": f"At the MAP the slowest time constant is {fz['tau_h']:.3g} h, "
-                    f"{fz['records']:.0f} times the calibration record: that node keeps its "
+                    "text": f"At the MAP the slowest time constant is {fz.tau_h:.3g} h, "
+                    f"{fz.records:.0f} times the calibration record: that node keeps its "
                     "start value, a constant standing in for a fixed node, a missing input "
                     "or a missing node"
                     + (
                         "; its start is estimated freely, so it acts as a free offset "
                         "(compare with the default initial_state_horizon or "
                         "initial_state: steady)."
-                        if fz.get("start_free")
+                        if fz.start_free
                         else "; its start is held to the steady state of the first "
                         "window's mean inputs."
                     )
@@ -162,11 +164,7 @@ def run_notes(
                     "text": "The MAP's nodes all move over the record, but" + branch,
                 }
             )
-        flagged = [
-            n
-            for n in (i.get("practical_identifiability") or {}).get("unidentified") or []
-            if not n.startswith(("sigma_", "phi_"))
-        ]
+        flagged = [n for n in i.unidentified if not n.startswith(("sigma_", "phi_"))]
         if flagged:
             out.append(
                 {
@@ -181,10 +179,9 @@ def run_notes(
                     "ladder.",
                 }
             )
-        found = i.get("map") or {}
-        if len(modes := found.get("modes") or []) > 1:
-            out.append(_modes_note(m, modes, found.get("restarts")))
-        if (i.get("chain") or {}).get("stopped_by") == "max_seconds":
+        if len(i.map_modes) > 1:
+            out.append(_modes_note(m, i.map_modes, i.map_restarts))
+        if i.stopped_by == "max_seconds":
             out.append(
                 {
                     "level": "amber",
@@ -193,11 +190,7 @@ def run_notes(
                     "it converged: raise the budget, or continue it with `--resume`.",
                 }
             )
-    nulls = [
-        m
-        for m, i in (s.get("models") or {}).items()
-        if (i.get("identifiability") or {}).get("n_null", 0)
-    ]
+    nulls = [m for m, i in s.models.items() if i.identifiability.n_null]
     if nulls:
         out.append(
             {
@@ -223,9 +216,9 @@ def run_notes(
                 + " not found in the run directory.",
             }
         )
-    if s.get("truth"):
-        p_truth = any(v.get("truth") is not None for v in (s.get("parameters") or {}).values())
-        d_truth = any(v.get("truth") is not None for v in (s.get("derived") or {}).values())
+    if s.has_truth:
+        p_truth = any(e.truth is not None for e in s.parameters.values())
+        d_truth = any(e.truth is not None for e in s.derived.values())
         if p_truth:
             where = "the true values are shown next to the estimates"
         elif d_truth:

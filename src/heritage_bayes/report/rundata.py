@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from heritage_bayes.errors import InputError
+from heritage_bayes.rundir.summary import Estimate, RunSummary
 
 __all__ = [
     "REQUIRED_FILES",
@@ -36,7 +37,8 @@ REQUIRED_FILES = ("posterior.nc", "summary.json", "config.yaml")
 class RunData:
     path: Path
     run: object  # heritage_bayes.run.Run
-    summary: dict
+    #: ``summary.json``, typed (its untyped parts: ``summary.raw``)
+    summary: RunSummary
     config_text: str
     #: values computed once and shared by several sections (e.g. identifiable coordinates)
     cache: dict = field(default_factory=dict, repr=False)
@@ -58,14 +60,14 @@ def load_run_data(run_dir) -> RunData:
 
     p = check_run_files(run_dir, REQUIRED_FILES)
     run = load_run(p)
-    recorded = isinstance(run.summary.get("provenance"), dict)
+    recorded = isinstance(run.run_summary.raw.get("provenance"), dict)
     # the config that produced the posterior (hash checked by load_run), not an edit
     text = (
         config_yaml(run.config)
         if recorded
         else (p / "config.yaml").read_text("utf-8", errors="replace")
     )
-    return RunData(path=p, run=run, summary=run.summary, config_text=text)
+    return RunData(path=p, run=run, summary=run.run_summary, config_text=text)
 
 
 def time_axis(ds) -> np.ndarray:
@@ -102,19 +104,17 @@ def predictive_quantiles(idata, var: str, levels) -> np.ndarray:
     return np.quantile(flat_draws(idata.posterior_predictive[var]), levels, axis=0)
 
 
-def model_label(summary: dict, m: str) -> str:
+def model_label(summary: RunSummary, m: str) -> str:
+    """The model of section ``m`` (``combined``: the models joined by ``+``)."""
     if m == "combined":
-        models = summary.get("models") or {}
-        return " + ".join(str(models[k].get("model", k)) for k in models)
-    return str((summary.get("models") or {}).get(m, {}).get("model", m))
+        return " + ".join(info.model for info in summary.models.values())
+    info = summary.models.get(m)
+    return m if info is None else info.model
 
 
-def section_params(summary: dict, m: str) -> dict:
-    return {
-        k.split(".", 1)[1]: v
-        for k, v in (summary.get("parameters") or {}).items()
-        if k.startswith(f"{m}.")
-    }
+def section_params(summary: RunSummary, m: str) -> dict[str, Estimate]:
+    """The parameters of section ``m`` by name."""
+    return {e.name: e for e in summary.parameters.values() if e.section == m}
 
 
 def parameter_set(rd: RunData, m: str):
@@ -127,12 +127,13 @@ def parameter_set(rd: RunData, m: str):
         _, ps = section_parameters(rd.cfg, m, rd.run.models[m])
     except (InputError, AttributeError, KeyError, ValueError):  # ConfigError is one
         return None
-    names = list(((rd.summary.get("correlations") or {}).get(m) or {}).get("names") or [])
+    info = rd.summary.models.get(m)
+    names = list(info.free_names) if info is not None else []
     if list(ps.free_names) != names:
         return None
     params = section_params(rd.summary, m)
     for n in names:
-        if ps[n].prior.describe() != (params.get(n) or {}).get("prior"):
+        if n not in params or ps[n].prior.describe() != params[n].prior:
             return None
     return ps
 
@@ -142,13 +143,15 @@ def measurement_gaps(rd: RunData, dt: np.timedelta64, column: str | None = None)
     the input gaps too long to bridge (nothing is simulated there: a gap in every
     output)."""
     out = []
-    al = rd.summary.get("alignment") or {}
-    long_inputs = [g for g in al.get("input_gaps") or [] if not g.get("filled", True)]
-    for g in (al.get("measurement_gaps") or []) + long_inputs:
-        if column is not None and g.get("column") != column and g.get("filled", True):
+    al = rd.summary.alignment
+    long_inputs = [g for g in al.input_gaps if g.filled is False]
+    for g in (*al.measurement_gaps, *long_inputs):
+        if column is not None and g.column != column and g.filled is not False:
+            continue
+        if g.start is None or g.end is None:
             continue
         try:
-            out.append((utc64(g["start"]), utc64(g["end"]) + dt))
-        except (KeyError, TypeError, ValueError):
+            out.append((utc64(g.start), utc64(g.end) + dt))
+        except (TypeError, ValueError):
             continue
     return sorted(set(out))

@@ -1,9 +1,12 @@
 """The verdict on a run: convergence level (green/amber/red) and its reasons, and the notes.
 
-Pure functions on the run's ``summary.json`` (a dict) and what the report found in the
-run directory; no HTML here (the summary section renders the verdict box,
-:mod:`heritage_bayes.report.sections.summary`). Change the rules here and every page
-that shows a verdict (report, portfolio) follows.
+Pure functions on the run's summary (typed,
+:class:`~heritage_bayes.rundir.summary.RunSummary`, or its ``summary.json`` object) and
+what the report found in the run directory; no HTML here (the summary section renders
+the verdict box, :mod:`heritage_bayes.report.sections.summary`). Change the rules here
+and every page that shows a verdict (report, portfolio) follows: the report records the
+verdict it shows in ``summary.json`` (:func:`verdict_record`), where the portfolio
+reads it.
 
 - :func:`convergence_verdict`: the level, a title, plain-words text, one line per model
   naming what failed, the statistics and the advice;
@@ -20,7 +23,7 @@ import math
 from heritage_bayes.format import fmt, fmt_int, fmt_interval, quantity_name
 from heritage_bayes.report.accuracy import accuracy_failures, missing_physics
 from heritage_bayes.report.notes import run_notes
-from heritage_bayes.rundir.summary import RunSummary
+from heritage_bayes.rundir.summary import RunSummary, Verdict, typed_summary
 
 __all__ = [
     "AMBER",
@@ -33,13 +36,14 @@ __all__ = [
     "run_notes",
     "truth_advice",
     "truth_misses",
+    "verdict_record",
 ]
 
 #: "Close to converged" (amber) thresholds; green uses the run's own criteria.
 AMBER = {"max_rhat": 1.05, "min_ess_bulk": 100.0}
 
 
-def model_checks(summary: dict, residuals: list[dict] | None = None) -> list[str]:
+def model_checks(summary: RunSummary | dict, residuals: list[dict] | None = None) -> list[str]:
     """What is wrong with the noise model of a run, in words (empty: nothing found).
 
     - **Whiteness** (``residuals``: the report's residual checks, one per output): what
@@ -65,36 +69,39 @@ def model_checks(summary: dict, residuals: list[dict] | None = None) -> list[str
                 f"1-72 h outside the 95 % band; largest {c.get('worst_rho', float('nan')):.2f} "
                 f"at {c.get('worst_lag_h', float('nan')):g} h)"
             )
-    params = summary.get("parameters") or {}
-    for sec, outs in (summary.get("metrics") or {}).items():
+    rs = typed_summary(summary)
+    for (sec, out), periods in rs.metrics_by_output().items():
         if sec == "combined":
             continue
-        info = (summary.get("models") or {}).get(sec) or {}
-        for out, periods in outs.items():
-            val = periods.get("validation") or {}
-            cov, n = val.get("coverage90"), val.get("n")
-            if cov is None or not n:
-                continue
-            pred = (info.get("predictive_noise") or {}).get(out) or {}
-            phi = pred.get("phi", (params.get(f"{sec}.phi_{out}") or {}).get("median", 0.0))
-            phi = min(max(float(phi or 0.0), 0.0), 0.999)
-            n_eff = max(1.0, n * (1 - phi) / (1 + phi))
-            tol = 2.58 * math.sqrt(0.09 / n_eff)
-            if abs(cov - 0.90) > tol:
-                problems.append(
-                    f"{sec} {out}: the 90 % predictive band covers {100 * cov:.0f} % of "
-                    f"the validation hours (expected 90 ± {100 * tol:.0f} % for about "
-                    f"{n_eff:.0f} independent hours)"
-                )
+        info = rs.models.get(sec)
+        val = periods.get("validation")
+        cov, n = (None, None) if val is None else (val.coverage90, val.n)
+        if cov is None or not n:
+            continue
+        pred = None if info is None else info.predictive_noise.get(out)
+        if pred is not None:
+            phi = pred.phi
+        else:
+            e = rs.parameters.get(f"{sec}.phi_{out}")
+            phi = 0.0 if e is None else e.median
+        phi = min(max(float(phi or 0.0), 0.0), 0.999)
+        n_eff = max(1.0, n * (1 - phi) / (1 + phi))
+        tol = 2.58 * math.sqrt(0.09 / n_eff)
+        if abs(cov - 0.90) > tol:
+            problems.append(
+                f"{sec} {out}: the 90 % predictive band covers {100 * cov:.0f} % of "
+                f"the validation hours (expected 90 ± {100 * tol:.0f} % for about "
+                f"{n_eff:.0f} independent hours)"
+            )
     problems += truth_misses(summary)
     return problems
 
 
-def truth_misses(summary: dict) -> list[str]:
+def truth_misses(summary: RunSummary | dict) -> list[str]:
     """Quantities whose known true value lies outside their 90 % interval: the derived
     quantities, and the parameters the data identify (a parameter on a scale direction
     only the priors pin is named by :func:`prior_pinned` instead)."""
-    rs = _typed(summary)
+    rs = typed_summary(summary)
     out = []
     for key in _truth_keys(summary):
         e = rs.estimate(key)
@@ -108,16 +115,16 @@ def truth_misses(summary: dict) -> list[str]:
     return out
 
 
-def _truth_keys(summary: dict) -> list[str]:
+def _truth_keys(summary: RunSummary | dict) -> list[str]:
     """The quantities whose known true value the verdict weighs: derived quantities,
     then free parameters not on a scale direction only the priors pin."""
-    rs = _typed(summary)
+    rs = typed_summary(summary)
     pinned = {e.key for es in prior_pinned(summary).values() for e in es}
     es = [*rs.derived.values(), *(e for e in rs.parameters.values() if e.free)]
     return [e.key for e in es if e.truth is not None and e.key not in pinned]
 
 
-def prior_pinned(summary: dict) -> dict[str, list]:
+def prior_pinned(summary: RunSummary | dict) -> dict[str, list]:
     """Per section, the free parameters whose absolute value the measurements cannot
     tell: those on a scale direction of the structural identifiability analysis
     (identifiable only once the scale is pinned). Their posterior follows the priors
@@ -130,17 +137,13 @@ def prior_pinned(summary: dict) -> dict[str, list]:
         section -> list of :class:`~heritage_bayes.rundir.summary.Estimate` (empty
         sections left out).
     """
-    rs = _typed(summary)
+    rs = typed_summary(summary)
     out = {}
-    for m, info in (summary.get("models") or {}).items():
-        idf = info.get("identifiability") or {}
-        if not idf.get("has_scale_direction"):
+    for m, info in rs.models.items():
+        idf = info.identifiability
+        if not idf.has_scale_direction:
             continue
-        on_scale = [
-            n
-            for n, d in (idf.get("parameters") or {}).items()
-            if not d.get("identifiable") and d.get("identifiable_given_scale")
-        ]
+        on_scale = [n for n in idf.parameters if idf.on_scale(n)]
         es = [rs.parameters[f"{m}.{n}"] for n in on_scale if f"{m}.{n}" in rs.parameters]
         es = [e for e in es if e.free]
         if es:
@@ -148,7 +151,7 @@ def prior_pinned(summary: dict) -> dict[str, list]:
     return out
 
 
-def prior_pinned_lines(summary: dict) -> list[str]:
+def prior_pinned_lines(summary: RunSummary | dict) -> list[str]:
     """The verdict's words on the parameters :func:`prior_pinned` names: which, and,
     with known true values, those outside their intervals and by what factor."""
     lines = []
@@ -176,7 +179,7 @@ def prior_pinned_lines(summary: dict) -> list[str]:
     return lines
 
 
-def truth_advice(summary: dict, k: int) -> str:
+def truth_advice(summary: RunSummary | dict, k: int) -> str:
     """What ``k`` known truths outside their 90 % intervals mean, in words.
 
     With n derived quantities checked, a calibrated posterior puts about n/10 truths
@@ -200,7 +203,7 @@ def truth_advice(summary: dict, k: int) -> str:
 
 
 def convergence_verdict(
-    summary: dict,
+    summary: RunSummary | dict,
     residuals: list[dict] | None = None,
     *,
     shapes: dict | None = None,
@@ -228,7 +231,10 @@ def convergence_verdict(
         saved in ``posterior.nc`` within the same criteria, and the residual,
         coverage and truth checks pass; ``"amber"``: the rule met but the saved draws
         or a check fail, or close to converged — max R-hat ≤ 1.05 and min bulk ESS ≥
-        100; ``"red"``: not converged), ``title``, ``text``, ``rule`` (the rule
+        100; ``"red"``: not converged), ``status`` (one of
+        :data:`~heritage_bayes.rundir.summary.STATUSES`: *converged* when green,
+        *checks failed* when the stopping rule was met and the headline does not say
+        otherwise, else *not converged*), ``title``, ``text``, ``rule`` (the rule
         applied, in words, for the page), ``models`` (one plain-words line per model,
         per failed check and per model whose scale only the priors pin,
         :func:`prior_pinned_lines`), ``checks``, ``accuracy`` (the failures of the
@@ -245,7 +251,7 @@ def convergence_verdict(
     recomputes their R-hat and ESS with arviz: a run whose saved draws miss the
     stated criteria is therefore amber, never green, and the page states the rule.
     """
-    rs = _typed(summary)
+    rs = typed_summary(summary)
     conv = rs.convergence
     r_ok, e_ok, tf = conv.target_rhat, conv.target_ess, conv.tau_factor
     max_rhat = _nan_low(conv.max_rhat)
@@ -257,13 +263,12 @@ def convergence_verdict(
     # within the stated criteria
     saved_ok = conv.saved_draws_ok
     lines = []
-    for m, info in (summary.get("models") or {}).items():
+    for m, info in rs.models.items():
         pr = [e for e in rs.parameters.values() if e.section == m and e.r_hat is not None]
-        ch = info.get("chain") or {}
         problems = []
-        steps, tmax = ch.get("steps"), ch.get("tau_max")
-        if not ch.get("converged_tau", False):
-            if steps is not None and tmax is not None and math.isfinite(tmax):
+        steps, tmax = info.steps, info.tau_max
+        if not info.converged_tau:
+            if steps is not None and tmax is not None:
                 problems.append(
                     f"the chains ran {fmt_int(steps)} steps but need at least "
                     f"{tf:g} × τ = {fmt_int(tf * tmax)} steps (τ ≈ {fmt_int(tmax)}) with a "
@@ -280,7 +285,7 @@ def convergence_verdict(
                 rhat_text = f"R-hat up to {rmax:.3f} for the {quantity_name(worst_r.key)}"
             if not emin >= e_ok:
                 ess_text = f"bulk ESS down to {fmt_int(emin)} for the {quantity_name(worst_e.key)}"
-        name = f"{m} model (`{info.get('model', '?')}`)"
+        name = f"{m} model (`{info.model}`)"
         saved = [t for t in (rhat_text, ess_text) if t]
         if rule_ok and not problems and saved:
             lines.append(
@@ -377,21 +382,21 @@ def convergence_verdict(
             "chains; if it still does not converge, the model may be over-parameterised "
             "for the data (see the identifiability section and the model-order ladder)."
         )
-    if level != "green" and any(
-        (i.get("identifiability") or {}).get("n_null", 0)
-        for i in (summary.get("models") or {}).values()
-    ):
+    if level != "green" and any(i.identifiability.n_null for i in rs.models.values()):
         advice += (
             " Parameter combinations that the data cannot identify (section 6) "
             "slow the sampler down: pinning them with prior knowledge, e.g. the "
             "room volume (`room_volume`), usually helps."
         )
     failures = accuracy_failures(summary, resolutions)
+    # the headline says the sampling did not converge (the portfolio's "not converged")
+    says_unconverged = level == "red"
     if failures:
         converged = rule_ok and saved_ok
         nearly = level == "amber" and not converged
         level = "red"
         title = "This model does not reproduce the room"
+        says_unconverged = not converged
         if not converged:
             title += " — and " + ("not fully converged" if nearly else "NOT CONVERGED")
         text = (
@@ -412,8 +417,15 @@ def convergence_verdict(
             "diagnostics (section 7), change the model, and calibrate again."
         )
     lines += prior_pinned_lines(summary)
+    if level == "green":
+        status = "converged"
+    elif conv.converged and conv.converged_tau and not says_unconverged:
+        status = "checks failed"
+    else:
+        status = "not converged"
     return {
         "level": level,
+        "status": status,
         "title": title,
         "text": text,
         "rule": rule,
@@ -425,8 +437,18 @@ def convergence_verdict(
     }
 
 
-def _typed(summary) -> RunSummary:
-    return summary if isinstance(summary, RunSummary) else RunSummary.from_dict(summary)
+def verdict_record(verdict: dict) -> Verdict:
+    """What ``summary.json`` records of a :func:`convergence_verdict` (its level,
+    status, headline, text, reasons and advice): the report writes it beside the page
+    it shows it on, and the portfolio reads it from there."""
+    return Verdict(
+        level=verdict["level"],
+        status=verdict["status"],
+        title=verdict["title"],
+        text=verdict["text"],
+        reasons=tuple(verdict["models"]),
+        advice=verdict["advice"],
+    )
 
 
 def _nan_low(v) -> float:

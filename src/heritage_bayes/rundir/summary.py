@@ -12,18 +12,23 @@ no consumer pokes at nested dicts:
 - :class:`Convergence` — the criteria the run states (max R-hat, min bulk ESS, chain
   length in τ), the figures of the draws saved in ``posterior.nc`` and the stopping
   rule's decision;
-- :class:`ModelInfo` — one section's model, noise model and chain.
+- :class:`ModelInfo` — one section's model, noise model, chain and MAP findings
+  (:class:`Identifiability`, :class:`FrozenNode`);
+- :class:`Period` — the calibration and validation periods;
+- :class:`Verdict` — the report's verdict (level, status, headline, reasons), written
+  with the report: the portfolio reads the verdict the report shows.
 
 Versions: a summary without ``schema_version`` is version 1 (every hbayes before the
 typed summary); its keys are read as they were written, missing ones as absent
 (None). A summary of a newer schema than this hbayes knows is refused with a message
 naming the file. The whole JSON object stays available as :attr:`RunSummary.raw`
-for the parts not typed here (alignment, provenance, ladder).
+for the parts not typed here (provenance, ladder, selection, correlation matrices);
+:mod:`heritage_bayes.rundir.summary_parts` holds the models', periods', alignment's and
+verdict's types.
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
@@ -31,30 +36,46 @@ from typing import Any
 
 from heritage_bayes.format import fmt_int, quantity_label
 from heritage_bayes.rundir.reader import SCHEMA_VERSION, damaged, read_summary
+from heritage_bayes.rundir.summary_parts import (
+    STATUSES,
+    Alignment,
+    FrozenNode,
+    Gap,
+    Identifiability,
+    ModelInfo,
+    NullDirection,
+    Period,
+    PredictiveNoise,
+    Saturation,
+    SourceNote,
+    Verdict,
+    finite_float,
+)
 
 __all__ = [
     "SCHEMA_VERSION",
+    "STATUSES",
+    "Alignment",
     "Convergence",
     "Estimate",
     "FitMetrics",
+    "FrozenNode",
+    "Gap",
+    "Identifiability",
     "ModelInfo",
+    "NullDirection",
+    "Period",
+    "PredictiveNoise",
     "RunSummary",
+    "Saturation",
+    "SourceNote",
+    "Verdict",
     "load_summary",
+    "typed_summary",
 ]
 
 #: The convergence criteria of runs that did not state them (hbayes before they did).
 _DEFAULT_CRITERIA = {"max_rhat": 1.01, "min_ess_bulk": 400.0, "tau_factor": 50.0}
-
-
-def _num(v) -> float | None:
-    """A finite float, or None (absent, null, NaN, not a number)."""
-    if isinstance(v, bool) or v is None:
-        return None
-    try:
-        f = float(v)
-    except (TypeError, ValueError):
-        return None
-    return f if math.isfinite(f) else None
 
 
 @dataclass(frozen=True)
@@ -117,23 +138,23 @@ class Estimate:
         return cls(
             key=key,
             unit=str(d.get("unit") or ""),
-            median=_num(d.get("median")),
-            q05=_num(d.get("q05")),
-            q95=_num(d.get("q95")),
-            mean=_num(d.get("mean")),
-            sd=_num(d.get("sd")),
-            truth=_num(d.get("truth")),
+            median=finite_float(d.get("median")),
+            q05=finite_float(d.get("q05")),
+            q95=finite_float(d.get("q95")),
+            mean=finite_float(d.get("mean")),
+            sd=finite_float(d.get("sd")),
+            truth=finite_float(d.get("truth")),
             kind="derived" if derived else str(d.get("kind") or ""),
             description=str(d.get("description") or ""),
             derived=derived,
-            fixed=_num(fixed) if fixed is not None else None,
+            fixed=finite_float(fixed) if fixed is not None else None,
             prior=d.get("prior") if isinstance(d.get("prior"), str) else None,
-            map=_num(d.get("map")),
-            r_hat=_num(d.get("r_hat")),
-            ess_bulk=_num(d.get("ess_bulk")),
-            ess_tail=_num(d.get("ess_tail")),
-            tau=_num(d.get("tau")),
-            contraction=_num(d.get("contraction")),
+            map=finite_float(d.get("map")),
+            r_hat=finite_float(d.get("r_hat")),
+            ess_bulk=finite_float(d.get("ess_bulk")),
+            ess_tail=finite_float(d.get("ess_tail")),
+            tau=finite_float(d.get("tau")),
+            contraction=finite_float(d.get("contraction")),
             at_bound=d.get("at_bound") if isinstance(d.get("at_bound"), str) else None,
         )
 
@@ -156,6 +177,8 @@ class FitMetrics:
     n: int | None = None
     coverage50: float | None = None
     coverage90: float | None = None
+    SD: float | None = None
+    coverage90_1step: float | None = None
 
 
 @dataclass(frozen=True)
@@ -176,6 +199,7 @@ class Convergence:
     converged: bool
     converged_tau: bool
     reasons: tuple[str, ...] = ()
+    tau_rtol: float | None = None
 
     @property
     def saved_draws_ok(self) -> bool:
@@ -207,21 +231,6 @@ class Convergence:
 
 
 @dataclass(frozen=True)
-class ModelInfo:
-    """One section (``thermal``/``hygric``) of a run: its model and chain."""
-
-    section: str
-    model: str
-    noise: str = ""
-    domain: str = ""
-    steps: int | None = None
-    walkers: int | None = None
-    tau_max: float | None = None
-    converged_tau: bool = False
-    likelihood_temperature: float = 1.0
-
-
-@dataclass(frozen=True)
 class RunSummary:
     """``summary.json`` of a calibration run, typed (see the module docstring)."""
 
@@ -240,6 +249,23 @@ class RunSummary:
     models: MappingProxyType  # section -> ModelInfo
     timings: MappingProxyType  # what -> seconds
     wall_seconds: float | None
+    periods: tuple[Period, ...]
+    warmup_steps: int
+    init_steps: int | None
+    notes: str
+    heritage_bayes_version: str
+    irradiance_source: str
+    #: library versions the run recorded (empty: an older run)
+    versions: MappingProxyType
+    #: synthetic data with known true values
+    has_truth: bool
+    #: the site's longitude [° east] (None: not recorded)
+    longitude: float | None
+    #: how the ground temperature was set, in words ("" if not recorded)
+    ground_temperature: str
+    #: the report's verdict (None: no report written since the run, or an older run)
+    verdict: Verdict | None
+    alignment: Alignment
     raw: MappingProxyType = field(repr=False)
 
     # ------------------------------------------------------------------ reading
@@ -251,6 +277,14 @@ class RunSummary:
         """Parameters then derived quantities (of one section)."""
         out = [*self.parameters.values(), *self.derived.values()]
         return [e for e in out if section is None or e.section == section]
+
+    def metrics_by_output(self) -> dict[tuple[str, str], dict[str, FitMetrics]]:
+        """(section, output) -> period -> its metrics, in the order the run wrote them
+        (``combined``: the relative humidity of the two models)."""
+        out: dict[tuple[str, str], dict[str, FitMetrics]] = {}
+        for m in self.metrics:
+            out.setdefault((m.section, m.output), {})[m.period] = m
+        return out
 
     def metric(self, section: str, output: str, period: str) -> FitMetrics | None:
         for m in self.metrics:
@@ -300,20 +334,12 @@ class RunSummary:
                 "(a newer one: upgrade heritage_bayes)",
             )
         crit = {**_DEFAULT_CRITERIA, **(d.get("criteria") or {})}
-        models = {}
-        for sec, info in (d.get("models") or {}).items():
-            ch = info.get("chain") or {}
-            models[sec] = ModelInfo(
-                section=sec,
-                model=str(info.get("model") or sec),
-                noise=str(info.get("noise") or ""),
-                domain=str(info.get("domain") or sec),
-                steps=ch.get("steps"),
-                walkers=ch.get("walkers"),
-                tau_max=_num(ch.get("tau_max")),
-                converged_tau=bool(ch.get("converged_tau", False)),
-                likelihood_temperature=_num(info.get("likelihood_temperature")) or 1.0,
-            )
+        site = (d.get("sources") or {}).get("site") or {}
+        corr = d.get("correlations") or {}
+        models = {
+            sec: ModelInfo.from_dict(sec, info, corr.get(sec))
+            for sec, info in (d.get("models") or {}).items()
+        }
         metrics = []
         for sec, outs in (d.get("metrics") or {}).items():
             for out, periods in (outs or {}).items():
@@ -325,23 +351,26 @@ class RunSummary:
                             section=sec,
                             output=out,
                             period=per,
-                            FIT=_num(m.get("FIT")),
-                            MSE=_num(m.get("MSE")),
-                            MAE=_num(m.get("MAE")),
+                            FIT=finite_float(m.get("FIT")),
+                            MSE=finite_float(m.get("MSE")),
+                            MAE=finite_float(m.get("MAE")),
                             n=m.get("n"),
-                            coverage50=_num(m.get("coverage50")),
-                            coverage90=_num(m.get("coverage90")),
+                            coverage50=finite_float(m.get("coverage50")),
+                            coverage90=finite_float(m.get("coverage90")),
+                            SD=finite_float(m.get("SD")),
+                            coverage90_1step=finite_float(m.get("coverage90_1step")),
                         )
                     )
         conv = Convergence(
-            max_rhat=_num(d.get("max_rhat")),
-            min_ess_bulk=_num(d.get("min_ess_bulk")),
+            max_rhat=finite_float(d.get("max_rhat")),
+            min_ess_bulk=finite_float(d.get("min_ess_bulk")),
             target_rhat=float(crit["max_rhat"]),
             target_ess=float(crit["min_ess_bulk"]),
             tau_factor=float(crit["tau_factor"]),
             converged=bool(d.get("converged", False)),
             converged_tau=bool(d.get("converged_tau", d.get("converged", False))),
             reasons=tuple(str(r) for r in d.get("unconverged_reasons") or ()),
+            tau_rtol=finite_float(crit.get("tau_rtol")),
         )
         return cls(
             schema_version=version,
@@ -351,7 +380,7 @@ class RunSummary:
             seed=d.get("seed") if isinstance(d.get("seed"), int) else None,
             config_hash=str(d.get("config_hash") or ""),
             created_at=str(d.get("created_at") or ""),
-            dt=_num(d.get("dt")) or 3600.0,
+            dt=finite_float(d.get("dt")) or 3600.0,
             parameters=MappingProxyType(
                 {k: Estimate.from_dict(k, v) for k, v in (d.get("parameters") or {}).items()}
             ),
@@ -365,11 +394,40 @@ class RunSummary:
             convergence=conv,
             models=MappingProxyType(models),
             timings=MappingProxyType(
-                {k: float(v) for k, v in (d.get("timings") or {}).items() if _num(v) is not None}
+                {
+                    k: float(v)
+                    for k, v in (d.get("timings") or {}).items()
+                    if finite_float(v) is not None
+                }
             ),
-            wall_seconds=_num(d.get("wall_seconds")),
+            wall_seconds=finite_float(d.get("wall_seconds")),
+            periods=tuple(
+                Period(name=k, start=p.get("start"), end=p.get("end"), steps=p.get("steps", 0))
+                for k, p in (d.get("periods") or {}).items()
+            ),
+            warmup_steps=int(d.get("warmup_steps") or 0),
+            init_steps=d.get("init_steps"),
+            notes=str(d.get("notes") or ""),
+            heritage_bayes_version=str(d.get("heritage_bayes_version") or ""),
+            irradiance_source=str(d.get("irradiance_source") or ""),
+            versions=MappingProxyType(
+                dict(d["versions"]) if isinstance(d.get("versions"), dict) else {}
+            ),
+            has_truth=bool(d.get("truth")),
+            longitude=finite_float(site.get("longitude")),
+            ground_temperature=str(
+                ((d.get("sources") or {}).get("ground_temperature") or {}).get("method") or ""
+            ),
+            verdict=Verdict.from_dict(d.get("verdict")),
+            alignment=Alignment.from_dict(d.get("alignment")),
             raw=MappingProxyType(d),
         )
+
+
+def typed_summary(summary: RunSummary | dict) -> RunSummary:
+    """``summary`` typed: a :class:`RunSummary` as it is, a ``summary.json`` object
+    through :meth:`RunSummary.from_dict` (for callers that hold the JSON)."""
+    return summary if isinstance(summary, RunSummary) else RunSummary.from_dict(summary)
 
 
 def load_summary(run_dir: str | Path) -> RunSummary:

@@ -8,6 +8,7 @@ from heritage_bayes.format import fmt_int, fmt_time
 from heritage_bayes.report.page import Section
 from heritage_bayes.report.rundata import RunData, measurement_gaps, time_axis
 from heritage_bayes.report.sections._fragment import render_fragment
+from heritage_bayes.rundir.summary import SourceNote
 
 ID, TITLE = "data", "2. Data"
 
@@ -23,25 +24,24 @@ def _input_units(rd: RunData) -> dict:
     return units
 
 
-def _sources(notes: list[dict]) -> list[dict]:
+def _sources(notes: tuple[SourceNote, ...]) -> list[dict]:
     """One row per source file and role: the tables derived from one record (its
     facade irradiance, ``"<file> (irradiance on surfaces)"``) join its row."""
     rows: dict[tuple, dict] = {}
-    names = {str(src.get("source", "")) for src in notes}
+    names = {src.source for src in notes}
     for src in notes:
-        name = str(src.get("source", ""))
+        name = src.source
         base = name.rsplit(" (", 1)[0] if name.endswith(")") else name
         base = base if base in names else name
-        key = (src.get("role", ""), base)
+        key = (src.role, base)
         row = rows.setdefault(
             key,
             {"role": key[0], "source": base, "columns": [], "timezone": [], "averaged": []},
         )
         for k in ("columns", "averaged"):
-            row[k] += [str(c) for c in src.get(k) or [] if str(c) not in row[k]]
-        tz = str(src.get("timezone", "") or "")
-        if tz and tz not in row["timezone"]:
-            row["timezone"].append(tz)
+            row[k] += [c for c in getattr(src, k) if c not in row[k]]
+        if src.timezone and src.timezone not in row["timezone"]:
+            row["timezone"].append(src.timezone)
     return [
         {k: v if isinstance(v, str) else ", ".join(v) for k, v in row.items()}
         for row in rows.values()
@@ -140,71 +140,56 @@ def data_context(rd: RunData) -> dict:
                 }
             )
     fig = fig_data_overview(times, codes, panels, measurement_gaps(rd, dt), flags)
-    al = rd.summary.get("alignment") or {}
-    period = al.get("period") or {}
-    rows = []
-    for role, n in (al.get("rows_in") or {}).items():
-        rows.append(
-            {
-                "role": role,
-                "rows_in": fmt_int(n),
-                "dropped": fmt_int((al.get("rows_dropped") or {}).get(role)),
-            }
-        )
+    al = rd.summary.alignment
+    rows = [
+        {"role": role, "rows_in": fmt_int(n), "dropped": fmt_int(al.rows_dropped.get(role))}
+        for role, n in al.rows_in.items()
+    ]
     interp = [
-        {
-            "column": c,
-            "filled": fmt_int(n),
-            "flagged": fmt_int((al.get("flagged_rows") or {}).get(c)),
-        }
-        for c, n in (al.get("interpolated") or {}).items()
+        {"column": c, "filled": fmt_int(n), "flagged": fmt_int(al.flagged_rows.get(c))}
+        for c, n in al.interpolated.items()
     ]
     gaps = []
     for kind, key in (
         ("input (filled by interpolation)", "input_gaps"),
         ("measurement", "measurement_gaps"),
     ):
-        for g in al.get(key) or []:
-            long = key == "input_gaps" and not g.get("filled")
+        for g in getattr(al, key):
+            long = key == "input_gaps" and not g.filled
             gaps.append(
                 {
                     "kind": "input (too long: not simulated, the record splits)" if long else kind,
-                    "column": g.get("column", "?"),
-                    "start": fmt_time(g.get("start")),
-                    "end": fmt_time(g.get("end")),
-                    "length": g.get("length", "?"),
-                    "n": fmt_int(g.get("n_missing")),
-                    "filled": "yes" if g.get("filled") else "no",
+                    "column": g.column,
+                    "start": fmt_time(g.start),
+                    "end": fmt_time(g.end),
+                    "length": g.length,
+                    "n": fmt_int(g.n_missing),
+                    "filled": "yes" if g.filled else "no",
                 }
             )
-    missing = [
-        {"column": c, "n": fmt_int(n)} for c, n in (al.get("measurement_missing") or {}).items()
-    ]
-    sources = _sources(al.get("sources") or [])
-    n_interp = sum(int(v or 0) for v in (al.get("interpolated") or {}).values())
-    n_flag = sum(int(v or 0) for v in (al.get("flagged_rows") or {}).values())
+    missing = [{"column": c, "n": fmt_int(n)} for c, n in al.measurement_missing.items()]
+    sources = _sources(al.sources)
+    n_interp = sum(int(v or 0) for v in al.interpolated.values())
+    n_flag = sum(int(v or 0) for v in al.flagged_rows.values())
     spans: dict[tuple, list[str]] = {}
-    for g in al.get("measurement_gaps") or []:
-        spans.setdefault((g.get("start"), g.get("end")), []).append(str(g.get("column")))
+    for g in al.measurement_gaps:
+        spans.setdefault((g.start, g.end), []).append(g.column)
     n_gap_meas = len(spans)
     words = (
-        f"The data were aligned on a {period.get('step', '?')} grid from "
-        f"{fmt_time(period.get('start'))} to {fmt_time(period.get('end'))} "
-        f"({fmt_int(period.get('n_rows'))} rows). "
+        f"The data were aligned on a {al.step} grid from "
+        f"{fmt_time(al.start)} to {fmt_time(al.end)} "
+        f"({fmt_int(al.n_rows)} rows). "
     )
     if n_interp:
         words += (
             f"{fmt_int(n_interp)} missing input values were filled by interpolation "
-            f"(gaps up to {al.get('max_gap', '?')}), affecting {fmt_int(n_flag)} "
+            f"(gaps up to {al.max_gap}), affecting {fmt_int(n_flag)} "
             "rows (marked × in the figure). "
         )
     else:
         words += "No input value had to be interpolated. "
     if n_gap_meas:
-        longest = max(
-            (float(g.get("length_hours") or 0) for g in al.get("measurement_gaps") or []),
-            default=0.0,
-        )
+        longest = max((g.length_hours for g in al.measurement_gaps), default=0.0)
         words += (
             f"The measurements have {n_gap_meas} "
             f"{'gap' if n_gap_meas == 1 else 'gaps'} (hatched; the longest "
@@ -215,7 +200,7 @@ def data_context(rd: RunData) -> dict:
         words += "The measurements have no gaps. "
     dropped = [
         f"{fmt_int(n)} {role.removesuffix('s')} rows"
-        for role, n in (al.get("rows_dropped") or {}).items()
+        for role, n in al.rows_dropped.items()
         if int(n or 0)
     ]
     if dropped:
@@ -229,10 +214,8 @@ def data_context(rd: RunData) -> dict:
         "sources": sources,
         "hold": _hold_words(rd),
         "words": words.strip(),
-        "irradiance": rd.summary.get("irradiance_source", "?"),
-        "ground": ((rd.summary.get("sources") or {}).get("ground_temperature") or {}).get(
-            "method", ""
-        ),
+        "irradiance": rd.summary.irradiance_source or "?",
+        "ground": rd.summary.ground_temperature,
     }
 
 

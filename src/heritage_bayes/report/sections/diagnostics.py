@@ -21,15 +21,16 @@ from heritage_bayes.errors import InputError
 from heritage_bayes.format import OUT_UNITS, fmt_int, fmt_pct
 from heritage_bayes.names import noise_traits
 from heritage_bayes.report.page import Section
-from heritage_bayes.report.rundata import RunData, parameter_set, section_params
+from heritage_bayes.report.rundata import RunData, parameter_set
 from heritage_bayes.report.sections._fragment import render_fragment
+from heritage_bayes.rundir.summary import ModelInfo, RunSummary
 
 ID, TITLE = "diagnostics", "7. Sampler diagnostics"
 
 _TRACE_POINTS = 400  # thinned steps per walker in trace plots
 
 
-def _traces(rd: RunData, m: str, info: dict):
+def _traces(rd: RunData, m: str, info: ModelInfo):
     import h5py
 
     from heritage_bayes.report.figures import fig_traces
@@ -52,8 +53,7 @@ def _traces(rd: RunData, m: str, info: dict):
         raise InputError(f"{path}: cannot be read ({exc})") from None
     steps = kept * np.arange(0, n, stride)[: X.shape[0]]
     stride *= kept
-    names = list(((rd.summary.get("correlations") or {}).get(m) or {}).get("names") or [])
-    params = section_params(rd.summary, m)
+    names = list(info.free_names)
     ps = parameter_set(rd, m)
     S, W, d = X.shape
     if ps is not None and d == ps.ndim:
@@ -78,20 +78,18 @@ def _traces(rd: RunData, m: str, info: dict):
             else [f"x{j}" for j in range(d)]
         )
         coords = "the sampler's unconstrained coordinates"
-    del params
-    ch = info.get("chain") or {}
     fig = fig_traces(
         steps,
         V,
         labels,
         lp,
-        int(ch.get("burn", 0)),
-        title=f"{m} ({info.get('model', '')}): {W} walkers, every {stride}th step shown",
+        int(info.burn or 0),
+        title=f"{m} ({info.model}): {W} walkers, every {stride}th step shown",
     )
     return {"figure": fig, "coords": coords}
 
 
-def _ranks(rd: RunData, m: str, info: dict) -> dict | None:
+def _ranks(rd: RunData, m: str, info: ModelInfo) -> dict | None:
     """Rank plot of the slowest τ, the gains and the scale of section ``m`` (or None)."""
     from heritage_bayes.report.figures import fig_rank
     from heritage_bayes.report.identifiable import (
@@ -117,8 +115,7 @@ def _ranks(rd: RunData, m: str, info: dict) -> dict | None:
         panels.append({"label": c.label, "counts": counts, "band": band, "expected": expected})
     fig = fig_rank(
         panels,
-        title=f"{m} ({info.get('model', '')}): rank plots, {len(groups)} groups of "
-        f"{len(groups[0])} walkers",
+        title=f"{m} ({info.model}): rank plots, {len(groups)} groups of {len(groups[0])} walkers",
     )
     return {
         "figure": fig,
@@ -161,16 +158,21 @@ def _residual_check(
     }
 
 
+def _median(s: RunSummary, key: str, absent=None):
+    """The posterior median of the parameter ``key`` (``absent`` if the run has none)."""
+    e = s.parameters.get(key)
+    return absent if e is None else e.median
+
+
 def diagnostics_context(rd: RunData, fits: list[dict]) -> dict:
     from heritage_bayes.report.figures import fig_residuals, fig_tau_history
 
     s = rd.summary
-    dt_hours = float(s.get("dt", 3600.0)) / 3600.0
-    crit = s.get("criteria") or {}
+    dt_hours = s.dt / 3600.0
+    conv = s.convergence
     models = []
     missing = []
-    for m, info in (s.get("models") or {}).items():
-        ch = info.get("chain") or {}
+    for m, info in s.models.items():
         tr = _traces(rd, m, info)
         rk = _ranks(rd, m, info)
         if tr is None:
@@ -178,32 +180,25 @@ def diagnostics_context(rd: RunData, fits: list[dict]) -> dict:
         models.append(
             {
                 "section": m,
-                "model": info.get("model", m),
-                "walkers": fmt_int(ch.get("walkers")),
-                "steps": fmt_int(ch.get("steps")),
-                "burn": fmt_int(ch.get("burn")),
-                "thin": fmt_int(ch.get("thin")),
-                "draws": fmt_int(ch.get("draws_per_walker")),
-                "tau_max": fmt_int(ch.get("tau_max")),
-                "needed": fmt_int(float(crit.get("tau_factor", 50)) * ch["tau_max"])
-                if ch.get("tau_max") is not None
+                "model": info.model,
+                "walkers": fmt_int(info.walkers),
+                "steps": fmt_int(info.steps),
+                "burn": fmt_int(info.burn),
+                "thin": fmt_int(info.thin),
+                "draws": fmt_int(info.draws_per_walker),
+                "tau_max": fmt_int(info.tau_max),
+                "needed": fmt_int(conv.tau_factor * info.tau_max)
+                if info.tau_max is not None
                 else "—",
-                "converged_tau": bool(ch.get("converged_tau")),
-                "acceptance": fmt_pct(ch.get("acceptance_mean")),
-                "resumed_from": fmt_int(ch.get("resumed_from")),
+                "converged_tau": info.converged_tau,
+                "acceptance": fmt_pct(info.acceptance_mean),
+                "resumed_from": fmt_int(info.resumed_from),
                 "trace": tr,
                 "rank": rk,
             }
         )
-    hist = {
-        m: (i.get("chain") or {}).get("tau_history") or []
-        for m, i in (s.get("models") or {}).items()
-    }
-    tau_fig = (
-        fig_tau_history(hist, float(crit.get("tau_factor", 50.0)))
-        if any(len(h) for h in hist.values())
-        else None
-    )
+    hist = {m: info.tau_history for m, info in s.models.items()}
+    tau_fig = fig_tau_history(hist, conv.tau_factor) if any(len(h) for h in hist.values()) else None
     residuals = []
     for fit in fits:
         if fit["section"] == "combined":
@@ -211,20 +206,16 @@ def diagnostics_context(rd: RunData, fits: list[dict]) -> dict:
         if fit.get("resid") is None:
             continue  # a one-step-ahead band: its residuals are the filter's innovations
         m, o = fit["section"], fit["output"]
-        info = (s.get("models") or {}).get(m) or {}
+        noise = s.models[m].noise if m in s.models else ""
         cal = fit["codes"] == 1
         if cal.sum() < 4:
             continue
         phi, white = None, None
-        pars = s.get("parameters") or {}
-        traits = noise_traits(info.get("noise"))
+        traits = noise_traits(noise)
         if traits.ar1:
-            phi = (pars.get(f"{m}.phi_{o}") or {}).get("median")
+            phi = _median(s, f"{m}.phi_{o}")
         if traits.white:
-            white = tuple(
-                (pars.get(f"{m}.{k}_{o}") or {}).get("median", 0.0)
-                for k in ("sigma", "phi", "sigma_meas")
-            )
+            white = tuple(_median(s, f"{m}.{k}_{o}", 0.0) for k in ("sigma", "phi", "sigma_meas"))
         resid = fit["resid"][cal]
         check = _residual_check(resid, phi, dt_hours, white)
         fig = fig_residuals(
@@ -300,8 +291,8 @@ def diagnostics_context(rd: RunData, fits: list[dict]) -> dict:
         "tau_fig": tau_fig,
         "residuals": residuals,
         "missing": missing,
-        "tau_factor": f"{float(crit.get('tau_factor', 50)):g}",
-        "tau_rtol": fmt_pct(crit.get("tau_rtol"), 0),
+        "tau_factor": f"{conv.tau_factor:g}",
+        "tau_rtol": fmt_pct(conv.tau_rtol, 0),
     }
 
 

@@ -29,8 +29,8 @@ def fit_outputs(rd: RunData) -> list[dict]:
     pp = rd.idata.posterior_predictive
     obs = rd.idata.observed_data
     out = []
-    for m, info in (rd.summary.get("models") or {}).items():
-        for o in info.get("output_names", []):
+    for m, info in rd.summary.models.items():
+        for o in info.output_names:
             if f"{m}.{o}" in pp and f"{m}.{o}_sim" in pp and o in obs:
                 out.append(
                     {
@@ -38,7 +38,7 @@ def fit_outputs(rd: RunData) -> list[dict]:
                         "output": o,
                         "pp": f"{m}.{o}",
                         "sim": f"{m}.{o}_sim",
-                        "model": info.get("model", m),
+                        "model": info.model,
                     }
                 )
     if "RHi" in pp and "RHi_sim" in pp and "RHi" in obs:
@@ -87,11 +87,11 @@ def fit_context(rd: RunData, outputs: list[dict]) -> list[dict]:
             gaps=gaps,
         )
         what = OUT_WORDS.get(o["output"], o["output"])
-        models = rd.summary.get("models") or {}
-        pred = ((models.get(o["section"]) or {}).get("predictive_noise") or {}).get(o["output"])
+        info = rd.summary.models.get(o["section"])
+        pred = None if info is None else info.predictive_noise.get(o["output"])
         band_note = ""
         if pred:
-            kalman = noise_traits((models.get(o["section"]) or {}).get("noise")).state_space
+            kalman = noise_traits(info.noise).state_space
             band_note = (
                 (
                     " The process noise is estimated for one-step prediction (the "
@@ -102,22 +102,22 @@ def fit_context(rd: RunData, outputs: list[dict]) -> list[dict]:
                     "so its error model leaves out the slow misfit; the bands use the "
                     "free-run error instead: "
                 )
-                + f"AR(1) of sd {pred['sigma']:.3g} with hourly coefficient "
-                f"{pred['phi']:.3f} plus white noise of sd {pred['sigma_meas']:.3g}, fitted "
+                + f"AR(1) of sd {pred.sigma:.3g} with hourly coefficient "
+                f"{pred.phi:.3f} plus white noise of sd {pred.sigma_meas:.3g}, fitted "
                 "to the calibration residuals of the posterior-median simulation."
             )
-        sat = (models.get(o["section"]) or {}).get("saturation")
+        sat = None if info is None else info.saturation
         if sat and o["output"] == "Pi":
             band_note += (
                 " Predicted vapour pressure is limited to saturation at the predicted "
-                f"indoor temperature ({sat['temperature']}): the excess would condense. "
-                f"The limit acted on {100 * sat['share_predictive_samples']:.1f} % of the "
+                f"indoor temperature ({sat.temperature}): the excess would condense. "
+                f"The limit acted on {100 * sat.share_predictive_samples:.1f} % of the "
                 "predictive samples and on the noise-free median in "
-                f"{100 * sat['share_hours_median_saturated']:.1f} % of the hours"
+                f"{100 * sat.share_hours_median_saturated:.1f} % of the hours"
                 + (
                     ": the model predicts condensation conditions that often; check them "
                     "against the measured RH before trusting its dampest hours."
-                    if sat["share_hours_median_saturated"] > 0.01
+                    if sat.share_hours_median_saturated > 0.01
                     else "."
                 )
             )
@@ -164,10 +164,10 @@ def _one_step_item(rd: RunData, o: dict, pp, times, y, codes, gaps, what: str) -
         model_name=o["model"],
         gaps=gaps,
     )
-    met = ((rd.summary.get("metrics") or {}).get(o["section"]) or {}).get(o["output"]) or {}
     cov = []
     for period in ("calibration", "validation"):
-        c = (met.get(period) or {}).get("coverage90_1step")
+        met = rd.summary.metric(o["section"], o["output"], period)
+        c = None if met is None else met.coverage90_1step
         if c is not None:
             cov.append(f"{period} {100 * c:.0f} %")
     return {

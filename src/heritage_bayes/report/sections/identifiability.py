@@ -42,6 +42,7 @@ from heritage_bayes.report.identifiable import (
 from heritage_bayes.report.page import Section
 from heritage_bayes.report.rundata import RunData, section_params
 from heritage_bayes.report.sections._fragment import render_fragment
+from heritage_bayes.rundir.summary import Identifiability, RunSummary
 
 ID, TITLE = "identifiability", "6. Identifiability"
 
@@ -53,28 +54,28 @@ def identifiability_context(rd: RunData) -> list[dict]:
 
     s = rd.summary
     out = []
-    for m, info in (s.get("models") or {}).items():
-        idf = info.get("identifiability") or {}
+    for m, info in s.models.items():
+        idf = info.identifiability
         params = section_params(s, m)
         nulls = [
             {
-                "label": d.get("label", ""),
-                "description": tick_names(d.get("description", ""), params),
-                "pinned_by": ", ".join(f"`{n}`" for n in d.get("pinned_by") or []),
-                "is_scale": bool(d.get("is_scale")),
+                "label": d.label,
+                "description": tick_names(d.description, params),
+                "pinned_by": ", ".join(f"`{n}`" for n in d.pinned_by),
+                "is_scale": d.is_scale,
             }
-            for d in idf.get("null_directions") or []
+            for d in idf.null_directions
         ]
         summ_lines = [
             tick_names(ln.strip()[:1].upper() + ln.strip()[1:], params)
-            for ln in str(idf.get("summary", "")).splitlines()[1:]
+            for ln in idf.summary.splitlines()[1:]
             if ln.strip() and not ln.strip().startswith("- ")
         ]
-        n_params, rank = idf.get("n_params"), idf.get("rank")
-        if idf:
-            if idf.get("n_null", 0):
+        n_params, rank = idf.n_params, idf.rank
+        if idf.recorded:
+            if idf.n_null:
                 verdict = (
-                    f"{idf.get('n_null')} combination(s) of the {n_params} model "
+                    f"{idf.n_null} combination(s) of the {n_params} model "
                     f"parameters cannot be determined from these inputs and outputs "
                     f"(rank {rank} of {n_params}), whatever the data quality."
                 )
@@ -85,33 +86,32 @@ def identifiability_context(rd: RunData) -> list[dict]:
                 )
         else:
             verdict = "The structural check was not recorded for this run."
-        corr = (s.get("correlations") or {}).get(m) or {}
-        names = list(corr.get("names") or [])
+        names = list(info.free_names)
         fig_raw = None
         if len(names) > 1:
-            logs = [is_log_prior((params.get(n) or {}).get("prior")) for n in names]
+            logs = [is_log_prior(params[n].prior if n in params else None) for n in names]
             fig_raw = fig_correlation(
                 [f"log {n}" if lg else n for n, lg in zip(names, logs, strict=True)],
-                np.asarray(corr.get("matrix"), dtype=float),
+                np.asarray(info.correlation, dtype=float),
                 title=f"{m}: raw parameters (log where the prior is)",
                 max_size=5.5,
             )
         coords = identifiable_coordinates(rd, m)
-        figs = _coordinate_figures(coords, f"{m} ({info.get('model', '')})")
+        figs = _coordinate_figures(coords, f"{m} ({info.model})")
         out.append(
             {
                 "section": m,
-                "model": info.get("model", m),
+                "model": info.model,
                 "verdict": verdict,
                 "nulls": nulls,
-                "control": sorted((idf.get("control") or {}).items()),
+                "control": sorted(idf.control.items()),
                 "lines": summ_lines,
-                "cond": fmt(idf.get("condition_number_identifiable")),
+                "cond": fmt(idf.condition_number_identifiable),
                 "corr_raw_fig": fig_raw,
                 **figs,
                 "scale": _scale_words(rd, m, idf, coords),
                 "tradeoffs": tradeoff_words(coords),
-                "derived": _derived_rows(s, m, info, mcse_table(rd, _derived_keys(s, m))),
+                "derived": _derived_rows(s, m, mcse_table(rd, _derived_keys(s, m))),
             }
         )
     return out
@@ -200,14 +200,14 @@ def tradeoff_words(coords: list) -> list[str]:
     return out
 
 
-def _scale_words(rd: RunData, m: str, idf: dict, coords: list) -> str:
+def _scale_words(rd: RunData, m: str, idf: Identifiability, coords: list) -> str:
     """Why the scale coordinate is there, for the figure captions ('' without one)."""
     from heritage_bayes.report.identifiable import scale_capacities
 
     if not coords or coords[-1].name != "scale":
         return ""
     caps = " + ".join(scale_capacities(rd.summary, m))
-    if idf.get("has_scale_direction") is False:
+    if idf.has_scale_direction is False:
         return (
             f"Scale: log10 ΣC = log10({caps}), the total capacity; this model's inputs "
             "fix it (no scale direction in the structural check)."
@@ -221,46 +221,41 @@ def _scale_words(rd: RunData, m: str, idf: dict, coords: list) -> str:
     )
 
 
-def _derived_keys(s: dict, m: str) -> list[str]:
-    return [k for k in (s.get("derived") or {}) if k.startswith(f"{m}.")]
+def _derived_keys(s: RunSummary, m: str) -> list[str]:
+    return [e.key for e in s.derived.values() if e.section == m]
 
 
-def _derived_rows(s: dict, m: str, info: dict, mc: dict | None = None) -> dict:
+def _derived_rows(s: RunSummary, m: str, mc: dict | None = None) -> dict:
     taus, gains = [], []
-    for key, v in (s.get("derived") or {}).items():
-        if not key.startswith(f"{m}."):
+    for e in s.derived.values():
+        if e.section != m:
             continue
-        name = key.split(".", 1)[1]
-        r = v.get("r_hat")
-        truth = v.get("truth")
-        inside = None
-        if truth is not None and v.get("q05") is not None and v.get("q95") is not None:
-            inside = v["q05"] <= truth <= v["q95"]
+        name, truth = e.name, e.truth
         base = {
             "name": name,
-            "r_hat": "—" if r is None else f"{r:.3f}",
-            "ess": fmt_int(v.get("ess_bulk")),
+            "r_hat": "—" if e.r_hat is None else f"{e.r_hat:.3f}",
+            "ess": fmt_int(e.ess_bulk),
             "truth": fmt(truth) if truth is not None else "—",
             "truth_d": fmt(_div(truth, 24)) if truth is not None else "—",
-            "inside": inside,
-            **mcse_cells((mc or {}).get(key)),
+            "inside": e.truth_inside,
+            **mcse_cells((mc or {}).get(e.key)),
         }
         if name.startswith("tau_") and name.endswith("_h"):
             base.update(
                 label=quantity_name(name).removeprefix("time constant "),
-                median_h=fmt(v.get("median")),
-                int_h=fmt_interval(v.get("q05"), v.get("q95")),
-                median_d=fmt(_div(v.get("median"), 24)),
-                int_d=fmt_interval(_div(v.get("q05"), 24), _div(v.get("q95"), 24)),
+                median_h=fmt(e.median),
+                int_h=fmt_interval(e.q05, e.q95),
+                median_d=fmt(_div(e.median, 24)),
+                int_d=fmt_interval(_div(e.q05, 24), _div(e.q95, 24)),
             )
             taus.append(base)
             continue
         base.update(
             label=quantity_name(name, domain=m),
             name=name,
-            unit=v.get("unit", ""),
-            median=fmt(v.get("median")),
-            interval=fmt_interval(v.get("q05"), v.get("q95")),
+            unit=e.unit,
+            median=fmt(e.median),
+            interval=fmt_interval(e.q05, e.q95),
         )
         gains.append(base)
     return {
@@ -294,10 +289,12 @@ def _ladder_cell(metrics: dict[str, dict], key: str) -> str:
     return "; ".join(f"{o}: {txt(v.get(key))}" for o, v in metrics.items())
 
 
-def ladder_context(s: dict) -> dict | None:
+def ladder_context(s: RunSummary) -> dict | None:
+    """The model-order ladder's tables and figure (None without a ladder); the ladder
+    and the screen's choice are read as ``summary.json`` holds them (not typed)."""
     from heritage_bayes.report.figures import fig_ladder
 
-    ladder = s.get("ladder")
+    ladder = s.raw.get("ladder")
     if not ladder:
         return None
     tables = []
@@ -337,9 +334,9 @@ def ladder_context(s: dict) -> dict | None:
     return {"tables": tables, "figure": fig_ladder(ladder)}
 
 
-def _selection_text(s: dict, domain: str) -> str | None:
+def _selection_text(s: RunSummary, domain: str) -> str | None:
     """``model: auto``: the model the screen chose, why, and the rule (None otherwise)."""
-    sel = (s.get("selection") or {}).get(domain)
+    sel = (s.raw.get("selection") or {}).get(domain)
     if not sel:
         return None
     text = (

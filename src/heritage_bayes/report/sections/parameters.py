@@ -19,29 +19,28 @@ from heritage_bayes.report.page import Section
 from heritage_bayes.report.rundata import RunData, parameter_set, section_params
 from heritage_bayes.report.sections._fragment import render_fragment
 from heritage_bayes.report.verdict import ess_class, rhat_class
+from heritage_bayes.rundir.summary import ModelInfo
 
 ID, TITLE = "parameters", "5. Parameters"
 
 
 def parameter_tables(rd: RunData) -> list[dict]:
     """One table per model, every figure from the typed run summary."""
-    s = rd.summary
-    rs = rd.run.run_summary
+    rs = rd.summary
     r_ok, e_ok = rs.convergence.target_rhat, rs.convergence.target_ess
     tables = []
-    for m, info in (s.get("models") or {}).items():
-        ident = (info.get("identifiability") or {}).get("parameters") or {}
+    for m, info in rs.models.items():
+        idf = info.identifiability
         params = [e for e in rs.parameters.values() if e.section == m]
         has_truth = any(e.truth is not None for e in params)
         mc = mcse_table(rd, [e.key for e in params if e.fixed is None])
         rows = []
         for e in params:
-            idf = ident.get(e.name)
-            if idf is None:
+            if e.name not in idf.parameters:
                 id_text = "noise" if e.kind in ("sigma", "phi", "sigma_meas") else "—"
-            elif idf.get("identifiable"):
+            elif e.name in idf.identifiable:
                 id_text = "yes"
-            elif idf.get("identifiable_given_scale"):
+            elif e.name in idf.identifiable_given_scale:
                 id_text = "if scale pinned"
             else:
                 id_text = "no"
@@ -69,30 +68,29 @@ def parameter_tables(rd: RunData) -> list[dict]:
                     **mcse_cells(mc.get(e.key)),
                 }
             )
-        mp = info.get("map") or {}
         tables.append(
             {
                 "section": m,
-                "model": info.get("model", m),
-                "noise": info.get("noise", "?"),
+                "model": info.model,
+                "noise": info.noise or "?",
                 "rows": rows,
                 "has_truth": has_truth,
-                "map_lp": fmt(mp.get("log_posterior")),
-                "map_agreed": f"{mp.get('agreed', '?')} of {mp.get('starts', '?')}",
-                "map_method": mp.get("method", "?"),
+                "map_lp": fmt(info.map_log_posterior),
+                "map_agreed": f"{info.map_agreed} of {info.map_starts}",
+                "map_method": info.map_method,
                 "prior_fig": _prior_figure(rd, m, info),
                 "cap_h": None
-                if info.get("time_constant_cap_h") is None
-                else fmt(info["time_constant_cap_h"]),
+                if info.time_constant_cap_h is None
+                else fmt(info.time_constant_cap_h),
                 "temperature": None
-                if (info.get("likelihood_temperature") or 1.0) == 1.0
-                else fmt(info["likelihood_temperature"]),
+                if info.likelihood_temperature == 1.0
+                else fmt(info.likelihood_temperature),
             }
         )
     return tables
 
 
-def _prior_figure(rd: RunData, m: str, info: dict):
+def _prior_figure(rd: RunData, m: str, info: ModelInfo):
     """Prior vs posterior of every free parameter of section ``m`` (None without the
     run's ParameterSet, e.g. a config that no longer matches the summary)."""
     from heritage_bayes.report.figures import fig_prior_posterior
@@ -110,7 +108,7 @@ def _prior_figure(rd: RunData, m: str, info: dict):
         p = ps[name]
         log = p.prior.log_scale
         x = np.asarray(post[key].values, dtype=float).reshape(-1)
-        truth = (params.get(name) or {}).get("truth")
+        truth = params[name].truth if name in params else None
         if log:
             with np.errstate(divide="ignore", invalid="ignore"):
                 x = np.log10(x)
@@ -130,8 +128,7 @@ def _prior_figure(rd: RunData, m: str, info: dict):
         return None
     return fig_prior_posterior(
         panels,
-        title=f"{m} ({info.get('model', '')}): prior (line) and posterior (histogram) "
-        "of the free parameters",
+        title=f"{m} ({info.model}): prior (line) and posterior (histogram) of the free parameters",
     )
 
 

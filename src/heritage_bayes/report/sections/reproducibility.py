@@ -8,6 +8,7 @@ from heritage_bayes.report.page import Section
 from heritage_bayes.report.rundata import RunData
 from heritage_bayes.report.sections._fragment import render_fragment
 from heritage_bayes.report.snippet import from_python
+from heritage_bayes.rundir.summary import RunSummary
 
 ID, TITLE = "reproducibility", "8. Reproducibility"
 
@@ -27,12 +28,13 @@ _VERSIONS = (
 )
 
 
-def library_versions(s: dict) -> tuple[list[dict], str]:
+def library_versions(s: RunSummary) -> tuple[list[dict], str]:
+    """The library versions the run recorded (``"run"``), else those of this Python
+    (``"report"``)."""
     from importlib.metadata import PackageNotFoundError, version
 
-    recorded = s.get("versions")
-    if isinstance(recorded, dict) and recorded:
-        return [{"name": k, "version": str(v)} for k, v in recorded.items()], "run"
+    if s.versions:
+        return [{"name": k, "version": str(v)} for k, v in s.versions.items()], "run"
     rows = [{"name": "heritage_bayes", "version": __version__}]
     import platform
 
@@ -45,12 +47,13 @@ def library_versions(s: dict) -> tuple[list[dict], str]:
     return rows, "report"
 
 
-def timings(s: dict) -> list[dict]:
+def timings(s: RunSummary) -> list[dict]:
+    """The run's timings [s], the calibration's total last."""
     rows = []
-    for k, v in (s.get("timings") or {}).items():
+    for k, v in s.timings.items():
         rows.append({"name": k.removesuffix("_seconds").replace("_", " "), "seconds": fmt(v)})
-    if s.get("wall_seconds") is not None:
-        rows.append({"name": "calibration, total", "seconds": fmt(s["wall_seconds"])})
+    if s.wall_seconds is not None:
+        rows.append({"name": "calibration, total", "seconds": fmt(s.wall_seconds)})
     return rows
 
 
@@ -63,9 +66,9 @@ def reproducibility_context(rd: RunData) -> dict:
         "from_python": from_python(rd.path, rd.run.sections, rd.idata.posterior.data_vars),
         "versions": versions,
         "versions_from": when,
-        "seed": rd.summary.get("seed"),
-        "config_hash": rd.summary.get("config_hash", "?"),
-        "created_at": fmt_time(rd.summary.get("created_at")),
+        "seed": rd.summary.seed,
+        "config_hash": rd.summary.config_hash or "?",
+        "created_at": fmt_time(rd.summary.created_at or None),
         "timings": timings(rd.summary),
         "files": sorted(
             p.name for p in rd.path.iterdir() if p.is_file() and not p.name.startswith(".")

@@ -16,45 +16,43 @@ ID, TITLE = "summary", "1. Summary"
 
 def header_context(rd: RunData) -> dict:
     s = rd.summary
-    models = []
-    for m, info in (s.get("models") or {}).items():
-        n_free = len((s.get("correlations") or {}).get(m, {}).get("names", []))
-        models.append(
-            {
-                "section": m,
-                "model": info.get("model", "?"),
-                "noise": info.get("noise", "?"),
-                "n_free": n_free,
-                "outputs": ", ".join(info.get("output_names", [])),
-            }
-        )
+    models = [
+        {
+            "section": m,
+            "model": info.model,
+            "noise": info.noise or "?",
+            "n_free": len(info.free_names),
+            "outputs": ", ".join(info.output_names),
+        }
+        for m, info in s.models.items()
+    ]
     periods = []
-    for name, p in (s.get("periods") or {}).items():
-        hours = p.get("steps", 0) * float(s.get("dt", 3600.0)) / 3600.0
+    for p in s.periods:
+        hours = p.steps * s.dt / 3600.0
         periods.append(
             {
-                "name": name,
-                "start": fmt_time(p.get("start")),
-                "end": fmt_time(p.get("end")),
+                "name": p.name,
+                "start": fmt_time(p.start),
+                "end": fmt_time(p.end),
                 "length": f"{hours / 24:.1f} d" if hours >= 48 else f"{hours:g} h",
             }
         )
-    warmup_h = s.get("warmup_steps", 0) * float(s.get("dt", 3600.0)) / 3600.0
+    warmup_h = s.warmup_steps * s.dt / 3600.0
     return {
-        "name": s.get("name") or rd.path.name,
-        "building": s.get("building") or rd.cfg.building,
-        "room": s.get("room") or rd.cfg.room,
-        "notes": (s.get("notes") or rd.cfg.notes or "").strip(),
+        "name": s.name or rd.path.name,
+        "building": s.building or rd.cfg.building,
+        "room": s.room or rd.cfg.room,
+        "notes": (s.notes or rd.cfg.notes or "").strip(),
         "models": models,
         "periods": periods,
         "warmup": ""
         if warmup_h <= 0
         else (f"{warmup_h / 24:g} d" if warmup_h >= 24 else f"{warmup_h:g} h"),
-        "created_at": fmt_time(s.get("created_at")),
-        "version": s.get("heritage_bayes_version", "?"),
-        "seed": s.get("seed"),
-        "config_hash": s.get("config_hash", "?"),
-        "irradiance": s.get("irradiance_source", "?"),
+        "created_at": fmt_time(s.created_at or None),
+        "version": s.heritage_bayes_version or "?",
+        "seed": s.seed,
+        "config_hash": s.config_hash or "?",
+        "irradiance": s.irradiance_source or "?",
     }
 
 

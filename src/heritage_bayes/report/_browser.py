@@ -8,8 +8,8 @@ Debian's ``chromium`` package (or the executable named by ``HB_CHROMIUM``).
 :func:`open_page` loads the file, waits for the load event, and returns the console
 messages, uncaught exceptions, browser log entries (CSP violations, failed loads), every
 network request the page made, the result of a few DOM queries and a PNG screenshot.
-:func:`phone_layout` checks a page for horizontal overflow (the browser tests);
-:func:`screenshot_figure` embeds a page's first screen in the manual (the docs build).
+:func:`screenshot_figure` embeds a page's first screen in the manual (the docs build);
+the browser tests (``tests/_browser_checks.py``) check pages with :func:`open_page`.
 """
 
 from __future__ import annotations
@@ -32,7 +32,6 @@ __all__ = [
     "PageResult",
     "find_chromium",
     "open_page",
-    "phone_layout",
     "screenshot_figure",
 ]
 
@@ -325,28 +324,6 @@ def open_page(
             proc.wait(timeout=10)
         shutil.rmtree(profile, ignore_errors=True)
     return res
-
-
-def phone_layout(path: str | Path, *, width: int = 390, height: int = 844, extra: str = ""):
-    """Open ``path`` at ``width`` px and check that the page has no horizontal scroll:
-    the document no wider than the screen, no element outside the sideways-scrolling
-    tables and code sticking out (:data:`PHONE_OVERFLOW_JS`), no console error. Skips
-    the calling test when Chromium is not installed. Returns the layout dict, with the
-    value of the JavaScript expression ``extra`` under ``"extra"``."""
-    import pytest
-
-    chromium = find_chromium()
-    if chromium is None:
-        pytest.skip("chromium not installed: the page was not opened in a real browser")
-    js = PHONE_OVERFLOW_JS
-    if extra:
-        js = f"Object.assign({PHONE_OVERFLOW_JS}, {{extra: {extra}}})"
-    res = open_page(path, chromium=chromium, width=width, height=height, extra_js=js)
-    assert res.errors == [], res.errors
-    lay = res.dom["extra"]
-    assert lay["docw"] <= lay["W"] <= width, (Path(path).name, lay)
-    assert lay["wide"] == [], (Path(path).name, lay["wide"])
-    return lay
 
 
 def screenshot_figure(

@@ -114,13 +114,16 @@ def replicate(args) -> dict:
 
     ``args``: (room type, replicate, seed, max_steps, calibration days, parts of the
     generator left out[, {quantity: factor}: truths multiplied by a factor before they
-    are ranked, a deliberately wrong truth for the test that the ranking can fail])."""
+    are ranked, a deliberately wrong truth for the test that the ranking can fail[,
+    the fit's variant, ``NOISE:INIT[:T=X]`` of ``bench_sbc.fit_and_rank``, default
+    :data:`VARIANT`]])."""
     import heritage_bayes as hb
     from bench_sbc import ACH, VOLUME, fit_and_rank
 
     room_type, rep, seed, max_steps, cal_days, without = args[:6]
     # a deliberately wrong truth (quantity -> factor), to show that the ranking can miss
     shift = args[6] if len(args) > 6 else {}
+    variant = args[7] if len(args) > 7 else VARIANT
     assert (VOLUME, ACH) == (rooms.VOLUME, rooms.ACH), "the survey differs from the rooms'"
     room = rooms.generate(room_type, [seed, rooms.ROOMS.index(room_type), rep], cal_days,
                           without=without)  # fmt: skip
@@ -147,6 +150,8 @@ def replicate(args) -> dict:
         "seed": seed,
         "without": sorted(without),
         "truth_shift": shift,
+        "variant": variant,
+        "capacity_means": room["capacity_means"],
         "truth": truth,
         "truth_parameters": room["truth"],
         "generator": room["generator"],
@@ -159,7 +164,7 @@ def replicate(args) -> dict:
         U[rows],
         y[rows],
         truth,
-        [VARIANT],
+        [variant],
         rep,
         max_steps,
         {},
@@ -223,6 +228,12 @@ def misfit_lines(room_types, reps, seed: int, cal_days: int) -> list[str]:
 
 
 # --------------------------------------------------------------------------- tables
+def fit_of(r: dict) -> dict:
+    """The fit of a replicate (its variant's entry; logs before ``--variant``:
+    :data:`VARIANT`)."""
+    return r["variants"][r.get("variant", VARIANT)]
+
+
 def read_logs(paths) -> list[dict]:
     """Replicates of one or more logs; a (room, replicate, without) found twice must
     agree (a replicate is a function of its seed)."""
@@ -233,7 +244,7 @@ def read_logs(paths) -> list[dict]:
                 if not line.strip():
                     continue
                 r = json.loads(line)
-                key = (r["room"], r["rep"], r["seed"], tuple(r["without"]))
+                key = (r["room"], r["rep"], r["seed"], tuple(r["without"]), r.get("variant"))
                 if key in merged and merged[key]["truth"] != r["truth"]:
                     raise SystemExit(f"{path}: replicate {key} differs from an earlier log's")
                 merged[key] = r
@@ -255,9 +266,9 @@ def summary(results: list[dict], room: str, quantity: str) -> dict | None:
     of log(quantity) over the sd of log(truth) across the rooms (≪ 1: the data, not
     the spread of the truths, set the interval)."""
     v = [
-        (r["variants"][VARIANT]["ranks"][quantity], r["truth"][quantity])
+        (fit_of(r)["ranks"][quantity], r["truth"][quantity])
         for r in results
-        if r["room"] == room and quantity in r["variants"][VARIANT]["ranks"]
+        if r["room"] == room and quantity in fit_of(r)["ranks"]
     ]
     if not v:
         return None
@@ -303,8 +314,8 @@ def table_lines(results: list[dict], markdown: bool = False) -> list[str]:
         rs = [r for r in results if r["room"] == room]
         if not rs:
             continue
-        conv = sum(r["variants"][VARIANT]["converged"] for r in rs)
-        cpu = np.mean([r["variants"][VARIANT]["cpu"] for r in rs])
+        conv = sum(fit_of(r)["converged"] for r in rs)
+        cpu = np.mean([fit_of(r)["cpu"] for r in rs])
         label = f"{room} → {MODELS[room][0]} ({len(rs)}, {conv})"
         if not markdown:
             mis = np.median([r["misfit_Pa"]["sd"] for r in rs])
@@ -347,8 +358,8 @@ def paired_lines(a: list[dict], b: list[dict]) -> list[str]:
         for q in IDENTIFIABLE[room] + OTHERS[room]:
             za, zb, ia, ib = [], [], 0, 0
             for r in reps:
-                xa = ra[r]["variants"][VARIANT]["ranks"].get(q)
-                xb = rb[r]["variants"][VARIANT]["ranks"].get(q)
+                xa = fit_of(ra[r])["ranks"].get(q)
+                xb = fit_of(rb[r])["ranks"].get(q)
                 if xa is None or xb is None:
                     continue
                 za.append((xa["median"] - ra[r]["truth"][q]) / xa["sd"])
@@ -372,6 +383,8 @@ def main(argv=None) -> int:
     ap.add_argument("--seed", type=int, default=SEED)
     ap.add_argument("--max-steps", type=int, default=4000)
     ap.add_argument("--cal-days", type=int, default=CAL_DAYS)
+    ap.add_argument("--variant", default=VARIANT, help="the fit: NOISE:INIT[:T=X] "
+                    "(bench_sbc.fit_and_rank; T=X a likelihood tempered by X)")  # fmt: skip
     ap.add_argument("--log", help="append each replicate's result as a JSON line")
     ap.add_argument("--without", default="", help="parts of the generator left out: "
                     "isotherm, source, noise, outage (coupled_rooms.generate)")  # fmt: skip
@@ -407,7 +420,7 @@ def main(argv=None) -> int:
     from bench_sbc import run_tasks
 
     tasks = [
-        (room, rep, args.seed, args.max_steps, args.cal_days, without)
+        (room, rep, args.seed, args.max_steps, args.cal_days, without, {}, args.variant)
         for rep in range(args.first_rep, args.first_rep + args.reps)
         for room in room_types
     ]

@@ -281,14 +281,15 @@ def generate(
 
     Returns a dict: ``truth`` (the fit's parameters by name, the buffer's capacity
     the harmonic mean of ``M u'(φ_w)`` over the calibration period; module docstring),
-    ``capacity_means`` (its ``harmonic`` and ``arithmetic`` means [kg per unit RH]), ``generator`` (the drawn physical
-    parameters), ``hourly`` (dict of arrays over every full hour from the start:
-    ``Te``, ``RHe`` [%] (station, rounded), ``Ti``, ``RHi`` [%] (logger, NaN where
-    lost), ``Tf`` (cellar), and the noise-free ``Pi_true``, ``Ti_true``), ``rows``
-    (slice of the calibration hours), ``start_doy``, ``Tf_mean`` (cellar: the ground's
-    mean over the calibration hours [°C]) and ``wall_psat`` (cellar: p_sat at the wall
-    [Pa]), ``start`` (the buffer's RH and the air's vapour pressure at the record's
-    start) and the buffer's RH range over the calibration hours.
+    ``capacity_means`` (its ``harmonic`` and ``arithmetic`` means [kg per unit RH]),
+    ``generator`` (the drawn physical parameters), ``hourly`` (dict of arrays over
+    every full hour from the start: ``Te``, ``RHe`` [%] (station, rounded), ``Ti``,
+    ``RHi`` [%] (logger, NaN where lost), ``Tf`` (cellar), and the noise-free
+    ``Pi_true``, ``Ti_true``), ``rows`` (slice of the calibration hours),
+    ``start_doy``, ``Tf_mean`` (cellar: the ground's mean over the calibration hours
+    [°C]) and ``wall_psat`` (cellar: p_sat at the wall [Pa]), ``start`` (the buffer's
+    RH and the air's vapour pressure at the record's start) and the buffer's RH range
+    over the calibration hours.
     """
     rng = np.random.default_rng(seed)
     p = draw_truth(room, rng)

@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
 import sys
 import time
@@ -227,6 +228,54 @@ def misfit_lines(room_types, reps, seed: int, cal_days: int) -> list[str]:
     return lines
 
 
+def capacity_lines(room_types, reps, seed: int, cal_days: int) -> list[str]:
+    """``--capacity``: which mean of the isotherm's slope a constant capacity matches.
+    Rooms ``reps`` without the moisture source, the logger's noise and the outage (the
+    nonlinear isotherm is the only structural error left, with the true Ti as the
+    coupling's input), the fitted model's capacity (``Cm`` or ``Cw``) by least squares
+    on the noise-free hourly ``Pi`` with every other parameter at its truth and the
+    generator's start state; printed: the buffer's RH range and the harmonic and
+    arithmetic means of ``M du/dφ`` over the calibration (:func:`coupled_rooms.generate`)
+    over that least-squares capacity, and the latter's rms misfit [Pa]."""
+    from scipy.optimize import minimize_scalar
+
+    import heritage_bayes as hb
+    from heritage_bayes.rc.sorption import P_REF
+
+    lines = ["room rep: buffer RH range; harmonic / LS, arithmetic / LS; rms at LS [Pa]"]
+    for room_type in room_types:
+        name, opts = MODELS[room_type]
+        model = hb.model(name, **opts).with_slopes(("Pe",))
+        for rep in reps:
+            room = rooms.generate(room_type, [seed, rooms.ROOMS.index(room_type), rep],
+                                  cal_days, without=("source", "noise", "outage"))  # fmt: skip
+            U, _ = fit_inputs(room, model)
+            if "Ti" in model.input_names:
+                U[:, model.input_names.index("Ti")] = room["hourly"]["Ti_true"][: len(U)]
+            rows, truth = room["rows"], room["truth"]
+            cap = "Cm" if room_type == "attic" else "Cw"
+            x0 = np.array([room["start"]["phi_w"] * room.get("wall_psat", P_REF),
+                           room["start"]["pi"]])  # fmt: skip
+            target = room["hourly"]["Pi_true"][: len(U)][rows]
+
+            def sse(log_c, _m=model, _t=truth, _c=cap, _u=U, _x=x0, _y=target, _r=rows):
+                sim = hb.simulate(_m, {**_t, _c: math.exp(log_c)}, _u, 3600.0, _x)
+                return float(np.sum((sim[_r, 0] - _y) ** 2))
+
+            c0 = math.log(truth[cap])
+            best = minimize_scalar(sse, bounds=(c0 - 1.0, c0 + 1.0), method="bounded")
+            ls = math.exp(best.x)
+            to_ls = room["capacity_means"]
+            scale = 1.0 if room_type == "attic" else room["wall_psat"]  # Cw = Cm / p_sat
+            lo, hi = room["phi_w_range"]
+            lines.append(
+                f"{room_type} {rep}: RH {lo:.2f}-{hi:.2f}; "
+                f"{to_ls['harmonic'] / scale / ls:.3f}, {to_ls['arithmetic'] / scale / ls:.3f}; "
+                f"{math.sqrt(best.fun / target.size):.1f}"
+            )
+    return lines
+
+
 # --------------------------------------------------------------------------- tables
 def fit_of(r: dict) -> dict:
     """The fit of a replicate (its variant's entry; logs before ``--variant``:
@@ -394,6 +443,9 @@ def main(argv=None) -> int:
                     "what a part left out moves (paired_lines)")  # fmt: skip
     ap.add_argument("--misfit", action="store_true", help="no fit: the structural error "
                     "of rooms --first-rep.. with each part of the generator left out")  # fmt: skip
+    ap.add_argument("--capacity", action="store_true", help="no fit: the isotherm's "
+                    "harmonic and arithmetic mean slope against the least-squares "
+                    "capacity of rooms --first-rep.. (capacity_lines)")  # fmt: skip
     args = ap.parse_args(argv)
     without = tuple(w for w in args.without.split(",") if w)
     bad = set(without) - {"isotherm", "source", "noise", "outage"}
@@ -411,6 +463,11 @@ def main(argv=None) -> int:
         print(f"SBC of the coupled models, {' '.join(args.table)}: {len(results)} rooms")
         for line in table_lines(results, args.markdown):
             print(line)
+        return 0
+    if args.capacity:
+        reps = range(args.first_rep, args.first_rep + args.reps)
+        for line in capacity_lines(room_types, reps, args.seed, args.cal_days):
+            print(line, flush=True)
         return 0
     if args.misfit:
         reps = range(args.first_rep, args.first_rep + args.reps)

@@ -391,6 +391,39 @@ def table_lines(results: list[dict], markdown: bool = False) -> list[str]:
     return lines
 
 
+def mean_lines(results: list[dict]) -> list[str]:
+    """``--means``: per room type and quantity, the mean z = (posterior median -
+    truth)/posterior sd with the capacity's truth the harmonic mean of the isotherm's
+    slope (the logs' truth) and with it the arithmetic mean (``capacity_means``; the
+    other truths unchanged): what the choice of the truth moves."""
+    lines = []
+    for room in rooms.ROOMS:
+        rs = [r for r in results if r["room"] == room and "capacity_means" in r]
+        if not rs:
+            continue
+        lines.append(f"{room}: {len(rs)} rooms, mean z with the harmonic / arithmetic mean")
+        cap = "Cm" if room == "attic" else "Cw"
+        for q in IDENTIFIABLE[room] + OTHERS[room]:
+            z = []
+            for r in rs:
+                x = fit_of(r)["ranks"].get(q)
+                if x is None:
+                    continue
+                m = r["capacity_means"]
+                arith = dict(r["truth_parameters"])
+                arith[cap] *= m["arithmetic"] / m["harmonic"]
+                # the quantities of the capacity (the sink's pull, the gain, φ_f and the
+                # buffer share do not involve it; the ground's mean only enters the pull)
+                t_a = r["truth"][q]
+                if q in ("tau1_h", "tau2_h", "buffer_hours", "Cm"):
+                    t_a = float(rooms.network_quantities(room, arith, 10.0)[q])
+                z.append(((x["median"] - r["truth"][q]) / x["sd"], (x["median"] - t_a) / x["sd"]))
+            if z:
+                za, zb = np.mean(z, axis=0)
+                lines.append(f"  {q:14s} {za:+.2f} / {zb:+.2f}")
+    return lines
+
+
 def paired_lines(a: list[dict], b: list[dict]) -> list[str]:
     """Two logs of the same rooms (e.g. every part, and ``--without outage``): per room
     type and quantity over the replicates in both, mean z in each, the mean and sd of
@@ -443,6 +476,8 @@ def main(argv=None) -> int:
                     "what a part left out moves (paired_lines)")  # fmt: skip
     ap.add_argument("--misfit", action="store_true", help="no fit: the structural error "
                     "of rooms --first-rep.. with each part of the generator left out")  # fmt: skip
+    ap.add_argument("--means", nargs="+", metavar="LOG", help="mean z with the "
+                    "capacity's harmonic and arithmetic truth (mean_lines)")  # fmt: skip
     ap.add_argument("--capacity", action="store_true", help="no fit: the isotherm's "
                     "harmonic and arithmetic mean slope against the least-squares "
                     "capacity of rooms --first-rep.. (capacity_lines)")  # fmt: skip
@@ -462,6 +497,10 @@ def main(argv=None) -> int:
         results = read_logs(args.table)
         print(f"SBC of the coupled models, {' '.join(args.table)}: {len(results)} rooms")
         for line in table_lines(results, args.markdown):
+            print(line)
+        return 0
+    if args.means:
+        for line in mean_lines(read_logs(args.means)):
             print(line)
         return 0
     if args.capacity:

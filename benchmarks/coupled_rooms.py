@@ -36,9 +36,15 @@ Physics (SI units; vapour pressures [Pa], moisture [kg], temperatures [°C]):
   temperature (cellar) hourly, rounded to 0.1 °C.
 
 The truths are the physical parameters, with the buffer's capacity taken where the
-nonlinear isotherm puts it: ``C_m = M du/dφ`` averaged over the buffer's trajectory in
-the calibration period (per unit surface RH [kg]; the cellar's ``C_w = C_m /
-p_sat(T_wall)`` [kg/Pa]). References: R.B. Anderson, J. Am. Chem. Soc. 68 (1946) 686
+nonlinear isotherm puts it. The buffer's RH obeys ``dφ_w/dt = J(t) / (M u'(φ_w))``
+(``J`` the vapour flux into it [kg/s]): its rate is the inverse of the local capacity
+``M u'(φ_w)``. A model with one constant capacity follows it, to first order in the
+slope's variation (the averaging of a slowly varying rate), when ``1/C_m`` is the time
+mean of ``1 / (M u'(φ_w(t)))`` over the calibration period: the truth is that
+**harmonic mean** of the slope along the buffer's trajectory, per unit surface RH [kg]
+(the cellar's ``C_w = C_m / p_sat(T_wall)`` [kg/Pa]); the arithmetic mean, larger by
+Jensen's inequality where the buffer's RH moves, is kept for the record
+(``capacity_means``). References: R.B. Anderson, J. Am. Chem. Soc. 68 (1946) 686
 (GAB); T. Kusuda, P.R. Achenbach, ASHRAE Trans. 71 (1965) 61; O.A. Alduchov, R.E.
 Eskridge, J. Appl. Meteor. 35 (1996) 601 (Magnus form of p_sat).
 """
@@ -274,14 +280,16 @@ def generate(
     outage). Leaving parts out keeps every random draw of the room.
 
     Returns a dict: ``truth`` (the fit's parameters by name, the buffer's capacity
-    averaged over the calibration period), ``generator`` (the drawn physical
-    parameters), ``hourly`` (dict of arrays over every full hour from the start:
-    ``Te``, ``RHe`` [%] (station, rounded), ``Ti``, ``RHi`` [%] (logger, NaN where
-    lost), ``Tf`` (cellar), and the noise-free ``Pi_true``, ``Ti_true``), ``rows``
-    (slice of the calibration hours), ``start_doy``, ``Tf_mean`` (cellar: the ground's
-    mean over the calibration hours [°C]) and ``wall_psat`` (cellar: p_sat at the wall
-    [Pa]), ``start`` (the buffer's RH and the air's vapour pressure at the record's
-    start) and the buffer's RH range over the calibration hours.
+    the harmonic mean of ``M u'(φ_w)`` over the calibration period; module docstring),
+    ``capacity_means`` (its ``harmonic`` and ``arithmetic`` means [kg per unit RH]),
+    ``generator`` (the drawn physical parameters), ``hourly`` (dict of arrays over
+    every full hour from the start: ``Te``, ``RHe`` [%] (station, rounded), ``Ti``,
+    ``RHi`` [%] (logger, NaN where lost), ``Tf`` (cellar), and the noise-free
+    ``Pi_true``, ``Ti_true``), ``rows`` (slice of the calibration hours),
+    ``start_doy``, ``Tf_mean`` (cellar: the ground's mean over the calibration hours
+    [°C]) and ``wall_psat`` (cellar: p_sat at the wall [Pa]), ``start`` (the buffer's
+    RH and the air's vapour pressure at the record's start) and the buffer's RH range
+    over the calibration hours.
     """
     rng = np.random.default_rng(seed)
     p = draw_truth(room, rng)
@@ -337,8 +345,11 @@ def generate(
     phi_cal = sim["phi_w"][steps]
     if "isotherm" in without:
         cm = p["M"] * lin[1]
+        means = {"harmonic": cm, "arithmetic": cm}
     else:
-        cm = float(np.mean(p["M"] * gab_slope(phi_cal, p["um"], p["C"], p["K"])))
+        slope = p["M"] * gab_slope(phi_cal, p["um"], p["C"], p["K"])
+        means = {"harmonic": float(1.0 / np.mean(1.0 / slope)), "arithmetic": float(slope.mean())}
+        cm = means["harmonic"]
     truth = {"Ci": p["Ci"], "Gi": p["Gi"], "Gfast": p["Gfast"]}
     out = {"rows": rows, "start_doy": doy0, "spin_days": spin, "source_sd": src_sd / g_all}
     if room == "attic":
@@ -356,6 +367,7 @@ def generate(
         hourly=hourly,
         phi_w_range=(float(phi_cal.min()), float(phi_cal.max())),
         start={"phi_w": float(sim["phi_w"][0]), "pi": float(sim["pi"][0])},
+        capacity_means=means,
         noise_truth={"sd_T": sd_t, "sd_RH": float(sd_rh)},
         gap=(g0, g_len),
         air_capacity=air,

@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
 import sys
 import time
@@ -114,13 +115,16 @@ def replicate(args) -> dict:
 
     ``args``: (room type, replicate, seed, max_steps, calibration days, parts of the
     generator left out[, {quantity: factor}: truths multiplied by a factor before they
-    are ranked, a deliberately wrong truth for the test that the ranking can fail])."""
+    are ranked, a deliberately wrong truth for the test that the ranking can fail[,
+    the fit's variant, ``NOISE:INIT[:T=X]`` of ``bench_sbc.fit_and_rank``, default
+    :data:`VARIANT`]])."""
     import heritage_bayes as hb
     from bench_sbc import ACH, VOLUME, fit_and_rank
 
     room_type, rep, seed, max_steps, cal_days, without = args[:6]
     # a deliberately wrong truth (quantity -> factor), to show that the ranking can miss
     shift = args[6] if len(args) > 6 else {}
+    variant = args[7] if len(args) > 7 else VARIANT
     assert (VOLUME, ACH) == (rooms.VOLUME, rooms.ACH), "the survey differs from the rooms'"
     room = rooms.generate(room_type, [seed, rooms.ROOMS.index(room_type), rep], cal_days,
                           without=without)  # fmt: skip
@@ -147,6 +151,8 @@ def replicate(args) -> dict:
         "seed": seed,
         "without": sorted(without),
         "truth_shift": shift,
+        "variant": variant,
+        "capacity_means": room["capacity_means"],
         "truth": truth,
         "truth_parameters": room["truth"],
         "generator": room["generator"],
@@ -159,7 +165,7 @@ def replicate(args) -> dict:
         U[rows],
         y[rows],
         truth,
-        [VARIANT],
+        [variant],
         rep,
         max_steps,
         {},
@@ -222,7 +228,61 @@ def misfit_lines(room_types, reps, seed: int, cal_days: int) -> list[str]:
     return lines
 
 
+def capacity_lines(room_types, reps, seed: int, cal_days: int) -> list[str]:
+    """``--capacity``: which mean of the isotherm's slope a constant capacity matches.
+    Rooms ``reps`` without the moisture source, the logger's noise and the outage (the
+    nonlinear isotherm is the only structural error left, with the true Ti as the
+    coupling's input), the fitted model's capacity (``Cm`` or ``Cw``) by least squares
+    on the noise-free hourly ``Pi`` with every other parameter at its truth and the
+    generator's start state; printed: the buffer's RH range and the harmonic and
+    arithmetic means of ``M du/dφ`` over the calibration (:func:`coupled_rooms.generate`)
+    over that least-squares capacity, and the latter's rms misfit [Pa]."""
+    from scipy.optimize import minimize_scalar
+
+    import heritage_bayes as hb
+    from heritage_bayes.rc.sorption import P_REF
+
+    lines = ["room rep: buffer RH range; harmonic / LS, arithmetic / LS; rms at LS [Pa]"]
+    for room_type in room_types:
+        name, opts = MODELS[room_type]
+        model = hb.model(name, **opts).with_slopes(("Pe",))
+        for rep in reps:
+            room = rooms.generate(room_type, [seed, rooms.ROOMS.index(room_type), rep],
+                                  cal_days, without=("source", "noise", "outage"))  # fmt: skip
+            U, _ = fit_inputs(room, model)
+            if "Ti" in model.input_names:
+                U[:, model.input_names.index("Ti")] = room["hourly"]["Ti_true"][: len(U)]
+            rows, truth = room["rows"], room["truth"]
+            cap = "Cm" if room_type == "attic" else "Cw"
+            x0 = np.array([room["start"]["phi_w"] * room.get("wall_psat", P_REF),
+                           room["start"]["pi"]])  # fmt: skip
+            target = room["hourly"]["Pi_true"][: len(U)][rows]
+
+            def sse(log_c, _m=model, _t=truth, _c=cap, _u=U, _x=x0, _y=target, _r=rows):
+                sim = hb.simulate(_m, {**_t, _c: math.exp(log_c)}, _u, 3600.0, _x)
+                return float(np.sum((sim[_r, 0] - _y) ** 2))
+
+            c0 = math.log(truth[cap])
+            best = minimize_scalar(sse, bounds=(c0 - 1.0, c0 + 1.0), method="bounded")
+            ls = math.exp(best.x)
+            to_ls = room["capacity_means"]
+            scale = 1.0 if room_type == "attic" else room["wall_psat"]  # Cw = Cm / p_sat
+            lo, hi = room["phi_w_range"]
+            lines.append(
+                f"{room_type} {rep}: RH {lo:.2f}-{hi:.2f}; "
+                f"{to_ls['harmonic'] / scale / ls:.3f}, {to_ls['arithmetic'] / scale / ls:.3f}; "
+                f"{math.sqrt(best.fun / target.size):.1f}"
+            )
+    return lines
+
+
 # --------------------------------------------------------------------------- tables
+def fit_of(r: dict) -> dict:
+    """The fit of a replicate (its variant's entry; logs before ``--variant``:
+    :data:`VARIANT`)."""
+    return r["variants"][r.get("variant", VARIANT)]
+
+
 def read_logs(paths) -> list[dict]:
     """Replicates of one or more logs; a (room, replicate, without) found twice must
     agree (a replicate is a function of its seed)."""
@@ -233,7 +293,7 @@ def read_logs(paths) -> list[dict]:
                 if not line.strip():
                     continue
                 r = json.loads(line)
-                key = (r["room"], r["rep"], r["seed"], tuple(r["without"]))
+                key = (r["room"], r["rep"], r["seed"], tuple(r["without"]), r.get("variant"))
                 if key in merged and merged[key]["truth"] != r["truth"]:
                     raise SystemExit(f"{path}: replicate {key} differs from an earlier log's")
                 merged[key] = r
@@ -255,9 +315,9 @@ def summary(results: list[dict], room: str, quantity: str) -> dict | None:
     of log(quantity) over the sd of log(truth) across the rooms (≪ 1: the data, not
     the spread of the truths, set the interval)."""
     v = [
-        (r["variants"][VARIANT]["ranks"][quantity], r["truth"][quantity])
+        (fit_of(r)["ranks"][quantity], r["truth"][quantity])
         for r in results
-        if r["room"] == room and quantity in r["variants"][VARIANT]["ranks"]
+        if r["room"] == room and quantity in fit_of(r)["ranks"]
     ]
     if not v:
         return None
@@ -303,8 +363,8 @@ def table_lines(results: list[dict], markdown: bool = False) -> list[str]:
         rs = [r for r in results if r["room"] == room]
         if not rs:
             continue
-        conv = sum(r["variants"][VARIANT]["converged"] for r in rs)
-        cpu = np.mean([r["variants"][VARIANT]["cpu"] for r in rs])
+        conv = sum(fit_of(r)["converged"] for r in rs)
+        cpu = np.mean([fit_of(r)["cpu"] for r in rs])
         label = f"{room} → {MODELS[room][0]} ({len(rs)}, {conv})"
         if not markdown:
             mis = np.median([r["misfit_Pa"]["sd"] for r in rs])
@@ -331,6 +391,39 @@ def table_lines(results: list[dict], markdown: bool = False) -> list[str]:
     return lines
 
 
+def mean_lines(results: list[dict]) -> list[str]:
+    """``--means``: per room type and quantity, the mean z = (posterior median -
+    truth)/posterior sd with the capacity's truth the harmonic mean of the isotherm's
+    slope (the logs' truth) and with it the arithmetic mean (``capacity_means``; the
+    other truths unchanged): what the choice of the truth moves."""
+    lines = []
+    for room in rooms.ROOMS:
+        rs = [r for r in results if r["room"] == room and "capacity_means" in r]
+        if not rs:
+            continue
+        lines.append(f"{room}: {len(rs)} rooms, mean z with the harmonic / arithmetic mean")
+        cap = "Cm" if room == "attic" else "Cw"
+        for q in IDENTIFIABLE[room] + OTHERS[room]:
+            z = []
+            for r in rs:
+                x = fit_of(r)["ranks"].get(q)
+                if x is None:
+                    continue
+                m = r["capacity_means"]
+                arith = dict(r["truth_parameters"])
+                arith[cap] *= m["arithmetic"] / m["harmonic"]
+                # the quantities of the capacity (the sink's pull, the gain, φ_f and the
+                # buffer share do not involve it; the ground's mean only enters the pull)
+                t_a = r["truth"][q]
+                if q in ("tau1_h", "tau2_h", "buffer_hours", "Cm"):
+                    t_a = float(rooms.network_quantities(room, arith, 10.0)[q])
+                z.append(((x["median"] - r["truth"][q]) / x["sd"], (x["median"] - t_a) / x["sd"]))
+            if z:
+                za, zb = np.mean(z, axis=0)
+                lines.append(f"  {q:14s} {za:+.2f} / {zb:+.2f}")
+    return lines
+
+
 def paired_lines(a: list[dict], b: list[dict]) -> list[str]:
     """Two logs of the same rooms (e.g. every part, and ``--without outage``): per room
     type and quantity over the replicates in both, mean z in each, the mean and sd of
@@ -347,8 +440,8 @@ def paired_lines(a: list[dict], b: list[dict]) -> list[str]:
         for q in IDENTIFIABLE[room] + OTHERS[room]:
             za, zb, ia, ib = [], [], 0, 0
             for r in reps:
-                xa = ra[r]["variants"][VARIANT]["ranks"].get(q)
-                xb = rb[r]["variants"][VARIANT]["ranks"].get(q)
+                xa = fit_of(ra[r])["ranks"].get(q)
+                xb = fit_of(rb[r])["ranks"].get(q)
                 if xa is None or xb is None:
                     continue
                 za.append((xa["median"] - ra[r]["truth"][q]) / xa["sd"])
@@ -372,6 +465,8 @@ def main(argv=None) -> int:
     ap.add_argument("--seed", type=int, default=SEED)
     ap.add_argument("--max-steps", type=int, default=4000)
     ap.add_argument("--cal-days", type=int, default=CAL_DAYS)
+    ap.add_argument("--variant", default=VARIANT, help="the fit: NOISE:INIT[:T=X] "
+                    "(bench_sbc.fit_and_rank; T=X a likelihood tempered by X)")  # fmt: skip
     ap.add_argument("--log", help="append each replicate's result as a JSON line")
     ap.add_argument("--without", default="", help="parts of the generator left out: "
                     "isotherm, source, noise, outage (coupled_rooms.generate)")  # fmt: skip
@@ -381,6 +476,11 @@ def main(argv=None) -> int:
                     "what a part left out moves (paired_lines)")  # fmt: skip
     ap.add_argument("--misfit", action="store_true", help="no fit: the structural error "
                     "of rooms --first-rep.. with each part of the generator left out")  # fmt: skip
+    ap.add_argument("--means", nargs="+", metavar="LOG", help="mean z with the "
+                    "capacity's harmonic and arithmetic truth (mean_lines)")  # fmt: skip
+    ap.add_argument("--capacity", action="store_true", help="no fit: the isotherm's "
+                    "harmonic and arithmetic mean slope against the least-squares "
+                    "capacity of rooms --first-rep.. (capacity_lines)")  # fmt: skip
     args = ap.parse_args(argv)
     without = tuple(w for w in args.without.split(",") if w)
     bad = set(without) - {"isotherm", "source", "noise", "outage"}
@@ -399,6 +499,15 @@ def main(argv=None) -> int:
         for line in table_lines(results, args.markdown):
             print(line)
         return 0
+    if args.means:
+        for line in mean_lines(read_logs(args.means)):
+            print(line)
+        return 0
+    if args.capacity:
+        reps = range(args.first_rep, args.first_rep + args.reps)
+        for line in capacity_lines(room_types, reps, args.seed, args.cal_days):
+            print(line, flush=True)
+        return 0
     if args.misfit:
         reps = range(args.first_rep, args.first_rep + args.reps)
         for line in misfit_lines(room_types, reps, args.seed, args.cal_days):
@@ -407,7 +516,7 @@ def main(argv=None) -> int:
     from bench_sbc import run_tasks
 
     tasks = [
-        (room, rep, args.seed, args.max_steps, args.cal_days, without)
+        (room, rep, args.seed, args.max_steps, args.cal_days, without, {}, args.variant)
         for rep in range(args.first_rep, args.first_rep + args.reps)
         for room in room_types
     ]

@@ -371,6 +371,7 @@ def test_envelope_area_bounds_the_envelope_node():
         C_BUFFER_MAX,
         C_ENVELOPE_MAX,
         G_VAPOUR_MAX,
+        G_VAPOUR_MIN,
         H_EXTERIOR,
         U_ENVELOPE_MIN,
         default_prior,
@@ -403,9 +404,11 @@ def test_envelope_area_bounds_the_envelope_node():
     hprior = {p.name: p.prior for p in hps.parameters}
     assert hprior["Gw"].upper == pytest.approx(2e-9 * 259.0) == G_VAPOUR_MAX * 259.0
     assert hprior["Cw"].upper == pytest.approx(0.04 * 259.0) == C_BUFFER_MAX * 259.0
+    # the buffer's link to outdoors: no tighter than s_d = 100 m of envelope
+    assert hprior["Gw"].lower == pytest.approx(2e-12 * 259.0) == G_VAPOUR_MIN * 259.0
+    assert hprior["Cw"].lower == default_prior("hygric", "capacity").lower
     for name, kind in (("Gw", "conductance"), ("Cw", "capacity")):
-        d = default_prior("hygric", kind)
-        assert (hprior[name].dist, hprior[name].lower) == (d.dist, d.lower)
+        assert hprior[name].dist == default_prior("hygric", kind).dist
     assert hprior["Gi"] == default_prior("hygric", "conductance")
     with pytest.raises(ConfigError, match="envelope_area"):
         envelope_priors(1e-4)

@@ -50,6 +50,22 @@ def test_gab_isotherm_inverse_and_slope():
     assert rooms.gab_slope(0.85, um, c, k) > 1.5 * rooms.gab_slope(0.45, um, c, k)
 
 
+def test_true_capacity_is_the_harmonic_mean_of_the_isotherm_slope():
+    """The truth of the buffer's capacity is the harmonic mean of M du/dφ over the
+    calibration (the constant capacity whose rate 1/C is the buffer's mean rate): below
+    the arithmetic mean where the nonlinear isotherm's slope varies, equal to it with a
+    linear isotherm."""
+    room = rooms.generate("attic", 7, cal_days=20, max_spin_days=7)
+    m = room["capacity_means"]
+    assert room["truth"]["Cm"] == m["harmonic"] < m["arithmetic"]
+    lo, hi = room["phi_w_range"]
+    g = room["generator"]
+    slopes = g["M"] * rooms.gab_slope(np.array([lo, hi]), g["um"], g["C"], g["K"])
+    assert slopes[0] < m["harmonic"] < slopes[1]
+    flat = rooms.generate("attic", 7, cal_days=20, max_spin_days=7, without=("isotherm",))
+    assert flat["capacity_means"]["harmonic"] == flat["capacity_means"]["arithmetic"]
+
+
 @pytest.mark.parametrize("room_type", rooms.ROOMS)
 def test_generator_and_package_agree_where_their_physics_is_the_same(room_type):
     """With a linear isotherm, no moisture source and the true indoor temperature as

@@ -567,6 +567,13 @@ C_ENVELOPE_MAX = 3.0 * 2.5e6
 #: thickness s_d = 0.1 m (δ_air ≈ 2e-10 kg/(m·s·Pa), EN ISO 12572; a thin open board;
 #: masonry walls have s_d of metres, EN ISO 10456). Air leaks are Gfast's.
 G_VAPOUR_MAX = 2e-9
+#: Most vapour-tight envelope per m² [kg/(m²·s·Pa)] that a buffer linked to the outdoor
+#: air (a model's ``Gw``) stands for: s_d = 100 m (δ_air 2e-10 / 100; a metre of dense
+#: masonry, μ ≈ 100, EN ISO 10456; brick walls of monuments have s_d of 2-20 m): the
+#: hygric ``Gw``'s lower bound, as ``U_ENVELOPE_MIN`` is the thermal one's. A tighter
+#: envelope (a membrane, a metal roof) is a buffer linked to nothing but the air: a
+#: model without ``Gw``.
+G_VAPOUR_MIN = 2e-12
 #: Largest moisture buffer per m² of envelope [kg/(m²·Pa)]: 10 cm of wood (moisture
 #: capacity dw/dφ ≈ 250 kg/m³ at high RH) in equilibrium at 0 °C (p_sat 611 Pa):
 #: 0.1 × 250 / 611 ≈ 0.04, generous enough to include the interior's contents.
@@ -604,7 +611,12 @@ def envelope_priors(envelope_area: float, domain: str = "thermal") -> dict[str, 
     1e3 kg/Pa (a tonne of water per pascal), a low-pass filtered Pe that trades the
     gain from Pe against the fixed node's offset (measured by
     ``benchmarks/bench_sbc_independent.py`` before these bounds: the MAPs of 9 of 27 rooms
-    with ``ar1_white`` and 27 of 39 with ``kalman``; docs/science/noise.md).
+    with ``ar1_white`` and 27 of 39 with ``kalman``; docs/science/noise.md). And the
+    hygric ``Gw`` at least ``G_VAPOUR_MIN × area`` (an envelope no tighter than
+    s_d = 100 m): a wall's exchange with outdoors that relaxes over months to years is
+    barely seen in a few months of data, and the default's log-uniform prior, down to
+    1e-12, then holds most of its volume in envelopes tighter than any masonry
+    (docs/science/sbc.md, "The coupled hygric models").
 
     Parameters
     ----------
@@ -627,8 +639,9 @@ def envelope_priors(envelope_area: float, domain: str = "thermal") -> dict[str, 
                 "roof in m² (tens to thousands)"
             )
         lower = d.lower
-        if (domain, name) == ("thermal", "Gw"):
-            lower = max(lower, U_ENVELOPE_MIN * envelope_area)
+        if name == "Gw":
+            floor = U_ENVELOPE_MIN if domain == "thermal" else G_VAPOUR_MIN
+            lower = max(lower, floor * envelope_area)
         out[name] = Prior(d.dist, lower, limit)
     return out
 

@@ -297,7 +297,8 @@ def _calibrate_into(
         t0, deadline = time.perf_counter(), share_deadline(end, len(sections) - i)
         known = maps.get(s.name)
         if known is not None and known.x.size == s.logpost.ndim:
-            s.map = _refined_map(cfg, s, i, known, deadline, len(sections), say)
+            s.map = known  # the screen's MAP starts the chain
+            say.say(f"[{s.name}] {s.model.name}: the screen's MAP starts the sampler")
         else:
             say.say(
                 f"[{s.name}] {s.model.name}: {s.logpost.ndim} free parameters, MAP search "
@@ -424,33 +425,8 @@ def _calibrate_into(
         say.say(f"report: {final / 'report.html'}")
 
 
-def _refined_map(cfg: CalibrationConfig, s: _Section, i: int, known, deadline, n: int, say):
-    """The MAP that starts section ``s``'s chain from one found beforehand (a screen's
-    single global search): as found for a small network; for a rich one
-    (``optimizer.restarts_for`` its nodes > 1) the restarts' global searches, the first
-    from the known MAP, keeping the best, so that a screened model starts where its
-    own calibration would (one search can stop at a local optimum of a rich network).
-    The known MAP stands when the time budget ends the searches first."""
-    from heritage_bayes.inference.optimize import BudgetError
-
-    restarts = cfg.optimizer.restarts_for(s.model.n_states)
-    if restarts <= getattr(known, "restarts", 1) or known.unit is None:
-        say.say(f"[{s.name}] {s.model.name}: the screen's MAP starts the sampler")
-        return known
-    say.say(
-        f"[{s.name}] {s.model.name}: the screen's MAP starts the search of {restarts} "
-        "global searches (optimizer.restarts: a network of three or more nodes)"
-    )
-    try:
-        found = _section_map(cfg, s, i, deadline, time.perf_counter(), n, start=known.unit)
-    except BudgetError:
-        return known
-    return found if found.log_post >= known.log_post else known
-
-
-def _section_map(cfg: CalibrationConfig, s: _Section, i: int, deadline, t0, n: int, start=None):
-    """The MAP search of section ``s`` (the ``i``-th of ``n``) within its deadline;
-    ``start``: a unit-cube point put into the first search."""
+def _section_map(cfg: CalibrationConfig, s: _Section, i: int, deadline, t0, n: int):
+    """The MAP search of section ``s`` (the ``i``-th of ``n``) within its deadline."""
     from heritage_bayes.inference.optimize import find_map
 
     return find_map(
@@ -465,7 +441,6 @@ def _section_map(cfg: CalibrationConfig, s: _Section, i: int, deadline, t0, n: i
         budget=f"the time budget sampler.max_time = "
         f"{format_timedelta(cfg.sampler.max_time or 0)} ({n - i} section(s) "
         f"left: {(deadline or t0) - t0:.0f} s for this one)",
-        start=start,
     )
 
 

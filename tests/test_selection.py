@@ -120,3 +120,57 @@ def test_model_auto_end_to_end(tmp_path, capsys):
     assert "auto" in (run / "config.original.yaml").read_text()
     page = (run / "report.html").read_text()
     assert "chosen by the screen" in page and summary["selection"]["thermal"]["reason"] in page
+
+
+#: Ctrl-C in the middle of the second rung's MAP search (its third batch of
+#: log-posterior evaluations), as a terminal delivers it
+_SIGINT_IN_SCREEN = """
+import os, signal, sys
+signal.signal(signal.SIGINT, signal.default_int_handler)
+import heritage_bayes.inference.optimize as _o
+_orig, _n = _o._Objective.__init__, [0, 0]
+def _init(self, *a, **k):
+    _orig(self, *a, **k)
+    _n[0] += 1
+    if _n[0] == 2:
+        call = self._values
+        def _values(S):
+            _n[1] += 1
+            if _n[1] == 3:
+                print("SIGINT-SENT", file=sys.stderr, flush=True)
+                os.kill(os.getpid(), signal.SIGINT)
+            return call(S)
+        self._values = _values
+_o._Objective.__init__ = _init
+from heritage_bayes.cli import main
+sys.exit(main(sys.argv[1:]))
+"""
+
+
+def test_ctrl_c_in_the_auto_screen_stops_the_run_at_once(tmp_path):
+    """SIGINT while ``model: auto`` screens its ladder (the second rung's MAP search)
+    ends ``hbayes calibrate`` with 130: the search stops at once (no later rung screened,
+    no chain started) and the folder is as before (no run, staging folder or lock)."""
+    import subprocess
+    import sys
+
+    from test_faults import _clean, _env
+    from test_paths import snapshot
+
+    work = tmp_path / "w"
+    work.mkdir()
+    cfg = work / "auto.yaml"
+    cfg.write_text(yaml.safe_dump({**AUTO, "hygric": None}), encoding="utf-8")
+    before = snapshot(work)
+    p = subprocess.run(
+        [sys.executable, "-c", _SIGINT_IN_SCREEN, "calibrate", str(cfg), "--out", str(work / "r")],
+        capture_output=True,
+        text=True,
+        env=_env(),
+        check=False,
+    )
+    err = p.stderr
+    assert p.returncode == 130 and "SIGINT-SENT" in err and "interrupted" in err, err
+    assert "[thermal] screen 1/3: thermal_1c" in err and "screen 2/3" not in err, err
+    assert "chosen:" not in err and "emcee" not in err and _clean(err), err
+    assert snapshot(work) == before, sorted(work.rglob("*"))

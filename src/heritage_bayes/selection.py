@@ -42,7 +42,15 @@ from heritage_bayes.errors import ConfigError, InputError
 from heritage_bayes.ladder import ladder_row, rung_log_posterior
 from heritage_bayes.models import AUTO, AUTO_LADDERS, auto_rungs, rung_label
 
-__all__ = ["MARGIN_FIT", "Screen", "choose", "chosen_section", "row_score", "screen"]
+__all__ = [
+    "MARGIN_FIT",
+    "Screen",
+    "choose",
+    "chosen_section",
+    "row_score",
+    "screen",
+    "screen_maps",
+]
 
 #: [percentage points of validation FIT] a richer rung must beat a simpler one by more
 #: than this to be chosen; rungs within it of the choice tie with it.
@@ -176,58 +184,123 @@ def screen(
     margin : float
         :data:`MARGIN_FIT`.
     """
-    from heritage_bayes.inference.optimize import BudgetError, find_map
-
     say = say or (lambda msg: None)
     sec = getattr(cfg, section)
-    rungs = auto_rungs(cfg, section)
     own = {rung_label(n, o): (n, dict(o)) for n, o, _ in AUTO_LADDERS[section]}
-    out = Screen(section, [], {})
-    opt = cfg.optimizer
-    for k, (label, model, parent) in enumerate(rungs, 1):
-        row_head = {"model": label, "parent": parent}
-        if k > 1 and deadline is not None and time.perf_counter() > deadline:
-            out.rows.append({**row_head, "error": "not screened: the time budget ran out"})
-            continue
-        t0 = time.perf_counter()
-        try:
-            lp = rung_log_posterior(cfg, prep, section, model, sec.initial_state)
-            start = None
-            if parent in out.maps:
-                start = carried_start(lp, out.logposts[parent], out.maps[parent])
-            mp = find_map(
-                lp,
-                seed=seed,
-                method=opt.method,
-                popsize=opt.popsize,
-                maxiter=opt.maxiter,
-                starts=opt.starts,
-                deadline=deadline if k > 1 else None,
-                start=start,
-            )
-            row = ladder_row(prep, section, model, lp, mp, label=label)
-        except BudgetError:
-            out.rows.append({**row_head, "error": "not screened: the time budget ran out"})
-            continue
-        except (ConfigError, InputError) as exc:
-            out.rows.append({**row_head, "error": f"not screened: {exc}"})
-            say(f"[{section}] screen {k}/{len(rungs)}: {label}: not screened ({exc})")
-            continue
-        row.update(parent=parent, seeded_from=parent if start is not None else None)
-        row["map_seconds"] = time.perf_counter() - t0
-        row["score"] = row_score(row, _period(prep))[0]
-        out.rows.append(row)
+
+    def build(model):
+        return lambda: (
+            prep,
+            model,
+            rung_log_posterior(cfg, prep, section, model, sec.initial_state),
+        )
+
+    rungs = [(label, parent, build(model)) for label, model, parent in auto_rungs(cfg, section)]
+    rows, found = screen_maps(
+        rungs,
+        section,
+        seed=seed,
+        optimizer=cfg.optimizer,
+        deadline=deadline,
+        say=lambda msg: say(f"[{section}] {msg}"),
+    )
+    out = Screen(section, rows, {})
+    for label, (model, lp, mp) in found.items():
         out.models[label], out.logposts[label], out.maps[label] = model, lp, mp
         out.options[label] = own[label]
-        say(
-            f"[{section}] screen {k}/{len(rungs)}: {label}: {lp.ndim} free parameters, "
-            f"{_fit_text(row)} ({row['map_seconds']:.0f} s)"
-        )
     out.choice = choose([r for r in out.rows if "error" not in r], margin)
     for r in out.rows:
         r["chosen"] = r["sampled"] = r["model"] == out.choice["choice"]
     say(f"[{section}] chosen: {out.choice['choice']}: {out.choice['reason']}")
     return out
+
+
+def screen_maps(
+    rungs: Sequence[tuple[str, str | None, Callable]],
+    section: str,
+    *,
+    seed: int,
+    optimizer,
+    deadline: float | None = None,
+    say: Callable[[str], None] | None = None,
+) -> tuple[list[dict], dict]:
+    """The MAP screen's loop, shared by ``model: auto`` (:func:`screen`) and ``hbayes
+    compare``: each rung's MAP and its ladder row, in turn.
+
+    Parameters
+    ----------
+    rungs : sequence of (label, parent, build)
+        ``build()`` returns (prepared data, model, log-posterior) of the rung; ``parent``
+        is the label of its nested simpler rung (or None), whose MAP, when found
+        before, is carried over as one start of the search (:func:`carried_start`).
+        One global search per rung (no restarts): the carried start puts the richer
+        rung's search where the simpler one ended.
+    section : {"thermal", "hygric"}
+    seed : int
+        Seed of every rung's MAP search.
+    optimizer : OptimizerSettings
+        ``method``, ``popsize``, ``maxiter`` and ``starts`` of the search.
+    deadline : float, optional
+        A :func:`time.perf_counter` value: rungs not reached by then are left out
+        (recorded as such); the first rung always runs.
+    say : callable, optional
+        A progress line per rung.
+
+    Returns
+    -------
+    rows : list of dict
+        Per rung, in order: its ladder row (:func:`heritage_bayes.ladder.ladder_row`,
+        with ``parent``, ``seeded_from``, ``map_seconds`` and ``score``, the FIT
+        compared, :func:`row_score`), or ``model`` and ``error`` (why not screened: a
+        configuration or data error of the rung, or the time budget).
+    found : dict
+        label -> (model, log-posterior, MAP) of the rungs screened.
+    """
+    from heritage_bayes.inference.optimize import BudgetError, find_map
+
+    say = say or (lambda msg: None)
+    rows: list[dict] = []
+    found: dict = {}
+    n = len(rungs)
+    for k, (label, parent, build) in enumerate(rungs, 1):
+        head = {"model": label, "parent": parent}
+        if k > 1 and deadline is not None and time.perf_counter() > deadline:
+            rows.append({**head, "error": "not screened: the time budget ran out"})
+            continue
+        t0 = time.perf_counter()
+        try:
+            prep, model, lp = build()
+            start = None
+            if parent in found:
+                start = carried_start(lp, found[parent][1], found[parent][2])
+            mp = find_map(
+                lp,
+                seed=seed,
+                method=optimizer.method,
+                popsize=optimizer.popsize,
+                maxiter=optimizer.maxiter,
+                starts=optimizer.starts,
+                deadline=deadline if k > 1 else None,
+                start=start,
+            )
+            row = ladder_row(prep, section, model, lp, mp, label=label)
+        except BudgetError:
+            rows.append({**head, "error": "not screened: the time budget ran out"})
+            continue
+        except (ConfigError, InputError) as exc:
+            rows.append({**head, "error": f"not screened: {exc}"})
+            say(f"screen {k}/{n}: {label}: not screened ({exc})")
+            continue
+        row.update(parent=parent, seeded_from=parent if start is not None else None)
+        row["map_seconds"] = time.perf_counter() - t0
+        row["score"] = row_score(row, _period(prep))[0]
+        rows.append(row)
+        found[label] = (model, lp, mp)
+        say(
+            f"screen {k}/{n}: {label}: {lp.ndim} free parameters, {_fit_text(row)} "
+            f"({row['map_seconds']:.0f} s)"
+        )
+    return rows, found
 
 
 def unit_point(logpost, values: dict[str, float]) -> np.ndarray:

@@ -3,16 +3,16 @@ reach of the best.
 
 Part of :mod:`heritage_bayes.compare` (see its documentation). Each candidate's MAP is
 found on exactly the log-posterior its calibration samples (its own config, the same
-prepared data), so the MAP found here starts its chain; the MAP of a nested simpler
-candidate (:data:`heritage_bayes.models.AUTO_LADDERS`) is carried over as one start of
-the search. The score is the validation FIT of the simulation from the MAP
+prepared data), so the MAP found here starts its chain; the search is ``model: auto``'s
+(:func:`heritage_bayes.selection.screen_maps`, one loop for both): the MAP of a nested
+simpler candidate (:data:`heritage_bayes.models.AUTO_LADDERS`) carried over as one start
+of one global search. The score is the validation FIT of the simulation from the MAP
 (:func:`heritage_bayes.selection.row_score`).
 """
 
 from __future__ import annotations
 
 import math
-import time
 from collections.abc import Callable, Mapping
 
 from heritage_bayes.models import AUTO_LADDERS
@@ -77,53 +77,38 @@ def within_reach(
 def screen_candidates(
     cands: Mapping, section: str, *, tell: Callable[[str], None]
 ) -> tuple[dict, dict, dict]:
-    """MAP and ladder row of every candidate config: (label -> row, label -> MAP result,
-    label -> score [%]). A candidate whose MAP cannot be found scores NaN (its row says
-    why)."""
-    from heritage_bayes.errors import ConfigError, InputError
-    from heritage_bayes.inference.optimize import find_map
-    from heritage_bayes.ladder import ladder_row, section_log_posterior
+    """MAP and ladder row of every candidate config, by the loop of ``model: auto``'s
+    screen (:func:`heritage_bayes.selection.screen_maps`): (label -> row, label -> MAP
+    result, label -> score [%]). A candidate whose MAP cannot be found scores NaN (its
+    row says why)."""
+    from heritage_bayes.ladder import section_log_posterior
     from heritage_bayes.models import build_model
     from heritage_bayes.prepare import prepare
-    from heritage_bayes.selection import _period, carried_start, row_score
+    from heritage_bayes.selection import screen_maps
 
     parents = {n: p for n, _, p in AUTO_LADDERS.get(section, ())}
     preps: dict = {}
-    rows, maps, scores, lps = {}, {}, {}, {}
-    n = len(cands)
-    for k, (label, cand) in enumerate(cands.items(), 1):
-        t0 = time.perf_counter()
-        try:
+
+    def build(cand):
+        def run():
             model = build_model(cand, section)
             key = tuple(model.input_names)
             if key not in preps:  # one preparation per set of inputs
                 preps[key] = prepare(cand)
-            prep = preps[key]
             sec = getattr(cand, section)
-            lp = section_log_posterior(cand, prep, section, model, sec.priors)
-            parent = parents.get(label)
-            start = carried_start(lp, lps[parent], maps[parent]) if parent in maps else None
-            opt = cand.optimizer
-            mp = find_map(
-                lp,
-                seed=cand.seed,
-                method=opt.method,
-                popsize=opt.popsize,
-                maxiter=opt.maxiter,
-                starts=opt.starts,
-                restarts=opt.restarts_for(model.n_states),
-                start=start,
-            )
-            row = ladder_row(prep, section, model, lp, mp, label=label)
-        except (ConfigError, InputError) as exc:
-            rows[label], scores[label] = {"model": label, "error": str(exc)}, math.nan
-            tell(f"screen {k}/{n}: {label}: no MAP ({exc})")
-            continue
-        row["map_seconds"] = time.perf_counter() - t0
-        row["score"] = scores[label] = row_score(row, _period(prep))[0]
-        rows[label], maps[label], lps[label] = row, mp, lp
-        tell(
-            f"screen {k}/{n}: {label}: {lp.ndim} free parameters, MAP validation FIT "
-            f"{row['score']:.1f} % ({row['map_seconds']:.0f} s)"
-        )
-    return rows, maps, scores
+            lp = section_log_posterior(cand, preps[key], section, model, sec.priors)
+            return preps[key], model, lp
+
+        return run
+
+    first = next(iter(cands.values()))
+    rows, found = screen_maps(
+        [(label, parents.get(label), build(c)) for label, c in cands.items()],
+        section,
+        seed=first.seed,
+        optimizer=first.optimizer,
+        say=tell,
+    )
+    rows = {r["model"]: r for r in rows}
+    scores = {n: float(rows[n].get("score", math.nan)) for n in cands}
+    return rows, {n: mp for n, (_, _, mp) in found.items()}, scores

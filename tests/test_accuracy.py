@@ -88,10 +88,14 @@ def test_nearly_constant_is_a_few_sensor_resolutions():
     assert [x["fit"] for x in f] == [1.2]
     # the metrics table's note follows the same rule
     from heritage_bayes.report.sections.metrics import _nearly_constant
+    from heritage_bayes.rundir.summary import FitMetrics
 
-    bad = {"MAE": 8.0, "MSE": 100.0, "FIT": 1.2, "SD": 10.8}
+    def metrics(**v):
+        return FitMetrics(section="thermal", output="Ti", period="validation", **v)
+
+    bad = metrics(MAE=8.0, MSE=100.0, FIT=1.2, SD=10.8)
     assert _nearly_constant(bad, 0.1) == ""
-    flat = {"MAE": 0.4, "MSE": 0.25, "FIT": -98.0, "SD": 0.3}
+    flat = metrics(MAE=0.4, MSE=0.25, FIT=-98.0, SD=0.3)
     assert "nearly constant" in _nearly_constant(flat, 0.1)
     assert _nearly_constant(flat, 0.05) == ""  # 0.3 K is 6 resolutions of 0.05 K
 

@@ -99,7 +99,7 @@ def roof_finding(attic: str) -> str:
     return (
         f"roof: the room looks like an attic or loft ({attic}): data.roof with init's "
         f"default pitch {DEFAULT_PITCH:g}° and ridge {DEFAULT_RIDGE_AZIMUTH:g}° (east-west); "
-        "give your roof's"
+        "give your roof's pitch and ridge direction there"
     )
 
 

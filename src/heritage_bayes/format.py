@@ -48,14 +48,22 @@ OUT_WORDS = {
 _SUP = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
 
 
-def fmt(x, digits: int = 3) -> str:
-    """A number for people: 3 significant digits, ``2.41×10⁶`` for large/small ones."""
+def _number(x) -> float | str:
+    """``x`` as a float, or the text a page prints for it: "—" for None, ``str(x)`` for
+    what is not a number."""
     if x is None:
         return "—"
     try:
-        v = float(x)
+        return float(x)
     except (TypeError, ValueError):
         return str(x)
+
+
+def fmt(x, digits: int = 3) -> str:
+    """A number for people: 3 significant digits, ``2.41×10⁶`` for large/small ones."""
+    v = _number(x)
+    if isinstance(v, str):
+        return v
     if not math.isfinite(v):
         return "—" if math.isnan(v) else ("∞" if v > 0 else "−∞")
     if v == 0:
@@ -71,12 +79,9 @@ def fmt(x, digits: int = 3) -> str:
 
 
 def fmt_int(x) -> str:
-    if x is None:
-        return "—"
-    try:
-        v = float(x)
-    except (TypeError, ValueError):
-        return str(x)
+    v = _number(x)
+    if isinstance(v, str):
+        return v
     if not math.isfinite(v):
         return "—"
     return f"{round(v):,}".replace(",", " ")
@@ -230,6 +235,17 @@ def _input_words(u: str) -> str:
     return _INPUT_WORDS.get(u, u)
 
 
+#: Names built from a pattern (time constants, gains, offsets, apertures, initial
+#: states) and their words.
+_NAME_PATTERNS = (
+    (re.compile(r"tau_(\d+)_h"), lambda m: f"time constant τ{m.group(1).translate(_SUB)}"),
+    (re.compile(r"gain_(Ti|Pi|RHi)_(.+)"), lambda m: f"gain from {_input_words(m.group(2))}"),
+    (re.compile(r"offset_(Ti|Pi|RHi)_(.+)"), lambda m: f"offset from {_input_words(m.group(2))}"),
+    (re.compile(r"fI_(\w+)"), lambda m: f"solar aperture, {surface_words(m.group(1))}"),
+    (re.compile(r"x0_(\w+)"), lambda m: f"initial state of node {m.group(1)}"),
+)
+
+
 def quantity_name(name: str, description: str | None = None, *, domain: str = "") -> str:
     """The plain-words name of a parameter or derived quantity of a run, without unit.
 
@@ -240,21 +256,9 @@ def quantity_name(name: str, description: str | None = None, *, domain: str = ""
     """
     if "." in name:
         domain, name = name.split(".", 1)
-    m = re.fullmatch(r"tau_(\d+)_h", name)
-    if m:
-        return f"time constant τ{m.group(1).translate(_SUB)}"
-    m = re.fullmatch(r"gain_(Ti|Pi|RHi)_(.+)", name)
-    if m:
-        return f"gain from {_input_words(m.group(2))}"
-    m = re.fullmatch(r"offset_(Ti|Pi|RHi)_(.+)", name)
-    if m:
-        return f"offset from {_input_words(m.group(2))}"
-    m = re.fullmatch(r"fI_(\w+)", name)
-    if m:
-        return f"solar aperture, {surface_words(m.group(1))}"
-    m = re.fullmatch(r"x0_(\w+)", name)
-    if m:
-        return f"initial state of node {m.group(1)}"
+    for pattern, words in _NAME_PATTERNS:
+        if m := pattern.fullmatch(name):
+            return words(m)
     for kind, words in _NOISE_WORDS.items():
         if name.startswith(f"{kind}_"):
             return words.format(o=name[len(kind) + 1 :])

@@ -139,8 +139,8 @@ def _solve_capacity(A_of_cw, target_tau_h: float) -> float:
 #: The hygric truths' log-uniform ranges [kg/(s·Pa)] (:func:`truth`; ``Gf`` without a
 #: floor area only): :func:`truth_priors` gives the fit these very distributions. The
 #: fixed node's ``Pf`` and (with a floor area) ``Gf`` are drawn from the fit's default
-#: priors (:func:`~heritage_bayes.inference.parameters.fixed_vapour_pressure_prior`,
-#: :func:`~heritage_bayes.inference.parameters.vapour_ground_prior`).
+#: priors (:func:`~heritage_bayes.inference.survey.fixed_vapour_pressure_prior`,
+#: :func:`~heritage_bayes.inference.survey.vapour_ground_prior`).
 HYGRIC_TRUTH = {"Gw": (5e-9, 5e-8), "Gi": (3e-7, 3e-6), "Gf": (2e-8, 2e-7)}
 #: log-uniform ranges of the thermal truths [W/K], [W/K], [W/K] (Gf: without a floor
 #: area), [m²]
@@ -174,7 +174,7 @@ def truth_priors(
     prior). SBC is exact only when the truths are drawn from the prior the fit uses:
     ``--truth-priors`` measures what is left of a bias once the prior and the truth
     distribution agree."""
-    from heritage_bayes.inference.parameters import (
+    from heritage_bayes.inference.survey import (
         air_capacity_prior,
         ground_prior,
         ventilation_prior,
@@ -212,7 +212,7 @@ def truth(
     5-40 W/K (the study before the floor-area prior). A hygric fixed node's Pf and Gf
     from the fit's physical priors (Gf's with ``floor_area``), or with ``flat_node``
     from the ranges of the study before them (:data:`PF_FLAT`, ``HYGRIC_TRUTH``)."""
-    from heritage_bayes.inference.parameters import (
+    from heritage_bayes.inference.survey import (
         air_capacity_prior,
         fixed_vapour_pressure_prior,
         ground_prior,
@@ -367,7 +367,7 @@ def log_posterior(model, noise, U, y, priors, floor, envelope, init: str):
     and envelope areas; the soft cap on time constants) with ``priors`` (those of the
     model's and the noise's parameters) over them, ``init`` the initial state
     (``estimate`` or ``steady``, the latter with a 14-day warm-up)."""
-    from heritage_bayes.config import ModelSection
+    from heritage_bayes.config import ModelSection, prior_specs
     from heritage_bayes.inference.parameters import parameters_for
     from heritage_bayes.inference.posterior import LogPosterior
 
@@ -378,7 +378,7 @@ def log_posterior(model, noise, U, y, priors, floor, envelope, init: str):
     ps = parameters_for(
         model,
         noise,
-        {k: v for k, v in priors.items() if k in names},
+        prior_specs({k: v for k, v in priors.items() if k in names}),
         room_volume=VOLUME,
         air_change_rate=ACH,
         floor_area=floor,

@@ -13,6 +13,7 @@ import pytest
 
 import heritage_bayes as hb
 from heritage_bayes.climate.psychro import saturation_vapour_pressure
+from heritage_bayes.config import prior_specs
 from heritage_bayes.inference.likelihoods import get_noise_model
 from heritage_bayes.inference.optimize import find_map
 from heritage_bayes.inference.parameters import parameters_for
@@ -96,7 +97,7 @@ def _se(lp, theta, names):
 
 def _fit(m, truth, U, y, free, seed):
     noise = get_noise_model("iid")
-    priors = {k: {"fixed": v} for k, v in truth.items() if k not in free}
+    priors = prior_specs({k: {"fixed": v} for k, v in truth.items() if k not in free})
     ps = parameters_for(m, noise, priors)
     lp = LogPosterior(m, ps, noise, U, y[:, None], warmup=48, init_window=1)
     mp = find_map(lp, seed=seed, maxiter=100, starts=2)

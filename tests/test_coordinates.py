@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import heritage_bayes as hb
+from heritage_bayes.config import prior_specs
 from heritage_bayes.inference.coordinates import NodeTimeConstants, node_time_constants
 from heritage_bayes.inference.likelihoods import get_noise_model
 from heritage_bayes.inference.parameters import parameters_for
@@ -27,7 +28,7 @@ def _logpost(name="thermal_2c", N=24 * 20, priors=None, seed=0):
     truth = dict(Cw=5e7, Ci=2e6, Gw=150.0, Gi=300.0, Gfast=80.0, Gf=30.0, fI_S=3.0, Ge=230.0)
     y = hb.simulate(m, {k: truth[k] for k in m.parameter_names}, U)[:, 0]
     noise = get_noise_model("ar1")
-    ps = parameters_for(m, noise, priors or {}, room_volume=400)
+    ps = parameters_for(m, noise, prior_specs(priors or {}), room_volume=400)
     y = y + rng.normal(0, 0.1, N)
     return LogPosterior(m, ps, noise, U, y[:, None], warmup=24, init_window=24), truth
 
@@ -204,7 +205,7 @@ def _logpost_4a(surfaces=("S", "N"), priors=None):
     m = hb.model("thermal_4a", surfaces=surfaces)
     noise = get_noise_model("ar1")
     U = np.ones((48, len(m.input_names)))
-    ps = parameters_for(m, noise, priors or {})
+    ps = parameters_for(m, noise, prior_specs(priors or {}))
     return LogPosterior(m, ps, noise, U, np.ones((48, 1)), warmup=0)
 
 

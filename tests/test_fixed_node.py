@@ -13,16 +13,16 @@ import pytest
 
 import heritage_bayes as hb
 from heritage_bayes.climate.psychro import saturation_vapour_pressure
-from heritage_bayes.config import parse_config
+from heritage_bayes.config import parse_config, prior_specs
 from heritage_bayes.errors import ConfigError
 from heritage_bayes.inference.likelihoods import get_noise_model
-from heritage_bayes.inference.parameters import (
+from heritage_bayes.inference.parameters import parameters_for
+from heritage_bayes.inference.survey import (
     DELTA_AIR,
     RH_FIXED_NODE,
     SD_FLOOR,
     SIGMA_FIXED_NODE,
     fixed_vapour_pressure_prior,
-    parameters_for,
     vapour_ground_prior,
 )
 from heritage_bayes.inputs import fixed_node_temperature
@@ -79,7 +79,7 @@ def test_parameters_for_sets_the_fixed_node_priors_of_hygric_2c_fixed_only():
     user = parameters_for(
         hy,
         NOISE,
-        {"Pf": {"dist": "uniform", "lower": 0, "upper": 3000}},
+        prior_specs({"Pf": {"dist": "uniform", "lower": 0, "upper": 3000}}),
         fixed_node_temperature=10.0,
     )
     assert (_prior(user, "Pf").dist, _prior(user, "Pf").upper) == ("uniform", 3000.0)

@@ -7,18 +7,15 @@ import pytest
 from scipy import integrate, stats
 
 import heritage_bayes as hb
+from heritage_bayes.config import prior_specs
 from heritage_bayes.errors import ConfigError, InputError
 from heritage_bayes.inference.likelihoods import AR1Noise, IIDNoise, _ar1_sample, get_noise_model
 from heritage_bayes.inference.optimize import find_map
-from heritage_bayes.inference.parameters import (
-    Parameter,
-    ParameterSet,
-    Prior,
-    air_capacity_prior,
-    parameters_for,
-)
+from heritage_bayes.inference.parameters import Parameter, ParameterSet, parameters_for
 from heritage_bayes.inference.posterior import LogPosterior
+from heritage_bayes.inference.priors import Prior, configured_prior, default_prior
 from heritage_bayes.inference.sampler import run_sampler
+from heritage_bayes.inference.survey import air_capacity_prior
 from heritage_bayes.rc.discretize import modal_form
 
 PRIORS = [
@@ -76,18 +73,31 @@ def test_vectorised_transform_matches_per_prior_path():
 
 
 def test_prior_specs_and_errors_name_the_key():
-    p = Prior.from_spec({"dist": "lognormal", "median": 100.0, "sigma": 0.5}, where="x")
+    default = default_prior("thermal", "conductance")
+    spec = prior_specs({"x": {"dist": "lognormal", "median": 100.0, "sigma": 0.5}})["x"]
+    p = configured_prior(spec, default, where="x")
     assert p.lower == pytest.approx(100 * math.exp(-2.5))
     with pytest.raises(ConfigError, match=r"priors\.Gw\.lower: must be < upper \(got 500 >= 200\)"):
-        Prior.from_spec({"dist": "loguniform", "lower": 500, "upper": 200}, where="priors.Gw")
-    with pytest.raises(ConfigError, match=r"priors\.Gw: unknown key\(s\) \['low'\]"):
-        Prior.from_spec({"dist": "loguniform", "low": 1}, where="priors.Gw")
+        prior_specs({"Gw": {"dist": "loguniform", "lower": 500, "upper": 200}})
+    with pytest.raises(ConfigError, match=r"priors\.Gw\.low: unknown key; did you mean 'lower'"):
+        prior_specs({"Gw": {"dist": "loguniform", "low": 1}})
+    # bounds checked once merged with the default's: lower 0.01 W/K above this upper
+    with pytest.raises(ConfigError, match=r"priors\.Gw\.lower: must be < upper"):
+        configured_prior(prior_specs({"Gw": {"upper": 0.001}})["Gw"], default, where="priors.Gw")
+    # a centre the default family has not: named, not ignored
+    with pytest.raises(ConfigError, match=r"priors\.Gw\.median: a loguniform prior has no"):
+        configured_prior(
+            prior_specs({"Gw": {"median": 5, "sigma": 1}})["Gw"], default, where="priors.Gw"
+        )
     m = hb.model("thermal_1c")
     with pytest.raises(ConfigError, match=r"thermal\.priors: unknown parameter\(s\) \['Gx'\]"):
-        parameters_for(m, AR1Noise(), {"Gx": {"fixed": 1}}, where="thermal.priors")
+        parameters_for(m, AR1Noise(), prior_specs({"Gx": {"fixed": 1}}), where="thermal.priors")
     with pytest.raises(ConfigError, match=r"priors\.Ge\.fixed: expected a number"):
-        parameters_for(m, AR1Noise(), {"Ge": {"fixed": "abc"}})
-    ps = parameters_for(m, AR1Noise(), {"Ge": {"fixed": 50}, "Gf": {"upper": 10}}, room_volume=400)
+        prior_specs({"Ge": {"fixed": "abc"}})
+    with pytest.raises(ConfigError, match=r"priors\.Ge\.fixed: a conductance must be within"):
+        parameters_for(m, AR1Noise(), prior_specs({"Ge": {"fixed": -1}}))
+    given = prior_specs({"Ge": {"fixed": 50}, "Gf": {"upper": 10}})
+    ps = parameters_for(m, AR1Noise(), given, room_volume=400)
     assert ps["Ge"].fixed == 50 and "Ge" not in ps.free_names
     assert ps["Gf"].prior.upper == 10 and ps["Gf"].prior.dist == "loguniform"
     # the room volume sets a log-normal prior on the air capacity around 5 x rho c V
@@ -268,7 +278,7 @@ def test_floor_area_sets_the_ground_prior_of_thermal_models():
     from heritage_bayes.config import parse_config
     from heritage_bayes.errors import ConfigError
     from heritage_bayes.inference.likelihoods import get_noise_model
-    from heritage_bayes.inference.parameters import U_GROUND, ground_prior, parameters_for
+    from heritage_bayes.inference.survey import U_GROUND, ground_prior
     from heritage_bayes.run import section_parameters
 
     noise = get_noise_model("ar1_white")
@@ -302,12 +312,7 @@ def test_glazing_area_sets_the_aperture_priors():
     ignores it; a surface the model or data.surfaces lacks, an area ≤ 0 and a key with
     no solar input are ConfigErrors naming the key."""
     from heritage_bayes.config import parse_config
-    from heritage_bayes.inference.parameters import (
-        APERTURE_PER_GLAZING,
-        aperture_prior,
-        default_prior,
-        parameters_for,
-    )
+    from heritage_bayes.inference.survey import APERTURE_PER_GLAZING, aperture_prior
     from heritage_bayes.run import section_parameters
 
     p = aperture_prior(8.0)
@@ -367,16 +372,14 @@ def test_envelope_area_bounds_the_envelope_node():
     from heritage_bayes.config import parse_config
     from heritage_bayes.errors import ConfigError
     from heritage_bayes.inference.likelihoods import get_noise_model
-    from heritage_bayes.inference.parameters import (
+    from heritage_bayes.inference.survey import (
         C_BUFFER_MAX,
         C_ENVELOPE_MAX,
         G_VAPOUR_MAX,
         G_VAPOUR_MIN,
         H_EXTERIOR,
         U_ENVELOPE_MIN,
-        default_prior,
         envelope_priors,
-        parameters_for,
     )
     from heritage_bayes.run import section_parameters
 
@@ -427,7 +430,7 @@ def test_interior_area_sets_a_lognormal_prior_on_gint():
     the config states on Gint wins; the config key reaches the parameters; an area ≤ 0
     is a ConfigError naming the key."""
     from heritage_bayes.config import parse_config
-    from heritage_bayes.inference.parameters import H_INTERIOR, default_prior, interior_prior
+    from heritage_bayes.inference.survey import H_INTERIOR, interior_prior
     from heritage_bayes.run import section_parameters
 
     noise = get_noise_model("ar1_white")
@@ -453,7 +456,7 @@ def test_interior_area_sets_a_lognormal_prior_on_gint():
     for m in (hb.model("thermal_2c", surfaces=("S",)), hb.model("hygric_2c")):
         base = parameters_for(m, noise).to_dict()
         assert parameters_for(m, noise, interior_area=80.0).to_dict() == base
-    own = {"Gint": {"dist": "loguniform", "lower": 10, "upper": 1000}}
+    own = prior_specs({"Gint": {"dist": "loguniform", "lower": 10, "upper": 1000}})
     stated = {
         p.name: p.prior for p in parameters_for(th, noise, own, interior_area=80.0).parameters
     }

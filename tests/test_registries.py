@@ -124,7 +124,8 @@ def test_every_declared_name_has_its_implementation_and_no_other():
 def test_a_model_s_own_parameter_roles_take_the_room_s_priors(restore_registries):
     """The room's description sets priors by role: a model naming its air capacity
     ``Ca`` declares the role and gets ``room_volume``'s prior on it."""
-    from heritage_bayes.inference.parameters import air_capacity_prior, parameters_for
+    from heritage_bayes.inference.parameters import parameters_for
+    from heritage_bayes.inference.survey import air_capacity_prior
 
     def network() -> Network:
         return Network(

@@ -788,7 +788,7 @@ def test_identifiable_coordinates_are_tau_gains_and_scale(run_dir):
 def test_prior_density_is_the_prior():
     from scipy.stats import truncnorm
 
-    from heritage_bayes.inference.parameters import Prior
+    from heritage_bayes.inference.priors import Prior
     from heritage_bayes.report.identifiable import prior_density
 
     x, p = prior_density(Prior("loguniform", 1e4, 1e12), log10=True)

@@ -11,7 +11,7 @@ import pytest
 from heritage_bayes.climate.solar import roof_planes, surface_irradiance
 from heritage_bayes.config import load_config, parse_config
 from heritage_bayes.errors import ConfigError, InputError
-from heritage_bayes.inference.parameters import ROOF_APERTURE_PER_AREA
+from heritage_bayes.inference.survey import ROOF_APERTURE_PER_AREA
 from heritage_bayes.init_config import init_config
 from heritage_bayes.inputs import solar_inputs
 from heritage_bayes.models import build_model

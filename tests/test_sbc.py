@@ -58,7 +58,7 @@ def test_hygric_truths_of_the_fixed_node_are_drawn_from_the_fit_priors():
     mean temperature) and vapour_ground_prior (80 m²): mean of log(x / median) within 4
     standard errors of 0 (σ/√200), its sd within 4 standard errors (σ/√400) of σ."""
     import heritage_bayes as hb
-    from heritage_bayes.inference.parameters import (
+    from heritage_bayes.inference.survey import (
         fixed_vapour_pressure_prior,
         vapour_ground_prior,
     )

@@ -11,7 +11,7 @@ import pytest
 import yaml
 
 from heritage_bayes.calibrate import build_model
-from heritage_bayes.config import parse_config
+from heritage_bayes.config import parse_config, prior_specs
 from heritage_bayes.inference.optimize import find_map
 from heritage_bayes.inference.posterior import LogPosterior
 from heritage_bayes.inference.results import fit_metrics
@@ -234,7 +234,7 @@ def test_a_controlled_room_restarts_steady_after_a_gap():
     truth = {n: truth.get(n, 1000.0) for n in m.parameter_names}
     y = hb.simulate(m, truth, te[:, None])[:, 0] + 0.1 * rng.standard_normal(N)
     noise = get_noise_model("iid")
-    ps = parameters_for(m, noise, {n: {"fixed": v} for n, v in truth.items()})
+    ps = parameters_for(m, noise, prior_specs({n: {"fixed": v} for n, v in truth.items()}))
     segs = ((0, 400), (440, N))
     lp = SegmentedLogPosterior(
         m, ps, noise, te[:, None], y[:, None], warmup=48, init_window=24, segments=segs

@@ -8,6 +8,7 @@ from scipy.integrate import solve_ivp
 
 import heritage_bayes as hb
 from heritage_bayes.climate.psychro import saturation_vapour_pressure as psat
+from heritage_bayes.config import prior_specs
 from heritage_bayes.errors import ConfigError
 from heritage_bayes.inference.likelihoods import get_noise_model
 from heritage_bayes.inference.optimize import find_map
@@ -214,7 +215,7 @@ def test_calibration_recovers_an_independent_room_with_a_nonlinear_isotherm():
     m = hb.model("hygric_2c_sorption").with_slopes(["Pe"])
     nm = get_noise_model("ar1_white")
     # the air's capacity known (the room's volume): it pins the overall scale
-    ps = parameters_for(m, nm, {"Ci": {"fixed": truth["Ci"]}})
+    ps = parameters_for(m, nm, prior_specs({"Ci": {"fixed": truth["Ci"]}}))
     lp = LogPosterior(m, ps, nm, U, obs[:, None], warmup=0, init_window=24,
                       initial_state="estimate")  # fmt: skip
     x0 = find_map(lp, seed=1, maxiter=60, starts=2).x

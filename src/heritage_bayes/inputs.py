@@ -38,7 +38,7 @@ def fixed_node_temperature(
     frame: pd.DataFrame, rows: slice, te: pd.Series | None, constant: float | None = None
 ) -> dict:
     """Temperature [°C] of the ground or crypt behind a hygric fixed vapour-pressure node
-    (the centre of :func:`heritage_bayes.inference.parameters.fixed_vapour_pressure_prior`).
+    (the centre of :func:`heritage_bayes.inference.survey.fixed_vapour_pressure_prior`).
 
     Parameters
     ----------

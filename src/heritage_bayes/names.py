@@ -1,4 +1,5 @@
-"""The name lists a user chooses from, declared once: noise models and sampler moves.
+"""The name lists a user chooses from, declared once: noise models, sampler moves and
+prior families.
 
 Layer 0, imported by the settings (the choices of ``noise:`` and ``sampler.moves``,
 :class:`heritage_bayes.config._base.Choices`), by the command line (``hbayes models
@@ -16,7 +17,16 @@ from __future__ import annotations
 
 from typing import NamedTuple
 
-__all__ = ["DEFAULT_NOISE", "MOVES", "NOISE_MODELS", "NoiseName", "declare_noise", "noise_traits"]
+__all__ = [
+    "DEFAULT_NOISE",
+    "MOVES",
+    "NOISE_MODELS",
+    "PRIOR_DISTRIBUTIONS",
+    "DistributionName",
+    "NoiseName",
+    "declare_noise",
+    "noise_traits",
+]
 
 
 class NoiseName(NamedTuple):
@@ -81,4 +91,41 @@ MOVES: dict[str, str] = {
     "de_global": "de_snooker whose DE part is replaced, for a walker in ten, by an "
     "independent draw from a Student-t fitted to the chain so far",
     "dime": "DE with those independent draws, no snooker",
+}
+
+
+class DistributionName(NamedTuple):
+    """What the package knows of a prior family (``priors.<name>.dist``) without
+    importing its numerics (:class:`heritage_bayes.inference.priors.Prior`)."""
+
+    #: One line for the references.
+    description: str
+    #: Sampled in log θ: the parameter must be positive (``lower > 0``).
+    log_scale: bool = False
+    #: The config key of its centre besides ``sigma`` (``median`` or ``mean``), in the
+    #: parameter's units; None for a flat family.
+    centre: str | None = None
+    #: Without bounds, the support is the centre ± ``span`` × ``sigma`` (in log θ for a
+    #: log-scale family).
+    span: float = 0.0
+
+
+#: ``priors.<name>.dist`` choices: the bounded prior families.
+PRIOR_DISTRIBUTIONS: dict[str, DistributionName] = {
+    "uniform": DistributionName("flat between lower and upper"),
+    "loguniform": DistributionName(
+        "flat in log θ between lower and upper (density ∝ 1/θ)", log_scale=True
+    ),
+    "normal": DistributionName(
+        "normal of mean and sd sigma, truncated to the bounds (default: mean ± 6 sigma)",
+        centre="mean",
+        span=6.0,
+    ),
+    "lognormal": DistributionName(
+        "log-normal of median and sd of log sigma, truncated to the bounds (default: "
+        "median × exp(±5 sigma))",
+        log_scale=True,
+        centre="median",
+        span=5.0,
+    ),
 }

@@ -14,7 +14,8 @@ the expected form and the value found, e.g. ``priors.Gw.lower: must be < upper (
 Modules, by topic: :mod:`~heritage_bayes.config.sources` (``site``, the tables),
 :mod:`~heritage_bayes.config.data` (``data``: solar input, ground, grid),
 :mod:`~heritage_bayes.config.periods`, :mod:`~heritage_bayes.config.models` (one
-calibrated model: options, noise, initial state, priors),
+calibrated model: options, noise, initial state), :mod:`~heritage_bayes.config.priors`
+(a parameter's prior or fixed value),
 :mod:`~heritage_bayes.config.sampler` (``sampler``, ``optimizer``),
 :mod:`~heritage_bayes.config.calibration` (the top level, outputs, :func:`load_config`),
 :mod:`~heritage_bayes.config.loader` (strict YAML), :mod:`~heritage_bayes.config.reference`
@@ -76,6 +77,7 @@ from heritage_bayes.config.data import Data, GroundTemperature
 from heritage_bayes.config.loader import load_yaml_text, read_yaml
 from heritage_bayes.config.models import ModelSection
 from heritage_bayes.config.periods import Period, Periods
+from heritage_bayes.config.priors import PriorSpec, prior_specs
 from heritage_bayes.config.reference import ConfigKey, config_keys, describe_key
 from heritage_bayes.config.sampler import OptimizerSettings, SamplerSettings
 from heritage_bayes.config.sources import DemoData, Site, Source
@@ -94,6 +96,7 @@ __all__ = [
     "OptimizerSettings",
     "Period",
     "Periods",
+    "PriorSpec",
     "SamplerSettings",
     "Site",
     "Source",
@@ -110,5 +113,6 @@ __all__ = [
     "nearest_key",
     "parse_config",
     "parse_duration",
+    "prior_specs",
     "read_yaml",
 ]

@@ -87,7 +87,7 @@ class Roof(_Strict):
     each tilted by ``pitch`` (:func:`heritage_bayes.climate.solar.roof_planes`); their
     irradiance is transposed from the same global (measured or estimated) irradiance and
     sky model as any surface. ``area`` sets the prior of their apertures
-    (:func:`heritage_bayes.inference.parameters.roof_aperture_prior`).
+    (:func:`heritage_bayes.inference.survey.roof_aperture_prior`).
     """
 
     pitch: float = key(

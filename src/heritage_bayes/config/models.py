@@ -1,8 +1,9 @@
 """Settings of one calibrated model (``thermal:``, ``hygric:``): the catalogue model and
-its options, the noise model, the initial state and the priors.
+its options, the noise model, the initial state and the priors
+(:class:`~heritage_bayes.config.priors.PriorSpec`, typed here).
 
-The model names, options and prior keys are checked where the catalogue is known
-(:func:`heritage_bayes.models.build_model`,
+The model names and options, and the parameter names of the priors, are checked where
+the catalogue is known (:func:`heritage_bayes.models.build_model`,
 :func:`heritage_bayes.inference.parameters.parameters_for`), before any data are read.
 """
 
@@ -15,6 +16,7 @@ import pandas as pd
 from pydantic import PlainSerializer, PlainValidator, WithJsonSchema
 
 from heritage_bayes.config._base import DURATION_UNIT, Choices, _duration, _Strict, key
+from heritage_bayes.config.priors import PriorSpec
 from heritage_bayes.convert import format_timedelta
 from heritage_bayes.names import DEFAULT_NOISE, NOISE_MODELS
 
@@ -115,10 +117,10 @@ class ModelSection(_Strict):
         ge=1,
         le=10,
     )
-    priors: dict[str, dict[str, Any]] = key(
+    priors: dict[str, PriorSpec] = key(
         unit="SI",
-        description="per parameter: {dist, lower, upper, mu, sigma, fixed} (hbayes models "
-        "NAME lists the names, units and default priors)",
+        description="per parameter name: a prior {dist, lower, upper, median or mean, sigma} "
+        "or {fixed: value} (hbayes models NAME lists the names, units and default priors)",
         default_factory=dict,
     )
     room_volume: float | None = key(

@@ -40,7 +40,7 @@ import math
 import numba
 import numpy as np
 
-from heritage_bayes.inference.parameters import Prior
+from heritage_bayes.inference.priors import Prior
 from heritage_bayes.names import NOISE_MODELS as DECLARED
 
 __all__ = [

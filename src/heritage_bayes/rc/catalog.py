@@ -67,7 +67,7 @@ Control of the air node (a heated, humidity-controlled or occupied room; see
 from __future__ import annotations
 
 import inspect
-from collections.abc import Callable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from typing import NamedTuple
 
 from heritage_bayes.rc.control import _parse_control, controlled
@@ -76,6 +76,7 @@ from heritage_bayes.rc.network import Link, Network, Node, Source
 from heritage_bayes.rc.sorption import CoupledHygricModel, coupled_network
 
 __all__ = [
+    "APERTURE_PREFIX",
     "CATALOG",
     "DOMAINS",
     "ROLES",
@@ -87,6 +88,7 @@ __all__ = [
     "model_ladder",
     "register",
     "roles_of",
+    "solar_apertures",
     "takes_option",
 ]
 
@@ -265,7 +267,7 @@ class CatalogModel(NamedTuple):
 
 
 #: The roles of a network's parameters that a description of the room sets a prior on
-#: (:func:`heritage_bayes.inference.parameters.parameters_for`): parameter name -> role,
+#: (:data:`heritage_bayes.inference.survey.ROLE_PRIORS`): parameter name -> role,
 #: by the catalogue's names. ``air_capacity`` (``room_volume``), ``ventilation``
 #: (``air_change_rate``), ``ground`` (``floor_area``), ``interior_mass``
 #: (``interior_area``), ``envelope`` (a conductance and a capacity: ``envelope_area``),
@@ -286,6 +288,19 @@ def roles_of(name: str) -> Mapping[str, str]:
     (a custom network named by the catalogue's conventions)."""
     entry = CATALOG.get(name)
     return entry.roles if entry is not None and entry.roles is not None else ROLES
+
+
+#: The name of the effective solar aperture [m²] of a surface: the gain of its
+#: irradiance input ``I_<surface>`` in the catalogue's networks.
+APERTURE_PREFIX = "fI_"
+
+
+def solar_apertures(parameter_names: Iterable[str]) -> dict[str, str]:
+    """The solar apertures among a network's parameters: name -> surface
+    (``fI_S`` -> ``S``); a custom network that names them so gets the priors a survey
+    sets on them (``glazing_area``, ``data.roof``)."""
+    n = len(APERTURE_PREFIX)
+    return {p: p[n:] for p in parameter_names if p.startswith(APERTURE_PREFIX)}
 
 
 #: Sections a catalogue model belongs to.

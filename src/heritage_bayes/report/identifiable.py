@@ -205,7 +205,7 @@ def prior_density(prior, log10: bool, n: int = 400) -> tuple[np.ndarray, np.ndar
 
     Parameters
     ----------
-    prior : heritage_bayes.inference.parameters.Prior
+    prior : heritage_bayes.inference.priors.Prior
     log10 : bool
         Density of ``y = log10 θ`` [1/decade] (``p(θ) · θ · ln 10``) instead of θ.
     n : int

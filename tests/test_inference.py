@@ -328,7 +328,10 @@ def test_glazing_area_sets_the_aperture_priors():
     assert prior["fI_N"] == default_prior("thermal", "gain")
     # an explicit prior in the section still wins over the survey's
     ps = parameters_for(
-        th, noise, {"fI_S": {"dist": "uniform", "lower": 0, "upper": 5}}, glazing_area={"S": 8}
+        th,
+        noise,
+        prior_specs({"fI_S": {"dist": "uniform", "lower": 0, "upper": 5}}),
+        glazing_area={"S": 8},
     )
     assert {q.name: q.prior for q in ps.parameters}["fI_S"].dist == "uniform"
     with pytest.raises(ConfigError, match=r"glazing_area: surface\(s\) \['E'\]"):

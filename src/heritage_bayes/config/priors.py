@@ -36,6 +36,13 @@ def _number(v: Any) -> Any:
     return v
 
 
+class _FamilyOrNone(Choices):
+    """A prior family's name, or None (the parameter's default family)."""
+
+    def _check(self, value: Any) -> str | None:
+        return None if value is None else super()._check(value)
+
+
 #: A finite number in the parameter's unit.
 Number = Annotated[int | float, BeforeValidator(_number)]
 
@@ -46,11 +53,12 @@ class PriorSpec(_Strict):
     NAME`` lists the names, units and default priors). Keys left out keep the default
     prior's: its family, and its bounds when the family is the same."""
 
-    dist: Annotated[str, Choices(PRIOR_DISTRIBUTIONS)] | None = key(
+    dist: Annotated[str | None, _FamilyOrNone(PRIOR_DISTRIBUTIONS)] = key(
         None,
         unit=None,
-        description="the family: uniform, loguniform (flat in log), normal, lognormal "
-        "(default: the parameter's default prior's)",
+        description="the family: "
+        + "; ".join(f"{k}, {v.description}" for k, v in PRIOR_DISTRIBUTIONS.items())
+        + " (default: the parameter's default prior's)",
     )
     lower: Number | None = key(
         None,

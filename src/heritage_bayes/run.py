@@ -61,8 +61,8 @@ def section_parameters(cfg: CalibrationConfig, section: str, model: RCModel, pri
     section : {"thermal", "hygric"}
     model : RCModel
         The section's model.
-    priors : mapping, optional
-        Prior overrides (default: the section's ``priors``).
+    priors : mapping name -> PriorSpec, optional
+        Prior overrides, typed (default: the section's ``priors``).
 
     Returns
     -------

@@ -170,18 +170,18 @@ def patched(variant: str, raw: pd.DataFrame):
 
     orig = inputs.solar_inputs
 
-    def solar_inputs(weather, site, surfaces, mode, *, where="data.weather", roof=()):
+    def solar_inputs(weather, site, surfaces, mode, *, where="data.weather", roof=(), **kw):
         if variant.startswith("wind_u"):
             u = float(variant[6:])
             w = solair.roof_wind_weight(
                 weather["wind"].interpolate(limit_direction="both").to_numpy(), u
             )
             out, label, detail = orig(weather.drop(columns="wind"), site, surfaces, mode,
-                                      where=where)  # fmt: skip
+                                      where=where, roof=roof, **kw)  # fmt: skip
             for k in roof:
                 out[f"I_{k}"] = out[f"I_{k}"].to_numpy() * w
             return out, label, detail
-        out, label, detail = orig(weather, site, surfaces, mode, where=where, roof=roof)
+        out, label, detail = orig(weather, site, surfaces, mode, where=where, roof=roof, **kw)
         if variant == "sky":
             table = weather if "ghi" in weather else _estimated(weather, site)
             cols = {f"I_{k}": v for k, v in surfaces.items()}

@@ -244,14 +244,6 @@ def _output_hint(missing: Sequence[str]) -> str:
     return "; ".join(hints) or "unknown output"
 
 
-def _roof_inputs(roof) -> dict:
-    """The roof's keywords of :func:`~heritage_bayes.inputs.weather_inputs`: its planes
-    and their skyline [°] (none without ``data.roof``)."""
-    if roof is None:
-        return {"roof": (), "roof_horizon": 0.0}
-    return {"roof": tuple(roof.planes()), "roof_horizon": roof.horizon}
-
-
 def _extra_inputs(cfg) -> list[str]:
     """Model inputs beyond those built here (Te, Pe, Tf, I_<surface>), in model order."""
     from heritage_bayes.models import build_model  # the models decide their inputs
@@ -346,7 +338,7 @@ def prepare(cfg) -> Prepared:
         surfaces=surfaces,
         where="data.weather",
         extra=_extra_inputs(cfg),
-        **_roof_inputs(data.roof),
+        **(data.roof.input_keywords() if data.roof is not None else {}),
     )
     sources["irradiance"] = note["irradiance"]
     irradiance_source = note["irradiance_source"]

@@ -135,6 +135,11 @@ class Roof(_Strict):
 
         return roof_planes(self.pitch, self.ridge_azimuth)
 
+    def input_keywords(self) -> dict:
+        """``roof`` (the planes' names) and ``roof_horizon`` [°] of
+        :func:`heritage_bayes.inputs.weather_inputs`."""
+        return {"roof": tuple(self.planes()), "roof_horizon": self.horizon}
+
     def plane_areas(self) -> dict[str, float]:
         """Each slope's area [m²] (half of ``area``); empty without ``area``."""
         if self.area is None:

@@ -124,8 +124,9 @@ def solar_surface_lines(attic: str | None) -> list[str]:
         "slopes along the slope] for a prior on the apertures. A mono-pitch or flat roof, or "
         "not an attic: replace 'roof' by surfaces (e.g. {H: [0, 0]}). With a wind speed in "
         "the weather (weather.columns.wind [m/s]) the slopes' sun is weighted by the wind "
-        "on the roof (a calm day's sun heats the attic more). The low sun is shaded below "
-        f"horizon: {ROOF_HORIZON:g}° (houses, trees around; 0 for a roof open to the horizon)."
+        "on the roof (a calm day's sun heats the attic more). The slopes are shaded while the "
+        f"sun is below horizon: [°] (default {ROOF_HORIZON:g}: the houses and trees around); "
+        "give 0 for a roof open to the horizon."
     )
     return [
         *wrap_comment(text, "  # ", "  # "),

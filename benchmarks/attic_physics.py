@@ -20,7 +20,30 @@ variant of the roof planes' irradiance input:
   degree-day snowpack on FMI's precipitation (snow below +1 °C, melt 3 mm/(K d), a
   roof covered from 5 mm water equivalent; snow absorbs a third of what the roof does).
 
-The three candidates are not in the package (only the wind weight paid, see
+- ``horizon<N>``: the roof's skyline ``data.roof.horizon`` set to N° (the package's
+  default 20°; ``horizon0``: none, the package before it).
+
+Candidate models (``--models``; none of them is in the package, see
+``docs/science/real_rooms.md``, "The sun on the roof and the house below"), registered
+here for the run:
+
+- ``thermal_1c``: the catalogue's (the default);
+- ``deck``: a light roof deck ``Tr`` (capacity ``Cr``, prior log-uniform 1e4-1e7 J/K:
+  tiles, battens and underlay) between the sun on the slopes and the attic air ``Ti``:
+  ``Gr`` deck - outdoor air, ``Gri`` deck - attic air, ``Gfast`` attic air - outdoor
+  air, ``Gf`` to ``Tf``; the slopes' apertures heat the deck;
+- ``deck_heavy``: ``deck`` with a heavy node ``Tint`` (``Cint``, ``Gint``) on the air
+  (the ceiling's insulation and joists);
+- ``below20``: ``thermal_1c`` plus a conductance ``Gb`` to a heated room below at a
+  constant 20 °C (fixed), beside the ground ``Tf``;
+- ``below_measured``: the same with the room below's measured temperature
+  (``indoor1.csv``) instead of 20 °C, beside the ground (it enters through the
+  weather's one free column, ``Ph``, as a temperature);
+- ``ground_measured``: ``thermal_1c`` with ``Tf`` = the room below's measured
+  temperature, replacing the ground (init's written advice for a room without a floor
+  on the ground).
+
+The three roof-input candidates are not in the package (only the wind weight paid, see
 ``docs/science/real_rooms.md``, "The wind on the roof"); they are written here as
 changes of the irradiance table before alignment. ``--hours``: the MAP's residual
 (measured - simulated Ti) by season and hour of day, calibration and validation, and
@@ -28,7 +51,8 @@ the correlation of its daily mean with FMI's daily mean wind speed.
 
 Usage (from the repository root)::
 
-    python benchmarks/attic_physics.py [ROOM ...] [--variants none wind sky snow] [--hours]
+    python benchmarks/attic_physics.py [ROOM ...] [--variants none wind sky snow horizon0]
+        [--models thermal_1c deck below20 ...] [--hours] [--measured]
 
 ROOM: R2 R4 R6 (the tuning attics, the default); the held-out ones are refused.
 """
@@ -52,6 +76,48 @@ from real_rooms import ROOMS, run_init  # noqa: E402
 
 TUNING = ["R2", "R4", "R6"]
 SIGMA = 5.670374419e-8  # Stefan-Boltzmann [W/(m² K⁴)]
+DECK_PRIOR = {"Cr": {"dist": "loguniform", "lower": 1e4, "upper": 1e7}}  # [J/K]
+#: candidate -> catalogue name, options, priors (see the module docstring)
+MODELS = {
+    "thermal_1c": ("thermal_1c", {}, {}),
+    "deck": ("x_deck", {}, DECK_PRIOR),
+    "deck_heavy": ("x_deck_heavy", {}, DECK_PRIOR),
+    "below20": ("x_below", {"below": "constant"}, {"Tb": {"fixed": 20.0}}),
+    "below_measured": ("x_below", {"below": "column"}, {}),
+    "ground_measured": ("thermal_1c", {}, {}),
+}
+
+
+def _candidate(name, surfaces=None, ground=True, deck=True, heavy=False, below=None):
+    """The candidates' networks: [°C], [J/K], [W/K], apertures [m²]."""
+    from heritage_bayes.rc.network import Link, Network, Node, Source
+
+    nodes = [Node("Tr", "Cr")] * deck + [Node("Ti", "Ci")] + [Node("Tint", "Cint")] * heavy
+    links = [Link("Tr", "Te", "Gr"), Link("Tr", "Ti", "Gri")] * deck
+    links += [Link("Ti", "Te", "Gfast" if deck else "Ge")] + [Link("Ti", "Tint", "Gint")] * heavy
+    links += [Link("Ti", "Tf", "Gf")] * bool(ground)
+    inputs = ["Te", *(f"I_{s}" for s in surfaces or ()), *["Tf"] * bool(ground)]
+    if below:  # the room below: a fixed constant Tb or the measured column (as Ph)
+        links.append(Link("Ti", "Tb" if below == "constant" else "Ph", "Gb"))
+        inputs += ["Ph"] * (below == "column")
+    sources = [Source(f"I_{s}", "Tr" if deck else "Ti", f"fI_{s}") for s in surfaces or ()]
+    return Network(name=name, domain="thermal", nodes=tuple(nodes), links=tuple(links),
+                   inputs=tuple(inputs), outputs=("Ti",), sources=tuple(sources),
+                   constants=("Tb",) * (below == "constant"))  # fmt: skip
+
+
+def _register() -> None:
+    from heritage_bayes.rc.catalog import CATALOG, CatalogModel, register
+
+    for name, fixed in (("x_deck", {}), ("x_deck_heavy", {"heavy": True}),
+                        ("x_below", {"deck": False})):  # fmt: skip
+        if name in CATALOG:
+            continue
+
+        def build(surfaces=None, ground=True, heating=False, below=None, _n=name, _f=fixed):
+            return _candidate(_n, surfaces, ground, below=below, **_f)
+
+        register(name, CatalogModel(build, "a candidate of attic_physics.py", "thermal", True))
 
 
 def _fmi(room: str, data: Path) -> pd.DataFrame:
@@ -104,18 +170,18 @@ def patched(variant: str, raw: pd.DataFrame):
 
     orig = inputs.solar_inputs
 
-    def solar_inputs(weather, site, surfaces, mode, *, where="data.weather", roof=()):
+    def solar_inputs(weather, site, surfaces, mode, *, where="data.weather", roof=(), **kw):
         if variant.startswith("wind_u"):
             u = float(variant[6:])
             w = solair.roof_wind_weight(
                 weather["wind"].interpolate(limit_direction="both").to_numpy(), u
             )
             out, label, detail = orig(weather.drop(columns="wind"), site, surfaces, mode,
-                                      where=where)  # fmt: skip
+                                      where=where, roof=roof, **kw)  # fmt: skip
             for k in roof:
                 out[f"I_{k}"] = out[f"I_{k}"].to_numpy() * w
             return out, label, detail
-        out, label, detail = orig(weather, site, surfaces, mode, where=where, roof=roof)
+        out, label, detail = orig(weather, site, surfaces, mode, where=where, roof=roof, **kw)
         if variant == "sky":
             table = weather if "ghi" in weather else _estimated(weather, site)
             cols = {f"I_{k}": v for k, v in surfaces.items()}
@@ -134,25 +200,53 @@ def _estimated(weather, site):
     return temperature_range_weather(weather["Te"], dict(site))
 
 
-def run(room, variant, bare, data, work, hours):
+def _weather(room, data, w, bare, below) -> Path | None:
+    """The FMI file as published, or a copy without its radiation and/or with the room
+    below's measured temperature as column ``Tb`` (mapped to ``Ph`` after init)."""
+    if not bare and not below:
+        return None
+    fmi = pd.read_csv(data / ROOMS[room][1])
+    if bare:
+        fmi = fmi.drop(columns=["Rglob", "Rdif"])
+    if below:
+        house = pd.read_csv(data / Path(ROOMS[room][0]).parent / "indoor1.csv")
+        fmi = fmi.merge(house[["t_UTC+2", "T"]].rename(columns={"T": "Tb"}), "left", "t_UTC+2")
+    fmi.to_csv(w / "wx" / "fmi.csv", index=False)
+    return w / "wx" / "fmi.csv"
+
+
+def _config(room, variant, model, bare, data, w):
+    """init's config for the variant and the candidate model (MAP at 100 generations,
+    2 starts, thermal section only)."""
     from heritage_bayes.config import load_config
+    from real_rooms import room_below
+
+    config = run_init(room, data, w, _weather(room, data, w, bare, model == "below_measured"))[0]
+    if model == "ground_measured":
+        config = room_below(config, data / ROOMS[room][0])
+    cfg = load_config(config)
+    d = cfg.data
+    if variant == "none":
+        cols = {k: v for k, v in d.weather.columns.items() if k != "wind"}
+        d = d.model_copy(update={"weather": d.weather.model_copy(update={"columns": cols})})
+    if variant.startswith("horizon"):
+        roof = d.roof.model_copy(update={"horizon": float(variant[7:])})
+        d = d.model_copy(update={"roof": roof})
+    if model == "below_measured":
+        cols = {**d.weather.columns, "Ph": "Tb"}
+        d = d.model_copy(update={"weather": d.weather.model_copy(update={"columns": cols})})
+    name, options, priors = MODELS[model]
+    th = cfg.thermal.model_copy(update={"model": name, "options": options, "priors": priors})
+    opt = cfg.optimizer.model_copy(update={"maxiter": 100, "starts": 2})
+    return cfg.model_copy(update={"data": d, "optimizer": opt, "thermal": th, "hygric": None})
+
+
+def run(room, variant, bare, data, work, hours, model="thermal_1c"):
     from heritage_bayes.inference.results import fit_metrics
 
-    w = work / room / ("bare" if bare else "meas")
+    w = work / room / ("bare" if bare else "meas") / model
     (w / "wx").mkdir(parents=True, exist_ok=True)
-    weather = None
-    if bare:
-        weather = w / "wx" / "fmi.csv"
-        bare_fmi = pd.read_csv(data / ROOMS[room][1]).drop(columns=["Rglob", "Rdif"])
-        bare_fmi.to_csv(weather, index=False)
-    cfg = load_config(run_init(room, data, w, weather)[0])
-    if variant == "none":
-        cols = {k: v for k, v in cfg.data.weather.columns.items() if k != "wind"}
-        src = cfg.data.weather.model_copy(update={"columns": cols})
-        cfg = cfg.model_copy(update={"data": cfg.data.model_copy(update={"weather": src})})
-    opt = cfg.optimizer.model_copy(update={"maxiter": 100, "starts": 2})
-    th = cfg.thermal.model_copy(update={"model": "thermal_1c"})
-    cfg = cfg.model_copy(update={"optimizer": opt, "thermal": th, "hygric": None})
+    cfg = _config(room, variant, model, bare, data, w)
     undo = patched(variant, _fmi(room, data))
     try:
         prep, m, lp, mp = config_map(cfg, "thermal")
@@ -164,6 +258,7 @@ def run(room, variant, bare, data, work, hours):
     v = prep.validation
     fit = fit_metrics(obs[v], y[v])["FIT"]
     if hours:
+        print(" ".join(f"{k}={x:.3g}" for k, x in zip(lp.params.names, mp.theta, strict=True)))
         sl = slice(prep.calibration.start, v.stop)
         e = pd.Series(obs[sl] - y[sl], index=prep.frame.index[sl] + pd.Timedelta(hours=2))
         season = np.array(["DJF", "DJF", "MAM", "MAM", "MAM", "JJA", "JJA", "JJA", "SON",
@@ -183,17 +278,23 @@ def main(argv=None) -> int:
     ap.add_argument("rooms", nargs="*", default=TUNING)
     ap.add_argument("--variants", nargs="+", default=["none", "wind", "sky", "snow"])
     ap.add_argument("--data", type=Path, default=ROOT.parent / "shared" / "data")
+    ap.add_argument("--models", nargs="+", default=["thermal_1c"], choices=list(MODELS))
     ap.add_argument("--hours", action="store_true", help="residual by season and hour")
+    ap.add_argument("--measured", action="store_true", help="measured radiation only")
     args = ap.parse_args(argv)
     if set(args.rooms) - set(TUNING):
         ap.error(f"tuning attics only: {TUNING} (the others are held out)")
     work = Path(tempfile.mkdtemp(prefix="attic_physics_"))
-    print("validation FIT of Ti [%], thermal_1c MAP (100 generations, 2 starts)")
-    print("| room | variant | measured radiation | estimated |")
+    _register()
+    print("validation FIT of Ti [%], MAP (100 generations, 2 starts)")
+    print("| room | variant | model | measured radiation | estimated |")
     for room in args.rooms:
-        for variant in args.variants:
-            fits = [run(room, variant, bare, args.data, work, args.hours) for bare in (0, 1)]
-            print(f"| {room} | {variant} | {fits[0]:.1f} | {fits[1]:.1f} |", flush=True)
+        for model in args.models:
+            for variant in args.variants:
+                modes = (0,) if args.measured else (0, 1)
+                fits = [run(room, variant, b, args.data, work, args.hours, model) for b in modes]
+                cells = " | ".join(f"{f:.1f}" for f in fits) + " | -" * args.measured
+                print(f"| {room} | {variant} | {model} | {cells} |", flush=True)
     return 0
 
 

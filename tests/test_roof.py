@@ -228,3 +228,42 @@ def test_init_reads_a_wind_speed_column(tmp_path):
     lay = inspect_table(p)
     assert lay.first("wind").name == "ws" and lay.first("wind").unit == "m/s"
     assert [c.name for c in lay.columns if c.kind is None] == ["wd"]
+
+
+def test_a_skyline_shades_the_low_sun_on_the_roof_planes_only():
+    """Below the roof's skyline the slopes get the isotropic sky without the beam, above it
+    the unshaded transposition; a facade beside them is unchanged; horizon 0 is the
+    unshaded surface; the config's default and its bounds."""
+    idx = pd.date_range("2011-03-20 04:00", "2011-03-20 16:00", freq="1h", tz="UTC")
+    loc = pvlib.location.Location(SITE["latitude"], SITE["longitude"], altitude=30.0)
+    weather = loc.get_clearsky(idx)[["ghi", "dni", "dhi"]]
+    planes = {"roof_S": (45.0, 180.0), "S": (90.0, 180.0)}
+    open_sky = surface_irradiance(weather, SITE, planes, averaged=False)
+    shaded = surface_irradiance(weather, SITE, planes, averaged=False, horizon=20.0)
+    pd.testing.assert_frame_equal(
+        surface_irradiance(weather, SITE, planes, averaged=False, horizon=0.0), open_sky
+    )
+    elevation = loc.get_solarposition(idx)["elevation"].to_numpy()
+    low, high = (elevation > 3) & (elevation < 20), elevation > 20
+    assert low.any() and high.any()
+    np.testing.assert_allclose(shaded["roof_S"][high], open_sky["roof_S"][high])
+    iso = (weather["dhi"] * (1 + np.cos(np.radians(45))) / 2
+           + weather["ghi"] * 0.2 * (1 - np.cos(np.radians(45))) / 2)  # fmt: skip
+    np.testing.assert_allclose(shaded["roof_S"][low], iso[low], rtol=1e-9)
+    assert (shaded["roof_S"][low] < 0.6 * open_sky["roof_S"][low]).all()
+    with pytest.raises(InputError, match=r"horizon must be in \[0, 45\]"):
+        surface_irradiance(weather, SITE, planes, horizon=50.0)
+    # solar_inputs: the roof planes shaded, the facade not
+    ghi = weather.assign(Te=5.0)
+    plain, _, _ = solar_inputs(ghi, SITE, planes, "measured")
+    got, _, detail = solar_inputs(ghi, SITE, planes, "measured", roof=("roof_S",),
+                                  roof_horizon=20.0)  # fmt: skip
+    np.testing.assert_allclose(got["I_S"], plain["I_S"])
+    assert (got["I_roof_S"] <= plain["I_roof_S"] + 1e-9).all()
+    assert got["I_roof_S"].sum() < plain["I_roof_S"].sum()
+    assert "shaded below 20°" in detail
+    # the config: 20° by default, 0 for a roof open to the horizon, bounded
+    assert _config({"pitch": 45, "ridge_azimuth": 90}).data.roof.horizon == 20.0
+    assert _config({"pitch": 45, "ridge_azimuth": 90, "horizon": 0}).data.roof.horizon == 0.0
+    with pytest.raises(ConfigError, match=r"data\.roof\.horizon: outside"):
+        _config({"pitch": 45, "ridge_azimuth": 90, "horizon": 60})

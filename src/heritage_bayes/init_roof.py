@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import pandas as pd
 
+from heritage_bayes.config.data import ROOF_HORIZON
 from heritage_bayes.yaml_text import wrap_comment
 
 __all__ = [
@@ -123,7 +124,9 @@ def solar_surface_lines(attic: str | None) -> list[str]:
         "slopes along the slope] for a prior on the apertures. A mono-pitch or flat roof, or "
         "not an attic: replace 'roof' by surfaces (e.g. {H: [0, 0]}). With a wind speed in "
         "the weather (weather.columns.wind [m/s]) the slopes' sun is weighted by the wind "
-        "on the roof (a calm day's sun heats the attic more)."
+        "on the roof (a calm day's sun heats the attic more). The slopes are shaded while the "
+        f"sun is below horizon: [°] (default {ROOF_HORIZON:g}: the houses and trees around); "
+        "give 0 for a roof open to the horizon."
     )
     return [
         *wrap_comment(text, "  # ", "  # "),

@@ -294,6 +294,7 @@ def solar_inputs(
     *,
     where: str = "data.weather",
     roof: Sequence[str] = (),
+    roof_horizon: float = 0.0,
 ) -> tuple[pd.DataFrame, str, str]:
     """Irradiance on each solar surface as model inputs ``I_<surface>`` [W/m²].
 
@@ -317,6 +318,10 @@ def solar_inputs(
         (:func:`heritage_bayes.climate.solair.roof_wind_weight`; gaps in the wind
         interpolated in time); without it, or for other surfaces, unweighted (the
         standard exterior resistance).
+    roof_horizon : float, default 0
+        Skyline [° of sun elevation] of the roof planes: while the sun is lower their
+        beam is shaded (``horizon`` of
+        :func:`heritage_bayes.climate.solar.surface_irradiance`); other surfaces none.
 
     Returns
     -------
@@ -382,6 +387,16 @@ def solar_inputs(
         raise ConfigError(f"{where}: {exc}") from None
     detail = irr.attrs.get("irradiance_source", label)
     planes = [k for k in roof if k in surfaces]
+    if planes and roof_horizon:
+        try:
+            shaded = surface_irradiance(
+                table, dict(site), {k: tuple(surfaces[k]) for k in planes},
+                model=_TRANSPOSITION, albedo=_ALBEDO, horizon=roof_horizon, **kwargs,
+            )  # fmt: skip
+        except InputError as exc:
+            raise ConfigError(f"data.roof.horizon: {exc}") from None
+        irr = irr.assign(**{k: shaded[k] for k in planes})
+        detail += f"; roof planes shaded below {roof_horizon:g}° of sun elevation"
     if planes and "wind" in weather.columns:
         irr = _wind_weighted(irr, weather["wind"], planes, where)
         detail += f"; roof planes {planes} weighted by the wind on the roof (ISO 6946 h_e)"
@@ -458,6 +473,7 @@ def weather_inputs(
     where: str = "data.weather",
     extra: Sequence[str] = (),
     roof: Sequence[str] = (),
+    roof_horizon: float = 0.0,
 ) -> tuple[list[pd.DataFrame], dict]:
     """The input tables to align: ``Te`` (thermal), ``Pe`` (hygric), ``I_<surface>``.
 
@@ -466,7 +482,7 @@ def weather_inputs(
     inputs of a custom network); a missing one is reported when the model asks for it.
     ``irradiance`` None (``data.irradiance``'s default) is ``"measured"`` when the weather
     has ``ghi``, else ``"estimated"``. ``roof``: the surfaces that are roof planes (their
-    sun weighted by the wind, :func:`solar_inputs`).
+    sun weighted by the wind and shaded below ``roof_horizon`` [°], :func:`solar_inputs`).
 
     Returns the tables and a dict ``{"irradiance_source": short, "irradiance": {...}}``.
     """
@@ -498,7 +514,7 @@ def weather_inputs(
                 "surfaces; or set data.irradiance: none"
             )
         irr, label, detail = solar_inputs(
-            weather, site, surfaces, irradiance, where=where, roof=roof
+            weather, site, surfaces, irradiance, where=where, roof=roof, roof_horizon=roof_horizon
         )
         tables.append(irr)
         note = {

@@ -338,7 +338,7 @@ def prepare(cfg) -> Prepared:
         surfaces=surfaces,
         where="data.weather",
         extra=_extra_inputs(cfg),
-        roof=tuple(data.roof.planes()) if data.roof is not None else (),
+        **(data.roof.input_keywords() if data.roof is not None else {}),
     )
     sources["irradiance"] = note["irradiance"]
     irradiance_source = note["irradiance_source"]

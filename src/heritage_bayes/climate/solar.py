@@ -13,7 +13,7 @@ Without a pyranometer, :func:`temperature_range_weather` estimates the global ho
 irradiance from the daily range of the outdoor air temperature (Hargreaves-Samani), and
 :func:`clear_sky_weather` gives the cloudless sky on request.
 
-Why one module (about 620 lines): the cloudless sky, the estimate from the temperature
+Why one module (about 690 lines): the cloudless sky, the estimate from the temperature
 range and the transposition share one timing convention (stamps at the interval end, the
 sun at mid-interval) and its helpers (site, interval, index checks); the estimate is a
 cloudless sky scaled day by day.
@@ -160,6 +160,15 @@ def _site(site) -> tuple[float, float, float]:
     if not -500.0 <= alt <= 9000.0:
         raise InputError(f"site: altitude must be in metres above sea level (got {alt})")
     return lat, lon, alt
+
+
+def _max_zenith(horizon) -> float:
+    """Zenith angle [°] above which the beam is cut: 87° or the skyline's."""
+    if isinstance(horizon, bool) or not isinstance(horizon, int | float):
+        raise InputError(f"horizon must be a number of degrees (got {horizon!r})")
+    if not 0.0 <= horizon <= 45.0:
+        raise InputError(f"horizon must be in [0, 45] ° of sun elevation (got {horizon:g})")
+    return min(_MAX_ZENITH, 90.0 - float(horizon))
 
 
 def _surfaces(surfaces) -> dict[str, tuple[float, float]]:
@@ -482,6 +491,7 @@ def surface_irradiance(
     averaged: bool | None = None,
     interval=None,
     clear_sky: bool = False,
+    horizon: float = 0.0,
 ) -> pd.DataFrame:
     """Total (beam + sky diffuse + ground-reflected) irradiance on each surface [W/m²].
 
@@ -535,8 +545,8 @@ def surface_irradiance(
     and :math:`G_{d,sky}` from the chosen model (Perez et al. [2]_ by default). Closure:
     :math:`G_h = G_d + G_b\\cos\\theta_z`. With only GHI, Erbs et al. [1]_ (or DIRINT)
     estimate the diffuse fraction from the clearness index. For zenith angles above 87°
-    at mid-interval the beam is set to zero and the sky diffuse is isotropic; at night
-    (``ghi`` = 0) every surface gets 0. Negative results are clipped to 0.
+    (or ``90 - horizon``) at mid-interval the beam is set to zero and the sky diffuse is
+    isotropic; at night (``ghi`` = 0) every surface gets 0. Negative results are clipped to 0.
     """
     import pvlib
 
@@ -602,7 +612,7 @@ def surface_irradiance(
     app_zenith = sun["apparent_zenith"].to_numpy()
     azimuth = sun["azimuth"].to_numpy()
     cosz = np.cos(np.radians(zenith))
-    low = zenith > _MAX_ZENITH
+    low = zenith > _max_zenith(horizon)
 
     ghi = weather["ghi"].to_numpy(dtype=float)
     dni = weather["dni"].to_numpy(dtype=float) if "dni" in weather else None

@@ -80,14 +80,20 @@ class GroundTemperature(_Strict):
         return self
 
 
+#: Default skyline of a roof's slopes [° of sun elevation]: below it the low sun's beam
+#: is shaded (neighbouring houses and trees around a house).
+ROOF_HORIZON = 20.0
+
+
 class Roof(_Strict):
     """A gable roof over the room (an attic, a loft): its two slopes become solar surfaces.
 
     The slopes face away from the ridge on either side, azimuths ``ridge_azimuth ± 90``,
     each tilted by ``pitch`` (:func:`heritage_bayes.climate.solar.roof_planes`); their
     irradiance is transposed from the same global (measured or estimated) irradiance and
-    sky model as any surface. ``area`` sets the prior of their apertures
-    (:func:`heritage_bayes.inference.survey.roof_aperture_prior`).
+    sky model as any surface, their beam shaded while the sun is below ``horizon``
+    (:func:`heritage_bayes.climate.solar.surface_irradiance`). ``area`` sets the prior
+    of their apertures (:func:`heritage_bayes.inference.survey.roof_aperture_prior`).
     """
 
     pitch: float = key(
@@ -113,12 +119,26 @@ class Roof(_Strict):
         "0.07 × its half; without it the wide default prior",
         gt=0,
     )
+    horizon: float = key(
+        ROOF_HORIZON,
+        unit="°",
+        description="sun elevation below which the slopes are shaded (neighbouring "
+        "houses, trees; the low sun's beam on a steep slope): 0 for a roof open to the "
+        "horizon",
+        ge=0,
+        le=45,
+    )
 
     def planes(self) -> dict[str, tuple[float, float]]:
         """The two slopes, ``{name: (tilt, azimuth)}`` [°]."""
         from heritage_bayes.climate.solar import roof_planes
 
         return roof_planes(self.pitch, self.ridge_azimuth)
+
+    def input_keywords(self) -> dict:
+        """``roof`` (the planes' names) and ``roof_horizon`` [°] of
+        :func:`heritage_bayes.inputs.weather_inputs`."""
+        return {"roof": tuple(self.planes()), "roof_horizon": self.horizon}
 
     def plane_areas(self) -> dict[str, float]:
         """Each slope's area [m²] (half of ``area``); empty without ``area``."""

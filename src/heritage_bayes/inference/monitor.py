@@ -88,9 +88,8 @@ class ChainBuffer:
     R-hat) on the whole chain each time; a list of chunks concatenated for each check
     held the chain twice at every check (and three times at the R-hat check). Here the
     rows live in one array whose capacity grows by a quarter at a time (amortised
-    copies, at most 25 % slack), and :attr:`chain` is a view of the rows filled.
-    Measured on the demo's thermal_4a at 74 500 steps × 34 walkers × 16 parameters:
-    324 MB of float64 either way, the copies for the checks gone.
+    copies, at most 25 % slack), and :attr:`chain` is a view of the rows filled
+    (memory of a long chain: docs/science/benchmarks.md).
 
     Bounded (``max_rows``): the buffer holds every ``stride``-th step, the steps ``s``
     (0-based) with ``(s + 1) % stride == 0``; :meth:`halve` keeps every other row and

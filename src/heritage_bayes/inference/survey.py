@@ -199,8 +199,8 @@ def aperture_prior(
     shading, and the sun the opaque wall passes on, all uncertain). Why: with the
     default log-uniform prior over five decades a facade whose sun is mostly diffuse
     (north) is hardly told from the others, and the prior's volume pulls its aperture
-    towards zero (measured on the demo's north facade over 24 logger-noise seeds,
-    with the commands: docs/science/sbc.md, "The demo's solar apertures"); a window
+    towards zero (measured over logger-noise seeds, with the commands:
+    docs/science/sbc.md, "The demo's solar apertures"); a window
     count is in every building survey.
 
     Parameters

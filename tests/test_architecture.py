@@ -296,6 +296,7 @@ MEASURED_NOTE = re.compile(
     r"|\bspent \d+(?:\.\d+)? ?s\b"
     r"|τ(?:max)? (?:≈ ?)?\d[\d ]*(?:steps )?(?:after|against|vs|→)"
     r"|\d+(?:\.\d+)? ?[MG]B (?:of |instead of \d)"
+    r"|(?<![\w/.])\d(?:\.\d+)? instead of \d"
     r"|\b\d+ of \d[\d ]* (?:days|rooms|replicates|seeds|chains)\b"
     r"|\bmean z [+−-]\d"
     r"|\bcoverage (?:rose|fell) from \d"
@@ -334,6 +335,7 @@ def test_the_measured_note_finder_finds_notes():
         "(a population of 130 000 spent 540 s there)",
         "gain from Pe above the truth in 7 of 8 (mean z +1.36)",
         "the solar gain's coverage rose from 0.81 to 0.86",
+        "(a 3-d Gaussian: posterior sd 0.002 instead of 1 after 20 000 steps)",
     ]  # fmt: skip
     science = [
         "the measured indoor temperature ``Ti``", "measured : (N,) array",
@@ -341,7 +343,8 @@ def test_the_measured_note_finder_finds_notes():
         "accuracy_failures` (FIT below 50 % on the validation)",
         "τmax 1311 asks for about 65 550 steps (50 τ) with a stable τ",
         "a 100 MB line in a logger file", "(10.5 MB for 262 770 h)",
-        "the 90 % interval", "Offset of the file's clock measured on each usable day",
+        "the 90 % interval", "or use 1/3 instead of 1.3",
+        "Offset of the file's clock measured on each usable day",
         "hours with RH > 80 % and T > 0 °C [h/year]", "a margin of 2 FIT points",
         "the time budget ran out after 68 000 steps", "differential evolution 80 %",
     ]  # fmt: skip

@@ -38,8 +38,8 @@ def make_moves(name: str, block=(), block_weight: float = 0.0):
     list is the named moves alone (the same chain as before the block move existed).
 
     The snooker move alone is not offered: from the start ball (walkers 1e-3 apart) it
-    does not spread the ensemble (a 3-d Gaussian: posterior sd 0.002 instead of 1 after
-    20 000 steps), its proposals lie along lines through other walkers."""
+    does not spread the ensemble (docs/science/benchmarks.md, "Figures behind the code's
+    choices"), its proposals lie along lines through other walkers."""
     if name not in MOVES:
         raise ValueError(f"sampler.moves must be one of {sorted(MOVES)} (got {name!r})")
     if not 0.0 <= block_weight < 1.0:

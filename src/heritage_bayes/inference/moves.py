@@ -57,9 +57,10 @@ class BlockDEMove(emcee.moves.DEMove):
     ``Cint``, ``Gint`` and ``fsol`` on a room without one): along them the posterior is
     wide and nearly independent of the identified parameters, but a full DE step also
     moves the identified ones, along narrow curved ridges, and is rejected most of the
-    time (docs/science/benchmarks.md, "A block move"), so the wide directions are crossed
-    by a random walk of short steps. A step within the block leaves the identified
-    parameters where they are (a Metropolis-within-Gibbs update; DE proposals on a
+    time (the acceptance: docs/science/benchmarks.md, "Sampler moves, ensemble size and
+    the estimate of τ"), so the wide directions are crossed by a random walk of short
+    steps. A step within the block leaves the identified parameters where they are (a
+    Metropolis-within-Gibbs update; DE proposals on a
     subspace as in DREAM [4]_), with DE's scale for the block's dimension, γ₀ = 2.38 /
     √(2 k) for k coordinates.
 

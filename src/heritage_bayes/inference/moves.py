@@ -60,9 +60,8 @@ class BlockDEMove(emcee.moves.DEMove):
     time (the acceptance: docs/science/benchmarks.md, "Sampler moves, ensemble size and
     the estimate of τ"), so the wide directions are crossed by a random walk of short
     steps. A step within the block leaves the identified parameters where they are (a
-    Metropolis-within-Gibbs update; DE proposals on a
-    subspace as in DREAM [4]_), with DE's scale for the block's dimension, γ₀ = 2.38 /
-    √(2 k) for k coordinates.
+    Metropolis-within-Gibbs update; DE proposals on a subspace as in DREAM [4]_), with
+    DE's scale for the block's dimension, γ₀ = 2.38 / √(2 k) for k coordinates.
 
     The proposal is symmetric (the pair of walkers and the block do not depend on the
     walker's position; the reverse step takes the same pair in the other order), so it

@@ -372,8 +372,8 @@ def clock_switch(
     (the later on a tie), bounded at the 1st of January of the later run's first year
     (in winter the two clocks agree). The fixed clock is taken as the zone's standard
     offset (the logger's DST switched off). None without a site, for a zone without DST,
-    or when the years do not fall in two runs (a logger that switched: docs/science/
-    real_rooms.md, "Figures behind the code's choices").
+    or when the years do not fall in two runs (a logger that switched:
+    docs/science/real_rooms.md, "Figures behind the code's choices").
     """
     if lat is None or lon is None or len(times) < 3:
         return None

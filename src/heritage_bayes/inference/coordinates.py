@@ -33,9 +33,9 @@ a straight ridge the affine-invariant moves follow. The map is again triangular 
 a unit diagonal (each :math:`\\log fI_s` is its ``y`` plus a function of ``v`` only):
 unit Jacobian.
 
-The fsol-aperture ridge is not what slows ``fsol`` (measured: docs/science/
-benchmarks.md, "The coordinate of fsol"), and ``hbayes`` keeps the apertures in log
-coordinates (``solar=False``, the default).
+The fsol-aperture ridge is not what slows ``fsol`` (measured:
+docs/science/benchmarks.md, "The coordinate of fsol"), and ``hbayes`` keeps the
+apertures in log coordinates (``solar=False``, the default).
 
 References
 ----------

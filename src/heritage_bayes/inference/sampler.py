@@ -260,8 +260,9 @@ def _run_sampler(
         on (burn-in at least that fraction). Leaving out the first half is the classical
         burn-in of Gelman et al. [4]_ and removes the walkers' spread from their start
         ball from the estimate; it is not the default because it can underestimate τ
-        while a slow direction is still being explored (measured: docs/science/
-        benchmarks.md, "Sampler moves, ensemble size and the estimate of τ").
+        while a slow direction is still being explored (measured:
+        docs/science/benchmarks.md, "Sampler moves, ensemble size and the estimate of
+        τ").
     max_rhat, min_ess : float or None
         Once the chain is long enough for τ, it also runs until the rank-normalised
         R-hat (walkers as chains) is at most ``max_rhat`` and the bulk ESS at least

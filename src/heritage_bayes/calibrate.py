@@ -177,8 +177,8 @@ def run_calibration(
     ``config.yaml`` names the model chosen.
 
     BLAS is limited to one thread for the duration: the hot loops multiply many small
-    matrices, where OpenBLAS worker threads spin-wait; on a busy 2-core machine that
-    made the MAP search 8x slower (measured: 37 s against 4.5 s).
+    matrices, where OpenBLAS worker threads spin-wait on a busy machine (measured:
+    docs/science/benchmarks.md, "Figures behind the code's choices").
     """
     from threadpoolctl import threadpool_limits
 

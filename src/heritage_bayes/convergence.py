@@ -56,8 +56,9 @@ def unconverged_reasons(summary: Mapping[str, Any]) -> list[str]:
     A run the sampler's rule declared converged (``summary["converged"]`` true: τ, R-hat
     and ESS on all retained draws) has no reasons, even where the R-hat of the ~1 000
     draws saved in ``posterior.nc`` (``parameters``, what ``az.summary`` reads) scatters
-    above 1.01 (32 walkers × ~31 saved draws; measured 1.013-1.020 on converged 4a and
-    1c runs): the portfolio's "why not converged" column then stays empty for it.
+    above 1.01 (32 walkers × ~31 saved draws; measured: docs/science/benchmarks.md,
+    "Figures behind the code's choices"): the portfolio's "why not converged" column
+    then stays empty for it.
 
     Parameters
     ----------

@@ -231,9 +231,8 @@ def heating_floor(ti: pd.Series, te: pd.Series) -> tuple[float, int, int]:
 
     The floor is the 5th percentile of the daily indoor minima; a day is *held* when its
     indoor minimum is within 0.5 K of the floor while the outdoor air averaged more than
-    5 K below it. Measured: the TRH-1 attic 0 of 581 days (free-running), the heated house
-    below it 206 of 581 (floor 20.4 °C), Ørholm 426 of 4 414 (10.2 °C), Annisse church
-    114 of 1 536 (16.0 °C).
+    5 K below it (its counts on real rooms: docs/science/models.md, "The model init
+    proposes").
     """
     dti = ti.resample("1D").min().rename("ti")
     dte = te.resample("1D").mean().rename("te")
@@ -373,8 +372,8 @@ def clock_switch(
     (the later on a tie), bounded at the 1st of January of the later run's first year
     (in winter the two clocks agree). The fixed clock is taken as the zone's standard
     offset (the logger's DST switched off). None without a site, for a zone without DST,
-    or when the years do not fall in two runs. Measured: the Ørholm store's logger
-    follows Europe/Copenhagen's changes 2009-2011 and keeps a fixed clock 2012-2021.
+    or when the years do not fall in two runs (a logger that switched:
+    docs/science/real_rooms.md, "Figures behind the code's choices").
     """
     if lat is None or lon is None or len(times) < 3:
         return None

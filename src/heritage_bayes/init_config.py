@@ -12,15 +12,13 @@ see :mod:`heritage_bayes.questions`) that ``hbayes calibrate`` refuses until ans
 The written file is validated by the same schema as any config
 (:func:`heritage_bayes.config.parse_config`).
 
-Choices, with the measurements behind them (TRH-1 attic, ``benchmarks/bench_init.py``
-and ``tests/test_init.py``):
+Choices (the measurements behind them: docs/science/inputs.md, "The TRH-1 attics", and
+docs/science/models.md, "Figures behind the code's choices"):
 
 * **One solar aperture on the horizontal** (``surfaces: {H: [0, 0]}``), not the four
-  facades: the data pin one aperture; with four, thermal_1c put fI_E on its bound and
-  left fI_N unidentified, and its MAP validation FIT of Ti was 76.7 % against 78.0 % with
-  H (calibration Dec 2010-Aug 2011, validation Aug-Dec 2011; 4 facades also sampled
-  slowly: τmax 141 after 13 000 steps, stopped). A room that looks like an attic gets
-  its roof's two slopes instead (``data.roof``, :mod:`heritage_bayes.init_roof`).
+  facades: the data pin one aperture, where four leave some unidentified. A room that
+  looks like an attic gets its roof's two slopes instead (``data.roof``,
+  :mod:`heritage_bayes.init_roof`).
 * **Periods**: chosen after the clocks, on UTC, in the usable span
   (:func:`~heritage_bayes.init_checks.usable_span`: the overlap of the files, else its
   most recent 12 months, with readings in 70 % of the hours from each file), within its

@@ -214,8 +214,8 @@ def extrapolated_seasons(te: pd.Series, cs, ce, ve) -> str | None:
     calibrate, a summer to validate): the 95th percentile of the daily mean outdoor
     temperature [°C] higher by :data:`WARMER_K` or more. The sun's gain and the summer's
     conditions (a roof free of snow) are then learned from a season they do not hold;
-    None otherwise. Measured: the TRH-1 R4 attic cut to 8 months (2010-11-15 to
-    2011-07-26, a winter to calibrate) validated at 61 % FIT Ti against 80 % with a year.
+    None otherwise (what it costs on a real attic: docs/science/real_rooms.md, "Figures
+    behind the code's choices").
     """
     d = te.resample("1D").mean().dropna()
     d.index = d.index.tz_localize(None) if d.index.tz is not None else d.index

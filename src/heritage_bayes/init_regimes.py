@@ -28,10 +28,8 @@ enough for a calendar year to calibrate and :data:`~heritage_bayes.init_periods.
 VALIDATION_MONTHS` months after it to validate; the calibration and validation then
 describe one regime.
 
-Measured on the Ørholm store's logger file (2012-2020, UTC+1): the RH band 4-9 points in
-2012-2017, 14 in 2018, 23 and 18 in 2019 and 2020; the summer excess 5.2-5.9 K in
-2013-2017, 3.0 K in 2018, 2.3 and 2.5 K in 2019 and 2020 (the dehumidifier and its heat
-gone); the heating floor 10.0-10.2 °C in every year from 2013.
+The signatures of a real logger file year by year: docs/science/real_rooms.md,
+"Figures behind the code's choices".
 """
 
 from __future__ import annotations
@@ -50,8 +48,7 @@ __all__ = ["YearRegime", "regime_stretch", "year_regimes"]
 #: Points [% RH] above :data:`~heritage_bayes.init_model.BAND_MAX_PCT` at which a band is
 #: clearly free, and below it at which it is clearly held.
 BAND_MARGIN_PCT = 3.0
-#: Change of the summer excess [K] between two years that is a gain switched on or off
-#: (Ørholm's years of one regime agree within 0.7 K).
+#: Change of the summer excess [K] between two years that is a gain switched on or off.
 EXCESS_SHIFT_K = 2.0
 #: Shift of the heating floor [K] between two heated years that is a new set-point.
 FLOOR_SHIFT_K = 2.0

@@ -34,9 +34,8 @@ __all__ = [
 DEFAULT_LIKELIHOOD_TEMPERATURE = {"thermal": 2.0, "hygric": 1.0}
 #: The default temperature applies to networks of at most this many capacity nodes
 #: (1c, 2c: where it was measured). Richer ones (thermal_4a) keep 1: the directions
-#: their data leave to the priors widen with it and the chain slows (Ørholm's
-#: thermal_4a in its 10-minute budget: τmax 772 after 47 000 steps tempered, 300 after
-#: 36 000 untempered; docs/science/sbc.md).
+#: their data leave to the priors widen with it and the chain slows (measured:
+#: docs/science/sbc.md, "A tempered likelihood").
 TEMPERED_MAX_NODES = 2
 
 

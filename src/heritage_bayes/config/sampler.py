@@ -60,7 +60,7 @@ class SamplerSettings(_Strict):
         description="steps of each chain held in memory and in its checkpoint at most: past "
         "it the chain is thinned in place (every other stored step dropped, the stride "
         "doubled, never beyond τ/10) and τ estimated on the thinned chain × the stride; "
-        "null: every step (the demo's thermal_4a chain at 171 500 steps: 0.9 GB)",
+        "null: every step (a long chain's memory: docs/science/benchmarks.md)",
         ge=100,
     )
     max_time: Budget = key(
@@ -90,7 +90,7 @@ class SamplerSettings(_Strict):
         unit="-",
         description="fraction of the chain left out of the estimate of τ and of the "
         "retained draws (0: the whole chain; 0.5: the classical burn-in of half the chain, "
-        "which on the demo's thermal_4a underestimated τ at 40 000 steps)",
+        "which can underestimate τ of a slow direction: docs/science/benchmarks.md)",
         ge=0,
         lt=1,
     )
@@ -100,9 +100,8 @@ class SamplerSettings(_Strict):
         description="emcee's proposal moves: de_snooker (differential evolution 80 %, "
         "snooker 20 %), de_global (de_snooker whose DE part is replaced, for a walker in "
         "ten, by an independent draw from a Student-t fitted to the chain so far), dime "
-        "(DE with those draws, no snooker), de, or stretch (measured on the demo's "
-        "thermal_4a, 40 000 steps: τmax 1 049 with de_snooker, 712 with de_global, 2 129 "
-        "with dime; on Ørholm's thermal_4a 319 and 372)",
+        "(DE with those draws, no snooker), de, or stretch (their τ compared: "
+        'docs/science/benchmarks.md, "Global proposals")',
     )
     block_weight: float | None = key(
         None,
@@ -132,9 +131,9 @@ class SamplerSettings(_Strict):
         description="where the walkers start: ball (init_ball around the MAP), laplace "
         "(drawn from the Laplace approximation N(MAP, H^-1), flat directions at most the "
         "widest prior range), or auto: laplace for networks of three or more nodes, ball "
-        "for smaller ones. Default ball: on the demo's thermal_4a laplace lowers τmax at "
-        "60 000 steps (1 683 → 969; neither converged), but Ørholm's thermal_4a, converged "
-        "from the ball at 12 000 steps, had not converged from laplace at 74 500 (τmax 648)",
+        "for smaller ones. Default ball: a room whose data leave directions to the priors "
+        "converged from the ball and not from laplace (docs/science/benchmarks.md, "
+        '"Where the demo\'s thermal_4a spends its steps")',
     )
     init_ball: float = key(
         1e-3,
@@ -151,8 +150,8 @@ class SamplerSettings(_Strict):
         unit="draws",
         description="draws (all walkers) saved in posterior.nc, the same in the posterior "
         "and log-likelihood groups (the predictive keeps about 64 of them, its bands all); "
-        "PSIS-LOO and the report's R-hat and ESS use them (with 640 the demo's max R-hat "
-        "over its saved draws was 1.021, noise of 20 draws per walker, against 1.01)",
+        "PSIS-LOO and the report's R-hat and ESS use them (fewer make the R-hat of the saved "
+        "draws noisy: docs/science/benchmarks.md)",
         ge=10,
     )
 

@@ -69,11 +69,8 @@ class _Checkpoint:
     commit intact. SIGINT/SIGTERM are deferred until the commit is done. The datasets
     carry Fletcher-32 checksums, so damaged chunks are detected on load and the valid
     prefix is kept. The file is created under a unique temporary name (never through
-    a symlink) and renamed into place. The rows are gzip-compressed (lossless): the
-    first 20 000 steps of the demo's thermal_4a chain (34 walkers × 16 parameters,
-    acceptance 0.08) take 8.6 MB instead of 87 MB, for 0.44 s of CPU in all
-    (measured with h5py on the chain of ``benchmarks/bench_coordinates.py demo_4a
-    --save-chain``).
+    a symlink) and renamed into place. The rows are gzip-compressed (lossless; rejected
+    proposals repeat rows; sizes and CPU: docs/science/benchmarks.md, "Bounded chains").
     """
 
     FORMAT = 3
@@ -366,7 +363,7 @@ def _cat(parts, ds):
 #: ``format`` attribute of a compacted checkpoint (see :func:`write_compact`).
 COMPACT_FORMAT = "compact-1"
 #: Steps per walker of the trace a compacted checkpoint keeps (the report's trace plot,
-#: a few hundred pixels wide). 400 steps were 0.53 MB of the demo's chain_thermal.h5.
+#: a few hundred pixels wide).
 TRACE_STEPS = 200
 
 

@@ -103,9 +103,9 @@ def compact_checkpoint(path, tag: str, result: ChainResult, max_draws: int) -> N
     Keeps what the run's outputs were built from (``result.draws(max_draws)``, float64)
     and what describes the chain (steps, burn, thin, τ, acceptance), so that
     ``--resume`` on the finished run rebuilds the same outputs without sampling. Why:
-    the full chain of the demo's thermal_2c (8 000 steps × 32 walkers × 13 parameters,
-    float64) is 28.8 MB, its retained draws 0.4 MB, and an unconverged chain (the case
-    ``--resume`` is for) is never compacted.
+    the full chain is many times the size of its retained draws (sizes:
+    docs/science/benchmarks.md, "Figures behind the code's choices"), and an
+    unconverged chain (the case ``--resume`` is for) is never compacted.
     """
     if not result.converged or result.thinned:
         return

@@ -33,15 +33,9 @@ a straight ridge the affine-invariant moves follow. The map is again triangular 
 a unit diagonal (each :math:`\\log fI_s` is its ``y`` plus a function of ``v`` only):
 unit Jacobian.
 
-Measured on the demo's thermal_4a (``benchmarks/bench_coordinates.py demo_4a --only
-node_tau --moves de_snooker --max-steps 40000 --solar``, same MAP start and seed):
-τ of ``fsol`` 1 307 steps against 1 285 without, ``Cint`` and ``Gint`` 704 and 680
-against 564 and 575, the others within 13 %: the fsol-aperture ridge is not what
-slows ``fsol``, and ``hbayes`` keeps the apertures in log coordinates
-(``solar=False``, the default).
-
-Measured τ per parameter, before and after: ``benchmarks/bench_coordinates.py`` (the
-table is in ``benchmarks/README.md``).
+The fsol-aperture ridge is not what slows ``fsol`` (measured:
+docs/science/benchmarks.md, "The coordinate of fsol"), and ``hbayes`` keeps the
+apertures in log coordinates (``solar=False``, the default).
 
 References
 ----------
@@ -290,24 +284,20 @@ def default_coordinates(logpost) -> NodeTimeConstants | None:
     networks of :data:`MIN_NODES` or more capacity nodes, the log coordinates (None)
     for smaller ones.
 
-    Chosen by measured τ (``benchmarks/bench_coordinates.py``, 30 000 steps from the
-    same MAP and seed): on the demo's data thermal_4a's τ fell for every one of its 16
-    parameters (τmax 1 686 → 1 190 steps, min bulk ESS per CPU second × 1.60), while on
-    the two-node models it changed nothing beyond the noise of the τ estimate and
-    never helped (demo thermal_2c τmax 133 → 149, hygric_2c 47 → 50, ESS per CPU
-    second × 1.05 and × 0.87): their node time constants are nearly their modes'
-    already, and the log coordinates are kept there. TRH-1's thermal_2c (a loose
-    envelope node, 30 000 steps) gained most (τmax 2 889 → 855, ESS per CPU second
-    × 6.3): ``sampler.coordinates: node_tau`` in a config chooses them for such rooms
-    (:func:`sampling_coordinates`); the default for two-node networks stays until the
-    statistical tests that pin their chains have been re-run with it.
+    Chosen by measured τ (docs/science/benchmarks.md, "Figures behind the code's
+    choices"): on networks of three or more nodes τ fell, while on the two-node models
+    it changed nothing beyond the noise of the τ estimate (their node time constants
+    are nearly their modes' already), and the log coordinates are kept there. A
+    two-node room with a loose envelope node can gain: ``sampler.coordinates:
+    node_tau`` in a config chooses them for such rooms (:func:`sampling_coordinates`);
+    the default for two-node networks stays until the statistical tests that pin their
+    chains have been re-run with it.
 
     A split solar fraction (thermal_4a's ``fsol``) is sampled as ``log(1 - fsol)``
-    (``air_share``): on the demo's data it is tied to the envelope's time constant,
-    ``log(1 - fsol)`` linear in ``log Cw/(Gw + Gi)`` (R² 0.994, against 0.956 for
-    ``logit fsol``, ``benchmarks/chain_geometry.py``), and the logit stretched its
-    tail towards 0 (the 1 % quantile 0.13 after 20 000 steps in the logit, 0.011 in
-    log(1 - fsol)). Only networks with such a fraction change.
+    (``air_share``): it is tied to the envelope's time constant, ``log(1 - fsol)``
+    nearly linear in ``log Cw/(Gw + Gi)``, and the logit stretched its tail towards 0
+    (measured: docs/science/benchmarks.md, "The coordinate of fsol"). Only networks
+    with such a fraction change.
     """
     if logpost.model.n_states < MIN_NODES:
         return None

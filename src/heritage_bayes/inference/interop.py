@@ -44,7 +44,7 @@ def loglik_groups(loglik: dict[str, xr.DataArray], coords: dict, attrs: dict) ->
     terms still sum to the log-likelihood the sampler used), with the coordinates
     ``observation_variable`` and ``observation_time`` saying which hour of which output
     each is. The per-output terms are not stored a second time (they would double the
-    largest part of the file: 7.3 MB of the demo's 25.6 MB ``posterior.nc``):
+    largest part of the file; sizes: docs/science/benchmarks.md):
     :func:`split_outputs` rebuilds them from the combined variable.
     """
     if len(loglik) <= 1:

@@ -443,9 +443,9 @@ class AR1WhiteNoise(NoiseModel):
     #: The model error's correlation time tau_e = -dt/ln(phi) is capped at about a day
     #: (24.5 h: phi <= 0.96 at hourly steps, 0.98 at half-hourly ones). Without a cap the
     #: likelihood prefers a near-random-walk error that carries the slow (seasonal)
-    #: response while the simulated room goes flat (issue 10; configs/orholm.yaml 2015,
-    #: thermal: phi -> 0.998 and MAP simulation FIT 68 % vs 81 % with iid; with the cap
-    #: 80 %). What persists for longer than a day is the model's to explain; a posterior
+    #: response while the simulated room goes flat (measured: docs/science/noise.md,
+    #: "Figures behind the code's choices"). What persists for longer than a day is the
+    #: model's to explain; a posterior
     #: piled up at the cap says the model misses a slow process (the run says so).
     #: Override with a prior on ``phi_<output>``.
     TAU_MAX_H = 24.5

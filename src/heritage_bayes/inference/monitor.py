@@ -38,8 +38,8 @@ def make_moves(name: str, block=(), block_weight: float = 0.0):
     list is the named moves alone (the same chain as before the block move existed).
 
     The snooker move alone is not offered: from the start ball (walkers 1e-3 apart) it
-    does not spread the ensemble (a 3-d Gaussian: posterior sd 0.002 instead of 1 after
-    20 000 steps), its proposals lie along lines through other walkers."""
+    does not spread the ensemble (docs/science/benchmarks.md, "Figures behind the code's
+    choices"), its proposals lie along lines through other walkers."""
     if name not in MOVES:
         raise ValueError(f"sampler.moves must be one of {sorted(MOVES)} (got {name!r})")
     if not 0.0 <= block_weight < 1.0:
@@ -88,9 +88,8 @@ class ChainBuffer:
     R-hat) on the whole chain each time; a list of chunks concatenated for each check
     held the chain twice at every check (and three times at the R-hat check). Here the
     rows live in one array whose capacity grows by a quarter at a time (amortised
-    copies, at most 25 % slack), and :attr:`chain` is a view of the rows filled.
-    Measured on the demo's thermal_4a at 74 500 steps × 34 walkers × 16 parameters:
-    324 MB of float64 either way, the copies for the checks gone.
+    copies, at most 25 % slack), and :attr:`chain` is a view of the rows filled
+    (memory of a long chain: docs/science/benchmarks.md).
 
     Bounded (``max_rows``): the buffer holds every ``stride``-th step, the steps ``s``
     (0-based) with ``(s + 1) % stride == 0``; :meth:`halve` keeps every other row and

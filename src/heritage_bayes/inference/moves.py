@@ -57,19 +57,18 @@ class BlockDEMove(emcee.moves.DEMove):
     ``Cint``, ``Gint`` and ``fsol`` on a room without one): along them the posterior is
     wide and nearly independent of the identified parameters, but a full DE step also
     moves the identified ones, along narrow curved ridges, and is rejected most of the
-    time (acceptance 0.06 on the demo's thermal_4a), so the wide directions are crossed
-    by a random walk of short steps. A step within the block leaves the identified
-    parameters where they are (a Metropolis-within-Gibbs update; DE proposals on a
-    subspace as in DREAM [4]_), with DE's scale for the block's dimension, γ₀ = 2.38 /
-    √(2 k) for k coordinates.
+    time (the acceptance: docs/science/benchmarks.md, "Sampler moves, ensemble size and
+    the estimate of τ"), so the wide directions are crossed by a random walk of short
+    steps. A step within the block leaves the identified parameters where they are (a
+    Metropolis-within-Gibbs update; DE proposals on a subspace as in DREAM [4]_), with
+    DE's scale for the block's dimension, γ₀ = 2.38 / √(2 k) for k coordinates.
 
     The proposal is symmetric (the pair of walkers and the block do not depend on the
     walker's position; the reverse step takes the same pair in the other order), so it
     leaves the posterior invariant as emcee's ``DEMove`` does. Independent draws of the
     block from a Student-t fitted to the chain (as :class:`GlobalDEMove` makes for all
-    coordinates) were tried and made the demo's thermal_4a slower (τmax 2 285 against
-    1 919 steps at 40 000; docs/science/benchmarks.md): a t fitted to an L-shaped region
-    holds walkers in the region's arms.
+    coordinates) were tried and made the chain slower (docs/science/benchmarks.md, "A
+    block move"): a t fitted to an L-shaped region holds walkers in the region's arms.
 
     Parameters
     ----------

@@ -16,11 +16,9 @@ unit of the best ("agreed") measures how unambiguous the optimum is.
 
 Restarts (``restarts`` > 1): the global search again from other seeds. One population of
 differential evolution collapses into one basin, so the polished starts of one search
-agree even where the posterior has several optima: on the demo's data ``thermal_4a``
-with the survey's ``interior_area`` has one with the interior mass merged into the air
-(log-posterior 938.0 at the optimiser's seeds 1 and 7) and one with a slow interior mass
-the sun does not reach (938.5-938.75, seeds 3-6), and seed 2 stops at 790.2
-(``docs/science/benchmarks.md``, "The interior area and several optima"). The first
+agree even where the posterior has several optima (e.g. an interior mass merged into
+the air and a slow one the sun does not reach: ``docs/science/benchmarks.md``, "The
+interior area and several optima"). The first
 search's optimum is kept unless a restart beats it by more than :data:`MODE_PICK`;
 optima of the restarts within :data:`MODE_WINDOW` of the best, apart in the unit cube
 (:data:`MODE_DISTANCE`) and separated by a dip of the log-posterior on the straight line
@@ -81,8 +79,8 @@ def _generation_seconds(n: int) -> float:
     differential evolution for a population of ``n``: for each member it shuffles the
     whole population index (``DifferentialEvolutionSolver._select_samples``, scipy
     1.17), so a generation costs ``n`` shuffles of ``n`` — quadratic, and beyond the
-    reach of a deadline checked between likelihood evaluations (a population of
-    130 000 spent 540 s there)."""
+    reach of a deadline checked between likelihood evaluations (a large population's
+    cost: docs/science/benchmarks.md, "Figures behind the code's choices")."""
     idx = np.arange(n)
     rng = np.random.default_rng(0)
     t0 = time.perf_counter()

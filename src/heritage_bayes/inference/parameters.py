@@ -13,7 +13,8 @@ space ``x``:
 Log rather than logit for C, G and apertures matters: RC posteriors have ridges that are
 exactly straight in log space (scaling all C and G together leaves the output unchanged),
 and a logit of each parameter's own range would bend them into thin curved bananas,
-which ensemble samplers explore badly (measured: τ ≈ 1750 vs a few hundred steps).
+which ensemble samplers explore badly (docs/science/benchmarks.md, "Figures behind the
+code's choices").
 
 The log-prior in ``x`` includes the log-Jacobian :math:`\\log|d\\theta/dx|`, so the
 posterior is the same distribution whatever the transform (lmfit's bounded-parameter

@@ -29,8 +29,8 @@ __all__ = [
 #: At least this many posterior-predictive draws are stored per variable (the
 #: ``posterior_predictive`` group; with 32 walkers 2 per walker), for users who want
 #: draws; the report's bands are computed over all saved draws first
-#: (``predictive_bands``). On the demo (3 months hourly, six series) 224 draws were
-#: 5.6 MB of posterior.nc, 128 draws 3.2 MB (issue 28: the run directory within 15 MB).
+#: (``predictive_bands``); their size: docs/science/benchmarks.md, "Figures behind the
+#: code's choices".
 PREDICTIVE_DRAWS = 64
 #: Quantile levels of ``predictive_bands`` [-] (the report's 50 % and 90 % bands and
 #: the median).
@@ -121,11 +121,13 @@ def predictive_noise(s, prep, Ysim: np.ndarray, tn: np.ndarray):
 
     - ``ar1_white`` whose correlation sits at its cap: the noise model of the likelihood
       describes only the misfit's fast part, and bands drawn from it would leave out the
-      slow misfit (configs/orholm.yaml: a 90 % band covering 49 % of the hours).
+      slow misfit.
     - ``kalman`` (a state-space noise model): its process noise is estimated for
       one-step-ahead prediction; propagated without the data it is not the error of a
-      free run (the demo, seeds 7-12: the Ti band covered 99.9-100 % of the validation
-      hours; TRH-1's Pi band 80 %; docs/science/noise.md).
+      free run.
+
+    The coverage of such bands on real and generated rooms: docs/science/noise.md,
+    "Figures behind the code's choices".
 
     The error of *prediction* is then the free-run error: AR(1) + white noise fitted by
     maximum likelihood (phi up to 0.999) to the calibration residuals of the

@@ -179,9 +179,9 @@ def write_inference_data(idata, path: str | Path) -> None:
     predictive series and bands (groups ``posterior_predictive``,
     ``predictive_bands``) of a unit in :data:`PREDICTIVE_QUANTUM` are stored as int32
     multiples of its quantum; log-likelihood terms (groups starting with
-    ``log_likelihood``) as float32 rounded to 12 mantissa bits (on the demo's terms,
-    |ℓ| < 6 nats, at most 4.9e-4 nats each; PSIS-LOO and the validation ELPD move by
-    far less than their Monte Carlo error). Posterior draws and the data keep their
+    ``log_likelihood``) as float32 rounded to 12 mantissa bits (the error on the demo's
+    terms and its effect on PSIS-LOO: docs/science/benchmarks.md, "Figures behind the
+    code's choices"). Posterior draws and the data keep their
     precision. Not atomic by itself: call it through :func:`atomic_write`.
 
     The demo's file sizes before and after this format, with the command: the

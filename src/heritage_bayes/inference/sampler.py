@@ -259,12 +259,10 @@ def _run_sampler(
         chain, the default); the retained draws then come from the part τ was estimated
         on (burn-in at least that fraction). Leaving out the first half is the classical
         burn-in of Gelman et al. [4]_ and removes the walkers' spread from their start
-        ball from the estimate; it is not the default because on the demo's thermal_4a
-        (node time constants) τ of the second half was 775 at 40 000 steps, so 50 τ
-        seemed reached, but R-hat/ESS were not, and as the chain went on τ of its
-        second half grew to 1 579 at 74 500 steps (a slow direction, ``fsol``, still
-        being explored): the whole-chain estimate (1 285 at 40 000) was the better
-        guide. See ``benchmarks/README.md``.
+        ball from the estimate; it is not the default because it can underestimate τ
+        while a slow direction is still being explored (measured:
+        docs/science/benchmarks.md, "Sampler moves, ensemble size and the estimate of
+        τ").
     max_rhat, min_ess : float or None
         Once the chain is long enough for τ, it also runs until the rank-normalised
         R-hat (walkers as chains) is at most ``max_rhat`` and the bulk ESS at least

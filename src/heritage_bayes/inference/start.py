@@ -19,12 +19,10 @@ the prior's bounds, and draws whose log-posterior is not finite (a wall the boun
 not describe, e.g. an unstable network) are redrawn with the covariance halved each
 round, ending in the MAP's 1e-3 ball if nothing else is finite.
 
-Measured on the demo's thermal_4a (``benchmarks/bench_coordinates.py demo_4a --only
-node_tau --start ball,laplace``): see ``benchmarks/README.md``. An option
-(``sampler.start: laplace`` or ``auto``), not the default: on Ørholm's thermal_4a
-(``benchmarks/configs/orholm_4a.yaml``), where the data leave Gw, Gint and Cint to the
-priors, the walkers drawn over those flat directions had not converged at 74 500 steps
-(τmax 648, 543 s of sampling CPU), the ball's at 12 000 (τmax 227, 73 s).
+An option (``sampler.start: laplace`` or ``auto``), not the default: where the data
+leave parameters to the priors, walkers drawn over those flat directions can converge
+later than the ball's (measured, with the commands: docs/science/benchmarks.md, "Where
+the demo's thermal_4a spends its steps").
 
 References
 ----------
@@ -53,14 +51,10 @@ def start_hessian(logpost, lap, choice: str = "auto") -> np.ndarray | None:
     :data:`~heritage_bayes.inference.coordinates.MIN_NODES` or more
     capacity nodes, the ball for smaller ones.
 
-    Chosen by measured τ (``benchmarks/bench_coordinates.py demo_4a --only node_tau
-    --air-share --start ball|laplace --max-steps 60000``, same MAP and seed): on the
-    demo's thermal_4a τmax on the whole chain (the package's rule) 1 683 steps from the
-    ball (696 on its second half: the walkers' spread from the ball inflates it) and 969
-    from the Laplace start; min bulk ESS per CPU second 1.92 and 4.43. The two-node
-    models keep the ball (their chains, which the statistical tests pin, unchanged).
-    The default of ``sampler.start`` is ``"ball"`` (see the module docstring: Ørholm's
-    thermal_4a converges from the ball, not from the Laplace start).
+    Chosen by measured τ (docs/science/benchmarks.md, "Where the demo's thermal_4a
+    spends its steps"). The two-node models keep the ball (their chains, which the
+    statistical tests pin, unchanged). The default of ``sampler.start`` is ``"ball"``
+    (see the module docstring).
     """
     if choice not in ("auto", "ball", "laplace"):
         raise ValueError(f"sampler.start must be 'auto', 'ball' or 'laplace' (got {choice!r})")

@@ -130,9 +130,8 @@ def ground_prior(floor_area: float, *, u_value: float = U_GROUND, sigma: float =
     W/(m²·K) within one σ). Why: with a constant ground temperature ``Tf`` the data see
     ``Gf`` only through the mean level, which a slow envelope mode and the start also
     move, so the default log-uniform prior (seven decades) lets ``Gf`` drift to zero and
-    the gain from ``Te`` to one; measured by ``benchmarks/bench_sbc.py``: the gain from
-    ``Te`` came out above the truth in most replicates (rank test p 0.01), while a floor
-    area is in every building survey.
+    the gain from ``Te`` to one (measured: docs/science/sbc.md, "Figures behind the
+    code's choices"), while a floor area is in every building survey.
 
     Parameters
     ----------
@@ -164,13 +163,10 @@ def interior_prior(interior_area: float, *, h: float = H_INTERIOR, sigma: float 
     Median ``h × interior_area`` (:data:`H_INTERIOR`, 5 W/(m²·K)), width σ_log = 0.7 (a
     factor 2: 2.5-10 W/(m²·K) within one σ). Why: what couples a mass to the air is its
     surface, and a building survey knows the surface while hourly temperatures do not.
-    With the default log-uniform prior over seven decades the demo's ``thermal_4a``
-    posterior has an arm in which the interior mass is decoupled (``Gint`` 0.3-3.5 W/K,
-    physically a few tenths of a square metre of surface) and the MAP lies there; the
-    chain crosses between that arm and a merged mass in rare long excursions (τ of
-    ``Gint`` 3 899 steps after 150 000 steps, not converged); with the demo's
-    80 m² it converges in 9 500 steps (docs/science/benchmarks.md, "The interior area
-    and several optima").
+    With the default log-uniform prior over seven decades a posterior can hold an arm in
+    which the interior mass is decoupled (a few tenths of a square metre of surface),
+    which the chain crosses only in rare long excursions (measured:
+    docs/science/benchmarks.md, "The interior area and several optima").
 
     Parameters
     ----------
@@ -203,8 +199,8 @@ def aperture_prior(
     shading, and the sun the opaque wall passes on, all uncertain). Why: with the
     default log-uniform prior over five decades a facade whose sun is mostly diffuse
     (north) is hardly told from the others, and the prior's volume pulls its aperture
-    towards zero (measured on the demo's north facade over 24 logger-noise seeds,
-    with the commands: docs/science/sbc.md, "The demo's solar apertures"); a window
+    towards zero (measured over logger-noise seeds, with the commands:
+    docs/science/sbc.md, "The demo's solar apertures"); a window
     count is in every building survey.
 
     Parameters
@@ -303,28 +299,22 @@ def envelope_priors(envelope_area: float, domain: str = "thermal") -> dict[str, 
     can hold a ridge running to an envelope node clamped to the outdoor air (Gw at the
     default's 1e5 W/K) that keeps its slow mode with a capacity of 1e11 J/K: a low-pass
     filtered outdoor temperature, physically a wall tens of metres thick. Along the
-    ridge the solar gain moves by a factor 2-3. Measured by ``benchmarks/bench_sbc.py
-    --room 88 --reps 24 --envelope-area 0`` (a 400 m³ hall, true Gw 87 W/K, Cw 3.4e8
-    J/K): the MAPs of 24 fresh observations of the room spread from Gw 0.01 to 1e5 W/K
-    (Cw up to 2e11 J/K), 22 chains had not converged after 12 000 steps and the 90 %
-    interval of the solar gain covered the truth 9 times in 24; with these bounds (area
-    259 m²) 16 in 24, and over 100 such rooms the solar gain's coverage rose from 0.81
-    to 0.86 (README: simulation-based calibration).
+    ridge the solar gain moves (measured: docs/science/sbc.md, "Figures behind the
+    code's choices").
 
     And ``Gw`` at least ``U_ENVELOPE_MIN × area``: an envelope node nearly detached
     from the outdoor air (Gw 0.01-0.3 W/K for a 259 m² envelope) is the trap of the
     Kalman likelihoods, whose process noise then makes the detached node a random walk
-    that carries the slow response (``noise: kalman``, independent SBC rooms 4 and 12:
-    Gw 0.27 and 0.01 W/K for truths of 92 and 369 W/K; docs/science/noise.md).
+    that carries the slow response (``noise: kalman``; docs/science/noise.md, "Two
+    traps, and the bounds that close them").
 
     Hygric models (``domain="hygric"``): the buffer node's ``Gw`` (buffer - outdoor)
     [kg/(s·Pa)] at most ``G_VAPOUR_MAX × area`` and ``Cw`` [kg/Pa] at most
     ``C_BUFFER_MAX × area``. Without them hygric_2c_fixed holds the same kind of ridge:
     a buffer welded to the outdoor air (Gw at the default's 1e-3) with a capacity of
     1e3 kg/Pa (a tonne of water per pascal), a low-pass filtered Pe that trades the
-    gain from Pe against the fixed node's offset (measured by
-    ``benchmarks/bench_sbc_independent.py`` before these bounds: the MAPs of 9 of 27 rooms
-    with ``ar1_white`` and 27 of 39 with ``kalman``; docs/science/noise.md). And the
+    gain from Pe against the fixed node's offset (measured: docs/science/noise.md, "Two
+    traps, and the bounds that close them"). And the
     hygric ``Gw`` at least ``G_VAPOUR_MIN × area`` (an envelope no tighter than
     s_d = 100 m): a wall's exchange with outdoors that relaxes over months to years is
     barely seen in a few months of data, and the default's log-uniform prior, down to
@@ -399,11 +389,7 @@ def fixed_vapour_pressure_prior(
     Why: the gain from ``Pe`` and the node's offset ``Gf/(ΣG) × Pf`` trade along a ridge
     three months of data barely resolve; the former default (uniform on 0-5 000 Pa) gives
     the weak-node, high-``Pf`` end of the ridge most of its volume, so the posterior
-    leant there. Measured on eight rooms the fitted model generated (``python
-    benchmarks/bench_sbc.py --reps 8 --models hygric_2c_fixed --noise
-    ar1_white:estimate``): gain from Pe above the truth in 7 of 8 (mean z +1.36), no
-    chain converged in 12 000 steps; with the fit's priors equal to the truth's
-    distribution (``--truth-priors``) mean z +0.34, 7 of 8 converged (τ 55-220 steps).
+    leant there (measured: docs/science/sbc.md, "The fixed vapour-pressure node").
 
     Parameters
     ----------

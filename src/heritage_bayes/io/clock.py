@@ -57,10 +57,8 @@ __all__ = [
 ]
 
 #: Lag [h] of the first harmonic of the outdoor air temperature's daily cycle behind
-#: solar noon. Measured on two stations whose clocks are known (median of the daily
-#: phases, days with a daily range of at least 3 K): FMI Espoo 2010-2012 (UTC+2, TRH-1
-#: ``fmi.csv``): 2.40 h over 494 days; KNMI De Bilt 2011-2020 (UT): 2.37 h over 3 342
-#: days (``tests/test_clock.py`` checks both).
+#: solar noon: the median of the daily phases on stations whose clocks are known
+#: (docs/science/real_rooms.md, "Figures behind the code's choices").
 TE_PEAK_LAG_H = 2.4
 
 #: Months of the northern summer half (DST in force in Europe and North America) and of

@@ -53,9 +53,9 @@ draw). A free-running room calibrated on temperatures and RH only identifies tim
 constants and gains, not the absolute conductances [W/K] (the architecture notes): the
 scale of these figures, and so their interval, comes from the priors that pin it (room
 volume, air change rate) and the page says so; only measured heating power as an input
-of the calibration would fix it from data (the Ørholm store was heated but logged no
-power: ``benchmarks/bench_orholm_interventions.py`` gives 345 kWh/a with a 90 %
-interval of [0.7, 45 118] kWh/a there).
+of the calibration would fix it from data (an example, the Ørholm store, heated but
+logging no power: docs/science/interventions.md, "Ørholm: a thermostat re-simulated
+against the log").
 
 References
 ----------

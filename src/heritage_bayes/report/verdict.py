@@ -185,9 +185,9 @@ def truth_advice(summary: RunSummary | dict, k: int) -> str:
     With n derived quantities checked, a calibrated posterior puts about n/10 truths
     outside by chance; P(at least k) is the binomial tail for independent quantities
     (an approximation: derived quantities share parameters, e.g. the static gains of
-    one node sum to one, so misses come in pairs). The demo misses 4 of 11 with its
-    logger-noise seed 7 and 0-3 with seeds 8-12 (``benchmarks/noise_default.py``,
-    docs/science/noise.md): one data set cannot tell bad luck from bias.
+    one node sum to one, so misses come in pairs): one data set cannot tell bad luck
+    from bias (the demo's misses over its logger-noise seeds: docs/science/noise.md,
+    "Figures behind the code's choices").
     """
     n = len(_truth_keys(summary))
     p = sum(math.comb(n, j) * 0.1**j * 0.9 ** (n - j) for j in range(k, n + 1))

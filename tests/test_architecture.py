@@ -275,7 +275,6 @@ LONG_FUNCTIONS = {
     "climate/risk/_fused.py::series_indicators": 128,
     "climate/solar.py::surface_irradiance": 134,
     "init_config.py::init_config": 272,
-    "io/loggers.py::inspect_table": 126,
     "prepare.py::prepare": 218,
     "projection/__init__.py::project": 124,
     "rc/identify.py::structural_identifiability": 121,

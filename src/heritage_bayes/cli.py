@@ -23,11 +23,11 @@ Tested by calling :func:`main` directly, and as a subprocess (``tests/test_fault
 from __future__ import annotations
 
 import argparse
-import errno
 import signal
 import sys
 import threading
 
+from heritage_bayes._terminal import DISK_ERRORS, disk_error_text, internal_error
 from heritage_bayes._terminal import print_error as _error
 from heritage_bayes._terminal import reader_gone as _reader_gone
 from heritage_bayes._terminal import tolerant_streams as _tolerant_streams
@@ -46,6 +46,13 @@ def _build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"hbayes {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
 
+    for add in (_add_run_commands, _add_model_commands, _add_setup_commands):
+        add(sub)
+    return parser
+
+
+def _add_run_commands(sub) -> None:
+    """``calibrate``, ``report`` and ``project``."""
     cal = sub.add_parser(
         "calibrate",
         help="calibrate the models of a YAML config",
@@ -95,6 +102,9 @@ def _build_parser() -> argparse.ArgumentParser:
     prj.add_argument("--quiet", action="store_true", help="no progress output")
     prj.set_defaults(func=_cmd_project)
 
+
+def _add_model_commands(sub) -> None:
+    """``models`` and ``compare``."""
     mod = sub.add_parser(
         "models",
         help="list the catalogue of RC models, or describe one",
@@ -149,6 +159,9 @@ def _build_parser() -> argparse.ArgumentParser:
     )
     cmp_.set_defaults(func=_cmd_compare)
 
+
+def _add_setup_commands(sub) -> None:
+    """``init`` and ``batch``."""
     ini = sub.add_parser(
         "init",
         help="write a commented config.yaml from a logger file and a weather file",
@@ -218,7 +231,6 @@ def _build_parser() -> argparse.ArgumentParser:
     )
     bat.add_argument("--quiet", action="store_true", help="no progress output")
     bat.set_defaults(func=_cmd_batch)
-    return parser
 
 
 def _cmd_calibrate(args) -> int:
@@ -557,42 +569,13 @@ def _main(argv: list[str] | None) -> int:
     except BrokenPipeError:
         return _reader_gone()
     except OSError as exc:
-        if exc.errno not in _DISK_ERRORS:
-            return _internal_error()
-        print(f"hbayes: error: {_disk_error_text(exc, args)}", file=sys.stderr)
+        if exc.errno not in DISK_ERRORS:
+            return internal_error()
+        print(f"hbayes: error: {disk_error_text(exc, args)}", file=sys.stderr)
         _notes(exc)
         return 2
     except Exception:  # an internal error: a bug, so show where it happened
-        return _internal_error()
-
-
-#: A full or read-only disk: the user's to fix, not a bug.
-_DISK_ERRORS = (errno.ENOSPC, errno.EDQUOT, errno.EROFS)
-
-
-def _disk_error_text(exc: OSError, args) -> str:
-    """A full or read-only disk, named by the file or, when the library that wrote
-    (HDF5, NetCDF) did not say which, by the command's output."""
-    where = exc.filename or next(
-        (v for v in (getattr(args, k, None) for k in ("out", "output", "run_dir")) if v), None
-    )
-    text = exc.strerror or str(exc)
-    if where:
-        text += f" while writing {where}"
-    return (
-        text + "; free some space or choose another --out (earlier outputs are kept as they were)"
-    )
-
-
-def _internal_error() -> int:
-    import traceback
-
-    traceback.print_exc()
-    print(
-        "hbayes: internal error (exit code 1); please report it with the traceback above",
-        file=sys.stderr,
-    )
-    return 1
+        return internal_error()
 
 
 if __name__ == "__main__":  # pragma: no cover

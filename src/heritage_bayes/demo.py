@@ -428,34 +428,10 @@ def virtual_monument(
     4.0
     """
     import heritage_bayes as hb
-    from heritage_bayes.climate.psychro import relative_humidity
 
-    if weather not in _WEATHERS:
-        raise ConfigError(
-            f"weather: unknown demo weather {weather!r}; available: {list(_WEATHERS)}"
-        )
-    if weather in _KNMI_SITES and weather_path is None:
-        raise ConfigError(
-            f"weather_path: required for the demo weather {weather!r} (the KNMI hourly "
-            "file, e.g. ../shared/data/knmi-debilt/uurgeg_260_2011-2020.txt.gz)"
-        )
-    if isinstance(seed, bool) or not isinstance(seed, int | np.integer):
-        raise ConfigError(f"seed: expected an integer (got {seed!r})")
-    for name, v in (
-        ("sensor_noise_T", sensor_noise_T),
-        ("sensor_noise_RH", sensor_noise_RH),
-        ("model_error_T", model_error_T),
-        ("model_error_P", model_error_P),
-    ):
-        if not (np.isfinite(v) and v >= 0):
-            raise ConfigError(f"{name}: expected a non-negative number (got {v!r})")
-    if not 0 <= model_error_phi < 1:
-        raise ConfigError(f"model_error_phi: expected 0 <= phi < 1 (got {model_error_phi!r})")
-
-    if thermal_model not in ("thermal_4a", "thermal_2c"):
-        raise ConfigError(
-            f"thermal_model: expected 'thermal_4a' or 'thermal_2c' (got {thermal_model!r})"
-        )
+    noise = {"sensor_noise_T": sensor_noise_T, "sensor_noise_RH": sensor_noise_RH}
+    noise |= {"model_error_T": model_error_T, "model_error_P": model_error_P}
+    _check_settings(weather, weather_path, seed, noise, model_error_phi, thermal_model)
     m_th = hb.model(thermal_model, surfaces=tuple(DEMO_SURFACES), ground=True)
     m_hy = hb.model(_MODELS["hygric"])
     p_th = _check_overrides("thermal", thermal, m_th)
@@ -470,7 +446,6 @@ def virtual_monument(
     )
     w, inputs = w.copy(), inputs.copy()  # the cache stays pristine (attrs are copied too)
     index = inputs.index
-    n = len(index)
     states = {
         "thermal": _simulate_states(m_th, p_th, inputs),
         "hygric": _simulate_states(m_hy, p_hy, inputs),
@@ -478,42 +453,11 @@ def virtual_monument(
     T_model = states["thermal"]["Ti"].to_numpy()
     P_model = states["hygric"]["Pi"].to_numpy()
 
-    rng = np.random.default_rng(int(seed))
-    z = rng.standard_normal((4, n))
-    T_room = T_model + _ar1(z[0], model_error_phi, model_error_T)
-    P_room = P_model + _ar1(z[1], model_error_phi, model_error_P)
-    T_obs = np.round(T_room + sensor_noise_T * z[2], 1)
-    rh = relative_humidity(T_room, P_room) + sensor_noise_RH * z[3]
-    rh_obs = np.round(rh, 1)
-    capped = int(np.sum((rh_obs > 100.0) | (rh_obs < 0.0)))
-    rh_obs = np.clip(rh_obs, 0.0, 100.0)
+    T_room, P_room, meas, capped = _logger_readings(
+        T_model, P_model, index, seed, model_error_phi, noise, gap
+    )
 
-    meas = pd.DataFrame({"Ti": T_obs, "RHi": rh_obs}, index=index)
-    if gap is not None:
-        g0, g1 = (_utc(g) for g in gap)
-        if not g0 < g1:
-            raise ConfigError(f"gap: start must be before end (got {gap[0]} >= {gap[1]})")
-        meas = meas[(meas.index < g0) | (meas.index >= g1)]
-    meas.index.name = "time"
-    meas.attrs = {
-        "source": f"virtual monument (the built-in demo, seed {int(seed)})",
-        "format": "demo",
-        "units": {"Ti": "°C", "RHi": "%"},
-        "averaged": (),
-        "interval": "1h",
-        "timezone": "UTC",
-        "dropped": {},
-        "clipped": {"RHi": capped} if capped else {},
-    }
-
-    station = str(w.attrs.get("station", "")).strip()
-    if weather in _KNMI_SITES:
-        wfile, irr = str(weather_path), f"measured global irradiance (KNMI station {station})"
-        wdesc = f"the KNMI hourly weather of station {station} ({weather_path})"
-    else:
-        wfile = f"pvlib/data/{_WEATHERS[weather]}"
-        irr = f"measured (TMY3 {station}, shipped with pvlib)"
-        wdesc = f"the TMY3 weather of {station} ({wfile})"
+    station, wfile, irr, wdesc = _weather_words(weather, weather_path, w)
     info = {
         "inputs": inputs,
         "Ti_model": pd.Series(T_model, index=index, name="Ti"),
@@ -557,6 +501,84 @@ def virtual_monument(
     truth["thermal"].update(nominal_noise(monument, "Ti"))
     truth["hygric"].update(nominal_noise(monument, "Pi"))
     return monument
+
+
+def _check_settings(weather, weather_path, seed, noise: dict, model_error_phi, thermal_model):
+    """Refuse an unknown weather or generating model, a KNMI weather without its file, a
+    seed that is not an integer and negative noise levels (see :func:`virtual_monument`)."""
+    if weather not in _WEATHERS:
+        raise ConfigError(
+            f"weather: unknown demo weather {weather!r}; available: {list(_WEATHERS)}"
+        )
+    if weather in _KNMI_SITES and weather_path is None:
+        raise ConfigError(
+            f"weather_path: required for the demo weather {weather!r} (the KNMI hourly "
+            "file, e.g. ../shared/data/knmi-debilt/uurgeg_260_2011-2020.txt.gz)"
+        )
+    if isinstance(seed, bool) or not isinstance(seed, int | np.integer):
+        raise ConfigError(f"seed: expected an integer (got {seed!r})")
+    for name, v in noise.items():
+        if not (np.isfinite(v) and v >= 0):
+            raise ConfigError(f"{name}: expected a non-negative number (got {v!r})")
+    if not 0 <= model_error_phi < 1:
+        raise ConfigError(f"model_error_phi: expected 0 <= phi < 1 (got {model_error_phi!r})")
+    if thermal_model not in ("thermal_4a", "thermal_2c"):
+        raise ConfigError(
+            f"thermal_model: expected 'thermal_4a' or 'thermal_2c' (got {thermal_model!r})"
+        )
+
+
+def _logger_readings(T_model, P_model, index, seed, model_error_phi, noise: dict, gap):
+    """The room (the models' states plus an AR(1) model error, coefficient
+    ``model_error_phi``) and what the logger reads of it: white noise, rounded to 0.1, RH
+    clipped to [0, 100] %, nothing during ``gap`` (``noise``: the sd of each, as named in
+    :func:`virtual_monument`). Returns (T_room, P_room, the readings, the RH values
+    clipped)."""
+    from heritage_bayes.climate.psychro import relative_humidity
+
+    n = len(index)
+    rng = np.random.default_rng(int(seed))
+    z = rng.standard_normal((4, n))
+    T_room = T_model + _ar1(z[0], model_error_phi, noise["model_error_T"])
+    P_room = P_model + _ar1(z[1], model_error_phi, noise["model_error_P"])
+    T_obs = np.round(T_room + noise["sensor_noise_T"] * z[2], 1)
+    rh = relative_humidity(T_room, P_room) + noise["sensor_noise_RH"] * z[3]
+    rh_obs = np.round(rh, 1)
+    capped = int(np.sum((rh_obs > 100.0) | (rh_obs < 0.0)))
+    rh_obs = np.clip(rh_obs, 0.0, 100.0)
+
+    meas = pd.DataFrame({"Ti": T_obs, "RHi": rh_obs}, index=index)
+    if gap is not None:
+        g0, g1 = (_utc(g) for g in gap)
+        if not g0 < g1:
+            raise ConfigError(f"gap: start must be before end (got {gap[0]} >= {gap[1]})")
+        meas = meas[(meas.index < g0) | (meas.index >= g1)]
+    meas.index.name = "time"
+    meas.attrs = {
+        "source": f"virtual monument (the built-in demo, seed {int(seed)})",
+        "format": "demo",
+        "units": {"Ti": "°C", "RHi": "%"},
+        "averaged": (),
+        "interval": "1h",
+        "timezone": "UTC",
+        "dropped": {},
+        "clipped": {"RHi": capped} if capped else {},
+    }
+
+    return T_room, P_room, meas, capped
+
+
+def _weather_words(weather: str, weather_path, w) -> tuple[str, str, str, str]:
+    """(station, weather file, irradiance label, description) of the demo's weather."""
+    station = str(w.attrs.get("station", "")).strip()
+    if weather in _KNMI_SITES:
+        wfile, irr = str(weather_path), f"measured global irradiance (KNMI station {station})"
+        wdesc = f"the KNMI hourly weather of station {station} ({weather_path})"
+    else:
+        wfile = f"pvlib/data/{_WEATHERS[weather]}"
+        irr = f"measured (TMY3 {station}, shipped with pvlib)"
+        wdesc = f"the TMY3 weather of {station} ({wfile})"
+    return station, wfile, irr, wdesc
 
 
 def _utc(text) -> pd.Timestamp:

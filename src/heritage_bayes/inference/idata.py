@@ -9,6 +9,7 @@ sampled independently; their retained draws share the (chain, draw) grid so that
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass, field
 from datetime import UTC, datetime
 
 import numpy as np
@@ -33,7 +34,7 @@ from heritage_bayes.inference.predictive import (
     predictive_noise,
 )
 from heritage_bayes.inference.results import as_stored, coverage, fit_metrics
-from heritage_bayes.inference.runinfo import _periods, _truth_for, _versions
+from heritage_bayes.inference.runinfo import _frozen_share, _hours, _periods, _truth_for, _versions
 from heritage_bayes.rc.discretize import modal_form
 from heritage_bayes.rc.identify import derived_quantities, derived_units
 
@@ -43,6 +44,7 @@ __all__ = ["CONVERGENCE", "build_run_outputs"]
 CONVERGENCE = {"max_rhat": 1.01, "min_ess_bulk": 400.0}
 
 _OUT_UNITS = {"Ti": "°C", "Pi": "Pa", "RHi": "%"}
+_CDIMS = ("chain", "draw")
 
 
 def _times(prep) -> np.ndarray:
@@ -163,253 +165,301 @@ def _summ(x: np.ndarray) -> dict:
     }
 
 
+@dataclass
+class _Outputs:
+    """What :func:`build_run_outputs` gathers section by section: the InferenceData
+    groups' variables and the summary's entries."""
+
+    W: int
+    D: int
+    sel: np.ndarray
+    times: np.ndarray
+    codes: np.ndarray
+    post: dict = field(default_factory=dict)
+    stats: dict = field(default_factory=dict)
+    loglik: dict = field(default_factory=dict)
+    loglik_val: dict = field(default_factory=dict)
+    pp: dict = field(default_factory=dict)
+    params: dict = field(default_factory=dict)
+    derived: dict = field(default_factory=dict)
+    metrics: dict = field(default_factory=dict)
+    models: dict = field(default_factory=dict)
+    correlations: dict = field(default_factory=dict)
+    #: output -> (K, N) predictive and simulated draws
+    pp_outputs: dict = field(default_factory=dict)
+    #: output -> (K, N) one-step samples (state-space noise)
+    one_step: dict = field(default_factory=dict)
+
+    def series(self, values: np.ndarray, attrs: dict) -> xr.DataArray:
+        """(K, N) draws of a time series -> a float32 (chain, draw, time) DataArray."""
+        n_sel = len(self.sel)
+        return xr.DataArray(
+            values.reshape(self.W, n_sel, -1).astype(np.float32),
+            dims=("chain", "draw", "time"),
+            coords={"chain": np.arange(self.W), "draw": np.arange(n_sel), "time": self.times},
+            attrs=attrs,
+        )
+
+
 def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
     """(InferenceData, summary dict) for sampled sections (see module docstring)."""
     rng = np.random.default_rng(seed + 7)
-    times = _times(prep)
-    codes = _period_codes(prep)
     W, D = sections[0].X.shape[:2]
     # every group holds the same draws (arviz convention: az.loo takes the relative
     # efficiency from the posterior and the terms from log_likelihood)
     sel = _saved_index(W, D, cfg.sampler.n_predictive)
-    n_sel = len(sel)
-    post: dict[str, xr.DataArray] = {}
-    stats: dict[str, xr.DataArray] = {}
-    loglik: dict[str, xr.DataArray] = {}
-    loglik_val: dict[str, xr.DataArray] = {}
-    pp: dict[str, xr.DataArray] = {}
-    summary_params: dict[str, dict] = {}
-    summary_derived: dict[str, dict] = {}
-    metrics: dict[str, dict] = {}
-    sec_info: dict[str, dict] = {}
-    correlations: dict[str, dict] = {}
-    pp_outputs: dict[str, np.ndarray] = {}
-    one_step: dict[str, np.ndarray] = {}  # output -> (K, N) one-step samples (kalman)
-    truth_all = prep.truth or {}
-    cdims = ("chain", "draw")
-    coords = {"chain": np.arange(W), "draw": np.arange(n_sel)}
+    o = _Outputs(W, D, sel, _times(prep), _period_codes(prep))
     for s in sections:
-        ps = s.logpost.params
-        names = ps.names
-        tm = s.theta[..., : s.logpost.n_model]
-        for j, p in enumerate(ps.parameters):
-            post[f"{s.name}.{p.name}"] = xr.DataArray(
-                np.ascontiguousarray(s.theta[:, sel, j], dtype=np.float64),
-                dims=cdims,
-                attrs={"unit": p.unit, "kind": p.kind, "description": p.description},
-            )
-        dq = derived_quantities(s.model, tm.reshape(-1, tm.shape[-1]))
-        units = derived_units(s.model)
-        dq_all = {}
-        for k, v in dq.items():
-            arr = np.broadcast_to(np.asarray(v, dtype=float), (W * D,)).reshape(W, D)
-            dq_all[k] = arr
-            post[f"{s.name}.{k}"] = xr.DataArray(
-                np.ascontiguousarray(arr[:, sel], dtype=np.float64),
-                dims=cdims,
-                attrs={"unit": units.get(k, "")},
-            )
-        stats[f"{s.name}.lp"] = xr.DataArray(s.lp[:, sel], dims=cdims)
-        stats[f"{s.name}.acceptance_rate"] = xr.DataArray(
-            np.broadcast_to(s.chain.acceptance[:, None], (W, n_sel)).copy(), dims=cdims
+        dq_all, dq_units = _posterior_draws(o, s)
+        x0, pred_info, saturation = _predictive_draws(o, s, prep, rng, seed)
+        _parameter_summaries(o, cfg, prep, s, seed, dq_units)
+        o.metrics[s.name] = _metrics_for(
+            prep, o.codes, s.model.output_names, o.pp_outputs, o.one_step
         )
-        # predictive over the whole frame for the selected draws
-        th_sel = s.theta[:, sel].reshape(-1, s.theta.shape[-1])
-        tn_sel = th_sel[:, s.logpost.n_model :]
-        U = prep.model_inputs(s.name, s.model)
-        # the initial state: a draw from its conditional posterior for each draw
-        x0 = s.logpost.initial_states(th_sel, rng)
-        if x0 is not None:
-            for i, node in enumerate(s.model.state_names):
-                post[f"{s.name}.x0_{node}"] = xr.DataArray(
-                    x0[:, i].reshape(W, n_sel),
-                    dims=cdims,
-                    attrs={
-                        "unit": "°C" if s.model.domain == "thermal" else "Pa",
-                        "description": f"state of node {node} at the first calibration "
-                        f"step ({initial_state_text(s.logpost)})",
-                    },
-                )
-        Ysim, _ = s.logpost.simulate_frame(th_sel, U, prep.calibration.start, x0=x0)
-        band_nm, tn_pred, pred_info = predictive_noise(s, prep, Ysim, tn_sel)
-        if getattr(band_nm, "statespace", False):
-            mf = modal_form(s.model, th_sel[:, : s.logpost.n_model], prep.dt)
-            noise = band_nm.sample_statespace(rng, mf, tn_pred, U.shape[0], s.model.n_outputs)
-        else:
-            noise = band_nm.sample(rng, tn_pred, U.shape[0], s.model.n_outputs)
-        noise += Ysim  # the predictive draws, in the noise's array (one fewer K x N copy)
-        Ypp, noise = noise, None
-        saturation = condensation_cap(s, prep, Ysim, Ypp, pp_outputs)
-        Y1 = None
-        if getattr(s.logpost.noise, "statespace", False):
-            # its own stream: the free-run outputs above do not depend on it
-            Y1 = _one_step_sample(s, prep, th_sel, np.random.default_rng([seed, 17]))
-        shape = (W, n_sel, U.shape[0])
-        pcoords = {"chain": np.arange(W), "draw": np.arange(n_sel), "time": times}
-        for o, out in enumerate(s.model.output_names):
-            attrs = {"unit": _OUT_UNITS.get(out, "")}
-            pp[f"{s.name}.{out}"] = xr.DataArray(
-                Ypp[..., o].reshape(shape).astype(np.float32),
-                dims=("chain", "draw", "time"),
-                coords=pcoords,
-                attrs=attrs,
+        o.models[s.name] = _section_info(o, s, x0, pred_info, saturation, dq_all)
+    _combined_rh(o, prep)
+    attrs = {
+        "heritage_bayes_version": __version__,
+        "seed": int(seed),
+        "config_hash": chash,
+        "created_at": datetime.now(UTC).isoformat(timespec="seconds"),
+        "run_name": cfg.name or "",
+        "dt_seconds": float(prep.dt),
+    }
+    idata = _inference_data(o, prep, sections, attrs)
+    return idata, _summary(o, cfg, prep, sections, attrs)
+
+
+def _posterior_draws(o: _Outputs, s) -> tuple[dict, dict]:
+    """The saved draws of a section's parameters and derived quantities, and its sampler
+    statistics; returns (derived quantity -> its (W, D) kept draws, -> its unit)."""
+    ps, W, D = s.logpost.params, o.W, o.D
+    for j, p in enumerate(ps.parameters):
+        o.post[f"{s.name}.{p.name}"] = xr.DataArray(
+            np.ascontiguousarray(s.theta[:, o.sel, j], dtype=np.float64),
+            dims=_CDIMS,
+            attrs={"unit": p.unit, "kind": p.kind, "description": p.description},
+        )
+    tm = s.theta[..., : s.logpost.n_model]
+    dq = derived_quantities(s.model, tm.reshape(-1, tm.shape[-1]))
+    units = derived_units(s.model)
+    dq_all = {}
+    for k, v in dq.items():
+        arr = np.broadcast_to(np.asarray(v, dtype=float), (W * D,)).reshape(W, D)
+        dq_all[k] = arr
+        o.post[f"{s.name}.{k}"] = xr.DataArray(
+            np.ascontiguousarray(arr[:, o.sel], dtype=np.float64),
+            dims=_CDIMS,
+            attrs={"unit": units.get(k, "")},
+        )
+    o.stats[f"{s.name}.lp"] = xr.DataArray(s.lp[:, o.sel], dims=_CDIMS)
+    o.stats[f"{s.name}.acceptance_rate"] = xr.DataArray(
+        np.broadcast_to(s.chain.acceptance[:, None], (W, len(o.sel))).copy(), dims=_CDIMS
+    )
+    return dq_all, {k: units.get(k, "") for k in dq}
+
+
+def _predictive_draws(o: _Outputs, s, prep, rng, seed: int):
+    """The initial states, the predictive and simulated outputs over the whole frame and
+    the pointwise log-likelihoods of the saved draws; returns (initial states (K, n) or
+    None, the predictive noise's description, the condensation cap's)."""
+    W, n_sel, n_model = o.W, len(o.sel), s.logpost.n_model
+    th_sel = s.theta[:, o.sel].reshape(-1, s.theta.shape[-1])
+    tn_sel = th_sel[:, n_model:]
+    U = prep.model_inputs(s.name, s.model)
+    # the initial state: a draw from its conditional posterior for each draw
+    x0 = s.logpost.initial_states(th_sel, rng)
+    if x0 is not None:
+        for i, node in enumerate(s.model.state_names):
+            o.post[f"{s.name}.x0_{node}"] = xr.DataArray(
+                x0[:, i].reshape(W, n_sel),
+                dims=_CDIMS,
+                attrs={
+                    "unit": "°C" if s.model.domain == "thermal" else "Pa",
+                    "description": f"state of node {node} at the first calibration "
+                    f"step ({initial_state_text(s.logpost)})",
+                },
             )
-            pp[f"{s.name}.{out}_sim"] = xr.DataArray(
-                Ysim[..., o].reshape(shape).astype(np.float32),
-                dims=("chain", "draw", "time"),
-                coords=pcoords,
-                attrs=attrs,
+    Ysim, _ = s.logpost.simulate_frame(th_sel, U, prep.calibration.start, x0=x0)
+    band_nm, tn_pred, pred_info = predictive_noise(s, prep, Ysim, tn_sel)
+    if getattr(band_nm, "statespace", False):
+        mf = modal_form(s.model, th_sel[:, :n_model], prep.dt)
+        noise = band_nm.sample_statespace(rng, mf, tn_pred, U.shape[0], s.model.n_outputs)
+    else:
+        noise = band_nm.sample(rng, tn_pred, U.shape[0], s.model.n_outputs)
+    noise += Ysim  # the predictive draws, in the noise's array (one fewer K x N copy)
+    Ypp, noise = noise, None
+    saturation = condensation_cap(s, prep, Ysim, Ypp, o.pp_outputs)
+    Y1 = None
+    if getattr(s.logpost.noise, "statespace", False):
+        # its own stream: the free-run outputs above do not depend on it
+        Y1 = _one_step_sample(s, prep, th_sel, np.random.default_rng([seed, 17]))
+    for k, out in enumerate(s.model.output_names):
+        attrs = {"unit": _OUT_UNITS.get(out, "")}
+        o.pp[f"{s.name}.{out}"] = o.series(Ypp[..., k], attrs)
+        o.pp[f"{s.name}.{out}_sim"] = o.series(Ysim[..., k], attrs)
+        o.pp_outputs[out] = (Ypp[..., k], Ysim[..., k])
+        if Y1 is not None:
+            description = "one-step-ahead predictive samples"
+            o.pp[f"{s.name}.{out}_1step"] = o.series(
+                Y1[..., k], {**attrs, "description": description}
             )
-            pp_outputs[out] = (Ypp[..., o], Ysim[..., o])
-            if Y1 is not None:
-                pp[f"{s.name}.{out}_1step"] = xr.DataArray(
-                    Y1[..., o].reshape(shape).astype(np.float32),
-                    dims=("chain", "draw", "time"),
-                    coords=pcoords,
-                    attrs={**attrs, "description": "one-step-ahead predictive samples"},
-                )
-                one_step[out] = Y1[..., o]
-        pw = s.logpost.pointwise_log_likelihood(th_sel)
-        loglik.update(_pointwise(s, pw, times[prep.calibration], (W, n_sel)))
-        pw = _validation_pointwise(s, prep, Ysim, tn_sel, th_sel)
-        loglik_val.update(_pointwise(s, pw, times, (W, n_sel)))
-        # parameter summaries: quantiles, R-hat and ESS of the draws posterior.nc holds,
-        # as it holds them, so that a reader of the file reproduces every digit;
-        # contraction, bounds and correlations on all draws the sampler kept
-        kept = s.theta_kept
-        free_vars = [f"{s.name}.{n}" for n in ps.free_names]
-        rhat, ess_b, ess_t = convergence_stats(post, free_vars)
-        tau = dict(zip(ps.free_names, s.chain.tau, strict=True))
-        truth, truth_dq = _truth_for(cfg, prep, s)
-        mapv = dict(zip(names, s.map.theta, strict=True))
-        prng = np.random.default_rng(seed + 11)
-        for j, p in enumerate(ps.parameters):
-            key = f"{s.name}.{p.name}"
-            x = kept[..., j].reshape(-1)
-            entry = {
-                "unit": p.unit,
-                "kind": p.kind,
-                "description": p.description,
-                "fixed": p.fixed,
-                "prior": None if p.fixed is not None else p.prior.describe(),
-                "prior_spec": None if p.fixed is not None else p.prior.to_dict(),
-                "transform": None if p.fixed is not None else ps.modes[ps.free_names.index(p.name)],
-                "map": mapv[p.name],
-                **_summ(post[key].values.reshape(-1)),
-                "truth": truth.get(p.name),
-            }
-            if p.free:
-                y = np.log(x) if p.prior.log_scale else x
-                a, b = (
-                    (math.log(p.prior.lower), math.log(p.prior.upper))
-                    if p.prior.log_scale
-                    else (p.prior.lower, p.prior.upper)
-                )
-                pos = (np.quantile(y, [0.05, 0.95]) - a) / (b - a)
-                entry.update(
-                    r_hat=float(rhat[key]),
-                    ess_bulk=float(ess_b[key]),
-                    ess_tail=float(ess_t[key]),
-                    tau=float(tau[p.name]),
-                    contraction=float(1 - np.var(y) / _prior_variance(p.prior, prng)),
-                    at_bound=("lower" if pos[0] < 0.01 else "upper" if pos[1] > 0.99 else None),
-                )
-            summary_params[key] = entry
-        for k in dq:
-            key = f"{s.name}.{k}"
-            x = post[key].values.reshape(-1)
-            summary_derived[key] = {"unit": units.get(k, ""), **_summ(x), "truth": truth_dq.get(k)}
-            if np.all(np.isfinite(x)) and np.ptp(x) > 0:
-                r, e, _ = convergence_stats(post, [key])
-                summary_derived[key]["r_hat"] = float(r[key])
-                summary_derived[key]["ess_bulk"] = float(e[key])
-        # posterior correlations of the free parameters (log scale where the prior is)
-        Y = []
-        for j, p in enumerate(ps.parameters):
-            if p.free:
-                x = kept[..., j].reshape(-1)
-                Y.append(np.log(x) if p.prior.log_scale else x)
-        corr = np.corrcoef(np.array(Y)) if len(Y) > 1 else np.ones((1, 1))
-        correlations[s.name] = {"names": list(ps.free_names), "matrix": corr.tolist()}
-        # fit metrics per output and period
-        metrics[s.name] = _metrics_for(prep, codes, s.model.output_names, pp_outputs, one_step)
-        sec_info[s.name] = {
-            "predictive_noise": pred_info,
-            "saturation": saturation,
-            "model": s.model.name,
-            "domain": s.model.domain,
-            "state_names": list(s.model.state_names),
-            "input_names": list(s.model.input_names),
-            "output_names": list(s.model.output_names),
-            "noise": s.logpost.noise.name,
-            "initial_state": {
-                "mode": s.logpost.initial_state
-                if isinstance(s.logpost.initial_state, str)
-                else dict(s.logpost.initial_state),
-                "how": initial_state_text(s.logpost),
-                "prior_sd": s.logpost.initial_state_sd,
-                "horizon_h": s.logpost.initial_state_horizon / 3600.0,
-                "unit": "°C" if s.model.domain == "thermal" else "Pa",
-                "nodes": (
-                    {node: _summ(x0[:, i]) for i, node in enumerate(s.model.state_names)}
-                    if x0 is not None
-                    else None
-                ),
-            },
-            "map": s.map.to_dict(names),
-            "identifiability": s.identifiability.to_dict(),
-            "chain": {
-                "coordinates": getattr(s.chain, "coordinates", "log"),
-                # the block move: the flagged parameters and its share of the steps
-                # (0: the named moves alone)
-                "block_move": getattr(s, "block_move", None) or None,
-                "walkers": int(W),
-                "steps": int(s.chain.steps),
-                "burn": int(s.chain.burn),
-                "thin": int(s.chain.thin),
-                "draws_per_walker": int(D),
-                "converged_tau": bool(s.chain.converged),
-                "tau_max": float(np.nanmax(s.chain.tau)),
-                "tau_history": [list(map(float, r)) for r in s.chain.tau_history],
-                "acceptance_mean": float(np.mean(s.chain.acceptance)),
-                "resumed_from": int(s.chain.resumed_from),
-                "stopped_by": getattr(s.chain, "stopped_by", ""),
-                "cpu_seconds": float(getattr(s.chain, "cpu_seconds", 0.0)),
-            },
-            # findings before sampling: a MAP on a prior bound, and practical
-            # identifiability from the Laplace approximation at the MAP
-            "map_at_bound": [list(b) for b in getattr(s, "map_at_bound", [])],
-            "frozen_node": getattr(s, "frozen_node", None),
-            # the share of draws whose slowest mode is frozen (a second posterior branch)
-            "frozen_share": _frozen_share(dq_all.get("tau_1_h"), s.logpost),
-            "time_constant_cap_h": _hours(s.logpost.time_constant_cap),
-            "likelihood_temperature": float(s.logpost.temperature),
-            "practical_identifiability": (
-                s.laplace.to_dict(ps.free_names) if getattr(s, "laplace", None) else None
-            ),
+            o.one_step[out] = Y1[..., k]
+    pw = s.logpost.pointwise_log_likelihood(th_sel)
+    o.loglik.update(_pointwise(s, pw, o.times[prep.calibration], (W, n_sel)))
+    pw = _validation_pointwise(s, prep, Ysim, tn_sel, th_sel)
+    o.loglik_val.update(_pointwise(s, pw, o.times, (W, n_sel)))
+    return x0, pred_info, saturation
+
+
+def _parameter_summaries(o: _Outputs, cfg, prep, s, seed: int, dq_units: dict) -> None:
+    """The summary's entries of a section's parameters and derived quantities, and the
+    posterior correlations of its free parameters.
+
+    Quantiles, R-hat and ESS are those of the draws ``posterior.nc`` holds, as it holds
+    them, so that a reader of the file reproduces every digit; contraction, bounds and
+    correlations are taken on all draws the sampler kept."""
+    ps = s.logpost.params
+    kept = s.theta_kept
+    free_vars = [f"{s.name}.{n}" for n in ps.free_names]
+    rhat, ess_b, ess_t = convergence_stats(o.post, free_vars)
+    tau = dict(zip(ps.free_names, s.chain.tau, strict=True))
+    truth, truth_dq = _truth_for(cfg, prep, s)
+    mapv = dict(zip(ps.names, s.map.theta, strict=True))
+    prng = np.random.default_rng(seed + 11)
+    for j, p in enumerate(ps.parameters):
+        key = f"{s.name}.{p.name}"
+        x = kept[..., j].reshape(-1)
+        entry = {
+            "unit": p.unit,
+            "kind": p.kind,
+            "description": p.description,
+            "fixed": p.fixed,
+            "prior": None if p.fixed is not None else p.prior.describe(),
+            "prior_spec": None if p.fixed is not None else p.prior.to_dict(),
+            "transform": None if p.fixed is not None else ps.modes[ps.free_names.index(p.name)],
+            "map": mapv[p.name],
+            **_summ(o.post[key].values.reshape(-1)),
+            "truth": truth.get(p.name),
         }
-    # combined RH from paired thermal and hygric draws
-    if "Ti" in pp_outputs and "Pi" in pp_outputs:
-        ti_pp, ti_sim = pp_outputs["Ti"]
-        pi_pp, pi_sim = pp_outputs["Pi"]
-        rh_pp = 100.0 * pi_pp / saturation_vapour_pressure(ti_pp)
-        rh_sim = 100.0 * pi_sim / saturation_vapour_pressure(ti_sim)
-        shape = (W, n_sel, prep.n_rows)
-        pcoords = {"chain": np.arange(W), "draw": np.arange(n_sel), "time": times}
-        pp["RHi"] = xr.DataArray(
-            rh_pp.reshape(shape).astype(np.float32),
-            dims=("chain", "draw", "time"),
-            coords=pcoords,
-            attrs={"unit": "%"},
-        )
-        pp["RHi_sim"] = xr.DataArray(
-            rh_sim.reshape(shape).astype(np.float32),
-            dims=("chain", "draw", "time"),
-            coords=pcoords,
-            attrs={"unit": "%"},
-        )
-        if "RHi" in prep.frame:
-            metrics["combined"] = _metrics_for(prep, codes, ("RHi",), {"RHi": (rh_pp, rh_sim)})
+        if p.free:
+            y = np.log(x) if p.prior.log_scale else x
+            a, b = (
+                (math.log(p.prior.lower), math.log(p.prior.upper))
+                if p.prior.log_scale
+                else (p.prior.lower, p.prior.upper)
+            )
+            pos = (np.quantile(y, [0.05, 0.95]) - a) / (b - a)
+            entry.update(
+                r_hat=float(rhat[key]),
+                ess_bulk=float(ess_b[key]),
+                ess_tail=float(ess_t[key]),
+                tau=float(tau[p.name]),
+                contraction=float(1 - np.var(y) / _prior_variance(p.prior, prng)),
+                at_bound=("lower" if pos[0] < 0.01 else "upper" if pos[1] > 0.99 else None),
+            )
+        o.params[key] = entry
+    for k, unit in dq_units.items():
+        key = f"{s.name}.{k}"
+        x = o.post[key].values.reshape(-1)
+        o.derived[key] = {"unit": unit, **_summ(x), "truth": truth_dq.get(k)}
+        if np.all(np.isfinite(x)) and np.ptp(x) > 0:
+            r, e, _ = convergence_stats(o.post, [key])
+            o.derived[key]["r_hat"] = float(r[key])
+            o.derived[key]["ess_bulk"] = float(e[key])
+    # posterior correlations of the free parameters (log scale where the prior is)
+    Y = []
+    for j, p in enumerate(ps.parameters):
+        if p.free:
+            x = kept[..., j].reshape(-1)
+            Y.append(np.log(x) if p.prior.log_scale else x)
+    corr = np.corrcoef(np.array(Y)) if len(Y) > 1 else np.ones((1, 1))
+    o.correlations[s.name] = {"names": list(ps.free_names), "matrix": corr.tolist()}
+
+
+def _section_info(o: _Outputs, s, x0, pred_info, saturation, dq_all: dict) -> dict:
+    """The summary's ``models.<section>`` entry: the model, its noise and initial state,
+    the MAP, identifiability, the chain and the findings before sampling."""
+    ps = s.logpost.params
+    return {
+        "predictive_noise": pred_info,
+        "saturation": saturation,
+        "model": s.model.name,
+        "domain": s.model.domain,
+        "state_names": list(s.model.state_names),
+        "input_names": list(s.model.input_names),
+        "output_names": list(s.model.output_names),
+        "noise": s.logpost.noise.name,
+        "initial_state": {
+            "mode": s.logpost.initial_state
+            if isinstance(s.logpost.initial_state, str)
+            else dict(s.logpost.initial_state),
+            "how": initial_state_text(s.logpost),
+            "prior_sd": s.logpost.initial_state_sd,
+            "horizon_h": s.logpost.initial_state_horizon / 3600.0,
+            "unit": "°C" if s.model.domain == "thermal" else "Pa",
+            "nodes": (
+                {node: _summ(x0[:, i]) for i, node in enumerate(s.model.state_names)}
+                if x0 is not None
+                else None
+            ),
+        },
+        "map": s.map.to_dict(ps.names),
+        "identifiability": s.identifiability.to_dict(),
+        "chain": _chain_info(o, s),
+        # findings before sampling: a MAP on a prior bound, and practical
+        # identifiability from the Laplace approximation at the MAP
+        "map_at_bound": [list(b) for b in getattr(s, "map_at_bound", [])],
+        "frozen_node": getattr(s, "frozen_node", None),
+        # the share of draws whose slowest mode is frozen (a second posterior branch)
+        "frozen_share": _frozen_share(dq_all.get("tau_1_h"), s.logpost),
+        "time_constant_cap_h": _hours(s.logpost.time_constant_cap),
+        "likelihood_temperature": float(s.logpost.temperature),
+        "practical_identifiability": (
+            s.laplace.to_dict(ps.free_names) if getattr(s, "laplace", None) else None
+        ),
+    }
+
+
+def _chain_info(o: _Outputs, s) -> dict:
+    """The summary's ``models.<section>.chain``: the sampler's settings and course."""
+    return {
+        "coordinates": getattr(s.chain, "coordinates", "log"),
+        # the block move: the flagged parameters and its share of the steps
+        # (0: the named moves alone)
+        "block_move": getattr(s, "block_move", None) or None,
+        "walkers": int(o.W),
+        "steps": int(s.chain.steps),
+        "burn": int(s.chain.burn),
+        "thin": int(s.chain.thin),
+        "draws_per_walker": int(o.D),
+        "converged_tau": bool(s.chain.converged),
+        "tau_max": float(np.nanmax(s.chain.tau)),
+        "tau_history": [list(map(float, r)) for r in s.chain.tau_history],
+        "acceptance_mean": float(np.mean(s.chain.acceptance)),
+        "resumed_from": int(s.chain.resumed_from),
+        "stopped_by": getattr(s.chain, "stopped_by", ""),
+        "cpu_seconds": float(getattr(s.chain, "cpu_seconds", 0.0)),
+    }
+
+
+def _combined_rh(o: _Outputs, prep) -> None:
+    """The indoor RH [%] of paired thermal and hygric draws, and its fit metrics."""
+    if "Ti" not in o.pp_outputs or "Pi" not in o.pp_outputs:
+        return
+    ti_pp, ti_sim = o.pp_outputs["Ti"]
+    pi_pp, pi_sim = o.pp_outputs["Pi"]
+    rh_pp = 100.0 * pi_pp / saturation_vapour_pressure(ti_pp)
+    rh_sim = 100.0 * pi_sim / saturation_vapour_pressure(ti_sim)
+    o.pp["RHi"] = o.series(rh_pp, {"unit": "%"})
+    o.pp["RHi_sim"] = o.series(rh_sim, {"unit": "%"})
+    if "RHi" in prep.frame:
+        o.metrics["combined"] = _metrics_for(prep, o.codes, ("RHi",), {"RHi": (rh_pp, rh_sim)})
+
+
+def _inference_data(o: _Outputs, prep, sections, attrs: dict):
+    """The run's InferenceData from the gathered groups, the observations and inputs."""
+    times = o.times
     observed = {
         c: xr.DataArray(
             prep.frame[c].to_numpy(dtype=float),
@@ -426,7 +476,7 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
         for c in inputs
     }
     const["period"] = xr.DataArray(
-        codes,
+        o.codes,
         dims=("time",),
         coords={"time": times},
         attrs={"codes": "-1 outside, 0 warm-up, 1 calibration, 2 validation"},
@@ -436,56 +486,51 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
             const[f"interpolated.{c}"] = xr.DataArray(
                 prep.flags[c].to_numpy(dtype=np.int8), dims=("time",), coords={"time": times}
             )
-    attrs = {
-        "heritage_bayes_version": __version__,
-        "seed": int(seed),
-        "config_hash": chash,
-        "created_at": datetime.now(UTC).isoformat(timespec="seconds"),
-        "run_name": cfg.name or "",
-        "dt_seconds": float(prep.dt),
-    }
+    coords = {"chain": np.arange(o.W), "draw": np.arange(len(o.sel))}
     groups = {
-        "posterior": xr.Dataset(post, coords=coords, attrs=attrs),
-        "sample_stats": xr.Dataset(stats, coords=coords, attrs=attrs),
-        **loglik_groups(loglik, coords, attrs),
-        # a bounded number of draws, the bands over all of them (issue 28: the
-        # predictive was 75 % of a 130 MB demo run directory)
-        "posterior_predictive": xr.Dataset(bounded_predictive(pp), attrs=attrs),
-        "predictive_bands": xr.Dataset(predictive_bands(pp), attrs=attrs),
+        "posterior": xr.Dataset(o.post, coords=coords, attrs=attrs),
+        "sample_stats": xr.Dataset(o.stats, coords=coords, attrs=attrs),
+        **loglik_groups(o.loglik, coords, attrs),
+        # a bounded number of draws, the bands over all of them (the predictive was 75 %
+        # of a 130 MB demo run directory)
+        "posterior_predictive": xr.Dataset(bounded_predictive(o.pp), attrs=attrs),
+        "predictive_bands": xr.Dataset(predictive_bands(o.pp), attrs=attrs),
         "observed_data": xr.Dataset(observed, attrs=attrs),
         "constant_data": xr.Dataset(const, attrs=attrs),
     }
-    if loglik_val:
+    if o.loglik_val:
         # not an arviz group: the validation period is not conditioned on; what the
         # expected log predictive density of new data needs (heritage_bayes.compare) is
         # each hour's log mean density over the saved draws, stored as that: the terms
-        # per draw were 4.1 MB of the demo's posterior.nc (issue 28)
+        # per draw were 4.1 MB of the demo's posterior.nc
         groups[VALIDATION_LPD] = xr.Dataset(
-            {k: _validation_lpd(v, n_sel * W) for k, v in loglik_val.items()}, attrs=attrs
+            {k: _validation_lpd(v, len(o.sel) * o.W) for k, v in o.loglik_val.items()},
+            attrs=attrs,
         )
-    idata = az.InferenceData(**groups)
-    free_rhat = [v["r_hat"] for v in summary_params.values() if "r_hat" in v]
-    free_ess = [v["ess_bulk"] for v in summary_params.values() if "ess_bulk" in v]
-    max_rhat = float(np.max(free_rhat))
-    min_ess = float(np.min(free_ess))
+    return az.InferenceData(**groups)
+
+
+def _summary(o: _Outputs, cfg, prep, sections, attrs: dict) -> dict:
+    """The run's ``summary.json`` from the gathered entries."""
+    free_rhat = [v["r_hat"] for v in o.params.values() if "r_hat" in v]
+    free_ess = [v["ess_bulk"] for v in o.params.values() if "ess_bulk" in v]
     # the decision is the sampler's stopping rule: 50 τ with a stable τ, and R-hat/ESS
     # within CONVERGENCE on every retained draw; max_rhat/min_ess below are those of the
     # ~1000 saved draws (what az.summary of posterior.nc gives), a noisier diagnostic
     tau_ok = all(s.chain.converged for s in sections)
-    converged = bool(tau_ok)
-    summary = {
+    return {
         "name": cfg.name,
         "building": cfg.building,
         "room": cfg.room,
         "notes": cfg.notes,
         "heritage_bayes_version": __version__,
-        "seed": int(seed),
-        "config_hash": chash,
+        "seed": attrs["seed"],
+        "config_hash": attrs["config_hash"],
         "created_at": attrs["created_at"],
-        "converged": converged,
+        "converged": bool(tau_ok),
         "converged_tau": tau_ok,
-        "max_rhat": max_rhat,
-        "min_ess_bulk": min_ess,
+        "max_rhat": float(np.max(free_rhat)),
+        "min_ess_bulk": float(np.min(free_ess)),
         "criteria": {
             **CONVERGENCE,
             "tau_factor": cfg.sampler.tau_factor,
@@ -496,33 +541,16 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
         "init_steps": int(prep.init_steps),
         "periods": _periods(prep),
         "irradiance_source": prep.irradiance_source,
-        "parameters": summary_params,
-        "derived": summary_derived,
-        "metrics": metrics,
-        "models": sec_info,
-        "correlations": correlations,
+        "parameters": o.params,
+        "derived": o.derived,
+        "metrics": o.metrics,
+        "models": o.models,
+        "correlations": o.correlations,
         "alignment": prep.alignment,
         "sources": prep.sources,
-        "truth": truth_all or None,
+        "truth": prep.truth or None,
         "versions": _versions(),
     }
-    return idata, summary
-
-
-def _hours(seconds: float | None) -> float | None:
-    """Seconds -> hours; None for none or infinity (JSON has no infinity)."""
-    return None if seconds is None or not np.isfinite(seconds) else seconds / 3600.0
-
-
-def _frozen_share(tau_h, lp) -> float | None:
-    """Share of the draws whose slowest time constant [h] exceeds ``FROZEN_RECORDS``
-    calibration records (:func:`heritage_bayes.rc.derived.frozen_time_constant`)."""
-    from heritage_bayes.rc.derived import FROZEN_RECORDS
-
-    if tau_h is None:
-        return None
-    record_h = lp.record_seconds / 3600.0
-    return float(np.mean(np.asarray(tau_h).reshape(-1) > FROZEN_RECORDS * record_h))
 
 
 def _metrics_for(prep, codes, outputs, pp_outputs, one_step=None) -> dict:

@@ -1,4 +1,5 @@
-"""What a run's summary records beside the posterior: truths, periods, versions.
+"""What a run's summary records beside the posterior: truths, periods, versions, the
+share of frozen draws.
 
 The true parameters and derived quantities of generated data (the demo), shown beside
 the posterior; the calibration and validation periods; the versions of the libraries
@@ -92,3 +93,19 @@ def _periods(prep) -> dict:
             "steps": int(sl.stop - sl.start),
         }
     return out
+
+
+def _hours(seconds: float | None) -> float | None:
+    """Seconds -> hours; None for none or infinity (JSON has no infinity)."""
+    return None if seconds is None or not np.isfinite(seconds) else seconds / 3600.0
+
+
+def _frozen_share(tau_h, lp) -> float | None:
+    """Share of the draws whose slowest time constant [h] exceeds ``FROZEN_RECORDS``
+    calibration records (:func:`heritage_bayes.rc.derived.frozen_time_constant`)."""
+    from heritage_bayes.rc.derived import FROZEN_RECORDS
+
+    if tau_h is None:
+        return None
+    record_h = lp.record_seconds / 3600.0
+    return float(np.mean(np.asarray(tau_h).reshape(-1) > FROZEN_RECORDS * record_h))

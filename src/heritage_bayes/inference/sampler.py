@@ -53,6 +53,7 @@ from __future__ import annotations
 
 import os
 import time
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import emcee
@@ -286,6 +287,93 @@ def _run_sampler(
         steps are kept; ``resume=True`` rebuilds the same rows. A chain shorter than
         ``max_rows`` steps is held and decided exactly as without the bound.
     """
+    nwalkers, d = _walkers(x_map, nwalkers, max_rows, tau_discard)
+    target = logpost if coordinates is None else coordinates
+    move_list = make_moves(moves, block, block_weight)
+    c = _Chain(
+        emcee.EnsembleSampler(nwalkers, d, target, vectorize=True, moves=move_list),
+        move_list,
+        ChainBuffer(nwalkers, d),
+        _Checkpoint(Path(checkpoint), tag) if checkpoint is not None else None,
+        coordinates,
+        nwalkers,
+        d,
+        np.zeros(nwalkers),
+    )
+    kept = read_compact(c.ck.path, tag) if resume and c.ck is not None else None
+    if kept is not None:  # a converged chain, compacted: its draws are the result
+        return _from_compact(c.ck.path, kept, nwalkers, d, tau_factor)
+    if resume and c.ck is not None:
+        _resume(c, seed, notice)
+    resumed_from = c.done
+    if c.done == 0:
+        _start(c, logpost, target, x_map, seed, start_hessian, bounds, init_ball)
+    t0 = time.perf_counter()
+    c0 = time.process_time()
+    out_of_time = False
+    converged = False
+    tau = np.full(d, np.nan)
+    rule = _Rule(tau_factor, tau_rtol, tau_discard, max_rhat, min_ess, max_draws)
+    if c.done > 0:  # resumed: the saved chain may already be long enough
+        tau, _, converged = rule.decide(c.buf, c.tau_hist, c.done)
+    # SIGINT/SIGTERM only set a flag while sampling: the chain stops after the current
+    # step, the steps done are committed, then KeyboardInterrupt (never an exception
+    # inside emcee's likelihood call, which would print the parameter matrix)
+    with DeferSignals(redeliver=False) as sig:
+        while c.done < max_steps and not converged:
+            # the budget is checked between chunks (at least one chunk runs)
+            spent = time.perf_counter() - t0
+            if max_seconds is not None and c.done > resumed_from and spent >= max_seconds:
+                out_of_time = True
+                break
+            # chunk boundaries at fixed step counts (resume-invariant)
+            n = min(_next_check(c.done, check_every) - c.done, max_steps - c.done)
+            x, lp, rows = _chunk(c, n, check_every, sig)
+            halved = _bound_rows(c.buf, max_rows, c.tau_hist)
+            tau, tmax, converged = rule.decide(c.buf, c.tau_hist, c.done)
+            c.tau_hist.append((float(c.done), tmax))
+            if c.ck is not None:
+                _save_chunk(c, x, lp, rows, halved)
+            del x, lp, rows
+            if progress is not None:
+                progress(
+                    c.done,
+                    int(min(max_steps, max(c.done, tau_factor * tmax))),
+                    {
+                        "seconds": time.perf_counter() - t0,
+                        "tau_max": tmax,
+                        "needed": tau_factor * tmax,
+                        "acceptance": float(np.mean(c.accepted) / c.done),
+                    },
+                )
+            if converged:
+                break
+    buf = c.buf
+    burn, thin = _burn_thin(tau / buf.stride, buf.chain.shape[0], tau_discard)
+    result = ChainResult(
+        chain=buf.chain,
+        log_prob=buf.log_prob,
+        accepted=c.accepted,
+        tau=tau,
+        tau_history=c.tau_hist,
+        converged=bool(converged),
+        burn=burn * buf.stride,
+        thin=thin * buf.stride,
+        wall_seconds=time.perf_counter() - t0,
+        resumed_from=resumed_from,
+        cpu_seconds=time.process_time() - c0,
+        stopped_by="converged" if converged else "max_seconds" if out_of_time else "max_steps",
+        coordinates="log" if coordinates is None else getattr(coordinates, "name", "custom"),
+        n_steps=buf.steps if buf.stride > 1 else None,
+        stride=buf.stride,
+    )
+    if compact and c.ck is not None:
+        compact_checkpoint(c.ck.path, tag, result, max_draws)
+    return result
+
+
+def _walkers(x_map, nwalkers: int | None, max_rows: int | None, tau_discard: float):
+    """(walkers, dimensions) of a chain, its settings checked (see :func:`_run_sampler`)."""
     if max_rows is not None and max_rows < 2:
         raise InputError(f"sampler.max_stored_steps: expected at least 2 (got {max_rows})")
     d = int(np.size(x_map))
@@ -298,200 +386,190 @@ def _run_sampler(
         raise InputError(
             f"sampler.walkers: need at least 2 × dimensions = {2 * d} (got {nwalkers})"
         )
-    target = logpost if coordinates is None else coordinates
+    return nwalkers, d
 
-    def to_x(a: np.ndarray) -> np.ndarray:  # (..., d) in emcee's coordinates -> logpost's
-        if coordinates is None:
+
+@dataclass
+class _Chain:
+    """One sampling call's state: emcee's sampler and moves, the rows kept, their
+    checkpoint, the acceptance counts, τ's history, the steps done and emcee's state."""
+
+    sampler: emcee.EnsembleSampler
+    moves: list
+    buf: ChainBuffer
+    ck: _Checkpoint | None
+    coordinates: object
+    nwalkers: int
+    d: int
+    accepted: np.ndarray
+    tau_hist: list = field(default_factory=list)
+    done: int = 0
+    state: emcee.State | None = None
+
+    def to_x(self, a: np.ndarray) -> np.ndarray:
+        """(..., d) in emcee's coordinates -> the log-posterior's."""
+        if self.coordinates is None:
             return a
-        return coordinates.to_x(a.reshape(-1, d)).reshape(a.shape)
+        return self.coordinates.to_x(a.reshape(-1, self.d)).reshape(a.shape)
 
-    def to_y(a: np.ndarray) -> np.ndarray:
-        return a if coordinates is None else coordinates.to_y(a)
+    def to_y(self, a: np.ndarray) -> np.ndarray:
+        return a if self.coordinates is None else self.coordinates.to_y(a)
 
-    move_list = make_moves(moves, block, block_weight)
-    sampler = emcee.EnsembleSampler(nwalkers, d, target, vectorize=True, moves=move_list)
-    ck = _Checkpoint(Path(checkpoint), tag) if checkpoint is not None else None
-    buf = ChainBuffer(nwalkers, d)
-    accepted = np.zeros(nwalkers)
-    tau_hist: list[tuple[float, float]] = []
-    done = 0
-    kept = read_compact(ck.path, tag) if resume and ck is not None else None
-    if kept is not None:  # a converged chain, compacted: its draws are the result
-        return _from_compact(ck.path, kept, nwalkers, d, tau_factor)
-    if resume and ck is not None:
-        if not ck.path.exists():
-            _tell(notice, f"--resume: no checkpoint {ck.path}; starting a new chain")
-        else:
-            saved = ck.load()
-            if saved.chain.shape[1:] != (nwalkers, d):
-                raise InputError(
-                    f"{ck.path}: checkpoint has {saved.chain.shape[1]} walkers × "
-                    f"{saved.chain.shape[2]} parameters, the run needs {nwalkers} × "
-                    f"{d}; run without --resume"
-                )
-            if saved.problem is not None:
-                _tell(notice, f"{ck.path}: {saved.problem}")
-            done = saved.chain.shape[0] if saved.steps is None else saved.steps
-            if done == 0:
-                _tell(notice, f"--resume: {ck.path} holds no steps yet; starting a new chain")
-            else:
-                rs = saved.random_state
-                if rs is None:  # continue the kept steps with a stream of their own
-                    rs = np.random.RandomState([seed, done]).get_state()
-                    _tell(
-                        notice,
-                        f"{ck.path}: no random-number state for step {done}; continuing "
-                        "with a new random stream (seeded by the seed and the step count): "
-                        "a valid chain, but not bit-identical to an uninterrupted run",
-                    )
-                accepted = saved.accepted
-                tau_hist = [h for h in saved.tau_history if h[0] <= done]
-                if saved.problem is not None:  # keep the damaged file, write a clean one
-                    kept = ck.path.with_name(ck.path.name + ".damaged")
-                    os.replace(ck.path, kept)
-                    ck.create(nwalkers, d)
-                    ck.append(
-                        saved.chain, saved.log_prob, accepted, rs, tau_hist, **_thinned(saved)
-                    )
-                    _tell(
-                        notice,
-                        f"{ck.path}: rewritten from the valid steps; the damaged "
-                        f"file is kept as {kept}",
-                    )
-                buf = ChainBuffer(nwalkers, d, stride=saved.stride)
-                buf.load(saved.chain, saved.log_prob, done)
-                x_last, lp_last = saved.last or (buf.chain[-1], buf.log_prob[-1])
-                del saved
-                state = emcee.State(to_y(x_last), log_prob=lp_last, random_state=rs)
-                sampler.random_state = rs
-    resumed_from = done
-    if done == 0:
-        rng = np.random.default_rng(seed)
-        got = None
-        if start_hessian is not None:
-            got = laplace_ensemble(
-                logpost, x_map, start_hessian, nwalkers, rng, bounds=_support(bounds, d)
-            )
-        p0, lp_init = got or start_ensemble(
-            logpost, x_map, nwalkers, rng, init_ball=init_ball, bounds=bounds
-        )
-        if coordinates is not None:  # the density emcee compares: in its own coordinates
-            lp_init = np.asarray(target(to_y(p0)), dtype=float)
-        sampler.random_state = np.random.RandomState(seed).get_state()
-        state = emcee.State(to_y(p0), log_prob=lp_init, random_state=sampler.random_state)
-        if ck is not None:
-            ck.create(nwalkers, d)
-    t0 = time.perf_counter()
-    c0 = time.process_time()
-    out_of_time = False
-    converged = False
-    tau = np.full(d, np.nan)
-    if done > 0:  # resumed: the saved chain may already be long enough
-        tau = _tau(buf.chain, tau_discard) * buf.stride
+
+@dataclass(frozen=True)
+class _Rule:
+    """The stopping rule: ``tau_factor`` τ with τ stable to ``tau_rtol``, then R-hat and
+    bulk ESS within ``max_rhat`` and ``min_ess`` (see :func:`_run_sampler`)."""
+
+    tau_factor: float
+    tau_rtol: float
+    tau_discard: float
+    max_rhat: float | None
+    min_ess: float | None
+    max_draws: int
+
+    def decide(self, buf: ChainBuffer, tau_hist: list, done: int):
+        """(τ per parameter [steps], τmax, converged) of the rows in ``buf`` after
+        ``done`` steps, τ's earlier estimates in ``tau_hist``."""
+        tau = _tau(buf.chain, self.tau_discard) * buf.stride
         tmax = float(np.max(tau))
-        stable = bool(tau_hist) and abs(tmax - tau_hist[-1][1]) / tmax < tau_rtol
-        converged = bool(done >= tau_factor * tmax and stable and np.all(np.isfinite(tau)))
-        if converged and (max_rhat is not None or min_ess is not None):
+        stable = bool(tau_hist) and abs(tmax - tau_hist[-1][1]) / tmax < self.tau_rtol
+        converged = bool(done >= self.tau_factor * tmax and stable and np.all(np.isfinite(tau)))
+        if converged and (self.max_rhat is not None or self.min_ess is not None):
             converged = _mixing_ok(
-                buf.chain, tau / buf.stride, max_rhat, min_ess, max_draws, tau_discard
+                buf.chain,
+                tau / buf.stride,
+                self.max_rhat,
+                self.min_ess,
+                self.max_draws,
+                self.tau_discard,
             )
-    # SIGINT/SIGTERM only set a flag while sampling: the chain stops after the current
-    # step, the steps done are committed, then KeyboardInterrupt (never an exception
-    # inside emcee's likelihood call, which would print the parameter matrix)
-    with DeferSignals(redeliver=False) as sig:
-        while done < max_steps and not converged:
-            # the budget is checked between chunks (at least one chunk runs)
-            spent = time.perf_counter() - t0
-            if max_seconds is not None and done > resumed_from and spent >= max_seconds:
-                out_of_time = True
-                break
-            # chunk boundaries at fixed step counts (resume-invariant)
-            n = min(_next_check(done, check_every) - done, max_steps - done)
-            # global proposals: refitted to the rows up to the last check (the same
-            # rows after a resume mid-chunk)
-            last = _last_check(done, check_every)
-            refit_moves(move_list, buf.chain[: last // buf.stride], to_y)
-            sampler.reset()
-            try:
-                for step in sampler.sample(state, iterations=n):  # noqa: B007
-                    if sig.received is not None:
-                        raise KeyboardInterrupt
-                state = step
-            except KeyboardInterrupt:
-                if ck is not None and sampler.backend.iteration > 0:
-                    x, lp = to_x(sampler.get_chain()), sampler.get_log_prob()
-                    rows = buf.append(x, lp)
-                    ck.append(
-                        *rows,
-                        accepted + sampler.backend.accepted,
-                        sampler.backend.random_state,
-                        tau_hist,
-                        **_thinned(buf, x[-1], lp[-1]),
-                    )
-                raise KeyboardInterrupt from None
-            x, lp = to_x(sampler.get_chain()), sampler.get_log_prob()
-            accepted = accepted + sampler.backend.accepted
-            rows = buf.append(x, lp)
-            done += n
-            halved = False
-            while (
-                max_rows is not None
-                and buf.n > max_rows
-                and tau_hist
-                and 2 * buf.stride <= tau_hist[-1][1] / 10
-            ):
-                buf.halve()
-                halved = True
-            tau = _tau(buf.chain, tau_discard) * buf.stride
-            tmax = float(np.max(tau))
-            stable = bool(tau_hist) and abs(tmax - tau_hist[-1][1]) / tmax < tau_rtol
-            tau_hist.append((float(done), tmax))
-            if ck is not None:
-                thinned = _thinned(buf, x[-1], lp[-1])
-                if halved:
-                    ck.rewrite(
-                        buf.chain, buf.log_prob, accepted, state.random_state, tau_hist, **thinned
-                    )
-                else:
-                    ck.append(*rows, accepted, state.random_state, tau_hist, **thinned)
-            del x, lp, rows
-            converged = done >= tau_factor * tmax and stable and np.all(np.isfinite(tau))
-            if converged and (max_rhat is not None or min_ess is not None):
-                converged = _mixing_ok(
-                    buf.chain, tau / buf.stride, max_rhat, min_ess, max_draws, tau_discard
-                )
-            if progress is not None:
-                progress(
-                    done,
-                    int(min(max_steps, max(done, tau_factor * tmax))),
-                    {
-                        "seconds": time.perf_counter() - t0,
-                        "tau_max": tmax,
-                        "needed": tau_factor * tmax,
-                        "acceptance": float(np.mean(accepted) / done),
-                    },
-                )
-            if converged:
-                break
-    chain, log_prob = buf.chain, buf.log_prob
-    burn, thin = _burn_thin(tau / buf.stride, chain.shape[0], tau_discard)
-    result = ChainResult(
-        chain=chain,
-        log_prob=log_prob,
-        accepted=accepted,
-        tau=tau,
-        tau_history=tau_hist,
-        converged=bool(converged),
-        burn=burn * buf.stride,
-        thin=thin * buf.stride,
-        wall_seconds=time.perf_counter() - t0,
-        resumed_from=resumed_from,
-        cpu_seconds=time.process_time() - c0,
-        stopped_by="converged" if converged else "max_seconds" if out_of_time else "max_steps",
-        coordinates="log" if coordinates is None else getattr(coordinates, "name", "custom"),
-        n_steps=buf.steps if buf.stride > 1 else None,
-        stride=buf.stride,
+        return tau, tmax, converged
+
+
+def _resume(c: _Chain, seed: int, notice) -> None:
+    """Continue the chain saved in ``c.ck`` (a damaged file rewritten from its valid
+    steps), or say why a new chain starts."""
+    ck, nwalkers, d = c.ck, c.nwalkers, c.d
+    if not ck.path.exists():
+        _tell(notice, f"--resume: no checkpoint {ck.path}; starting a new chain")
+        return
+    saved = ck.load()
+    if saved.chain.shape[1:] != (nwalkers, d):
+        raise InputError(
+            f"{ck.path}: checkpoint has {saved.chain.shape[1]} walkers × "
+            f"{saved.chain.shape[2]} parameters, the run needs {nwalkers} × "
+            f"{d}; run without --resume"
+        )
+    if saved.problem is not None:
+        _tell(notice, f"{ck.path}: {saved.problem}")
+    done = saved.chain.shape[0] if saved.steps is None else saved.steps
+    if done == 0:
+        _tell(notice, f"--resume: {ck.path} holds no steps yet; starting a new chain")
+        return
+    rs = saved.random_state
+    if rs is None:  # continue the kept steps with a stream of their own
+        rs = np.random.RandomState([seed, done]).get_state()
+        _tell(
+            notice,
+            f"{ck.path}: no random-number state for step {done}; continuing "
+            "with a new random stream (seeded by the seed and the step count): "
+            "a valid chain, but not bit-identical to an uninterrupted run",
+        )
+    c.done = done
+    c.accepted = saved.accepted
+    c.tau_hist = [h for h in saved.tau_history if h[0] <= done]
+    if saved.problem is not None:  # keep the damaged file, write a clean one
+        kept = ck.path.with_name(ck.path.name + ".damaged")
+        os.replace(ck.path, kept)
+        ck.create(nwalkers, d)
+        ck.append(saved.chain, saved.log_prob, c.accepted, rs, c.tau_hist, **_thinned(saved))
+        _tell(
+            notice,
+            f"{ck.path}: rewritten from the valid steps; the damaged file is kept as {kept}",
+        )
+    c.buf = ChainBuffer(nwalkers, d, stride=saved.stride)
+    c.buf.load(saved.chain, saved.log_prob, done)
+    x_last, lp_last = saved.last or (c.buf.chain[-1], c.buf.log_prob[-1])
+    del saved
+    c.state = emcee.State(c.to_y(x_last), log_prob=lp_last, random_state=rs)
+    c.sampler.random_state = rs
+
+
+def _start(c: _Chain, logpost, target, x_map, seed, start_hessian, bounds, init_ball) -> None:
+    """A new chain: the walkers' start (the Laplace approximation at the MAP, else a
+    ball around it), emcee's random stream seeded, the checkpoint created."""
+    rng = np.random.default_rng(seed)
+    got = None
+    if start_hessian is not None:
+        got = laplace_ensemble(
+            logpost, x_map, start_hessian, c.nwalkers, rng, bounds=_support(bounds, c.d)
+        )
+    p0, lp_init = got or start_ensemble(
+        logpost, x_map, c.nwalkers, rng, init_ball=init_ball, bounds=bounds
     )
-    if compact and ck is not None:
-        compact_checkpoint(ck.path, tag, result, max_draws)
-    return result
+    if c.coordinates is not None:  # the density emcee compares: in its own coordinates
+        lp_init = np.asarray(target(c.to_y(p0)), dtype=float)
+    c.sampler.random_state = np.random.RandomState(seed).get_state()
+    c.state = emcee.State(c.to_y(p0), log_prob=lp_init, random_state=c.sampler.random_state)
+    if c.ck is not None:
+        c.ck.create(c.nwalkers, c.d)
+
+
+def _chunk(c: _Chain, n: int, check_every: int, sig):
+    """``n`` steps of emcee from ``c.state``, appended to ``c.buf``: (their positions
+    (n, walkers, d), log-posteriors (n, walkers), the rows kept). On SIGINT/SIGTERM
+    (``sig``) the steps done are checkpointed, then KeyboardInterrupt."""
+    sampler = c.sampler
+    # global proposals: refitted to the rows up to the last check (the same rows after a
+    # resume mid-chunk)
+    last = _last_check(c.done, check_every)
+    refit_moves(c.moves, c.buf.chain[: last // c.buf.stride], c.to_y)
+    sampler.reset()
+    try:
+        for step in sampler.sample(c.state, iterations=n):  # noqa: B007
+            if sig.received is not None:
+                raise KeyboardInterrupt
+        c.state = step
+    except KeyboardInterrupt:
+        if c.ck is not None and sampler.backend.iteration > 0:
+            x, lp = c.to_x(sampler.get_chain()), sampler.get_log_prob()
+            rows = c.buf.append(x, lp)
+            c.ck.append(
+                *rows,
+                c.accepted + sampler.backend.accepted,
+                sampler.backend.random_state,
+                c.tau_hist,
+                **_thinned(c.buf, x[-1], lp[-1]),
+            )
+        raise KeyboardInterrupt from None
+    x, lp = c.to_x(sampler.get_chain()), sampler.get_log_prob()
+    c.accepted = c.accepted + sampler.backend.accepted
+    rows = c.buf.append(x, lp)
+    c.done += n
+    return x, lp, rows
+
+
+def _bound_rows(buf: ChainBuffer, max_rows: int | None, tau_hist: list) -> bool:
+    """Thin ``buf`` in place while it holds over ``max_rows`` rows and the stride stays
+    at most τmax/10 (of the last check); True if it was thinned."""
+    halved = False
+    while (
+        max_rows is not None
+        and buf.n > max_rows
+        and tau_hist
+        and 2 * buf.stride <= tau_hist[-1][1] / 10
+    ):
+        buf.halve()
+        halved = True
+    return halved
+
+
+def _save_chunk(c: _Chain, x, lp, rows, halved: bool) -> None:
+    """Checkpoint a chunk: its rows appended, or the whole buffer rewritten once thinned."""
+    thinned = _thinned(c.buf, x[-1], lp[-1])
+    rs = c.state.random_state
+    if halved:
+        c.ck.rewrite(c.buf.chain, c.buf.log_prob, c.accepted, rs, c.tau_hist, **thinned)
+    else:
+        c.ck.append(*rows, c.accepted, rs, c.tau_hist, **thinned)

@@ -307,24 +307,7 @@ def inspect_table(path, *, what: str = "file") -> TableLayout:
     layout, h, after, sep = _layout(lines)
     notes: list[str] = []
     if sep is None:
-        sep = _sep_for(lines)
-        counts = [len(_split(ln, sep)) for ln in lines]
-        width = max(set(counts[-200:]), key=counts[-200:].count)
-        # the header: the first line from which every line has the table's width
-        filled = [sum(bool(c.strip()) for c in _split(ln, sep)) for ln in lines]
-        h = next(  # (a title line padded to the table's width is not the header)
-            (
-                k
-                for k in range(len(lines))
-                if all(c == width for c in counts[k : k + 20]) and filled[k] >= min(2, width)
-            ),
-            None,
-        )
-        if h is None or width < 2:
-            raise DataError(
-                f"{source_name(path)}: no table found (no run of lines with the same number of "
-                f"fields separated by ',', ';' or tab)"
-            )
+        sep, h = _table_header(path, lines)
     header = [c.strip().strip('"') for c in _split(lines[h], sep)]
     skip_set = set(range(h)) | set(after)
     body = [_split(ln, sep) for k, ln in enumerate(lines) if k > h and k not in skip_set]
@@ -344,7 +327,69 @@ def inspect_table(path, *, what: str = "file") -> TableLayout:
             )
         )
 
-    # -- time column -----------------------------------------------------------------------
+    time_column, fmt = _time_column(path, cols, header, body, lines[h + 1])
+    tnames = [time_column] if isinstance(time_column, str) else time_column
+    zone = None if fmt == "ISO8601" else _zone_in(" ".join(tnames))
+
+    # -- decimal mark ----------------------------------------------------------------------
+    value_cols = [n for n in cols if n not in tnames and n]
+    decimal = "."
+    if sep != ",":
+        commas = sum(
+            bool(re.match(r"^-?\d+,\d+$", v.strip())) for n in value_cols for v in cols[n][:200]
+        )
+        if commas:
+            decimal = ","
+            notes.append(f"decimal comma ({commas} values like '{_first_comma(cols, value_cols)}')")
+
+    # -- value columns ---------------------------------------------------------------------
+    prop_names = _split(lines[after[-1]], sep) if layout == "tinytag" else None
+    guesses = _column_guesses(header, cols, tnames, decimal, prop_names, lines[:h], layout)
+    return TableLayout(
+        path=path,
+        layout=layout,
+        encoding=encoding,
+        sep=sep,
+        decimal=decimal,
+        skiprows=sorted(skip_set - {h}) if after else h,
+        header=header,
+        time_column=time_column,
+        time_format=fmt,
+        timezone=zone,
+        columns=guesses,
+        notes=notes,
+    )
+
+
+def _table_header(path: Path, lines: list[str]) -> tuple[str, int]:
+    """(separator, header line) of a plain table: the first line from which every line
+    has the table's width (the commonest in its last 200 lines)."""
+    sep = _sep_for(lines)
+    counts = [len(_split(ln, sep)) for ln in lines]
+    width = max(set(counts[-200:]), key=counts[-200:].count)
+    # the header: the first line from which every line has the table's width
+    filled = [sum(bool(c.strip()) for c in _split(ln, sep)) for ln in lines]
+    h = next(  # (a title line padded to the table's width is not the header)
+        (
+            k
+            for k in range(len(lines))
+            if all(c == width for c in counts[k : k + 20]) and filled[k] >= min(2, width)
+        ),
+        None,
+    )
+    if h is None or width < 2:
+        raise DataError(
+            f"{source_name(path)}: no table found (no run of lines with the same number of "
+            f"fields separated by ',', ';' or tab)"
+        )
+    return sep, h
+
+
+def _time_column(path: Path, cols: dict, header: list[str], body: list, first: str):
+    """(time column or columns, strptime format) of a table: one column of time stamps,
+    a date and a time column side by side, or Year, Month, Day, Hour [, Minute]
+    columns; the format checked on the whole sample (``first``: its first data line,
+    for the message)."""
     time_column: str | list[str] | None = None
     fmt = None
     for name, vals in cols.items():
@@ -366,27 +411,19 @@ def inspect_table(path, *, what: str = "file") -> TableLayout:
     if time_column is None:
         raise DataError(
             f"{source_name(path)}: no column holds time stamps in a known format; columns are "
-            f"{_quote_list(header)}; first data line {quoted(lines[h + 1], 80)}"
+            f"{_quote_list(header)}; first data line {quoted(first, 80)}"
         )
     tnames = [time_column] if isinstance(time_column, str) else time_column
     if fmt != "ISO8601":  # check the format on the whole sample
         joined = [" ".join(r[header.index(n)] for n in tnames) for r in body]
         fmt = _time_format(joined) or fmt
-    zone = None if fmt == "ISO8601" else _zone_in(" ".join(tnames))
+    return time_column, fmt
 
-    # -- decimal mark ----------------------------------------------------------------------
-    value_cols = [n for n in cols if n not in tnames and n]
-    decimal = "."
-    if sep != ",":
-        commas = sum(
-            bool(re.match(r"^-?\d+,\d+$", v.strip())) for n in value_cols for v in cols[n][:200]
-        )
-        if commas:
-            decimal = ","
-            notes.append(f"decimal comma ({commas} values like '{_first_comma(cols, value_cols)}')")
 
-    # -- value columns ---------------------------------------------------------------------
-    prop_names = _split(lines[after[-1]], sep) if layout == "tinytag" else None
+def _column_guesses(header, cols, tnames, decimal: str, prop_names, head: list[str], layout):
+    """A :class:`ColumnGuess` per value column: empty, not numeric, or classified from its
+    label (``prop_names``: Tinytag's channel names), its range and the file's header
+    lines ``head``."""
     guesses = []
     for i, name in enumerate(header):
         if name in tnames or not name:
@@ -400,21 +437,8 @@ def inspect_table(path, *, what: str = "file") -> TableLayout:
             guesses.append(ColumnGuess(name, None, why=why, named=_named_role(label)))
             continue
         stats = (float(vals.min()), float(np.median(vals)), float(vals.max()))
-        guesses.append(_classify(name, label, stats, lines[:h], layout))
-    return TableLayout(
-        path=path,
-        layout=layout,
-        encoding=encoding,
-        sep=sep,
-        decimal=decimal,
-        skiprows=sorted(skip_set - {h}) if after else h,
-        header=header,
-        time_column=time_column,
-        time_format=fmt,
-        timezone=zone,
-        columns=guesses,
-        notes=notes,
-    )
+        guesses.append(_classify(name, label, stats, head, layout))
+    return guesses
 
 
 _PARTS = (("year", "%Y"), ("month", "%m"), ("day", "%d"), ("hour", "%H"), ("minute", "%M"))

@@ -69,8 +69,15 @@ def run_notes(
         ``level`` (``"amber"`` or ``"info"``), ``title`` and ``text`` (plain text) per note.
     """
     s = typed_summary(summary)
+    out = _irradiance_notes(s.irradiance_source, irradiance_setting) + _bound_notes(s)
+    for m, i in s.models.items():
+        out += _model_notes(m, i)
+    return out + _closing_notes(s, chains_missing)
+
+
+def _irradiance_notes(irr: str, irradiance_setting: str | None) -> list[dict]:
+    """A note on a solar input that was not measured (a clear-sky proxy, an estimate)."""
     out = []
-    irr = s.irradiance_source
     if "clear" in irr.lower() or irradiance_setting == "clear_sky":
         out.append(
             {
@@ -94,6 +101,12 @@ def run_notes(
                 "irradiance when it is available.",
             }
         )
+    return out
+
+
+def _bound_notes(s) -> list[dict]:
+    """A note on the parameters whose posterior presses against a prior bound."""
+    out = []
     bound = []
     for e in s.parameters.values():
         if e.at_bound:
@@ -114,82 +127,101 @@ def run_notes(
                 "the prior if the bound is not physical.",
             }
         )
-    for m, i in s.models.items():
-        on_bound = [f"{quantity_name(n, domain=m)} ({side})" for n, side in i.map_at_bound]
-        if on_bound:
-            out.append(
-                {
-                    "level": "amber",
-                    "title": f"The {m} MAP lies on a prior bound",
-                    "text": "The most probable parameter set presses against the prior "
-                    f"for {', '.join(on_bound)}: a finding about the prior (is the bound "
-                    "physical? widen it if not) or the model (a node or input the data do "
-                    "not support often shows up this way). The sampler started inside the "
-                    "bounds regardless.",
-                }
-            )
-        fz, share = i.frozen_node, i.frozen_share
-        branch = (
-            f" {share:.0%} of the posterior draws lie on this branch (the slowest time "
-            "constant beyond ten records), the rest on one where every node moves: the "
-            "posterior has two modes, and the intervals of the time constants span both."
-            if share and share >= 0.05
-            else ""
+    return out
+
+
+def _model_notes(m: str, i) -> list[dict]:
+    """The notes on one model: its MAP on a bound, a frozen node, parameters the data
+    leave to their priors, several MAP modes, a chain out of time."""
+    out = []
+    on_bound = [f"{quantity_name(n, domain=m)} ({side})" for n, side in i.map_at_bound]
+    if on_bound:
+        out.append(
+            {
+                "level": "amber",
+                "title": f"The {m} MAP lies on a prior bound",
+                "text": "The most probable parameter set presses against the prior "
+                f"for {', '.join(on_bound)}: a finding about the prior (is the bound "
+                "physical? widen it if not) or the model (a node or input the data do "
+                "not support often shows up this way). The sampler started inside the "
+                "bounds regardless.",
+            }
         )
-        if fz:
-            out.append(
-                {
-                    "level": "amber",
-                    "title": f"A {m} node barely moves over the record",
-                    "text": f"At the MAP the slowest time constant is {fz.tau_h:.3g} h, "
-                    f"{fz.records:.0f} times the calibration record: that node keeps its "
-                    "start value, a constant standing in for a fixed node, a missing input "
-                    "or a missing node"
-                    + (
-                        "; its start is estimated freely, so it acts as a free offset "
-                        "(compare with the default initial_state_horizon or "
-                        "initial_state: steady)."
-                        if fz.start_free
-                        else "; its start is held to the steady state of the first "
-                        "window's mean inputs."
-                    )
-                    + branch,
-                }
-            )
-        elif branch:
-            out.append(
-                {
-                    "level": "amber",
-                    "title": f"Some {m} draws freeze a node",
-                    "text": "The MAP's nodes all move over the record, but" + branch,
-                }
-            )
-        flagged = [n for n in i.unidentified if not n.startswith(("sigma_", "phi_"))]
-        if flagged:
-            out.append(
-                {
-                    "level": "amber",
-                    "title": f"The {m} model is over-parameterised for these data",
-                    "text": "At the MAP the data leave the "
-                    + ", ".join(quantity_name(n, domain=m) for n in flagged)
-                    + " almost as uncertain as their priors (Laplace standard deviation "
-                    "above 25 % of the prior range, with the overall scale held fixed): "
-                    "their posteriors are mostly prior and slow the chain. Choose: fix "
-                    "them, add an informative prior, or use the smaller model of the "
-                    "ladder.",
-                }
-            )
-        if len(i.map_modes) > 1:
-            out.append(_modes_note(m, i.map_modes, i.map_restarts))
-        if i.stopped_by == "max_seconds":
-            out.append(
-                {
-                    "level": "amber",
-                    "title": f"The {m} chain ran out of time",
-                    "text": "The wall-time budget `sampler.max_time` ended the chain before "
-                    "it converged: raise the budget, or continue it with `--resume`.",
-                }
-            )
+    out += _frozen_notes(m, i)
+    flagged = [n for n in i.unidentified if not n.startswith(("sigma_", "phi_"))]
+    if flagged:
+        out.append(
+            {
+                "level": "amber",
+                "title": f"The {m} model is over-parameterised for these data",
+                "text": "At the MAP the data leave the "
+                + ", ".join(quantity_name(n, domain=m) for n in flagged)
+                + " almost as uncertain as their priors (Laplace standard deviation "
+                "above 25 % of the prior range, with the overall scale held fixed): "
+                "their posteriors are mostly prior and slow the chain. Choose: fix "
+                "them, add an informative prior, or use the smaller model of the "
+                "ladder.",
+            }
+        )
+    if len(i.map_modes) > 1:
+        out.append(_modes_note(m, i.map_modes, i.map_restarts))
+    if i.stopped_by == "max_seconds":
+        out.append(
+            {
+                "level": "amber",
+                "title": f"The {m} chain ran out of time",
+                "text": "The wall-time budget `sampler.max_time` ended the chain before "
+                "it converged: raise the budget, or continue it with `--resume`.",
+            }
+        )
+    return out
+
+
+def _frozen_notes(m: str, i) -> list[dict]:
+    """A note on a node that barely moves at the MAP, or on draws that freeze one."""
+    out = []
+    fz, share = i.frozen_node, i.frozen_share
+    branch = (
+        f" {share:.0%} of the posterior draws lie on this branch (the slowest time "
+        "constant beyond ten records), the rest on one where every node moves: the "
+        "posterior has two modes, and the intervals of the time constants span both."
+        if share and share >= 0.05
+        else ""
+    )
+    if fz:
+        out.append(
+            {
+                "level": "amber",
+                "title": f"A {m} node barely moves over the record",
+                "text": f"At the MAP the slowest time constant is {fz.tau_h:.3g} h, "
+                f"{fz.records:.0f} times the calibration record: that node keeps its "
+                "start value, a constant standing in for a fixed node, a missing input "
+                "or a missing node"
+                + (
+                    "; its start is estimated freely, so it acts as a free offset "
+                    "(compare with the default initial_state_horizon or "
+                    "initial_state: steady)."
+                    if fz.start_free
+                    else "; its start is held to the steady state of the first "
+                    "window's mean inputs."
+                )
+                + branch,
+            }
+        )
+    elif branch:
+        out.append(
+            {
+                "level": "amber",
+                "title": f"Some {m} draws freeze a node",
+                "text": "The MAP's nodes all move over the record, but" + branch,
+            }
+        )
+    return out
+
+
+def _closing_notes(s, chains_missing: list[str]) -> list[dict]:
+    """The notes on identifiability, missing chain files and synthetic data."""
+    out = []
     nulls = [m for m, i in s.models.items() if i.identifiability.n_null]
     if nulls:
         out.append(

@@ -262,6 +262,62 @@ def convergence_verdict(
     # green also needs the saved draws (what the pages and arviz on posterior.nc read)
     # within the stated criteria
     saved_ok = conv.saved_draws_ok
+    lines = _model_lines(rs, rule_ok)
+    stats = (
+        f"max R-hat {max_rhat:.3f} (target ≤ {r_ok:g}), min bulk ESS "
+        f"{fmt_int(min_ess)} (target ≥ {e_ok:g}) of the saved draws, chain length ≥ "
+        f"{tf:g} τ: {'yes' if conv.converged_tau else 'no'}; stopping rule "
+        f"met: {'yes' if conv.converged else 'no'}"
+    )
+    rule = (
+        "Rule applied: green only when the sampler's stopping rule is met (chains of "
+        f"at least {tf:g} τ with a stable τ) and the draws saved in `posterior.nc`, which "
+        f"every figure on this page uses, meet the stated criteria (R-hat ≤ {r_ok:g}, "
+        f"bulk ESS ≥ {e_ok:g}, as arviz recomputes them from the file) and the checks "
+        "pass."
+    )
+    checks = model_checks(summary, residuals)
+    level, title, text, advice = _sampling_verdict(
+        summary, rs, rule_ok, saved_ok, within_amber, checks
+    )
+    if rule_ok:  # the stopping rule met: the failed checks are the reasons
+        lines += [f"Check: {c}." for c in checks]
+    failures = accuracy_failures(summary, resolutions)
+    # the headline says the sampling did not converge (the portfolio's "not converged")
+    says_unconverged = level == "red"
+    if failures:
+        converged = rule_ok and saved_ok
+        says_unconverged = not converged
+        title, text, advice = _accuracy_verdict(
+            summary, failures, shapes, converged, nearly=level == "amber" and not converged
+        )
+        level = "red"
+    lines += prior_pinned_lines(summary)
+    if level == "green":
+        status = "converged"
+    elif conv.converged and conv.converged_tau and not says_unconverged:
+        status = "checks failed"
+    else:
+        status = "not converged"
+    return {
+        "level": level,
+        "status": status,
+        "title": title,
+        "text": text,
+        "rule": rule,
+        "stats": stats,
+        "models": lines,
+        "checks": checks,
+        "accuracy": failures,
+        "advice": advice.strip(),
+    }
+
+
+def _model_lines(rs, rule_ok: bool) -> list[str]:
+    """One plain-words line per model: its chain length against τ and the saved draws'
+    R-hat and bulk ESS against the run's criteria."""
+    conv = rs.convergence
+    r_ok, e_ok, tf = conv.target_rhat, conv.target_ess, conv.tau_factor
     lines = []
     for m, info in rs.models.items():
         pr = [e for e in rs.parameters.values() if e.section == m and e.r_hat is not None]
@@ -303,33 +359,24 @@ def convergence_verdict(
             lines.append(f"{name}: " + "; ".join(problems) + ".")
         else:
             lines.append(f"{name}: all criteria met.")
-    stats = (
-        f"max R-hat {max_rhat:.3f} (target ≤ {r_ok:g}), min bulk ESS "
-        f"{fmt_int(min_ess)} (target ≥ {e_ok:g}) of the saved draws, chain length ≥ "
-        f"{tf:g} τ: {'yes' if conv.converged_tau else 'no'}; stopping rule "
-        f"met: {'yes' if conv.converged else 'no'}"
-    )
-    rule = (
-        "Rule applied: green only when the sampler's stopping rule is met (chains of "
-        f"at least {tf:g} τ with a stable τ) and the draws saved in `posterior.nc`, which "
-        f"every figure on this page uses, meet the stated criteria (R-hat ≤ {r_ok:g}, "
-        f"bulk ESS ≥ {e_ok:g}, as arviz recomputes them from the file) and the checks "
-        "pass."
-    )
+    return lines
+
+
+def _sampling_verdict(summary, rs, rule_ok: bool, saved_ok: bool, within_amber: bool, checks):
+    """(level, title, text, advice) of the sampling and the noise model's checks, before
+    the accuracy rule (see :func:`convergence_verdict`)."""
     green = rule_ok and saved_ok
-    checks = model_checks(summary, residuals)
     if rule_ok and not saved_ok:
         level, title = "amber", "Stopping rule met, but the saved draws miss the criteria"
         text = (
             f"The sampler's stopping rule was met on its retained draws, but "
-            f"{conv.saved_draws_text}. Medians are usable; treat the intervals, bands and "
-            "tail values as approximate."
+            f"{rs.convergence.saved_draws_text}. Medians are usable; treat the intervals, "
+            "bands and tail values as approximate."
         )
         advice = (
             "Continue the chains: raise `sampler.max_steps` in the config and run "
             "`hbayes calibrate CONFIG --out RUN_DIR --resume`."
         )
-        lines += [f"Check: {c}." for c in checks]
     elif green and checks:
         level, title = "amber", "Converged, but the checks below fail"
         text = (
@@ -349,7 +396,6 @@ def convergence_verdict(
         )
         if misses:
             advice += " " + truth_advice(summary, len(misses))
-        lines += [f"Check: {c}." for c in checks]
     elif green:
         level, title = "green", "Converged"
         text = (
@@ -358,7 +404,7 @@ def convergence_verdict(
             "assumptions of the model."
         )
         advice = ""
-    elif max_rhat <= AMBER["max_rhat"] and min_ess >= AMBER["min_ess_bulk"]:
+    elif within_amber:
         level, title = "amber", "Nearly converged — use with care"
         text = (
             "The chains are close to, but do not meet, the convergence criteria. "
@@ -388,53 +434,33 @@ def convergence_verdict(
             "slow the sampler down: pinning them with prior knowledge, e.g. the "
             "room volume (`room_volume`), usually helps."
         )
-    failures = accuracy_failures(summary, resolutions)
-    # the headline says the sampling did not converge (the portfolio's "not converged")
-    says_unconverged = level == "red"
-    if failures:
-        converged = rule_ok and saved_ok
-        nearly = level == "amber" and not converged
-        level = "red"
-        title = "This model does not reproduce the room"
-        says_unconverged = not converged
-        if not converged:
-            title += " — and " + ("not fully converged" if nearly else "NOT CONVERGED")
-        text = (
-            "The posterior-median model misses the measurements: "
-            + "; ".join(f["text"] for f in failures)
-            + ". Its parameters, intervals and projections describe a model that lacks "
-            "part of the room's physics: do not use them to judge the room. "
-            + (
-                "The sampler converged; the fault is the model, not the sampling."
-                if converged
-                else "The sampler did not converge either."
-            )
+    return level, title, text, advice
+
+
+def _accuracy_verdict(summary, failures, shapes, converged: bool, nearly: bool):
+    """(title, text, advice) of a model that fails the accuracy rule: red, whatever the
+    sampler did, with the most likely missing physics as advice."""
+    title = "This model does not reproduce the room"
+    if not converged:
+        title += " — and " + ("not fully converged" if nearly else "NOT CONVERGED")
+    text = (
+        "The posterior-median model misses the measurements: "
+        + "; ".join(f["text"] for f in failures)
+        + ". Its parameters, intervals and projections describe a model that lacks "
+        "part of the room's physics: do not use them to judge the room. "
+        + (
+            "The sampler converged; the fault is the model, not the sampling."
+            if converged
+            else "The sampler did not converge either."
         )
-        causes = missing_physics(summary, failures, shapes)
-        advice = (
-            ("Most likely missing: " + " ".join(causes) + " " if causes else "")
-            + "Compare the model orders of the ladder (section 6) and the residual "
-            "diagnostics (section 7), change the model, and calibrate again."
-        )
-    lines += prior_pinned_lines(summary)
-    if level == "green":
-        status = "converged"
-    elif conv.converged and conv.converged_tau and not says_unconverged:
-        status = "checks failed"
-    else:
-        status = "not converged"
-    return {
-        "level": level,
-        "status": status,
-        "title": title,
-        "text": text,
-        "rule": rule,
-        "stats": stats,
-        "models": lines,
-        "checks": checks,
-        "accuracy": failures,
-        "advice": advice.strip(),
-    }
+    )
+    causes = missing_physics(summary, failures, shapes)
+    advice = (
+        ("Most likely missing: " + " ".join(causes) + " " if causes else "")
+        + "Compare the model orders of the ladder (section 6) and the residual "
+        "diagnostics (section 7), change the model, and calibrate again."
+    )
+    return title, text, advice
 
 
 def verdict_record(verdict: dict) -> Verdict:

@@ -49,13 +49,36 @@ def _sources(notes: tuple[SourceNote, ...]) -> list[dict]:
 
 
 def data_context(rd: RunData) -> dict:
-    import pandas as pd
+    al = rd.summary.alignment
+    rows = [
+        {"role": role, "rows_in": fmt_int(n), "dropped": fmt_int(al.rows_dropped.get(role))}
+        for role, n in al.rows_in.items()
+    ]
+    interp = [
+        {"column": c, "filled": fmt_int(n), "flagged": fmt_int(al.flagged_rows.get(c))}
+        for c, n in al.interpolated.items()
+    ]
+    missing = [{"column": c, "n": fmt_int(n)} for c, n in al.measurement_missing.items()]
+    return {
+        "figure": _overview_figure(rd),
+        "rows": rows,
+        "interpolated": interp,
+        "gaps": _gap_rows(al),
+        "missing": missing,
+        "sources": _sources(al.sources),
+        "hold": _hold_words(rd),
+        "words": _alignment_words(al),
+        "irradiance": rd.summary.irradiance_source or "?",
+        "ground": rd.summary.ground_temperature,
+    }
 
-    from heritage_bayes.report.figures import C_MEAS, fig_data_overview
 
-    idata = rd.idata
-    const = idata.constant_data
-    obs = idata.observed_data
+def _overview_figure(rd: RunData):
+    """The figure of the inputs and measurements over the whole record, periods shaded,
+    interpolated values marked, measurement gaps hatched."""
+    from heritage_bayes.report.figures import fig_data_overview
+
+    const = rd.idata.constant_data
     times = time_axis(const)
     codes = np.asarray(const["period"].values)
     dt = np.median(np.diff(times[:1000])) if times.size > 1 else np.timedelta64(3600, "s")
@@ -70,6 +93,17 @@ def data_context(rd: RunData) -> dict:
         for c in const.data_vars
         if c.startswith("interpolated.")
     }
+    panels = _panels(times, const, rd.idata.observed_data, inputs, units)
+    return fig_data_overview(times, codes, panels, measurement_gaps(rd, dt), flags)
+
+
+def _panels(times, const, obs, inputs: list[str], units: dict) -> list[dict]:
+    """The overview's panels: temperatures, vapour pressures, RH, the daily means of the
+    irradiances, then one per other input."""
+    import pandas as pd
+
+    from heritage_bayes.report.figures import C_MEAS
+
     used: set[str] = set()
 
     def series(name, label, style, source):
@@ -139,16 +173,11 @@ def data_context(rd: RunData) -> dict:
                     "series": [series(c, "(input)", {"color": "#7f8c8d", "lw": 0.6}, const)],
                 }
             )
-    fig = fig_data_overview(times, codes, panels, measurement_gaps(rd, dt), flags)
-    al = rd.summary.alignment
-    rows = [
-        {"role": role, "rows_in": fmt_int(n), "dropped": fmt_int(al.rows_dropped.get(role))}
-        for role, n in al.rows_in.items()
-    ]
-    interp = [
-        {"column": c, "filled": fmt_int(n), "flagged": fmt_int(al.flagged_rows.get(c))}
-        for c, n in al.interpolated.items()
-    ]
+    return panels
+
+
+def _gap_rows(al) -> list[dict]:
+    """One row per input or measurement gap of the alignment."""
     gaps = []
     for kind, key in (
         ("input (filled by interpolation)", "input_gaps"),
@@ -167,8 +196,12 @@ def data_context(rd: RunData) -> dict:
                     "filled": "yes" if g.filled else "no",
                 }
             )
-    missing = [{"column": c, "n": fmt_int(n)} for c, n in al.measurement_missing.items()]
-    sources = _sources(al.sources)
+    return gaps
+
+
+def _alignment_words(al) -> str:
+    """The alignment in words: the grid, interpolated inputs, measurement gaps, rows
+    outside the period."""
     n_interp = sum(int(v or 0) for v in al.interpolated.values())
     n_flag = sum(int(v or 0) for v in al.flagged_rows.values())
     spans: dict[tuple, list[str]] = {}
@@ -205,18 +238,7 @@ def data_context(rd: RunData) -> dict:
     ]
     if dropped:
         words += f"{' and '.join(dropped)} lie outside this period and were not used."
-    return {
-        "figure": fig,
-        "rows": rows,
-        "interpolated": interp,
-        "gaps": gaps,
-        "missing": missing,
-        "sources": sources,
-        "hold": _hold_words(rd),
-        "words": words.strip(),
-        "irradiance": rd.summary.irradiance_source or "?",
-        "ground": rd.summary.ground_temperature,
-    }
+    return words.strip()
 
 
 def _hold_words(rd: RunData) -> str:

@@ -165,10 +165,9 @@ def _median(s: RunSummary, key: str, absent=None):
 
 
 def diagnostics_context(rd: RunData, fits: list[dict]) -> dict:
-    from heritage_bayes.report.figures import fig_residuals, fig_tau_history
+    from heritage_bayes.report.figures import fig_tau_history
 
     s = rd.summary
-    dt_hours = s.dt / 3600.0
     conv = s.convergence
     models = []
     missing = []
@@ -199,93 +198,7 @@ def diagnostics_context(rd: RunData, fits: list[dict]) -> dict:
         )
     hist = {m: info.tau_history for m, info in s.models.items()}
     tau_fig = fig_tau_history(hist, conv.tau_factor) if any(len(h) for h in hist.values()) else None
-    residuals = []
-    for fit in fits:
-        if fit["section"] == "combined":
-            continue  # RH is not a model output: its residuals have no noise model
-        if fit.get("resid") is None:
-            continue  # a one-step-ahead band: its residuals are the filter's innovations
-        m, o = fit["section"], fit["output"]
-        noise = s.models[m].noise if m in s.models else ""
-        cal = fit["codes"] == 1
-        if cal.sum() < 4:
-            continue
-        phi, white = None, None
-        traits = noise_traits(noise)
-        if traits.ar1:
-            phi = _median(s, f"{m}.phi_{o}")
-        if traits.white:
-            white = tuple(_median(s, f"{m}.{k}_{o}", 0.0) for k in ("sigma", "phi", "sigma_meas"))
-        resid = fit["resid"][cal]
-        check = _residual_check(resid, phi, dt_hours, white)
-        fig = fig_residuals(
-            fit["times"][cal],
-            resid,
-            output=o,
-            unit=OUT_UNITS.get(o, ""),
-            phi=phi,
-            dt_hours=dt_hours,
-            innov=check.pop("innovations"),
-            acf_scale=white[0] ** 2 / (white[0] ** 2 + white[2] ** 2) if white else 1.0,
-        )
-        if white is not None:
-            words = (
-                f"Lag-1 autocorrelation of the residuals {check['lag1']:.2f}; the "
-                f"AR(1) + white noise model expects about "
-                f"{phi * white[0] ** 2 / (white[0] ** 2 + white[2] ** 2):.2f}. "
-            )
-            subject = "the standardised one-step innovations of the AR(1) + white model"
-        elif phi is not None:
-            words = (
-                f"Lag-1 autocorrelation of the residuals {check['lag1']:.2f}; the "
-                f"AR(1) noise model expects ≈ φ = {phi:.2f}. "
-            )
-            subject = "the innovations left after the AR(1) model"
-        else:
-            words = (
-                f"Lag-1 autocorrelation of the residuals {check['lag1']:.2f}; the iid "
-                "noise model expects ≈ 0. "
-            )
-            subject = "the residuals"
-        share = fmt_pct(check["out_share"])
-        if phi is not None:
-            words += f"Lag-1 autocorrelation of the innovations {check['lag1_innovations']:.2f}. "
-        if check["adequate"]:
-            words += (
-                f"The noise model looks adequate: {subject} are close to white "
-                f"noise ({share} of the lags 1–72 h outside the 95 % band)."
-            )
-        else:
-            words += (
-                f"The noise model is not fully adequate: {subject} are not white "
-                f"({share} of the lags 1–72 h outside the 95 % band"
-                + (
-                    ", cumulative periodogram outside its band"
-                    if math.isfinite(check["dev"]) and check["dev"] > check["band"]
-                    else ""
-                )
-                + f"; the largest at a lag of {check['worst_lag_h']:g} h: "
-                f"{check['worst_rho']:.2f}"
-                + (
-                    ", a daily cycle the model misses"
-                    if check["worst_lag_h"] in (24, 48, 72)
-                    else ""
-                )
-                + "). Correlation the noise model misses makes the posterior intervals "
-                "and predictive bands too narrow."
-            )
-        residuals.append(
-            {
-                "id": f"fig-resid-{m}-{o}",
-                "section": m,
-                "output": o,
-                "model": fit["model"],
-                "figure": fig,
-                "words": words,
-                "adequate": check["adequate"],
-                "check": check,
-            }
-        )
+    residuals = [r for fit in fits if (r := _residual_entry(s, fit)) is not None]
     return {
         "models": models,
         "tau_fig": tau_fig,
@@ -294,6 +207,100 @@ def diagnostics_context(rd: RunData, fits: list[dict]) -> dict:
         "tau_factor": f"{conv.tau_factor:g}",
         "tau_rtol": fmt_pct(conv.tau_rtol, 0),
     }
+
+
+def _residual_entry(s, fit: dict) -> dict | None:
+    """The residual check of one fitted output over the calibration period: its figure,
+    the check's figures and the verdict in words; None for an output without a noise
+    model of its own (RH, a one-step band) or with under four calibration hours."""
+    from heritage_bayes.report.figures import fig_residuals
+
+    if fit["section"] == "combined":
+        return None  # RH is not a model output: its residuals have no noise model
+    if fit.get("resid") is None:
+        return None  # a one-step-ahead band: its residuals are the filter's innovations
+    dt_hours = s.dt / 3600.0
+    m, o = fit["section"], fit["output"]
+    noise = s.models[m].noise if m in s.models else ""
+    cal = fit["codes"] == 1
+    if cal.sum() < 4:
+        return None
+    phi, white = None, None
+    traits = noise_traits(noise)
+    if traits.ar1:
+        phi = _median(s, f"{m}.phi_{o}")
+    if traits.white:
+        white = tuple(_median(s, f"{m}.{k}_{o}", 0.0) for k in ("sigma", "phi", "sigma_meas"))
+    resid = fit["resid"][cal]
+    check = _residual_check(resid, phi, dt_hours, white)
+    fig = fig_residuals(
+        fit["times"][cal],
+        resid,
+        output=o,
+        unit=OUT_UNITS.get(o, ""),
+        phi=phi,
+        dt_hours=dt_hours,
+        innov=check.pop("innovations"),
+        acf_scale=white[0] ** 2 / (white[0] ** 2 + white[2] ** 2) if white else 1.0,
+    )
+    return {
+        "id": f"fig-resid-{m}-{o}",
+        "section": m,
+        "output": o,
+        "model": fit["model"],
+        "figure": fig,
+        "words": _residual_words(check, phi, white),
+        "adequate": check["adequate"],
+        "check": check,
+    }
+
+
+def _residual_words(check: dict, phi: float | None, white: tuple | None) -> str:
+    """The residual check in words: the lag-1 autocorrelation against the noise model's
+    and whether what is left is white noise."""
+    if white is not None:
+        words = (
+            f"Lag-1 autocorrelation of the residuals {check['lag1']:.2f}; the "
+            f"AR(1) + white noise model expects about "
+            f"{phi * white[0] ** 2 / (white[0] ** 2 + white[2] ** 2):.2f}. "
+        )
+        subject = "the standardised one-step innovations of the AR(1) + white model"
+    elif phi is not None:
+        words = (
+            f"Lag-1 autocorrelation of the residuals {check['lag1']:.2f}; the "
+            f"AR(1) noise model expects ≈ φ = {phi:.2f}. "
+        )
+        subject = "the innovations left after the AR(1) model"
+    else:
+        words = (
+            f"Lag-1 autocorrelation of the residuals {check['lag1']:.2f}; the iid "
+            "noise model expects ≈ 0. "
+        )
+        subject = "the residuals"
+    share = fmt_pct(check["out_share"])
+    if phi is not None:
+        words += f"Lag-1 autocorrelation of the innovations {check['lag1_innovations']:.2f}. "
+    if check["adequate"]:
+        words += (
+            f"The noise model looks adequate: {subject} are close to white "
+            f"noise ({share} of the lags 1–72 h outside the 95 % band)."
+        )
+    else:
+        words += (
+            f"The noise model is not fully adequate: {subject} are not white "
+            f"({share} of the lags 1–72 h outside the 95 % band"
+            + (
+                ", cumulative periodogram outside its band"
+                if math.isfinite(check["dev"]) and check["dev"] > check["band"]
+                else ""
+            )
+            + f"; the largest at a lag of {check['worst_lag_h']:g} h: "
+            f"{check['worst_rho']:.2f}"
+            + (", a daily cycle the model misses" if check["worst_lag_h"] in (24, 48, 72) else "")
+            + "). Correlation the noise model misses makes the posterior intervals "
+            "and predictive bands too narrow."
+        )
+    return words
 
 
 def section(ctx: dict) -> Section:

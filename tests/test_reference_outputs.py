@@ -1,0 +1,286 @@
+"""Every shipped config's numbers do not move: a guard for changes that should change no
+result (refactorings above all).
+
+What is compared with the values recorded in ``reference_outputs.json`` (beside this
+file):
+
+- **Each calibration config** in ``configs/`` and each room of
+  ``configs/portfolio_demo.yaml`` (its defaults and overrides merged): the data are
+  prepared as ``hbayes calibrate`` prepares them, and for each section the model's name,
+  the parameter names, the checksums of the model inputs and observations over the whole
+  prepared frame (a plain and a position-weighted sum: a moved row or a swapped column
+  shows), the log-likelihood, the log-posterior (priors, time-constant prior, tempering)
+  and the estimated initial state at one fixed parameter vector: every free parameter at
+  its prior's centre (the median of a log-normal, the mean of a normal, the geometric
+  mean of a log-uniform's bounds, the middle of a uniform's), fixed ones at their value.
+  The vector itself is recorded too, so that a moved prior shows by name.
+- **A tiny calibration run** of the virtual monument (``thermal_1c`` + ``hygric_1c``
+  on ten days, a 10-generation MAP search and 100 sampler steps, no ladder): the sums of
+  every numeric variable of ``posterior.nc`` and the whole of ``summary.json`` but for
+  what differs between two runs of one tree (times, versions, the creation date) and the
+  config's provenance and hash (a settings refactoring may reorder the recorded
+  config). The whole path (MAP search, sampler, run outputs) runs, so a change in any
+  of them shows.
+- **The projection configs** ``projection_demo.yaml`` and
+  ``projection_interventions.yaml`` projected from that run with 4 draws: the sums of
+  every numeric variable of the projection's dataset (every case, indicator, measure
+  and cost). ``projection_knmi.yaml`` is not projected: it needs a second run on De
+  Bilt weather and projects ten years under eight futures (about 20 s of CPU more);
+  its file is validated by ``tests/test_projection.py``.
+
+Floats agree to 12 significant digits: the same arithmetic gives the same bits, and the
+margin only admits a numpy or BLAS that sums in another order (the MAP search and the
+sampler may amplify such a difference: after a dependency upgrade the tiny run's
+numbers can move while every config's hold). Configs that read
+``../shared/data`` skip, saying so, when it is not beside the checkout.
+
+Re-recording: ``PYTHONPATH=src python tests/test_reference_outputs.py`` rewrites
+``reference_outputs.json`` from the current tree. That is legitimate only in a commit
+that means to change a result (a fix in the physics or the data reading, a new default,
+a shipped config edited, a new dependency version that sums differently) and that says
+in its message which numbers moved and why. A refactoring re-records nothing: if this
+test fails after one, the refactoring changed behaviour. The values were first recorded
+on commit 212f59b.
+
+Cost: the nine configs' preparations and two likelihood evaluations each, the tiny run
+and two projections: 19 s of CPU for the module alone (imports and numba compilation
+included, which the full suite pays once anyway).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+from functools import cache
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+CONFIGS = ROOT / "configs"
+RECORD = Path(__file__).with_name("reference_outputs.json")
+SHARED_DATA = ROOT.parent / "shared" / "data"
+
+#: The calibration configs: file stem, or ``portfolio_demo/<room>`` for a portfolio's room.
+CALIBRATIONS = (
+    "demo",
+    "debilt_demo",
+    "orholm",
+    "annisse",
+    "trh1_attic",
+    "armadillo",
+    "portfolio_demo/hall",
+    "portfolio_demo/hall_logger2",
+    "portfolio_demo/draughty_hall",
+)
+#: The projection configs projected from the tiny run.
+PROJECTIONS = ("projection_demo", "projection_interventions")
+#: Draws of each projection (the files' own 100-200 cost seconds each).
+PROJECTION_DRAWS = 4
+#: Significant digits every float must keep.
+RTOL = 1e-12
+
+
+# ---------------------------------------------------------------------- the numbers
+def _config(key: str):
+    """The validated config of ``key`` (see :data:`CALIBRATIONS`)."""
+    from heritage_bayes.config import load_config, parse_config
+    from heritage_bayes.portfolio.spec import load_portfolio
+
+    if "/" not in key:
+        return load_config(CONFIGS / f"{key}.yaml")
+    stem, room = key.split("/")
+    spec = {r.name: r for r in load_portfolio(CONFIGS / f"{stem}.yaml").rooms}[room]
+    return parse_config(spec.raw, source=str(spec.config_path), base_dir=spec.base_dir)
+
+
+def _needs_shared_data(key: str) -> bool:
+    return "shared/data" in (CONFIGS / f"{key.split('/')[0]}.yaml").read_text(encoding="utf-8")
+
+
+def _prior_centre(p) -> float:
+    """The fixed value of a parameter, else the centre of its prior."""
+    if p.fixed is not None:
+        return float(p.fixed)
+    pr = p.prior
+    if pr.dist in ("normal", "lognormal"):
+        return float(pr.mu)
+    if pr.dist == "loguniform":
+        return math.sqrt(pr.lower * pr.upper)
+    return 0.5 * (pr.lower + pr.upper)
+
+
+def _checksums(a: np.ndarray) -> list[float]:
+    """A plain and a position-weighted sum of a (rows, columns) array (NaN skipped)."""
+    a = np.asarray(a, dtype=float).reshape(len(a), -1)
+    w = np.linspace(1.0, 2.0, len(a))[:, None] * np.arange(1, a.shape[1] + 1)[None, :]
+    return [float(np.nansum(a)), float(np.nansum(a * w))]
+
+
+def calibration_values(key: str) -> dict:
+    """section -> the recorded numbers of one calibration config."""
+    from heritage_bayes.ladder import section_log_posterior
+    from heritage_bayes.models import SECTIONS, build_model
+    from heritage_bayes.prepare import prepare
+
+    cfg = _config(key)
+    prep = prepare(cfg)
+    if (fixed := prep.sources.get("fixed_node_temperature")) is not None:
+        cfg = cfg.model_copy(update={"fixed_node_temperature": fixed["value"]})  # as calibrate
+    out = {}
+    for section in SECTIONS:
+        if getattr(cfg, section) is None:
+            continue
+        model = build_model(cfg, section)
+        lp = section_log_posterior(cfg, prep, section, model, getattr(cfg, section).priors)
+        theta = np.array([[_prior_centre(p) for p in lp.params.parameters]])
+        u, y = prep.model_inputs(section, model), prep.observed(section, model)
+        start = lp.initial_states(theta)
+        out[section] = {
+            "model": model.name,
+            "names": list(lp.params.names),
+            "point": [float(v) for v in theta[0]],
+            "rows": len(u),
+            "observed_finite": int(np.isfinite(y).sum()),
+            "inputs": _checksums(u),
+            "observed": _checksums(y),
+            "log_likelihood": float(lp.log_likelihood(theta)[0]),
+            "log_posterior": float(lp(lp.params.to_unconstrained(theta))[0]),
+            "initial_state": None if start is None else [float(v) for v in start[0]],
+        }
+    return out
+
+
+#: The tiny run: the report tests' ten days, with smaller budgets and no ladder.
+def _tiny_config() -> dict:
+    from test_report import TINY
+
+    return dict(
+        TINY,
+        ladder=False,
+        sampler={"max_steps": 100, "check_every": 100},
+        optimizer={"maxiter": 10, "starts": 1, "popsize": 4},
+    )
+
+
+def _dataset_sums(ds) -> dict:
+    """variable -> the sum of its finite values, for every numeric variable."""
+    out = {}
+    for name, var in sorted(ds.data_vars.items()):
+        a = np.asarray(var.values)
+        if a.dtype.kind in "fiub":
+            out[str(name)] = float(np.nansum(a.astype(float)))
+    return out
+
+
+def run_values(run_dir: Path) -> dict:
+    """The recorded numbers of the tiny run: ``posterior.nc``'s sums and the MAPs."""
+    from heritage_bayes.run import load_run
+
+    r = load_run(run_dir)
+    groups = {g: _dataset_sums(r.idata[g]) for g in sorted(r.idata.groups())}
+    summary = json.loads((run_dir / "summary.json").read_text(encoding="utf-8"))
+    return {"posterior.nc": groups, "summary.json": _steady(summary)}
+
+
+#: ``summary.json``'s keys that differ between two runs of the same tree.
+VOLATILE = {
+    "created_at", "heritage_bayes_version", "versions", "timings", "wall_seconds",
+    "cpu_seconds", "provenance", "config_hash", "schema_version",
+}  # fmt: skip
+
+
+def _steady(d):
+    """``d`` without the :data:`VOLATILE` keys, at every depth."""
+    if isinstance(d, dict):
+        return {k: _steady(v) for k, v in d.items() if k not in VOLATILE}
+    if isinstance(d, list):
+        return [_steady(v) for v in d]
+    return d
+
+
+def projection_values(run_dir: Path, name: str) -> dict:
+    """The recorded numbers of one projection config on the tiny run."""
+    from heritage_bayes.projection import project
+
+    p = project(run_dir, CONFIGS / f"{name}.yaml", draws=PROJECTION_DRAWS, write=False)
+    return {"labels": list(p.labels), "dataset": _dataset_sums(p.dataset)}
+
+
+def _tiny_run(out: Path) -> Path:
+    from heritage_bayes.calibrate import run_calibration
+    from heritage_bayes.config import parse_config
+
+    run_calibration(parse_config(_tiny_config()), out_dir=out, report=False, quiet=True)
+    return out
+
+
+# ---------------------------------------------------------------------- comparison
+def _differences(got, ref, where: str = "") -> list[str]:
+    """Where ``got`` differs from ``ref`` (floats to :data:`RTOL`, the rest exactly)."""
+    if isinstance(ref, dict) and isinstance(got, dict):
+        if sorted(got) != sorted(ref):
+            return [f"{where}: keys {sorted(set(got) ^ set(ref))} differ"]
+        return [d for k in ref for d in _differences(got[k], ref[k], f"{where}/{k}")]
+    if isinstance(ref, list) and isinstance(got, list | tuple):
+        if len(got) != len(ref):
+            return [f"{where}: {len(got)} items, recorded {len(ref)}"]
+        pairs = enumerate(zip(got, ref, strict=True))
+        return [d for i, (g, r) in pairs for d in _differences(g, r, f"{where}[{i}]")]
+    if isinstance(ref, float) and isinstance(got, float | int):
+        if got == ref or abs(got - ref) <= RTOL * max(abs(ref), abs(got)):
+            return []
+        return [f"{where}: {got!r}, recorded {ref!r}"]
+    return [] if got == ref else [f"{where}: {got!r}, recorded {ref!r}"]
+
+
+@cache
+def _recorded() -> dict:
+    return json.loads(RECORD.read_text(encoding="utf-8"))
+
+
+def _assert_recorded(got, key: str) -> None:
+    diffs = _differences(got, _recorded()[key], key)
+    assert not diffs, "changed from the recorded values:\n  " + "\n  ".join(diffs[:20])
+
+
+# ---------------------------------------------------------------------- the tests
+@pytest.mark.parametrize("key", CALIBRATIONS)
+def test_calibration_config_gives_the_recorded_numbers(key):
+    if _needs_shared_data(key) and not SHARED_DATA.is_dir():
+        pytest.skip(f"configs/{key}.yaml reads ../shared/data, not found at {SHARED_DATA}")
+    _assert_recorded(calibration_values(key), key)
+
+
+@pytest.fixture(scope="module")
+def tiny_run(tmp_path_factory) -> Path:
+    return _tiny_run(tmp_path_factory.mktemp("reference") / "run")
+
+
+def test_tiny_run_gives_the_recorded_outputs(tiny_run):
+    _assert_recorded(run_values(tiny_run), "tiny_run")
+
+
+@pytest.mark.parametrize("name", PROJECTIONS)
+def test_projection_config_gives_the_recorded_outputs(tiny_run, name):
+    _assert_recorded(projection_values(tiny_run, name), name)
+
+
+def _record() -> None:
+    """Rewrite :data:`RECORD` from the current tree (see the module docstring)."""
+    import tempfile
+
+    values = {key: calibration_values(key) for key in CALIBRATIONS}
+    with tempfile.TemporaryDirectory() as tmp:
+        run_dir = _tiny_run(Path(tmp) / "run")
+        values["tiny_run"] = run_values(run_dir)
+        values.update({name: projection_values(run_dir, name) for name in PROJECTIONS})
+    RECORD.write_text(json.dumps(values, indent=1, ensure_ascii=False) + "\n", encoding="utf-8")
+    print(f"recorded {len(values)} entries in {RECORD}")
+
+
+if __name__ == "__main__":
+    sys.path.insert(0, str(Path(__file__).parent))  # test_report's TINY
+    _record()

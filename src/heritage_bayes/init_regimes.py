@@ -28,10 +28,20 @@ enough for a calendar year to calibrate and :data:`~heritage_bayes.init_periods.
 VALIDATION_MONTHS` months after it to validate; the calibration and validation then
 describe one regime.
 
+A heating set-point is set for a winter, and a winter straddles the calendar year: the
+**heating level** is measured per heating season (July to June, :func:`season_levels`:
+the indoor daily mean on heated days at a common outdoor temperature). A level moved
+by :data:`LEVEL_SHIFT_K` or more between two winters is a set-point moved by hand,
+which a model with one set-point cannot carry; within the calendar years run one way,
+:func:`level_stretch` keeps the most recent heating seasons at one level when they are
+long enough (12 months and the validation months after them).
+
 Measured on the Ørholm store's logger file (2012-2020, UTC+1): the RH band 4-9 points in
 2012-2017, 14 in 2018, 23 and 18 in 2019 and 2020; the summer excess 5.2-5.9 K in
 2013-2017, 3.0 K in 2018, 2.3 and 2.5 K in 2019 and 2020 (the dehumidifier and its heat
-gone); the heating floor 10.0-10.2 °C in every year from 2013.
+gone); the heating floor 10.0-10.2 °C in every year from 2013; the heating level
+(indoor daily mean at 2.3 °C outdoors) 11.0-11.2 °C in the winters 2014/15 to 2016/17,
+then 11.9, 10.8, 11.7 and 11.6 °C in 2017/18 to 2020/21 (moved by hand).
 """
 
 from __future__ import annotations

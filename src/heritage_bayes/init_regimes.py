@@ -228,7 +228,11 @@ def regime_stretch(
     agrees (:func:`season_levels`, :func:`level_stretch`) narrow it further.
     """
     s, e, notes = _year_stretch(ti, te, rhi, rhe, start, end)
-    ls, le, level_notes = level_stretch(season_levels(ti[s:e], te[s:e]), s, e)
+
+    def inside(x):
+        return x[(x.index >= s) & (x.index < e)]
+
+    ls, le, level_notes = level_stretch(season_levels(inside(ti), inside(te)), s, e)
     return ls, le, notes + level_notes
 
 

@@ -101,6 +101,9 @@ def variants(init_cfg):
         "init, thermal_1c, Tf 2.24 m deep": lambda: _with(
             init_cfg, thermal={"model": "thermal_1c"}, data={"ground_temperature": deep(2.24)}
         ),
+        "init, thermal_2c, Tf 2.24 m deep": lambda: _with(
+            init_cfg, thermal={"model": "thermal_2c"}, data={"ground_temperature": deep(2.24)}
+        ),
         "init, thermal_1c, Tf 3 m deep": lambda: _with(
             init_cfg, thermal={"model": "thermal_1c"}, data={"ground_temperature": deep(3.0)}
         ),

@@ -2,17 +2,17 @@
 FIT [%] (benchmarks/real_rooms.py's budget: 100 generations, 2 local starts).
 
 Two families: the hand-written ``configs/orholm.yaml`` on its periods (2015 / 2016) as
-shipped, without its constant gain, and with each of init's choices in turn (two
-nodes, the seasonal ground, the estimated sun on one horizontal aperture); and init's
-config from the raw files (written to a temporary folder): as written (2019-07 to
-2020-07 / to 2021-03, the most recent stretch the store was run one way: its
-dehumidifier and its heat gone from 2018, its heating level moved by hand between the
-winters 2018/19 and 2019/20), with the estimated sun put back, without the constant gain, and on other periods:
-2012 split 8/4 months without the constant gain (what init proposed when it took the
-first year), 2014 split 8/4, and 2014 / 2015 (the dehumidified years); and on init's
-periods each thermal model, the ground as the running annual mean, and the seasonal
-ground deeper than the default 1 m (2.24 m, a clay/silt soil's periodic penetration
-depth; 3 m).
+shipped, without its constant gain, and with each of init's choices in turn (two nodes,
+the seasonal ground, the estimated sun on one horizontal aperture); and init's config
+from the raw files (written to a temporary folder): as written (2019-07 to 2020-07 / to
+2021-03, the most recent stretch the store was run one way: its dehumidifier and its
+heat gone from 2018, its heating level moved by hand between the winters 2018/19 and
+2019/20), with the estimated sun put back, without the constant gain, and on other
+periods: 2012 split 8/4 months without the constant gain (what init proposed when it
+took the first year), 2014 split 8/4, and 2014 / 2015 (the dehumidified years); and on
+init's periods each thermal model, the ground as the running annual mean, and the
+seasonal ground deeper than the default 1 m (2.24 m, a clay/silt soil's periodic
+penetration depth; 3 m).
 
 Usage (from the repository root)::
 

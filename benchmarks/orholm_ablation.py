@@ -2,13 +2,17 @@
 FIT [%] (benchmarks/real_rooms.py's budget: 100 generations, 2 local starts).
 
 Two families: the hand-written ``configs/orholm.yaml`` on its periods (2015 / 2016) as
-shipped, without its constant gain, and with each of init's choices in turn (two
-nodes, the seasonal ground, the estimated sun on one horizontal aperture); and init's
-config from the raw files (written to a temporary folder): as written (2019 / 2020, the
-most recent stretch the store was run one way: its dehumidifier and its heat gone from
-2018), with the estimated sun put back, without the constant gain, and on other periods:
-2012 split 8/4 months without the constant gain (what init proposed when it took the
-first year), 2014 split 8/4, and 2014 / 2015 (the dehumidified years).
+shipped, without its constant gain, and with each of init's choices in turn (two nodes,
+the seasonal ground, the estimated sun on one horizontal aperture); and init's config
+from the raw files (written to a temporary folder): as written (2019-07 to 2020-07 / to
+2021-03, the most recent stretch the store was run one way: its dehumidifier and its
+heat gone from 2018, its heating level moved by hand between the winters 2018/19 and
+2019/20), with the estimated sun put back, without the constant gain, and on other
+periods: 2012 split 8/4 months without the constant gain (what init proposed when it
+took the first year), 2014 split 8/4, and 2014 / 2015 (the dehumidified years); and on
+init's periods each thermal model, the ground as the running annual mean, and the
+seasonal ground deeper than the default 1 m (2.24 m, a clay/silt soil's periodic
+penetration depth; 3 m).
 
 Usage (from the repository root)::
 
@@ -51,6 +55,11 @@ def variants(init_cfg):
     opts = dict(hand.thermal.options)
     iopts = dict(init_cfg.thermal.options)
     no_gain = {k: v for k, v in iopts.items() if k != "source"}
+    annual = GroundTemperature(mode="annual_mean")
+
+    def deep(depth):
+        return GroundTemperature(mode="seasonal", depth=depth)
+
     return {
         "hand": lambda: _with(hand),
         "hand without source": lambda: _with(
@@ -79,6 +88,28 @@ def variants(init_cfg):
             init_cfg, data={"irradiance": "estimated", "surfaces": {"H": (0.0, 0.0)}}
         ),
         "init without source": lambda: _with(init_cfg, thermal={"options": no_gain}),
+        # on init's periods (the heating seasons at one level), each model and ground
+        "init, thermal_1c": lambda: _with(init_cfg, thermal={"model": "thermal_1c"}),
+        "init, thermal_2c": lambda: _with(init_cfg, thermal={"model": "thermal_2c"}),
+        "init, thermal_4a": lambda: _with(init_cfg, thermal={"model": "thermal_4a"}),
+        "init, thermal_1c, annual-mean Tf": lambda: _with(
+            init_cfg, thermal={"model": "thermal_1c"}, data={"ground_temperature": annual}
+        ),
+        "init, thermal_2c, annual-mean Tf": lambda: _with(
+            init_cfg, thermal={"model": "thermal_2c"}, data={"ground_temperature": annual}
+        ),
+        "init, thermal_1c, Tf 2.24 m deep": lambda: _with(
+            init_cfg, thermal={"model": "thermal_1c"}, data={"ground_temperature": deep(2.24)}
+        ),
+        "init, thermal_2c, Tf 2.24 m deep": lambda: _with(
+            init_cfg, thermal={"model": "thermal_2c"}, data={"ground_temperature": deep(2.24)}
+        ),
+        "init, thermal_1c, Tf 3 m deep": lambda: _with(
+            init_cfg, thermal={"model": "thermal_1c"}, data={"ground_temperature": deep(3.0)}
+        ),
+        "init, thermal_2c, Tf 3 m deep": lambda: _with(
+            init_cfg, thermal={"model": "thermal_2c"}, data={"ground_temperature": deep(3.0)}
+        ),
     }
 
 

@@ -5,6 +5,8 @@ European `;` logger export on a fixed UTC+1 clock, a DMI weather file in UTC).""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -139,3 +141,77 @@ def test_twenty_months_calibrate_a_whole_year():
     # 26 months: the most recent 12 with a year after them
     cs, ce, _, ve, _ = choose_periods(s, pd.Timestamp("2015-05-01", tz=utc))
     assert (cs, ce, ve) == ("2013-05-01", "2014-05-01", "2015-05-01")
+
+
+MOVED = pd.Timestamp("2014-09-15", tz="UTC")  # the heating turned up by hand
+
+
+def _moved_store():
+    """The store of :func:`_store` without its dehumidifier (RH free, a 1 K gain), heated
+    to 10 °C until :data:`MOVED` and to 11.5 °C after it: the calendar years' floors
+    differ by 1.5 K, under the 2 K of a set-point shift year by year."""
+    utc, te, rhe, _, _ = _store("2016-05-01")
+    rng = np.random.default_rng(5)
+    setpoint = np.where(np.asarray(utc < MOVED), 10.0, 11.5)
+    smooth = pd.Series(te).ewm(halflife=48).mean().to_numpy()
+    ti = np.maximum(smooth + 1.0, setpoint + rng.normal(0, 0.05, te.size))
+    pe = rhe / 100 * saturation_vapour_pressure(te)
+    rhi = np.clip(
+        100 * pd.Series(pe).ewm(halflife=24).mean().to_numpy() / saturation_vapour_pressure(ti),
+        5,
+        99,
+    )
+    return utc, te, rhe, ti, rhi
+
+
+@pytest.fixture(scope="module")
+def moved_by_hand(tmp_path_factory):
+    """init on the store whose heating level moved between the winters of 2013/14 and
+    2014/15."""
+    tmp = tmp_path_factory.mktemp("moved")
+    lp, wp = _write(tmp, *_moved_store())
+    out = tmp / "room" / "config.yaml"
+    res = init_config(lp, wp, output=out, timezone="UTC+1", **SITE)
+    return res, out
+
+
+def test_a_heating_level_moved_between_winters_ends_the_stretch(moved_by_hand):
+    res, out = moved_by_hand
+    assert res.questions == []
+    cfg = load_config(out)
+    # the 22 months from the 1st of July before the first winter at the new level: 12
+    # months to calibrate, the rest to validate (without the seasons: 2014 / 2015, a
+    # calibration year holding both levels)
+    assert (cfg.periods.calibration.start, cfg.periods.calibration.end) == (
+        "2014-07-01",
+        "2015-07-01",
+    )
+    assert cfg.periods.validation.end >= "2016-04-30"
+    text = out.read_text(encoding="utf-8")
+    flat = " ".join(line.strip("# ") for line in text.splitlines() if line.startswith("  #"))
+    assert "2013/14 10.0 °C; 2014/15 11.5 °C" in flat
+    assert "moved by 0.8 K or more between seasons (2013/14 to 2014/15" in flat
+    assert any("heating level by season" in f for f in res.findings)
+
+
+def test_season_levels_and_their_stretch():
+    """The levels per heating season (July to June) and the stretch at one level; a
+    free-running room has none; a move under the threshold keeps the whole span."""
+    from heritage_bayes.init_regimes import LEVEL_SHIFT_K, level_stretch, season_levels
+
+    utc, te, _, ti, _ = _moved_store()
+    s_ti, s_te = pd.Series(ti, index=utc), pd.Series(te, index=utc)
+    levels = season_levels(s_ti, s_te)
+    assert [lv.season for lv in levels] == [2012, 2013, 2014, 2015]
+    assert [round(lv.level, 1) for lv in levels] == [10.0, 10.0, 11.5, 11.5]
+    s, e = utc[0], utc[-1] + pd.Timedelta(hours=1)
+    start, end, notes = level_stretch(levels, s, e)
+    assert (start, end) == (pd.Timestamp("2014-07-01", tz="UTC"), e)
+    # free-running (no floor): no level to move
+    assert season_levels(pd.Series(np.asarray(te) + 1.0, index=utc), s_te) == []
+    # a move under the threshold is one level
+    small = [replace(lv, level=10.0 + (LEVEL_SHIFT_K - 0.1) * (lv.level > 11)) for lv in levels]
+    assert level_stretch(small, s, e) == (s, e, [])
+    # too short after the move: the whole span, with a note
+    start, end, notes = level_stretch(levels, s, pd.Timestamp("2015-12-01", tz="UTC"))
+    assert start == s and "the periods span the move" in notes[-1]

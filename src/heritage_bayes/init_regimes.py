@@ -28,8 +28,16 @@ enough for a calendar year to calibrate and :data:`~heritage_bayes.init_periods.
 VALIDATION_MONTHS` months after it to validate; the calibration and validation then
 describe one regime.
 
-The signatures of a real logger file year by year: docs/science/real_rooms.md,
-"Figures behind the code's choices".
+A heating set-point is set for a winter, and a winter straddles the calendar year: the
+**heating level** is measured per heating season (July to June, :func:`season_levels`:
+the indoor daily mean on heated days at a common outdoor temperature). A level moved
+by :data:`LEVEL_SHIFT_K` or more between two winters is a set-point moved by hand,
+which a model with one set-point cannot carry; within the calendar years run one way,
+:func:`level_stretch` keeps the most recent heating seasons at one level when they are
+long enough (12 months and the validation months after them).
+
+The signatures of a real logger file year by year and season by season:
+docs/science/real_rooms.md, "Figures behind the code's choices".
 """
 
 from __future__ import annotations
@@ -43,7 +51,14 @@ from heritage_bayes.init_checks import heating_floor
 from heritage_bayes.init_model import BAND_MAX_PCT, BAND_RATIO
 from heritage_bayes.init_periods import VALIDATION_MONTHS
 
-__all__ = ["YearRegime", "regime_stretch", "year_regimes"]
+__all__ = [
+    "SeasonLevel",
+    "YearRegime",
+    "level_stretch",
+    "regime_stretch",
+    "season_levels",
+    "year_regimes",
+]
 
 #: Points [% RH] above :data:`~heritage_bayes.init_model.BAND_MAX_PCT` at which a band is
 #: clearly free, and below it at which it is clearly held.
@@ -58,6 +73,12 @@ MIN_RH_DAYS = 90
 MIN_COLD_DAYS = 60
 #: Months with 20 days of data a year needs for its summer excess.
 MIN_MONTHS = 9
+#: Move of the heating level [K] between two heating seasons in a row that one set-point
+#: cannot carry: three standard errors of the difference of two seasons' levels when a
+#: season's monthly levels scatter by 0.4 K over 4-5 months (Ørholm's).
+LEVEL_SHIFT_K = 0.8
+#: Heated days a heating season needs for its level.
+MIN_HEAT_DAYS = 30
 
 
 @dataclass(frozen=True)
@@ -198,7 +219,20 @@ def regime_stretch(
     :data:`~heritage_bayes.init_periods.VALIDATION_MONTHS` after it to validate: its
     ``(start, end)`` and notes (each year's signatures, the changes found, the choice).
     The whole span when no year differs, or no stretch is long enough (a note says so).
+    Within the calendar years run one way, the heating seasons whose heating level
+    agrees (:func:`season_levels`, :func:`level_stretch`) narrow it further.
     """
+    s, e, notes = _year_stretch(ti, te, rhi, rhe, start, end)
+
+    def inside(x):
+        return x[(x.index >= s) & (x.index < e)]
+
+    ls, le, level_notes = level_stretch(season_levels(inside(ti), inside(te)), s, e)
+    return ls, le, notes + level_notes
+
+
+def _year_stretch(ti, te, rhi, rhe, start, end):
+    """:func:`regime_stretch` on the calendar years' signatures alone."""
     years = year_regimes(ti, te, rhi, rhe, start, end)
     if len(years) < 2:
         return start, end, []
@@ -238,5 +272,137 @@ def regime_stretch(
         "the operation changed within the record, and no stretch run one way holds a "
         "calendar year and "
         f"{VALIDATION_MONTHS} months after it: the periods span the change"
+    )
+    return start, end, notes
+
+
+@dataclass(frozen=True)
+class SeasonLevel:
+    """One heating season's heating level.
+
+    Attributes
+    ----------
+    season : int
+        The year the season starts (a season runs from July to June: one winter).
+    level : float
+        The indoor daily mean [°C] on its heated days, brought to a common outdoor
+        temperature ``ref`` along the slope of the indoor on the outdoor daily mean.
+    days : int
+        Its heated days (outdoor daily mean 5 K or more below the heating floor).
+    ref : float
+        The common outdoor daily mean [°C] (the median of the heated days measured).
+    """
+
+    season: int
+    level: float
+    days: int
+    ref: float
+
+    def name(self) -> str:
+        """``2019/20``."""
+        return f"{self.season}/{(self.season + 1) % 100:02d}"
+
+
+def season_levels(ti: pd.Series, te: pd.Series) -> list[SeasonLevel]:
+    """Each heating season's heating level (:class:`SeasonLevel`), oldest first; none
+    when the record shows no heating floor (:func:`heritage_bayes.init_checks.
+    heating_floor`: a free-running room has no level to move).
+
+    A set-point is set for a winter, and winters straddle the calendar year: the seasons
+    run July to June. A heated day is one whose outdoor daily mean lies 5 K or more
+    below the record's floor (the heating then carries the room). A heated store's
+    air still follows the outdoors a little on such days (the heaters' spread, a
+    thermostat away from the logger): the level is each day's indoor mean less
+    ``b`` times its outdoor mean's distance from the common ``ref``, ``b`` [K/K] the
+    slope of the indoor on the outdoor daily mean within seasons, pooled over them
+    (clipped to 0-1), its median over the season's heated days; at least
+    :data:`MIN_HEAT_DAYS` of them.
+
+    Parameters
+    ----------
+    ti, te : pandas.Series
+        Indoor and outdoor temperature [°C] on UTC stamps.
+    """
+    ti, te = ti.dropna(), te.dropna()
+    if len(ti) < 48 or len(te) < 48:
+        return []
+    floor, held, ndays = heating_floor(ti, te)
+    if not held >= max(20, 0.05 * ndays):
+        return []
+    d = pd.concat(
+        [ti.resample("1D").mean().rename("ti"), te.resample("1D").mean().rename("te")],
+        axis=1,
+        sort=True,
+    ).dropna()
+    d = d[d["te"] < floor - 5]
+    if len(d) < MIN_HEAT_DAYS:
+        return []
+    idx = d.index.tz_localize(None) if d.index.tz is not None else d.index
+    season = pd.Series((idx - pd.DateOffset(months=6)).year, index=d.index)
+    g = d.groupby(season)
+    x = d["te"] - g["te"].transform("mean")
+    y = d["ti"] - g["ti"].transform("mean")
+    slope = float(np.clip((x * y).sum() / max(float((x * x).sum()), 1e-9), 0.0, 1.0))
+    ref = float(d["te"].median())
+    level = d["ti"] - slope * (d["te"] - ref)
+    return [
+        SeasonLevel(int(k), float(v.median()), len(v), ref)
+        for k, v in level.groupby(season)
+        if len(v) >= MIN_HEAT_DAYS
+    ]
+
+
+def level_stretch(
+    levels: list[SeasonLevel], start: pd.Timestamp, end: pd.Timestamp
+) -> tuple[pd.Timestamp, pd.Timestamp, list[str]]:
+    """The most recent stretch of ``[start, end)`` [UTC] whose heating seasons keep one
+    heating level (no two seasons in a row apart by :data:`LEVEL_SHIFT_K` or more: a
+    set-point is moved between winters), long enough for 12
+    months and :data:`~heritage_bayes.init_periods.VALIDATION_MONTHS` after them; a
+    stretch begins on the 1st of July before its first season. Returns ``(start, end,
+    notes)``; the whole span (and no notes) when the level never moved, with a note when
+    it moved and no steady stretch is long enough.
+    """
+    if len(levels) < 2:
+        return start, end, []
+    runs = []  # [first, last] seasons, newest first
+    run = [levels[-1]]
+    for lv in levels[-2::-1]:
+        if abs(lv.level - run[-1].level) >= LEVEL_SHIFT_K:
+            runs.append(run)
+            run = []
+        run.append(lv)
+    runs.append(run)
+    if len(runs) == 1:
+        return start, end, []
+    notes = [
+        "heating level by season (the indoor daily mean on heated days at an outdoor "
+        f"daily mean of {levels[0].ref:.1f} °C): "
+        + "; ".join(f"{lv.name()} {lv.level:.1f} °C" for lv in levels)
+    ]
+    moves = ", ".join(
+        f"{a[0].name()} to {b[-1].name()}" for a, b in zip(runs[1:], runs[:-1], strict=True)
+    )
+    need = pd.DateOffset(years=1, months=VALIDATION_MONTHS)
+    for k, run in enumerate(runs):
+        s = (
+            start
+            if k == len(runs) - 1
+            else pd.Timestamp(year=run[-1].season, month=7, day=1, tz=start.tz)
+        )
+        e = end if k == 0 else pd.Timestamp(year=run[0].season + 1, month=7, day=1, tz=start.tz)
+        s, e = max(s, start), min(e, end)
+        if s + need <= e:
+            notes.append(
+                f"the heating level moved by {LEVEL_SHIFT_K:.1f} K or more between seasons "
+                f"({moves}; the model has one set-point): the periods are in "
+                f"{s:%Y-%m-%d} to {e:%Y-%m-%d}, the most recent stretch of heating seasons "
+                "at one level"
+            )
+            return s, e, notes
+    notes.append(
+        f"the heating level moved by {LEVEL_SHIFT_K:.1f} K or more between seasons "
+        f"({moves}), and no stretch at one level holds 12 months and {VALIDATION_MONTHS} "
+        "after them: the periods span the move"
     )
     return start, end, notes

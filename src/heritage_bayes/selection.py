@@ -44,10 +44,14 @@ from heritage_bayes.models import AUTO, AUTO_LADDERS, auto_rungs, rung_label
 
 __all__ = [
     "MARGIN_FIT",
+    "NEGLIGIBLE_ELPD",
+    "PARETO_K_MAX",
     "Screen",
     "choose",
     "chosen_section",
+    "decide",
     "row_score",
+    "rule_text",
     "screen",
     "screen_maps",
 ]
@@ -83,8 +87,9 @@ def choose(rows: Sequence[Mapping], margin: float = MARGIN_FIT) -> dict:
     -------
     dict
         ``choice`` (label), ``score`` (what was compared), ``reason`` (a sentence),
-        ``best`` (the best-scoring label), ``runner_up`` (the best other rung within
-        ``margin`` of the choice, or None) and ``margin``.
+        ``best`` (the best-scoring label), ``tied`` (the other rungs within ``margin``
+        of the best, best first), ``runner_up`` (the first of them, or None),
+        ``scores`` and ``n_params`` (label -> value, the rungs scored) and ``margin``.
 
     Raises
     ------
@@ -119,16 +124,178 @@ def choose(rows: Sequence[Mapping], margin: float = MARGIN_FIT) -> dict:
             f"{best[1].get('n_params')}): a richer model must beat it by more than "
             f"{margin:g} points"
         )
-    rivals = [t for t in ok if t is not pick]
-    runner = max(rivals, key=lambda t: t[2])[1]["model"] if rivals else None
+    rivals = sorted((t for t in ok if t is not pick), key=lambda t: -t[2])
     return {
         "choice": name,
         "score": what,
         "reason": reason,
         "best": best[1]["model"],
-        "runner_up": runner,
+        "runner_up": rivals[0][1]["model"] if rivals else None,
+        "tied": [t[1]["model"] for t in rivals],
+        "scores": {t[1]["model"]: t[2] for t in scored},
+        "n_params": {t[1]["model"]: int(t[1].get("n_params", 0)) for t in scored},
         "margin": margin,
     }
+
+
+#: [nats] ELPD differences smaller than this are negligible whatever their SE (two
+#: nearly identical models have a tiny SE of their difference); Sivula et al. (2020).
+NEGLIGIBLE_ELPD = 4.0
+#: Pareto k above which a PSIS-LOO estimate is not reliable (Vehtari et al. 2024).
+PARETO_K_MAX = 0.7
+
+
+def rule_text(score: str = "validation FIT", margin: float = MARGIN_FIT) -> str:
+    """The selection rule in words, as the run, the report and the comparison state it."""
+    return (
+        f"each model's MAP scored by the {score} of its simulation; the simplest within "
+        f"{margin:g} points of the best is chosen, and the others within {margin:g} points "
+        "of the best tie with it. `hbayes compare` samples the choice and its best tied "
+        "rival: their ELPD breaks the tie only when it is reliable (both chains converged; "
+        f"for a blocked LOO, Pareto k at most {PARETO_K_MAX:g}) and the rival is ahead by "
+        f"more than 2 SE and {NEGLIGIBLE_ELPD:g} nats; otherwise the screen's choice stands"
+    )
+
+
+def decide(
+    rows: Sequence[Mapping],
+    posteriors: Mapping[str, Mapping] | None = None,
+    *,
+    score: str = "validation ELPD",
+    margin: float = MARGIN_FIT,
+) -> dict:
+    """The one selection rule of ``model: auto`` and ``hbayes compare``.
+
+    First the screen (:func:`choose`): the simplest rung within ``margin`` FIT points of
+    the best; the other rungs within the margin tie with it. Then, given posteriors of
+    sampled candidates (``hbayes compare``), the ELPD may break a tie: a tied rival is
+    taken when its ELPD beats the screen's choice by more than 2 SE of the difference
+    and :data:`NEGLIGIBLE_ELPD`, and only when that is reliable (both chains converged;
+    with ``score`` a blocked LOO, Pareto k at most :data:`PARETO_K_MAX`). Outside a tie
+    the screen decides: a FIT difference beyond the margin is a difference of the
+    simulation the report and projections use, where the ELPD scores each hour predicted
+    from the previous hour's residual (the noise model); where the ELPD ranks a candidate
+    outside the tie above the recommendation, the record says so.
+
+    Parameters
+    ----------
+    rows : sequence of dict
+        The screen's ladder rows (:func:`choose`).
+    posteriors : mapping label -> dict, optional
+        Per sampled candidate: ``elpd`` [nats], ``se`` (label -> SE of the pointwise
+        difference to that candidate [nats]), ``converged`` (bool) and ``max_pareto_k``
+        (of its blocked LOO, or None). None: the screen alone (``model: auto``).
+    score : str
+        The ELPD's name in the sentences: ``"validation ELPD"`` or ``"blocked LOO
+        ELPD"`` (whose Pareto k counts).
+    margin : float
+        :data:`MARGIN_FIT`.
+
+    Returns
+    -------
+    dict
+        :func:`choose`'s keys, and ``model`` (the recommendation), ``decided_by``
+        (``"screen"`` or ``"ELPD"``), ``tie`` (a sentence on the tie, or None) and
+        ``posterior`` (None, or the ELPD stage: ``verdict``, ``reason``, ``rivals``,
+        ``notes``).
+    """
+    sel = choose(rows, margin)
+    out = {**sel, "model": sel["choice"], "decided_by": "screen", "posterior": None, "tie": None}
+    if sel["tied"]:
+        out["tie"] = (
+            f"{', '.join(sel['tied'])} {'ties' if len(sel['tied']) == 1 else 'tie'} with it "
+            f"(within {margin:g} points of the best): `hbayes compare` samples it and "
+            f"{sel['runner_up']} and lets their ELPD break the tie where it is reliable"
+        )
+    if posteriors is not None:
+        out["posterior"] = stage = _elpd_stage(sel, posteriors, score)
+        out["model"], out["decided_by"] = stage.pop("model"), stage.pop("decided_by")
+    return out
+
+
+def _elpd_stage(sel: Mapping, post: Mapping[str, Mapping], score: str) -> dict:
+    """:func:`decide`'s second step: the ELPD of the sampled candidates on the screen's
+    tie (``sel``: :func:`choose`'s result)."""
+    c, n, fit = sel["choice"], sel["n_params"], sel["scores"]
+    elpd = {m: float(p["elpd"]) for m, p in post.items()}
+
+    def se(a: str, b: str) -> float:
+        v = (post[a].get("se") or {}).get(b)
+        v = (post[b].get("se") or {}).get(a) if v is None else v
+        return float(v) if v is not None and math.isfinite(v) else 0.0
+
+    def beats(a: str, b: str) -> bool:
+        return elpd[a] - elpd[b] > max(2.0 * se(a, b), NEGLIGIBLE_ELPD)
+
+    def diff(a: str, b: str) -> str:
+        return f"{elpd[a] - elpd[b]:+.1f} ± {se(a, b):.1f} nats"
+
+    def unreliable(m: str) -> list[str]:
+        why = [] if post[m].get("converged") is True else [f"{m}'s chain did not converge"]
+        k = post[m].get("max_pareto_k")
+        if "LOO" in score and k is not None and k > PARETO_K_MAX:
+            why.append(f"{m}'s Pareto k {k:.2f} > {PARETO_K_MAX:g}")
+        return why
+
+    def on_screen(m: str) -> str:
+        return f"MAP {sel['score']} {fit[m]:.1f} against {fit[c]:.1f} %"
+
+    stage: dict = {"model": c, "decided_by": "screen", "score": score, "notes": []}
+    if c not in post:
+        return stage | {"verdict": "not sampled", "rivals": [], "reason": f"{c} not sampled"}
+    rivals = [m for m in sel["tied"] if m in post]
+    stage["rivals"] = rivals
+    ahead = [m for m in rivals if beats(m, c)]
+    if not rivals:
+        stage["verdict"] = "no tie"
+        stage["reason"] = f"no sampled rival ties with {c} on the screen: the screen decides"
+    elif not ahead:
+        stage["verdict"] = "not separated"
+        stage["reason"] = "; ".join(
+            f"{m} ties with {c} on the screen ({on_screen(m)}) and its {score} "
+            + (
+                f"is lower ({diff(m, c)})"
+                if beats(c, m)
+                else f"does not separate them ({diff(m, c)}, within 2 SE or "
+                f"{NEGLIGIBLE_ELPD:g} nats)"
+            )
+            for m in rivals
+        ) + f": the simpler {c} stands"
+    else:
+        top = max(ahead, key=elpd.__getitem__)
+        pick = min((m for m in ahead if not beats(top, m)), key=lambda m: (n.get(m, 0), -elpd[m]))
+        head = (
+            f"{pick} ties with {c} on the screen ({on_screen(pick)}) and its {score} is "
+            f"higher ({diff(pick, c)}: more than 2 SE and {NEGLIGIBLE_ELPD:g} nats)"
+        )
+        why = unreliable(c) + unreliable(pick)
+        if why:
+            stage["verdict"] = "not reliable"
+            stage["reason"] = (
+                f"{head}, but that is not reliable ({'; '.join(why)}): the screen's choice "
+                f"{c} stands, as `model: auto` chooses; longer chains (sampler.max_time) "
+                "let the ELPD decide"
+            )
+        else:
+            stage.update(model=pick, decided_by="ELPD", verdict="ELPD breaks the tie")
+            stage["reason"] = (
+                f"{head}, and reliable (both chains converged"
+                + (f", Pareto k at most {PARETO_K_MAX:g}" if "LOO" in score else "")
+                + f"): the ELPD breaks the tie, so {pick}, where `model: auto` (the "
+                f"screen alone) samples {c}"
+            )
+    rec = stage["model"]
+    best_fit = max(fit.values())
+    for m in post:
+        if m != rec and m not in rivals and m != c and beats(m, rec):
+            stage["notes"].append(
+                f"the {score} ranks {m} above {rec} ({diff(m, rec)}), but its MAP "
+                f"{sel['score']} is {best_fit - fit.get(m, math.nan):.1f} points below the "
+                f"best, outside the {sel['margin']:g}-point tie: the fit of the simulation, "
+                f"which the report and projections use, decides there; the {score} scores "
+                "each hour predicted from the previous hour's residual (the noise model)"
+            )
+    return stage
 
 
 @dataclass
@@ -145,11 +312,10 @@ class Screen:
     options: dict = field(default_factory=dict)  # label -> (catalogue name, own options)
 
     def record(self) -> dict:
-        """The JSON record: ``rule``, ``rows`` and the choice (summary.json, comparison)."""
+        """The JSON record: ``rule``, ``rows`` and the decision (:func:`decide`: the
+        choice, why, the tie) as summary.json's ``selection`` holds it."""
         return {
-            "rule": f"the simplest model whose {self.choice['score']} is within "
-            f"{self.choice['margin']:g} points of the best (MAP of each rung; a richer "
-            f"model must beat a simpler one by more than {self.choice['margin']:g} points)",
+            "rule": rule_text(self.choice["score"], self.choice["margin"]),
             "rows": self.rows,
             **self.choice,
         }
@@ -164,6 +330,7 @@ def screen(
     deadline: float | None = None,
     say: Callable[[str], None] | None = None,
     margin: float = MARGIN_FIT,
+    guarded: bool = True,
 ) -> Screen:
     """MAP of every rung of the section's ladder, its validation score and the choice.
 
@@ -183,6 +350,8 @@ def screen(
         Progress lines.
     margin : float
         :data:`MARGIN_FIT`.
+    guarded : bool
+        :func:`screen_maps`'s restart guard (default on).
     """
     say = say or (lambda msg: None)
     sec = getattr(cfg, section)
@@ -203,12 +372,13 @@ def screen(
         optimizer=cfg.optimizer,
         deadline=deadline,
         say=lambda msg: say(f"[{section}] {msg}"),
+        guarded=guarded,
     )
     out = Screen(section, rows, {})
     for label, (model, lp, mp) in found.items():
         out.models[label], out.logposts[label], out.maps[label] = model, lp, mp
         out.options[label] = own[label]
-    out.choice = choose([r for r in out.rows if "error" not in r], margin)
+    out.choice = decide([r for r in out.rows if "error" not in r], margin=margin)
     for r in out.rows:
         r["chosen"] = r["sampled"] = r["model"] == out.choice["choice"]
     say(f"[{section}] chosen: {out.choice['choice']}: {out.choice['reason']}")
@@ -223,6 +393,7 @@ def screen_maps(
     optimizer,
     deadline: float | None = None,
     say: Callable[[str], None] | None = None,
+    guarded: bool = True,
 ) -> tuple[list[dict], dict]:
     """The MAP screen's loop, shared by ``model: auto`` (:func:`screen`) and ``hbayes
     compare``: each rung's MAP and its ladder row, in turn.
@@ -233,8 +404,9 @@ def screen_maps(
         ``build()`` returns (prepared data, model, log-posterior) of the rung; ``parent``
         is the label of its nested simpler rung (or None), whose MAP, when found
         before, is carried over as one start of the search (:func:`carried_start`).
-        One global search per rung (no restarts): the carried start puts the richer
-        rung's search where the simpler one ended.
+        One global search per rung: the carried start puts the richer rung's search
+        where the simpler one ended; where the polished starts end more than
+        :data:`SPREAD_LOGPOST` apart, :func:`restart_guard` runs more searches.
     section : {"thermal", "hygric"}
     seed : int
         Seed of every rung's MAP search.
@@ -245,6 +417,8 @@ def screen_maps(
         (recorded as such); the first rung always runs.
     say : callable, optional
         A progress line per rung.
+    guarded : bool
+        Apply :func:`restart_guard` (default; False measures what it changes).
 
     Returns
     -------
@@ -273,17 +447,20 @@ def screen_maps(
             start = None
             if parent in found:
                 start = carried_start(lp, found[parent][1], found[parent][2])
-            mp = find_map(
-                lp,
-                seed=seed,
+            search = dict(
                 method=optimizer.method,
                 popsize=optimizer.popsize,
                 maxiter=optimizer.maxiter,
                 starts=optimizer.starts,
                 deadline=deadline if k > 1 else None,
-                start=start,
             )
+            mp = find_map(lp, seed=seed, start=start, **search)
+            mp, guard = restart_guard(lp, mp, seed=seed, search=search) if guarded else (mp, None)
+            if guard is not None:
+                say(f"screen {k}/{n}: {label}: {guard['said']}")
             row = ladder_row(prep, section, model, lp, mp, label=label)
+            if guard is not None:
+                row["map_guard"] = guard
         except BudgetError:
             rows.append({**head, "error": "not screened: the time budget ran out"})
             continue
@@ -301,6 +478,58 @@ def screen_maps(
             f"({row['map_seconds']:.0f} s)"
         )
     return rows, found
+
+
+#: [log-posterior units] polished starts of one search ending further apart than this
+#: found separate optima (one holds e^-10 of the other's mass if as wide: the optimizer's
+#: ``MODE_WINDOW``): the search is repeated from other seeds (:func:`restart_guard`).
+SPREAD_LOGPOST = 10.0
+#: Global searches the guard adds (seeds ``[seed, 1]``, ``[seed, 2]``, ...).
+GUARD_SEARCHES = 2
+
+
+def restart_guard(lp, mp, *, seed: int, search: Mapping) -> tuple:
+    """A guard against a local optimum: where the polished starts of a rung's search
+    (its population's best points and the carried start) end more than
+    :data:`SPREAD_LOGPOST` apart, the log-posterior has several optima within reach, so
+    :data:`GUARD_SEARCHES` more global searches from other seeds run and the highest
+    optimum is kept when it beats the first by more than the optimizer's ``MODE_PICK``.
+
+    Returns
+    -------
+    (MAPResult, dict or None)
+        The MAP kept and, when the guard ran, its record: ``spread`` of the first
+        search's starts, the ``log_posteriors`` of the searches (the first first),
+        ``moved`` (the MAP kept is another search's) and ``said``, a sentence.
+    """
+    from heritage_bayes.inference.optimize import MODE_PICK, BudgetError, find_map
+
+    cands = [c for c in mp.candidates if math.isfinite(c)]
+    spread = max(cands) - min(cands) if cands else 0.0
+    if spread <= SPREAD_LOGPOST:
+        return mp, None
+    found = [mp]
+    for j in range(1, GUARD_SEARCHES + 1):
+        try:
+            found.append(find_map(lp, seed=[seed, j], **search))
+        except BudgetError:
+            break
+    best = max(found, key=lambda r: r.log_post)
+    keep = best if best.log_post > mp.log_post + MODE_PICK else mp
+    lps = [float(r.log_post) for r in found]
+    said = (
+        f"its {len(cands)} MAP starts ended {spread:.0f} log-posterior units apart "
+        f"(several optima): {len(found) - 1} more searches from other seeds reached "
+        + ", ".join(f"{v:.1f}" for v in lps[1:])
+        + f" against {lps[0]:.1f}; "
+        + ("the higher optimum is kept" if keep is not mp else "the first optimum stands")
+    )
+    return keep, {
+        "spread": spread,
+        "log_posteriors": lps,
+        "moved": keep is not mp,
+        "said": said,
+    }
 
 
 def unit_point(logpost, values: dict[str, float]) -> np.ndarray:

@@ -6,7 +6,6 @@ end on a small demo problem."""
 from __future__ import annotations
 
 import json
-import math
 
 import pytest
 import yaml
@@ -276,3 +275,66 @@ def test_ctrl_c_in_the_auto_screen_stops_the_run_at_once(tmp_path):
     assert "[thermal] screen 1/3: thermal_1c" in err and "screen 2/3" not in err, err
     assert "chosen:" not in err and "emcee" not in err and _clean(err), err
     assert snapshot(work) == before, sorted(work.rglob("*"))
+
+
+def test_model_auto_and_compare_screen_alike_and_choose_alike(tmp_path):
+    """The same config screened by ``model: auto`` and by ``hbayes compare`` (its
+    candidates, the same ladder): the same rows scored alike and the same choice; with
+    posteriors that do not reliably break the tie, compare's recommendation is that
+    choice."""
+    from heritage_bayes.compare.orchestrate import _candidate_config
+    from heritage_bayes.compare.screen import screen_candidates
+    from heritage_bayes.config import load_config
+    from heritage_bayes.models import AUTO_LADDERS
+    from heritage_bayes.prepare import prepare
+    from heritage_bayes.selection import screen
+
+    raw = {**AUTO, "hygric": None, "optimizer": {"maxiter": 10, "starts": 1, "popsize": 4}}
+    p = tmp_path / "auto.yaml"
+    p.write_text(yaml.safe_dump(raw), encoding="utf-8")
+    cfg = load_config(p)
+    auto = screen(cfg, prepare(cfg), "thermal", seed=cfg.seed)
+    names = [n for n, _, _ in AUTO_LADDERS["thermal"]]
+    cands = {n: _candidate_config(cfg, "thermal", n) for n in names}
+    rows, _, scores = screen_candidates(cands, "thermal", tell=lambda m: None)
+    assert [r["model"] for r in auto.rows] == names
+    for r in auto.rows:
+        assert scores[r["model"]] == pytest.approx(r["score"], abs=1e-6), r["model"]
+    sel = choose(list(rows.values()))
+    assert sel["choice"] == auto.choice["choice"] and sel["tied"] == auto.choice["tied"]
+    # posteriors that cannot overturn it (the rival unconverged): the same model
+    post = {m: {"elpd": 0.0, "converged": False, "max_pareto_k": 0.2} for m in names}
+    post[sel["choice"]]["converged"] = True
+    assert decide(list(rows.values()), post)["model"] == auto.choice["model"]
+
+
+def test_the_restart_guard_runs_only_where_the_starts_disagree(monkeypatch):
+    """Starts within 10 log-posterior units (the carried start left out): no more
+    searches; further apart: two more from other seeds, a higher optimum kept only when
+    it beats the first by more than the optimizer's MODE_PICK, and said in words."""
+    import heritage_bayes.inference.optimize as opt
+    from heritage_bayes.selection import GUARD_SEARCHES, SPREAD_LOGPOST, restart_guard
+
+    def result(lp, cands, carried=None):
+        return opt.MAPResult(
+            x=None, theta=None, log_post=lp, n_starts=len(cands), n_agreed=1,
+            candidates=cands, carried=carried,
+        )  # fmt: skip
+
+    seeds = []
+    later = iter([-990.0, -1001.0])
+
+    def fake(lp, *, seed, **kw):
+        seeds.append(seed)
+        return result(next(later), [-990.0])
+
+    monkeypatch.setattr(opt, "find_map", fake)
+    # the carried start stayed on the simpler optimum 250 units lower: no guard
+    mp = result(-1000.0, [-1000.0, -1001.0, -1250.0], carried=-1250.0)
+    assert restart_guard(None, mp, seed=4, search={}) == (mp, None) and not seeds
+    # the search's own starts 12 units apart: two more searches; the first beaten by 10
+    mp = result(-1000.0, [-1000.0, -1000.0 - SPREAD_LOGPOST - 2.0])
+    kept, g = restart_guard(None, mp, seed=4, search={})
+    assert seeds == [[4, k] for k in range(1, GUARD_SEARCHES + 1)]
+    assert kept.log_post == -990.0 and g["moved"] and g["spread"] == pytest.approx(12.0)
+    assert g["said"].endswith("reached -990.0, -1001.0 against -1000.0; the higher optimum is kept")

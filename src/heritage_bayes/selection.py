@@ -251,16 +251,19 @@ def _elpd_stage(sel: Mapping, post: Mapping[str, Mapping], score: str) -> dict:
         stage["reason"] = f"no sampled rival ties with {c} on the screen: the screen decides"
     elif not ahead:
         stage["verdict"] = "not separated"
-        stage["reason"] = "; ".join(
-            f"{m} ties with {c} on the screen ({on_screen(m)}) and its {score} "
-            + (
-                f"is lower ({diff(m, c)})"
-                if beats(c, m)
-                else f"does not separate them ({diff(m, c)}, within 2 SE or "
-                f"{NEGLIGIBLE_ELPD:g} nats)"
+        stage["reason"] = (
+            "; ".join(
+                f"{m} ties with {c} on the screen ({on_screen(m)}) and its {score} "
+                + (
+                    f"is lower ({diff(m, c)})"
+                    if beats(c, m)
+                    else f"does not separate them ({diff(m, c)}, within 2 SE or "
+                    f"{NEGLIGIBLE_ELPD:g} nats)"
+                )
+                for m in rivals
             )
-            for m in rivals
-        ) + f": the simpler {c} stands"
+            + f": the simpler {c} stands"
+        )
     else:
         top = max(ahead, key=elpd.__getitem__)
         pick = min((m for m in ahead if not beats(top, m)), key=lambda m: (n.get(m, 0), -elpd[m]))
@@ -490,7 +493,8 @@ GUARD_SEARCHES = 2
 
 def restart_guard(lp, mp, *, seed: int, search: Mapping) -> tuple:
     """A guard against a local optimum: where the polished starts of a rung's search
-    (its population's best points and the carried start) end more than
+    (its population's best points; not the carried start, which often stays on the
+    simpler rung's optimum, a saddle of the richer one) end more than
     :data:`SPREAD_LOGPOST` apart, the log-posterior has several optima within reach, so
     :data:`GUARD_SEARCHES` more global searches from other seeds run and the highest
     optimum is kept when it beats the first by more than the optimizer's ``MODE_PICK``.
@@ -505,6 +509,9 @@ def restart_guard(lp, mp, *, seed: int, search: Mapping) -> tuple:
     from heritage_bayes.inference.optimize import MODE_PICK, BudgetError, find_map
 
     cands = [c for c in mp.candidates if math.isfinite(c)]
+    carried = getattr(mp, "carried", None)
+    if carried is not None and cands:  # the carried start may rest on the simpler optimum
+        cands.remove(min(cands, key=lambda c: abs(c - carried)))
     spread = max(cands) - min(cands) if cands else 0.0
     if spread <= SPREAD_LOGPOST:
         return mp, None
@@ -518,7 +525,7 @@ def restart_guard(lp, mp, *, seed: int, search: Mapping) -> tuple:
     keep = best if best.log_post > mp.log_post + MODE_PICK else mp
     lps = [float(r.log_post) for r in found]
     said = (
-        f"its {len(cands)} MAP starts ended {spread:.0f} log-posterior units apart "
+        f"{len(cands)} starts of its MAP search ended {spread:.0f} log-posterior units apart "
         f"(several optima): {len(found) - 1} more searches from other seeds reached "
         + ", ".join(f"{v:.1f}" for v in lps[1:])
         + f" against {lps[0]:.1f}; "

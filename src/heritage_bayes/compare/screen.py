@@ -29,9 +29,7 @@ def to_sample(sel: Mapping) -> dict[str, str | None]:
     other candidate scored (a comparison needs two posteriors). Candidates not scored:
     screened out."""
     c, fit, tied = sel["choice"], sel["scores"], sel["tied"]
-    second = sel["runner_up"] or max(
-        (m for m in fit if m != c), key=fit.__getitem__, default=None
-    )
+    second = sel["runner_up"] or max((m for m in fit if m != c), key=fit.__getitem__, default=None)
     best = max(fit.values())
     out: dict[str, str | None] = {}
     for m, s in fit.items():

@@ -159,6 +159,9 @@ class MAPResult:
     n_evaluations : int
     unit : (d,) array, optional
         The MAP's free parameters in the unit cube of the search.
+    carried : float, optional
+        Final objective of the polished carried start (``start``), when it was polished
+        as a start of its own.
     restarts : int
         Global searches run (the first and its restarts).
     modes : list of dict
@@ -178,6 +181,7 @@ class MAPResult:
     unit: np.ndarray | None = None
     restarts: int = 1
     modes: list[dict] = field(default_factory=list)
+    carried: float | None = None
 
     def to_dict(self, names) -> dict:
         out = {
@@ -416,6 +420,7 @@ def _search(logpost, obj, seed, method, popsize, maxiter, starts, start=None) ->
         raise ValueError(
             f"optimizer.method must be 'differential_evolution' or 'multistart' (got {method!r})"
         )
+    carried = len(cands) - 1 if x0 is not None and cands[-1] is x0 else None
     finals = []
     for s0 in cands:
         r = minimize(
@@ -427,6 +432,7 @@ def _search(logpost, obj, seed, method, popsize, maxiter, starts, start=None) ->
             options={"maxiter": 500, "ftol": 1e-12, "gtol": 1e-8},
         )
         finals.append((float(r.fun), np.clip(r.x, _EPS, 1 - _EPS)))
+    carried_lp = None if carried is None else -finals[carried][0]
     finals.sort(key=lambda t: t[0])
     best_f, best_s = finals[0]
     agreed = sum(1 for f, _ in finals if f - best_f <= 1.0)
@@ -442,6 +448,7 @@ def _search(logpost, obj, seed, method, popsize, maxiter, starts, start=None) ->
         n_evaluations=obj.n,
         method=method,
         unit=best_s,
+        carried=carried_lp,
     )
 
 

@@ -262,7 +262,8 @@ def test_recommendation_words():
     assert rec["reason"].startswith("`thermal_1c`: the screen's choice, as `model: auto` chooses")
     assert "not reliable (thermal_4a's chain did not converge)" in rec["reason"]
     assert "All its time constants are identified." in rec["reason"]
-    assert "provisional: `thermal_4a`" in rec["reason"]
+    assert "so its figures are provisional: `thermal_4a`" in rec["reason"]
+    assert rec["provisional"]  # longer chains may change it
     models["thermal_4a"]["converged"] = True
     rec = recommend(decide(rows, post(models)), models, "elpd_validation")
     assert rec["model"] == "thermal_4a" and rec["decided_by"] == "ELPD"
@@ -272,6 +273,7 @@ def test_recommendation_words():
     )
     assert "Not all its time constants are identified (τ₂)" in rec["reason"]
     assert "tau_" not in rec["reason"] and "provisional" not in rec["reason"]
+    assert not rec["provisional"]
     models["thermal_1c"] = model(7, 0.0, below=["tau_2_h"])
     models["thermal_4a"]["accuracy"]["elpd_validation"]["elpd"] = 1.0
     rec = recommend(decide(rows, post(models)), models, "elpd_validation")

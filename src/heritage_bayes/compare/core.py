@@ -279,7 +279,7 @@ def recommend(sel: dict, models: dict, score: str) -> dict:
     unconverged = [m for m, info in models.items() if info.get("converged") is False]
     if unconverged:
         names = ", ".join(f"`{m}`" for m in unconverged)
-        text += f" Not converged (R-hat/ESS/τ criteria), so provisional: {names}."
+        text += f" Not converged (R-hat/ESS/τ criteria), so its figures are provisional: {names}."
     return {
         "model": rec,
         "reason": text,
@@ -288,4 +288,7 @@ def recommend(sel: dict, models: dict, score: str) -> dict:
         "agrees_with_screen": rec == sel["choice"],
         "best_accuracy": max(models, key=lambda m: models[m]["accuracy"][score]["elpd"]),
         "not_converged": unconverged,
+        # the decision may change with longer chains: the rival's ELPD was not reliable,
+        # or the model recommended did not converge
+        "provisional": stage.get("verdict") == "not reliable" or rec in unconverged,
     }

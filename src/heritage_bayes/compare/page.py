@@ -220,7 +220,7 @@ def render_comparison(result: dict) -> str:
 
     rec = result["recommendation"]
     s = result["settings"]
-    level = "amber" if rec.get("not_converged") else "green"  # provisional: amber
+    level = "amber" if rec.get("provisional") else "green"
     by = {"ELPD": "the posteriors' ELPD breaks the screen's tie", "screen": "the screen"}
     lead = (
         f"<div class='verdict {level}'><strong>Recommended: <code>"

@@ -248,7 +248,13 @@ def _elpd_stage(sel: Mapping, post: Mapping[str, Mapping], score: str) -> dict:
     ahead = [m for m in rivals if beats(m, c)]
     if not rivals:
         stage["verdict"] = "no tie"
-        stage["reason"] = f"no sampled rival ties with {c} on the screen: the screen decides"
+        stage["reason"] = f"no sampled rival ties with {c} on the screen, so the screen decides" + (
+            " ("
+            + "; ".join(f"{score} of {m}: {diff(m, c)} against it" for m in post if m != c)
+            + ")"
+            if len(post) > 1
+            else ""
+        )
     elif not ahead:
         stage["verdict"] = "not separated"
         stage["reason"] = (

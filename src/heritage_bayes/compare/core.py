@@ -258,7 +258,8 @@ def recommend(sel: dict, models: dict, score: str) -> dict:
         head = f"the ELPD breaks the screen's tie; the screen chose {sel['choice']}"
     else:
         head = "the screen's choice, as `model: auto` chooses"
-    text = f"`{rec}`: {head} ({sel['reason']}). {stage.get('reason', '')}."
+    why = stage.get("reason", "")
+    text = f"`{rec}`: {head} ({sel['reason']}). {why[:1].upper()}{why[1:]}."
     text += "".join(f" {n[0].upper()}{n[1:]}." for n in stage.get("notes", []))
     ident = models[rec]["identifiability"] if rec in models else None
     if ident is not None and ident["time_constants_identified"]:

@@ -23,7 +23,7 @@ from heritage_bayes.compare.scores import (
 from heritage_bayes.errors import InputError
 from heritage_bayes.format import quantity_name
 from heritage_bayes.rc.catalog import DomainView, model_ladder
-from heritage_bayes.selection import NEGLIGIBLE_ELPD, decide, rule_text
+from heritage_bayes.selection_rule import NEGLIGIBLE_ELPD, decide, rule_text
 
 __all__ = ["DEFAULT_MODELS", "NEGLIGIBLE_ELPD", "compare_runs", "recommend"]
 
@@ -44,7 +44,7 @@ def compare_runs(
 ) -> dict:
     """Compare calibrated runs of one section on accuracy and identifiability, and
     recommend one by the selection rule of ``model: auto``
-    (:func:`heritage_bayes.selection.decide`): the screen's choice, unless the ELPD
+    (:func:`heritage_bayes.selection_rule.decide`): the screen's choice, unless the ELPD
     reliably breaks its tie.
 
     Parameters
@@ -72,7 +72,7 @@ def compare_runs(
     dict
         ``models`` (per label: accuracy, identifiability, convergence), ``loo_compare``
         (``az.compare`` on the blocked LOO), ``selection`` (the rule's record:
-        :func:`heritage_bayes.selection.decide`), ``recommendation`` and the settings.
+        :func:`heritage_bayes.selection_rule.decide`), ``recommendation`` and the settings.
     """
     from heritage_bayes.run import load_run
 
@@ -251,7 +251,7 @@ def _pair_se(a: tuple, b: tuple, block_hours: float, score: str) -> float | None
 
 def recommend(sel: dict, models: dict, score: str) -> dict:
     """The comparison's recommendation: the selection rule's decision
-    (:func:`heritage_bayes.selection.decide`, ``sel``) in words, with the identifiability
+    (:func:`heritage_bayes.selection_rule.decide`, ``sel``) in words, with the identifiability
     of the model recommended and the candidates not converged."""
     rec, stage = sel["model"], sel["posterior"] or {}
     if sel["decided_by"] == "ELPD":

@@ -13,7 +13,7 @@ from heritage_bayes.compare.core import DEFAULT_MODELS, compare_runs
 from heritage_bayes.compare.page import write_comparison
 from heritage_bayes.compare.screen import screen_candidates, to_sample
 from heritage_bayes.errors import ConfigError
-from heritage_bayes.selection import choose, rule_text
+from heritage_bayes.selection_rule import choose, rule_text
 
 
 def _section_of(cfg, models: Sequence[str] | None) -> tuple[str, list[str]]:
@@ -241,12 +241,12 @@ def run_compare(
 
     First every candidate's MAP and its validation FIT
     (:mod:`heritage_bayes.compare.screen`: seconds each) and the choice of ``model:
-    auto``'s rule (:func:`heritage_bayes.selection.choose`); then the choice and its best
+    auto``'s rule (:func:`heritage_bayes.selection_rule.choose`); then the choice and its best
     tied rival (without a tie, the best other candidate:
     :func:`~heritage_bayes.compare.screen.to_sample`) are calibrated, each chain started
     at its screened MAP, compared by their posteriors (blocked LOO, validation ELPD),
     and one is recommended by the same rule, the ELPD breaking the screen's tie where it
-    is reliable (:func:`heritage_bayes.selection.decide`; ``comparison.json``:
+    is reliable (:func:`heritage_bayes.selection_rule.decide`; ``comparison.json``:
     ``selection``). The others are in ``comparison.json`` (``screened_out``,
     ``screen``) and the page with their MAP score and the reason. Ctrl-C or SIGTERM
     stops every worker at once (exit 130): no run written, the chains so far kept in

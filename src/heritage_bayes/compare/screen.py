@@ -6,8 +6,8 @@ prepared data), so the MAP found here starts its chain; the search is ``model: a
 (:func:`heritage_bayes.selection.screen_maps`, one loop for both): the MAP of a nested
 simpler candidate (:data:`heritage_bayes.models.AUTO_LADDERS`) carried over as one start
 of one global search, with the same restart guard. The score is the validation FIT of
-the simulation from the MAP (:func:`heritage_bayes.selection.row_score`), the choice
-that of ``model: auto`` (:func:`heritage_bayes.selection.choose`), and the candidates
+the simulation from the MAP (:func:`heritage_bayes.selection_rule.row_score`), the choice
+that of ``model: auto`` (:func:`heritage_bayes.selection_rule.choose`), and the candidates
 sampled those whose posteriors can change it (:func:`to_sample`).
 """
 
@@ -23,9 +23,9 @@ __all__ = ["screen_candidates", "to_sample"]
 
 def to_sample(sel: Mapping) -> dict[str, str | None]:
     """Candidate -> None when it is sampled, else why not, from the screen's choice
-    (:func:`heritage_bayes.selection.choose`, ``sel``): the choice and its best tied
+    (:func:`heritage_bayes.selection_rule.choose`, ``sel``): the choice and its best tied
     rival (the runner-up: the only one whose ELPD may overturn the choice,
-    :func:`heritage_bayes.selection.decide`); without a tie, the choice and the best
+    :func:`heritage_bayes.selection_rule.decide`); without a tie, the choice and the best
     other candidate scored (a comparison needs two posteriors). Candidates not scored:
     screened out."""
     c, fit, tied = sel["choice"], sel["scores"], sel["tied"]

@@ -114,7 +114,7 @@ def test_the_rule_without_posteriors_is_the_screen_and_names_the_tie():
             "but that is not reliable (thermal_4a's chain did not converge): the screen's "
             "choice thermal_1c stands",
         ),
-        # ahead by 3 SE but within 2 SE? no: 30 ± 20 is within 2 SE: not separated
+        # ahead by 30 ± 20 nats: within 2 SE, not separated
         (
             {"thermal_1c": _post(0.0), "thermal_4a": _post(30.0, se={"thermal_1c": 20.0})},
             "validation ELPD",

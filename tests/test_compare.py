@@ -21,14 +21,15 @@ from heritage_bayes.cli import main
 from heritage_bayes.compare import (
     _block_se,
     _practical_rank,
-    _recommend,
     blocked_loo_data,
     elpd_validation,
     load_inference,
+    recommend,
 )
 from heritage_bayes.config.sampler import SamplerSettings
 from heritage_bayes.inference.predictive import PREDICTIVE_DRAWS
 from heritage_bayes.report._browser import PHONE_OVERFLOW_JS, find_chromium, open_page
+from heritage_bayes.selection import choose, decide
 
 TINY = {
     "name": "tiny",
@@ -78,7 +79,15 @@ def test_the_screen_is_recorded(compared):
     for r in screen["rows"]:
         assert {"n_params", "fit", "score", "map_seconds"} <= set(r), r
         assert r["score"] == pytest.approx(r["fit"]["validation"]["Ti"]["FIT"])
-    assert "within 5 points of the best" in screen["rule"]
+    assert "the simplest within 2 points of the best is chosen" in screen["rule"]
+    # the same rule as model: auto: the screen's choice from the same rows, recorded
+    sel = res["selection"]
+    assert sel["choice"] == choose([r for r in screen["rows"] if "error" not in r])["choice"]
+    assert sel["rule"] == screen["rule"]
+    rec = res["recommendation"]
+    assert rec["screen_choice"] == sel["choice"] and rec["model"] == sel["model"]
+    if sel["decided_by"] == "screen":  # the ELPD did not (reliably) break a tie
+        assert rec["model"] == sel["choice"] and rec["agrees_with_screen"]
 
 
 def test_results_do_not_depend_on_where_a_candidate_ran(compared, cfg_path, tmp_path):
@@ -214,62 +223,61 @@ def test_comparison_json(compared):
     assert "Gw" not in res["models"]["thermal_1c"]["identifiability"]["parameters"]
     rec = res["recommendation"]
     assert rec["model"] in MODELS and rec["reason"].startswith(f"`{rec['model']}`:")
-    assert rec["best_accuracy"] in rec["equivalent"]
+    assert rec["best_accuracy"] in MODELS
     assert (out / "comparison.html").is_file()
 
 
-def test_recommendation_rule():
-    def model(n, diff, dse, taus_bad, params_bad=()):
+def test_recommendation_words():
+    """The comparison's sentence: the rule's decision (synthetic screen and posteriors),
+    the identifiability of the model recommended, the candidates not converged."""
+
+    def model(n, elpd, taus_bad=(), converged=True, below=()):
         return {
-            "accuracy": {"elpd_validation": {"diff_to_best": diff, "dse_to_best": dse}},
+            "converged": converged,
+            "accuracy": {"elpd_validation": {"elpd": elpd}},
             "identifiability": {
                 "n_free_physical": n,
                 "time_constants_identified": not taus_bad,
                 "time_constants_not_identified": list(taus_bad),
-                "time_constants_below_step": [],
-                "parameters_not_identified": list(params_bad),
-                "practical_rank": n - len(params_bad),
+                "time_constants_below_step": list(below),
             },
         }
 
-    models = {
-        "thermal_1c": model(7, -40.0, 8.0, []),
-        "thermal_2c": model(10, -3.0, 2.0, []),
-        "thermal_4a": model(13, 0.0, 0.0, ["tau_2_h"], ["Cint"]),
-    }
-    rec = _recommend(models, "elpd_validation")
-    assert rec["model"] == "thermal_2c"
-    assert "within 2 SE or 4 nats of `thermal_4a` (difference -3.0 ± 2.0)" in rec["reason"]
-    assert (
-        "`thermal_4a` is as accurate but its time constants are not identified: τ₂"
-        in (rec["reason"])
+    rows = [
+        {"model": m, "n_params": k, "fit": {"validation": {"Ti": {"FIT": f}}}}
+        for m, k, f in (("thermal_1c", 8, 82.8), ("thermal_4a", 14, 83.8))
+    ]
+    models = {"thermal_1c": model(7, 0.0), "thermal_4a": model(13, 176.2, ["tau_2_h"], False)}
+
+    def post(ms):
+        se = {"thermal_1c": {"thermal_4a": 20.2}, "thermal_4a": {"thermal_1c": 20.2}}
+        return {
+            m: {"elpd": i["accuracy"]["elpd_validation"]["elpd"], "converged": i["converged"],
+                "max_pareto_k": 0.3, "se": se[m]}
+            for m, i in ms.items()
+        }  # fmt: skip
+
+    rec = recommend(decide(rows, post(models)), models, "elpd_validation")
+    assert rec["model"] == "thermal_1c" and rec["agrees_with_screen"]
+    assert rec["reason"].startswith("`thermal_1c`: the screen's choice, as `model: auto` chooses")
+    assert "not reliable (thermal_4a's chain did not converge)" in rec["reason"]
+    assert "All its time constants are identified." in rec["reason"]
+    assert "so its figures are provisional: `thermal_4a`" in rec["reason"]
+    assert rec["provisional"]  # longer chains may change it
+    models["thermal_4a"]["converged"] = True
+    rec = recommend(decide(rows, post(models)), models, "elpd_validation")
+    assert rec["model"] == "thermal_4a" and rec["decided_by"] == "ELPD"
+    assert not rec["agrees_with_screen"] and rec["screen_choice"] == "thermal_1c"
+    assert rec["reason"].startswith(
+        "`thermal_4a`: the ELPD breaks the screen's tie; the screen chose thermal_1c"
     )
-    assert "`thermal_1c` is less accurate" in rec["reason"]
-    assert "Not converged" not in rec["reason"]
-    models["thermal_4a"]["converged"] = False
-    assert "provisional: `thermal_4a`" in _recommend(models, "elpd_validation")["reason"]
-    # 2c outside 2 SE: the accurate model is recommended, with its unidentified tau named
-    models["thermal_2c"] = model(10, -5.0, 2.0, [])
-    rec = _recommend(models, "elpd_validation")
-    assert rec["model"] == "thermal_4a" and "(τ₂; no candidate" in rec["reason"]
-    assert "tau_" not in rec["reason"]  # no code names in the sentence
-    # a negligible difference (< 4) counts as equal even with a tiny SE (1c == 2c)
-    models["thermal_2c"] = model(10, -0.8, 0.01, [])
-    assert _recommend(models, "elpd_validation")["model"] == "thermal_2c"
-    # the sentence agrees with the identifiability table: a time constant shorter than
-    # the step is said to be unidentified and why, and "as accurate" names how many of
-    # the larger model's parameters are identified (0 of 13 here)
-    models["thermal_2c"]["identifiability"]["time_constants_below_step"] = ["tau_2_h"]
-    models["thermal_4a"] = model(13, 0.0, 0.0, [], [f"p{i}" for i in range(13)])
-    rec = _recommend(models, "elpd_validation")
-    assert rec["model"] == "thermal_2c"
-    assert "all its time constants identified" not in rec["reason"]
-    assert "time constants longer than the time step identified (τ₂ shorter" in rec["reason"]
-    assert (
-        "`thermal_4a` is as accurate, its time constants identified, but has more"
-        in (rec["reason"])
-    )
-    assert "0 of its 13 parameters identified" in rec["reason"]
+    assert "Not all its time constants are identified (τ₂)" in rec["reason"]
+    assert "tau_" not in rec["reason"] and "provisional" not in rec["reason"]
+    assert not rec["provisional"]
+    models["thermal_1c"] = model(7, 0.0, below=["tau_2_h"])
+    models["thermal_4a"]["accuracy"]["elpd_validation"]["elpd"] = 1.0
+    rec = recommend(decide(rows, post(models)), models, "elpd_validation")
+    assert "time step are identified (τ₂ shorter than the step" in rec["reason"]
 
 
 def test_block_se_and_practical_rank():

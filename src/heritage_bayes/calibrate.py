@@ -473,11 +473,8 @@ def _select_models(cfg: CalibrationConfig, prep, say, end) -> tuple[CalibrationC
             say=say.say,
         )
         scr.choice["screen_seconds"] = time.perf_counter() - t0
-        if scr.choice.get("runner_up"):
-            say.say(
-                f"[{name}] {scr.choice['runner_up']} is within {scr.choice['margin']:g} points "
-                f"of it: `hbayes compare --models` weighs the two by their posteriors"
-            )
+        if scr.choice.get("tie"):
+            say.say(f"[{name}] {scr.choice['tie']}")
         cfg = chosen_section(cfg, name, scr)
         screens[name] = scr
     return cfg, screens

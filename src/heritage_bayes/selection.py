@@ -8,13 +8,18 @@ simulation from the MAP scored on the validation period by the paper's FIT [%]
 (Kramer, van Schijndel & Schellen 2013). A MAP costs seconds where a posterior costs
 minutes: only the model chosen is sampled.
 
-**The choice rule** (:func:`choose`): the score is the validation FIT of the section's
+**The choice rule** (:mod:`heritage_bayes.selection_rule`: :func:`choose`,
+:func:`decide`): the score is the validation FIT of the section's
 output (without a validation period, the calibration FIT after the warm-up). Among the
 rungs scored, the simplest (fewest free parameters, then ladder order) whose score is
 within :data:`MARGIN_FIT` points of the best is chosen: a richer model must beat a
-simpler one by more than the margin to be taken. A rung within the margin of the choice
-is its **runner-up** (a tie: the posteriors, ``hbayes compare --models A,B``, weigh them
-by ELPD).
+simpler one by more than the margin to be taken. The other rungs within the margin of
+the best **tie** with the choice. ``hbayes compare`` uses the same screen and choice, then
+samples the choice and its best tied rival (the runner-up), and the ELPD of the two
+posteriors breaks the tie only when it is reliable (:func:`decide`): one rule, so the two
+commands recommend the same model unless reliable posteriors break the screen's tie, and
+then both say so. A rung whose polished MAP starts end far apart gets more global
+searches (:func:`restart_guard`).
 
 Why FIT on validation and not an information criterion at the MAP: the hourly residuals
 are strongly correlated and the likelihood is tempered, so AIC/BIC count nearly
@@ -41,94 +46,33 @@ import numpy as np
 from heritage_bayes.errors import ConfigError, InputError
 from heritage_bayes.ladder import ladder_row, rung_log_posterior
 from heritage_bayes.models import AUTO, AUTO_LADDERS, auto_rungs, rung_label
+from heritage_bayes.selection_rule import (
+    MARGIN_FIT,
+    NEGLIGIBLE_ELPD,
+    PARETO_K_MAX,
+    choose,
+    decide,
+    row_score,
+    rule_text,
+)
 
 __all__ = [
     "MARGIN_FIT",
+    "NEGLIGIBLE_ELPD",
+    "PARETO_K_MAX",
     "Screen",
     "choose",
     "chosen_section",
+    "decide",
     "row_score",
+    "rule_text",
     "screen",
     "screen_maps",
 ]
 
-#: [percentage points of validation FIT] a richer rung must beat a simpler one by more
-#: than this to be chosen; rungs within it of the choice tie with it.
-MARGIN_FIT = 2.0
-
 #: A parameter of a simpler rung whose value starts a richer rung's one of another name:
 #: one node's total conductance to outdoors is the fast path's first guess.
 _CARRY = {"Gfast": "Ge"}
-
-
-def row_score(row: Mapping, period: str | None = None) -> tuple[float, str]:
-    """(score [%], what it is) of a ladder row: the FIT of ``period`` (the mean over the
-    outputs); by default the validation FIT where the row has one, else the calibration
-    FIT. NaN when the row has none."""
-    for p in (period,) if period else ("validation", "calibration"):
-        per = (row.get("fit") or {}).get(p) or {}
-        vals = [v.get("FIT") for v in per.values() if isinstance(v, Mapping)]
-        vals = [float(v) for v in vals if v is not None and math.isfinite(float(v))]
-        if vals:
-            return sum(vals) / len(vals), f"{p} FIT"
-    return math.nan, f"{period or 'no'} FIT"
-
-
-def choose(rows: Sequence[Mapping], margin: float = MARGIN_FIT) -> dict:
-    """The screen's choice among ladder rows (each with ``model``, ``n_params``, ``fit``;
-    rows in ladder order): the simplest whose score (:func:`row_score`) is within
-    ``margin`` points of the best.
-
-    Returns
-    -------
-    dict
-        ``choice`` (label), ``score`` (what was compared), ``reason`` (a sentence),
-        ``best`` (the best-scoring label), ``runner_up`` (the best other rung within
-        ``margin`` of the choice, or None) and ``margin``.
-
-    Raises
-    ------
-    InputError
-        No row has a finite score (every rung failed).
-    """
-    # one period for every row: the validation FIT when any row has one
-    has_val = any((r.get("fit") or {}).get("validation") for r in rows)
-    period = "validation" if has_val else "calibration"
-    scored = [(i, r, *row_score(r, period)) for i, r in enumerate(rows)]
-    scored = [t for t in scored if math.isfinite(t[2])]
-    if not scored:
-        raise InputError("model: auto: no model of the ladder could be fitted and scored")
-    what = scored[0][3]
-    best = max(scored, key=lambda t: t[2])
-    ok = [t for t in scored if t[2] >= best[2] - margin]
-    pick = min(ok, key=lambda t: (int(t[1].get("n_params", 0)), t[0]))
-    name, s = pick[1]["model"], pick[2]
-    if pick is best:
-        reason = f"the best {what} of the ladder ({s:.1f} %)"
-        simpler = [t for t in scored if t[1].get("n_params", 0) < pick[1].get("n_params", 0)]
-        if simpler:
-            nxt = max(simpler, key=lambda t: t[2])
-            reason += (
-                f", more than {margin:g} points above the best simpler model "
-                f"({nxt[1]['model']}: {nxt[2]:.1f} %)"
-            )
-    else:
-        reason = (
-            f"{what} {s:.1f} %, within {margin:g} points of the best, {best[1]['model']} "
-            f"({best[2]:.1f} %), with fewer parameters ({pick[1].get('n_params')} against "
-            f"{best[1].get('n_params')}): a richer model must beat it by more than "
-            f"{margin:g} points"
-        )
-    rivals = [t for t in ok if t is not pick]
-    runner = max(rivals, key=lambda t: t[2])[1]["model"] if rivals else None
-    return {
-        "choice": name,
-        "score": what,
-        "reason": reason,
-        "best": best[1]["model"],
-        "runner_up": runner,
-        "margin": margin,
-    }
 
 
 @dataclass
@@ -145,11 +89,10 @@ class Screen:
     options: dict = field(default_factory=dict)  # label -> (catalogue name, own options)
 
     def record(self) -> dict:
-        """The JSON record: ``rule``, ``rows`` and the choice (summary.json, comparison)."""
+        """The JSON record: ``rule``, ``rows`` and the decision (:func:`decide`: the
+        choice, why, the tie) as summary.json's ``selection`` holds it."""
         return {
-            "rule": f"the simplest model whose {self.choice['score']} is within "
-            f"{self.choice['margin']:g} points of the best (MAP of each rung; a richer "
-            f"model must beat a simpler one by more than {self.choice['margin']:g} points)",
+            "rule": rule_text(self.choice["score"], self.choice["margin"]),
             "rows": self.rows,
             **self.choice,
         }
@@ -164,6 +107,7 @@ def screen(
     deadline: float | None = None,
     say: Callable[[str], None] | None = None,
     margin: float = MARGIN_FIT,
+    guarded: bool = True,
 ) -> Screen:
     """MAP of every rung of the section's ladder, its validation score and the choice.
 
@@ -183,6 +127,8 @@ def screen(
         Progress lines.
     margin : float
         :data:`MARGIN_FIT`.
+    guarded : bool
+        :func:`screen_maps`'s restart guard (default on).
     """
     say = say or (lambda msg: None)
     sec = getattr(cfg, section)
@@ -203,12 +149,13 @@ def screen(
         optimizer=cfg.optimizer,
         deadline=deadline,
         say=lambda msg: say(f"[{section}] {msg}"),
+        guarded=guarded,
     )
     out = Screen(section, rows, {})
     for label, (model, lp, mp) in found.items():
         out.models[label], out.logposts[label], out.maps[label] = model, lp, mp
         out.options[label] = own[label]
-    out.choice = choose([r for r in out.rows if "error" not in r], margin)
+    out.choice = decide([r for r in out.rows if "error" not in r], margin=margin)
     for r in out.rows:
         r["chosen"] = r["sampled"] = r["model"] == out.choice["choice"]
     say(f"[{section}] chosen: {out.choice['choice']}: {out.choice['reason']}")
@@ -223,6 +170,7 @@ def screen_maps(
     optimizer,
     deadline: float | None = None,
     say: Callable[[str], None] | None = None,
+    guarded: bool = True,
 ) -> tuple[list[dict], dict]:
     """The MAP screen's loop, shared by ``model: auto`` (:func:`screen`) and ``hbayes
     compare``: each rung's MAP and its ladder row, in turn.
@@ -233,8 +181,9 @@ def screen_maps(
         ``build()`` returns (prepared data, model, log-posterior) of the rung; ``parent``
         is the label of its nested simpler rung (or None), whose MAP, when found
         before, is carried over as one start of the search (:func:`carried_start`).
-        One global search per rung (no restarts): the carried start puts the richer
-        rung's search where the simpler one ended.
+        One global search per rung: the carried start puts the richer rung's search
+        where the simpler one ended; where the polished starts end more than
+        :data:`SPREAD_LOGPOST` apart, :func:`restart_guard` runs more searches.
     section : {"thermal", "hygric"}
     seed : int
         Seed of every rung's MAP search.
@@ -245,6 +194,8 @@ def screen_maps(
         (recorded as such); the first rung always runs.
     say : callable, optional
         A progress line per rung.
+    guarded : bool
+        Apply :func:`restart_guard` (default; False measures what it changes).
 
     Returns
     -------
@@ -273,17 +224,20 @@ def screen_maps(
             start = None
             if parent in found:
                 start = carried_start(lp, found[parent][1], found[parent][2])
-            mp = find_map(
-                lp,
-                seed=seed,
+            search = dict(
                 method=optimizer.method,
                 popsize=optimizer.popsize,
                 maxiter=optimizer.maxiter,
                 starts=optimizer.starts,
                 deadline=deadline if k > 1 else None,
-                start=start,
             )
+            mp = find_map(lp, seed=seed, start=start, **search)
+            mp, guard = restart_guard(lp, mp, seed=seed, search=search) if guarded else (mp, None)
+            if guard is not None:
+                say(f"screen {k}/{n}: {label}: {guard['said']}")
             row = ladder_row(prep, section, model, lp, mp, label=label)
+            if guard is not None:
+                row["map_guard"] = guard
         except BudgetError:
             rows.append({**head, "error": "not screened: the time budget ran out"})
             continue
@@ -301,6 +255,62 @@ def screen_maps(
             f"({row['map_seconds']:.0f} s)"
         )
     return rows, found
+
+
+#: [log-posterior units] polished starts of one search ending further apart than this
+#: found separate optima (one holds e^-10 of the other's mass if as wide: the optimizer's
+#: ``MODE_WINDOW``): the search is repeated from other seeds (:func:`restart_guard`).
+SPREAD_LOGPOST = 10.0
+#: Global searches the guard adds (seeds ``[seed, 1]``, ``[seed, 2]``, ...).
+GUARD_SEARCHES = 2
+
+
+def restart_guard(lp, mp, *, seed: int, search: Mapping) -> tuple:
+    """A guard against a local optimum: where the polished starts of a rung's search
+    (its population's best points; not the carried start, which often stays on the
+    simpler rung's optimum, a saddle of the richer one) end more than
+    :data:`SPREAD_LOGPOST` apart, the log-posterior has several optima within reach, so
+    :data:`GUARD_SEARCHES` more global searches from other seeds run and the highest
+    optimum is kept when it beats the first by more than the optimizer's ``MODE_PICK``.
+
+    Returns
+    -------
+    (MAPResult, dict or None)
+        The MAP kept and, when the guard ran, its record: ``spread`` of the first
+        search's starts, the ``log_posteriors`` of the searches (the first first),
+        ``moved`` (the MAP kept is another search's) and ``said``, a sentence.
+    """
+    from heritage_bayes.inference.optimize import MODE_PICK, BudgetError, find_map
+
+    cands = [c for c in mp.candidates if math.isfinite(c)]
+    carried = getattr(mp, "carried", None)
+    if carried is not None and cands:  # the carried start may rest on the simpler optimum
+        cands.remove(min(cands, key=lambda c: abs(c - carried)))
+    spread = max(cands) - min(cands) if cands else 0.0
+    if spread <= SPREAD_LOGPOST:
+        return mp, None
+    found = [mp]
+    for j in range(1, GUARD_SEARCHES + 1):
+        try:
+            found.append(find_map(lp, seed=[seed, j], **search))
+        except BudgetError:
+            break
+    best = max(found, key=lambda r: r.log_post)
+    keep = best if best.log_post > mp.log_post + MODE_PICK else mp
+    lps = [float(r.log_post) for r in found]
+    said = (
+        f"{len(cands)} starts of its MAP search ended {spread:.0f} log-posterior units apart "
+        f"(several optima): {len(found) - 1} more searches from other seeds reached "
+        + ", ".join(f"{v:.1f}" for v in lps[1:])
+        + f" against {lps[0]:.1f}; "
+        + ("the higher optimum is kept" if keep is not mp else "the first optimum stands")
+    )
+    return keep, {
+        "spread": spread,
+        "log_posteriors": lps,
+        "moved": keep is not mp,
+        "said": said,
+    }
 
 
 def unit_point(logpost, values: dict[str, float]) -> np.ndarray:

@@ -47,12 +47,18 @@ computed from daily block sums for the same reason (hourly terms are correlated)
   (eigenvalues of the prior-whitened posterior covariance);
 - the widest 90 % interval of a physical parameter, in decades.
 
-**Recommendation** (computed from the numbers): the models whose accuracy score
-(validation ELPD, or blocked LOO without a validation period) is within 2 standard
-errors of the best, or within 4 nats (a negligible difference [4]_), are equivalent in
-accuracy; among them, the simplest one whose time
-constants are all identified is recommended; if none is, the best-identified one is,
-with a warning.
+**Recommendation**: the one selection rule of ``model: auto``
+(:func:`heritage_bayes.selection_rule.decide`). The screen ranks the candidates by the
+validation FIT of their MAP's simulation and chooses the simplest within 2 points of
+the best; the others within 2 points tie with it. The choice and its best tied rival
+are sampled (with no tie, the best other candidate, for the comparison), and their
+ELPD (validation ELPD, or blocked LOO without a validation period) breaks the tie only
+when it is reliable: both chains converged (for blocked LOO, Pareto k at most 0.7),
+and the rival ahead by more than 2 standard errors and 4 nats (a negligible
+difference [4]_). Otherwise the screen's choice stands, and ``model: auto`` and
+``hbayes compare`` recommend the same model; where the ELPD disagrees with the screen,
+the recommendation says which way and why. The identifiability of the model
+recommended is stated beside it.
 
 References
 ----------
@@ -71,11 +77,11 @@ References
 
 from __future__ import annotations
 
-from heritage_bayes.compare.core import (  # noqa: F401  (_recommend: tested directly)
+from heritage_bayes.compare.core import (
     DEFAULT_MODELS,
     NEGLIGIBLE_ELPD,
-    _recommend,
     compare_runs,
+    recommend,
 )
 from heritage_bayes.compare.identifiability import _practical_rank  # noqa: F401
 from heritage_bayes.compare.orchestrate import run_compare
@@ -103,6 +109,7 @@ __all__ = [
     "fig_tradeoff",
     "identifiability_rows",
     "load_inference",
+    "recommend",
     "render_comparison",
     "run_compare",
     "write_comparison",

@@ -23,10 +23,9 @@ from heritage_bayes.compare.scores import (
 from heritage_bayes.errors import InputError
 from heritage_bayes.format import quantity_name
 from heritage_bayes.rc.catalog import DomainView, model_ladder
+from heritage_bayes.selection_rule import NEGLIGIBLE_ELPD, decide, rule_text
 
-#: ELPD differences smaller than this are negligible whatever their SE (two nearly
-#: identical models have a tiny SE of their difference) [nats]; Sivula et al. (2020).
-NEGLIGIBLE_ELPD = 4.0
+__all__ = ["DEFAULT_MODELS", "NEGLIGIBLE_ELPD", "compare_runs", "recommend"]
 
 #: Candidates when ``--models`` is not given: the model-order ladder of each section
 #: (the catalogue entries marked ``ladder``, :func:`heritage_bayes.rc.catalog.model_ladder`).
@@ -41,8 +40,12 @@ def compare_runs(
     identified_factor: float = 2.0,
     practical_ratio: float = 0.01,
     seed: int = 0,
+    screen_rows: list[dict] | None = None,
 ) -> dict:
-    """Compare calibrated runs of one section on accuracy and identifiability.
+    """Compare calibrated runs of one section on accuracy and identifiability, and
+    recommend one by the selection rule of ``model: auto``
+    (:func:`heritage_bayes.selection_rule.decide`): the screen's choice, unless the ELPD
+    reliably breaks its tie.
 
     Parameters
     ----------
@@ -58,12 +61,18 @@ def compare_runs(
         rank.
     seed : int
         Seed of the prior draws of the derived quantities.
+    screen_rows : list of dict, optional
+        The MAP screen's ladder rows of the candidates (``hbayes compare``'s screen).
+        Without them (runs compared as they are), each run's own validation FIT (of
+        its posterior-median simulation; calibration FIT without a validation period)
+        stands in for the screen's score.
 
     Returns
     -------
     dict
         ``models`` (per label: accuracy, identifiability, convergence), ``loo_compare``
-        (``az.compare`` on the blocked LOO), ``recommendation`` and the settings.
+        (``az.compare`` on the blocked LOO), ``selection`` (the rule's record:
+        :func:`heritage_bayes.selection_rule.decide`), ``recommendation`` and the settings.
     """
     from heritage_bayes.run import load_run
 
@@ -148,13 +157,27 @@ def compare_runs(
     for m, row in loo_table.items():
         out_models[m]["accuracy"]["loo_blocked"]["diff_to_best"] = -row["elpd_diff"]
         out_models[m]["accuracy"]["loo_blocked"]["dse_to_best"] = row["dse"]
-    rec = _recommend(out_models, score)
+    rows = screen_rows if screen_rows is not None else _rows_of_runs(out_models)
+    what = "validation ELPD" if score == "elpd_validation" else "blocked LOO ELPD"
+    pairs = val_pw if score == "elpd_validation" else _loo_pointwise(loo_data)
+    post = {
+        m: {
+            "elpd": info["accuracy"][score]["elpd"],
+            "se": {o: _pair_se(pairs[m], pairs[o], block_hours, score) for o in pairs if o != m},
+            "converged": info["converged"],
+            "max_pareto_k": info["accuracy"]["loo_blocked"]["max_pareto_k"],
+        }
+        for m, info in out_models.items()
+    }
+    sel = decide(rows, post, score=what)
+    sel["rule"] = rule_text(sel["score"], sel["margin"])
     return {
         "section": section,
         "models": out_models,
         "loo_compare": loo_table,
         "accuracy_score": score,
-        "recommendation": rec,
+        "selection": sel,
+        "recommendation": recommend(sel, out_models, score),
         "settings": {
             "block_hours": block_hours,
             "identified_factor": identified_factor,
@@ -186,86 +209,87 @@ def _tau_label(key: str) -> str:
     return quantity_name(key).removeprefix("time constant ")
 
 
-def _recommend(models: dict, score: str) -> dict:
-    """The simplest accuracy-equivalent model whose time constants are identified."""
-    what = "validation ELPD" if score == "elpd_validation" else "blocked LOO ELPD"
-    rows = {}
-    for m, info in models.items():
-        a = info["accuracy"][score]
-        diff, dse = a.get("diff_to_best", 0.0), a.get("dse_to_best", 0.0)
-        equivalent = diff >= -max(2.0 * (dse or 0.0), NEGLIGIBLE_ELPD)
-        rows[m] = (diff, dse or 0.0, equivalent, info["identifiability"])
-    best = max(rows, key=lambda m: rows[m][0])
-    equiv = [m for m in rows if rows[m][2]]
-    ok = [m for m in equiv if rows[m][3]["time_constants_identified"]]
-    by_size = sorted(ok or equiv, key=lambda m: (rows[m][3]["n_free_physical"], -rows[m][0]))
-    if ok:
-        choice = by_size[0]
+def _rows_of_runs(models: dict) -> list[dict]:
+    """Screen rows standing in for a MAP screen when runs are compared as they are:
+    each run's own FIT per period (its posterior-median simulation) and its free
+    physical parameters."""
+    return [
+        {
+            "model": m,
+            "n_params": info["identifiability"]["n_free_physical"],
+            "fit": {
+                p: {"y": {"FIT": info["accuracy"][p]["FIT"]}}
+                for p in ("calibration", "validation")
+                if (info["accuracy"].get(p) or {}).get("FIT") is not None
+            },
+        }
+        for m, info in models.items()
+    ]
+
+
+def _loo_pointwise(loo_data: dict) -> dict:
+    """label -> (the blocked LOO's terms, their blocks' start times)."""
+    out = {}
+    for m, loo in loo_data.items():
+        li = loo.loo_i
+        out[m] = (np.asarray(li.values, dtype=float).ravel(), np.asarray(li[li.dims[-1]].values))
+    return out
+
+
+def _pair_se(a: tuple, b: tuple, block_hours: float, score: str) -> float | None:
+    """SE of the ELPD difference of two candidates over their common hours (validation:
+    from daily block sums) or blocks (blocked LOO: blocks are independent terms)."""
+    (pa, ta), (pb, tb) = a, b
+    common, ia, ib = np.intersect1d(ta, tb, return_indices=True)
+    if common.size < 2:
+        return None
+    d = pa[ia] - pb[ib]
+    if score == "elpd_validation":
+        return _num(_block_se(d, common, block_hours))
+    return _num(math.sqrt(d.size * np.var(d, ddof=1)))
+
+
+def recommend(sel: dict, models: dict, score: str) -> dict:
+    """The comparison's recommendation: the selection rule's decision
+    (:func:`heritage_bayes.selection_rule.decide`, ``sel``) in words, with the identifiability
+    of the model recommended and the candidates not converged."""
+    rec, stage = sel["model"], sel["posterior"] or {}
+    if sel["decided_by"] == "ELPD":
+        head = f"the ELPD breaks the screen's tie; the screen chose {sel['choice']}"
     else:
-        choice = max(
-            equiv,
-            key=lambda m: (
-                -len(rows[m][3]["time_constants_not_identified"]),
-                rows[m][3]["practical_rank"],
-            ),
-        )
-    diff, dse, _, ident = rows[choice]
-    parts = []
-    if choice == best:
-        parts.append(f"the best {what} of the candidates")
-    else:
-        parts.append(
-            f"{what} within 2 SE or {NEGLIGIBLE_ELPD:g} nats of `{best}` "
-            f"(difference {diff:.1f} ± {dse:.1f})"
-        )
-    if ident["time_constants_identified"]:
+        head = "the screen's choice, as `model: auto` chooses"
+    why = stage.get("reason", "")
+    text = f"`{rec}`: {head} ({sel['reason']}). {why[:1].upper()}{why[1:]}."
+    text += "".join(f" {n[0].upper()}{n[1:]}." for n in stage.get("notes", []))
+    ident = models[rec]["identifiability"] if rec in models else None
+    if ident is not None and ident["time_constants_identified"]:
         fast = ident["time_constants_below_step"]
-        if fast:
-            parts.append(
-                "its time constants longer than the time step identified ("
-                + ", ".join(_tau_label(k) for k in fast)
-                + " shorter than the step: the data see only its static effect, so it is "
-                "neither identified nor needed)"
-            )
-        else:
-            parts.append("all its time constants identified")
-    else:
-        parts.append(
-            "but not all its time constants are identified ("
-            + ", ".join(_tau_label(k) for k in ident["time_constants_not_identified"])
-            + "; no candidate of equal accuracy has all of them)"
+        text += (
+            " Its time constants longer than the time step are identified ("
+            + ", ".join(_tau_label(k) for k in fast)
+            + " shorter than the step: the data see only its static effect)."
+            if fast
+            else " All its time constants are identified."
         )
-    others = []
-    for m, (d, se, eq, idf) in rows.items():
-        if m == choice:
-            continue
-        if not eq:
-            others.append(f"`{m}` is less accurate ({what} {d:.1f} ± {se:.1f} below the best)")
-            continue
-        bad = idf["time_constants_not_identified"]
-        if bad:
-            others.append(
-                f"`{m}` is as accurate but its time constants are not identified: "
-                + ", ".join(_tau_label(k) for k in bad)
-            )
-        else:
-            n_ok = idf["n_free_physical"] - len(idf.get("parameters_not_identified", []))
-            others.append(
-                f"`{m}` is as accurate, its time constants identified, but has more "
-                f"parameters ({idf['n_free_physical']} against {ident['n_free_physical']}; "
-                f"{n_ok} of its {idf['n_free_physical']} parameters identified)"
-            )
-    text = f"`{choice}`: " + ", ".join(parts) + "."
-    if others:
-        text += " " + "; ".join(others) + "."
+    elif ident is not None:
+        text += (
+            " Not all its time constants are identified ("
+            + ", ".join(_tau_label(k) for k in ident["time_constants_not_identified"])
+            + "): their intervals are wide."
+        )
     unconverged = [m for m, info in models.items() if info.get("converged") is False]
     if unconverged:
         names = ", ".join(f"`{m}`" for m in unconverged)
-        text += f" Not converged (R-hat/ESS/τ criteria), so provisional: {names}."
+        text += f" Not converged (R-hat/ESS/τ criteria), so its figures are provisional: {names}."
     return {
-        "model": choice,
+        "model": rec,
         "reason": text,
-        "best_accuracy": best,
-        "equivalent": equiv,
+        "decided_by": sel["decided_by"],
+        "screen_choice": sel["choice"],
+        "agrees_with_screen": rec == sel["choice"],
+        "best_accuracy": max(models, key=lambda m: models[m]["accuracy"][score]["elpd"]),
         "not_converged": unconverged,
+        # the decision may change with longer chains: the rival's ELPD was not reliable,
+        # or the model recommended did not converge
+        "provisional": stage.get("verdict") == "not reliable" or rec in unconverged,
     }

@@ -11,9 +11,9 @@ from pathlib import Path
 from heritage_bayes._memory import release_memory
 from heritage_bayes.compare.core import DEFAULT_MODELS, compare_runs
 from heritage_bayes.compare.page import write_comparison
-from heritage_bayes.compare.screen import REACH_FIT, screen_candidates, within_reach
+from heritage_bayes.compare.screen import screen_candidates, to_sample
 from heritage_bayes.errors import ConfigError
-from heritage_bayes.selection import MARGIN_FIT
+from heritage_bayes.selection_rule import choose, rule_text
 
 
 def _section_of(cfg, models: Sequence[str] | None) -> tuple[str, list[str]]:
@@ -240,13 +240,14 @@ def run_compare(
     and write the comparison; return its folder.
 
     First every candidate's MAP and its validation FIT
-    (:mod:`heritage_bayes.compare.screen`: seconds each); then only the candidates
-    within :data:`~heritage_bayes.compare.screen.REACH_FIT` points of the best, each
-    beating the simpler ones sampled by more than
-    :data:`~heritage_bayes.selection.MARGIN_FIT` points (at least the best two:
-    :func:`~heritage_bayes.compare.screen.within_reach`) are calibrated, each chain
-    started at its screened MAP, and compared by their posteriors (blocked LOO,
-    validation ELPD). The others are in ``comparison.json`` (``screened_out``,
+    (:mod:`heritage_bayes.compare.screen`: seconds each) and the choice of ``model:
+    auto``'s rule (:func:`heritage_bayes.selection_rule.choose`); then the choice and its best
+    tied rival (without a tie, the best other candidate:
+    :func:`~heritage_bayes.compare.screen.to_sample`) are calibrated, each chain started
+    at its screened MAP, compared by their posteriors (blocked LOO, validation ELPD),
+    and one is recommended by the same rule, the ELPD breaking the screen's tie where it
+    is reliable (:func:`heritage_bayes.selection_rule.decide`; ``comparison.json``:
+    ``selection``). The others are in ``comparison.json`` (``screened_out``,
     ``screen``) and the page with their MAP score and the reason. Ctrl-C or SIGTERM
     stops every worker at once (exit 130): no run written, the chains so far kept in
     the staging folders for ``--resume``, no candidate started after.
@@ -323,7 +324,13 @@ def run_compare(
             RunWriter(out / n, force=force, resume=resume).check()
         tell(f"screening {', '.join(names)} by their MAP (validation FIT)")
         rows, maps, scores = screen_candidates(cands, section, tell=tell)
-        verdicts = within_reach(scores, {n: r.get("n_params", 0) for n, r in rows.items()})
+        sel = choose([r for r in rows.values() if "error" not in r])  # as model: auto
+        tell(f"the screen chose {sel['choice']}: {sel['reason']}")
+        sampled = to_sample(sel)
+        verdicts = {
+            n: sampled[n] if n in sampled else f"screened out: {rows[n].get('error', 'no score')}"
+            for n in names
+        }
         keep = [n for n in names if verdicts[n] is None]
         for n in names:
             if verdicts[n] is not None:
@@ -343,12 +350,14 @@ def run_compare(
         dirs = {n: dirs[n] for n in keep}
         release_memory()
         tell("comparing the posteriors (blocked LOO, validation ELPD)")
-        result = compare_runs(dirs, section, seed=cfg.seed if seed is None else int(seed))
+        result = compare_runs(
+            dirs,
+            section,
+            seed=cfg.seed if seed is None else int(seed),
+            screen_rows=[r for r in rows.values() if "error" not in r],
+        )
         result["screen"] = {
-            "rule": f"each candidate's MAP scored by its validation FIT; sampled, simplest "
-            f"first: those within {REACH_FIT:g} points of the best that beat every simpler "
-            f"one sampled by more than {MARGIN_FIT:g} points; at least the best two",
-            "reach_fit": REACH_FIT,
+            "rule": rule_text(sel["score"], sel["margin"]),
             "rows": [rows[n] for n in names],
             "sampled": keep,
         }

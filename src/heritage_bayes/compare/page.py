@@ -220,9 +220,19 @@ def render_comparison(result: dict) -> str:
 
     rec = result["recommendation"]
     s = result["settings"]
+    level = "amber" if rec.get("provisional") else "green"
+    by = {"ELPD": "the posteriors' ELPD breaks the screen's tie", "screen": "the screen"}
     lead = (
-        f"<div class='verdict green'><strong>Recommended: <code>{html.escape(rec['model'])}"
-        f"</code></strong><p>{prose_html(rec['reason'])}</p></div>"
+        f"<div class='verdict {level}'><strong>Recommended: <code>"
+        f"{html.escape(rec['model'])}</code></strong>"
+        + (
+            f" <span>(decided by {by.get(rec.get('decided_by'), 'the screen')}; "
+            f"<code>model: auto</code> chooses <code>{html.escape(rec['screen_choice'])}"
+            "</code>)</span>"
+            if rec.get("screen_choice")
+            else ""
+        )
+        + f"<p>{prose_html(rec['reason'])}</p></div>"
     )
     fig = fig_tradeoff(result)
     summary = (

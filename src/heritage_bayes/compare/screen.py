@@ -1,13 +1,14 @@
-"""The candidates' MAP screen before any is sampled, and the rule that keeps those within
-reach of the best.
+"""The candidates' MAP screen before any is sampled, and the candidates it samples.
 
 Part of :mod:`heritage_bayes.compare` (see its documentation). Each candidate's MAP is
 found on exactly the log-posterior its calibration samples (its own config, the same
 prepared data), so the MAP found here starts its chain; the search is ``model: auto``'s
 (:func:`heritage_bayes.selection.screen_maps`, one loop for both): the MAP of a nested
 simpler candidate (:data:`heritage_bayes.models.AUTO_LADDERS`) carried over as one start
-of one global search. The score is the validation FIT of the simulation from the MAP
-(:func:`heritage_bayes.selection.row_score`).
+of one global search, with the same restart guard. The score is the validation FIT of
+the simulation from the MAP (:func:`heritage_bayes.selection_rule.row_score`), the choice
+that of ``model: auto`` (:func:`heritage_bayes.selection_rule.choose`), and the candidates
+sampled those whose posteriors can change it (:func:`to_sample`).
 """
 
 from __future__ import annotations
@@ -16,62 +17,36 @@ import math
 from collections.abc import Callable, Mapping
 
 from heritage_bayes.models import AUTO_LADDERS
-from heritage_bayes.selection import MARGIN_FIT
 
-__all__ = ["REACH_FIT", "screen_candidates", "within_reach"]
-
-#: [percentage points of validation FIT] candidates whose MAP scores within this of the
-#: best may be sampled (:func:`within_reach`). Wider than
-#: :data:`heritage_bayes.selection.MARGIN_FIT`: the ELPD of the posteriors, not the
-#: MAP's FIT, decides between those sampled.
-REACH_FIT = 5.0
+__all__ = ["screen_candidates", "to_sample"]
 
 
-def within_reach(
-    scores: Mapping[str, float],
-    n_params: Mapping[str, int] | None = None,
-    reach: float = REACH_FIT,
-    margin: float = MARGIN_FIT,
-) -> dict[str, str | None]:
-    """Candidate -> None when it is sampled, else why it is screened out.
-
-    ``scores``: candidate -> MAP validation score [%] (NaN: not scored, screened out);
-    ``n_params``: candidate -> free parameters (default: all equal). Sampled, simplest
-    first: a candidate within ``reach`` points of the best that beats every simpler
-    candidate sampled by more than ``margin`` points (a richer model that adds nothing
-    over a simpler one is not worth its posterior); then, were fewer than two taken,
-    the best-scoring others (a comparison needs two posteriors).
-    """
-    n_params = n_params or {}
-    ok = {m: s for m, s in scores.items() if math.isfinite(s)}
-    if not ok:
-        return {m: "screened out: no MAP score" for m in scores}
-    best = max(ok.values())
-    ranked = sorted(ok, key=lambda m: -ok[m])
-    keep: list[str] = []
-    why: dict[str, str] = {}
-    for m in sorted(ok, key=lambda m: (n_params.get(m, 0), list(scores).index(m))):
-        if ok[m] < best - reach:
-            why[m] = (
-                f"screened out: MAP validation FIT {ok[m]:.1f} %, {best - ok[m]:.1f} points "
-                f"below the best ({ranked[0]}: {best:.1f} %; reach {reach:g} points)"
+def to_sample(sel: Mapping) -> dict[str, str | None]:
+    """Candidate -> None when it is sampled, else why not, from the screen's choice
+    (:func:`heritage_bayes.selection_rule.choose`, ``sel``): the choice and its best tied
+    rival (the runner-up: the only one whose ELPD may overturn the choice,
+    :func:`heritage_bayes.selection_rule.decide`); without a tie, the choice and the best
+    other candidate scored (a comparison needs two posteriors). Candidates not scored:
+    screened out."""
+    c, fit, tied = sel["choice"], sel["scores"], sel["tied"]
+    second = sel["runner_up"] or max((m for m in fit if m != c), key=fit.__getitem__, default=None)
+    best = max(fit.values())
+    out: dict[str, str | None] = {}
+    for m, s in fit.items():
+        if m in (c, second):
+            out[m] = None
+        elif m in tied:
+            out[m] = (
+                f"not sampled: ties with {c} on the screen (MAP {sel['score']} {s:.1f} %), "
+                f"but {second} ties closer to the best ({fit[second]:.1f} %) and is sampled"
             )
-            continue
-        simpler = [k for k in keep if n_params.get(k, 0) < n_params.get(m, 0)]
-        top = max(simpler, key=lambda k: ok[k]) if simpler else None
-        if top is not None and ok[m] <= ok[top] + margin:
-            why[m] = (
-                f"screened out: MAP validation FIT {ok[m]:.1f} %, not more than {margin:g} "
-                f"points above the simpler {top} ({ok[top]:.1f} %)"
+        else:
+            out[m] = (
+                f"screened out: MAP {sel['score']} {s:.1f} %, {best - s:.1f} points below "
+                f"the best ({sel['best']}: {best:.1f} %), outside the {sel['margin']:g}-point "
+                "tie: it cannot be recommended"
             )
-            continue
-        keep.append(m)
-    for m in ranked:
-        if len(keep) >= 2:
-            break
-        if m not in keep:
-            keep.append(m)
-    return {m: None if m in keep else why.get(m, "screened out: no MAP score") for m in scores}
+    return out
 
 
 def screen_candidates(

@@ -153,7 +153,8 @@ class MAPResult:
     n_starts, n_agreed : int
         Polished candidates and how many reached the best value within 1 unit.
     candidates : list of float
-        Final objective of each polished start, best first.
+        Final objective of each polished start, best first (``carried``: that of the
+        carried ``start``, None without one).
     n_evaluations : int
     unit : (d,) array, optional
         The MAP's free parameters in the unit cube of the search.
@@ -176,6 +177,7 @@ class MAPResult:
     unit: np.ndarray | None = None
     restarts: int = 1
     modes: list[dict] = field(default_factory=list)
+    carried: float | None = None
 
     def to_dict(self, names) -> dict:
         out = {
@@ -203,9 +205,7 @@ class _Objective:
     """Negative MAP objective on the unit cube, vectorised, counting evaluations."""
 
     def __init__(self, logpost, deadline: float | None = None):
-        self.lp = logpost
-        ps = logpost.params
-        self.ps = ps
+        self.lp, self.ps = logpost, logpost.params
         self.n = 0
         self.deadline = deadline  # time.perf_counter() value, or None
 
@@ -424,10 +424,10 @@ def _search(logpost, obj, seed, method, popsize, maxiter, starts, start=None) ->
             bounds=[(_EPS, 1 - _EPS)] * d,
             options={"maxiter": 500, "ftol": 1e-12, "gtol": 1e-8},
         )
-        finals.append((float(r.fun), np.clip(r.x, _EPS, 1 - _EPS)))
+        finals.append((float(r.fun), np.clip(r.x, _EPS, 1 - _EPS), s0 is x0))
     finals.sort(key=lambda t: t[0])
-    best_f, best_s = finals[0]
-    agreed = sum(1 for f, _ in finals if f - best_f <= 1.0)
+    best_f, best_s, _ = finals[0]
+    agreed = sum(1 for f, *_ in finals if f - best_f <= 1.0)
     theta, _ = obj.values(best_s[None])
     x = logpost.params.to_unconstrained(theta)[0]
     return MAPResult(
@@ -436,10 +436,11 @@ def _search(logpost, obj, seed, method, popsize, maxiter, starts, start=None) ->
         log_post=-best_f,
         n_starts=len(finals),
         n_agreed=agreed,
-        candidates=[-f for f, _ in finals],
+        candidates=[-f for f, *_ in finals],
         n_evaluations=obj.n,
         method=method,
         unit=best_s,
+        carried=next((-f for f, _, c in finals if c), None),
     )
 
 

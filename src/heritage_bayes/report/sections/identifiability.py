@@ -342,11 +342,11 @@ def _selection_text(s: RunSummary, domain: str) -> str | None:
     text = (
         f"model: auto — {sel['choice']} chosen by the screen: {sel['reason']}. Rule: {sel['rule']}."
     )
-    if sel.get("runner_up"):
-        text += (
-            f" {sel['runner_up']} is within the margin of it: `hbayes compare --models` "
-            "weighs the two by their posteriors."
-        )
+    if sel.get("tie"):
+        text += f" {sel['tie'][0].upper()}{sel['tie'][1:]}."
+    for r in sel.get("rows") or []:  # the restart guard, where it ran
+        if (r.get("map_guard") or {}).get("said"):
+            text += f" {r['model']}: {r['map_guard']['said']}."
     return text
 
 

@@ -1,4 +1,5 @@
-"""The name lists a user chooses from, declared once: noise models and sampler moves.
+"""The name lists a user chooses from, declared once: noise models, sampler moves and the
+controls of a room's air.
 
 Layer 0, imported by the settings (the choices of ``noise:`` and ``sampler.moves``,
 :class:`heritage_bayes.config._base.Choices`), by the command line (``hbayes models
@@ -16,7 +17,16 @@ from __future__ import annotations
 
 from typing import NamedTuple
 
-__all__ = ["DEFAULT_NOISE", "MOVES", "NOISE_MODELS", "NoiseName", "declare_noise", "noise_traits"]
+__all__ = [
+    "CONTROLS",
+    "DEFAULT_NOISE",
+    "HUMIDISTAT_MODES",
+    "MOVES",
+    "NOISE_MODELS",
+    "NoiseName",
+    "declare_noise",
+    "noise_traits",
+]
 
 
 class NoiseName(NamedTuple):
@@ -82,3 +92,11 @@ MOVES: dict[str, str] = {
     "independent draw from a Student-t fitted to the chain so far",
     "dime": "DE with those independent draws, no snooker",
 }
+
+
+#: Controls of a room's air (``<section>.options``, :mod:`heritage_bayes.rc.control`):
+#: name -> the domain of the model it acts on (None: either).
+CONTROLS: dict[str, str | None] = {"thermostat": "thermal", "humidistat": "hygric", "source": None}
+#: Modes of a humidistat: the air's RH held within ``[RH_lo, RH_hi]``, below ``RH_hi``,
+#: above ``RH_lo``, at ``RH_set``.
+HUMIDISTAT_MODES = ("band", "dehumidifier", "humidifier", "setpoint")

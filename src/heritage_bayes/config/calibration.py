@@ -141,6 +141,15 @@ class CalibrationConfig(_Strict):
     def _needs_models(self):
         if self.thermal is None and self.hygric is None:
             raise ValueError("give at least one of 'thermal' and 'hygric'")
+        for name in ("thermal", "hygric"):
+            sec = getattr(self, name)
+            bad = sec.options.misplaced_control(name) if sec is not None else None
+            if bad:
+                other = "hygric" if name == "thermal" else "thermal"
+                raise ValueError(
+                    f"{name}.options.{bad}: a {bad} controls the air of a {other} model; "
+                    f"give it under {other}.options"
+                )
         if self.data.demo is not None and self.site is not None:
             raise ValueError(
                 "site: the demo uses the site of its weather file (Greensboro, NC; De Bilt "

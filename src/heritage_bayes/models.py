@@ -6,6 +6,7 @@ needs), by the orchestrator and by the run directory's loader; imports neither.
 
 from __future__ import annotations
 
+import json
 import re
 import weakref
 from collections.abc import Mapping
@@ -90,8 +91,8 @@ def build_model(cfg: CalibrationConfig, section: str) -> RCModel:
     Catalogue models get their solar surfaces from ``data.surfaces`` (none when
     ``data.irradiance: none``); a mapping under ``model:`` is a custom network
     (:meth:`heritage_bayes.rc.Network.from_dict`). Built once per config object and
-    section: a later call returns the same model, unless the section's settings were
-    replaced since.
+    section: a later call returns the same model while the settings it reads are
+    unchanged.
 
     Raises
     ------
@@ -99,12 +100,11 @@ def build_model(cfg: CalibrationConfig, section: str) -> RCModel:
         An unknown model, an option the model does not take (naming
         ``<section>.options.<key>``), or a model of the other domain.
     """
-    sec = getattr(cfg, section)
-    key = (id(sec), id(sec.model), id(sec.options), id(cfg.data))
     cache = _CACHE.get(id(cfg))
     if cache is None:
         cache = _CACHE[id(cfg)] = {}
         weakref.finalize(cfg, _CACHE.pop, id(cfg), None)
+    key = _settings_key(cfg, section)
     hit = cache.get(section)
     if hit is not None and hit[0] == key:
         return hit[1]
@@ -113,9 +113,22 @@ def build_model(cfg: CalibrationConfig, section: str) -> RCModel:
     return m
 
 
-#: id(config) -> {section: (identity of the section's settings, model)}: the models of a
-#: config object, built once (an entry leaves when its config is collected).
+#: id(config) -> {section: (the settings it was built from, model)}: the models of a
+#: config object, built once; an entry leaves with its config.
 _CACHE: dict[int, dict[str, tuple]] = {}
+
+
+def _settings_key(cfg: CalibrationConfig, section: str) -> tuple:
+    """Everything :func:`build_model` reads, as values: the section's model and options
+    as written, the solar surfaces and the input hold."""
+    sec = getattr(cfg, section)
+    written = [sec.model, sec.options.given()]
+    return (
+        json.dumps(written, sort_keys=True, default=str),
+        tuple(cfg.data.surfaces),
+        cfg.data.irradiance,
+        input_hold_of(cfg),
+    )
 
 
 def models_of(cfg: CalibrationConfig) -> dict[str, RCModel]:

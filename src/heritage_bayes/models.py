@@ -172,14 +172,7 @@ def catalog_build(cfg: CalibrationConfig, section: str, name: str, options: dict
         An option ``name`` does not take (``<section>.options.<key>``, listing those it
         takes), or a combination it refuses (``<section>.options``, the model's reason).
     """
-    taken = [k for k in options if not takes_option(name, k)]
-    if taken:
-        allowed = [k for k in NETWORK_OPTIONS if takes_option(name, k)]
-        raise ConfigError(
-            f"{section}.options.{taken[0]}: model {name!r} does not take this option; its "
-            f"network options: {allowed or 'none'} (and the control: thermostat or "
-            "humidistat, source)"
-        )
+    _check_takes(name, options, f"{section}.options.")
     try:
         return catalog_model(name, getattr(cfg, section).options.control(), **options)
     except ValueError as exc:
@@ -297,11 +290,21 @@ def model(name: str, **options) -> RCModel:
     if bad:
         raise ConfigError(f"model {name!r}: option {bad} needs a {COMPONENTS[bad]} model")
     net = opts.network_options()
-    taken = [k for k in net if not takes_option(name, k)]
-    if taken:
-        allowed = [k for k in NETWORK_OPTIONS if takes_option(name, k)]
-        raise ConfigError(f"model {name!r}: unknown option(s) {taken}; allowed: {allowed}")
+    _check_takes(name, net, "")
     return catalog_model(name, opts.control(), **net)
+
+
+def _check_takes(name: str, options: Mapping, prefix: str) -> None:
+    """:class:`ConfigError` naming ``<prefix><key>`` for a network option that catalogue
+    model ``name``'s factory does not take (listing those it takes)."""
+    refused = [k for k in options if not takes_option(name, k)]
+    if refused:
+        allowed = [k for k in NETWORK_OPTIONS if takes_option(name, k)]
+        raise ConfigError(
+            f"{prefix}{refused[0]}: model {name!r} does not take this option; its "
+            f"network options: {allowed or 'none'} (and the control: thermostat or "
+            "humidistat, source)"
+        )
 
 
 def describe_model(name: str, noise: str = DEFAULT_NOISE) -> str:

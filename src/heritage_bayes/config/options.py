@@ -112,7 +112,7 @@ class HumidistatOptions(_Strict):
     )
 
 
-def _switch(value: Any, name: str, shape: str, short: type | None = None) -> Any:
+def _switch(value: Any, shape: str, short: type | None = None) -> Any:
     """A control given as ``true`` (the defaults), ``false``/null (none), a mapping, or
     (``short``) a bare value of its first key."""
     if value is None or value is False:
@@ -123,7 +123,7 @@ def _switch(value: Any, name: str, shape: str, short: type | None = None) -> Any
         return {"mode": value}
     if isinstance(value, dict | ThermostatOptions | HumidistatOptions):
         return value
-    raise ValueError(f"{name}: expected {shape} (got {value!r})")
+    raise ValueError(f"expected {shape} (got {value!r})")
 
 
 class ModelOptions(_Strict):
@@ -185,7 +185,7 @@ class ModelOptions(_Strict):
     @classmethod
     def _thermostat(cls, v):
         shape = "true, false or a mapping with keys " + _keys(ThermostatOptions)
-        return _switch(v, "thermostat", shape)
+        return _switch(v, shape)
 
     @field_validator("humidistat", mode="before")
     @classmethod
@@ -193,7 +193,7 @@ class ModelOptions(_Strict):
         shape = f"true, false, a mode {list(HUMIDISTAT_MODES)} or a mapping with keys " + _keys(
             HumidistatOptions
         )
-        return _switch(v, "humidistat", shape, short=str)
+        return _switch(v, shape, short=str)
 
     @model_validator(mode="wrap")
     @classmethod

@@ -19,7 +19,6 @@ from typing import TYPE_CHECKING, Annotated, Any, Literal
 
 from pydantic import (
     PrivateAttr,
-    StrictBool,
     field_validator,
     model_serializer,
     model_validator,
@@ -47,9 +46,10 @@ NETWORK_OPTIONS = ("surfaces", "ground", "heating", "sink")
 class ThermostatOptions(_Strict):
     """Heating of the air node to an estimated set-point ``Tset`` [°C]."""
 
-    power_limit: StrictBool = key(
+    power_limit: bool = key(
         False,
         unit=None,
+        strict=True,
         description="estimate the maximum heating power Pmax [W] (otherwise the heating is ideal)",
     )
     schedule: str | dict[str, Any] | None = key(
@@ -59,9 +59,10 @@ class ThermostatOptions(_Strict):
         "column (1 in use, 0 not, fractions allowed) or a weekly calendar {weekly: "
         "['Sun 08-12'], timezone: UTC+1}",
     )
-    conservation: StrictBool = key(
+    conservation: bool = key(
         False,
         unit=None,
+        strict=True,
         description="conservation heating: the set-point is raised to keep the RH of the "
         "measured vapour pressure Pi at most RH_ch [-]",
     )
@@ -104,9 +105,10 @@ class HumidistatOptions(_Strict):
         description="band: within [RH_lo, RH_hi]; dehumidifier: below RH_hi; humidifier: "
         "above RH_lo; setpoint: at RH_set",
     )
-    capacity: StrictBool = key(
+    capacity: bool = key(
         False,
         unit=None,
+        strict=True,
         description="estimate the dehumidifier's and humidifier's capacities M_dehum, "
         "M_hum [kg/s] (otherwise ideal)",
     )
@@ -136,13 +138,13 @@ class ModelOptions(_Strict):
         description="solar surfaces of a thermal model with solar input (default: "
         "data.surfaces, none with data.irradiance: none)",
     )
-    ground: StrictBool | Literal["estimate"] | None = key(
+    ground: bool | Literal["estimate"] | None = key(
         None,
         unit=None,
         description="thermal: true (default): a conductance Gf to the ground temperature "
         "Tf (an input); false: none; estimate: Tf [°C] a constant to estimate",
     )
-    heating: StrictBool | None = key(
+    heating: bool | None = key(
         None,
         unit=None,
         description="thermal: a measured heating power Ph [W] into the air (an input of "
@@ -166,9 +168,10 @@ class ModelOptions(_Strict):
         description="hygric: a humidistat: true, a mode (band, dehumidifier, humidifier, "
         "setpoint) or a mapping of the keys below",
     )
-    source: StrictBool = key(
+    source: bool = key(
         False,
         unit=None,
+        strict=True,
         description="a constant source into the air, estimated: heat Qs [W] (thermal) or "
         "moisture Ms [kg/s] (hygric)",
     )
@@ -180,6 +183,13 @@ class ModelOptions(_Strict):
         if v is None or isinstance(v, bool) or v == "estimate":
             return v
         raise ValueError(f"option ground must be true, false or 'estimate' (got {v!r})")
+
+    @field_validator("heating", mode="before")
+    @classmethod
+    def _heating(cls, v):
+        if v is None or isinstance(v, bool):
+            return v
+        raise ValueError(f"expected true or false (got {v!r})")
 
     @field_validator("thermostat", mode="before")
     @classmethod

@@ -170,6 +170,28 @@ def test_options_errors_and_identifiability_notes():
     assert r.has_scale_direction  # the network part is still free-running
 
 
+def test_the_rc_catalogue_takes_typed_options_only():
+    """Below the settings nothing parses: ``rc.model`` takes a typed ``Control`` and the
+    network's keywords, and refuses a control keyword or one the model cannot have."""
+    from heritage_bayes.rc import Control
+    from heritage_bayes.rc import model as rc_model
+
+    m = rc_model("thermal_2c", Control(thermostat=True, power_limit=True), ground=False)
+    assert m.parameter_names[-2:] == ("Tset", "Pmax")
+    assert (
+        m.parameter_names
+        == hb.model("thermal_2c", ground=False, thermostat={"power_limit": True}).parameter_names
+    )
+    with pytest.raises(ValueError, match=r"unknown option\(s\) \['thermostat'\]"):
+        rc_model("thermal_2c", thermostat=True)
+    with pytest.raises(ValueError, match="a thermostat needs a thermal model"):
+        rc_model("hygric_2c", Control(thermostat=True))
+    with pytest.raises(ValueError, match="not available for a thermo-hygric coupled model"):
+        rc_model("hygric_2c_sorption", Control(source=True))
+    with pytest.raises(ValueError, match=r"Control\.humidistat: expected one of"):
+        Control(humidistat="sometimes")
+
+
 def test_schedule_and_conservation_heating():
     N = 24 * 40
     te, _ = _weather(N)

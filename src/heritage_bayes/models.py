@@ -141,9 +141,13 @@ def _build_model(cfg: CalibrationConfig, section: str) -> RCModel:
     where = f"{section}.model"
     if isinstance(sec.model, Mapping):
         try:
-            m = RCModel(Network.from_dict(sec.model, where=where))
-        except ValueError as exc:  # the network's messages name their key path
+            net = Network.from_dict(sec.model, where=where)
+        except ValueError as exc:  # its messages name their key path
             raise ConfigError(str(exc)) from None
+        try:
+            m = RCModel(net)
+        except ValueError as exc:
+            raise ConfigError(f"{where}: {exc}") from None
         _check_names(m, where)
     elif sec.model == AUTO:  # the richest rung: its inputs cover every rung's
         return auto_rungs(cfg, section)[-1][1]

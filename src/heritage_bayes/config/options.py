@@ -18,6 +18,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Annotated, Any, Literal
 
 from pydantic import (
+    ConfigDict,
     PrivateAttr,
     field_validator,
     model_serializer,
@@ -45,6 +46,8 @@ NETWORK_OPTIONS = ("surfaces", "ground", "heating", "sink")
 
 class ThermostatOptions(_Strict):
     """Heating of the air node to an estimated set-point ``Tset`` [°C]."""
+
+    model_config = ConfigDict(frozen=True)
 
     power_limit: bool = key(
         False,
@@ -99,6 +102,8 @@ class ThermostatOptions(_Strict):
 class HumidistatOptions(_Strict):
     """The air's RH at the indoor temperature held by a (de)humidifier."""
 
+    model_config = ConfigDict(frozen=True)
+
     mode: Annotated[str, Choices(dict.fromkeys(HUMIDISTAT_MODES))] = key(
         "band",
         unit=None,
@@ -130,7 +135,10 @@ def _switch(value: Any, shape: str, short: type | None = None) -> Any:
 
 class ModelOptions(_Strict):
     """The options of one model section. Serialised as written (a run's ``config.yaml``
-    echoes the user's text), used typed."""
+    echoes the user's text), used typed; frozen, so that the two agree (other options
+    are a new :meth:`model_validate`)."""
+
+    model_config = ConfigDict(frozen=True)
 
     surfaces: list[str] | None = key(
         None,

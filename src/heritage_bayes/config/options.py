@@ -4,9 +4,10 @@ the config is loaded.
 Two kinds: the network's own (``surfaces``, ``ground``, ``heating`` of the thermal
 catalogue models, ``sink`` of the hygric models with a fixed node), passed to the
 catalogue model's factory as keywords, and the control of the air node (``thermostat``,
-``humidistat``, ``source``), which becomes one :class:`heritage_bayes.rc.control_spec.
-Control`. Which catalogue model takes which network option is the model's own business
-(its factory's keywords): the model building checks that, naming the key.
+``humidistat``, ``source``), which becomes one
+:class:`~heritage_bayes.rc.control_spec.Control`. Which catalogue model takes which
+network option is the model's own business (its factory's keywords): the model building
+checks that, naming the key.
 
 The YAML shorthands become typed values here and nowhere else: ``thermostat: true`` is a
 thermostat with the defaults, ``humidistat: band`` a humidistat in that mode, ``false``

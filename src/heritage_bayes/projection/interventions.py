@@ -147,6 +147,7 @@ class Measure:
         (k, n), steady-state shift (k, n)) of a calibrated constant source ``Qs`` [W] or
         ``Ms`` [kg/s] (``options.source``), added to the modal arrays."""
         from heritage_bayes.rc import control_kernels as rc
+        from heritage_bayes.rc.control import ControlledModel
 
         cp = np.zeros(rc.N_CP)
         cp[rc.CP_P_MAX] = np.inf
@@ -175,7 +176,7 @@ class Measure:
             air = int(m._ix["out"][0])
             bz = mf.s[:, air, None] * mf.V[:, air, :]
             bd[s] = np.ascontiguousarray(mf.phi * bz)
-            if isinstance(m, rc.ControlledModel) and m.control.source:
+            if isinstance(m, ControlledModel) and m.control.source:
                 names = m.parameter_names
                 q = P[s][:, names.index("Qs" if "Qs" in names else "Ms")][:, None]
                 lam = np.where(mf.lam > 0, mf.lam, np.inf)

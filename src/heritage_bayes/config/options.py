@@ -122,7 +122,7 @@ class HumidistatOptions(_Strict):
 
 def _switch(value: Any, shape: str, short: type | None = None) -> Any:
     """A control given as ``true`` (the defaults), ``false``/null (none), a mapping, or
-    (``short``) a bare value of its first key."""
+    (``short``) a bare ``mode``."""
     if value is None or value is False:
         return None
     if value is True:

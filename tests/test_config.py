@@ -403,3 +403,54 @@ def test_optimizer_restarts_key_its_default_and_the_chain_tag():
     assert '"restarts": null' in blob and '"interior_area": null' in blob
     for bad in (0, 21, "many"):
         assert "optimizer.restarts" in _error(_with(optimizer={"restarts": bad}))
+
+
+# -- model options: typed when the config is loaded ---------------------------------------
+
+
+def test_model_options_are_typed_at_load_and_echoed_as_written():
+    raw = _with(
+        thermal={
+            "model": "thermal_2c",
+            "options": {"ground": False, "thermostat": True, "source": True},
+        },
+        hygric={"model": "hygric_2c", "options": {"humidistat": "dehumidifier"}},
+    )
+    cfg = parse_config(raw)
+    th, hy = cfg.thermal.options, cfg.hygric.options
+    assert th.network_options() == {"ground": False}
+    c = th.control()
+    assert (c.thermostat, c.power_limit, c.source, c.humidistat) == (True, False, True, None)
+    assert hy.control().humidistat == "dehumidifier" and hy.network_options() == {}
+    # the run's config.yaml and the hashes read the options as the user wrote them
+    assert cfg.resolved()["thermal"]["options"] == raw["thermal"]["options"]
+    assert cfg.resolved()["hygric"]["options"] == {"humidistat": "dehumidifier"}
+
+
+def test_model_option_errors_name_the_key_expected_and_found():
+    msg = _error(_with(thermal={"model": "thermal_2c", "options": {"thermostat": 3}}))
+    assert "thermal.options.thermostat: expected true, false or a mapping" in msg
+    assert "(got 3)" in msg
+    msg = _error(_with(thermal={"model": "thermal_2c", "options": {"humidistat": "band"}}))
+    assert "thermal.options.humidistat: a humidistat controls the air of a hygric" in msg
+    msg = _error(_with(hygric={"model": "hygric_2c", "options": {"humidistat": {"capacty": True}}}))
+    assert "hygric.options.humidistat.capacty: unknown key; did you mean 'capacity'?" in msg
+    msg = _error(_with(thermal={"model": "thermal_2c", "options": {"source": 1}}))
+    assert "thermal.options.source: Input should be a valid boolean (got 1)" in msg
+
+
+def test_an_option_the_model_does_not_take_names_its_key_and_models_build_once():
+    from heritage_bayes.calibrate import check_models
+    from heritage_bayes.config.options import ModelOptions
+    from heritage_bayes.models import build_model
+
+    cfg = parse_config(_with(hygric={"model": "hygric_2c", "options": {"sink": "temperature"}}))
+    with pytest.raises(ConfigError, match=r"^hygric\.options\.sink: model 'hygric_2c' does not"):
+        check_models(cfg)
+    cfg = parse_config(_with(thermal={"model": "thermal_2c", "options": {"ground": False}}))
+    m = build_model(cfg, "thermal")
+    assert build_model(cfg, "thermal") is m and "Tf" not in m.input_names
+    sec = cfg.thermal.model_copy(update={"options": ModelOptions()})  # ground: default
+    other = cfg.model_copy(update={"thermal": sec})
+    assert "Tf" in build_model(other, "thermal").input_names
+    assert build_model(cfg, "thermal") is m

@@ -148,7 +148,7 @@ def test_options_errors_and_identifiability_notes():
         hb.model("hygric_2c", thermostat=True)
     with pytest.raises(ValueError, match=r"humidistat\.mode"):
         hb.model("hygric_2c", humidistat={"mode": "sometimes"})
-    with pytest.raises(ValueError, match=r"unknown thermostat option\(s\) \['pmax'\]"):
+    with pytest.raises(ValueError, match=r"thermostat\.pmax: unknown key"):
         hb.model("thermal_2c", thermostat={"pmax": True})
     m = hb.model(
         "thermal_1c",
@@ -169,6 +169,28 @@ def test_options_errors_and_identifiability_notes():
     assert set(r.control) == {"RH_hi", "Ms"}
     assert "overall-scale" in r.control["Ms"] and "hours in which" in r.control["RH_hi"]
     assert r.has_scale_direction  # the network part is still free-running
+
+
+def test_the_rc_catalogue_takes_typed_options_only():
+    """Below the settings nothing parses: ``rc.model`` takes a typed ``Control`` and the
+    network's keywords, and refuses a control keyword or one the model cannot have."""
+    from heritage_bayes.rc import Control
+    from heritage_bayes.rc import model as rc_model
+
+    m = rc_model("thermal_2c", Control(thermostat=True, power_limit=True), ground=False)
+    assert m.parameter_names[-2:] == ("Tset", "Pmax")
+    assert (
+        m.parameter_names
+        == hb.model("thermal_2c", ground=False, thermostat={"power_limit": True}).parameter_names
+    )
+    with pytest.raises(ValueError, match=r"unknown option\(s\) \['thermostat'\]"):
+        rc_model("thermal_2c", thermostat=True)
+    with pytest.raises(ValueError, match="a thermostat needs a thermal model"):
+        rc_model("hygric_2c", Control(thermostat=True))
+    with pytest.raises(ValueError, match="not available for a thermo-hygric coupled model"):
+        rc_model("hygric_2c_sorption", Control(source=True))
+    with pytest.raises(ValueError, match=r"Control\.humidistat: expected one of"):
+        Control(humidistat="sometimes")
 
 
 def test_schedule_and_conservation_heating():
@@ -212,9 +234,10 @@ def test_derived_quantities_of_a_controlled_model_are_the_networks():
     """A humidistat adds the input Ti, which is not a column of the linear network's B:
     the static gains are those of the free-running network (configs/orholm.yaml)."""
     from heritage_bayes.rc.catalog import model
+    from heritage_bayes.rc.control_spec import Control
     from heritage_bayes.rc.derived import derived_quantities, derived_units
 
-    m = model("hygric_2c", humidistat="band")
+    m = model("hygric_2c", Control(humidistat="band"))
     assert m.input_names == ("Pe", "Ti")
     p = dict(Cw=0.5, Ci=0.03, Gw=2e-8, Gi=1e-6, Gfast=4.2e-7, RH_lo=0.4, RH_hi=0.6)
     d = derived_quantities(m, p)
@@ -326,5 +349,7 @@ def test_weekly_schedule_from_a_config_builds_its_input_and_names_key_paths():
     m = build_model(cfg({"weekly": ["Sun 09-12"]}), "thermal")
     assert m.input_names[-1] == "hours_of_use"
     np.testing.assert_array_equal(prep.model_inputs("thermal", m)[:, -1], use.to_numpy())
-    with pytest.raises(ConfigError, match=r"^thermal\.options\.thermostat\.schedule\.weekly\[0\]"):
-        build_model(cfg({"weekly": ["Sun 9-"]}), "thermal")
+    with pytest.raises(
+        ConfigError, match=r"\n  thermal\.options\.thermostat\.schedule\.weekly\[0\]"
+    ):
+        cfg({"weekly": ["Sun 9-"]})  # refused when the config is loaded

@@ -304,7 +304,7 @@ def test_init_flags_a_heated_room(shared_data, tmp_path):
     # the thermostat proposed (no question), and the summer's excess as a constant gain
     assert res.questions == []
     cfg = load_config(tmp_path / "h.yaml")
-    assert cfg.thermal.options == {"thermostat": True, "source": True}
+    assert cfg.thermal.options.given() == {"thermostat": True, "source": True}
     assert "# Written by" in res.text and "sat at 20.4 °C (within 0.5 K) on 206" in res.text
     assert any("the air was +5.9 K from outdoors" in f for f in res.findings)
     # the attic above it: free-running

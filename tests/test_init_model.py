@@ -84,10 +84,10 @@ def test_a_dehumidified_heated_store(tmp_path):
     res, cfg, text = _init(tmp_path, ti, rhi, w)
     # 160 days: which of two or three nodes is not a signature: the ladder's screen
     assert cfg.thermal.model == "auto"
-    assert cfg.thermal.options["thermostat"] is True
-    assert cfg.thermal.options["source"] is True
+    assert cfg.thermal.options.given()["thermostat"] is True
+    assert cfg.thermal.options.given()["source"] is True
     assert cfg.hygric.model == "hygric_1c"
-    assert cfg.hygric.options == {"humidistat": "band"}
+    assert cfg.hygric.options.given() == {"humidistat": "band"}
     # the evidence, with the measured numbers, as comments above the keys
     assert "a heating floor: the indoor daily minimum sat at 9.9 °C" in text
     assert "held in a narrow band: a humidistat or dehumidifier" in text
@@ -101,7 +101,7 @@ def test_a_short_record_keeps_the_one_node_models(tmp_path):
     _, cfg, text = _init(tmp_path, ti, rhi, w)
     assert (cfg.thermal.model, cfg.hygric.model) == ("thermal_1c", "hygric_1c")
     assert "30 days of calibration data (< 60): the one-node model" in text
-    assert cfg.hygric.options == {"humidistat": "band"}  # the control, whatever the length
+    assert cfg.hygric.options.given() == {"humidistat": "band"}  # the control, whatever the length
 
 
 def test_a_sunlit_attic_with_sorption(tmp_path):
@@ -114,7 +114,7 @@ def test_a_sunlit_attic_with_sorption(tmp_path):
     pi = _smooth(pe, 24) + 0.12 * (ps - _smooth(ps, 24))
     rhi = np.clip(relative_humidity(ti, pi), 1, 99)
     _, cfg, text = _init(tmp_path, ti, rhi, w)
-    assert cfg.thermal.model == "auto" and "thermostat" not in cfg.thermal.options
+    assert cfg.thermal.model == "auto" and "thermostat" not in cfg.thermal.options.given()
     assert "(ratio 1.55): larger indoors: the sun heats the room" in text
     # a swing larger than outdoors: the roof's two slopes at init's default (45°, E-W ridge)
     assert cfg.data.surfaces == {"roof_N": (45.0, 0.0), "roof_S": (45.0, 180.0)}
@@ -133,7 +133,7 @@ def test_a_crawlspace_with_a_vapour_sink(tmp_path):
     rhi = 65 + 10 * np.cos(2 * np.pi * (doy - 15) / 365) + rng.normal(0, 3, ti.size)
     _, cfg, text = _init(tmp_path, ti, rhi, w)
     assert cfg.hygric.model == "hygric_2c_fixed"
-    assert cfg.hygric.options == {"sink": "temperature"}
+    assert cfg.hygric.options.given() == {"sink": "temperature"}
     assert "smaller indoors: damped by the envelope" in text
     assert "-135 Pa from outdoors on average, below in 7 of 8 months: a vapour sink" in text
 
@@ -191,6 +191,6 @@ def test_sorption_with_a_wet_offset_writes_no_source_the_model_cannot_take(tmp_p
     rhi = np.clip(relative_humidity(ti, pi), 1, 99)
     _, cfg, text = _init(tmp_path, ti, rhi, w)
     assert cfg.hygric.model == "hygric_2c_sorption"
-    assert "source" not in cfg.hygric.options
+    assert "source" not in cfg.hygric.options.given()
     assert "a moisture source (source: true" in text
     assert "the sorbing buffer has no moisture source term" in text

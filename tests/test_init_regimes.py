@@ -88,8 +88,8 @@ def test_the_periods_stay_in_one_regime(switched_off):
     )
     assert cfg.periods.validation.end == "2015-01-01"
     # the model measured over that stretch: the band and the dehumidifier's heat
-    assert cfg.hygric.options == {"humidistat": "band"}
-    assert cfg.thermal.options == {"thermostat": True, "source": True}
+    assert cfg.hygric.options.given() == {"humidistat": "band"}
+    assert cfg.thermal.options.given() == {"thermostat": True, "source": True}
     # the evidence, year by year, in the periods' comment and on the console
     text = out.read_text(encoding="utf-8")
     flat = " ".join(line.strip("# ") for line in text.splitlines() if line.startswith("  #"))

@@ -332,7 +332,7 @@ def test_rejections_name_the_culprit():
             hb.simulate(m, P4A, np.zeros((5, 6)), dt=dt)
     with pytest.raises(ValueError, match="unknown model 'thermal_9z'"):
         hb.model("thermal_9z")
-    with pytest.raises(ValueError, match="unknown option"):
+    with pytest.raises(ValueError, match="facades: unknown key; did you mean 'surfaces'"):
         hb.model("thermal_4a", facades=("S",))
     with pytest.raises(ValueError, match="common length"):
         hb.simulate(m, {**P4A, "Ci": np.ones(3) * 1e6, "Cw": np.ones(4) * 1e8}, np.zeros((5, 6)))

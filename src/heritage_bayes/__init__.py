@@ -19,7 +19,7 @@ _LAZY = {
     "RCModel": "heritage_bayes.rc",
     "available_models": "heritage_bayes.rc",
     "discretize": "heritage_bayes.rc",
-    "model": "heritage_bayes.rc",
+    "model": "heritage_bayes.models",
     "simulate": "heritage_bayes.rc",
     "structural_identifiability": "heritage_bayes.rc",
     "load_run": "heritage_bayes.run",

@@ -41,8 +41,14 @@ from heritage_bayes.ladder import (  # structural_at_map: re-exported
     section_log_posterior,
     structural_at_map,
 )
-from heritage_bayes.models import AUTO, SECTIONS, _catalog_options, build_model, initial_state_of
-from heritage_bayes.rc.catalog import model as catalog_model
+from heritage_bayes.models import (
+    AUTO,
+    SECTIONS,
+    build_model,
+    catalog_build,
+    catalog_options,
+    initial_state_of,
+)
 from heritage_bayes.rc.model import RCModel
 from heritage_bayes.run import (  # Run, load_run: re-exported
     Run,
@@ -504,8 +510,9 @@ def model_ladder(cfg: CalibrationConfig, prep, section: _Section, *, seed: int) 
             model, lp, mp = section.model, section.logpost, section.map
         else:
             try:
-                model = catalog_model(name, **_catalog_options(cfg, section.name, name))
-            except ValueError:
+                opts = catalog_options(cfg, section.name, name)
+                model = catalog_build(cfg, section.name, name, opts)
+            except ValueError:  # a rung that does not take the configured options
                 continue
             if model.output_names != out:
                 continue

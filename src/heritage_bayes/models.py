@@ -6,16 +6,20 @@ needs), by the orchestrator and by the run directory's loader; imports neither.
 
 from __future__ import annotations
 
+import json
 import re
+import weakref
 from collections.abc import Mapping
 
 import pandas as pd
 
 from heritage_bayes.config import CalibrationConfig
+from heritage_bayes.config.options import NETWORK_OPTIONS, parse_options
 from heritage_bayes.errors import ConfigError
 from heritage_bayes.names import DEFAULT_NOISE
 from heritage_bayes.rc.catalog import CATALOG, DomainView, auto_ladder, takes_option
 from heritage_bayes.rc.catalog import model as catalog_model
+from heritage_bayes.rc.control_spec import COMPONENTS
 from heritage_bayes.rc.model import RCModel
 from heritage_bayes.rc.network import Network
 
@@ -25,8 +29,13 @@ __all__ = [
     "SECTIONS",
     "auto_rungs",
     "build_model",
+    "catalog_build",
+    "catalog_options",
     "describe_model",
     "input_hold_of",
+    "model",
+    "models_of",
+    "with_input_hold",
 ]
 
 SECTIONS = ("thermal", "hygric")
@@ -51,9 +60,9 @@ def rung_label(name: str, own: Mapping) -> str:
 
 
 def rung_options(cfg: CalibrationConfig, section: str, name: str, own: Mapping) -> dict:
-    """Options of a rung: the configured ones without ``sink``, the rung's own, and the
-    solar surfaces (:func:`_catalog_options`)."""
-    opts = {k: v for k, v in _catalog_options(cfg, section, name).items() if k != "sink"}
+    """Network options of a rung: the configured ones without ``sink``, the rung's own,
+    and the solar surfaces (:func:`catalog_options`)."""
+    opts = {k: v for k, v in catalog_options(cfg, section, name).items() if k != "sink"}
     return {**opts, **own}
 
 
@@ -81,36 +90,97 @@ def build_model(cfg: CalibrationConfig, section: str) -> RCModel:
 
     Catalogue models get their solar surfaces from ``data.surfaces`` (none when
     ``data.irradiance: none``); a mapping under ``model:`` is a custom network
-    (:meth:`heritage_bayes.rc.Network.from_dict`).
+    (:meth:`heritage_bayes.rc.Network.from_dict`). Built once per config object and
+    section: a later call returns the same model while the settings it reads are
+    unchanged.
+
+    Raises
+    ------
+    ConfigError
+        An unknown model, an option the model does not take (naming
+        ``<section>.options.<key>``), or a model of the other domain.
     """
+    cache = _CACHE.get(id(cfg))
+    if cache is None:
+        cache = _CACHE[id(cfg)] = {}
+        weakref.finalize(cfg, _CACHE.pop, id(cfg), None)
+    key = _settings_key(cfg, section)
+    hit = cache.get(section)
+    if hit is not None and hit[0] == key:
+        return hit[1]
+    m = _build_model(cfg, section)
+    cache[section] = (key, m)
+    return m
+
+
+#: id(config) -> {section: (the settings it was built from, model)}: the models of a
+#: config object, built once; an entry leaves with its config.
+_CACHE: dict[int, dict[str, tuple]] = {}
+
+
+def _settings_key(cfg: CalibrationConfig, section: str) -> tuple:
+    """Everything :func:`build_model` reads, as values: the section's model and options
+    as written, the solar surfaces and the input hold."""
+    sec = getattr(cfg, section)
+    written = [sec.model, sec.options.given()]
+    return (
+        json.dumps(written, sort_keys=True, default=str),
+        tuple(cfg.data.surfaces),
+        cfg.data.irradiance,
+        input_hold_of(cfg),
+    )
+
+
+def models_of(cfg: CalibrationConfig) -> dict[str, RCModel]:
+    """The models of every configured section, built once (:func:`build_model`)."""
+    return {s: build_model(cfg, s) for s in SECTIONS if getattr(cfg, s) is not None}
+
+
+def _build_model(cfg: CalibrationConfig, section: str) -> RCModel:
     sec = getattr(cfg, section)
     where = f"{section}.model"
-    try:
-        if isinstance(sec.model, Mapping):
-            m = RCModel(Network.from_dict(sec.model, where=where))
-            _check_names(m, where)
-        else:
-            if sec.model == AUTO:  # the richest rung: its inputs cover every rung's
-                return auto_rungs(cfg, section)[-1][1]
-            if sec.model not in CATALOG:
-                raise ConfigError(
-                    f"{where}: unknown model {sec.model!r}; available: {sorted(CATALOG)}"
-                )
-            m = catalog_model(sec.model, **_catalog_options(cfg, section, sec.model))
-    except ConfigError:
-        raise
-    except ValueError as exc:
-        msg = str(exc)
-        if msg.startswith(("thermostat.", "humidistat.")):  # a control option's key path
-            raise ConfigError(f"{section}.options.{msg}") from None
-        raise ConfigError(msg if msg.startswith(f"{where}") else f"{where}: {msg}") from None
+    if isinstance(sec.model, Mapping):
+        try:
+            net = Network.from_dict(sec.model, where=where)
+        except ValueError as exc:  # its messages name their key path
+            raise ConfigError(str(exc)) from None
+        try:
+            m = RCModel(net)
+        except ValueError as exc:
+            raise ConfigError(f"{where}: {exc}") from None
+        _check_names(m, where)
+    elif sec.model == AUTO:  # the richest rung: its inputs cover every rung's
+        return auto_rungs(cfg, section)[-1][1]
+    elif sec.model not in CATALOG:
+        raise ConfigError(f"{where}: unknown model {sec.model!r}; available: {sorted(CATALOG)}")
+    else:
+        m = catalog_build(cfg, section, sec.model, catalog_options(cfg, section, sec.model))
     if m.domain != section:
         raise ConfigError(f"{where}: a {m.domain} model cannot be used in the {section!r} section")
-    if input_hold_of(cfg) == "exact":
-        # every network input gets its slope column: the data layer fills it with the
-        # change over the step for instantaneous readings, zeros for interval means
-        m = m.with_slopes(m.network.inputs)
-    return m
+    return with_input_hold(cfg, m)
+
+
+def with_input_hold(cfg: CalibrationConfig, m: RCModel) -> RCModel:
+    """``m`` as the data feed it: with ``data.input_hold: exact`` every network input
+    gets its slope column (the data layer fills it with the change over the step for
+    instantaneous readings, zeros for interval means)."""
+    return m.with_slopes(m.network.inputs) if input_hold_of(cfg) == "exact" else m
+
+
+def catalog_build(cfg: CalibrationConfig, section: str, name: str, options: dict) -> RCModel:
+    """Catalogue model ``name`` with the network ``options`` and the section's control.
+
+    Raises
+    ------
+    ConfigError
+        An option ``name`` does not take (``<section>.options.<key>``, listing those it
+        takes), or a combination it refuses (``<section>.options``, the model's reason).
+    """
+    _check_takes(name, options, f"{section}.options.")
+    try:
+        return catalog_model(name, getattr(cfg, section).options.control(), **options)
+    except ValueError as exc:
+        raise ConfigError(f"{section}.options: {exc}") from None
 
 
 def auto_rungs(cfg: CalibrationConfig, section: str) -> list[tuple[str, RCModel, str | None]]:
@@ -124,12 +194,11 @@ def auto_rungs(cfg: CalibrationConfig, section: str) -> list[tuple[str, RCModel,
         label = rung_label(name, own)
         labels.setdefault(name, label)  # a parent is named by its first rung
         try:
-            m = catalog_model(name, **rung_options(cfg, section, name, own))
-        except ValueError as exc:
+            m = catalog_build(cfg, section, name, rung_options(cfg, section, name, own))
+        except ConfigError as exc:
             refused.append(f"{label}: {exc}")
             continue
-        if input_hold_of(cfg) == "exact":
-            m = m.with_slopes(m.network.inputs)
+        m = with_input_hold(cfg, m)
         rungs.append((label, m, labels.get(parent) if parent else None))
     if not rungs:
         raise ConfigError(
@@ -183,13 +252,63 @@ def default_warmup(cfg: CalibrationConfig) -> pd.Timedelta:
     return pd.Timedelta(days=14) if steady else pd.Timedelta(0)
 
 
-def _catalog_options(cfg: CalibrationConfig, section: str, name: str) -> dict:
-    """Options of catalogue model ``name`` in a section: the configured ones, plus the
-    solar surfaces from ``data.surfaces`` (none when ``data.irradiance: none``)."""
-    options = dict(getattr(cfg, section).options)
+def catalog_options(cfg: CalibrationConfig, section: str, name: str) -> dict:
+    """Network options of catalogue model ``name`` in a section: the configured ones,
+    plus the solar surfaces from ``data.surfaces`` (none when ``data.irradiance:
+    none``)."""
+    options = getattr(cfg, section).options.network_options()
     if CATALOG[name].solar and "surfaces" not in options:
         options["surfaces"] = tuple(cfg.data.surfaces) if cfg.data.irradiance != "none" else ()
     return options
+
+
+def model(name: str, **options) -> RCModel:
+    """A catalogue model by name, with its options as a config section writes them.
+
+    Parameters
+    ----------
+    name : str
+        One of :func:`heritage_bayes.available_models`.
+    **options
+        The keys of ``<section>.options``
+        (:class:`heritage_bayes.config.options.ModelOptions`): ``surfaces``, ``ground``,
+        ``heating``, ``sink``, ``thermostat`` (true or a mapping), ``humidistat`` (true,
+        a mode or a mapping), ``source``.
+
+    Raises
+    ------
+    ValueError
+        Unknown name, an option of the wrong type or one the model does not take
+        (:class:`~heritage_bayes.errors.ConfigError`, naming the option).
+
+    Examples
+    --------
+    >>> model("thermal_2c", ground=False, thermostat={"power_limit": True}).parameter_names[-2:]
+    ('Tset', 'Pmax')
+    """
+    if name not in CATALOG:
+        raise ValueError(f"unknown model {name!r}; available: {sorted(CATALOG)}")
+    domain = CATALOG[name].domain
+    opts = parse_options(options, f"model {name!r}")
+    bad = opts.misplaced_control(domain)
+    if bad:
+        raise ConfigError(f"model {name!r}: option {bad} needs a {COMPONENTS[bad]} model")
+    net = opts.network_options()
+    _check_takes(name, net, "")
+    return catalog_model(name, opts.control(), **net)
+
+
+def _check_takes(name: str, options: Mapping, prefix: str) -> None:
+    """:class:`ConfigError` naming ``<prefix><key>`` for a network option that catalogue
+    model ``name``'s factory does not take (listing those it takes)."""
+    refused = [k for k in options if not takes_option(name, k)]
+    if refused:
+        allowed = [k for k in NETWORK_OPTIONS if takes_option(name, k)]
+        raise ConfigError(
+            f"{prefix}{refused[0]}: model {name!r} does not take this option; its "
+            f"network options: {allowed or 'none'} (and the control: thermostat or "
+            "humidistat, source)"
+        )
 
 
 def describe_model(name: str, noise: str = DEFAULT_NOISE) -> str:

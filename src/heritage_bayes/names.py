@@ -1,5 +1,5 @@
-"""The name lists a user chooses from, declared once: noise models, sampler moves and
-prior families.
+"""The name lists a user chooses from, declared once: noise models, sampler moves,
+prior families and the controls of a room's air.
 
 Layer 0, imported by the settings (the choices of ``noise:`` and ``sampler.moves``,
 :class:`heritage_bayes.config._base.Choices`), by the command line (``hbayes models
@@ -18,7 +18,9 @@ from __future__ import annotations
 from typing import NamedTuple
 
 __all__ = [
+    "CONTROLS",
     "DEFAULT_NOISE",
+    "HUMIDISTAT_MODES",
     "MOVES",
     "NOISE_MODELS",
     "PRIOR_DISTRIBUTIONS",
@@ -129,3 +131,11 @@ PRIOR_DISTRIBUTIONS: dict[str, DistributionName] = {
         span=5.0,
     ),
 }
+
+
+#: Controls of a room's air (``<section>.options``, :mod:`heritage_bayes.rc.control`):
+#: name -> the domain of the model it acts on (None: either).
+CONTROLS: dict[str, str | None] = {"thermostat": "thermal", "humidistat": "hygric", "source": None}
+#: Modes of a humidistat: the air's RH held within ``[RH_lo, RH_hi]``, below ``RH_hi``,
+#: above ``RH_lo``, at ``RH_set``.
+HUMIDISTAT_MODES = ("band", "dehumidifier", "humidifier", "setpoint")

@@ -44,7 +44,7 @@ the heated room below an attic, a crypt), aligned like the other inputs.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -283,7 +283,7 @@ def _check_models_vs_irradiance(cfg) -> None:
     sec = cfg.thermal
     if sec is None or cfg.data.irradiance != "none":
         return
-    surf = sec.options.get("surfaces") if isinstance(sec.options, Mapping) else None
+    surf = sec.options.surfaces
     if surf:
         raise ConfigError(
             f"thermal.options.surfaces: {list(surf)} are solar surfaces, but data.irradiance "

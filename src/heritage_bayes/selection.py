@@ -43,6 +43,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from heritage_bayes.config.options import ModelOptions
 from heritage_bayes.errors import ConfigError, InputError
 from heritage_bayes.ladder import ladder_row, rung_log_posterior
 from heritage_bayes.models import AUTO, AUTO_LADDERS, auto_rungs, rung_label
@@ -357,7 +358,8 @@ def chosen_section(cfg, section: str, scr: Screen):
     if sec.model != AUTO:
         raise ValueError(f"{section}.model is {sec.model!r}, not {AUTO!r}")
     model = scr.models[scr.choice["choice"]]
-    options = {k: v for k, v in sec.options.items() if k != "sink"} | own
+    given = {k: v for k, v in sec.options.given().items() if k != "sink"} | own
+    options = ModelOptions.model_validate(given)
     priors = {
         k: v
         for k, v in sec.priors.items()

@@ -57,18 +57,17 @@ def _candidate_config(cfg, section: str, name: str):
 
     sec = getattr(cfg, section)
     # the configured priors whose parameters exist in this model (as the ladder does)
-    from heritage_bayes.models import _catalog_options
-    from heritage_bayes.rc.catalog import model as catalog_model
+    from heritage_bayes.config.options import ModelOptions
+    from heritage_bayes.models import catalog_build, catalog_options
     from heritage_bayes.rc.catalog import takes_option
     from heritage_bayes.run import section_parameters
 
-    if "sink" in sec.options and not takes_option(name, "sink"):  # (a rung's own, as in auto)
-        sec = sec.model_copy(
-            update={"options": {k: v for k, v in sec.options.items() if k != "sink"}}
-        )
+    if sec.options.sink is not None and not takes_option(name, "sink"):  # a rung's own, as in auto
+        given = {k: v for k, v in sec.options.given().items() if k != "sink"}
+        sec = sec.model_copy(update={"options": ModelOptions.model_validate(given)})
         cfg = cfg.model_copy(update={section: sec})
     try:
-        model = catalog_model(name, **_catalog_options(cfg, section, name))
+        model = catalog_build(cfg, section, name, catalog_options(cfg, section, name))
     except ValueError as exc:
         raise ConfigError(f"--models: {name}: {exc}") from None
     keep = set(model.parameter_names) | {"sigma", "phi"}

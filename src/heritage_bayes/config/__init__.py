@@ -14,8 +14,9 @@ the expected form and the value found, e.g. ``priors.Gw.lower: must be < upper (
 Modules, by topic: :mod:`~heritage_bayes.config.sources` (``site``, the tables),
 :mod:`~heritage_bayes.config.data` (``data``: solar input, ground, grid),
 :mod:`~heritage_bayes.config.periods`, :mod:`~heritage_bayes.config.models` (one
-calibrated model: options, noise, initial state), :mod:`~heritage_bayes.config.priors`
-(a parameter's prior or fixed value),
+calibrated model: noise, initial state), :mod:`~heritage_bayes.config.options`
+(its options: the network's, and the thermostat, humidistat and source, typed),
+:mod:`~heritage_bayes.config.priors` (a parameter's prior or fixed value),
 :mod:`~heritage_bayes.config.sampler` (``sampler``, ``optimizer``),
 :mod:`~heritage_bayes.config.calibration` (the top level, outputs, :func:`load_config`),
 :mod:`~heritage_bayes.config.loader` (strict YAML), :mod:`~heritage_bayes.config.reference`

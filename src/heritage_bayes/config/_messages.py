@@ -104,7 +104,7 @@ def key_path(loc, raw: Any) -> str:
     return text
 
 
-_KEY_PREFIX = re.compile(r"^([A-Za-z_]\w*(?:\.[A-Za-z_]\w*)*): ")
+_KEY_PREFIX = re.compile(r"^([A-Za-z_]\w*(?:\[\d+\])*(?:\.[A-Za-z_]\w*(?:\[\d+\])*)*): ")
 
 
 def format_error(err: dict, raw: Any, root: type[BaseModel]) -> str:

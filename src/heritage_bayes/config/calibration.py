@@ -9,7 +9,7 @@ import json
 from pathlib import Path
 from typing import Any
 
-from pydantic import PrivateAttr, model_validator
+from pydantic import PrivateAttr, field_validator, model_validator
 
 from heritage_bayes.config._base import MAX_SEED, _Strict, key
 from heritage_bayes.config._messages import validate
@@ -136,6 +136,18 @@ class CalibrationConfig(_Strict):
     def source_text(self) -> str | None:
         """The YAML text the config was read from (set by :func:`load_config`)."""
         return self._source_text
+
+    @field_validator("thermal", "hygric")
+    @classmethod
+    def _control_of_its_domain(cls, sec, info):
+        bad = sec.options.misplaced_control(info.field_name) if sec is not None else None
+        if bad:
+            other = "hygric" if info.field_name == "thermal" else "thermal"
+            raise ValueError(
+                f"options.{bad}: a {bad} controls the air of a {other} model; give it "
+                f"under {other}.options"
+            )
+        return sec
 
     @model_validator(mode="after")
     def _needs_models(self):

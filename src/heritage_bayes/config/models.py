@@ -2,8 +2,9 @@
 its options, the noise model, the initial state and the priors
 (:class:`~heritage_bayes.config.priors.PriorSpec`, typed here).
 
-The model names and options, and the parameter names of the priors, are checked where
-the catalogue is known (:func:`heritage_bayes.models.build_model`,
+The options are typed here (:mod:`heritage_bayes.config.options`); the model names,
+which catalogue model takes which option, and the prior keys are checked where the
+catalogue is known (:func:`heritage_bayes.models.build_model`,
 :func:`heritage_bayes.inference.parameters.parameters_for`), before any data are read.
 """
 
@@ -16,6 +17,7 @@ import pandas as pd
 from pydantic import PlainSerializer, PlainValidator, WithJsonSchema
 
 from heritage_bayes.config._base import DURATION_UNIT, Choices, _duration, _Strict, key
+from heritage_bayes.config.options import ModelOptions
 from heritage_bayes.config.priors import PriorSpec
 from heritage_bayes.convert import format_timedelta
 from heritage_bayes.names import DEFAULT_NOISE, NOISE_MODELS
@@ -72,11 +74,11 @@ class ModelSection(_Strict):
         "simplest within 2 FIT points of the best sampled) or an RC network given as a "
         "mapping",
     )
-    options: dict[str, Any] = key(
+    options: ModelOptions = key(
         unit=None,
-        description="the model's options: surfaces, ground, heating, thermostat, "
+        description="the model's options: surfaces, ground, heating, sink, thermostat, "
         "humidistat, source (hbayes models)",
-        default_factory=dict,
+        default_factory=ModelOptions,
     )
     noise: Annotated[str, Choices(NOISE_MODELS)] = key(
         DEFAULT_NOISE,

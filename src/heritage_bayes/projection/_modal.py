@@ -3,7 +3,7 @@
 The arrays one draw of a free-running model hands to the compiled pass (its modal
 recursion as ``RCModel.forward`` sets it up), the pass's work arrays, and the noise-free
 series of a measure's controllers stepped on the free-running network
-(:func:`heritage_bayes.rc.control.coupled_draw`, the same arithmetic as the pass).
+(:func:`heritage_bayes.rc.control_kernels.coupled_draw`, the same arithmetic as the pass).
 The noise of a chunk and the reference path of a controlled measure are here too.
 Split from :mod:`heritage_bayes.projection.engine`, which calls them.
 """
@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from heritage_bayes.rc.control import N_COST
+from heritage_bayes.rc.control_kernels import N_COST
 
 if TYPE_CHECKING:
     from heritage_bayes.projection.cases import Case, CaseOut, Draws
@@ -70,8 +70,8 @@ def _work(plan, slots: int, N: int) -> tuple:
 def _coupled_series(c: Case, modal: dict, ctrl: tuple, sig, rows, w: int, cost=None):
     """Noise-free ``Ti``, ``Pi`` (section -> (k, N)) of the chunk's draws ``rows``
     (positions in the chunk) with a measure's controllers
-    (:func:`heritage_bayes.rc.control.coupled_draw`, the compiled pass's arithmetic)."""
-    from heritage_bayes.rc.control import coupled_draw
+    (:func:`heritage_bayes.rc.control_kernels.coupled_draw`, the compiled pass's arithmetic)."""
+    from heritage_bayes.rc.control_kernels import coupled_draw
 
     ctl, bdT, bdP, spin, src = ctrl
     mT = _modal_arrays(modal["thermal"], c.U["thermal"][: max(1, w)].mean(axis=0),
@@ -120,7 +120,7 @@ def _noise(draws: Draws, sl: slice, N: int, seed: int, i: int, models=None, dt=3
 def _controlled(run, P, c: Case, o: CaseOut | None, rows, dt, w, measure) -> dict:
     """The reference path: noise-free ``Ti``, ``Pi`` (section -> (k, N)) of draws
     ``rows`` through :meth:`Measure.simulate`; its running costs stored as sums in ``o``
-    (the compiled pass's :data:`~heritage_bayes.rc.control.N_COST` columns)."""
+    (the compiled pass's :data:`~heritage_bayes.rc.control_kernels.N_COST` columns)."""
     u0 = {s: c.U[s][: max(1, w)].mean(axis=0) for s in run.models}
     Y, costs = measure.simulate(run, {s: P[s][rows] for s in run.models}, c.U, u0, dt,
                                 index=c.index)  # fmt: skip

@@ -37,8 +37,8 @@ from heritage_bayes.climate.risk._fused import (
     wet,
 )
 from heritage_bayes.climate.risk.registry import ANNUAL
-from heritage_bayes.rc import control as _control
-from heritage_bayes.rc.control import coupled_draw
+from heritage_bayes.rc import control_kernels as _control
+from heritage_bayes.rc.control_kernels import coupled_draw
 
 
 @njit(cache=True, error_model="numpy")
@@ -267,12 +267,12 @@ def chunk_kernel(
     ``en`` = (mode, half window, wrap, -, -, LIM constant), ``hoy`` (hours,) the hour of
     the year of each hour; ``mabuf`` (slots, hours) and ``cbuf`` (slots, 8760) work.
 
-    An intervention (``ctl`` (draws, :data:`~heritage_bayes.rc.control.N_CP`), (0, ·)
+    An intervention (``ctl`` (draws, :data:`~heritage_bayes.rc.control_kernels.N_CP`), (0, ·)
     for none): both models are stepped together with their controllers
-    (:func:`heritage_bayes.rc.control.coupled_draw`, modal arrays as above, unit-flow
+    (:func:`heritage_bayes.rc.control_kernels.coupled_draw`, modal arrays as above, unit-flow
     responses ``bdT``/``bdP`` (draws, n), hours of use ``sig`` (hours,), periodic
     spin-up over ``spin`` steps), running-cost sums into ``cost`` (draws,
-    :data:`~heritage_bayes.rc.control.N_COST`). ``par_on`` False (with ``noise``): the
+    :data:`~heritage_bayes.rc.control_kernels.N_COST`). ``par_on`` False (with ``noise``): the
     noise-free indicators are not computed (NaN; a measure is compared predictive
     with predictive).
     """

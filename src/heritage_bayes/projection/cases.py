@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from heritage_bayes.rc.control import N_COST
+from heritage_bayes.rc.control_kernels import N_COST
 
 __all__ = ["Case", "CaseOut", "CaseResult", "Draws"]
 

@@ -46,7 +46,7 @@ from heritage_bayes.projection._modal import (
     coupled_pair,
 )
 from heritage_bayes.projection.cases import Case, CaseOut, CaseResult, Draws
-from heritage_bayes.rc.control import N_CP
+from heritage_bayes.rc.control_kernels import N_CP
 
 
 def select_draws(run, n: int | None, seed: int) -> Draws:
@@ -190,7 +190,7 @@ def simulate_cases(
         measures in one pass).
     compiled : bool
         A measure's controllers stepped in the compiled pass
-        (:func:`heritage_bayes.rc.control.coupled_draw`); False: through
+        (:func:`heritage_bayes.rc.control_kernels.coupled_draw`); False: through
         :meth:`~heritage_bayes.projection.interventions.Measure.simulate`
         (``ControlledModel.forward``, each controller against the other model's
         free-running series; the previous implementation, kept as the reference the
@@ -233,7 +233,7 @@ def simulate_measures(
     Per chunk of draws the noise is drawn once and each case's weather prepared once
     for doing nothing and every measure; a measure with a controller steps both models
     together
-    (:func:`heritage_bayes.rc.control.coupled_draw`) in the compiled pass, draws in
+    (:func:`heritage_bayes.rc.control_kernels.coupled_draw`) in the compiled pass, draws in
     parallel over the threads, and only its predictive indicators are computed (a
     measure is compared predictive with predictive; its ``parametric`` frame is NaN
     when ``noise``).

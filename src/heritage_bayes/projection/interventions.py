@@ -21,7 +21,7 @@ draw (:class:`Measure`):
   (dehumidification or a band), ventilation with any.
 
 The controllers are stepped in the compiled projection pass
-(:func:`heritage_bayes.rc.control.coupled_draw`, the step of
+(:func:`heritage_bayes.rc.control_kernels.coupled_draw`, the step of
 :class:`~heritage_bayes.rc.control.ControlledModel`): per draw both models advance
 together, each controller reading the air at the start of the step (conservation
 heating the controlled ``Pi``, the humidistat the saturation pressure at the
@@ -141,12 +141,13 @@ class Measure:
 
     def controller_arrays(self, k: int, modal: dict, run, P: dict) -> tuple:
         """The compiled pass's controllers for ``k`` draws: ``(cp (k, N_CP), bdT (k, nT),
-        bdP (k, nP), spin, sources)`` (:func:`heritage_bayes.rc.control.coupled_draw`;
+        bdP (k, nP), spin, sources)`` (:func:`heritage_bayes.rc.control_kernels.coupled_draw`;
         ``modal``: section -> modal form of the draws' networks, ``P``: section -> their
         parameters, after :meth:`params`). ``sources``: section -> (constant forcing
         (k, n), steady-state shift (k, n)) of a calibrated constant source ``Qs`` [W] or
         ``Ms`` [kg/s] (``options.source``), added to the modal arrays."""
-        from heritage_bayes.rc import control as rc
+        from heritage_bayes.rc import control_kernels as rc
+        from heritage_bayes.rc.control import ControlledModel
 
         cp = np.zeros(rc.N_CP)
         cp[rc.CP_P_MAX] = np.inf
@@ -175,7 +176,7 @@ class Measure:
             air = int(m._ix["out"][0])
             bz = mf.s[:, air, None] * mf.V[:, air, :]
             bd[s] = np.ascontiguousarray(mf.phi * bz)
-            if isinstance(m, rc.ControlledModel) and m.control.source:
+            if isinstance(m, ControlledModel) and m.control.source:
                 names = m.parameter_names
                 q = P[s][:, names.index("Qs" if "Qs" in names else "Ms")][:, None]
                 lam = np.where(mf.lam > 0, mf.lam, np.inf)
@@ -196,7 +197,7 @@ class Measure:
 
     def costs(self, sums: np.ndarray, dt: float, years: float) -> dict:
         """Running costs (:data:`COSTS` name -> (K,) values) from the compiled pass's
-        sums (:data:`heritage_bayes.rc.control.N_COST` columns) over ``years``."""
+        sums (:data:`heritage_bayes.rc.control_kernels.N_COST` columns) over ``years``."""
         out: dict = {}
         if self.heating is not None or self.thermostat is not None:
             out["heating_energy"] = sums[:, 0] * dt / 3.6e6 / years
@@ -284,7 +285,7 @@ class Measure:
 
     def cost_sums(self, costs: dict, dt: float, years: float) -> np.ndarray:
         """The inverse of :meth:`costs`: (K, N_COST) sums from running costs."""
-        from heritage_bayes.rc.control import N_COST
+        from heritage_bayes.rc.control_kernels import N_COST
 
         k = len(next(iter(costs.values()))) if costs else 0
         out = np.zeros((k, N_COST))

@@ -1,9 +1,12 @@
 """Layer 1: RC networks, exact discretization and the fast simulator (pure numpy/scipy).
 
-See :mod:`heritage_bayes.rc.catalog` for the paper's models.
+See :mod:`heritage_bayes.rc.catalog` for the paper's models. Its :func:`model` takes
+typed options (the network's keywords and a :class:`Control`);
+:func:`heritage_bayes.model` takes them as a config section writes them.
 """
 
 from heritage_bayes.rc.catalog import CATALOG, available_models, model
+from heritage_bayes.rc.control_spec import Control
 from heritage_bayes.rc.derived import (
     constant_contributions,
     derived_quantities,
@@ -26,6 +29,7 @@ from heritage_bayes.rc.simulate import iter_simulate, simulate
 
 __all__ = [
     "CATALOG",
+    "Control",
     "IdentifiabilityResult",
     "Link",
     "ModalForm",

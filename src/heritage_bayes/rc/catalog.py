@@ -55,13 +55,11 @@ e.g. measured heating power in a test cell; it makes the absolute scale of C and
 identifiable).
 
 Control of the air node (a heated, humidity-controlled or occupied room; see
-:mod:`heritage_bayes.rc.control`): ``thermostat`` (true, or a mapping with
-``power_limit``, ``schedule`` (an input column, or a weekly calendar
-``{weekly: ["Sun 08-12"], timezone: ...}``), ``conservation``), ``humidistat`` (true, a mode
-``band``/``dehumidifier``/``humidifier``/``setpoint``, or a mapping with ``mode`` and
-``capacity``) and ``source`` (true: a constant heat gain ``Qs`` [W] or moisture source
-``Ms`` [kg/s]). Any catalogue model takes them, e.g.
-``model("thermal_2c", thermostat={"power_limit": True})``.
+:mod:`heritage_bayes.rc.control`): a typed :class:`~heritage_bayes.rc.control_spec.Control`
+(thermostat, humidistat, constant source), which any catalogue model takes, e.g.
+``model("thermal_2c", Control(thermostat=True, power_limit=True))``; the settings build
+it from a section's ``options`` (:mod:`heritage_bayes.config.options`), and
+:func:`heritage_bayes.model` takes the options as the YAML writes them.
 """
 
 from __future__ import annotations
@@ -70,7 +68,8 @@ import inspect
 from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from typing import NamedTuple
 
-from heritage_bayes.rc.control import _parse_control, controlled
+from heritage_bayes.rc.control import controlled
+from heritage_bayes.rc.control_spec import Control
 from heritage_bayes.rc.model import RCModel
 from heritage_bayes.rc.network import Link, Network, Node, Source
 from heritage_bayes.rc.sorption import CoupledHygricModel, coupled_network
@@ -473,37 +472,42 @@ def available_models() -> dict[str, str]:
     return {k: v.description for k, v in CATALOG.items()}
 
 
-def model(name: str, **options) -> RCModel:
+def model(name: str, control: Control | None = None, **options) -> RCModel:
     """A catalogue model by name, compiled.
 
     Parameters
     ----------
     name : str
         One of :func:`available_models` (``"thermal_4a"``, ``"hygric_2c"``, ...).
+    control : Control, optional
+        The control of the air node: thermostat (thermal), humidistat (hygric),
+        constant source (both); see :mod:`heritage_bayes.rc.control`. Default none.
     **options
-        ``surfaces``, ``ground``, ``heating`` for thermal models (see module docstring);
-        the control of the air node: ``thermostat`` (thermal), ``humidistat``
-        (hygric), ``source`` (both); see :mod:`heritage_bayes.rc.control`.
+        The network's options, keywords of the model's factory: ``surfaces``,
+        ``ground``, ``heating`` for thermal models, ``sink`` for the hygric ones with a
+        fixed node (see the module docstring).
 
     Raises
     ------
     ValueError
-        Unknown name (the message lists the catalogue) or unknown option.
+        Unknown name (the message lists the catalogue), an option the model does not
+        take (the message lists those it takes), or a control the model cannot have.
+
+    Examples
+    --------
+    >>> from heritage_bayes.rc.control_spec import Control
+    >>> model("thermal_2c", Control(thermostat=True, power_limit=True), ground=False).name
+    'thermal_2c'
     """
     if name not in CATALOG:
         raise ValueError(f"unknown model {name!r}; available: {sorted(CATALOG)}")
-    entry = CATALOG[name]
-    factory = entry.factory
-    options = dict(options)
-    control = _parse_control(entry.domain, name, options)
-    try:
-        net = factory(**options)
-    except TypeError as exc:
-        allowed = [*inspect.signature(factory).parameters, "source"]
-        allowed += ["thermostat"] if entry.domain == "thermal" else ["humidistat"]
-        raise ValueError(
-            f"model {name!r}: unknown option(s) in {sorted(options)}; allowed: {allowed}"
-        ) from exc
+    factory = CATALOG[name].factory
+    allowed = list(inspect.signature(factory).parameters)
+    unknown = sorted(k for k in options if k not in allowed)
+    if unknown:
+        raise ValueError(f"model {name!r}: unknown option(s) {unknown}; allowed: {allowed}")
+    control = Control() if control is None else control
+    net = factory(**options)
     if isinstance(net, RCModel):  # a time-varying model, compiled by its factory
         if control.active:
             raise ValueError(

@@ -15,6 +15,7 @@ per model, its ladder position and solar capability included).
 
 from __future__ import annotations
 
+import math
 from typing import NamedTuple
 
 __all__ = [
@@ -101,7 +102,10 @@ class DistributionName:
 
     A family is flat or normal in its sampling coordinate :math:`y` (:math:`\\log\\theta`
     for a log-scale family, else :math:`\\theta`), truncated to the bounds; a new family
-    is one subclass and one entry of :data:`PRIOR_DISTRIBUTIONS`.
+    of these shapes is one subclass and one entry of :data:`PRIOR_DISTRIBUTIONS` (the
+    sampler's vectorised log-prior,
+    :meth:`heritage_bayes.inference.parameters.ParameterSet.transform`, reads its
+    ``log_scale`` and ``centre``; another shape would change it too).
     """
 
     #: Sampled in log θ: the parameter must be positive (``lower > 0``).
@@ -133,8 +137,6 @@ class DistributionName:
     def support(self, mu: float, sigma: float) -> tuple[float, float]:
         """The bounds a centred family takes when none are given: the centre ±
         ``span`` × ``sigma`` in the sampling coordinate, in parameter units."""
-        import math
-
         if self.log_scale:
             return mu * math.exp(-self.span * sigma), mu * math.exp(self.span * sigma)
         return mu - self.span * sigma, mu + self.span * sigma
@@ -187,8 +189,6 @@ class _LogNormal(_Centred):
     span = 5.0
 
     def logpdf(self, theta, mu, sigma):
-        import math
-
         import numpy as np
 
         lt = np.log(theta)

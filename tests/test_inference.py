@@ -11,11 +11,17 @@ from heritage_bayes.config import prior_specs
 from heritage_bayes.errors import ConfigError, InputError
 from heritage_bayes.inference.likelihoods import AR1Noise, IIDNoise, _ar1_sample, get_noise_model
 from heritage_bayes.inference.optimize import find_map
-from heritage_bayes.inference.parameters import Parameter, ParameterSet, parameters_for
+from heritage_bayes.inference.parameters import (
+    Parameter,
+    ParameterSet,
+    owned_priors,
+    parameters_for,
+)
 from heritage_bayes.inference.posterior import LogPosterior
 from heritage_bayes.inference.priors import Prior, configured_prior, default_prior
 from heritage_bayes.inference.sampler import run_sampler
 from heritage_bayes.inference.survey import air_capacity_prior
+from heritage_bayes.names import PRIOR_DISTRIBUTIONS
 from heritage_bayes.rc.discretize import modal_form
 
 PRIORS = [
@@ -70,6 +76,30 @@ def test_vectorised_transform_matches_per_prior_path():
     # outside the bounds of a direct (log) coordinate: zero prior density
     out = ps.transform(np.array([[0.0, math.log(1e6), 0.0, 12.0]]))[1]
     assert out[0] == -np.inf
+
+
+def test_every_prior_family_is_tested_and_labelled():
+    """The tests above cover each family of the registry; each describes itself."""
+    assert {p.dist for p in PRIORS} == set(PRIOR_DISTRIBUTIONS)
+    assert [p.describe() for p in PRIORS] == [
+        "uniform[-2, 5]",
+        "loguniform[0.01, 1e+05]",
+        "normal(3, 2) on [0, 10]",
+        "lognormal(median 2e+05, σ_log 1.5) on [1e+03, 1e+08]",
+    ]
+
+
+def test_owned_priors_keeps_those_of_the_model_and_its_noise_model():
+    """A ladder rung keeps the section's priors its model or noise model names: a
+    process-noise prior of a node it has, not one of a node it lacks."""
+    names = ("Ci", "Cw", "sigma_Ti", "phi_Ti", "q_Ti", "q_Tw")
+    priors = prior_specs({n: {"upper": 10.0} for n in names})
+    one, two = hb.model("thermal_1c"), hb.model("thermal_2c")
+    kalman = get_noise_model("kalman")
+    assert set(owned_priors(priors, one, kalman)) == {"Ci", "sigma_Ti", "q_Ti"}
+    assert set(owned_priors(priors, two, kalman)) == {"Ci", "Cw", "sigma_Ti", "q_Ti", "q_Tw"}
+    assert set(owned_priors(priors, one, get_noise_model("ar1"))) == {"Ci", "sigma_Ti", "phi_Ti"}
+    assert set(owned_priors(priors, two, get_noise_model("iid"))) == {"Ci", "Cw", "sigma_Ti"}
 
 
 def test_prior_specs_and_errors_name_the_key():

@@ -15,6 +15,8 @@ from collections.abc import Mapping
 import numpy as np
 
 from heritage_bayes.errors import InputError
+from heritage_bayes.inference.likelihoods import get_noise_model
+from heritage_bayes.inference.parameters import owned_priors
 from heritage_bayes.inference.posterior import LogPosterior
 from heritage_bayes.models import initial_state_of
 from heritage_bayes.rc.model import RCModel
@@ -65,11 +67,7 @@ def rung_log_posterior(cfg, prep, section: str, model: RCModel, initial_state) -
     configured model's mode; fixed nodes belong to the configured model, so a rung with
     a mapping estimates its own start, and a controlled rung starts steady."""
     sec_cfg = getattr(cfg, section)
-    priors = {
-        k: v
-        for k, v in sec_cfg.priors.items()
-        if k in model.parameter_names or k.split("_")[0] in ("sigma", "phi")
-    }
+    priors = owned_priors(sec_cfg.priors, model, get_noise_model(sec_cfg.noise))
     mode = initial_state
     if isinstance(mode, Mapping) or model.control is not None:
         mode = "steady" if model.control is not None else "estimate"

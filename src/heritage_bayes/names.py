@@ -1,5 +1,6 @@
 """The name lists a user chooses from, declared once: noise models, sampler moves,
-prior families and the controls of a room's air.
+prior families (each with its numerics, which import numpy only when called) and the
+controls of a room's air.
 
 Layer 0, imported by the settings (the choices of ``noise:`` and ``sampler.moves``,
 :class:`heritage_bayes.config._base.Choices`), by the command line (``hbayes models
@@ -15,6 +16,7 @@ per model, its ladder position and solar capability included).
 
 from __future__ import annotations
 
+import math
 from typing import NamedTuple
 
 __all__ = [
@@ -96,12 +98,19 @@ MOVES: dict[str, str] = {
 }
 
 
-class DistributionName(NamedTuple):
-    """What the package knows of a prior family (``priors.<name>.dist``) without
-    importing its numerics (:class:`heritage_bayes.inference.priors.Prior`)."""
+class DistributionName:
+    """A prior family (``priors.<name>.dist``): its traits, read by the settings and the
+    command line without importing numpy, and its numerics, which import it when called
+    (:class:`heritage_bayes.inference.priors.Prior` delegates to them).
 
-    #: One line for the references.
-    description: str
+    A family is flat or normal in its sampling coordinate :math:`y` (:math:`\\log\\theta`
+    for a log-scale family, else :math:`\\theta`), truncated to the bounds; a new family
+    of these shapes is one subclass and one entry of :data:`PRIOR_DISTRIBUTIONS` (the
+    sampler's vectorised log-prior,
+    :meth:`heritage_bayes.inference.parameters.ParameterSet.transform`, reads its
+    ``log_scale`` and ``centre``; another shape would change it too).
+    """
+
     #: Sampled in log θ: the parameter must be positive (``lower > 0``).
     log_scale: bool = False
     #: The config key of its centre besides ``sigma`` (``median`` or ``mean``), in the
@@ -111,24 +120,97 @@ class DistributionName(NamedTuple):
     #: log-scale family).
     span: float = 0.0
 
+    def __init__(self, description: str):
+        #: One line for the references.
+        self.description = description
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}({self.description!r})"
+
+    def logpdf(self, theta, mu: float | None, sigma: float | None):
+        """Unnormalised log density at ``theta`` (array, parameter units; bounds not
+        checked), centre ``mu`` (median or mean) and ``sigma``."""
+        raise NotImplementedError
+
+    def sample(self, rng, a: float, b: float, m: float, sigma: float | None, size: int):
+        """``size`` draws of the sampling coordinate y in [a, b] (flat in y; a normal
+        family overrides), centre ``m`` in y."""
+        return rng.uniform(a, b, size)
+
+    def support(self, mu: float, sigma: float) -> tuple[float, float]:
+        """The bounds a centred family takes when none are given: the centre ±
+        ``span`` × ``sigma`` in the sampling coordinate, in parameter units."""
+        if self.log_scale:
+            return mu * math.exp(-self.span * sigma), mu * math.exp(self.span * sigma)
+        return mu - self.span * sigma, mu + self.span * sigma
+
+    def describe(self, name: str, bounds: str, mu: float | None, sigma: float | None) -> str:
+        """Short human-readable form, e.g. ``loguniform[1e+04, 1e+12]``."""
+        return f"{name}{bounds}"
+
+
+class _Centred(DistributionName):
+    """Normal in the sampling coordinate, truncated to the bounds."""
+
+    def sample(self, rng, a, b, m, sigma, size):
+        from scipy.stats import truncnorm
+
+        lo, hi = (a - m) / sigma, (b - m) / sigma
+        return truncnorm.rvs(lo, hi, loc=m, scale=sigma, size=size, random_state=rng)
+
+
+class _Uniform(DistributionName):
+    def logpdf(self, theta, mu, sigma):
+        import numpy as np
+
+        return np.zeros_like(theta)
+
+
+class _LogUniform(DistributionName):
+    log_scale = True
+
+    def logpdf(self, theta, mu, sigma):
+        import numpy as np
+
+        return -np.log(theta)
+
+
+class _Normal(_Centred):
+    centre = "mean"
+    span = 6.0
+
+    def logpdf(self, theta, mu, sigma):
+        return -0.5 * ((theta - mu) / sigma) ** 2
+
+    def describe(self, name, bounds, mu, sigma):
+        return f"normal({mu:.3g}, {sigma:.3g}) on {bounds}"
+
+
+class _LogNormal(_Centred):
+    log_scale = True
+    centre = "median"
+    span = 5.0
+
+    def logpdf(self, theta, mu, sigma):
+        import numpy as np
+
+        lt = np.log(theta)
+        return -lt - 0.5 * ((lt - math.log(mu)) / sigma) ** 2
+
+    def describe(self, name, bounds, mu, sigma):
+        return f"lognormal(median {mu:.3g}, σ_log {sigma:.3g}) on {bounds}"
+
 
 #: ``priors.<name>.dist`` choices: the bounded prior families.
 PRIOR_DISTRIBUTIONS: dict[str, DistributionName] = {
-    "uniform": DistributionName("flat between lower and upper"),
-    "loguniform": DistributionName(
-        "flat in log θ between lower and upper (density ∝ 1/θ)", log_scale=True
+    "uniform": _Uniform("flat between lower and upper"),
+    "loguniform": _LogUniform("flat in log θ between lower and upper (density ∝ 1/θ)"),
+    "normal": _Normal(
+        "normal of mean and sd sigma, truncated to the bounds (default: mean ± 6 sigma)"
     ),
-    "normal": DistributionName(
-        "normal of mean and sd sigma, truncated to the bounds (default: mean ± 6 sigma)",
-        centre="mean",
-        span=6.0,
-    ),
-    "lognormal": DistributionName(
+    "lognormal": _LogNormal(
         "log-normal of median and sd of log sigma, truncated to the bounds (default: "
-        "median × exp(±5 sigma))",
-        log_scale=True,
-        centre="median",
-        span=5.0,
+        "median × exp(±5 sigma))"
     ),
 }
 

@@ -45,6 +45,8 @@ import numpy as np
 
 from heritage_bayes.config.options import ModelOptions
 from heritage_bayes.errors import ConfigError, InputError
+from heritage_bayes.inference.likelihoods import get_noise_model
+from heritage_bayes.inference.parameters import owned_priors
 from heritage_bayes.ladder import ladder_row, rung_log_posterior
 from heritage_bayes.models import AUTO, AUTO_LADDERS, auto_rungs, rung_label
 from heritage_bayes.selection_rule import (
@@ -360,11 +362,7 @@ def chosen_section(cfg, section: str, scr: Screen):
     model = scr.models[scr.choice["choice"]]
     given = {k: v for k, v in sec.options.given().items() if k != "sink"} | own
     options = ModelOptions.model_validate(given)
-    priors = {
-        k: v
-        for k, v in sec.priors.items()
-        if k in model.parameter_names or k.split("_")[0] in ("sigma", "phi")
-    }
+    priors = owned_priors(sec.priors, model, get_noise_model(sec.noise))
     new = sec.model_copy(update={"model": name, "options": options, "priors": priors})
     return cfg.model_copy(update={section: new})
 

@@ -58,6 +58,8 @@ def _candidate_config(cfg, section: str, name: str):
     sec = getattr(cfg, section)
     # the configured priors whose parameters exist in this model (as the ladder does)
     from heritage_bayes.config.options import ModelOptions
+    from heritage_bayes.inference.likelihoods import get_noise_model
+    from heritage_bayes.inference.parameters import owned_priors
     from heritage_bayes.models import catalog_build, catalog_options
     from heritage_bayes.rc.catalog import takes_option
     from heritage_bayes.run import section_parameters
@@ -70,8 +72,7 @@ def _candidate_config(cfg, section: str, name: str):
         model = catalog_build(cfg, section, name, catalog_options(cfg, section, name))
     except ValueError as exc:
         raise ConfigError(f"--models: {name}: {exc}") from None
-    keep = set(model.parameter_names) | {"sigma", "phi"}
-    priors = {k: v for k, v in sec.priors.items() if k in keep or k.split("_")[0] in keep}
+    priors = owned_priors(sec.priors, model, get_noise_model(sec.noise))
     new_sec = sec.model_copy(update={"model": name, "priors": priors})
     cand = cfg.model_copy(
         update={

@@ -47,7 +47,7 @@ from heritage_bayes.inference.priors import (
 from heritage_bayes.inference.survey import ROLE_PRIORS, Survey
 from heritage_bayes.rc.catalog import roles_of, solar_apertures
 
-__all__ = ["Parameter", "ParameterSet", "parameters_for"]
+__all__ = ["Parameter", "ParameterSet", "owned_priors", "parameters_for"]
 
 #: What the noise parameters are, by kind (for descriptions and units).
 _NOISE_DESCRIPTION = {
@@ -324,6 +324,16 @@ def parameters_for(
         spec = priors.get(name)
         params.append(_parameter(name, kind, unit, desc, prior, spec, f"{where}.{name}"))
     return ParameterSet(params)
+
+
+def owned_priors(priors: Mapping[str, PriorOverride], model, noise) -> dict:
+    """The configured priors whose parameters ``model`` or its noise model has: the
+    model's parameter names and those the noise model names for the model's outputs and
+    nodes (:meth:`~heritage_bayes.inference.likelihoods.NoiseModel.parameter_specs`), so
+    that a model of a ladder keeps the section's priors that fit it."""
+    own = set(model.parameter_names)
+    own |= {n for n, _, _ in noise.parameter_specs(model.output_names, model.state_names)}
+    return {k: v for k, v in priors.items() if k in own}
 
 
 def _check_names(model, noise, priors: Mapping, noise_specs, where: str) -> None:

@@ -23,7 +23,7 @@ import numpy as np
 from scipy.special import expit, logit
 
 from heritage_bayes.errors import ConfigError
-from heritage_bayes.names import PRIOR_DISTRIBUTIONS
+from heritage_bayes.names import PRIOR_DISTRIBUTIONS, DistributionName
 
 __all__ = [
     "FIXED_RANGE",
@@ -75,7 +75,7 @@ class Prior:
             raise ConfigError(f"{where}.lower: must be < upper (got {lo:g} >= {up:g})")
         if self.log_scale and lo <= 0:
             raise ConfigError(f"{where}.lower: a {self.dist} prior needs lower > 0 (got {lo:g})")
-        centre = PRIOR_DISTRIBUTIONS[self.dist].centre
+        centre = self.family.centre
         if centre is not None:
             if self.mu is None or self.sigma is None or not self.sigma > 0:
                 raise ConfigError(
@@ -88,25 +88,30 @@ class Prior:
                 )
 
     @property
+    def family(self) -> DistributionName:
+        """The family's traits and numerics (:data:`heritage_bayes.names.PRIOR_DISTRIBUTIONS`)."""
+        return PRIOR_DISTRIBUTIONS[self.dist]
+
+    @property
     def log_scale(self) -> bool:
         """Sampled in log θ (``loguniform``, ``lognormal``)."""
-        return PRIOR_DISTRIBUTIONS[self.dist].log_scale
+        return self.family.log_scale
 
     @property
     def gaussian(self) -> bool:
         """A normal density in the sampling coordinate (``normal``, ``lognormal``)."""
-        return PRIOR_DISTRIBUTIONS[self.dist].centre is not None
+        return self.family.centre is not None
 
     @property
     def centre(self) -> float:
         """The centre in the sampling coordinate: log(median) or the mean (0 if flat)."""
         if self.mu is None:
             return 0.0
-        return math.log(self.mu) if self.dist == "lognormal" else self.mu
+        return math.log(self.mu) if self.log_scale else self.mu
 
     def to_dict(self) -> dict:
         d = {"dist": self.dist, "lower": self.lower, "upper": self.upper}
-        centre = PRIOR_DISTRIBUTIONS[self.dist].centre
+        centre = self.family.centre
         if centre is not None:
             d.update({centre: self.mu, "sigma": self.sigma})
         return d
@@ -114,23 +119,12 @@ class Prior:
     def describe(self) -> str:
         """Short human-readable form, e.g. ``loguniform[1e+04, 1e+12]``."""
         b = f"[{self.lower:.3g}, {self.upper:.3g}]"
-        if self.dist == "lognormal":
-            return f"lognormal(median {self.mu:.3g}, σ_log {self.sigma:.3g}) on {b}"
-        if self.dist == "normal":
-            return f"normal({self.mu:.3g}, {self.sigma:.3g}) on {b}"
-        return f"{self.dist}{b}"
+        return self.family.describe(self.dist, b, self.mu, self.sigma)
 
     # -- numerics on arrays ------------------------------------------------------
     def logpdf(self, theta: np.ndarray) -> np.ndarray:
         """Unnormalised log density in parameter units (bounds not checked)."""
-        if self.dist == "uniform":
-            return np.zeros_like(theta)
-        if self.dist == "loguniform":
-            return -np.log(theta)
-        if self.dist == "normal":
-            return -0.5 * ((theta - self.mu) / self.sigma) ** 2
-        lt = np.log(theta)
-        return -lt - 0.5 * ((lt - math.log(self.mu)) / self.sigma) ** 2
+        return self.family.logpdf(theta, self.mu, self.sigma)
 
     def _ab(self) -> tuple[float, float]:
         if self.log_scale:
@@ -169,14 +163,7 @@ class Prior:
     def sample(self, rng: np.random.Generator, size: int) -> np.ndarray:
         """Draws from the (truncated) prior."""
         a, b = self._ab()
-        if not self.gaussian:
-            y = rng.uniform(a, b, size)
-        else:
-            from scipy.stats import truncnorm
-
-            m = self.centre
-            lo, hi = (a - m) / self.sigma, (b - m) / self.sigma
-            y = truncnorm.rvs(lo, hi, loc=m, scale=self.sigma, size=size, random_state=rng)
+        y = self.family.sample(rng, a, b, self.centre, self.sigma, size)
         return np.exp(y) if self.log_scale else y
 
 
@@ -308,12 +295,9 @@ def configured_prior(spec: PriorOverride, default: Prior, *, where: str) -> Prio
     mu = getattr(spec, info.centre) if info.centre else None
     sigma, lo, up = spec.sigma, spec.lower, spec.upper
     if mu is not None and sigma is not None:
-        if info.log_scale:
-            lo = lo if lo is not None else float(mu) * math.exp(-info.span * float(sigma))
-            up = up if up is not None else float(mu) * math.exp(info.span * float(sigma))
-        else:
-            lo = lo if lo is not None else float(mu) - info.span * float(sigma)
-            up = up if up is not None else float(mu) + info.span * float(sigma)
+        lo_c, up_c = info.support(float(mu), float(sigma))
+        lo = lo if lo is not None else lo_c
+        up = up if up is not None else up_c
     if dist == default.dist:
         lo = default.lower if lo is None else lo
         up = default.upper if up is None else up

@@ -380,7 +380,6 @@ LONG_FUNCTIONS = {
     "io/loggers.py::inspect_table": 126,
     "prepare.py::prepare": 218,
     "projection/__init__.py::project": 124,
-    "rc/identify.py::structural_identifiability": 121,
     "report/notes.py::run_notes": 169,
     "report/sections/data.py::data_context": 168,
     "report/sections/diagnostics.py::diagnostics_context": 129,

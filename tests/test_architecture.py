@@ -371,7 +371,6 @@ MAX_FUNCTION_LINES = 120
 LONG_FUNCTIONS = {
     "calibrate.py::_calibrate_into": 181,
     "cli.py::_build_parser": 180,
-    "climate/risk/_fused.py::series_indicators": 128,
     "demo.py::virtual_monument": 130,
     "inference/idata.py::build_run_outputs": 342,
     "inference/sampler.py::_run_sampler": 209,

@@ -377,7 +377,6 @@ LONG_FUNCTIONS = {
     "init_config.py::init_config": 272,
     "io/loggers.py::inspect_table": 126,
     "prepare.py::prepare": 218,
-    "projection/__init__.py::project": 124,
     "report/notes.py::run_notes": 169,
     "report/sections/data.py::data_context": 168,
     "report/sections/diagnostics.py::diagnostics_context": 129,

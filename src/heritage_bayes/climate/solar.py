@@ -480,6 +480,66 @@ def _fmt(td: pd.Timedelta) -> str:
     return f"{seconds}s"
 
 
+def _check_options(model: str, decomposition: str, albedo, clear_sky) -> float:
+    """The options of :func:`surface_irradiance` checked; returns ``albedo`` [-] as a float."""
+    if model not in _TRANSPOSITION:
+        raise InputError(f"model must be one of {list(_TRANSPOSITION)} (got {model!r})")
+    if decomposition not in _DECOMPOSITION:
+        raise InputError(
+            f"decomposition must be one of {list(_DECOMPOSITION)} (got {decomposition!r})"
+        )
+    try:
+        albedo = float(albedo)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"albedo must be a number in [0, 1] (got {albedo!r})") from exc
+    if not 0.0 <= albedo <= 1.0:
+        raise InputError(f"albedo must be in [0, 1] (got {albedo})")
+    if not isinstance(clear_sky, bool):
+        raise InputError(f"clear_sky must be True or False (got {clear_sky!r})")
+    return albedo
+
+
+def _beam_and_diffuse(ghi, dni, dhi, zenith, low, times, dni_extra, decomposition, alt):
+    """Beam normal and diffuse horizontal irradiance [W/m²] from what the weather holds.
+
+    The missing one(s) of ``dni`` and ``dhi`` follow from ``ghi`` by closure, or from the
+    ``decomposition`` model when both are absent; the beam is zero where ``low`` (sun
+    below the limiting zenith). Returns ``(dni, dhi, note)``, the note naming the
+    estimate made (None when both were given).
+    """
+    import pvlib
+
+    note = None
+    cosz = np.cos(np.radians(zenith))
+    if dni is None and dhi is None:
+        if decomposition == "erbs":
+            parts = pvlib.irradiance.erbs(ghi, zenith, times.day_of_year.to_numpy())
+            dni = np.asarray(parts["dni"], dtype=float)
+        else:
+            pressure = pvlib.atmosphere.alt2pres(alt)
+            with _quiet_pvlib():
+                dni = pvlib.irradiance.dirint(
+                    pd.Series(ghi, index=times), zenith, times, pressure=pressure
+                )
+            dni = np.asarray(dni, dtype=float)
+        dni = np.where(low | ~np.isfinite(dni), 0.0, dni)
+        dhi = ghi - dni * cosz
+        note = f"dni/dhi from ghi by {'Erbs' if decomposition == 'erbs' else 'DIRINT'}"
+    elif dni is None:
+        with np.errstate(divide="ignore", invalid="ignore"):
+            dni = np.where(low, 0.0, (ghi - dhi) / cosz)
+        dni = np.clip(np.nan_to_num(dni, nan=0.0), 0.0, dni_extra)
+        note = "dni from ghi and dhi by closure"
+    elif dhi is None:
+        dni = np.where(low, 0.0, dni)
+        dhi = ghi - dni * cosz
+        note = "dhi from ghi and dni by closure"
+    dni = np.where(low, 0.0, dni)
+    dhi = np.clip(np.minimum(dhi, np.where(np.isnan(ghi), np.inf, ghi)), 0.0, None)
+    dhi = np.where(np.isnan(ghi), np.nan, dhi)
+    return dni, dhi, note
+
+
 def surface_irradiance(
     weather: pd.DataFrame,
     site: Mapping,
@@ -556,20 +616,7 @@ def surface_irradiance(
     idx = _utc_index(weather.index, what)
     lat, lon, alt = _site(site)
     surf = _surfaces(surfaces)
-    if model not in _TRANSPOSITION:
-        raise InputError(f"model must be one of {list(_TRANSPOSITION)} (got {model!r})")
-    if decomposition not in _DECOMPOSITION:
-        raise InputError(
-            f"decomposition must be one of {list(_DECOMPOSITION)} (got {decomposition!r})"
-        )
-    try:
-        albedo = float(albedo)
-    except (TypeError, ValueError) as exc:
-        raise InputError(f"albedo must be a number in [0, 1] (got {albedo!r})") from exc
-    if not 0.0 <= albedo <= 1.0:
-        raise InputError(f"albedo must be in [0, 1] (got {albedo})")
-    if not isinstance(clear_sky, bool):
-        raise InputError(f"clear_sky must be True or False (got {clear_sky!r})")
+    albedo = _check_options(model, decomposition, albedo, clear_sky)
     present = [c for c in ("ghi", "dni", "dhi") if c in weather.columns]
 
     if clear_sky:
@@ -611,7 +658,6 @@ def surface_irradiance(
     zenith = sun["zenith"].to_numpy()
     app_zenith = sun["apparent_zenith"].to_numpy()
     azimuth = sun["azimuth"].to_numpy()
-    cosz = np.cos(np.radians(zenith))
     low = zenith > _max_zenith(horizon)
 
     ghi = weather["ghi"].to_numpy(dtype=float)
@@ -619,33 +665,9 @@ def surface_irradiance(
     dhi = weather["dhi"].to_numpy(dtype=float) if "dhi" in weather else None
     doy = times.day_of_year.to_numpy()
     dni_extra = np.asarray(pvlib.irradiance.get_extra_radiation(doy), dtype=float)
-    note = None
-    if dni is None and dhi is None:
-        if decomposition == "erbs":
-            parts = pvlib.irradiance.erbs(ghi, zenith, doy)
-            dni = np.asarray(parts["dni"], dtype=float)
-        else:
-            pressure = pvlib.atmosphere.alt2pres(alt)
-            with _quiet_pvlib():
-                dni = pvlib.irradiance.dirint(
-                    pd.Series(ghi, index=times), zenith, times, pressure=pressure
-                )
-            dni = np.asarray(dni, dtype=float)
-        dni = np.where(low | ~np.isfinite(dni), 0.0, dni)
-        dhi = ghi - dni * cosz
-        note = f"dni/dhi from ghi by {'Erbs' if decomposition == 'erbs' else 'DIRINT'}"
-    elif dni is None:
-        with np.errstate(divide="ignore", invalid="ignore"):
-            dni = np.where(low, 0.0, (ghi - dhi) / cosz)
-        dni = np.clip(np.nan_to_num(dni, nan=0.0), 0.0, dni_extra)
-        note = "dni from ghi and dhi by closure"
-    elif dhi is None:
-        dni = np.where(low, 0.0, dni)
-        dhi = ghi - dni * cosz
-        note = "dhi from ghi and dni by closure"
-    dni = np.where(low, 0.0, dni)
-    dhi = np.clip(np.minimum(dhi, np.where(np.isnan(ghi), np.inf, ghi)), 0.0, None)
-    dhi = np.where(np.isnan(ghi), np.nan, dhi)
+    dni, dhi, note = _beam_and_diffuse(
+        ghi, dni, dhi, zenith, low, times, dni_extra, decomposition, alt
+    )
     airmass = pvlib.atmosphere.get_relative_airmass(app_zenith)
 
     out = {}

@@ -97,8 +97,9 @@ class _Checkpoint:
                         dtype="f8",
                         chunks=(64, *shape),
                         fletcher32=True,
-                        # lossless: rejected proposals repeat a walker's row, so the
-                        # demo's thermal_4a chain (acceptance 0.08) shrinks 10×
+                        # lossless: rejected proposals repeat a walker's row, which
+                        # compresses well at a low acceptance (figure: docs/science/
+                        # benchmarks.md, "Figures behind the code's choices")
                         compression="gzip",
                         compression_opts=4,
                     )

@@ -140,8 +140,8 @@ def _encoding(group: str, da) -> dict:
     if da.dims[:2] == ("chain", "draw") and da.ndim == 3 and da.size:
         # every draw of a few hundred hours in one chunk: the terms (or values) of one
         # hour over the draws are alike, and after the byte shuffle their leading bytes
-        # compress together (the demo's log_likelihood: 7.43 MB with the library's
-        # default chunks, 6.38 MB so)
+        # compress together, smaller than with the library's default chunks (figure:
+        # docs/science/benchmarks.md, "Figures behind the code's choices")
         enc["chunksizes"] = (da.shape[0], da.shape[1], min(_CHUNK_HOURS, da.shape[2]))
     quantum = PREDICTIVE_QUANTUM.get(da.attrs.get("unit", ""))
     if group in _PACKED_GROUPS and quantum is not None and np.issubdtype(da.dtype, np.floating):

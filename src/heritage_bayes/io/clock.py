@@ -352,7 +352,8 @@ def dst_structure(naive_times, zone: str) -> DSTStructure:
             out.changes += 1
             if delta > pd.Timedelta(0):  # spring: [wall, wall + 1 h) does not exist
                 # a jump of an hour near the change is a DST clock even when it jumped an
-                # hour early or late (Ørholm's logger skipped 01:00, not 02:00, 2009-2011)
+                # hour early or late, as real loggers do (docs/science/real_rooms.md,
+                # "Figures behind the code's choices")
                 if np.diff(near.asi8).max() >= (delta + step).value:
                     out.spring_gap += 1
                 elif ((near >= start) & (near < end)).any():

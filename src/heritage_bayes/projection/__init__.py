@@ -182,7 +182,7 @@ def project(
     False, a banner on the page and a warning through ``progress``; ``hbayes project``
     then exits with :data:`EXIT_UNCONVERGED_RUN`.
     """
-    from heritage_bayes.climate.risk.registry import indicator_info, years_of
+    from heritage_bayes.climate.risk.registry import indicator_info
     from heritage_bayes.projection.decision import decision_table
     from heritage_bayes.projection.engine import select_draws, simulate_measures
     from heritage_bayes.projection.interventions import compare_measures, measures_from_config
@@ -192,18 +192,7 @@ def project(
 
     t_start = time.perf_counter()
     pcfg = _as_config(config)
-    if draws is not None or seed is not None:
-        upd = {k: v for k, v in (("draws", draws), ("seed", seed)) if v is not None}
-        if draws is not None and draws < 1:
-            from heritage_bayes.errors import ConfigError
-
-            raise ConfigError(f"--draws: expected a positive number (got {draws})")
-        if seed is not None:
-            from heritage_bayes.config._base import check_in_range
-            from heritage_bayes.projection.config import ProjectionConfig
-
-            check_in_range(ProjectionConfig, "seed", seed, "--seed")
-        pcfg = pcfg.model_copy(update=upd)
+    pcfg = _with_overrides(pcfg, draws, seed)
     dest = None
     if write:  # the output path checked before anything is read
         from heritage_bayes.projection.output import OUTPUT_FILES
@@ -255,19 +244,7 @@ def project(
     summary["interventions"] = compare_measures(
         labels, results, per_measure, pcfg.thresholds, units, {m.name: m.notes(r) for m in measures}
     )
-    summary["cases"] = [
-        {
-            "label": c.label,
-            "scenario": c.scenario,
-            "horizon": c.horizon,
-            "weather": c.note,
-            "mean_Te": float(c.weather["Te"].mean()),
-            "hours": len(c.inputs),
-            "years": years_of(len(c.inputs)),
-            "hours_dropped": int(c.inputs.attrs.get("hours_dropped", 0)),
-        }
-        for c in cases
-    ]
+    summary["cases"] = _cases_summary(cases)
     summary["decision"] = decision_table(
         labels, results, per_measure, summary, pcfg.interventions_rank_by, pcfg.tariffs
     )
@@ -281,17 +258,7 @@ def project(
     summary["run"] = str(r.path)
     summary["seed"] = pcfg.seed
     summary["noise"] = {s: nm.name for s, nm in sel.noise_models.items()} if pcfg.noise else None
-    summary["seconds"] = {
-        "total": time.perf_counter() - t_start,
-        **{k: float(sum(res.seconds[k] for res in results)) for k in ("simulate", "noise", "risk")},
-        "interventions": float(
-            sum(
-                res.seconds["simulate"] + res.seconds["risk"]
-                for rs in per_measure.values()
-                for res in rs
-            )
-        ),
-    }
+    summary["seconds"] = _seconds(time.perf_counter() - t_start, results, per_measure)
     proj = Projection(pcfg, labels, horizons, results, summary, interventions=per_measure)
     from heritage_bayes.projection.output import to_dataset, write_outputs
 
@@ -306,6 +273,57 @@ def project(
                 raise
         proj.paths = {k: dest.out / p.name for k, p in staged.items()}
     return proj
+
+
+def _with_overrides(pcfg, draws: int | None, seed: int | None):
+    """The projection settings with the caller's ``draws`` and ``seed``, checked."""
+    if draws is None and seed is None:
+        return pcfg
+    upd = {k: v for k, v in (("draws", draws), ("seed", seed)) if v is not None}
+    if draws is not None and draws < 1:
+        from heritage_bayes.errors import ConfigError
+
+        raise ConfigError(f"--draws: expected a positive number (got {draws})")
+    if seed is not None:
+        from heritage_bayes.config._base import check_in_range
+        from heritage_bayes.projection.config import ProjectionConfig
+
+        check_in_range(ProjectionConfig, "seed", seed, "--seed")
+    return pcfg.model_copy(update=upd)
+
+
+def _cases_summary(cases) -> list[dict]:
+    """One entry per weather case: its label, scenario, horizon and weather in brief."""
+    from heritage_bayes.climate.risk.registry import years_of
+
+    return [
+        {
+            "label": c.label,
+            "scenario": c.scenario,
+            "horizon": c.horizon,
+            "weather": c.note,
+            "mean_Te": float(c.weather["Te"].mean()),
+            "hours": len(c.inputs),
+            "years": years_of(len(c.inputs)),
+            "hours_dropped": int(c.inputs.attrs.get("hours_dropped", 0)),
+        }
+        for c in cases
+    ]
+
+
+def _seconds(total: float, results, per_measure) -> dict:
+    """Wall time of the projection [s]: in total, per stage, and for the measures."""
+    return {
+        "total": total,
+        **{k: float(sum(res.seconds[k] for res in results)) for k in ("simulate", "noise", "risk")},
+        "interventions": float(
+            sum(
+                res.seconds["simulate"] + res.seconds["risk"]
+                for rs in per_measure.values()
+                for res in rs
+            )
+        ),
+    }
 
 
 def _input_files(pcfg) -> list[Path]:

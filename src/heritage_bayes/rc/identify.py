@@ -220,25 +220,8 @@ def structural_identifiability(
         )
     model.check_values(P)
     if model.control is not None:
-        # a controlled room: the network's check, and the control's parameters described
-        from heritage_bayes.rc.control import control_identifiability
-
-        net = RCModel(model.network)
-        n_net = len(net.parameter_names)
-        fixed = tuple(fixed)
-        res = structural_identifiability(
-            net,
-            P[0, :n_net],
-            dt,
-            n_freq=n_freq,
-            longest_period=longest_period,
-            rtol=rtol,
-            threshold=threshold,
-            fixed=[f for f in fixed if f in net.parameter_names],
-        )
-        point = dict(res.point) | dict(zip(model.parameter_names, P[0].tolist(), strict=True))
-        notes = control_identifiability(model, res.has_scale_direction, fixed)
-        return replace(res, model_name=model.name, point=point, control=notes)
+        opts = dict(n_freq=n_freq, longest_period=longest_period, rtol=rtol, threshold=threshold)
+        return _controlled_identifiability(model, P, dt, opts, fixed)
     p0 = P[0]
     all_names = model.parameter_names
     all_kinds = [info.kind for info in model.parameters]
@@ -273,21 +256,7 @@ def structural_identifiability(
         scale.any() and Q.shape[1] and np.linalg.norm(Jn @ w) <= tol * np.linalg.norm(w)
     )
     ref = _scale_reference(model, names, kinds, scale) if scale_null else None
-    vecs: list[np.ndarray] = []
-    dead = [np.eye(len(names))[j] for j in np.flatnonzero(~live)]
-    Q_live = Q[:, : Q.shape[1] - len(dead)]
-    if scale_null:
-        # the scale first; the others span what remains free once the scale is pinned
-        # through the reference parameter (zero loading on it)
-        r = names.index(ref)
-        vecs.append(scale / np.linalg.norm(scale))
-        if Q_live.shape[1] > 1:
-            W = Q_live - np.outer(scale, Q_live[r] / scale[r])
-            U = np.linalg.svd(W, full_matrices=False)[0]
-            vecs.extend(U[:, : Q_live.shape[1] - 1].T)
-    else:
-        vecs.extend(Q_live.T)
-    vecs.extend(dead)  # parameters without any influence, one direction each
+    vecs = _null_vectors(Q, live, scale, names.index(ref) if scale_null else None)
 
     directions = []
     for k, v in enumerate(vecs):
@@ -323,6 +292,43 @@ def structural_identifiability(
         loading_given_scale={n: float(v) for n, v in zip(names, given_scale, strict=True)},
         jacobian=J,
     )
+
+
+def _controlled_identifiability(model, P: np.ndarray, dt: float, opts: dict, fixed):
+    """The network's check of a controlled room, and the control's parameters described."""
+    from heritage_bayes.rc.control import control_identifiability
+
+    net = RCModel(model.network)
+    n_net = len(net.parameter_names)
+    fixed = tuple(fixed)
+    res = structural_identifiability(
+        net, P[0, :n_net], dt, **opts, fixed=[f for f in fixed if f in net.parameter_names]
+    )
+    point = dict(res.point) | dict(zip(model.parameter_names, P[0].tolist(), strict=True))
+    notes = control_identifiability(model, res.has_scale_direction, fixed)
+    return replace(res, model_name=model.name, point=point, control=notes)
+
+
+def _null_vectors(Q: np.ndarray, live: np.ndarray, scale: np.ndarray, r: int | None) -> list:
+    """Unnormalised null directions: the scale first when ``r`` (its reference) is given.
+
+    The others span what remains free once the scale is pinned through the reference
+    parameter ``r`` (zero loading on it); parameters without any influence (not ``live``)
+    come last, one direction each.
+    """
+    vecs: list[np.ndarray] = []
+    dead = [np.eye(len(live))[j] for j in np.flatnonzero(~live)]
+    Q_live = Q[:, : Q.shape[1] - len(dead)]
+    if r is not None:
+        vecs.append(scale / np.linalg.norm(scale))
+        if Q_live.shape[1] > 1:
+            W = Q_live - np.outer(scale, Q_live[r] / scale[r])
+            U = np.linalg.svd(W, full_matrices=False)[0]
+            vecs.extend(U[:, : Q_live.shape[1] - 1].T)
+    else:
+        vecs.extend(Q_live.T)
+    vecs.extend(dead)
+    return vecs
 
 
 def _svd_rank(J: np.ndarray, rtol: float):

@@ -430,6 +430,63 @@ def _percentiles(f, n, q, hist, sel):  # pragma: no cover - compiled
 
 
 @njit(cache=True, error_model="numpy")
+def _first_pass_columns(out, sums, vtt, n, nea, fpar, ipar, mould):  # pragma: no cover
+    """Write the columns of the first pass (chemical, mechanical, mould); return the next
+    column's index. ``sums`` and ``vtt`` are that pass's accumulators."""
+    col = 0
+    if ipar[I_CHEM]:
+        for k in range(nea + 1):  # lifetime multipliers, then TWPI: harmonic means
+            out[col] = n / sums[k]
+            col += 1
+        out[col] = 100.0 * sums[nea + 4] / n / 100.0 * 8760.0  # time of wetness [h/year]
+        col += 1
+    if ipar[I_MECH]:
+        lo, hi = sums[nea + 1], sums[nea + 2]
+        out[col] = lo
+        out[col + 1] = hi
+        out[col + 2] = hi - lo
+        out[col + 3] = 100.0 * fpar[F_COEF] * (hi - lo)
+        col += 4
+    if mould:
+        out[col] = vtt[2]
+        out[col + 1] = 100.0 * sums[nea + 3] / n / 100.0 * 8760.0  # share → h/year
+        col += 2
+    return col
+
+
+@njit(cache=True, error_model="numpy")
+def _en_columns(RH, n, f, hist, sel, cs, half, wrap, sE, fpar, ipar, out, col):  # pragma: no cover
+    """Write the EN 15757 columns from the fluctuations ``f[:n]`` [%]: the share of hours
+    outside the band [%] and the band's lower and upper limits [%] around the centred
+    moving average read from the cumulative sums ``cs`` (``half``, ``wrap``); ``sE``
+    (BLOCK,) is work space."""
+    q = np.empty(2)
+    q[0] = fpar[F_QLO]
+    q[1] = fpar[F_QHI]
+    p_lo, p_hi = _percentiles(f, n, q, hist, sel)
+    mb = fpar[F_MINBAND]
+    if ipar[I_EN_WIDTH]:
+        mid = 0.5 * (p_lo + p_hi)
+        narrow = (p_hi - p_lo) < mb
+        lo = mid - 0.5 * mb if narrow else p_lo
+        hi = mid + 0.5 * mb if narrow else p_hi
+    else:
+        lo = min(p_lo, -mb)
+        hi = max(p_hi, mb)
+    cnt = 0
+    for b0 in range(0, n, BLOCK):
+        m = min(BLOCK, n - b0)
+        _centred(cs, b0, m, n, half, wrap, sE)
+        RHb = RH[b0 : b0 + m]
+        for t in range(m):
+            r = RHb[t]
+            cnt += 1 if (r < sE[t] + lo) or (r > sE[t] + hi) else 0
+    out[col] = 100.0 * cnt / n
+    out[col + 1] = lo
+    out[col + 2] = hi
+
+
+@njit(cache=True, error_model="numpy")
 def series_indicators(
     T, RH, n, ea_r, fpar, ipar, kinds, cls, ws, tmp, btmp, hist, out
 ):  # pragma: no cover
@@ -484,24 +541,7 @@ def series_indicators(
             _cumsum_block(RHb, m, csRH[b0 : b0 + m + 1])
     if bad > 0 or (above1 == 0 and above0 > 0):
         return 1
-    col = 0
-    if ipar[I_CHEM]:
-        for k in range(nea + 1):  # lifetime multipliers, then TWPI: harmonic means
-            out[col] = n / sums[k]
-            col += 1
-        out[col] = 100.0 * sums[nea + 4] / n / 100.0 * 8760.0  # time of wetness [h/year]
-        col += 1
-    if ipar[I_MECH]:
-        lo, hi = sums[nea + 1], sums[nea + 2]
-        out[col] = lo
-        out[col + 1] = hi
-        out[col + 2] = hi - lo
-        out[col + 3] = 100.0 * fpar[F_COEF] * (hi - lo)
-        col += 4
-    if mould:
-        out[col] = vtt[2]
-        out[col + 1] = 100.0 * sums[nea + 3] / n / 100.0 * 8760.0  # share → h/year
-        col += 2
+    col = _first_pass_columns(out, sums, vtt, n, nea, fpar, ipar, mould)
     if not (ashrae or en):
         return 0
     sT, sRH, sE = tmp[0], tmp[1], tmp[2]
@@ -543,32 +583,9 @@ def series_indicators(
         out[col + ncls] = best
         col += ncls + 1
     if ipar[I_EN]:
-        q = np.empty(2)
-        q[0] = fpar[F_QLO]
-        q[1] = fpar[F_QHI]
-        p_lo, p_hi = _percentiles(f, n, q, hist, sel)
-        mb = fpar[F_MINBAND]
-        if ipar[I_EN_WIDTH]:
-            mid = 0.5 * (p_lo + p_hi)
-            narrow = (p_hi - p_lo) < mb
-            lo = mid - 0.5 * mb if narrow else p_lo
-            hi = mid + 0.5 * mb if narrow else p_hi
-        else:
-            lo = min(p_lo, -mb)
-            hi = max(p_hi, mb)
-        cnt = 0
         cs = csE if not shared else csRH
         half, wrap = (half_e, wrap_e) if not shared else (half_a, wrap_a)
-        for b0 in range(0, n, BLOCK):
-            m = min(BLOCK, n - b0)
-            _centred(cs, b0, m, n, half, wrap, sE)
-            RHb = RH[b0 : b0 + m]
-            for t in range(m):
-                r = RHb[t]
-                cnt += 1 if (r < sE[t] + lo) or (r > sE[t] + hi) else 0
-        out[col] = 100.0 * cnt / n
-        out[col + 1] = lo
-        out[col + 2] = hi
+        _en_columns(RH, n, f, hist, sel, cs, half, wrap, sE, fpar, ipar, out, col)
     return 0
 
 

@@ -105,14 +105,17 @@ def test_trh1_fmi_weather_with_radiation(shared_data):
 def test_knmi_de_bilt(shared_data):
     df = knmi_2011_2020(shared_data)
     _tidy(df)
-    assert list(df.columns) == ["Te", "Tdew", "RHe", "ghi"]
+    assert list(df.columns) == ["Te", "Tdew", "RHe", "ghi", "wind"]
     # HH=1 of 2011-01-01 is the hour ending 01:00 UT; HH=24 of 2020-12-31 is midnight
     assert df.index[0] == pd.Timestamp("2011-01-01 01:00", tz="UTC")
     assert df.index[-1] == pd.Timestamp("2021-01-01 00:00", tz="UTC")
     assert len(df) == 87672 and not df[["Te", "RHe", "ghi"]].isna().any().any()
     assert df["Te"].iloc[0] == pytest.approx(3.6) and df["Tdew"].iloc[0] == pytest.approx(3.4)
-    assert df.attrs["averaged"] == ("ghi",) and df.attrs["interval"] == "1h"
+    assert df.attrs["averaged"] == ("ghi", "wind") and df.attrs["interval"] == "1h"
     assert df.attrs["station"] == 260
+    # FH, the hour's mean wind in 0.1 m/s: De Bilt's mean 10 m wind is 3-4 m/s
+    assert df["wind"].iloc[0] == pytest.approx(0.1 * int(_knmi_field(shared_data, "FH")))
+    assert 2.5 < df["wind"].loc["2015"].mean() < 4.5 and df["wind"].min() >= 0
     # Q in J/cm² per hour -> W/m²: annual sum ~ 1000-1150 kWh/m² in De Bilt
     annual = df["ghi"].loc["2015"].sum() / 1000
     assert 950 < annual < 1200
@@ -122,6 +125,18 @@ def test_knmi_de_bilt(shared_data):
     hours = june.index.hour + june.index.minute / 60
     centroid = float((np.where(hours == 0, 24, hours) * june).sum() / june.sum())
     assert abs(centroid - (11.65 + 0.5)) < 0.1
+
+
+def _knmi_field(shared_data, field: str) -> str:
+    """Field ``field`` of the first data line of De Bilt's 2011-2020 file, as written."""
+    import gzip
+
+    with gzip.open(shared_data / "knmi-debilt" / "uurgeg_260_2011-2020.txt.gz", "rt") as fh:
+        lines = iter(fh)
+        header = next(line for line in lines if line.startswith("# STN"))
+        names = [c.strip() for c in header[1:].split(",")]
+        next(lines)  # the blank line after the header
+        return next(lines).split(",")[names.index(field)].strip()
 
 
 def test_knmi_two_files_concatenated(shared_data):
@@ -146,7 +161,12 @@ def test_epw_uccle(shared_data):
     assert df.attrs["site"] == {"latitude": 50.7969, "longitude": 4.3581, "altitude": 101.0}
     assert df["Te"].iloc[0] == 7.1 and df["RHe"].iloc[0] == 95
     assert df.attrs["averaged"] == ("ghi", "dni", "dhi")
-    assert not df[["Te", "RHe", "ghi", "dni", "dhi"]].isna().any().any()
+    assert not df[["Te", "RHe", "ghi", "dni", "dhi", "wind"]].isna().any().any()
+    # the wind speed field [m/s], the 22nd of a data line
+    path = shared_data / "epw" / "BEL_VLG_Uccle.064470_TMYx.2007-2021.epw"
+    first = path.read_text(encoding="latin-1").splitlines()[8].split(",")
+    assert df["wind"].iloc[0] == float(first[21])
+    assert 2.0 < df["wind"].mean() < 6.0
 
 
 def test_epw_explicit_year(shared_data):

@@ -57,15 +57,17 @@ def read_knmi_hourly(
     pandas.DataFrame
         UTC index; columns ``Te`` [°C] (``T``, at the observation), ``Tdew`` [°C]
         (``TD``, when present), ``RHe`` [%] (``U``, at the observation) and ``ghi``
-        [W/m²] (``Q``, the mean of the hour ending at the stamp).
-        ``attrs["averaged"] == ("ghi",)``, ``attrs["interval"] == "1h"``,
+        [W/m²] (``Q``, the mean of the hour ending at the stamp); with ``FH``,
+        ``wind`` [m/s] (the mean wind speed of the hour ending at the stamp).
+        ``attrs["averaged"] == ("ghi",)`` (and ``"wind"``), ``attrs["interval"] == "1h"``,
         ``attrs["station"]`` the station number.
 
     Notes
     -----
     ``HH`` is the hour **ending** at HH UT (1..24; ``HH = 24`` is midnight of the next
     day), so the stamp is ``YYYYMMDD + HH h`` in UTC: exactly the interval-end convention
-    of this package. Units in the file: ``T``, ``TD`` in 0.1 °C; ``U`` in %; ``Q`` in
+    of this package. Units in the file: ``T``, ``TD`` in 0.1 °C; ``FH`` in 0.1 m/s;
+    ``U`` in %; ``Q`` in
     J/cm² per hour, hence
     :math:`G_h\\,[\\mathrm{W/m^2}] = Q \\cdot 10^4 / 3600`.
     Empty fields are missing values (NaN).
@@ -96,7 +98,7 @@ def read_knmi_hourly(
         frame,
         source=str(paths[0]) if len(paths) == 1 else [str(p) for p in paths],
         fmt="knmi-hourly",
-        averaged=("ghi",),
+        averaged=("ghi", "wind") if "wind" in frame else ("ghi",),
         interval=pd.Timedelta("1h"),
         counts=counts,
         clipped={},
@@ -130,7 +132,7 @@ def _read_knmi_one(path: Path, invalid: str):
             f"{name}: KNMI column(s) {_quote_list(missing)} not found; columns are: "
             f"{_quote_list(names)}"
         )
-    use = [c for c in ("STN", *_KNMI_REQUIRED, "TD") if c in names]
+    use = [c for c in ("STN", *_KNMI_REQUIRED, "TD", "FH") if c in names]
     try:
         raw = pd.read_csv(
             path,
@@ -179,12 +181,13 @@ def _read_knmi_one(path: Path, invalid: str):
             **({"Tdew": raw["TD"].to_numpy() / 10.0} if "TD" in raw else {}),
             "RHe": raw["U"].to_numpy(),
             "ghi": raw["Q"].to_numpy() * 1.0e4 / 3600.0,
+            **({"wind": raw["FH"].to_numpy() / 10.0} if "FH" in raw else {}),
         },
         index=index,
     )
     lines = np.arange(len(frame)) + number + 3  # header, blank line, then data
     counts: dict[str, int] = {}
-    source_cols = {"Te": "T", "Tdew": "TD", "RHe": "U", "ghi": "Q"}
+    source_cols = {"Te": "T", "Tdew": "TD", "RHe": "U", "ghi": "Q", "wind": "FH"}
     validate_ranges(frame, lines, name, source_cols, invalid, counts)
     frame["__line"] = lines
     station = int(stations[0]) if np.isfinite(stations[0]) else None

@@ -30,7 +30,12 @@ __all__ = ["TYPICAL_YEAR", "read_epw", "read_tmy3"]
 TYPICAL_YEAR = 2019
 
 # EPW missing-value markers (EnergyPlus Auxiliary Programs, "Weather file data fields").
-_EPW_MISSING = {"temp_air": 99.9, "temp_dew": 99.9, "relative_humidity": 999.0}
+_EPW_MISSING = {
+    "temp_air": 99.9,
+    "temp_dew": 99.9,
+    "relative_humidity": 999.0,
+    "wind_speed": 999.0,
+}
 _EPW_IRR_MISSING = 9999.0
 _WEATHER_MAP = {
     "temp_air": "Te",
@@ -39,6 +44,7 @@ _WEATHER_MAP = {
     "dni": "dni",
     "dhi": "dhi",
     "temp_dew": "Tdew",
+    "wind_speed": "wind",
 }
 
 
@@ -92,8 +98,9 @@ def read_epw(path: str | PathLike, *, year: int | None = None, invalid: str = "r
     Returns
     -------
     pandas.DataFrame
-        UTC index; ``Te`` [°C], ``Tdew`` [°C], ``RHe`` [%] at the stamp; ``ghi``,
-        ``dni``, ``dhi`` [W/m²] mean of the hour ending at the stamp.
+        UTC index; ``Te`` [°C], ``Tdew`` [°C], ``RHe`` [%], ``wind`` [m/s] (the wind
+        speed field) at the stamp; ``ghi``, ``dni``, ``dhi`` [W/m²] mean of the hour
+        ending at the stamp.
         ``attrs["site"]`` holds ``latitude``, ``longitude``, ``altitude`` from the
         header, ``attrs["coerced_year"]`` the year used (or None).
 
@@ -102,8 +109,8 @@ def read_epw(path: str | PathLike, *, year: int | None = None, invalid: str = "r
     EPW rows are in local **standard** time (``TZ`` of the LOCATION line, no DST). Hour
     ``h`` (1..24) is the interval from ``h-1`` to ``h``; radiation fields are energy over
     that hour [Wh/m²], i.e. its mean irradiance [W/m²], stamped here at ``h`` (pvlib
-    stamps the interval start). EPW missing-value markers (99.9 °C, 999 %, 9999 W/m²)
-    become NaN.
+    stamps the interval start). EPW missing-value markers (99.9 °C, 999 %, 999 m/s,
+    9999 W/m²) become NaN.
 
     References
     ----------

@@ -462,6 +462,8 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--reps", type=int, default=40)
     ap.add_argument("--first-rep", type=int, default=0)
+    ap.add_argument("--only", help="comma-separated replicates (instead of --first-rep "
+                    "and --reps): e.g. the rooms a change of the fit path reaches")  # fmt: skip
     ap.add_argument("--rooms", default=",".join(rooms.ROOMS))
     ap.add_argument("--jobs", type=int, default=1)
     ap.add_argument("--seed", type=int, default=SEED)
@@ -517,9 +519,13 @@ def main(argv=None) -> int:
         return 0
     from bench_sbc import run_tasks
 
+    reps = range(args.first_rep, args.first_rep + args.reps)
+    if args.only:
+        reps = [int(r) for r in args.only.split(",")]
+
     tasks = [
         (room, rep, args.seed, args.max_steps, args.cal_days, without, {}, args.variant)
-        for rep in range(args.first_rep, args.first_rep + args.reps)
+        for rep in reps
         for room in room_types
     ]
     t0 = time.perf_counter()

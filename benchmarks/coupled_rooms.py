@@ -318,11 +318,13 @@ def generate(
     quiet = "noise" in without
     sd_t, sd_rh = 0.1, rng.uniform(0.5, 1.0)
     rhi = 100.0 * pi_true / psat(ti_true)
-    ti_obs = ti_true + (0.0 if quiet else rng.normal(0.0, sd_t, hours))
-    rhi_obs = rhi + (0.0 if quiet else rng.normal(0.0, sd_rh, hours))
+    # drawn whether used or not: without the noise the room keeps its outage's draws
+    e_t, e_rh = rng.normal(0.0, sd_t, hours), rng.normal(0.0, sd_rh, hours)
+    lost = rng.random(hours) < 0.01
+    ti_obs = ti_true + (0.0 if quiet else e_t)
+    rhi_obs = rhi + (0.0 if quiet else e_rh)
     if not quiet:
         ti_obs, rhi_obs = np.round(ti_obs, 1), np.round(np.clip(rhi_obs, 0.0, 100.0), 1)
-        lost = rng.random(hours) < 0.01
         lost[[0, -1]] = False  # the record's ends are read
         ti_obs[lost] = np.nan
         rhi_obs[lost] = np.nan

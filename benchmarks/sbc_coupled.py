@@ -14,8 +14,8 @@ posterior draws:
 The fit's inputs are built as ``hbayes calibrate`` builds them from the records:
 :func:`heritage_bayes.io.align` on 1 h (the station's readings as instantaneous, the
 first-order hold of ``Pe`` through its slope column, ``data.input_hold: exact``), the
-indoor vapour pressure from the logged Ti and RHi
-(:func:`heritage_bayes.climate.psychro.vapour_pressure`), the logged Ti as the coupled
+indoor vapour pressure from the logged Ti and RHi, missing where RHi reads 99 % or more
+(:func:`heritage_bayes.io.derive.add_vapour_pressure`), the logged Ti as the coupled
 model's temperature input with its gaps interpolated linearly, the survey's room volume
 (400 m³), air change rate (0.5 /h) and, for the cellar, floor (80 m²) and envelope
 (259 m²) areas; the priors, the MAP and emcee are ``benchmarks/bench_sbc.fit_and_rank``'s
@@ -81,6 +81,7 @@ def fit_inputs(room: dict, fit_model):
     from heritage_bayes.climate.psychro import vapour_pressure
     from heritage_bayes.inputs import add_slope_columns
     from heritage_bayes.io.align import align
+    from heritage_bayes.io.derive import add_vapour_pressure
 
     h = room["hourly"]
     n = h["Te"].size
@@ -94,11 +95,12 @@ def fit_inputs(room: dict, fit_model):
         weather.append(ground)
     logger = pd.DataFrame({"Ti": h["Ti"], "RHi": h["RHi"]}, index=index)
     logger.attrs.update(averaged=(), interval="1h", source="logger")
+    logger = add_vapour_pressure(logger)  # Pi per reading, censored at saturation
     aligned = align(weather, logger, step="1h", max_gap="0h")
     frame = aligned.frame.copy()
     frame.attrs = dict(aligned.frame.attrs)
     add_slope_columns(frame, [fit_model], aligned.slopes)
-    y = vapour_pressure(frame["Ti"].to_numpy(float), frame["RHi"].to_numpy(float))
+    y = frame["Pi"].to_numpy(float)
     cols = []
     for c in fit_model.input_names:
         v = frame[c].to_numpy(float)
@@ -460,6 +462,8 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--reps", type=int, default=40)
     ap.add_argument("--first-rep", type=int, default=0)
+    ap.add_argument("--only", help="comma-separated replicates (instead of --first-rep "
+                    "and --reps): e.g. the rooms a change of the fit path reaches")  # fmt: skip
     ap.add_argument("--rooms", default=",".join(rooms.ROOMS))
     ap.add_argument("--jobs", type=int, default=1)
     ap.add_argument("--seed", type=int, default=SEED)
@@ -515,9 +519,13 @@ def main(argv=None) -> int:
         return 0
     from bench_sbc import run_tasks
 
+    reps = range(args.first_rep, args.first_rep + args.reps)
+    if args.only:
+        reps = [int(r) for r in args.only.split(",")]
+
     tasks = [
         (room, rep, args.seed, args.max_steps, args.cal_days, without, {}, args.variant)
-        for rep in range(args.first_rep, args.first_rep + args.reps)
+        for rep in reps
         for room in room_types
     ]
     t0 = time.perf_counter()

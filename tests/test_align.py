@@ -12,6 +12,7 @@ from _io_helpers import ESPOO, ORHOLM, knmi_2011_2020
 from heritage_bayes.climate import surface_irradiance
 from heritage_bayes.errors import DataError, InputError
 from heritage_bayes.io import add_vapour_pressure, align, read_csv
+from heritage_bayes.io.derive import RH_SENSOR_CEILING
 
 T0 = pd.Timestamp("2021-01-01 00:00", tz="UTC")
 
@@ -269,7 +270,11 @@ def test_trh1_attic_with_measured_radiation(shared_data):
     assert roof.attrs["averaged"] == ()  # instantaneous in, instantaneous out
     al = align([add_vapour_pressure(fmi), roof], add_vapour_pressure(attic))
     assert al.outputs == ("Ti", "RHi", "Pi")
-    assert len(al.frame) == 13920 and not al.frame.isna().any().any()
+    assert len(al.frame) == 13920 and not al.frame.drop(columns="Pi").isna().any().any()
+    # the attic's air reaches saturation: readings at the sensor's ceiling are censored
+    at_ceiling = (al.frame["RHi"] >= RH_SENSOR_CEILING).to_numpy()
+    assert 0 < at_ceiling.sum() < 100
+    assert np.array_equal(al.frame["Pi"].isna().to_numpy(), at_ceiling)
     assert al.frame["roof_S"].sum() > al.frame["roof_N"].sum()
 
 
@@ -295,3 +300,16 @@ def test_orholm_with_dmi_and_clear_sky_proxy(shared_data):
     longest = max(rep["measurement_gaps"], key=lambda g: g["length_hours"])
     assert longest["start"].startswith("2010-12") and longest["length_hours"] > 24 * 28
     assert not al.frame[list(al.inputs)].isna().any().any()
+
+
+def test_indoor_vapour_pressure_censored_at_the_sensor_ceiling():
+    idx = pd.date_range("2021-01-01", periods=4, freq="1h", tz="UTC")
+    df = pd.DataFrame(
+        {"Ti": 10.0, "RHi": [50.0, 98.9, RH_SENSOR_CEILING, 100.0], "Te": 5.0, "RHe": 100.0},
+        index=idx,
+    )
+    out = add_vapour_pressure(df)
+    pi = out["Pi"].to_numpy()
+    assert np.isfinite(pi[:2]).all() and np.isnan(pi[2:]).all()
+    assert np.isfinite(out["Pe"].to_numpy()).all()  # outdoors at saturation (fog): a reading
+    assert f"NaN where RHi >= {RH_SENSOR_CEILING:g} %" in out.attrs["derived"]["Pi"]

@@ -150,3 +150,21 @@ def test_simulate_runs_a_coupled_model_through_its_recursion():
     assert np.abs(y - flat).max() > 10.0  # the temperature acts
     eq = hb.model("hygric_2c_fixed", sink="temperature").equations()[0]
     assert eq == "Cw·dPw/dt = Gw·(Pe − Pw) + Gi·(Pi − Pw)", eq
+
+
+def test_fit_leaves_out_readings_at_the_sensor_ceiling():
+    """The generator's attic air passes saturation (it has no condensation) and the
+    logger clips at 100 %RH: the fit's Pi is missing exactly where the reading is lost
+    or at the sensor's ceiling, as ``hbayes calibrate`` derives it; the same room
+    without the logger's noise keeps its outage."""
+    import heritage_bayes as hb
+    from heritage_bayes.io.derive import RH_SENSOR_CEILING
+
+    room = rooms.generate("attic", [sbc.SEED, 0, 9], cal_days=30)
+    model = hb.model("hygric_2c_sorption").with_slopes(("Pe",))
+    _, y = sbc.fit_inputs(room, model)
+    rh = room["hourly"]["RHi"][: y.size]
+    assert np.sum(rh >= RH_SENSOR_CEILING) > 24
+    assert np.array_equal(np.isnan(y), ~(rh < RH_SENSOR_CEILING))
+    quiet = rooms.generate("attic", [sbc.SEED, 0, 9], cal_days=30, without=("noise",))
+    assert quiet["gap"] == room["gap"] and quiet["truth"] == room["truth"]

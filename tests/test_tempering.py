@@ -131,6 +131,11 @@ def test_likelihood_temperature_config_reaches_the_posterior():
     prep_d = prepare(cfg_d)
     lp_h = _log_posterior(cfg_d, prep_d, "hygric", build_model(cfg_d, "hygric"), {})
     assert lp_h.temperature == 1.0
+    # ... and 2 for a hygric model whose buffer sorbs at the materials' temperature
+    cfg_s = parse_config({**raw, "hygric": {"model": "hygric_2c_sorption"}})
+    m_s = build_model(cfg_s, "hygric")
+    assert m_s.sorption and cfg_s.hygric.likelihood_temperature is None
+    assert _log_posterior(cfg_s, prepare(cfg_s), "hygric", m_s, {}).temperature == 2.0
     # ... and 1 for a thermal network of more than two capacity nodes (thermal_4a),
     # unless the config sets it
     cfg_4a = parse_config({**raw, "thermal": {"model": "thermal_4a"}})

@@ -54,7 +54,9 @@ def section_log_posterior(
             initial_state_sd=getattr(cfg, section).initial_state_sd,
             initial_state_horizon=getattr(cfg, section).horizon_seconds,
             time_constant_cap=getattr(cfg, section).cap_seconds(model.domain),
-            temperature=getattr(cfg, section).temperature(model.domain, model.n_states),
+            temperature=getattr(cfg, section).temperature(
+                model.domain, model.n_states, getattr(model, "sorption", False)
+            ),
             **extra,
         )
     except ValueError as exc:

@@ -426,9 +426,9 @@ def prepare(cfg) -> Prepared:
                 "hours_per_week": cal.hours_per_week,
             }
     if "Pi" not in frame.columns and {"Ti", "RHi"} <= set(frame.columns):
-        from heritage_bayes.climate.psychro import vapour_pressure
+        from heritage_bayes.io.derive import add_vapour_pressure  # censored at saturation
 
-        frame["Pi"] = vapour_pressure(frame["Ti"].to_numpy(), frame["RHi"].to_numpy())
+        frame["Pi"] = add_vapour_pressure(frame[["Ti", "RHi"]])["Pi"].to_numpy()
         flags["Pi"] = False
 
     order = [c for c in ("Te", *[f"I_{k}" for k in surfaces], "Tf", "Pe") if c in frame]

@@ -2,14 +2,24 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pandas as pd
 
 from heritage_bayes.climate.psychro import vapour_pressure
 from heritage_bayes.errors import DataError, InputError
 
-__all__ = ["add_vapour_pressure"]
+__all__ = ["RH_SENSOR_CEILING", "add_vapour_pressure"]
 
 _PAIRS = {"Pe": ("Te", "RHe"), "Pi": ("Ti", "RHi")}
+
+#: Indoor relative humidity [%] at and above which a reading is censored, not measured:
+#: a capacitive hygrometer saturates near 100 %RH (condensation on its element; stated
+#: accuracies stop at 90-98 %RH), and loggers clip at 100 %, so a reading there says
+#: only that the air was at or near saturation. Air at saturation also condenses on
+#: cold surfaces, a moisture flow that no hygric model here has. ``Pi`` derived from
+#: such a reading is missing (NaN: the likelihood leaves it out, the report lists it
+#: with the gaps).
+RH_SENSOR_CEILING = 99.0
 
 
 def add_vapour_pressure(frame: pd.DataFrame, *, over: str = "water") -> pd.DataFrame:
@@ -43,7 +53,9 @@ def add_vapour_pressure(frame: pd.DataFrame, *, over: str = "water") -> pd.DataF
     Notes
     -----
     :math:`p_v = \\varphi/100 \\cdot p_{sat}(T)` with the IAPWS saturation pressure
-    (:mod:`heritage_bayes.climate.psychro`). A NaN in T or RH gives NaN.
+    (:mod:`heritage_bayes.climate.psychro`). A NaN in T or RH gives NaN. ``Pi`` is NaN
+    where ``RHi`` is at or above :data:`RH_SENSOR_CEILING` (a censored reading); ``Pe``,
+    a model input, keeps outdoor readings at saturation (fog: the air is saturated).
     """
     if over not in ("water", "ice", "auto"):
         raise InputError(f"over must be 'water', 'ice' or 'auto' (got {over!r})")
@@ -63,9 +75,14 @@ def add_vapour_pressure(frame: pd.DataFrame, *, over: str = "water") -> pd.DataF
     units = dict(attrs.get("units", {}))
     derived = dict(attrs.get("derived", {}))
     for p, (t, rh) in todo.items():
-        out[p] = vapour_pressure(frame[t].to_numpy(float), frame[rh].to_numpy(float), over=over)
+        phi = frame[rh].to_numpy(float)
+        out[p] = vapour_pressure(frame[t].to_numpy(float), phi, over=over)
         units[p] = "Pa"
         derived[p] = f"vapour_pressure({t}, {rh}, over={over!r})"
+        if p == "Pi":
+            with np.errstate(invalid="ignore"):
+                out.loc[phi >= RH_SENSOR_CEILING, p] = np.nan
+            derived[p] += f", NaN where {rh} >= {RH_SENSOR_CEILING:g} %"
         if t in averaged and rh in averaged:
             averaged = (*averaged, p)
         elif (t in averaged) != (rh in averaged):

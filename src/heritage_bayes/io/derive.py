@@ -12,7 +12,7 @@ __all__ = ["RH_SENSOR_CEILING", "add_vapour_pressure"]
 
 _PAIRS = {"Pe": ("Te", "RHe"), "Pi": ("Ti", "RHi")}
 
-#: Indoor relative humidity [%] at and above which a reading is censored, not measured:
+#: Indoor relative humidity [%] at and above which a reading is censored (not a measurement):
 #: a capacitive hygrometer saturates near 100 %RH (condensation on its element; stated
 #: accuracies stop at 90-98 %RH), and loggers clip at 100 %, so a reading there says
 #: only that the air was at or near saturation. Air at saturation also condenses on

@@ -121,7 +121,7 @@ def test_readers_state_the_sampling_of_their_columns(shared_data):
     HH; EPW: dry bulb at the hour, radiation over the hour ending at the stamp. The
     aligned slopes follow: the readings' change over the hour, zero for the means."""
     knmi = read_knmi_hourly(shared_data / "knmi-debilt" / "uurgeg_260_2011-2020.txt.gz")
-    assert knmi.attrs["averaged"] == ("ghi",) and knmi.attrs["interval"] == "1h"
+    assert knmi.attrs["averaged"] == ("ghi", "wind") and knmi.attrs["interval"] == "1h"
     assert "Te" not in knmi.attrs["averaged"]
     w = knmi.loc["2015-06-01":"2015-06-04"]
     al = align(w[["Te", "ghi"]])

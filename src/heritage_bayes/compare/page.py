@@ -12,7 +12,8 @@ from pathlib import Path
 
 from markupsafe import Markup
 
-from heritage_bayes.format import fmt, fmt_interval, prose_html, quantity_name
+from heritage_bayes.format import fmt, fmt_interval, prose_html, quantity_name, tick_names
+from heritage_bayes.rc.catalog import CATALOG
 from heritage_bayes.rundir.signals import DeferSignals
 
 
@@ -232,7 +233,7 @@ def render_comparison(result: dict) -> str:
             if rec.get("screen_choice")
             else ""
         )
-        + f"<p>{prose_html(rec['reason'])}</p></div>"
+        + f"<p>{prose_html(tick_names(rec['reason'], [*CATALOG, *result['models']]))}</p></div>"
     )
     fig = fig_tradeoff(result)
     summary = (

@@ -162,8 +162,8 @@ def test_lower_layers_do_not_import_higher_ones():
         "rc": 1, "climate": 1, "io": 1, "rundir": 1, "errors": 0, "_version": 0, "_arviz": 0,
         "convert": 0, "convergence": 0, "format": 0, "names": 0,
         "config": 1, "inputs": 2, "models": 2, "sources": 2, "demo": 2, "inference": 2,
-        "prepare": 3, "run": 3, "report": 4, "calibrate": 5, "projection": 5, "portfolio": 6,
-        "compare": 6,
+        "prepare": 3, "prepare_steps": 3, "run": 3, "report": 4, "calibrate": 5, "projection": 5,
+        "portfolio": 6, "compare": 6,
         "cli": 7,
     }  # fmt: skip
     bad = []
@@ -363,10 +363,7 @@ MAX_FUNCTION_LINES = 120
 # Functions above MAX_FUNCTION_LINES code lines today, each with its present length as a ceiling:
 # none may grow, and an entry leaves the list as soon as its function is split (the test
 # below fails while a short function is still listed, so the list stays true).
-LONG_FUNCTIONS = {
-    "calibrate.py::_calibrate_into": 181,
-    "prepare.py::prepare": 218,
-}
+LONG_FUNCTIONS: dict[str, int] = {}
 
 
 def function_lengths(root: Path = SRC) -> dict[str, int]:

@@ -258,12 +258,7 @@ def _calibrate_into(
     say = _Progress(quiet)
     start_maps = start_maps or {}
     # the heavy imports (arviz, scipy.optimize, emcee) only once the config is valid
-    from heritage_bayes.inference.coordinates import sampling_coordinates
-    from heritage_bayes.inference.idata import CONVERGENCE, build_run_outputs
-    from heritage_bayes.inference.moves import unidentified_block
-    from heritage_bayes.inference.optimize import seconds_left, share_deadline
-    from heritage_bayes.inference.sampler import run_sampler
-    from heritage_bayes.inference.start import start_hessian
+    from heritage_bayes.inference.idata import build_run_outputs
     from heritage_bayes.prepare import prepare
 
     say.say(f"hbayes {__version__}: calibrating {cfg.name!r} -> {final}")
@@ -301,91 +296,20 @@ def _calibrate_into(
     ndims = [s.logpost.ndim for s in sections]
     nwalkers = cfg.sampler.walkers or max(32, 2 * max(ndims) + 2)
     for i, s in enumerate(sections):  # one budget: MAP search and sampling, all sections
-        t0, deadline = time.perf_counter(), share_deadline(end, len(sections) - i)
-        known = maps.get(s.name)
-        if known is not None and known.x.size == s.logpost.ndim:
-            s.map = known  # the screen's MAP starts the chain
-            say.say(f"[{s.name}] {s.model.name}: the screen's MAP starts the sampler")
-        else:
-            say.say(
-                f"[{s.name}] {s.model.name}: {s.logpost.ndim} free parameters, MAP search "
-                f"({cfg.optimizer.method})"
-            )
-            s.map = _section_map(cfg, s, i, deadline, t0, len(sections))
-        s.timings["map_seconds"] = time.perf_counter() - t0
-        say.say(
-            f"[{s.name}] MAP log-posterior {s.map.log_post:.1f}; "
-            f"{s.map.n_agreed}/{s.map.n_starts} starts agreed"
+        _sample_section(
+            cfg,
+            prep,
+            s,
+            i,
+            len(sections),
+            maps.get(s.name),
+            say,
+            end,
+            nwalkers,
+            out=out,
+            resume=resume,
         )
-        t0 = time.perf_counter()
-        s.identifiability, s.laplace = identifiability_at_map(s.model, s.logpost, s.map, prep.dt)
-        s.timings["identifiability_seconds"] = time.perf_counter() - t0
-        say_findings(say, s, getattr(cfg, s.name).priors)
-        t0 = time.perf_counter()
-        update = say.sampler(s.name, cfg.sampler.max_steps)
-        coords = sampling_coordinates(s.logpost, cfg.sampler.coordinates)
-        hessian = start_hessian(s.logpost, s.laplace, cfg.sampler.start)
-        block = unidentified_block(s.logpost, s.laplace)
-        s.block_move = {
-            "parameters": [s.logpost.params.free_names[k] for k in block],
-            "weight": cfg.sampler.block_weight_for(s.model.n_states) if block else 0.0,
-        }
-        try:
-            s.chain = run_sampler(
-                s.logpost,
-                s.map.x,
-                seed=cfg.seed + 101 * i,
-                nwalkers=nwalkers,
-                moves=cfg.sampler.moves,
-                block=block,
-                block_weight=s.block_move["weight"],
-                max_steps=cfg.sampler.max_steps,
-                max_seconds=seconds_left(deadline),
-                bounds=s.logpost.params.bounds,
-                check_every=cfg.sampler.check_every,
-                tau_factor=cfg.sampler.tau_factor,
-                tau_rtol=cfg.sampler.tau_rtol,
-                tau_discard=cfg.sampler.tau_discard,
-                init_ball=cfg.sampler.init_ball,
-                checkpoint=out / f"chain_{s.name}.h5",
-                tag=f"{chain_tag(cfg)}:{s.logpost.data_hash()}:{s.name}",
-                resume=resume,
-                progress=update,
-                notice=say.warn,
-                max_rhat=CONVERGENCE["max_rhat"],
-                min_ess=CONVERGENCE["min_ess_bulk"],
-                max_draws=cfg.sampler.max_draws,
-                coordinates=coords,
-                compact=True,
-                start_hessian=hessian,
-                max_rows=cfg.sampler.max_stored_steps,
-            )
-        finally:
-            say.close()
-        s.timings["sampling_seconds"] = time.perf_counter() - t0
-        s.timings["sampling_cpu_seconds"] = s.chain.cpu_seconds
-        verdict = "converged" if s.chain.converged else "NOT converged"
-        if (budget := cfg.sampler.max_time) is not None and s.chain.stopped_by == "max_seconds":
-            say.warn(
-                f"[{s.name}] the time budget sampler.max_time = {format_timedelta(budget)} "
-                f"ran out after {s.chain.steps} steps (τmax {np.nanmax(s.chain.tau):.0f}, "
-                f"about {cfg.sampler.tau_factor * np.nanmax(s.chain.tau):.0f} steps needed): "
-                "raise it, or run again with --resume to continue the chain"
-            )
-        say.say(f"[{s.name}] {s.chain.steps} steps, τmax {np.nanmax(s.chain.tau):.0f}: {verdict}")
-    # the draws each sampler checked (R-hat, ESS) give the summaries; the posterior
-    # group holds a common number per walker, so draw i of one model pairs with draw i
-    # of the other (combined RH)
-    for s in sections:
-        s.X, s.lp = s.chain.draws(cfg.sampler.max_draws)
-        s.X_kept = s.X
-        s.theta_kept = s.logpost.params.values(s.X.reshape(-1, s.X.shape[-1])).reshape(
-            *s.X.shape[:2], -1
-        )
-    n_draw = min(s.X.shape[1] for s in sections)
-    for s in sections:
-        s.X, s.lp = s.X[:, -n_draw:], s.lp[:, -n_draw:]
-        s.theta = s.theta_kept[:, -n_draw:]
+    _common_draws(cfg, sections)
     ladder = {k: v.rows for k, v in screens.items()}  # model: auto: the screen is the ladder
     if cfg.ladder:
         for i, s in enumerate(sections):
@@ -435,6 +359,122 @@ def _calibrate_into(
         release_memory()
         write_report(out)
         say.say(f"report: {final / 'report.html'}")
+
+
+def _sample_section(
+    cfg: CalibrationConfig,
+    prep,
+    s: _Section,
+    i: int,
+    n_sections: int,
+    known,
+    say,
+    end,
+    nwalkers: int,
+    *,
+    out: Path,
+    resume: bool,
+) -> None:
+    """One section's share of the run's budget: its MAP (``known``, a MAP found
+    beforehand, when it fits, else a new search), the identifiability at the MAP and the
+    sampler's chain (checkpointed in ``out``), all stored on ``s`` with their timings.
+    Section ``i`` of ``n_sections`` gets an equal share of the time left before ``end``
+    and the seed ``cfg.seed + 101 i``."""
+    from heritage_bayes.inference.coordinates import sampling_coordinates
+    from heritage_bayes.inference.idata import CONVERGENCE
+    from heritage_bayes.inference.moves import unidentified_block
+    from heritage_bayes.inference.optimize import seconds_left, share_deadline
+    from heritage_bayes.inference.sampler import run_sampler
+    from heritage_bayes.inference.start import start_hessian
+
+    t0, deadline = time.perf_counter(), share_deadline(end, n_sections - i)
+    if known is not None and known.x.size == s.logpost.ndim:
+        s.map = known  # the screen's MAP starts the chain
+        say.say(f"[{s.name}] {s.model.name}: the screen's MAP starts the sampler")
+    else:
+        say.say(
+            f"[{s.name}] {s.model.name}: {s.logpost.ndim} free parameters, MAP search "
+            f"({cfg.optimizer.method})"
+        )
+        s.map = _section_map(cfg, s, i, deadline, t0, n_sections)
+    s.timings["map_seconds"] = time.perf_counter() - t0
+    say.say(
+        f"[{s.name}] MAP log-posterior {s.map.log_post:.1f}; "
+        f"{s.map.n_agreed}/{s.map.n_starts} starts agreed"
+    )
+    t0 = time.perf_counter()
+    s.identifiability, s.laplace = identifiability_at_map(s.model, s.logpost, s.map, prep.dt)
+    s.timings["identifiability_seconds"] = time.perf_counter() - t0
+    say_findings(say, s, getattr(cfg, s.name).priors)
+    t0 = time.perf_counter()
+    update = say.sampler(s.name, cfg.sampler.max_steps)
+    coords = sampling_coordinates(s.logpost, cfg.sampler.coordinates)
+    hessian = start_hessian(s.logpost, s.laplace, cfg.sampler.start)
+    block = unidentified_block(s.logpost, s.laplace)
+    s.block_move = {
+        "parameters": [s.logpost.params.free_names[k] for k in block],
+        "weight": cfg.sampler.block_weight_for(s.model.n_states) if block else 0.0,
+    }
+    try:
+        s.chain = run_sampler(
+            s.logpost,
+            s.map.x,
+            seed=cfg.seed + 101 * i,
+            nwalkers=nwalkers,
+            moves=cfg.sampler.moves,
+            block=block,
+            block_weight=s.block_move["weight"],
+            max_steps=cfg.sampler.max_steps,
+            max_seconds=seconds_left(deadline),
+            bounds=s.logpost.params.bounds,
+            check_every=cfg.sampler.check_every,
+            tau_factor=cfg.sampler.tau_factor,
+            tau_rtol=cfg.sampler.tau_rtol,
+            tau_discard=cfg.sampler.tau_discard,
+            init_ball=cfg.sampler.init_ball,
+            checkpoint=out / f"chain_{s.name}.h5",
+            tag=f"{chain_tag(cfg)}:{s.logpost.data_hash()}:{s.name}",
+            resume=resume,
+            progress=update,
+            notice=say.warn,
+            max_rhat=CONVERGENCE["max_rhat"],
+            min_ess=CONVERGENCE["min_ess_bulk"],
+            max_draws=cfg.sampler.max_draws,
+            coordinates=coords,
+            compact=True,
+            start_hessian=hessian,
+            max_rows=cfg.sampler.max_stored_steps,
+        )
+    finally:
+        say.close()
+    s.timings["sampling_seconds"] = time.perf_counter() - t0
+    s.timings["sampling_cpu_seconds"] = s.chain.cpu_seconds
+    verdict = "converged" if s.chain.converged else "NOT converged"
+    if (budget := cfg.sampler.max_time) is not None and s.chain.stopped_by == "max_seconds":
+        say.warn(
+            f"[{s.name}] the time budget sampler.max_time = {format_timedelta(budget)} "
+            f"ran out after {s.chain.steps} steps (τmax {np.nanmax(s.chain.tau):.0f}, "
+            f"about {cfg.sampler.tau_factor * np.nanmax(s.chain.tau):.0f} steps needed): "
+            "raise it, or run again with --resume to continue the chain"
+        )
+    say.say(f"[{s.name}] {s.chain.steps} steps, τmax {np.nanmax(s.chain.tau):.0f}: {verdict}")
+
+
+def _common_draws(cfg: CalibrationConfig, sections: list[_Section]) -> None:
+    """The draws each sampler checked (R-hat, ESS) give the summaries; the posterior
+    group holds a common number per walker, so draw i of one model pairs with draw i of
+    the other (combined RH). Sets ``X``, ``lp``, ``theta`` (common) and ``X_kept``,
+    ``theta_kept`` (all checked draws) on each section."""
+    for s in sections:
+        s.X, s.lp = s.chain.draws(cfg.sampler.max_draws)
+        s.X_kept = s.X
+        s.theta_kept = s.logpost.params.values(s.X.reshape(-1, s.X.shape[-1])).reshape(
+            *s.X.shape[:2], -1
+        )
+    n_draw = min(s.X.shape[1] for s in sections)
+    for s in sections:
+        s.X, s.lp = s.X[:, -n_draw:], s.lp[:, -n_draw:]
+        s.theta = s.theta_kept[:, -n_draw:]
 
 
 def _section_map(cfg: CalibrationConfig, s: _Section, i: int, deadline, t0, n: int):

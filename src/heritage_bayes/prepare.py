@@ -43,26 +43,31 @@ the heated room below an attic, a crypt), aligned like the other inputs.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
 
-from heritage_bayes.convert import format_timedelta, to_jsonable
-from heritage_bayes.errors import ConfigError, DataError, InputError
+from heritage_bayes.convert import to_jsonable
+from heritage_bayes.errors import ConfigError, DataError
 from heritage_bayes.inputs import (
     _with_vapour_pressure,
-    add_slope_columns,
     annual_mean_temperature,
-    calendar_inputs,
     fixed_node_temperature,
-    ground_input,
     solar_inputs,
     weather_inputs,
 )
-from heritage_bayes.sources import INPUT_COLUMNS, OUTPUT_COLUMNS, _ground_column, _iso, read_sources
+from heritage_bayes.prepare_steps import (
+    _check_observations,
+    _check_plausible,
+    align_tables,
+    check_outputs,
+    complete_frame,
+    demo_truth,
+    period_rows,
+)
+from heritage_bayes.sources import INPUT_COLUMNS, OUTPUT_COLUMNS, _ground_column, read_sources
 
 __all__ = [
     "INPUT_COLUMNS",
@@ -263,19 +268,6 @@ def _extra_inputs(cfg) -> list[str]:
     return extra
 
 
-# -- periods ----------------------------------------------------------------------------
-
-
-def _utc(text: str) -> pd.Timestamp:
-    ts = pd.Timestamp(text)
-    return ts.tz_localize("UTC") if ts.tzinfo is None else ts.tz_convert("UTC")
-
-
-def _rows(t: pd.Timestamp, start: pd.Timestamp, step: pd.Timedelta) -> int:
-    """Grid row of instant ``t`` (rounded up to the next row)."""
-    return math.ceil((t - start) / step - 1e-9)
-
-
 # -- prepare ----------------------------------------------------------------------------
 
 
@@ -313,13 +305,13 @@ def prepare(cfg) -> Prepared:
         ``data.max_gap`` inside the frame, a period not covered by the inputs, no
         observations in a period (names the key path and the file, column or row).
     """
-    from heritage_bayes.io import align
+    from heritage_bayes.models import build_model  # Tf: thermal, or a hygric sink at it
 
     thermal, hygric = cfg.thermal is not None, cfg.hygric is not None
     if not (thermal or hygric):
         raise ConfigError("give at least one of 'thermal' and 'hygric'")
     _check_models_vs_irradiance(cfg)
-    data, step = cfg.data, cfg.data.step
+    data = cfg.data
     surfaces = {k: tuple(v) for k, v in data.surfaces.items()}
     truth = None
 
@@ -345,175 +337,25 @@ def prepare(cfg) -> Prepared:
     if monument is not None and irradiance_source == "measured":
         irradiance_source = monument.info["irradiance_label"]
     gt = data.ground_temperature
-    from heritage_bayes.models import build_model  # Tf: thermal, or a hygric sink at it
-
     ground = thermal or (hygric and "Tf" in build_model(cfg, "hygric").input_names)
     if ground and gt.mode == "column":
         tf_table, sources["ground_temperature"] = _ground_column(cfg, gt, "data.ground_temperature")
         tables.append(tf_table)
 
-    # -- outputs ---------------------------------------------------------------------------
-    key = "data.measurements"
-    meas_tables = [_with_vapour_pressure(m, "Pi", key) for m in meas_tables]
-    measured = {c for m in meas_tables for c in m.columns}
-    if thermal and "Ti" not in measured:
-        raise ConfigError(
-            f"{key}.columns.Ti: the thermal section needs the indoor temperature Ti; the "
-            f"measurements provide {sorted(measured)}"
-        )
-    if hygric and "Pi" not in measured and not {"Ti", "RHi"} <= measured:
-        raise ConfigError(
-            f"{key}.columns.RHi: the hygric section needs the indoor vapour pressure Pi, "
-            f"or Ti and RHi to derive it; the measurements provide {sorted(measured)}"
-        )
-
-    # -- periods and alignment -------------------------------------------------------------
-    per = cfg.periods
-    start = end = None
-    if per.calibration is not None:
-        bounds = [per.calibration] + ([per.validation] if per.validation is not None else [])
-        start = min(_utc(p.start) for p in bounds)
-        end = max(_utc(p.end) for p in bounds)
-    try:
-        aligned = align(
-            tables,
-            meas_tables,
-            step=step,
-            max_gap=data.max_gap,
-            start=start,
-            end=end,
-            long_gaps="split",
-        )
-    except DataError as exc:
-        what = (
-            f"the periods ({_iso(start)} to {_iso(end)})"
-            if start is not None
-            else "the common period of all data (no periods given)"
-        )
-        raise DataError(
-            f"data.weather/data.measurements: aligning on {what} with data.step="
-            f"{format_timedelta(data.step)}, data.max_gap={format_timedelta(data.max_gap)}: "
-            f"{exc}"
-        ) from None
-    except InputError as exc:
-        raise ConfigError(f"data: {exc}") from None
-
-    frame = aligned.frame.copy()
-    flags = aligned.flags.copy()
-    n = len(frame)
-    s0 = frame.index[0]
-
-    # Tf (seasonal, annual mean or constant); column mode came through align
-    if ground and gt.mode != "column":
-        if gt.mode == "constant":
-            tf = np.full(n, float(gt.value))
-            sources["ground_temperature"] = {"mode": "constant", "value": float(gt.value)}
-        else:
-            mids = frame.index + step / 2
-            tf, sources["ground_temperature"] = ground_input(gt.mode, weather["Te"], mids, gt.depth)
-        frame["Tf"] = tf
-        flags["Tf"] = False
-    sections = [s for s in _SECTIONS if getattr(cfg, s) is not None]
-    models = [build_model(cfg, s) for s in sections]
-    for name, col in calendar_inputs(models, frame.index, step.total_seconds()).items():
-        frame[name] = col  # hours of use from a weekly calendar (thermostat.schedule)
-        flags[name] = False
-    for m in models:
-        for name, cal in getattr(m, "calendar_inputs", {}).items():
-            sources.setdefault("calendar", {})[name] = {
-                "weekly": list(cal.entries),
-                "timezone": cal.timezone,
-                "hours_per_week": cal.hours_per_week,
-            }
-    if "Pi" not in frame.columns and {"Ti", "RHi"} <= set(frame.columns):
-        from heritage_bayes.io.derive import add_vapour_pressure  # censored at saturation
-
-        frame["Pi"] = add_vapour_pressure(frame[["Ti", "RHi"]])["Pi"].to_numpy()
-        flags["Pi"] = False
-
-    order = [c for c in ("Te", *[f"I_{k}" for k in surfaces], "Tf", "Pe") if c in frame]
-    order += [c for c in frame.columns if c not in order and c not in OUTPUT_COLUMNS]
-    order += [c for c in ("Ti", "Pi", "RHi") if c in frame]
-    frame = frame[order]
-    flags = flags[order]
-    frame.attrs = dict(aligned.frame.attrs)
-    frame.attrs["inputs"] = tuple(c for c in order if c not in OUTPUT_COLUMNS)
-    frame.attrs["outputs"] = tuple(c for c in order if c in OUTPUT_COLUMNS)
-    frame.attrs["units"] = {
-        **frame.attrs.get("units", {}),
-        **{c: "W/m²" for c in order if c.startswith("I_")},
-        **{c: u for c, u in (("Tf", "°C"), ("Pi", "Pa")) if c in order},
-        **{c: "-" for m in models for c in getattr(m, "calendar_inputs", {})},
-    }
-    add_slope_columns(frame, models, aligned.slopes, flags)  # the first-order hold
+    # -- outputs, alignment, the frame -----------------------------------------------------
+    meas_tables = [_with_vapour_pressure(m, "Pi", "data.measurements") for m in meas_tables]
+    check_outputs(meas_tables, thermal, hygric)
+    aligned = align_tables(cfg, tables, meas_tables)
+    models = [build_model(cfg, s) for s in _SECTIONS if getattr(cfg, s) is not None]
+    frame, flags = complete_frame(cfg, aligned, weather, models, ground, sources)
 
     # -- period rows -----------------------------------------------------------------------
-    if per.calibration is not None:
-        cal = slice(
-            _rows(_utc(per.calibration.start), s0, step),
-            min(n, _rows(_utc(per.calibration.end), s0, step)),
-        )
-        val = None
-        if per.validation is not None:
-            val = slice(
-                _rows(_utc(per.validation.start), s0, step),
-                min(n, _rows(_utc(per.validation.end), s0, step)),
-            )
-        period_note = "config"
-    else:
-        k = round(2 * n / 3)
-        if k < 1 or k >= n:
-            raise DataError(
-                f"periods: the common period of all data has only {n} rows of "
-                f"{format_timedelta(data.step)}; too short to split into calibration and validation"
-            )
-        cal, val = slice(0, k), slice(k, n)
-        period_note = "default: first 2/3 of the common period of all data, then the rest"
-    dt = float(step.total_seconds())
-    from heritage_bayes.models import default_warmup
-
-    warmup = per.warmup if per.warmup is not None else default_warmup(cfg)
-    warmup_steps = math.ceil(warmup / step - 1e-9)
-    init_steps = math.ceil(per.init_window / step - 1e-9)
-    cal_rows = cal.stop - cal.start
-    if warmup_steps >= cal_rows:
-        raise ConfigError(
-            f"periods.warmup: {format_timedelta(warmup)} ({warmup_steps} rows) is not shorter "
-            f"than the calibration period ({cal_rows} rows, {_iso(frame.index[cal.start])} to "
-            f"{_iso(frame.index[cal.stop - 1] + step)})"
-        )
-    _check_observations(frame, cal, val, warmup_steps, thermal, hygric, step)
+    cal, val, sources["periods"], warmup_steps, init_steps = period_rows(cfg, frame)
+    _check_observations(frame, cal, val, warmup_steps, thermal, hygric, data.step)
     _check_plausible(frame, cfg)
 
-    def _span(sl):
-        if sl is None:
-            return None
-        return {
-            "start": _iso(frame.index[sl.start]),
-            "end": _iso(frame.index[sl.stop - 1] + step),
-            "rows": [sl.start, sl.stop],
-        }
-
-    sources["periods"] = {
-        "from": period_note,
-        "calibration": _span(cal),
-        "validation": _span(val),
-        "warmup": format_timedelta(warmup),
-        "warmup_steps": warmup_steps,
-        "init_window": format_timedelta(per.init_window),
-        "init_steps": init_steps,
-    }
-
     if monument is not None:
-        from heritage_bayes.demo import nominal_noise
-
-        truth = {sec: dict(vals) for sec, vals in monument.truth.items()}
-        rows = frame.index[cal.start + warmup_steps : cal.stop]
-        for sec, out in (("thermal", "Ti"), ("hygric", "Pi")):
-            sec_cfg = getattr(cfg, sec)
-            kind = sec_cfg.noise if sec_cfg is not None else "ar1_white"
-            truth[sec].update(nominal_noise(monument, out, rows, noise=kind))
-
+        truth = demo_truth(cfg, monument, frame, cal, warmup_steps)
     if cfg.fixed_node_temperature is None and any("Pf" in m.parameter_names for m in models):
         te, const = weather.get("Te"), (gt.value if gt.mode == "constant" else None)
         sources["fixed_node_temperature"] = fixed_node_temperature(frame, cal, te, const)
@@ -521,7 +363,7 @@ def prepare(cfg) -> Prepared:
         frame=frame,
         flags=flags,
         alignment=aligned.report.to_dict(),
-        dt=dt,
+        dt=float(data.step.total_seconds()),
         calibration=cal,
         validation=val,
         warmup_steps=warmup_steps,
@@ -531,70 +373,3 @@ def prepare(cfg) -> Prepared:
         sources=to_jsonable(sources),
         breaks=aligned.breaks if aligned.breaks.any() else None,
     )
-
-
-def _check_observations(frame, cal, val, warmup_steps, thermal, hygric, step) -> None:
-    needed = (["Ti"] if thermal else []) + (["Pi"] if hygric else [])
-    periods = [("calibration (after the warm-up)", slice(cal.start + warmup_steps, cal.stop))]
-    if val is not None:
-        if val.stop <= val.start:
-            raise ConfigError("periods.validation: has no rows on the grid")
-        periods.append(("validation", val))
-    for what, sl in periods:
-        hours = MIN_OBSERVED_HOURS[what.split()[0]]
-        n_min = max(2, math.ceil(pd.Timedelta(hours=hours) / step))
-        for col in needed:
-            n_obs = int(np.isfinite(frame[col].to_numpy()[sl]).sum())
-            if n_obs < n_min:
-                a = frame.index[sl.start] if sl.start < len(frame) else frame.index[-1]
-                b = frame.index[max(sl.stop - 1, 0)] + step
-                found = (
-                    f"no {col} observation" if n_obs == 0 else f"only {n_obs} {col} observations"
-                )
-                raise DataError(
-                    f"data.measurements: {found} in the {what} period "
-                    f"{_iso(a)} to {_iso(b)}; at least {n_min} ({hours} h of data) are needed "
-                    "for a meaningful fit; check periods and the measurement file's time zone"
-                )
-
-
-#: Least observed time in each period: fewer gives fit figures without meaning.
-MIN_OBSERVED_HOURS = {"calibration": 48, "validation": 24}
-
-
-def _column_origin(cfg, col: str) -> str:
-    """Where a standard column came from, for a message: config key, file, column."""
-    data = cfg.data
-    for i, m in enumerate(data.measurements or []):
-        if m.columns and col in m.columns:
-            return f"data.measurements[{i}] ({m.path}, column {m.columns[col]!r})"
-    if data.weather is not None:
-        return f"data.weather ({data.weather.path})"
-    return col
-
-
-def _check_plausible(frame: pd.DataFrame, cfg) -> None:
-    """Units the physical range checks cannot catch: relative humidity given as a
-    fraction (0-1) instead of percent, temperatures in °F beside ones in °C."""
-    for col in ("RHi", "RHe"):
-        if col in frame:
-            v = frame[col].to_numpy(dtype=float)
-            v = v[np.isfinite(v)]
-            if v.size >= 24 and np.percentile(v, 99) <= 1.0:
-                raise DataError(
-                    f"{_column_origin(cfg, col)}: relative humidity {col} never exceeds "
-                    f"{v.max():.3g}: a fraction (0-1)? hbayes expects percent (0-100); "
-                    "multiply the column by 100"
-                )
-    if {"Ti", "Te"} <= set(frame.columns):
-        ti, te = frame["Ti"].to_numpy(dtype=float), frame["Te"].to_numpy(dtype=float)
-        ok = np.isfinite(ti) & np.isfinite(te)
-        if ok.sum() >= 24:
-            mi, me = float(ti[ok].mean()), float(te[ok].mean())
-            for col, m, other in (("Ti", mi, me), ("Te", me, mi)):
-                if m > 40 and m - other > 20:
-                    raise DataError(
-                        f"{_column_origin(cfg, col)}: {col} averages {m:.1f} °C against "
-                        f"{other:.1f} °C for the other temperature: °F? hbayes expects °C; "
-                        "convert with (F - 32) / 1.8"
-                    )

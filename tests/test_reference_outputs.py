@@ -51,6 +51,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import sys
 from functools import cache
 from pathlib import Path
@@ -190,10 +191,16 @@ VOLATILE = {
     "created_at", "heritage_bayes_version", "versions", "timings", "wall_seconds",
     "cpu_seconds", "provenance", "config_hash", "schema_version",
 }  # fmt: skip
+#: The install folder in a path (of a virtual environment or a system Python).
+_SITE_PACKAGES = re.compile(r"\S*[\\/](?:site|dist)-packages[\\/]")
 
 
 def _steady(d):
-    """``d`` without the :data:`VOLATILE` keys, at every depth."""
+    """``d`` without the :data:`VOLATILE` keys, at every depth, and with the install
+    folder left out of file paths (``.../site-packages/pvlib/data/...`` ->
+    ``pvlib/data/...``): where the package's environment lives is not an output."""
+    if isinstance(d, str):
+        return _SITE_PACKAGES.sub("", d)
     if isinstance(d, dict):
         return {k: _steady(v) for k, v in d.items() if k not in VOLATILE}
     if isinstance(d, list):

@@ -131,13 +131,15 @@ def screen_auto(cfg) -> tuple:
     from threadpoolctl import threadpool_limits
 
     from heritage_bayes.calibrate import _select_models
-    from heritage_bayes.models import AUTO, SECTIONS
+    from heritage_bayes.models import AUTO, SECTIONS, models_of
     from heritage_bayes.prepare import prepare
 
     if not any(getattr(getattr(cfg, n, None), "model", None) == AUTO for n in SECTIONS):
         return cfg, {}
     with threadpool_limits(limits=1, user_api="blas"):
-        cfg, screens = _select_models(cfg, prepare(cfg), SimpleNamespace(say=lambda m: None), None)
+        models, rungs = models_of(cfg)
+        say = SimpleNamespace(say=lambda m: None)
+        cfg, screens = _select_models(cfg, prepare(cfg, models), say, None, rungs)
     out = {
         f"{name}_screen": "; ".join(
             f"{r['model']} {r.get('score', float('nan')):.1f}" for r in scr.rows if "error" not in r

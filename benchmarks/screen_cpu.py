@@ -19,6 +19,7 @@ from threadpoolctl import threadpool_limits
 
 from heritage_bayes.config import load_config
 from heritage_bayes.inference.optimize import find_map
+from heritage_bayes.models import models_of
 from heritage_bayes.prepare import prepare
 from heritage_bayes.selection import carried_start, screen
 
@@ -29,13 +30,15 @@ def main() -> None:
     ap.add_argument("--section", default="thermal", choices=("thermal", "hygric"))
     args = ap.parse_args()
     cfg = load_config(args.config)
-    prep = prepare(cfg)
+    models, rungs = models_of(cfg)
+    prep = prepare(cfg, models)
     with threadpool_limits(limits=1, user_api="blas"):
         c0 = time.process_time()
         scr = screen(
             cfg,
             prep,
             args.section,
+            rungs[args.section],
             seed=cfg.seed,
             say=lambda m: print(f"{time.process_time() - c0:7.1f} s CPU  {m}", flush=True),
         )

@@ -28,6 +28,7 @@ from real_rooms import ROOMS, run_init  # noqa: E402
 
 def main(argv=None) -> int:
     from heritage_bayes.config import load_config
+    from heritage_bayes.models import models_of
     from heritage_bayes.prepare import prepare
     from heritage_bayes.selection import screen
 
@@ -50,11 +51,14 @@ def main(argv=None) -> int:
         cfg = load_config(config)
         cfg = cfg.model_copy(update={args.section: getattr(cfg, args.section).model_copy(
             update={"model": "auto"})})  # fmt: skip
-        prep = prepare(cfg)
+        models, rungs = models_of(cfg)
+        prep = prepare(cfg, models)
         for guarded in (False, True):
             c0 = time.process_time()
             with threadpool_limits(limits=1, user_api="blas"):
-                scr = screen(cfg, prep, args.section, seed=cfg.seed, guarded=guarded)
+                scr = screen(
+                    cfg, prep, args.section, rungs[args.section], seed=cfg.seed, guarded=guarded
+                )
             cpu = time.process_time() - c0
             for r in scr.rows:
                 mp = scr.maps.get(r["model"])

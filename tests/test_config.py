@@ -439,7 +439,7 @@ def test_model_option_errors_name_the_key_expected_and_found():
     assert "thermal.options.source: Input should be a valid boolean (got 1)" in msg
 
 
-def test_an_option_the_model_does_not_take_names_its_key_and_models_build_once():
+def test_an_option_the_model_does_not_take_names_its_key_and_models_follow_options():
     from heritage_bayes.calibrate import check_models
     from heritage_bayes.config.options import ModelOptions
     from heritage_bayes.models import build_model
@@ -448,9 +448,8 @@ def test_an_option_the_model_does_not_take_names_its_key_and_models_build_once()
     with pytest.raises(ConfigError, match=r"^hygric\.options\.sink: model 'hygric_2c' does not"):
         check_models(cfg)
     cfg = parse_config(_with(thermal={"model": "thermal_2c", "options": {"ground": False}}))
-    m = build_model(cfg, "thermal")
-    assert build_model(cfg, "thermal") is m and "Tf" not in m.input_names
+    models, rungs = check_models(cfg)  # the run's models, built once
+    assert "Tf" not in models["thermal"].input_names and rungs == {}
     sec = cfg.thermal.model_copy(update={"options": ModelOptions()})  # ground: default
     other = cfg.model_copy(update={"thermal": sec})
     assert "Tf" in build_model(other, "thermal").input_names
-    assert build_model(cfg, "thermal") is m

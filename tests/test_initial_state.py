@@ -141,26 +141,33 @@ def test_estimated_initial_state_recovers_a_start_far_from_equilibrium():
 
 def test_initial_state_config_errors():
     from heritage_bayes.config import parse_config
-    from heritage_bayes.models import default_warmup, initial_state_of
+    from heritage_bayes.models import build_model, default_warmup, initial_state_of
 
     base = {
         "name": "t",
         "data": {"demo": {}},
         "thermal": {"model": "thermal_2c"},
     }
+
+    def state(cfg):
+        return initial_state_of(cfg, "thermal", build_model(cfg, "thermal"))
+
+    def warmup(cfg):
+        return default_warmup(cfg, {"thermal": build_model(cfg, "thermal")})
+
     cfg = parse_config(base)
-    assert initial_state_of(cfg, "thermal") == "estimate"
-    assert default_warmup(cfg) == pd.Timedelta(0)
+    assert state(cfg) == "estimate"
+    assert warmup(cfg) == pd.Timedelta(0)
     bad = parse_config({**base, "thermal": {"model": "thermal_2c", "initial_state": {"Tx": 3}}})
     with pytest.raises(ConfigError, match=r"thermal.initial_state: unknown node.*Tx"):
-        initial_state_of(bad, "thermal")
+        state(bad)
     ctl = {"model": "thermal_2c", "options": {"thermostat": True}, "initial_state": "estimate"}
     with pytest.raises(ConfigError, match=r"thermal\.initial_state: 'estimate' needs a model"):
-        initial_state_of(parse_config({**base, "thermal": ctl}), "thermal")
+        state(parse_config({**base, "thermal": ctl}))
     ctl.pop("initial_state")
     cfg = parse_config({**base, "thermal": ctl})
-    assert initial_state_of(cfg, "thermal") == "steady"
-    assert default_warmup(cfg) == pd.Timedelta(days=14)
+    assert state(cfg) == "steady"
+    assert warmup(cfg) == pd.Timedelta(days=14)
 
 
 def test_free_run_error_fit_recovers_a_slow_error():

@@ -285,7 +285,7 @@ def test_model_auto_and_compare_screen_alike_and_choose_alike(tmp_path):
     from heritage_bayes.compare.orchestrate import _candidate_config
     from heritage_bayes.compare.screen import screen_candidates
     from heritage_bayes.config import load_config
-    from heritage_bayes.models import AUTO_LADDERS
+    from heritage_bayes.models import AUTO_LADDERS, models_of
     from heritage_bayes.prepare import prepare
     from heritage_bayes.selection import screen
 
@@ -293,10 +293,12 @@ def test_model_auto_and_compare_screen_alike_and_choose_alike(tmp_path):
     p = tmp_path / "auto.yaml"
     p.write_text(yaml.safe_dump(raw), encoding="utf-8")
     cfg = load_config(p)
-    auto = screen(cfg, prepare(cfg), "thermal", seed=cfg.seed)
+    models, rungs = models_of(cfg)
+    auto = screen(cfg, prepare(cfg, models), "thermal", rungs["thermal"], seed=cfg.seed)
     names = [n for n, _, _ in AUTO_LADDERS["thermal"]]
-    cands = {n: _candidate_config(cfg, "thermal", n) for n in names}
-    rows, _, scores = screen_candidates(cands, "thermal", tell=lambda m: None)
+    built = {n: _candidate_config(cfg, "thermal", n) for n in names}
+    cands, models = {n: c for n, (c, _) in built.items()}, {n: m for n, (_, m) in built.items()}
+    rows, _, scores = screen_candidates(cands, models, "thermal", tell=lambda m: None)
     assert [r["model"] for r in auto.rows] == names
     for r in auto.rows:
         assert scores[r["model"]] == pytest.approx(r["score"], abs=1e-6), r["model"]

@@ -48,6 +48,7 @@ from heritage_bayes.models import (
     catalog_build,
     catalog_options,
     initial_state_of,
+    models_of,
 )
 from heritage_bayes.rc.model import RCModel
 from heritage_bayes.run import (  # Run, load_run: re-exported
@@ -75,15 +76,21 @@ __all__ = [
 ]
 
 
-def check_models(cfg: CalibrationConfig) -> None:
+def check_models(cfg: CalibrationConfig) -> tuple[dict[str, RCModel], dict[str, list]]:
     """Build every configured model and its priors without reading any data, so that a
-    wrong model name, option or prior fails at once (:class:`ConfigError` naming the key)."""
-    for section in SECTIONS:
-        sec_cfg = getattr(cfg, section)
-        if sec_cfg is not None:
-            model = build_model(cfg, section)
-            section_parameters(cfg, section, model, sec_cfg.priors)
-            initial_state_of(cfg, section, model)
+    wrong model name, option or prior fails at once (:class:`ConfigError` naming the key).
+
+    Returns
+    -------
+    models, rungs : dict
+        The run's models, built once and handed down
+        (:func:`heritage_bayes.models.models_of`).
+    """
+    models, rungs = models_of(cfg)
+    for section, model in models.items():
+        section_parameters(cfg, section, model, getattr(cfg, section).priors)
+        initial_state_of(cfg, section, model)
+    return models, rungs
 
 
 def _say_segments(say, prep) -> None:
@@ -222,13 +229,15 @@ def _run_calibration(
     writer = RunWriter(out_dir, force=force, resume=resume, protect=input_paths(cfg))
     writer.check()  # before reading any data: a bad --out fails at once
     out = writer.out
-    check_models(cfg)
+    models, rungs = check_models(cfg)
     with writer:
         try:
             _calibrate_into(
                 writer.staging,
                 cfg,
                 out,
+                models,
+                rungs,
                 resume=resume,
                 quiet=quiet,
                 report=report,
@@ -245,15 +254,18 @@ def _calibrate_into(
     out: Path,
     cfg: CalibrationConfig,
     final: Path,
+    models: dict[str, RCModel],
+    rungs: dict[str, list],
     *,
     resume: bool,
     quiet: bool,
     report: bool | None,
     start_maps: dict | None = None,
 ) -> None:
-    """Calibrate and write every output into ``out`` (the staging folder of ``final``);
-    ``start_maps``: section -> a MAP found beforehand (``hbayes compare``'s screen) that
-    starts the chain instead of a new search."""
+    """Calibrate and write every output into ``out`` (the staging folder of ``final``)
+    with the run's ``models`` and the ``rungs`` of its ``model: auto`` sections
+    (:func:`check_models`); ``start_maps``: section -> a MAP found beforehand (``hbayes
+    compare``'s screen) that starts the chain instead of a new search."""
     t_start = time.perf_counter()
     say = _Progress(quiet)
     start_maps = start_maps or {}
@@ -263,7 +275,7 @@ def _calibrate_into(
 
     say.say(f"hbayes {__version__}: calibrating {cfg.name!r} -> {final}")
     t0 = time.perf_counter()
-    prep = prepare(cfg)
+    prep = prepare(cfg, models)
     t_prep = time.perf_counter() - t0
     if (fixed := prep.sources.get("fixed_node_temperature")) is not None:
         # the Pf prior's centre, resolved from the data: recorded in config.yaml, so
@@ -279,7 +291,8 @@ def _calibrate_into(
     _say_segments(say, prep)
     end = None if cfg.sampler.max_seconds is None else t_start + cfg.sampler.max_seconds
     # model: auto: the ladder's MAP screen chooses the model sampled (heritage_bayes.selection)
-    cfg, screens = _select_models(cfg, prep, say, end)
+    cfg, screens = _select_models(cfg, prep, say, end, rungs)
+    models = {**models, **{k: v.models[v.choice["choice"]] for k, v in screens.items()}}
     maps = dict(start_maps or {})
     maps.update({k: v.maps[v.choice["choice"]] for k, v in screens.items()})
     atomic_write_text(out / "config.yaml", config_yaml(cfg))
@@ -290,9 +303,8 @@ def _calibrate_into(
         sec_cfg = getattr(cfg, name)
         if sec_cfg is None:
             continue
-        model = build_model(cfg, name)
-        lp = section_log_posterior(cfg, prep, name, model, sec_cfg.priors)
-        sections.append(_Section(name, model, lp))
+        lp = section_log_posterior(cfg, prep, name, models[name], sec_cfg.priors)
+        sections.append(_Section(name, models[name], lp))
     ndims = [s.logpost.ndim for s in sections]
     nwalkers = cfg.sampler.walkers or max(32, 2 * max(ndims) + 2)
     for i, s in enumerate(sections):  # one budget: MAP search and sampling, all sections
@@ -496,8 +508,11 @@ def _section_map(cfg: CalibrationConfig, s: _Section, i: int, deadline, t0, n: i
     )
 
 
-def _select_models(cfg: CalibrationConfig, prep, say, end) -> tuple[CalibrationConfig, dict]:
-    """Every ``model: auto`` section screened and replaced by its choice: (the config
+def _select_models(
+    cfg: CalibrationConfig, prep, say, end, rungs: dict[str, list]
+) -> tuple[CalibrationConfig, dict]:
+    """Every ``model: auto`` section screened (its built ``rungs``,
+    :func:`heritage_bayes.models.auto_rungs`) and replaced by its choice: (the config
     with the models chosen, section -> :class:`~heritage_bayes.selection.Screen`).
     Each screen may use a share of the time budget (``end``) of its own and of the
     sections still to sample."""
@@ -514,6 +529,7 @@ def _select_models(cfg: CalibrationConfig, prep, say, end) -> tuple[CalibrationC
             cfg,
             prep,
             name,
+            rungs[name],
             seed=cfg.seed + 101 * SECTIONS.index(name),
             deadline=share_deadline(end, 2 * (n_sections - i)),
             say=say.say,

@@ -6,9 +6,7 @@ needs), by the orchestrator and by the run directory's loader; imports neither.
 
 from __future__ import annotations
 
-import json
 import re
-import weakref
 from collections.abc import Mapping
 
 import pandas as pd
@@ -90,9 +88,9 @@ def build_model(cfg: CalibrationConfig, section: str) -> RCModel:
 
     Catalogue models get their solar surfaces from ``data.surfaces`` (none when
     ``data.irradiance: none``); a mapping under ``model:`` is a custom network
-    (:meth:`heritage_bayes.rc.Network.from_dict`). Built once per config object and
-    section: a later call returns the same model while the settings it reads are
-    unchanged.
+    (:meth:`heritage_bayes.rc.Network.from_dict`); ``model: auto`` gives the richest
+    rung of :func:`auto_rungs`. Each call builds a new model: a run builds its models
+    once (:func:`models_of`) and hands them down.
 
     Raises
     ------
@@ -100,43 +98,6 @@ def build_model(cfg: CalibrationConfig, section: str) -> RCModel:
         An unknown model, an option the model does not take (naming
         ``<section>.options.<key>``), or a model of the other domain.
     """
-    cache = _CACHE.get(id(cfg))
-    if cache is None:
-        cache = _CACHE[id(cfg)] = {}
-        weakref.finalize(cfg, _CACHE.pop, id(cfg), None)
-    key = _settings_key(cfg, section)
-    hit = cache.get(section)
-    if hit is not None and hit[0] == key:
-        return hit[1]
-    m = _build_model(cfg, section)
-    cache[section] = (key, m)
-    return m
-
-
-#: id(config) -> {section: (the settings it was built from, model)}: the models of a
-#: config object, built once; an entry leaves with its config.
-_CACHE: dict[int, dict[str, tuple]] = {}
-
-
-def _settings_key(cfg: CalibrationConfig, section: str) -> tuple:
-    """Everything :func:`build_model` reads, as values: the section's model and options
-    as written, the solar surfaces and the input hold."""
-    sec = getattr(cfg, section)
-    written = [sec.model, sec.options.given()]
-    return (
-        json.dumps(written, sort_keys=True, default=str),
-        tuple(cfg.data.surfaces),
-        cfg.data.irradiance,
-        input_hold_of(cfg),
-    )
-
-
-def models_of(cfg: CalibrationConfig) -> dict[str, RCModel]:
-    """The models of every configured section, built once (:func:`build_model`)."""
-    return {s: build_model(cfg, s) for s in SECTIONS if getattr(cfg, s) is not None}
-
-
-def _build_model(cfg: CalibrationConfig, section: str) -> RCModel:
     sec = getattr(cfg, section)
     where = f"{section}.model"
     if isinstance(sec.model, Mapping):
@@ -158,6 +119,24 @@ def _build_model(cfg: CalibrationConfig, section: str) -> RCModel:
     if m.domain != section:
         raise ConfigError(f"{where}: a {m.domain} model cannot be used in the {section!r} section")
     return with_input_hold(cfg, m)
+
+
+def models_of(cfg: CalibrationConfig) -> tuple[dict[str, RCModel], dict[str, list]]:
+    """The models of a run, each built once: (section -> its model, section -> the
+    rungs of a ``model: auto`` section, :func:`auto_rungs`). An automatic section's
+    model is its richest rung (:func:`build_model`), whose inputs cover every rung's,
+    until the screen chooses one."""
+    models, rungs = {}, {}
+    for section in SECTIONS:
+        sec = getattr(cfg, section)
+        if sec is None:
+            continue
+        if isinstance(sec.model, str) and sec.model == AUTO:
+            rungs[section] = auto_rungs(cfg, section)
+            models[section] = rungs[section][-1][1]
+        else:
+            models[section] = build_model(cfg, section)
+    return models, rungs
 
 
 def with_input_hold(cfg: CalibrationConfig, m: RCModel) -> RCModel:
@@ -217,13 +196,12 @@ def input_hold_of(cfg: CalibrationConfig) -> str:
     return hold
 
 
-def initial_state_of(cfg: CalibrationConfig, section: str, model: RCModel | None = None):
-    """The initial state of a section: ``initial_state`` as configured, else
-    ``"estimate"`` for a linear model and ``"steady"`` for a controlled room (its
-    simulator is not linear in the state). :class:`ConfigError` for an estimated state
-    on a controlled room."""
+def initial_state_of(cfg: CalibrationConfig, section: str, m: RCModel):
+    """The initial state of a section with model ``m``: ``initial_state`` as
+    configured, else ``"estimate"`` for a linear model and ``"steady"`` for a controlled
+    room (its simulator is not linear in the state). :class:`ConfigError` for an
+    estimated state on a controlled room."""
     sec = getattr(cfg, section)
-    m = model if model is not None else build_model(cfg, section)
     mode = sec.initial_state
     if mode is None:
         return "steady" if m.control is not None else "estimate"
@@ -243,12 +221,10 @@ def initial_state_of(cfg: CalibrationConfig, section: str, model: RCModel | None
     return mode
 
 
-def default_warmup(cfg: CalibrationConfig) -> pd.Timedelta:
-    """``periods.warmup`` when not configured: none when every model estimates its
-    initial state, 14 days when one starts from the steady state."""
-    steady = any(
-        initial_state_of(cfg, s) == "steady" for s in SECTIONS if getattr(cfg, s) is not None
-    )
+def default_warmup(cfg: CalibrationConfig, models: Mapping[str, RCModel]) -> pd.Timedelta:
+    """``periods.warmup`` when not configured: none when every model (section ->
+    model) estimates its initial state, 14 days when one starts from the steady state."""
+    steady = any(initial_state_of(cfg, s, m) == "steady" for s, m in models.items())
     return pd.Timedelta(days=14) if steady else pd.Timedelta(0)
 
 

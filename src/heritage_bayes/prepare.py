@@ -43,7 +43,7 @@ the heated room below an attic, a crypt), aligned like the other inputs.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -249,16 +249,12 @@ def _output_hint(missing: Sequence[str]) -> str:
     return "; ".join(hints) or "unknown output"
 
 
-def _extra_inputs(cfg) -> list[str]:
-    """Model inputs beyond those built here (Te, Pe, Tf, I_<surface>), in model order."""
-    from heritage_bayes.models import build_model  # the models decide their inputs
-
+def _extra_inputs(cfg, models: Sequence) -> list[str]:
+    """Inputs of ``models`` beyond those built here (Te, Pe, Tf, I_<surface>), in model
+    order."""
     built = {"Te", "Pe", "Tf"} | {f"I_{s}" for s in cfg.data.surfaces}
     extra: list[str] = []
-    for section in ("thermal", "hygric"):
-        if getattr(cfg, section) is None:
-            continue
-        m = build_model(cfg, section)
+    for m in models:
         generated = set(getattr(m, "calendar_inputs", {}))  # from the time grid
         for name in m.input_names:
             if name in generated:
@@ -285,12 +281,16 @@ def _check_models_vs_irradiance(cfg) -> None:
         )
 
 
-def prepare(cfg) -> Prepared:
+def prepare(cfg, models: Mapping | None = None) -> Prepared:
     """Read, derive, align: the model-ready data of a validated configuration.
 
     Parameters
     ----------
     cfg : heritage_bayes.config.CalibrationConfig
+    models : mapping, optional
+        Section -> :class:`~heritage_bayes.rc.model.RCModel` of every configured section,
+        as the run built them (:func:`heritage_bayes.models.models_of`): they decide the
+        inputs prepared. Default: built here from ``cfg``.
 
     Returns
     -------
@@ -305,8 +305,6 @@ def prepare(cfg) -> Prepared:
         ``data.max_gap`` inside the frame, a period not covered by the inputs, no
         observations in a period (names the key path and the file, column or row).
     """
-    from heritage_bayes.models import build_model  # Tf: thermal, or a hygric sink at it
-
     thermal, hygric = cfg.thermal is not None, cfg.hygric is not None
     if not (thermal or hygric):
         raise ConfigError("give at least one of 'thermal' and 'hygric'")
@@ -319,6 +317,11 @@ def prepare(cfg) -> Prepared:
     raw = read_sources(cfg)
     weather, meas_tables, site, monument = raw.weather, raw.measurements, raw.site, raw.monument
     sources = dict(raw.notes)
+    if models is None:
+        from heritage_bayes.models import models_of  # the models decide their inputs
+
+        models = models_of(cfg)[0]
+    ordered = [models[s] for s in _SECTIONS if getattr(cfg, s) is not None]
 
     # -- inputs ----------------------------------------------------------------------------
     tables, note = weather_inputs(
@@ -329,7 +332,7 @@ def prepare(cfg) -> Prepared:
         site=site,
         surfaces=surfaces,
         where="data.weather",
-        extra=_extra_inputs(cfg),
+        extra=_extra_inputs(cfg, ordered),
         **(data.roof.input_keywords() if data.roof is not None else {}),
     )
     sources["irradiance"] = note["irradiance"]
@@ -337,7 +340,8 @@ def prepare(cfg) -> Prepared:
     if monument is not None and irradiance_source == "measured":
         irradiance_source = monument.info["irradiance_label"]
     gt = data.ground_temperature
-    ground = thermal or (hygric and "Tf" in build_model(cfg, "hygric").input_names)
+    # Tf: thermal, or a hygric sink at it
+    ground = thermal or (hygric and "Tf" in models["hygric"].input_names)
     if ground and gt.mode == "column":
         tf_table, sources["ground_temperature"] = _ground_column(cfg, gt, "data.ground_temperature")
         tables.append(tf_table)
@@ -346,17 +350,16 @@ def prepare(cfg) -> Prepared:
     meas_tables = [_with_vapour_pressure(m, "Pi", "data.measurements") for m in meas_tables]
     check_outputs(meas_tables, thermal, hygric)
     aligned = align_tables(cfg, tables, meas_tables)
-    models = [build_model(cfg, s) for s in _SECTIONS if getattr(cfg, s) is not None]
-    frame, flags = complete_frame(cfg, aligned, weather, models, ground, sources)
+    frame, flags = complete_frame(cfg, aligned, weather, ordered, ground, sources)
 
     # -- period rows -----------------------------------------------------------------------
-    cal, val, sources["periods"], warmup_steps, init_steps = period_rows(cfg, frame)
+    cal, val, sources["periods"], warmup_steps, init_steps = period_rows(cfg, frame, models)
     _check_observations(frame, cal, val, warmup_steps, thermal, hygric, data.step)
     _check_plausible(frame, cfg)
 
     if monument is not None:
         truth = demo_truth(cfg, monument, frame, cal, warmup_steps)
-    if cfg.fixed_node_temperature is None and any("Pf" in m.parameter_names for m in models):
+    if cfg.fixed_node_temperature is None and any("Pf" in m.parameter_names for m in ordered):
         te, const = weather.get("Te"), (gt.value if gt.mode == "constant" else None)
         sources["fixed_node_temperature"] = fixed_node_temperature(frame, cal, te, const)
     return Prepared(

@@ -154,13 +154,14 @@ def complete_frame(cfg, aligned, weather, models, ground: bool, sources: dict):
     return frame, flags
 
 
-def period_rows(cfg, frame: pd.DataFrame):
+def period_rows(cfg, frame: pd.DataFrame, models):
     """Row slices of the calibration and validation periods on the frame's grid, and the
     warm-up and initial-state windows in rows.
 
     Without ``periods``: the first 2/3 of the rows (whole rows) for calibration, the rest
-    for validation. The warm-up (``periods.warmup``, else the models' default) must be
-    shorter than the calibration period.
+    for validation. The warm-up (``periods.warmup``, else the default of ``models``,
+    section -> model: :func:`heritage_bayes.models.default_warmup`) must be shorter than
+    the calibration period.
 
     Returns
     -------
@@ -195,7 +196,7 @@ def period_rows(cfg, frame: pd.DataFrame):
         cal, val = slice(0, k), slice(k, n)
         period_note = "default: first 2/3 of the common period of all data, then the rest"
 
-    warmup = per.warmup if per.warmup is not None else default_warmup(cfg)
+    warmup = per.warmup if per.warmup is not None else default_warmup(cfg, models)
     warmup_steps = math.ceil(warmup / step - 1e-9)
     init_steps = math.ceil(per.init_window / step - 1e-9)
     cal_rows = cal.stop - cal.start

@@ -48,7 +48,8 @@ from heritage_bayes.errors import ConfigError, InputError
 from heritage_bayes.inference.likelihoods import get_noise_model
 from heritage_bayes.inference.parameters import owned_priors
 from heritage_bayes.ladder import ladder_row, rung_log_posterior
-from heritage_bayes.models import AUTO, AUTO_LADDERS, auto_rungs, rung_label
+from heritage_bayes.models import AUTO, AUTO_LADDERS, rung_label
+from heritage_bayes.rc.model import RCModel
 from heritage_bayes.selection_rule import (
     MARGIN_FIT,
     NEGLIGIBLE_ELPD,
@@ -105,6 +106,7 @@ def screen(
     cfg,
     prep,
     section: str,
+    rungs: Sequence[tuple[str, RCModel, str | None]],
     *,
     seed: int,
     deadline: float | None = None,
@@ -121,6 +123,9 @@ def screen(
     prep : PreparedData
         Prepared for the richest rung (``build_model`` of ``model: auto``).
     section : {"thermal", "hygric"}
+    rungs : sequence of (label, model, parent label or None)
+        The section's ladder as the run built it
+        (:func:`heritage_bayes.models.auto_rungs`).
     seed : int
         Seed of every rung's MAP search.
     deadline : float, optional
@@ -144,9 +149,8 @@ def screen(
             rung_log_posterior(cfg, prep, section, model, sec.initial_state),
         )
 
-    rungs = [(label, parent, build(model)) for label, model, parent in auto_rungs(cfg, section)]
     rows, found = screen_maps(
-        rungs,
+        [(label, parent, build(model)) for label, model, parent in rungs],
         section,
         seed=seed,
         optimizer=cfg.optimizer,

@@ -52,7 +52,8 @@ def _section_of(cfg, models: Sequence[str] | None) -> tuple[str, list[str]]:
 
 
 def _candidate_config(cfg, section: str, name: str):
-    """The config calibrating only ``name`` in ``section`` (same data, noise, knowledge)."""
+    """The config calibrating only ``name`` in ``section`` (same data, noise, knowledge)
+    and its model, built once: (config, model)."""
     from heritage_bayes.models import SECTIONS
 
     sec = getattr(cfg, section)
@@ -60,7 +61,7 @@ def _candidate_config(cfg, section: str, name: str):
     from heritage_bayes.config.options import ModelOptions
     from heritage_bayes.inference.likelihoods import get_noise_model
     from heritage_bayes.inference.parameters import owned_priors
-    from heritage_bayes.models import catalog_build, catalog_options
+    from heritage_bayes.models import catalog_build, catalog_options, with_input_hold
     from heritage_bayes.rc.catalog import takes_option
     from heritage_bayes.run import section_parameters
 
@@ -83,7 +84,7 @@ def _candidate_config(cfg, section: str, name: str):
         }
     )
     section_parameters(cand, section, model, priors)  # a prior that does not fit fails now
-    return cand
+    return cand, with_input_hold(cand, model)
 
 
 def _calibrate_candidate(cand, run_dir: str, kwargs: dict) -> tuple[str, float, float]:
@@ -147,8 +148,11 @@ def _stop_workers(procs: dict, grace: float = 60.0) -> None:
             proc.join()
 
 
-def _sample_parallel(cands: dict, out: Path, kwargs_of: dict, n_workers: int, tell) -> dict:
-    """Calibrate the candidates in ``n_workers`` worker processes (largest first, a new
+def _sample_parallel(
+    cands: dict, models: dict, out: Path, kwargs_of: dict, n_workers: int, tell
+) -> dict:
+    """Calibrate the candidates (``models``: name -> the model of each, which sizes it)
+    in ``n_workers`` worker processes (largest first, a new
     one started as soon as one ends; ``kwargs_of``: name -> keywords of
     :func:`~heritage_bayes.calibrate.run_calibration`), with a progress line per start
     and end and every :data:`HEARTBEAT` seconds; return name -> run directory. Interrupted (Ctrl-C,
@@ -161,7 +165,7 @@ def _sample_parallel(cands: dict, out: Path, kwargs_of: dict, n_workers: int, te
 
     ctx = multiprocessing.get_context("spawn")  # no forked numba/BLAS threads
     results = ctx.Queue()
-    todo = sorted(cands, key=lambda n: -_n_free(cands[n], _section_name(cands[n])))
+    todo = sorted(cands, key=lambda n: -_n_free(cands[n], _section_name(cands[n]), models[n]))
     running: dict = {}
     started: dict[str, float] = {}
     dirs: dict[str, Path] = {}
@@ -211,12 +215,11 @@ def _section_name(cand) -> str:
     return next(s for s in SECTIONS if getattr(cand, s) is not None)
 
 
-def _n_free(cand, section: str) -> int:
-    """Free parameters of a candidate's section (the order in which to start them)."""
-    from heritage_bayes.models import build_model
+def _n_free(cand, section: str, model) -> int:
+    """Free parameters of a candidate's section with its ``model`` (the order in which
+    to start them)."""
     from heritage_bayes.run import section_parameters
 
-    model = build_model(cand, section)
     return section_parameters(cand, section, model)[1].ndim
 
 
@@ -297,7 +300,9 @@ def run_compare(
     from heritage_bayes.sources import input_paths
 
     section, names = _section_of(cfg, models)
-    cands = {n: _candidate_config(cfg, section, n) for n in names}
+    built = {n: _candidate_config(cfg, section, n) for n in names}
+    cands = {n: c for n, (c, _) in built.items()}
+    cand_models = {n: m for n, (_, m) in built.items()}  # each candidate's, built once
     if out_dir is None:
         out_dir = Path("reports") / check_name(f"{cfg.name or 'run'}-compare", what="name")
     if workers is not None and (isinstance(workers, bool) or int(workers) < 1):
@@ -323,7 +328,7 @@ def run_compare(
         for n in names:  # refuse a bad folder before any candidate starts
             RunWriter(out / n, force=force, resume=resume).check()
         tell(f"screening {', '.join(names)} by their MAP (validation FIT)")
-        rows, maps, scores = screen_candidates(cands, section, tell=tell)
+        rows, maps, scores = screen_candidates(cands, cand_models, section, tell=tell)
         sel = choose([r for r in rows.values() if "error" not in r])  # as model: auto
         tell(f"the screen chose {sel['choice']}: {sel['reason']}")
         sampled = to_sample(sel)
@@ -346,7 +351,8 @@ def run_compare(
         else:
             tell(f"sampling {', '.join(keep)}, {n_workers} at a time")
             per = {n: {**kwargs, "start_maps": {section: maps[n]}} for n in keep}
-            dirs = _sample_parallel({n: cands[n] for n in keep}, out, per, n_workers, tell)
+            keep_cands = {n: cands[n] for n in keep}
+            dirs = _sample_parallel(keep_cands, cand_models, out, per, n_workers, tell)
         dirs = {n: dirs[n] for n in keep}
         release_memory()
         tell("comparing the posteriors (blocked LOO, validation ELPD)")

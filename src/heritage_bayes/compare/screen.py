@@ -50,26 +50,25 @@ def to_sample(sel: Mapping) -> dict[str, str | None]:
 
 
 def screen_candidates(
-    cands: Mapping, section: str, *, tell: Callable[[str], None]
+    cands: Mapping, models: Mapping, section: str, *, tell: Callable[[str], None]
 ) -> tuple[dict, dict, dict]:
-    """MAP and ladder row of every candidate config, by the loop of ``model: auto``'s
-    screen (:func:`heritage_bayes.selection.screen_maps`): (label -> row, label -> MAP
-    result, label -> score [%]). A candidate whose MAP cannot be found scores NaN (its
-    row says why)."""
+    """MAP and ladder row of every candidate config (``models``: label -> its model, as
+    built with the config), by the loop of ``model: auto``'s screen
+    (:func:`heritage_bayes.selection.screen_maps`): (label -> row, label -> MAP result,
+    label -> score [%]). A candidate whose MAP cannot be found scores NaN (its row says
+    why)."""
     from heritage_bayes.ladder import section_log_posterior
-    from heritage_bayes.models import build_model
     from heritage_bayes.prepare import prepare
     from heritage_bayes.selection import screen_maps
 
     parents = {n: p for n, _, p in AUTO_LADDERS.get(section, ())}
     preps: dict = {}
 
-    def build(cand):
+    def build(cand, model):
         def run():
-            model = build_model(cand, section)
             key = tuple(model.input_names)
             if key not in preps:  # one preparation per set of inputs
-                preps[key] = prepare(cand)
+                preps[key] = prepare(cand, {section: model})
             sec = getattr(cand, section)
             lp = section_log_posterior(cand, preps[key], section, model, sec.priors)
             return preps[key], model, lp
@@ -78,7 +77,7 @@ def screen_candidates(
 
     first = next(iter(cands.values()))
     rows, found = screen_maps(
-        [(label, parents.get(label), build(c)) for label, c in cands.items()],
+        [(label, parents.get(label), build(c, models[label])) for label, c in cands.items()],
         section,
         seed=first.seed,
         optimizer=first.optimizer,

@@ -210,7 +210,7 @@ def model_inputs(run, pcfg, weather: pd.DataFrame, site: dict | None, where: str
         site=site,
         surfaces={k: tuple(v) for k, v in data.surfaces.items()},
         where=where,
-        extra=_extra_inputs(cfg),
+        extra=_extra_inputs(cfg, list(run.models.values())),
         roof=tuple(data.roof.planes()) if data.roof is not None else (),
     )
     try:

@@ -30,13 +30,14 @@ def config_map(cfg, section: str):
 
     from heritage_bayes.inference.optimize import find_map
     from heritage_bayes.ladder import section_log_posterior as _log_posterior
-    from heritage_bayes.models import build_model
+    from heritage_bayes.models import models_of
     from heritage_bayes.prepare import prepare
 
     opt = cfg.optimizer
     with threadpool_limits(limits=1, user_api="blas"):
-        prep = prepare(cfg)
-        m = build_model(cfg, section)
+        models = models_of(cfg)[0]
+        prep = prepare(cfg, models)
+        m = models[section]
         lp = _log_posterior(cfg, prep, section, m, getattr(cfg, section).priors)
         mp = find_map(
             lp,

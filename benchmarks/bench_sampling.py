@@ -39,7 +39,7 @@ from heritage_bayes.errors import InputError
 from heritage_bayes.inference.optimize import affine_coordinates, find_map, laplace
 from heritage_bayes.inference.sampler import run_sampler
 from heritage_bayes.ladder import section_log_posterior as _log_posterior
-from heritage_bayes.models import build_model
+from heritage_bayes.models import models_of
 from heritage_bayes.prepare import prepare
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -56,8 +56,9 @@ def _problem(path: Path, model_name: str | None = None):
         cfg = cfg.model_copy(
             update={"thermal": cfg.thermal.model_copy(update={"model": model_name})}
         )
-    prep = prepare(cfg)
-    model = build_model(cfg, "thermal")
+    models = models_of(cfg)[0]
+    prep = prepare(cfg, models)
+    model = models["thermal"]
     lp = _log_posterior(cfg, prep, "thermal", model, cfg.thermal.priors)
     m = find_map(
         lp,

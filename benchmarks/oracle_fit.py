@@ -22,7 +22,7 @@ import pandas as pd
 
 from heritage_bayes.config import load_config
 from heritage_bayes.inference.results import fit_metrics
-from heritage_bayes.models import build_model
+from heritage_bayes.models import models_of
 from heritage_bayes.prepare import prepare
 
 
@@ -32,8 +32,9 @@ def main() -> None:
     ap.add_argument("section", choices=["thermal", "hygric"])
     args = ap.parse_args()
     cfg = load_config(args.config)
-    prep = prepare(cfg)
-    m = build_model(cfg, args.section)
+    models = models_of(cfg)[0]
+    prep = prepare(cfg, models)
+    m = models[args.section]
     out = m.output_names[0]
     y = pd.Series(prep.observed(args.section, m)[:, 0], prep.frame.index)
     cal = prep.calibration

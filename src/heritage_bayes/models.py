@@ -196,27 +196,27 @@ def input_hold_of(cfg: CalibrationConfig) -> str:
     return hold
 
 
-def initial_state_of(cfg: CalibrationConfig, section: str, m: RCModel):
-    """The initial state of a section with model ``m``: ``initial_state`` as
+def initial_state_of(cfg: CalibrationConfig, section: str, model: RCModel):
+    """The initial state of a section with ``model``: ``initial_state`` as
     configured, else ``"estimate"`` for a linear model and ``"steady"`` for a controlled
     room (its simulator is not linear in the state). :class:`ConfigError` for an
     estimated state on a controlled room."""
     sec = getattr(cfg, section)
     mode = sec.initial_state
     if mode is None:
-        return "steady" if m.control is not None else "estimate"
-    if mode != "steady" and m.control is not None:
+        return "steady" if model.control is not None else "estimate"
+    if mode != "steady" and model.control is not None:
         raise ConfigError(
             f"{section}.initial_state: {mode!r} needs a model that is linear in its state; "
-            f"this {m.name} room is controlled (thermostat/humidistat): use 'steady' (with "
+            f"this {model.name} room is controlled (thermostat/humidistat): use 'steady' (with "
             "periods.warmup) or leave initial_state out"
         )
     if isinstance(mode, Mapping):
-        unknown = [k for k in mode if k not in m.state_names]
+        unknown = [k for k in mode if k not in model.state_names]
         if unknown:
             raise ConfigError(
                 f"{section}.initial_state: unknown node(s) {unknown}; the nodes of "
-                f"{m.name} are {list(m.state_names)}"
+                f"{model.name} are {list(model.state_names)}"
             )
     return mode
 

@@ -163,6 +163,28 @@ def test_thermal_only_and_default_periods():
         prep.model_inputs("hygric", hb.model("hygric_2c"))
 
 
+def test_handed_the_runs_models_prepare_builds_none(monkeypatch):
+    """A run builds its models once (``check_models``, ``model: auto``'s rungs among
+    them) and hands them down: prepare builds none again and prepares the same data as
+    when it builds them itself."""
+    import heritage_bayes.models as models_module
+    from heritage_bayes.calibrate import check_models
+
+    cfg = _demo_cfg(thermal={"model": "auto"}, hygric={"model": "hygric_1c"})
+    own = prepare(cfg)
+    models, rungs = check_models(cfg)
+    assert list(rungs) == ["thermal"] and models["thermal"] is rungs["thermal"][-1][1]
+
+    def build(*args, **kwargs):
+        raise AssertionError("a model was built again")
+
+    for name in ("build_model", "auto_rungs", "catalog_build"):
+        monkeypatch.setattr(models_module, name, build)
+    prep = prepare(cfg, models)
+    pd.testing.assert_frame_equal(prep.frame, own.frame)
+    assert prep.sources == own.sources and prep.warmup_steps == own.warmup_steps
+
+
 def test_hygric_only_has_no_thermal_inputs():
     prep = prepare(_demo_cfg(thermal=None, hygric={"model": "hygric_2c"}))
     assert [c for c in prep.frame.columns if c not in ("Ti", "Pi", "RHi")] == ["Pe"]

@@ -38,7 +38,9 @@ Candidate models (``--models``; none of them is in the package, see
 ``docs/science/real_rooms.md``, "The sun on the roof and the house below"), registered
 here for the run:
 
-- ``thermal_1c``: the catalogue's (the default);
+- ``thermal_1c``: the catalogue's (the default); ``thermal_2c``, ``thermal_4a``: the
+  catalogue's (``thermal_4a`` splits the sun between the air and its interior mass by
+  ``fsol``);
 - ``deck``: a light roof deck ``Tr`` (capacity ``Cr``, prior log-uniform 1e4-1e7 J/K:
   tiles, battens and underlay) between the sun on the slopes and the attic air ``Ti``:
   ``Gr`` deck - outdoor air, ``Gri`` deck - attic air, ``Gfast`` attic air - outdoor
@@ -95,6 +97,8 @@ DECK_PRIOR = {"Cr": {"dist": "loguniform", "lower": 1e4, "upper": 1e7}}  # [J/K]
 #: candidate -> catalogue name, options, priors (see the module docstring)
 MODELS = {
     "thermal_1c": ("thermal_1c", {}, {}),
+    "thermal_2c": ("thermal_2c", {}, {}),
+    "thermal_4a": ("thermal_4a", {}, {}),
     "deck": ("x_deck", {}, DECK_PRIOR),
     "deck_heavy": ("x_deck_heavy", {}, DECK_PRIOR),
     "deck_split": ("x_deck_split", {}, DECK_PRIOR),

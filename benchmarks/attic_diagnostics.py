@@ -18,15 +18,23 @@ checked against the data"):
 - ``--sun``: the same MAP's May-August days in quartiles of the roof planes' daily mean
   irradiance: the noon residual (11-15 h, UTC+2) and the daily range measured and
   simulated [K].
+- ``--slopes``: the calibration residual fitted on one more input through the MAP's
+  time constant (each 45° slope's sun, N, E, S, W, the horizontal's, the roof's
+  squared): the June-August noon residual left.
+- ``--validation``: the validation residual by month and hour, its worst days, and the
+  validation FIT a correction by one more input would reach (a ceiling: fitted on the
+  validation itself).
 
 Usage (from the repository root)::
 
     python benchmarks/attic_diagnostics.py [ROOM ...] [--clock] [--seasons] [--sun]
+        [--slopes] [--validation]
 """
 
 from __future__ import annotations
 
 import argparse
+import functools
 import sys
 import tempfile
 from pathlib import Path
@@ -109,11 +117,32 @@ def clock_check(room: str, data: Path) -> None:
         s, rms, scale = best_shift(meas, lambda k, c=conv: sky_as_read(cs, g.index, c, k)[mask])
         rms0 = best_shift(meas, lambda k, c=conv: sky_as_read(cs, g.index, c, k)[mask], [0])[1]
         print(f"| {room} | {name} | {rms0:.1f} | {s:+d} | {rms:.1f} | {scale:.2f} |")
+    day = (g.index + pd.Timedelta(hours=site[1] / 15)).floor("D")
+    shifts = []
+    for d in np.unique(day[mask]):
+        m = np.asarray(day == d)
+        sky_on_day = functools.partial(_sky_on, cs, g.index, m)
+        shifts.append(best_shift(g.to_numpy()[m], sky_on_day)[0])
+    q = np.percentile(shifts, [25, 50, 75])
+    at = sky_as_read(cs, g.index, None)
+    solar = (g.index.hour + g.index.minute / 60 + site[1] / 15) % 24  # solar time [h], roughly
+    am, pm = mask & (solar < 12), mask & (solar > 12)
+    meas_am, meas_pm = g.to_numpy()[am].sum() / at[am].sum(), g.to_numpy()[pm].sum() / at[pm].sum()
+    print(
+        f"{room}: per-day best shift (value at the stamp) median {q[1]:+.0f} min, IQR "
+        f"{q[0]:+.0f} to {q[2]:+.0f}; measured / cloudless before solar noon {meas_am:.3f}, "
+        f"after {meas_pm:.3f}"
+    )
 
 
-def _map_frame(room: str, data: Path, work: Path) -> pd.DataFrame:
-    """thermal_1c's MAP simulation beside the measured attic and the roof's irradiance,
-    calibration and validation, on the file clock (UTC+2)."""
+def _sky_on(cs, index, mask, shift_min):
+    return sky_as_read(cs, index, None, shift_min)[mask]
+
+
+def _map_frame(room: str, data: Path, work: Path) -> tuple[pd.DataFrame, dict]:
+    """thermal_1c's MAP simulation beside the measured attic, the roof's irradiance and
+    the boundary temperatures, calibration and validation (``val``), on the file clock
+    (UTC+2); and the MAP's parameters."""
     import attic_physics as ap
     from _common import config_map
 
@@ -124,12 +153,84 @@ def _map_frame(room: str, data: Path, work: Path) -> pd.DataFrame:
     y = lp.simulate_frame(mp.theta[None], prep.model_inputs("thermal", m),
                           prep.calibration.start)[0][0][:, 0]  # fmt: skip
     sl = slice(prep.calibration.start, prep.validation.stop)
-    roof = [c for c in prep.frame.columns if c.startswith("I_") and not c.endswith("_slope")]
-    return pd.DataFrame(
+    fr = prep.frame
+    roof = [c for c in fr.columns if c.startswith("I_") and not c.endswith("_slope")]
+    f = pd.DataFrame(
         {"obs": prep.observed("thermal", m)[sl, 0], "sim": y[sl],
-         "I": prep.frame[roof].sum(axis=1).to_numpy()[sl]},
-        index=prep.frame.index[sl].tz_convert("UTC+02:00").tz_localize(None),
+         "I": fr[roof].sum(axis=1).to_numpy()[sl], "Te": fr["Te"].to_numpy()[sl],
+         "Tf": fr["Tf"].to_numpy()[sl]},
+        index=fr.index[sl].tz_convert("UTC+02:00").tz_localize(None),
     )  # fmt: skip
+    f["val"] = np.arange(sl.start, sl.stop) >= prep.validation.start
+    return f, dict(zip(lp.params.names, mp.theta, strict=True))
+
+
+def through(x, tau_h: float) -> np.ndarray:
+    """``x`` through a first-order lag of time constant ``tau_h`` [h] (hourly steps)."""
+    a, out, acc = np.exp(-1.0 / tau_h), np.empty(len(x)), float(x[0])
+    for k, v in enumerate(np.asarray(x, dtype=float)):
+        acc = a * acc + (1.0 - a) * v
+        out[k] = acc
+    return out
+
+
+def fit_percent(obs, sim) -> float:
+    """FIT [%] = 100 (1 - |obs - sim| / |obs - mean(obs)|)."""
+    return 100.0 * (1.0 - np.linalg.norm(obs - sim) / np.linalg.norm(obs - obs.mean()))
+
+
+def slope_table(room: str, data: Path, f: pd.DataFrame, theta: dict) -> pd.DataFrame:
+    """The calibration residual fitted (least squares, with a constant) on one more
+    input through the MAP's time constant: each 45° slope's irradiance (wind-weighted,
+    20° skyline), the horizontal's, and the roof's squared; the June-August noon
+    residual left [K] (``--slopes``)."""
+    from heritage_bayes.climate.solair import roof_wind_weight
+    from heritage_bayes.climate.solar_surfaces import surface_irradiance
+
+    _, wfile, (lat, lon), *_ = ROOMS[room]
+    w = pd.read_csv(data / wfile, parse_dates=[0], index_col=0)
+    w.index = w.index.tz_localize("UTC+02:00")
+    wx = w.rename(columns={"Rglob": "ghi", "Rdif": "dhi"})[["ghi", "dhi"]]
+    site = {"latitude": lat, "longitude": lon, "altitude": 0}
+    planes = {k: (45, az) for k, az in zip("NESW", (0, 90, 180, 270), strict=True)}
+    irr = surface_irradiance(wx, site, planes, averaged=False, horizon=20)
+    irr = irr.mul(roof_wind_weight(w["ws"].interpolate(limit_direction="both").to_numpy()), axis=0)
+    irr["H"] = surface_irradiance(wx, site, {"H": (0, 0)}, averaged=False)["H"]
+    irr.index = irr.index.tz_localize(None)
+    x = irr.reindex(f.index).interpolate(limit_direction="both").fillna(0.0)
+    x["roof squared"] = f["I"] ** 2 / 1000.0
+    tau = theta["Ci"] / theta["Ge"] / 3600.0
+    e, cal = (f.obs - f.sim).to_numpy(), ~f.val.to_numpy()
+    noon = np.asarray(f.index.month.isin([6, 7, 8]) & (f.index.hour >= 11) & (f.index.hour <= 15))
+    rows = {"(none)": e[noon].mean()}
+    for name in x.columns:
+        z = np.column_stack([np.ones(len(e)), through(x[name].to_numpy(), tau)])
+        b = np.linalg.lstsq(z[cal], e[cal], rcond=None)[0]
+        rows[name] = (e - z @ b)[noon].mean()
+    return pd.Series(rows, name="JJA noon residual left [K]").round(2).to_frame().T
+
+
+def validation_table(f: pd.DataFrame, theta: dict) -> None:
+    """The validation residual: by month and hour, its worst days, and the FIT a
+    least-squares correction by one more input (through the MAP's time constant,
+    fitted on the validation itself) would reach (``--validation``)."""
+    v = f[f.val]
+    e = v.obs - v.sim
+    print(e.groupby([e.index.month, e.index.hour]).mean().unstack(0).iloc[4:21:2].round(1).T)
+    day = pd.DataFrame({"residual": e, "Te": v.Te}).resample("D").mean().dropna()
+    print(day.reindex(day.residual.abs().nlargest(5).index).round(1).T)
+    tau = theta["Ci"] / theta["Ge"] / 3600.0
+    inputs = {"heat from 20 °C": 20.0 - f.Te, "roof sun": f.I, "Te": f.Te}
+    ceil = {"(none)": fit_percent(v.obs.to_numpy(), v.sim.to_numpy())}
+    for name, x in {**{k: through(x.to_numpy(), tau) for k, x in inputs.items()},
+                    "Tf": f.Tf.to_numpy()}.items():  # fmt: skip
+        z = np.column_stack([np.ones(len(v)), x[f.val.to_numpy()]])
+        b = np.linalg.lstsq(z, e.to_numpy(), rcond=None)[0]
+        ceil[name] = fit_percent(v.obs.to_numpy(), v.sim.to_numpy() + z @ b)
+    rms = {k: float(np.sqrt(np.mean((g.obs - g.sim) ** 2))) for k, g in f.groupby("val")}
+    print(f"RMS residual calibration {rms[False]:.2f} K, validation {rms[True]:.2f} K; "
+          "validation FIT with one input more: "
+          + ", ".join(f"{k} {c:.1f}" for k, c in ceil.items()))  # fmt: skip
 
 
 def daily_phase(values: pd.Series) -> pd.Series:
@@ -181,6 +282,8 @@ def main(argv=None) -> int:
     ap.add_argument("--clock", action="store_true", help="the radiation's time stamp")
     ap.add_argument("--seasons", action="store_true", help="daily swing and phase by month")
     ap.add_argument("--sun", action="store_true", help="summer noon residual by sunniness")
+    ap.add_argument("--slopes", action="store_true", help="the residual on each slope's sun")
+    ap.add_argument("--validation", action="store_true", help="the validation residual")
     args = ap.parse_args(argv)
     if set(args.rooms) - set(TUNING):
         ap.error(f"tuning attics only: {TUNING} (the others are held out)")
@@ -188,14 +291,20 @@ def main(argv=None) -> int:
         print("| room | read as | RMS [W/m²] | best shift [min] | its RMS | scale |")
         for room in args.rooms:
             clock_check(room, args.data)
-    if args.seasons or args.sun:
+    if args.seasons or args.sun or args.slopes or args.validation:
         work = Path(tempfile.mkdtemp(prefix="attic_diagnostics_"))
         for room in args.rooms:
-            f = _map_frame(room, args.data, work)
+            f, theta = _map_frame(room, args.data, work)
+            print(f"{room}: MAP " + " ".join(f"{k}={x:.3g}" for k, x in theta.items()))
             if args.seasons:
                 print(f"{room}: by month\n{season_table(f).T.to_string()}")
             if args.sun:
                 print(f"{room}: May-August by sunniness\n{sun_table(f).to_string()}")
+            if args.slopes:
+                print(f"{room}: {slope_table(room, args.data, f, theta).to_string()}")
+            if args.validation:
+                print(f"{room}: the validation residual")
+                validation_table(f, theta)
     return 0
 
 

@@ -21,6 +21,8 @@ checked against the data"):
 - ``--slopes``: the calibration residual fitted on one more input through the MAP's
   time constant (each 45° slope's sun, N, E, S, W, the horizontal's, the roof's
   squared): the June-August noon residual left.
+- ``--variant``: the MAP of one of ``attic_physics.py``'s variants (default ``wind``,
+  init's config) for the three above and the one below.
 - ``--validation``: the validation residual by month and hour, its worst days, and the
   validation FIT a correction by one more input would reach (a ceiling: fitted on the
   validation itself).
@@ -28,7 +30,7 @@ checked against the data"):
 Usage (from the repository root)::
 
     python benchmarks/attic_diagnostics.py [ROOM ...] [--clock] [--seasons] [--sun]
-        [--slopes] [--validation]
+        [--slopes] [--validation] [--variant snow0]
 """
 
 from __future__ import annotations
@@ -139,7 +141,7 @@ def _sky_on(cs, index, mask, shift_min):
     return sky_as_read(cs, index, None, shift_min)[mask]
 
 
-def _map_frame(room: str, data: Path, work: Path) -> tuple[pd.DataFrame, dict]:
+def _map_frame(room: str, data: Path, work: Path, variant: str = "wind") -> tuple:
     """thermal_1c's MAP simulation beside the measured attic, the roof's irradiance and
     the boundary temperatures, calibration and validation (``val``), on the file clock
     (UTC+2); and the MAP's parameters."""
@@ -148,8 +150,12 @@ def _map_frame(room: str, data: Path, work: Path) -> tuple[pd.DataFrame, dict]:
 
     w = work / room
     (w / "wx").mkdir(parents=True, exist_ok=True)
-    cfg = ap._config(room, "wind", "thermal_1c", False, data, w)
-    prep, m, lp, mp = config_map(cfg, "thermal")
+    cfg = ap._config(room, variant, "thermal_1c", False, data, w)
+    undo = ap.patched(ap._roof_answers(variant)[1], ap._fmi(room, data))
+    try:
+        prep, m, lp, mp = config_map(cfg, "thermal")
+    finally:
+        undo()
     y = lp.simulate_frame(mp.theta[None], prep.model_inputs("thermal", m),
                           prep.calibration.start)[0][0][:, 0]  # fmt: skip
     sl = slice(prep.calibration.start, prep.validation.stop)
@@ -282,6 +288,7 @@ def main(argv=None) -> int:
     ap.add_argument("--clock", action="store_true", help="the radiation's time stamp")
     ap.add_argument("--seasons", action="store_true", help="daily swing and phase by month")
     ap.add_argument("--sun", action="store_true", help="summer noon residual by sunniness")
+    ap.add_argument("--variant", default="wind", help="an attic_physics.py variant")
     ap.add_argument("--slopes", action="store_true", help="the residual on each slope's sun")
     ap.add_argument("--validation", action="store_true", help="the validation residual")
     args = ap.parse_args(argv)
@@ -294,7 +301,7 @@ def main(argv=None) -> int:
     if args.seasons or args.sun or args.slopes or args.validation:
         work = Path(tempfile.mkdtemp(prefix="attic_diagnostics_"))
         for room in args.rooms:
-            f, theta = _map_frame(room, args.data, work)
+            f, theta = _map_frame(room, args.data, work, args.variant)
             print(f"{room}: MAP " + " ".join(f"{k}={x:.3g}" for k, x in theta.items()))
             if args.seasons:
                 print(f"{room}: by month\n{season_table(f).T.to_string()}")

@@ -47,6 +47,9 @@ here for the run:
   air, ``Gf`` to ``Tf``; the slopes' apertures heat the deck;
 - ``deck_heavy``: ``deck`` with a heavy node ``Tint`` (``Cint``, ``Gint``) on the air
   (the ceiling's insulation and joists);
+- ``air_mass``: ``thermal_1c`` with a heavy node ``Tint`` (``Cint``, ``Gint``) hanging
+  on the air (timber, the insulation's top), the sun and the outdoor air on the air:
+  a fast response and a slow one;
 - ``deck_split``: ``deck`` with the slopes' sun split: ``fsol`` [-] heats the deck, the
   rest the attic air (nests ``thermal_1c`` and ``deck``);
 - ``below20``: ``thermal_1c`` plus a conductance ``Gb`` to a heated room below at a
@@ -102,6 +105,7 @@ MODELS = {
     "deck": ("x_deck", {}, DECK_PRIOR),
     "deck_heavy": ("x_deck_heavy", {}, DECK_PRIOR),
     "deck_split": ("x_deck_split", {}, DECK_PRIOR),
+    "air_mass": ("x_air_mass", {}, {}),
     "below20": ("x_below_constant", {}, {"Tb": {"fixed": 20.0}}),
     "below_measured": ("x_below_column", {}, {}),
     "ground_measured": ("thermal_1c", {}, {}),
@@ -133,6 +137,7 @@ def _register() -> None:
 
     for name, fixed in (("x_deck", {}), ("x_deck_heavy", {"heavy": True}),
                         ("x_deck_split", {"split": True}),
+                        ("x_air_mass", {"deck": False, "heavy": True}),
                         ("x_below_constant", {"deck": False, "below": "constant"}),
                         ("x_below_column", {"deck": False, "below": "column"})):  # fmt: skip
         if name in CATALOG:

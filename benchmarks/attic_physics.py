@@ -22,18 +22,36 @@ variant of the roof planes' irradiance input:
 
 - ``horizon<N>``: the roof's skyline ``data.roof.horizon`` set to N° (the package's
   default 20°; ``horizon0``: none, the package before it).
+- ``ridge<deg>``, ``pitch<deg>``: the roof's answers to init's CHECK written into its
+  config (``data.roof.ridge_azimuth``, ``pitch``), alone or joined to another variant by
+  ``+`` (``ridge45+pitch30``);
+- ``snow0``: as ``snow`` but no sun through a covered roof (the absorbed sun melts the
+  snow), and a record starting in frost (first week's mean Te below 0 °C) starts under
+  20 mm of snow water;
+- ``phi<cap>``: the AR(1) model error's coefficient ``phi_Ti`` uniform on [0, cap]
+  (default cap 0.96 at hourly steps): a likelihood that leaves less of the slow misfit
+  to the error;
+- ``from<date>``: the calibration starts at the date (e.g. ``from2011-04-20``: after the
+  snow), its end and the validation as init chose them.
 
 Candidate models (``--models``; none of them is in the package, see
 ``docs/science/real_rooms.md``, "The sun on the roof and the house below"), registered
 here for the run:
 
-- ``thermal_1c``: the catalogue's (the default);
+- ``thermal_1c``: the catalogue's (the default); ``thermal_2c``, ``thermal_4a``: the
+  catalogue's (``thermal_4a`` splits the sun between the air and its interior mass by
+  ``fsol``);
 - ``deck``: a light roof deck ``Tr`` (capacity ``Cr``, prior log-uniform 1e4-1e7 J/K:
   tiles, battens and underlay) between the sun on the slopes and the attic air ``Ti``:
   ``Gr`` deck - outdoor air, ``Gri`` deck - attic air, ``Gfast`` attic air - outdoor
   air, ``Gf`` to ``Tf``; the slopes' apertures heat the deck;
 - ``deck_heavy``: ``deck`` with a heavy node ``Tint`` (``Cint``, ``Gint``) on the air
   (the ceiling's insulation and joists);
+- ``air_mass``: ``thermal_1c`` with a heavy node ``Tint`` (``Cint``, ``Gint``) hanging
+  on the air (timber, the insulation's top), the sun and the outdoor air on the air:
+  a fast response and a slow one;
+- ``deck_split``: ``deck`` with the slopes' sun split: ``fsol`` [-] heats the deck, the
+  rest the attic air (nests ``thermal_1c`` and ``deck``);
 - ``below20``: ``thermal_1c`` plus a conductance ``Gb`` to a heated room below at a
   constant 20 °C (fixed), beside the ground ``Tf``;
 - ``below_measured``: the same with the room below's measured temperature
@@ -53,6 +71,8 @@ Usage (from the repository root)::
 
     python benchmarks/attic_physics.py [ROOM ...] [--variants none wind sky snow horizon0]
         [--models thermal_1c deck below20 ...] [--hours] [--measured]
+    python benchmarks/attic_physics.py R2 R4 R6 --variants ridge0 ridge45 snow0 phi0.8 \
+        from2011-04-20 --measured
 
 ROOM: R2 R4 R6 (the tuning attics, the default); the held-out ones are refused.
 """
@@ -80,15 +100,19 @@ DECK_PRIOR = {"Cr": {"dist": "loguniform", "lower": 1e4, "upper": 1e7}}  # [J/K]
 #: candidate -> catalogue name, options, priors (see the module docstring)
 MODELS = {
     "thermal_1c": ("thermal_1c", {}, {}),
+    "thermal_2c": ("thermal_2c", {}, {}),
+    "thermal_4a": ("thermal_4a", {}, {}),
     "deck": ("x_deck", {}, DECK_PRIOR),
     "deck_heavy": ("x_deck_heavy", {}, DECK_PRIOR),
-    "below20": ("x_below", {"below": "constant"}, {"Tb": {"fixed": 20.0}}),
-    "below_measured": ("x_below", {"below": "column"}, {}),
+    "deck_split": ("x_deck_split", {}, DECK_PRIOR),
+    "air_mass": ("x_air_mass", {}, {}),
+    "below20": ("x_below_constant", {}, {"Tb": {"fixed": 20.0}}),
+    "below_measured": ("x_below_column", {}, {}),
     "ground_measured": ("thermal_1c", {}, {}),
 }
 
 
-def _candidate(name, surfaces=None, ground=True, deck=True, heavy=False, below=None):
+def _candidate(name, surfaces=None, ground=True, deck=True, heavy=False, below=None, split=False):
     """The candidates' networks: [°C], [J/K], [W/K], apertures [m²]."""
     from heritage_bayes.rc.network import Link, Network, Node, Source
 
@@ -100,7 +124,9 @@ def _candidate(name, surfaces=None, ground=True, deck=True, heavy=False, below=N
     if below:  # the room below: a fixed constant Tb or the measured column (as Ph)
         links.append(Link("Ti", "Tb" if below == "constant" else "Ph", "Gb"))
         inputs += ["Ph"] * (below == "column")
-    sources = [Source(f"I_{s}", "Tr" if deck else "Ti", f"fI_{s}") for s in surfaces or ()]
+    sources = [Source(f"I_{s}", "Tr" if deck else "Ti", f"fI_{s}", "fsol" if split else None)
+               for s in surfaces or ()]  # fmt: skip
+    sources += [Source(f"I_{s}", "Ti", f"fI_{s}", "1-fsol") for s in surfaces or ()] * split
     return Network(name=name, domain="thermal", nodes=tuple(nodes), links=tuple(links),
                    inputs=tuple(inputs), outputs=("Ti",), sources=tuple(sources),
                    constants=("Tb",) * (below == "constant"))  # fmt: skip
@@ -110,12 +136,15 @@ def _register() -> None:
     from heritage_bayes.rc.catalog import CATALOG, CatalogModel, register
 
     for name, fixed in (("x_deck", {}), ("x_deck_heavy", {"heavy": True}),
-                        ("x_below", {"deck": False})):  # fmt: skip
+                        ("x_deck_split", {"split": True}),
+                        ("x_air_mass", {"deck": False, "heavy": True}),
+                        ("x_below_constant", {"deck": False, "below": "constant"}),
+                        ("x_below_column", {"deck": False, "below": "column"})):  # fmt: skip
         if name in CATALOG:
             continue
 
-        def build(surfaces=None, ground=True, heating=False, below=None, _n=name, _f=fixed):
-            return _candidate(_n, surfaces, ground, below=below, **_f)
+        def build(surfaces=None, ground=True, heating=False, _n=name, _f=fixed):
+            return _candidate(_n, surfaces, ground, **_f)
 
         register(name, CatalogModel(build, "a candidate of attic_physics.py", "thermal", True))
 
@@ -151,16 +180,19 @@ def _sky_loss(irr, weather, site, surfaces, table):
     return out
 
 
-def _snow_factor(raw: pd.DataFrame, index) -> np.ndarray:
-    """1 - 2/3 of the roof's snow cover [-] from a degree-day snowpack."""
+def _snow_factor(raw: pd.DataFrame, index, keep: float = 1 / 3, start: bool = False):
+    """1 - (1 - keep) of the roof's snow cover [-] from a degree-day snowpack; ``start``:
+    a record starting in frost (its first week's mean Te below 0 °C) starts under 20 mm
+    of snow water (a winter's snow already on the roof)."""
     te, p = raw["Te"].to_numpy(float), np.nan_to_num(raw["precip"].to_numpy(float))
-    swe, cover = 0.0, np.empty(len(te))
+    swe = 20.0 if start and np.nanmean(te[:168]) < 0.0 else 0.0
+    cover = np.empty(len(te))
     for k in range(len(te)):
         t = te[k] if np.isfinite(te[k]) else 0.0
         swe = max(0.0, swe + (p[k] if t < 1.0 else 0.0) - 3.0 / 24.0 * max(t, 0.0))
         cover[k] = min(1.0, swe / 5.0)
     c = pd.Series(cover, index=raw.index).reindex(index).ffill().fillna(0.0).to_numpy()
-    return 1.0 - 2.0 / 3.0 * c
+    return 1.0 - (1.0 - keep) * c
 
 
 def patched(variant: str, raw: pd.DataFrame):
@@ -188,6 +220,8 @@ def patched(variant: str, raw: pd.DataFrame):
             out = _sky_loss(out, weather, dict(site), cols, table)
         elif variant == "snow":
             out = out.mul(_snow_factor(raw, out.index), axis=0)
+        elif variant == "snow0":  # no sun through a snow-covered roof, snow from the start
+            out = out.mul(_snow_factor(raw, out.index, keep=0.0, start=True), axis=0)
         return out, label, detail
 
     inputs.solar_inputs = solar_inputs
@@ -215,6 +249,31 @@ def _weather(room, data, w, bare, below) -> Path | None:
     return w / "wx" / "fmi.csv"
 
 
+def _roof_answers(variant: str) -> tuple[dict, str]:
+    """The roof's answers in a variant (``ridge<deg>``, ``pitch<deg>``, joined to another
+    variant by ``+``: ``ridge0+pitch30``, what a user answering init's roof CHECK
+    writes) as ``data.roof`` keys, and the variant left (``wind``: the default)."""
+    keys = {"ridge": "ridge_azimuth", "pitch": "pitch"}
+    parts = variant.split("+")
+    edits = {keys[k]: float(p[len(k) :]) for p in parts for k in keys if p.startswith(k)}
+    rest = [p for p in parts if not any(p.startswith(k) for k in keys)]
+    return edits, "+".join(rest) or "wind"
+
+
+def _roof_edit(config: Path, variant: str) -> tuple[Path, str]:
+    """init's config with the variant's roof answers written in, and the variant left."""
+    import yaml
+
+    edits, rest = _roof_answers(variant)
+    if not edits:
+        return config, rest
+    raw = yaml.safe_load(config.read_text(encoding="utf-8"))
+    raw["data"]["roof"].update(edits)
+    out = config.with_name("config_roof.yaml")
+    out.write_text(yaml.safe_dump(raw, sort_keys=False, allow_unicode=True), encoding="utf-8")
+    return out, rest
+
+
 def _config(room, variant, model, bare, data, w):
     """init's config for the variant and the candidate model (MAP at 100 generations,
     2 starts, thermal section only)."""
@@ -224,6 +283,7 @@ def _config(room, variant, model, bare, data, w):
     config = run_init(room, data, w, _weather(room, data, w, bare, model == "below_measured"))[0]
     if model == "ground_measured":
         config = room_below(config, data / ROOMS[room][0])
+    config, variant = _roof_edit(config, variant)
     cfg = load_config(config)
     d = cfg.data
     if variant == "none":
@@ -235,10 +295,25 @@ def _config(room, variant, model, bare, data, w):
     if model == "below_measured":
         cols = {**d.weather.columns, "Ph": "Tb"}
         d = d.model_copy(update={"weather": d.weather.model_copy(update={"columns": cols})})
+    from heritage_bayes.config.options import ModelOptions
+    from heritage_bayes.config.priors import PriorSpec
+
     name, options, priors = MODELS[model]
-    th = cfg.thermal.model_copy(update={"model": name, "options": options, "priors": priors})
+    typed = {k: PriorSpec.model_validate(v) for k, v in priors.items()}
+    th = cfg.thermal.model_copy(
+        update={"model": name, "options": ModelOptions.model_validate(options), "priors": typed}
+    )
+    if variant.startswith("phi"):  # the AR(1) error's coefficient capped lower
+        cap = {"phi_Ti": PriorSpec.model_validate({"dist": "uniform", "lower": 0.0,
+                                                   "upper": float(variant[3:])})}  # fmt: skip
+        th = th.model_copy(update={"priors": {**th.priors, **cap}})
+    periods = cfg.periods
+    if variant.startswith("from"):  # the calibration from a later date (e.g. after the snow)
+        cal = periods.calibration.model_copy(update={"start": variant[4:]})
+        periods = periods.model_copy(update={"calibration": cal})
     opt = cfg.optimizer.model_copy(update={"maxiter": 100, "starts": 2})
-    return cfg.model_copy(update={"data": d, "optimizer": opt, "thermal": th, "hygric": None})
+    return cfg.model_copy(update={"data": d, "optimizer": opt, "thermal": th, "hygric": None,
+                                  "periods": periods})  # fmt: skip
 
 
 def run(room, variant, bare, data, work, hours, model="thermal_1c"):
@@ -247,7 +322,7 @@ def run(room, variant, bare, data, work, hours, model="thermal_1c"):
     w = work / room / ("bare" if bare else "meas") / model
     (w / "wx").mkdir(parents=True, exist_ok=True)
     cfg = _config(room, variant, model, bare, data, w)
-    undo = patched(variant, _fmi(room, data))
+    undo = patched(_roof_answers(variant)[1], _fmi(room, data))
     try:
         prep, m, lp, mp = config_map(cfg, "thermal")
     finally:

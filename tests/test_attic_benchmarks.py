@@ -1,0 +1,62 @@
+"""The attic benchmarks' checks on synthetic data: a known stamp shift, phase and gain
+are found (benchmarks/attic_diagnostics.py), the roof's answers are parsed
+(benchmarks/attic_physics.py)."""
+
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+
+import attic_diagnostics as ad
+import attic_physics as ap
+
+SITE = (60.21, 24.66)
+
+
+@pytest.fixture(scope="module")
+def sky():
+    index = pd.date_range("2011-06-01", "2011-06-04", freq="1h", tz="UTC", inclusive="left")
+    return index, ad.clear_sky_minutes(index, SITE)
+
+
+@pytest.mark.parametrize(("convention", "shift"), [("mean of the hour ending", 30),
+                                                   ("value at the stamp", 0)])  # fmt: skip
+def test_best_shift_finds_the_stamp_convention(sky, convention, shift):
+    """Hourly means of the hour ending read as values at the stamp are 30 min late."""
+    index, cs = sky
+    measured = 0.9 * ad.sky_as_read(cs, index, ad.CONVENTIONS[convention])
+    found, rms, scale = ad.best_shift(measured, lambda k: ad.sky_as_read(cs, index, None, k))
+    assert found == -shift
+    assert scale == pytest.approx(0.9, abs=0.02) and rms < 5.0
+
+
+def test_clear_days_keep_a_clear_sky_and_drop_a_cloudy_one(sky):
+    index, cs = sky
+    at = ad.sky_as_read(cs, index, None)
+    g = pd.Series(at.copy(), index=index)
+    g.iloc[30:48] *= np.linspace(0.1, 1.0, 18)  # a cloudy second day
+    mask = ad.clear_days(g, at, SITE[1])
+    days = set((index[mask] + pd.Timedelta(hours=SITE[1] / 15)).floor("D").day)
+    assert 1 in days and 2 not in days
+
+
+def test_season_table_gain_and_phase():
+    """A measured swing half the simulated one and peaking an hour earlier."""
+    index = pd.date_range("2011-05-01", "2011-07-01", freq="1h", inclusive="left")
+    h = index.hour.to_numpy()
+    sim = 10 + 4 * np.cos(2 * np.pi * (h - 15) / 24)
+    obs = 10 + 2 * np.cos(2 * np.pi * (h - 14) / 24)
+    f = pd.DataFrame({"obs": obs, "sim": sim, "I": 0.0}, index=index)
+    t = ad.season_table(f)
+    assert t.phase_h.tolist() == pytest.approx([-1.0, -1.0], abs=0.01)
+    assert t.gain.tolist() == pytest.approx([np.cos(2 * np.pi / 24) / 2] * 2, abs=0.01)
+
+
+def test_roof_answers_parse():
+    assert ap._roof_answers("ridge45+pitch30") == ({"ridge_azimuth": 45.0, "pitch": 30.0}, "wind")
+    assert ap._roof_answers("ridge0+snow0") == ({"ridge_azimuth": 0.0}, "snow0")
+    assert ap._roof_answers("phi0.8") == ({}, "phi0.8")

@@ -121,7 +121,7 @@ def compare_runs(
             "model": model.name,
             "run_dir": str(run.path),
             "noise": info.noise if info else None,
-            "periods": rs.raw.get("periods"),
+            "periods": {p.name: p.to_dict() for p in rs.periods} or None,
             # the report's rule: the stopping rule met and the saved draws within the
             # stated criteria
             "converged": rs.convergence.converged and rs.convergence.saved_draws_ok,

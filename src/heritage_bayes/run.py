@@ -9,7 +9,7 @@ on new inputs (the entry point for climate-change projections).
 
 Layer: above the models and the inference core, below every consumer (report,
 projection, comparison, portfolio) and the orchestrator that writes it
-(:mod:`heritage_bayes.calibrate`); it imports none of them.
+(:mod:`heritage_bayes.calibration.calibrate`); it imports none of them.
 """
 
 from __future__ import annotations

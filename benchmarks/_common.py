@@ -28,8 +28,8 @@ def config_map(cfg, section: str):
     """
     from threadpoolctl import threadpool_limits
 
+    from heritage_bayes.calibration.ladder import section_log_posterior as _log_posterior
     from heritage_bayes.inference.optimize import find_map
-    from heritage_bayes.ladder import section_log_posterior as _log_posterior
     from heritage_bayes.models import models_of
     from heritage_bayes.prepare import prepare
 

@@ -47,7 +47,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import bench_sampling
 from _common import config_map
-from heritage_bayes.calibrate import identifiability_at_map
+from heritage_bayes.calibration.calibrate import identifiability_at_map
 from heritage_bayes.config import load_config
 from heritage_bayes.inference.coordinates import node_time_constants
 from heritage_bayes.inference.moves import unidentified_block

@@ -37,7 +37,7 @@ def _cpu() -> float:
 
 
 def _calibrate(config: Path, out: Path) -> dict:
-    from heritage_bayes.calibrate import run_calibration
+    from heritage_bayes.calibration.calibrate import run_calibration
     from heritage_bayes.config import load_config
 
     t0, c0 = time.perf_counter(), _cpu()

@@ -93,7 +93,7 @@ def main() -> int:
         "--no-sun", action="store_true", help="no solar proxy (the shipped orholm.yaml's choice)"
     )
     args = ap.parse_args()
-    from heritage_bayes.calibrate import run_calibration
+    from heritage_bayes.calibration.calibrate import run_calibration
     from heritage_bayes.projection import parse_projection_config
     from heritage_bayes.projection.engine import select_draws, simulate_measures
     from heritage_bayes.projection.interventions import Measure

@@ -34,11 +34,11 @@ from pathlib import Path
 import numpy as np
 
 from heritage_bayes._arviz import az
+from heritage_bayes.calibration.ladder import section_log_posterior as _log_posterior
 from heritage_bayes.config import load_config
 from heritage_bayes.errors import InputError
 from heritage_bayes.inference.optimize import affine_coordinates, find_map, laplace
 from heritage_bayes.inference.sampler import run_sampler
-from heritage_bayes.ladder import section_log_posterior as _log_posterior
 from heritage_bayes.models import models_of
 from heritage_bayes.prepare import prepare
 

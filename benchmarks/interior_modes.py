@@ -76,7 +76,7 @@ def _chain(found, args, moves=None, seed=1):
     (its seed, walkers, coordinates, block move and weight), at most ``args.steps``
     steps."""
     import bench_sampling
-    from heritage_bayes.calibrate import identifiability_at_map
+    from heritage_bayes.calibration.calibrate import identifiability_at_map
     from heritage_bayes.inference.coordinates import sampling_coordinates
     from heritage_bayes.inference.moves import unidentified_block
 

@@ -151,7 +151,7 @@ def run(
     split: str | None,
     temperature: dict | None = None,
 ) -> None:
-    from heritage_bayes.calibrate import run_calibration
+    from heritage_bayes.calibration.calibrate import run_calibration
     from heritage_bayes.config import load_config
 
     cfg0 = load_config(config)

@@ -130,7 +130,7 @@ def screen_auto(cfg) -> tuple:
 
     from threadpoolctl import threadpool_limits
 
-    from heritage_bayes.calibrate import _select_models
+    from heritage_bayes.calibration.calibrate import _select_models
     from heritage_bayes.models import AUTO, SECTIONS, models_of
     from heritage_bayes.prepare import prepare
 
@@ -207,7 +207,7 @@ def monthly_residuals(cfg, maxiter: int, starts: int) -> pd.DataFrame:
 def calibrate_fits(cfg, work: Path, max_steps: int) -> dict:
     """`hbayes calibrate` (no ladder, no report) with emcee capped at ``max_steps``:
     posterior-predictive validation FIT [%] and convergence."""
-    from heritage_bayes.calibrate import run_calibration
+    from heritage_bayes.calibration.calibrate import run_calibration
 
     sampler = cfg.sampler.model_copy(update={"max_steps": max_steps})
     cfg = cfg.model_copy(update={"sampler": sampler, "ladder": False})

@@ -6,7 +6,7 @@ rule, from its runs as they are (no sampling): the screen's rows from its
 
 Prints the screen (MAP validation FIT per candidate), the choice and its tie, each
 sampled candidate's convergence, validation ELPD and blocked-LOO Pareto k, the ELPD
-stage of :func:`heritage_bayes.selection_rule.decide`, and the recommendation's sentence
+stage of :func:`heritage_bayes.calibration.selection_rule.decide`, and the recommendation's sentence
 beside the one the folder holds. Writes nothing.
 """
 

@@ -17,11 +17,11 @@ import time
 
 from threadpoolctl import threadpool_limits
 
+from heritage_bayes.calibration.selection import carried_start, screen
 from heritage_bayes.config import load_config
 from heritage_bayes.inference.optimize import find_map
 from heritage_bayes.models import models_of
 from heritage_bayes.prepare import prepare
-from heritage_bayes.selection import carried_start, screen
 
 
 def main() -> None:

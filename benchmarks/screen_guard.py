@@ -1,6 +1,6 @@
 """What the screen's restart guard changes: the ``model: auto`` screen of the thermal
 section on rooms from their raw files (init's config, as :mod:`real_rooms` writes it),
-without and with :func:`heritage_bayes.selection.restart_guard`.
+without and with :func:`heritage_bayes.calibration.selection.restart_guard`.
 
     python benchmarks/screen_guard.py [ROOM ...] [--section thermal] [--out DIR]
 
@@ -27,10 +27,10 @@ from real_rooms import ROOMS, run_init  # noqa: E402
 
 
 def main(argv=None) -> int:
+    from heritage_bayes.calibration.selection import screen
     from heritage_bayes.config import load_config
     from heritage_bayes.models import models_of
     from heritage_bayes.prepare import prepare
-    from heritage_bayes.selection import screen
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("rooms", nargs="*", default=["R2", "R4", "R6"])

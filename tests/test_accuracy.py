@@ -163,7 +163,7 @@ def test_a_model_without_sun_on_the_demo_is_red_and_named(tmp_path):
     one node and no solar input: red, and the advice names the missing sun from the
     residuals' daily cycle (measured: ±0.45 K, a third of the measured cycle, largest at
     14 h solar time) and the slow drift."""
-    from heritage_bayes.calibrate import run_calibration
+    from heritage_bayes.calibration.calibrate import run_calibration
     from heritage_bayes.config import parse_config
     from heritage_bayes.report.build import build_context
 

@@ -160,9 +160,9 @@ def test_lower_layers_do_not_import_higher_ones():
     graph = import_graph()
     layers = {  # lower number = lower layer
         "rc": 1, "climate": 1, "io": 1, "rundir": 1, "errors": 0, "_version": 0, "_arviz": 0,
-        "convert": 0, "convergence": 0, "format": 0, "names": 0,
+        "convert": 0, "format": 0, "names": 0,
         "config": 1, "inputs": 2, "models": 2, "sources": 2, "demo": 2, "inference": 2,
-        "prepare": 3, "prepare_steps": 3, "run": 3, "report": 4, "calibrate": 5, "projection": 5,
+        "prepare": 3, "prepare_steps": 3, "run": 3, "report": 4, "calibration": 5, "projection": 5,
         "portfolio": 6, "compare": 6,
         "cli": 7,
     }  # fmt: skip

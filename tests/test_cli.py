@@ -131,7 +131,7 @@ def test_missing_config_and_bad_yaml_and_bad_data(tmp_path, capsys):
 
 
 def test_internal_errors_exit_1(monkeypatch, tmp_path, capsys):
-    import heritage_bayes.calibrate as calmod
+    import heritage_bayes.calibration.calibrate as calmod
 
     def boom(*a, **k):
         raise RuntimeError("a bug")

@@ -17,6 +17,7 @@ import xarray as xr
 import yaml
 
 from heritage_bayes._arviz import az
+from heritage_bayes.calibration.selection import choose, decide
 from heritage_bayes.cli import main
 from heritage_bayes.compare import (
     _block_se,
@@ -29,7 +30,6 @@ from heritage_bayes.compare import (
 from heritage_bayes.config.sampler import SamplerSettings
 from heritage_bayes.inference.predictive import PREDICTIVE_DRAWS
 from heritage_bayes.report._browser import PHONE_OVERFLOW_JS, find_chromium, open_page
-from heritage_bayes.selection import choose, decide
 
 TINY = {
     "name": "tiny",
@@ -174,7 +174,7 @@ def test_validation_elpd_of_stored_densities_equals_that_of_terms_per_draw():
     density per hour, :func:`_validation_lpd`) give the same ELPD and standard error;
     ``log_mean_exp`` is the naive formula where that does not overflow, and stable
     where it would."""
-    from heritage_bayes.inference.idata import _validation_lpd
+    from heritage_bayes.calibration.outputs import _validation_lpd
     from heritage_bayes.inference.interop import log_mean_exp
 
     rng = np.random.default_rng(3)

@@ -440,7 +440,7 @@ def test_model_option_errors_name_the_key_expected_and_found():
 
 
 def test_an_option_the_model_does_not_take_names_its_key_and_models_follow_options():
-    from heritage_bayes.calibrate import check_models
+    from heritage_bayes.calibration.calibrate import check_models
     from heritage_bayes.config.options import ModelOptions
     from heritage_bayes.models import build_model
 

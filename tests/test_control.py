@@ -219,7 +219,7 @@ def test_schedule_and_conservation_heating():
 def test_case_study_configs_build_controlled_models(name):
     from pathlib import Path
 
-    from heritage_bayes.calibrate import check_models
+    from heritage_bayes.calibration.calibrate import check_models
     from heritage_bayes.config import load_config
     from heritage_bayes.models import build_model
 

@@ -331,7 +331,7 @@ def test_a_converged_run_has_no_reasons_even_when_its_saved_draws_scatter():
     ~1 000 saved draws may scatter above 1.01 on a converged run (Ørholm's thermal_4a:
     1.018): no reason is listed then, while the same numbers on an unconverged run are
     named."""
-    from heritage_bayes.convergence import unconverged_reasons
+    from heritage_bayes.calibration.convergence import unconverged_reasons
 
     summary = {
         "converged": True,

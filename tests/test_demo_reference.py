@@ -20,9 +20,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from heritage_bayes.calibration.ladder import section_log_posterior
 from heritage_bayes.config import load_config
 from heritage_bayes.demo import TRUE_HYGRIC, TRUE_THERMAL
-from heritage_bayes.ladder import section_log_posterior
 from heritage_bayes.models import build_model
 from heritage_bayes.prepare import prepare
 

@@ -236,7 +236,7 @@ TINY = {**REPORT_TINY, "ladder": False}
 
 @pytest.fixture(scope="module")
 def tiny_run(tmp_path_factory) -> Path:
-    from heritage_bayes.calibrate import run_calibration
+    from heritage_bayes.calibration.calibrate import run_calibration
     from heritage_bayes.config import parse_config
 
     run_dir = tmp_path_factory.mktemp("docs") / "a run's folder"  # a quote, a space

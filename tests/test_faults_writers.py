@@ -384,7 +384,7 @@ def test_output_folder(box, capsys, case):
 def run_dir(tmp_path_factory) -> Path:
     """A tiny finished calibration (thermal_1c and hygric_1c, 300 steps: unconverged,
     enough draws)."""
-    from heritage_bayes.calibrate import run_calibration
+    from heritage_bayes.calibration.calibrate import run_calibration
     from heritage_bayes.config import parse_config
 
     out = tmp_path_factory.mktemp("writers") / "run"

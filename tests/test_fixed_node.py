@@ -150,7 +150,7 @@ def test_a_run_records_the_temperature_and_its_readers_rebuild_the_prior(tmp_pat
     rebuilds the Pf prior the chain sampled (summary's prior_spec)."""
     import yaml
 
-    from heritage_bayes.calibrate import run_calibration
+    from heritage_bayes.calibration.calibrate import run_calibration
     from heritage_bayes.run import load_run, section_parameters
 
     raw = {

@@ -580,7 +580,7 @@ def test_the_modes_finding_names_where_the_optima_differ():
     and the ways out (a survey's area, a prior, the smaller model)."""
     from types import SimpleNamespace
 
-    from heritage_bayes.findings import modes_finding
+    from heritage_bayes.calibration.findings import modes_finding
 
     names = ["Cw", "Cint", "Gint", "fsol", "sigma_Ti"]
     kept = {"log_posterior": 938.0, "theta": np.array([1.2e8, 1e4, 400, 0.41, 0.2])}

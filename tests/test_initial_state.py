@@ -226,9 +226,9 @@ def test_armadillo_from_yaml_fits_with_its_initial_state_estimated():
     """configs/armadillo.yaml (pySIP's TwTi_RoRi as a custom network): the cell starts
     far from the steady state of its mean inputs; with the start estimated the MAP
     simulation fits within pySIP's RMSE (0.85 K), the steady start does not."""
+    from heritage_bayes.calibration.ladder import section_log_posterior as _log_posterior
     from heritage_bayes.config import load_config
     from heritage_bayes.inference.optimize import find_map
-    from heritage_bayes.ladder import section_log_posterior as _log_posterior
     from heritage_bayes.models import build_model
     from heritage_bayes.prepare import prepare
 

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from heritage_bayes.calibrate import run_calibration
+from heritage_bayes.calibration.calibrate import run_calibration
 from heritage_bayes.config import parse_config
 from heritage_bayes.errors import ConfigError
 from heritage_bayes.projection import parse_projection_config, project
@@ -442,7 +442,7 @@ def test_a_calibrated_constant_source_stays_with_the_measure(run, case):
     th = hb.model("thermal_1c", source=True)
     src = SimpleNamespace(
         models={"thermal": th, "hygric": run.models["hygric"]}, summary=run.summary,
-        path=run.path,
+        run_summary=run.run_summary, path=run.path,
     )  # fmt: skip
     P = np.column_stack([draws.model["thermal"], np.full(len(draws.index), 300.0)])  # Qs [W]
     assert th.parameter_names[-1] == "Qs"

@@ -15,7 +15,7 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 
 noise_default = pytest.importorskip("noise_default")
 
-from heritage_bayes.calibrate import check_models  # noqa: E402
+from heritage_bayes.calibration.calibrate import check_models  # noqa: E402
 from heritage_bayes.config import load_config  # noqa: E402
 
 

@@ -23,7 +23,7 @@ import pytest
 import yaml
 
 from heritage_bayes._arviz import az
-from heritage_bayes.calibrate import run_calibration
+from heritage_bayes.calibration.calibrate import run_calibration
 from heritage_bayes.cli import main
 from heritage_bayes.climate.risk.registry import INDICATORS
 from heritage_bayes.config import parse_config

@@ -524,7 +524,7 @@ def _tiny_run(root: Path) -> Path:
     """A real (tiny) calibration run, once per session."""
     import yaml
 
-    from heritage_bayes.calibrate import run_calibration
+    from heritage_bayes.calibration.calibrate import run_calibration
     from heritage_bayes.config import load_config
     from test_faults import _tiny
 

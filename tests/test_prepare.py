@@ -168,7 +168,7 @@ def test_handed_the_runs_models_prepare_builds_none(monkeypatch):
     them) and hands them down: prepare builds none again and prepares the same data as
     when it builds them itself."""
     import heritage_bayes.models as models_module
-    from heritage_bayes.calibrate import check_models
+    from heritage_bayes.calibration.calibrate import check_models
 
     cfg = _demo_cfg(thermal={"model": "auto"}, hygric={"model": "hygric_1c"})
     own = prepare(cfg)

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 import yaml
 
-from heritage_bayes.calibrate import run_calibration
+from heritage_bayes.calibration.calibrate import run_calibration
 from heritage_bayes.cli import main
 from heritage_bayes.config import parse_config
 from heritage_bayes.errors import ConfigError, DataError, InputError

@@ -13,7 +13,7 @@ import copy
 import numpy as np
 import pytest
 
-from heritage_bayes.calibrate import run_calibration
+from heritage_bayes.calibration.calibrate import run_calibration
 from heritage_bayes.config import parse_config
 from heritage_bayes.errors import ConfigError, DataError
 from heritage_bayes.projection import parse_projection_config, project

@@ -30,15 +30,21 @@ from heritage_bayes.errors import InputError
 from heritage_bayes.inference.likelihoods import get_noise_model
 from heritage_bayes.projection import engine
 from heritage_bayes.projection.engine import Draws, _monthly, _relative_humidity
+from heritage_bayes.rundir.summary import RunSummary
 
 SEED = 4
 CHUNK = 3
 
 
+def _summaries(summary: dict) -> dict:
+    """A stub run's ``summary`` (the JSON) and ``run_summary`` (typed)."""
+    return {"summary": summary, "run_summary": RunSummary.from_dict(summary)}
+
+
 @pytest.fixture(scope="module")
 def setup():
     models = {"thermal": hb.model("thermal_2c"), "hygric": hb.model("hygric_2c")}
-    run = SimpleNamespace(models=models, summary={"dt": 3600.0, "init_steps": 720}, path="t")
+    run = SimpleNamespace(models=models, **_summaries({"dt": 3600.0, "init_steps": 720}), path="t")
     _, inp, _, _, _ = _inputs("greensboro_tmy3")  # 8759 h: a TMY on the UTC grid
     # two complete years (17 520 h, the third copy cut: months cut mid-way)
     two = pd.concat([inp, inp, inp], ignore_index=True).iloc[:17_520]
@@ -320,7 +326,7 @@ def test_select_draws_of_a_kalman_run_keeps_the_process_noise():
         idata=SimpleNamespace(posterior=post),
         models={"thermal": m},
         config=SimpleNamespace(thermal=SimpleNamespace(noise="kalman")),
-        summary={},
+        **_summaries({}),
         path="t",
         draws=lambda s: {p: v.reshape(-1) for p, v in params.items()},
     )
@@ -356,7 +362,7 @@ def test_select_draws_of_a_kalman_run_use_its_free_run_error():
         idata=SimpleNamespace(posterior=post),
         models={"thermal": m},
         config=SimpleNamespace(thermal=SimpleNamespace(noise="kalman")),
-        summary={"models": {"thermal": {"predictive_noise": {"Ti": fit}}}},
+        **_summaries({"models": {"thermal": {"predictive_noise": {"Ti": fit}}}}),
         path="t",
         draws=lambda s: {p: np.full(6, 1e6) for p in m.parameter_names},
     )

@@ -128,7 +128,7 @@ def _checksums(a: np.ndarray) -> list[float]:
 
 def calibration_values(key: str) -> dict:
     """section -> the recorded numbers of one calibration config."""
-    from heritage_bayes.ladder import section_log_posterior
+    from heritage_bayes.calibration.ladder import section_log_posterior
     from heritage_bayes.models import SECTIONS, build_model
     from heritage_bayes.prepare import prepare
 
@@ -230,7 +230,7 @@ def projection_values(run_dir: Path, name: str) -> dict:
 
 
 def _tiny_run(out: Path) -> Path:
-    from heritage_bayes.calibrate import run_calibration
+    from heritage_bayes.calibration.calibrate import run_calibration
     from heritage_bayes.config import parse_config
 
     run_calibration(parse_config(_tiny_config()), out_dir=out, report=False, quiet=True)

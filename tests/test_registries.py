@@ -7,12 +7,12 @@ import pytest
 import yaml
 
 from heritage_bayes import names
-from heritage_bayes.calibrate import check_models
+from heritage_bayes.calibration.calibrate import check_models
+from heritage_bayes.calibration.findings import LADDERS
 from heritage_bayes.cli import main
 from heritage_bayes.compare import DEFAULT_MODELS
 from heritage_bayes.config import parse_config
 from heritage_bayes.errors import ConfigError
-from heritage_bayes.findings import LADDERS
 from heritage_bayes.inference import likelihoods, monitor
 from heritage_bayes.models import AUTO_LADDERS, auto_rungs, build_model
 from heritage_bayes.rc import catalog

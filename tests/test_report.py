@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from heritage_bayes.calibrate import run_calibration
+from heritage_bayes.calibration.calibrate import run_calibration
 from heritage_bayes.cli import main
 from heritage_bayes.config import parse_config
 from heritage_bayes.errors import InputError
@@ -29,9 +29,9 @@ from heritage_bayes.report._browser import PHONE_OVERFLOW_JS, find_chromium, ope
 from heritage_bayes.report._diag import acf, cumulative_periodogram, innovations
 from heritage_bayes.report.build import SECTIONS, record_verdict
 from heritage_bayes.report.page import Section, render_page, script_hash
-from heritage_bayes.report.sections.identifiability import ladder_metrics
 from heritage_bayes.report.verdict import convergence_verdict, ess_class, rhat_class, run_notes
-from heritage_bayes.rundir.summary import load_summary
+from heritage_bayes.rundir.summary import LadderRow, RungFit, load_summary
+from heritage_bayes.rundir.summary_ladder import ladder_of
 
 ROOM = "<script>alert(1)</script>"
 BUILDING = 'Château "Ter <b>Horst</b>" & Co'
@@ -320,35 +320,39 @@ def test_diagnostics_and_reproducibility(report, run_dir):
     assert "thermal map" in repro and "this report" in repro
 
 
-def test_ladder_metrics_formats():
+def test_ladder_rows_read_both_formats():
+    """A ladder row's fit keyed by output, or flat (hbayes before the ladder named its
+    outputs: read under the output ``""``), or absent."""
     keyed = {"validation": {"Ti": {"FIT": 80.0}}}
     flat = {"validation": {"FIT": 80.0, "MSE": 0.1}}
-    assert ladder_metrics(keyed, "validation") == {"Ti": {"FIT": 80.0}}
-    assert ladder_metrics(flat, "validation") == {"": {"FIT": 80.0, "MSE": 0.1}}
-    assert ladder_metrics(None, "calibration") == {}
+    assert LadderRow.from_dict({"fit": keyed}).fits("validation") == {"Ti": RungFit(FIT=80.0)}
+    assert LadderRow.from_dict({"fit": flat}).fits("validation") == {"": RungFit(FIT=80.0, MSE=0.1)}
+    assert LadderRow.from_dict({"fit": None}).fits("calibration") == {}
     from heritage_bayes.report.figures import fig_ladder
 
     fig = fig_ladder(
-        {
-            "thermal": [
-                {
-                    "model": "a",
-                    "n_params": 3,
-                    "fit": flat,
-                    "n_null": 1,
-                    "condition_number_identifiable": None,
-                },
-                {
-                    "model": "b",
-                    "n_params": 5,
-                    "n_model_params": 4,
-                    "fit": keyed,
-                    "n_null": 0,
-                    "sampled": True,
-                    "condition_number_identifiable": 10.0,
-                },
-            ]
-        }
+        ladder_of(
+            {
+                "thermal": [
+                    {
+                        "model": "a",
+                        "n_params": 3,
+                        "fit": flat,
+                        "n_null": 1,
+                        "condition_number_identifiable": None,
+                    },
+                    {
+                        "model": "b",
+                        "n_params": 5,
+                        "n_model_params": 4,
+                        "fit": keyed,
+                        "n_null": 0,
+                        "sampled": True,
+                        "condition_number_identifiable": 10.0,
+                    },
+                ]
+            }
+        )
     )
     assert len(fig.axes) == 2
 

@@ -107,7 +107,9 @@ def outputs_projection() -> dict[str, str]:
     from test_projection_stream import demo_draws
 
     models = {"thermal": hb.model("thermal_2c"), "hygric": hb.model("hygric_2c")}
-    run = SimpleNamespace(models=models, summary={"dt": 3600.0, "init_steps": 720}, path="t")
+    from test_projection_stream import _summaries
+
+    run = SimpleNamespace(models=models, **_summaries({"dt": 3600.0, "init_steps": 720}), path="t")
     _, inp, _, _, _ = _inputs("greensboro_tmy3")  # 8759 h
     warm = inp.copy()
     warm[["Te", "Tf"]] += 3.0

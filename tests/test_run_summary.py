@@ -123,3 +123,137 @@ def test_prose_sets_names_as_code_and_escapes():
         "scaling <code>Cw</code>, <code>Ci</code> and <code>fI_N</code> &lt;together&gt;; "
         "Cint stays"
     )
+
+
+def _rung(model, n, n_model, fit_val, **extra):
+    """A ladder row as ``summary.json`` holds it (the screen's keys in ``extra``)."""
+    return {
+        "model": model,
+        "n_params": n,
+        "n_model_params": n_model,
+        "fit": {
+            "calibration": {"Pi": {"MSE": 577.7, "MAE": 19.69, "FIT": 63.29, "SD": 65.5, "n": 192}},
+            "validation": {
+                "Pi": {"MSE": 500.3, "MAE": 18.42, "FIT": fit_val, "SD": 63.9, "n": 120}
+            },
+        },
+        "log_likelihood": -806.12,
+        "aic": 1626.24,
+        "bic": 1649.04,
+        "rank": n_model,
+        "n_null": 2,
+        "null_directions": ["overall scale", "direction 2"],
+        "condition_number_identifiable": 1.52,
+        "map_agreed": "2/2",
+        "sampled": False,
+        **extra,
+    }
+
+
+#: ``selection``, ``ladder`` and ``provenance`` as ``hbayes calibrate`` writes them
+#: (``model: auto`` in the hygric section: the screen's rows are its ladder)
+SCREENED = {
+    "selection": {
+        "hygric": {
+            "rule": "each model's MAP scored by the validation FIT of its simulation",
+            "rows": [
+                _rung("hygric_1c", 4, 2, -48.8, parent=None, seeded_from=None, score=-48.8),
+                _rung(
+                    "hygric_2c",
+                    7,
+                    5,
+                    64.99,
+                    sampled=True,
+                    chosen=True,
+                    parent="hygric_1c",
+                    seeded_from="hygric_1c",
+                    map_seconds=0.16,
+                    score=64.99,
+                    map_guard={
+                        "spread": 31.0,
+                        "log_posteriors": [-806.1, -806.1],
+                        "moved": False,
+                        "said": "3 starts ended 31 units apart",
+                    },
+                ),
+                {
+                    "model": "hygric_2c_fixed",
+                    "parent": "hygric_2c",
+                    "error": "not screened: the time budget ran out",
+                },
+            ],
+            "choice": "hygric_2c",
+            "score": "validation FIT",
+            "reason": "the best validation FIT of the ladder (65.0 %)",
+            "best": "hygric_2c",
+            "runner_up": None,
+            "tied": [],
+            "scores": {"hygric_1c": -48.8, "hygric_2c": 64.99},
+            "n_params": {"hygric_1c": 4, "hygric_2c": 7},
+            "margin": 2.0,
+            "model": "hygric_2c",
+            "decided_by": "screen",
+            "posterior": None,
+            "tie": "hygric_2c_fixed ties with it (within 2 points of the best)",
+            "screen_seconds": 13.9,
+        }
+    },
+    "provenance": {
+        "config": {"name": "demo", "data": {"demo": {"seed": 7}}},
+        "config_sha256": "ab",
+    },
+}
+SCREENED["ladder"] = {"hygric": SCREENED["selection"]["hygric"]["rows"]}
+
+
+def test_the_ladder_selection_and_provenance_as_written_read_typed():
+    """The parts of ``summary.json`` on the model choice and the provenance, as a run
+    writes them, read typed and render as before; the file is written back unchanged."""
+    from heritage_bayes.report.sections.identifiability import ladder_context
+
+    d = json.loads(json.dumps({**V1, **SCREENED}))
+    s = RunSummary.from_dict(d)
+    assert s.to_dict() == {**d, "schema_version": SCHEMA_VERSION}
+    one, two, out = s.ladder["hygric"]
+    assert (one.model, one.n_params, one.n_model_params, one.rank, one.sampled) == (
+        "hygric_1c", 4, 2, 2, False,
+    )  # fmt: skip
+    assert one.fits("validation")["Pi"].FIT == -48.8 and one.fits("validation")["Pi"].n == 120
+    assert two.sampled and two.chosen and two.seeded_from == "hygric_1c"
+    assert two.map_guard.said == "3 starts ended 31 units apart" and two.map_guard.spread == 31.0
+    assert out.error == "not screened: the time budget ran out" and out.fits("validation") == {}
+    sel = s.selection["hygric"]
+    assert (sel.choice, sel.best, sel.runner_up, sel.tied, sel.margin) == (
+        "hygric_2c", "hygric_2c", None, (), 2.0,
+    )  # fmt: skip
+    assert sel.rows == s.ladder["hygric"] and sel.scores["hygric_2c"] == 64.99
+    assert s.provenance.recorded and s.provenance.config_sha256 == "ab"
+    assert s.provenance.snapshot() == SCREENED["provenance"]["config"]
+    assert s.seeds == {"calibration": 1, "synthetic data": 7}
+    ctx = ladder_context(s)
+    (table,) = ctx["tables"]
+    assert table["selection"] == (
+        "model: auto — hygric_2c chosen by the screen: the best validation FIT of the ladder "
+        "(65.0 %). Rule: each model's MAP scored by the validation FIT of its simulation. "
+        "Hygric_2c_fixed ties with it (within 2 points of the best). "
+        "hygric_2c: 3 starts ended 31 units apart."
+    )
+    first, second, third = table["rows"]
+    assert first == {
+        "model": "hygric_1c", "n_params": "2 + 2 noise", "rank": "2",
+        "n_null": "2 (overall scale, direction 2)", "cond": "1.52", "fit_cal": "63.3",
+        "fit_val": "−48.8", "mse_cal": "578", "mse_val": "500", "mae_cal": "19.7",
+        "mae_val": "18.4", "loglik": "−806", "aic": "1626", "bic": "1649",
+        "agreed": "2/2", "sampled": False,
+    }  # fmt: skip
+    assert (
+        second["sampled"]
+        and third["model"] == "hygric_2c_fixed (not screened: the time budget ran out)"
+    )
+    assert (third["fit_val"], third["n_params"], third["agreed"]) == ("—", "—", "—")
+
+
+def test_a_summary_without_ladder_selection_or_provenance():
+    s = RunSummary.from_dict({k: v for k, v in V1.items() if k != "provenance"})
+    assert s.ladder == {} and s.selection == {} and not s.provenance.recorded
+    assert s.seeds == {"calibration": 1} and s.provenance.snapshot() == {}

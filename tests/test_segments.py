@@ -10,7 +10,8 @@ import pandas as pd
 import pytest
 import yaml
 
-from heritage_bayes.calibrate import build_model
+from heritage_bayes.calibration.calibrate import build_model
+from heritage_bayes.calibration.ladder import section_log_posterior as _log_posterior
 from heritage_bayes.config import parse_config, prior_specs
 from heritage_bayes.inference.optimize import find_map
 from heritage_bayes.inference.posterior import LogPosterior
@@ -21,7 +22,6 @@ from heritage_bayes.inference.segments import (
     segments_of,
 )
 from heritage_bayes.init_config import init_config
-from heritage_bayes.ladder import section_log_posterior as _log_posterior
 from heritage_bayes.prepare import prepare
 from test_init_detect import _climate, _data, _hobo
 from test_prepare import _csv_config, _load, _write_files
@@ -195,7 +195,7 @@ def test_a_short_segment_is_dropped_with_a_note(tmp_path):
     """A calibration that starts 43 hours before a weather outage: that piece (shorter
     than the 2-day warm-up plus 48 h) is dropped, the console says so, and the
     calibration is fitted over the rest."""
-    from heritage_bayes.calibrate import _say_segments
+    from heritage_bayes.calibration.calibrate import _say_segments
 
     _write_files(tmp_path, weather_gap=35)
     raw = _csv_config(tmp_path)

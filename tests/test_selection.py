@@ -10,10 +10,10 @@ import json
 import pytest
 import yaml
 
+from heritage_bayes.calibration.selection import MARGIN_FIT, choose, decide, row_score
 from heritage_bayes.cli import main
 from heritage_bayes.compare.screen import to_sample
 from heritage_bayes.errors import InputError
-from heritage_bayes.selection import MARGIN_FIT, choose, decide, row_score
 from test_compare import TINY
 
 
@@ -282,12 +282,12 @@ def test_model_auto_and_compare_screen_alike_and_choose_alike(tmp_path):
     candidates, the same ladder): the same rows scored alike and the same choice; with
     posteriors that do not reliably break the tie, compare's recommendation is that
     choice."""
+    from heritage_bayes.calibration.selection import screen
     from heritage_bayes.compare.orchestrate import _candidate_config
     from heritage_bayes.compare.screen import screen_candidates
     from heritage_bayes.config import load_config
     from heritage_bayes.models import AUTO_LADDERS, models_of
     from heritage_bayes.prepare import prepare
-    from heritage_bayes.selection import screen
 
     raw = {**AUTO, "hygric": None, "optimizer": {"maxiter": 10, "starts": 1, "popsize": 4}}
     p = tmp_path / "auto.yaml"
@@ -315,7 +315,7 @@ def test_the_restart_guard_runs_only_where_the_starts_disagree(monkeypatch):
     searches; further apart: two more from other seeds, a higher optimum kept only when
     it beats the first by more than the optimizer's MODE_PICK, and said in words."""
     import heritage_bayes.inference.optimize as opt
-    from heritage_bayes.selection import GUARD_SEARCHES, SPREAD_LOGPOST, restart_guard
+    from heritage_bayes.calibration.selection import GUARD_SEARCHES, SPREAD_LOGPOST, restart_guard
 
     def result(lp, cands, carried=None):
         return opt.MAPResult(

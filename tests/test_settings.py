@@ -274,8 +274,8 @@ def _section_at_cap(noise="ar1_white"):
 
 
 def test_a_phi_at_its_cap_is_warned_once_and_not_when_the_config_sets_it(monkeypatch, capsys):
-    import heritage_bayes.calibrate as cal
-    import heritage_bayes.findings as fin
+    import heritage_bayes.calibration.calibrate as cal
+    import heritage_bayes.calibration.findings as fin
 
     monkeypatch.setattr(fin, "frozen_time_constant", lambda *a: None)
     fin.say_findings(cal._Progress(quiet=False), _section_at_cap())
@@ -294,8 +294,8 @@ def test_a_phi_at_its_cap_is_warned_once_and_not_when_the_config_sets_it(monkeyp
 def test_a_parameter_the_config_pins_is_not_flagged_as_unidentified(monkeypatch, capsys):
     """demo.yaml closes hygric_2c's Cw-Gw direction with a lognormal prior on Gw: the
     advice 'add an informative prior' is already taken, so no warning for it."""
-    import heritage_bayes.calibrate as cal
-    import heritage_bayes.findings as fin
+    import heritage_bayes.calibration.calibrate as cal
+    import heritage_bayes.calibration.findings as fin
 
     monkeypatch.setattr(fin, "frozen_time_constant", lambda *a: None)
     s = _section_at_cap("ar1")

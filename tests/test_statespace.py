@@ -14,7 +14,7 @@ from scipy.linalg import expm
 from scipy.stats import multivariate_normal
 
 import heritage_bayes as hb
-from heritage_bayes.convergence import EXIT_UNCONVERGED
+from heritage_bayes.calibration.convergence import EXIT_UNCONVERGED
 from heritage_bayes.inference.likelihoods import get_noise_model
 from heritage_bayes.inference.parameters import parameters_for
 from heritage_bayes.inference.posterior import LogPosterior

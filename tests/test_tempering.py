@@ -100,9 +100,9 @@ def test_likelihood_temperature_config_reaches_the_posterior():
     capacity nodes, 1 for a richer one and for a hygric one; at least 1): the section's
     LogPosterior divides its log-likelihood by it (the prior untouched), and a
     temperature below 1 is a ConfigError naming the key."""
+    from heritage_bayes.calibration.ladder import section_log_posterior as _log_posterior
     from heritage_bayes.config import parse_config
     from heritage_bayes.errors import ConfigError
-    from heritage_bayes.ladder import section_log_posterior as _log_posterior
     from heritage_bayes.models import build_model
     from heritage_bayes.prepare import prepare
 

@@ -24,7 +24,7 @@ _LAZY = {
     "structural_identifiability": "heritage_bayes.rc",
     "load_run": "heritage_bayes.run",
     "project": "heritage_bayes.projection",
-    "run_calibration": "heritage_bayes.calibrate",
+    "run_calibration": "heritage_bayes.calibration.calibrate",
 }
 
 

@@ -237,7 +237,7 @@ def _cmd_calibrate(args) -> int:
     from heritage_bayes.config import load_config
 
     cfg = load_config(args.config)  # config errors before the heavy imports
-    from heritage_bayes.calibrate import run_calibration
+    from heritage_bayes.calibration.calibrate import run_calibration
 
     out = run_calibration(
         cfg,
@@ -255,7 +255,7 @@ def _cmd_calibrate(args) -> int:
 
 def _converged_or_3(run_dir) -> int:
     """0 when the run's ``summary.json`` says converged; else name the reasons, return 3."""
-    from heritage_bayes.convergence import EXIT_UNCONVERGED
+    from heritage_bayes.calibration.convergence import EXIT_UNCONVERGED
     from heritage_bayes.report.accuracy import accuracy_failures, resolutions
     from heritage_bayes.rundir.summary import load_summary
 
@@ -464,7 +464,7 @@ def _cmd_batch(args) -> int:
         quiet=args.quiet,
         workers_unbounded=args.workers_unbounded,
     )
-    from heritage_bayes.convergence import EXIT_UNCONVERGED
+    from heritage_bayes.calibration.convergence import EXIT_UNCONVERGED
 
     bad = df[~df["status"].isin(["done", "skipped"])]
     for _, r in bad.iterrows():

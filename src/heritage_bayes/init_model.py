@@ -33,7 +33,7 @@ written as comments above them:
 The starting order: a calibration period of :data:`LONG_DAYS` days or more of hourly
 data pins two thermal nodes or more, and which of ``thermal_2c`` and Kramer et al.'s
 ``thermal_4a`` the room calls for is not a signature init can measure: it writes
-``model: auto`` (:mod:`heritage_bayes.selection`: the ladder screened by MAP and
+``model: auto`` (:mod:`heritage_bayes.calibration.selection`: the ladder screened by MAP and
 validation FIT, the winner sampled), and so for the hygric model where no signature
 names one; shorter records keep the one-node models.
 

@@ -39,7 +39,7 @@ __all__ = [
 SECTIONS = ("thermal", "hygric")
 
 #: ``model:`` value that screens the section's :data:`AUTO_LADDERS` (MAP and validation
-#: score, :mod:`heritage_bayes.selection`) and samples the model chosen.
+#: score, :mod:`heritage_bayes.calibration.selection`) and samples the model chosen.
 AUTO = "auto"
 #: The rungs ``model: auto`` screens, simplest first: (catalogue name, the rung's own
 #: options, the nested simpler rung whose MAP seeds this one's search), read from the

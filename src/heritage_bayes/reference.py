@@ -311,7 +311,7 @@ def check_config_snippet(snippet: str, base: str = "configs/demo.yaml") -> str:
     The snippet (YAML text) is merged key by key into the config ``base`` and the result
     goes through the same checks as ``hbayes calibrate`` before it reads any data: the
     schema (:func:`heritage_bayes.config.parse_config`) and the models with their
-    options and priors (:func:`heritage_bayes.calibrate.check_models`). The manual's
+    options and priors (:func:`heritage_bayes.calibration.calibrate.check_models`). The manual's
     how-to pages print their config examples through this function, so an example with
     a misspelt key or an option a model does not take fails the docs build.
 
@@ -332,7 +332,7 @@ def check_config_snippet(snippet: str, base: str = "configs/demo.yaml") -> str:
     heritage_bayes.ConfigError
         The merged config is not valid; the message names the key path.
     """
-    from heritage_bayes.calibrate import check_models
+    from heritage_bayes.calibration.calibrate import check_models
     from heritage_bayes.config import load_yaml_text, parse_config, read_yaml
 
     raw, _ = read_yaml(base)

@@ -9,7 +9,7 @@ on new inputs (the entry point for climate-change projections).
 
 Layer: above the models and the inference core, below every consumer (report,
 projection, comparison, portfolio) and the orchestrator that writes it
-(:mod:`heritage_bayes.calibrate`); it imports none of them.
+(:mod:`heritage_bayes.calibration.calibrate`); it imports none of them.
 """
 
 from __future__ import annotations
@@ -270,23 +270,24 @@ def stamp_provenance(cfg: CalibrationConfig, idata, summary: dict) -> None:
         idata[g].attrs["config_sha256"] = sha
 
 
-def _recorded_config(p: Path, summary: dict, idata) -> tuple[CalibrationConfig | None, list]:
+def _recorded_config(p: Path, rs: RunSummary, idata) -> tuple[CalibrationConfig | None, list]:
     """The config recorded in the provenance of run ``p`` (hash checked) and the notes
     on it: None for a run written before the provenance was recorded."""
-    prov = summary.get("provenance")
-    if not isinstance(prov, dict) or not isinstance(prov.get("config"), dict):
+    prov = rs.provenance
+    if not prov.recorded:
         return None, ["the run records no config snapshot (an older hbayes): the report "
                       "shows config.yaml as it is now"]  # fmt: skip
-    sha = _snapshot_sha256(prov["config"])
+    snapshot = prov.snapshot()
+    sha = _snapshot_sha256(snapshot)
     stamped = {idata[g].attrs.get("config_sha256") for g in idata.groups()} - {None}
-    if sha != prov.get("config_sha256") or stamped - {sha}:
+    if sha != prov.config_sha256 or stamped - {sha}:
         raise InputError(
             f"{p / 'summary.json'}: the config snapshot recorded in the provenance does not "
-            f"match its SHA-256 (recorded {prov.get('config_sha256')!s:.16}, posterior.nc "
+            f"match its SHA-256 (recorded {prov.config_sha256!s:.16}, posterior.nc "
             f"{', '.join(sorted(stamped)) or 'none'}, computed {sha:.16}): the run directory "
             "was edited; run `hbayes calibrate` again"
         )
-    cfg = parse_config(prov["config"], source=f"{p / 'summary.json'} (provenance)")
+    cfg = parse_config(snapshot, source=f"{p / 'summary.json'} (provenance)")
     notes = []
     seen = (p / "config.yaml").read_text(encoding="utf-8", errors="replace")
     if seen != config_yaml(cfg):
@@ -306,8 +307,8 @@ def load_run(path: str | Path) -> Run:
     InputError
         The folder or one of ``posterior.nc``, ``summary.json``, ``config.yaml`` is
         missing, truncated, of the wrong type or another file (see
-        :mod:`heritage_bayes.rundir.reader`), or the recorded config snapshot does not
-        match its SHA-256.
+        :mod:`heritage_bayes.rundir.reader`), the summary's schema is newer than this
+        hbayes reads, or the recorded config snapshot does not match its SHA-256.
     """
     from heritage_bayes.rundir.reader import (
         check_run_files,
@@ -318,12 +319,13 @@ def load_run(path: str | Path) -> Run:
 
     p = check_run_files(path)
     summary = read_summary(p)
+    rs = RunSummary.from_dict(summary, source=p / "summary.json")
     cfg = None
-    if not isinstance(summary.get("provenance"), dict):  # an older run: config.yaml
+    if not rs.provenance.recorded:  # an older run: config.yaml
         raw, _ = read_yaml(p / "config.yaml", what="run config")
         cfg = parse_config(raw, source=str(p / "config.yaml"))
     idata = read_posterior(p)
-    recorded, notes = _recorded_config(p, summary, idata)
+    recorded, notes = _recorded_config(p, rs, idata)
     cfg = recorded or cfg
     models = {s: build_model(cfg, s) for s in SECTIONS if getattr(cfg, s) is not None}
     for s, m in models.items():  # a posterior of other models (another run's file)
@@ -333,7 +335,7 @@ def load_run(path: str | Path) -> Run:
                 p / "posterior.nc",
                 f"no draws of {s}.{absent[0]} of the run's {m.name}: not this run's posterior",
             )
-    models = hold_as_recorded(models, summary)
+    models = hold_as_recorded(models, rs)
     return Run(path=p, config=cfg, idata=idata, summary=summary, models=models, notes=notes)
 
 

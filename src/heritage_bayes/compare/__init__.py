@@ -48,7 +48,7 @@ computed from daily block sums for the same reason (hourly terms are correlated)
 - the widest 90 % interval of a physical parameter, in decades.
 
 **Recommendation**: the one selection rule of ``model: auto``
-(:func:`heritage_bayes.selection_rule.decide`). The screen ranks the candidates by the
+(:func:`heritage_bayes.calibration.selection_rule.decide`). The screen ranks the candidates by the
 validation FIT of their MAP's simulation and chooses the simplest within 2 points of
 the best; the others within 2 points tie with it. The choice and its best tied rival
 are sampled (with no tie, the best other candidate, for the comparison), and their

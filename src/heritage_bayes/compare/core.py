@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from heritage_bayes._arviz import az
+from heritage_bayes.calibration.selection_rule import NEGLIGIBLE_ELPD, decide, rule_text
 from heritage_bayes.compare.identifiability import _identifiability
 from heritage_bayes.compare.scores import (
     _block_se,
@@ -23,7 +24,6 @@ from heritage_bayes.compare.scores import (
 from heritage_bayes.errors import InputError
 from heritage_bayes.format import quantity_name
 from heritage_bayes.rc.catalog import DomainView, model_ladder
-from heritage_bayes.selection_rule import NEGLIGIBLE_ELPD, decide, rule_text
 
 __all__ = ["DEFAULT_MODELS", "NEGLIGIBLE_ELPD", "compare_runs", "recommend"]
 
@@ -44,7 +44,7 @@ def compare_runs(
 ) -> dict:
     """Compare calibrated runs of one section on accuracy and identifiability, and
     recommend one by the selection rule of ``model: auto``
-    (:func:`heritage_bayes.selection_rule.decide`): the screen's choice, unless the ELPD
+    (:func:`heritage_bayes.calibration.selection_rule.decide`): the screen's choice, unless the ELPD
     reliably breaks its tie.
 
     Parameters
@@ -72,7 +72,8 @@ def compare_runs(
     dict
         ``models`` (per label: accuracy, identifiability, convergence), ``loo_compare``
         (``az.compare`` on the blocked LOO), ``selection`` (the rule's record:
-        :func:`heritage_bayes.selection_rule.decide`), ``recommendation`` and the settings.
+        :func:`heritage_bayes.calibration.selection_rule.decide`), ``recommendation``
+        and the settings.
     """
     from heritage_bayes.run import load_run
 
@@ -121,7 +122,7 @@ def compare_runs(
             "model": model.name,
             "run_dir": str(run.path),
             "noise": info.noise if info else None,
-            "periods": rs.raw.get("periods"),
+            "periods": {p.name: p.to_dict() for p in rs.periods} or None,
             # the report's rule: the stopping rule met and the saved draws within the
             # stated criteria
             "converged": rs.convergence.converged and rs.convergence.saved_draws_ok,
@@ -251,8 +252,8 @@ def _pair_se(a: tuple, b: tuple, block_hours: float, score: str) -> float | None
 
 def recommend(sel: dict, models: dict, score: str) -> dict:
     """The comparison's recommendation: the selection rule's decision
-    (:func:`heritage_bayes.selection_rule.decide`, ``sel``) in words, with the identifiability
-    of the model recommended and the candidates not converged."""
+    (:func:`heritage_bayes.calibration.selection_rule.decide`, ``sel``) in words, with
+    the identifiability of the model recommended and the candidates not converged."""
     rec, stage = sel["model"], sel["posterior"] or {}
     if sel["decided_by"] == "ELPD":
         head = f"the ELPD breaks the screen's tie; the screen chose {sel['choice']}"

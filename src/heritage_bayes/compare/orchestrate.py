@@ -9,11 +9,11 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from heritage_bayes._memory import release_memory
+from heritage_bayes.calibration.selection_rule import choose, rule_text
 from heritage_bayes.compare.core import DEFAULT_MODELS, compare_runs
 from heritage_bayes.compare.page import write_comparison
 from heritage_bayes.compare.screen import screen_candidates, to_sample
 from heritage_bayes.errors import ConfigError
-from heritage_bayes.selection_rule import choose, rule_text
 
 
 def _section_of(cfg, models: Sequence[str] | None) -> tuple[str, list[str]]:
@@ -91,7 +91,7 @@ def _calibrate_candidate(cand, run_dir: str, kwargs: dict) -> tuple[str, float, 
     """One candidate's calibration: (run directory, wall [s], CPU [s] of the process)."""
     import time
 
-    from heritage_bayes.calibrate import run_calibration
+    from heritage_bayes.calibration.calibrate import run_calibration
 
     t0, c0 = time.perf_counter(), time.process_time()
     out = run_calibration(cand, run_dir, **kwargs)
@@ -154,7 +154,7 @@ def _sample_parallel(
     """Calibrate the candidates (``models``: name -> the model of each, which sizes it)
     in ``n_workers`` worker processes (largest first, a new
     one started as soon as one ends; ``kwargs_of``: name -> keywords of
-    :func:`~heritage_bayes.calibrate.run_calibration`), with a progress line per start
+    :func:`~heritage_bayes.calibration.calibrate.run_calibration`), with a progress line per start
     and end and every :data:`HEARTBEAT` seconds; return name -> run directory. Interrupted (Ctrl-C,
     SIGTERM) or a candidate failing: every worker stopped at once, none started."""
     import multiprocessing
@@ -244,12 +244,12 @@ def run_compare(
 
     First every candidate's MAP and its validation FIT
     (:mod:`heritage_bayes.compare.screen`: seconds each) and the choice of ``model:
-    auto``'s rule (:func:`heritage_bayes.selection_rule.choose`); then the choice and its best
-    tied rival (without a tie, the best other candidate:
+    auto``'s rule (:func:`heritage_bayes.calibration.selection_rule.choose`); then the
+    choice and its best tied rival (without a tie, the best other candidate:
     :func:`~heritage_bayes.compare.screen.to_sample`) are calibrated, each chain started
     at its screened MAP, compared by their posteriors (blocked LOO, validation ELPD),
     and one is recommended by the same rule, the ELPD breaking the screen's tie where it
-    is reliable (:func:`heritage_bayes.selection_rule.decide`; ``comparison.json``:
+    is reliable (:func:`heritage_bayes.calibration.selection_rule.decide`; ``comparison.json``:
     ``selection``). The others are in ``comparison.json`` (``screened_out``,
     ``screen``) and the page with their MAP score and the reason. Ctrl-C or SIGTERM
     stops every worker at once (exit 130): no run written, the chains so far kept in
@@ -269,7 +269,7 @@ def run_compare(
         ``<out_dir>/<model>/``; the comparison is ``comparison.json`` and
         ``comparison.html``.
     seed, quiet, report, resume, force
-        As for :func:`heritage_bayes.calibrate.run_calibration` (applied to every
+        As for :func:`heritage_bayes.calibration.calibrate.run_calibration` (applied to every
         candidate; with ``force`` a candidate's run and the comparison are written
         beside the files of folders hbayes did not make, replacing none of them: see
         :class:`~heritage_bayes.rundir.folder.OutputFolder`).
@@ -292,7 +292,7 @@ def run_compare(
     import os
     import sys
 
-    from heritage_bayes.calibrate import run_calibration
+    from heritage_bayes.calibration.calibrate import run_calibration
     from heritage_bayes.errors import InputError
     from heritage_bayes.rundir import check_name
     from heritage_bayes.rundir.folder import OutputFolder

@@ -3,12 +3,13 @@
 Part of :mod:`heritage_bayes.compare` (see its documentation). Each candidate's MAP is
 found on exactly the log-posterior its calibration samples (its own config, the same
 prepared data), so the MAP found here starts its chain; the search is ``model: auto``'s
-(:func:`heritage_bayes.selection.screen_maps`, one loop for both): the MAP of a nested
+(:func:`heritage_bayes.calibration.selection.screen_maps`, one loop for both): the MAP of a nested
 simpler candidate (:data:`heritage_bayes.models.AUTO_LADDERS`) carried over as one start
 of one global search, with the same restart guard. The score is the validation FIT of
-the simulation from the MAP (:func:`heritage_bayes.selection_rule.row_score`), the choice
-that of ``model: auto`` (:func:`heritage_bayes.selection_rule.choose`), and the candidates
-sampled those whose posteriors can change it (:func:`to_sample`).
+the simulation from the MAP
+(:func:`heritage_bayes.calibration.selection_rule.row_score`), the choice that of
+``model: auto`` (:func:`heritage_bayes.calibration.selection_rule.choose`), and the
+candidates sampled those whose posteriors can change it (:func:`to_sample`).
 """
 
 from __future__ import annotations
@@ -23,10 +24,10 @@ __all__ = ["screen_candidates", "to_sample"]
 
 def to_sample(sel: Mapping) -> dict[str, str | None]:
     """Candidate -> None when it is sampled, else why not, from the screen's choice
-    (:func:`heritage_bayes.selection_rule.choose`, ``sel``): the choice and its best tied
-    rival (the runner-up: the only one whose ELPD may overturn the choice,
-    :func:`heritage_bayes.selection_rule.decide`); without a tie, the choice and the best
-    other candidate scored (a comparison needs two posteriors). Candidates not scored:
+    (:func:`heritage_bayes.calibration.selection_rule.choose`, ``sel``): the choice and
+    its best tied rival (the runner-up: the only one whose ELPD may overturn the choice,
+    :func:`heritage_bayes.calibration.selection_rule.decide`); without a tie, the choice
+    and the best other candidate scored (a comparison needs two posteriors). Candidates not scored:
     screened out."""
     c, fit, tied = sel["choice"], sel["scores"], sel["tied"]
     second = sel["runner_up"] or max((m for m in fit if m != c), key=fit.__getitem__, default=None)
@@ -54,12 +55,12 @@ def screen_candidates(
 ) -> tuple[dict, dict, dict]:
     """MAP and ladder row of every candidate config (``models``: label -> its model, as
     built with the config), by the loop of ``model: auto``'s screen
-    (:func:`heritage_bayes.selection.screen_maps`): (label -> row, label -> MAP result,
-    label -> score [%]). A candidate whose MAP cannot be found scores NaN (its row says
-    why)."""
-    from heritage_bayes.ladder import section_log_posterior
+    (:func:`heritage_bayes.calibration.selection.screen_maps`): (label -> row, label -> MAP
+    result, label -> score [%]). A candidate whose MAP cannot be found scores NaN (its row
+    says why)."""
+    from heritage_bayes.calibration.ladder import section_log_posterior
+    from heritage_bayes.calibration.selection import screen_maps
     from heritage_bayes.prepare import prepare
-    from heritage_bayes.selection import screen_maps
 
     parents = {n: p for n, _, p in AUTO_LADDERS.get(section, ())}
     preps: dict = {}

@@ -1,6 +1,6 @@
 """The predictive side of a calibration: initial states, noise, physical limits, bands.
 
-What :mod:`heritage_bayes.inference.idata` adds to each posterior draw before the bands
+What :mod:`heritage_bayes.calibration.outputs` adds to each posterior draw before the bands
 are drawn: how the initial state was obtained (in words), the noise model of the bands
 (the free-run error when the likelihood's noise model sits at its cap, and always for
 ``kalman``) and the limit of predicted vapour pressure at saturation; then what of the

@@ -7,7 +7,7 @@ a projection config); every room is one task on a Dask cluster: an embedded
 (``--scheduler tcp://host:8786``) where the user has a cluster of several machines.
 
 Layer: above the run directory (:mod:`heritage_bayes.run`) and the orchestrator
-(:mod:`heritage_bayes.calibrate`); nothing imports this module.
+(:mod:`heritage_bayes.calibration.calibrate`); nothing imports this module.
 
 Portfolio file (YAML)::
 
@@ -26,7 +26,7 @@ Portfolio file (YAML)::
 Every config is validated before any work starts; a bad entry is reported by name with
 its message (all bad entries at once). A room that fails while it runs (its data, say)
 is reported with its message in the table and does not stop the others. Inside a task
-the sampler stays single-threaded (BLAS too, see :func:`heritage_bayes.calibrate.
+the sampler stays single-threaded (BLAS too, see :func:`heritage_bayes.calibration.calibrate.
 run_calibration`): the parallelism is across rooms, one Dask worker process per core
 with one thread each.
 

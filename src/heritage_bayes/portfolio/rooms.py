@@ -46,7 +46,7 @@ def _room_task(spec: RoomSpec, out_dir: str, resume: bool) -> dict:
             row["status"] = "skipped"
             row["message"] = "done in an earlier run (--resume)"
         else:
-            from heritage_bayes.calibrate import run_calibration
+            from heritage_bayes.calibration.calibrate import run_calibration
             from heritage_bayes.run import saved_chains
 
             has_chain = bool(saved_chains(run_dir))

@@ -73,7 +73,7 @@ def load_portfolio(path: str | Path) -> Portfolio:
         invalid overrides, missing or invalid projection file), each with its room name
         and key path.
     """
-    from heritage_bayes.calibrate import check_models
+    from heritage_bayes.calibration.calibrate import check_models
     from heritage_bayes.config import parse_config
     from heritage_bayes.projection.config import load_projection_config
 

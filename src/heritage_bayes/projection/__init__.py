@@ -43,7 +43,7 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from heritage_bayes.convergence import EXIT_UNCONVERGED
+from heritage_bayes.calibration.convergence import EXIT_UNCONVERGED
 from heritage_bayes.projection.config import (
     ProjectionConfig,
     load_projection_config,
@@ -72,7 +72,8 @@ ASSUMPTIONS = (
 
 #: Exit status of ``hbayes project`` on a run whose sampler did not converge: the code of
 #: ``hbayes calibrate`` for an unconverged run (one definition, in
-#: :mod:`heritage_bayes.convergence`); the projection is written, with a banner on its page.
+#: :mod:`heritage_bayes.calibration.convergence`); the projection is written, with a
+#: banner on its page.
 EXIT_UNCONVERGED_RUN = EXIT_UNCONVERGED
 UNCONVERGED_TEXT = (
     "the calibration did not converge: the posterior draws may not represent the room, "

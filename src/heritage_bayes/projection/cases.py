@@ -15,7 +15,19 @@ import pandas as pd
 
 from heritage_bayes.rc.control_kernels import N_COST
 
-__all__ = ["Case", "CaseOut", "CaseResult", "Draws"]
+__all__ = ["Case", "CaseOut", "CaseResult", "Draws", "init_window"]
+
+#: [steps] the initial-state window (``periods.init_window``) of a run that did not
+#: record its own
+DEFAULT_INIT_STEPS = 720
+
+
+def init_window(run) -> int:
+    """[steps] the initial-state window the run was calibrated with
+    (:attr:`~heritage_bayes.rundir.summary.RunSummary.init_steps`;
+    :data:`DEFAULT_INIT_STEPS` where the run did not record it)."""
+    steps = run.run_summary.init_steps
+    return DEFAULT_INIT_STEPS if steps is None else int(steps)
 
 
 @dataclass

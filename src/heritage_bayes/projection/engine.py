@@ -45,7 +45,7 @@ from heritage_bayes.projection._modal import (
     case_inputs,
     coupled_pair,
 )
-from heritage_bayes.projection.cases import Case, CaseOut, CaseResult, Draws
+from heritage_bayes.projection.cases import Case, CaseOut, CaseResult, Draws, init_window
 from heritage_bayes.rc.control_kernels import N_CP
 
 
@@ -76,17 +76,18 @@ def select_draws(run, n: int | None, seed: int) -> Draws:
         model[section] = P
         nm = get_noise_model(getattr(run.config, section).noise)
         # the bands' error model where it replaced the posterior's (kalman: for every output)
-        pred = ((run.summary.get("models") or {}).get(section) or {}).get("predictive_noise")
+        info = run.run_summary.models.get(section)
+        pred = {} if info is None else info.predictive_noise
         if getattr(nm, "statespace", False) and pred and set(pred) >= set(m.output_names):
             nm = get_noise_model("ar1_white")  # its columns: all set from the fit below
         names = [f"{section}.{n}" for n, _, _ in nm.parameter_specs(m.output_names, m.state_names)]
         cols = [post[n].values.reshape(-1)[idx] if n in post else np.zeros(idx.size) for n in names]
         noise[section] = np.column_stack(cols) if cols else np.zeros((len(idx), 0))
-        for out, fit in (pred or {}).items():
+        for out, fit in pred.items():
             for kind in ("sigma", "phi", "sigma_meas"):
                 name = f"{section}.{kind}_{out}"
                 if name in names:
-                    noise[section][:, names.index(name)] = fit[kind]
+                    noise[section][:, names.index(name)] = getattr(fit, kind)
         nms[section] = nm
     return Draws(index=idx, model=model, noise=noise, noise_models=nms)
 
@@ -266,12 +267,12 @@ def _simulate(
             f"run {run.path}: a projection of risk needs both the thermal and the hygric "
             f"model (indoor T and RH); the run has {sorted(run.models)}"
         )
-    dt = float(run.summary.get("dt", 3600.0))
+    dt = run.run_summary.dt
     if dt != 3600.0:
         raise ConfigError(
             f"run {run.path}: data.step is {dt:g} s; the risk indicators need an hourly grid"
         )
-    w = int(init_steps or run.summary.get("init_steps", 720))
+    w = int(init_steps or init_window(run))
     params = []  # each variant's parameter draws (a measure's change applied)
     for v in variants:
         if v is not None:

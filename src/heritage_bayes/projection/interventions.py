@@ -364,7 +364,9 @@ class Measure:
                                                u0["thermal"], dt, spin, index)  # fmt: skip
             costs.update(_heating_costs(Q, dt, years))
         if sim:
-            w = int(run.summary.get("init_steps", 720))
+            from heritage_bayes.projection.cases import init_window
+
+            w = init_window(run)
             Y["hygric"] = hygric_on(run, model["hygric"], U["hygric"], Y["thermal"], dt, w)
         if self.dehumidifier is not None:
             rh, cap, e_kg = self.dehumidifier

@@ -239,18 +239,18 @@ def _better_rung(summary: RunSummary, failure: dict) -> str | None:
     """A ladder rung whose FIT of the failing output beats the sampled model's by
     :data:`LADDER_MARGIN` points on the judged period, in words (or None)."""
     sec, o, p = failure["section"], failure["output"], failure["period"]
-    rows = (summary.raw.get("ladder") or {}).get(sec) or []  # the ladder is not typed
     met = None if p is None else summary.metric(sec, o, p)
     own = None if met is None else met.FIT
     if own is None or p is None:
         return None
     best, best_fit = None, float(own) + LADDER_MARGIN
-    for r in rows:
-        m = (((r.get("fit") or {}).get(p) or {}).get(o) or {}).get("FIT")
-        if r.get("sampled") or m is None or not math.isfinite(float(m)):
+    for r in summary.ladder.get(sec, ()):
+        fit = r.fits(p).get(o)
+        m = None if fit is None else fit.FIT
+        if r.sampled or m is None:
             continue
-        if float(m) >= best_fit:
-            best, best_fit = r.get("model"), float(m)
+        if m >= best_fit:
+            best, best_fit = r.model, m
     if best is None:
         return None
     text = (

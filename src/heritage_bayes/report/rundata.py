@@ -37,7 +37,7 @@ REQUIRED_FILES = ("posterior.nc", "summary.json", "config.yaml")
 class RunData:
     path: Path
     run: object  # heritage_bayes.run.Run
-    #: ``summary.json``, typed (its untyped parts: ``summary.raw``)
+    #: ``summary.json``, typed
     summary: RunSummary
     config_text: str
     #: values computed once and shared by several sections (e.g. identifiable coordinates)
@@ -60,14 +60,15 @@ def load_run_data(run_dir) -> RunData:
 
     p = check_run_files(run_dir, REQUIRED_FILES)
     run = load_run(p)
-    recorded = isinstance(run.run_summary.raw.get("provenance"), dict)
+    summary = run.run_summary
+    recorded = summary.provenance.recorded
     # the config that produced the posterior (hash checked by load_run), not an edit
     text = (
         config_yaml(run.config)
         if recorded
         else (p / "config.yaml").read_text("utf-8", errors="replace")
     )
-    return RunData(path=p, run=run, summary=run.run_summary, config_text=text)
+    return RunData(path=p, run=run, summary=summary, config_text=text)
 
 
 def time_axis(ds) -> np.ndarray:

@@ -16,15 +16,18 @@ no consumer pokes at nested dicts:
   (:class:`Identifiability`, :class:`FrozenNode`);
 - :class:`Period` — the calibration and validation periods;
 - :class:`Verdict` — the report's verdict (level, status, headline, reasons), written
-  with the report: the portfolio reads the verdict the report shows.
+  with the report: the portfolio reads the verdict the report shows;
+- :class:`LadderRow`, :class:`Selection`, :class:`Provenance` — the model-order ladder,
+  the screen of ``model: auto`` and the config snapshot that produced the posterior.
 
 Versions: a summary without ``schema_version`` is version 1 (every hbayes before the
 typed summary); its keys are read as they were written, missing ones as absent
 (None). A summary of a newer schema than this hbayes knows is refused with a message
 naming the file. The whole JSON object stays available as :attr:`RunSummary.raw`
-for the parts not typed here (provenance, ladder, selection, correlation matrices);
+(what :meth:`RunSummary.to_dict` writes back);
 :mod:`heritage_bayes.rundir.summary_parts` holds the models', periods', alignment's and
-verdict's types.
+verdict's types, :mod:`heritage_bayes.rundir.summary_ladder` the ladder's, the
+selection's and the provenance's.
 """
 
 from __future__ import annotations
@@ -36,6 +39,15 @@ from typing import Any
 
 from heritage_bayes.format import fmt_int, quantity_label
 from heritage_bayes.rundir.reader import SCHEMA_VERSION, damaged, read_summary
+from heritage_bayes.rundir.summary_ladder import (
+    LadderRow,
+    MapGuard,
+    Provenance,
+    RungFit,
+    Selection,
+    ladder_of,
+    selection_of,
+)
 from heritage_bayes.rundir.summary_parts import (
     STATUSES,
     Alignment,
@@ -62,12 +74,17 @@ __all__ = [
     "FrozenNode",
     "Gap",
     "Identifiability",
+    "LadderRow",
+    "MapGuard",
     "ModelInfo",
     "NullDirection",
     "Period",
     "PredictiveNoise",
+    "Provenance",
     "RunSummary",
+    "RungFit",
     "Saturation",
+    "Selection",
     "SourceNote",
     "Verdict",
     "load_summary",
@@ -266,6 +283,12 @@ class RunSummary:
     #: the report's verdict (None: no report written since the run, or an older run)
     verdict: Verdict | None
     alignment: Alignment
+    #: section -> the model-order ladder's rows (:class:`LadderRow`; empty: no ladder)
+    ladder: MappingProxyType
+    #: section -> the screen of ``model: auto`` (:class:`Selection`; empty: none)
+    selection: MappingProxyType
+    #: the config snapshot that produced the posterior (not recorded: an older run)
+    provenance: Provenance
     raw: MappingProxyType = field(repr=False)
 
     # ------------------------------------------------------------------ reading
@@ -296,11 +319,8 @@ class RunSummary:
     def seeds(self) -> dict[str, int]:
         """The seeds that make the run reproducible (calibration; synthetic data)."""
         out = {"calibration": self.seed} if self.seed is not None else {}
-        demo = (((self.raw.get("provenance") or {}).get("config") or {}).get("data") or {}).get(
-            "demo"
-        )
-        if isinstance(demo, dict) and isinstance(demo.get("seed"), int):
-            out["synthetic data"] = demo["seed"]
+        if self.provenance.demo_seed is not None:
+            out["synthetic data"] = self.provenance.demo_seed
         return out
 
     def to_dict(self) -> dict[str, Any]:
@@ -420,6 +440,9 @@ class RunSummary:
             ),
             verdict=Verdict.from_dict(d.get("verdict")),
             alignment=Alignment.from_dict(d.get("alignment")),
+            ladder=ladder_of(d.get("ladder")),
+            selection=selection_of(d.get("selection")),
+            provenance=Provenance.from_dict(d.get("provenance")),
             raw=MappingProxyType(d),
         )
 

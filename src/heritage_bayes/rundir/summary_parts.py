@@ -274,6 +274,10 @@ class Period:
     end: str | None
     steps: int = 0
 
+    def to_dict(self) -> dict[str, Any]:
+        """The period as ``summary.json``'s ``periods`` holds it."""
+        return {"start": self.start, "end": self.end, "steps": self.steps}
+
 
 #: A room's status as its verdict gives it, most urgent first.
 STATUSES = ("not converged", "checks failed", "converged")

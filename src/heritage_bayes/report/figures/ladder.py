@@ -12,10 +12,12 @@ from heritage_bayes.report.figures.style import (
     _figure,
     tex_safe,
 )
+from heritage_bayes.rundir.summary import LadderRow
 
 
-def fig_ladder(ladder: Mapping[str, Sequence[Mapping]]):
-    """Accuracy vs identifiability of the model ladder (MAP fits).
+def fig_ladder(ladder: Mapping[str, Sequence[LadderRow]]):
+    """Accuracy vs identifiability of the model ladder (MAP fits): ``ladder`` is
+    section -> its rows (:attr:`heritage_bayes.rundir.summary.RunSummary.ladder`).
 
     Left: validation (filled) and calibration (open) FIT against the number of model
     parameters; right: validation FIT against the condition number of the identifiable
@@ -27,12 +29,12 @@ def fig_ladder(ladder: Mapping[str, Sequence[Mapping]]):
     for (domain, rows), c in zip(ladder.items(), colours, strict=False):
         xs, fc, fv, cond, lab, nn = [], [], [], [], [], []
         for r in rows:
-            xs.append(_num(r.get("n_model_params", r.get("n_params"))))
-            fc.append(_first_fit(r.get("fit"), "calibration"))
-            fv.append(_first_fit(r.get("fit"), "validation"))
-            cond.append(_num(r.get("condition_number_identifiable")))
-            lab.append(tex_safe(str(r.get("model", "?"))) + (" *" if r.get("sampled") else ""))
-            nn.append(r.get("n_null"))
+            xs.append(_num(r.n_params if r.n_model_params is None else r.n_model_params))
+            fc.append(_first_fit(r, "calibration"))
+            fv.append(_first_fit(r, "validation"))
+            cond.append(_num(r.condition_number_identifiable))
+            lab.append(tex_safe(r.model) + (" *" if r.sampled else ""))
+            nn.append(r.n_null)
         xs = np.asarray(xs, dtype=float)
         a0.plot(xs, fv, "o-", color=c, label=f"{tex_safe(domain)}: validation")
         a0.plot(xs, fc, "o--", mfc="white", color=c, label=f"{tex_safe(domain)}: calibration")
@@ -58,12 +60,10 @@ def fig_ladder(ladder: Mapping[str, Sequence[Mapping]]):
     return fig
 
 
-def _first_fit(fit, period: str) -> float:
-    """FIT [%] of a ladder row's period (the first output when keyed by output)."""
-    per = (fit or {}).get(period) or {}
-    if "FIT" not in per:
-        per = next((v for v in per.values() if isinstance(v, Mapping)), {})
-    return _num(per.get("FIT"))
+def _first_fit(row: LadderRow, period: str) -> float:
+    """FIT [%] of a ladder row's period (its first output's)."""
+    first = next(iter(row.fits(period).values()), None)
+    return _num(None if first is None else first.FIT)
 
 
 def _num(v) -> float:

@@ -270,83 +270,69 @@ def _div(v, d):
     return None if v is None else float(v) / d
 
 
-def ladder_metrics(fit: dict | None, period: str) -> dict[str, dict]:
-    """Fit metrics of a ladder row for one period: output -> {MSE, MAE, FIT}.
-
-    Accepts ``fit[period]`` keyed by output (``{"Ti": {"FIT": ...}}``) or flat
-    (``{"FIT": ...}``, returned under the key ``""``).
-    """
-    per = (fit or {}).get(period) or {}
-    if any(k in per for k in ("FIT", "MSE", "MAE")):
-        return {"": per}
-    return {str(k): v for k, v in per.items() if isinstance(v, dict)}
-
-
-def _ladder_cell(metrics: dict[str, dict], key: str) -> str:
+def _ladder_cell(metrics, key: str) -> str:
+    """One cell of the ladder's table: ``key`` (FIT, MSE, MAE) of each output
+    (``metrics``: output -> :class:`~heritage_bayes.rundir.summary.RungFit`)."""
     txt = _fit_txt if key == "FIT" else fmt
     if len(metrics) <= 1:
-        return txt(next(iter(metrics.values()), {}).get(key))
-    return "; ".join(f"{o}: {txt(v.get(key))}" for o, v in metrics.items())
+        first = next(iter(metrics.values()), None)
+        return txt(None if first is None else getattr(first, key))
+    return "; ".join(f"{o}: {txt(getattr(v, key))}" for o, v in metrics.items())
 
 
 def ladder_context(s: RunSummary) -> dict | None:
-    """The model-order ladder's tables and figure (None without a ladder); the ladder
-    and the screen's choice are read as ``summary.json`` holds them (not typed)."""
+    """The model-order ladder's tables and figure (None without a ladder), with the
+    screen's choice where ``model: auto`` chose the model."""
     from heritage_bayes.report.figures import fig_ladder
 
-    ladder = s.raw.get("ladder")
-    if not ladder:
+    if not s.ladder:
         return None
     tables = []
-    for domain, rows in ladder.items():
+    for domain, rows in s.ladder.items():
         out = []
-        for r in rows or []:
-            cal = ladder_metrics(r.get("fit"), "calibration")
-            val = ladder_metrics(r.get("fit"), "validation")
-            n_model = r.get("n_model_params")
-            n_all = r.get("n_params")
+        for r in rows:
+            cal, val = r.fits("calibration"), r.fits("validation")
+            n_model, n_all = r.n_model_params, r.n_params
             if n_model is not None and n_all is not None and n_all != n_model:
                 n_text = f"{fmt_int(n_model)} + {fmt_int(n_all - n_model)} noise"
             else:
                 n_text = fmt_int(n_all)
-            labels = ", ".join(map(str, r.get("null_directions") or []))
+            labels = ", ".join(r.null_directions)
             out.append(
                 {
-                    "model": r.get("model", "?") + (f" ({r['error']})" if r.get("error") else ""),
+                    "model": r.model + (f" ({r.error})" if r.error else ""),
                     "n_params": n_text,
-                    "rank": fmt_int(r.get("rank")),
-                    "n_null": fmt_int(r.get("n_null")) + (f" ({labels})" if labels else ""),
-                    "cond": fmt(r.get("condition_number_identifiable")),
+                    "rank": fmt_int(r.rank),
+                    "n_null": fmt_int(r.n_null) + (f" ({labels})" if labels else ""),
+                    "cond": fmt(r.condition_number_identifiable),
                     "fit_cal": _ladder_cell(cal, "FIT"),
                     "fit_val": _ladder_cell(val, "FIT"),
                     "mse_cal": _ladder_cell(cal, "MSE"),
                     "mse_val": _ladder_cell(val, "MSE"),
                     "mae_cal": _ladder_cell(cal, "MAE"),
                     "mae_val": _ladder_cell(val, "MAE"),
-                    "loglik": fmt(r.get("log_likelihood")),
-                    "aic": fmt(r.get("aic")),
-                    "bic": fmt(r.get("bic")),
-                    "agreed": r.get("map_agreed", "—"),
-                    "sampled": bool(r.get("sampled")),
+                    "loglik": fmt(r.log_likelihood),
+                    "aic": fmt(r.aic),
+                    "bic": fmt(r.bic),
+                    "agreed": "—" if r.map_agreed is None else r.map_agreed,
+                    "sampled": r.sampled,
                 }
             )
         tables.append({"domain": domain, "rows": out, "selection": _selection_text(s, domain)})
-    return {"tables": tables, "figure": fig_ladder(ladder)}
+    return {"tables": tables, "figure": fig_ladder(s.ladder)}
 
 
 def _selection_text(s: RunSummary, domain: str) -> str | None:
     """``model: auto``: the model the screen chose, why, and the rule (None otherwise)."""
-    sel = (s.raw.get("selection") or {}).get(domain)
-    if not sel:
+    sel = s.selection.get(domain)
+    if sel is None:
         return None
-    text = (
-        f"model: auto — {sel['choice']} chosen by the screen: {sel['reason']}. Rule: {sel['rule']}."
-    )
-    if sel.get("tie"):
-        text += f" {sel['tie'][0].upper()}{sel['tie'][1:]}."
-    for r in sel.get("rows") or []:  # the restart guard, where it ran
-        if (r.get("map_guard") or {}).get("said"):
-            text += f" {r['model']}: {r['map_guard']['said']}."
+    text = f"model: auto — {sel.choice} chosen by the screen: {sel.reason}. Rule: {sel.rule}."
+    if sel.tie:
+        text += f" {sel.tie[0].upper()}{sel.tie[1:]}."
+    for r in sel.rows:  # the restart guard, where it ran
+        if r.map_guard is not None and r.map_guard.said:
+            text += f" {r.model}: {r.map_guard.said}."
     return text
 
 

@@ -4,7 +4,7 @@ the ELPD on its tie.
 Pure functions of the screen's rows (each rung's MAP validation FIT and size) and, in
 ``hbayes compare``, of the sampled candidates' ELPD: :func:`choose` is the screen's
 choice, :func:`decide` the whole rule. The screen itself (the MAP searches) is
-:mod:`heritage_bayes.selection`, which documents the rule and why FIT on validation.
+:mod:`heritage_bayes.calibration.selection`, which documents the rule and why FIT on validation.
 
 References
 ----------

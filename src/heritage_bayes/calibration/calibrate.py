@@ -22,11 +22,17 @@ import numpy as np
 from heritage_bayes._memory import release_memory
 from heritage_bayes._progress import Progress as _Progress
 from heritage_bayes._version import __version__
+from heritage_bayes.calibration.convergence import unconverged_reasons
+from heritage_bayes.calibration.findings import LADDERS, say_findings
+from heritage_bayes.calibration.ladder import (  # structural_at_map: re-exported
+    ladder_row,
+    rung_log_posterior,
+    section_log_posterior,
+    structural_at_map,
+)
 from heritage_bayes.config import MAX_SEED, CalibrationConfig, chain_tag, config_hash
-from heritage_bayes.convergence import unconverged_reasons
 from heritage_bayes.convert import format_timedelta
 from heritage_bayes.errors import InputError
-from heritage_bayes.findings import LADDERS, say_findings
 from heritage_bayes.inference.posterior import LogPosterior
 from heritage_bayes.inference.results import (
     atomic_write,
@@ -34,12 +40,6 @@ from heritage_bayes.inference.results import (
     dump_json,
     ensure_free_space,
     write_inference_data,
-)
-from heritage_bayes.ladder import (  # structural_at_map: re-exported
-    ladder_row,
-    rung_log_posterior,
-    section_log_posterior,
-    structural_at_map,
 )
 from heritage_bayes.models import (
     AUTO,
@@ -185,7 +185,7 @@ def run_calibration(
     Notes
     -----
     A section with ``model: auto`` is chosen first by the screen of its model ladder
-    (:mod:`heritage_bayes.selection`), inside the time budget; the run records the
+    (:mod:`heritage_bayes.calibration.selection`), inside the time budget; the run records the
     screen (``summary.json``: ``selection``; its rows are the section's ladder) and its
     ``config.yaml`` names the model chosen.
 
@@ -270,7 +270,7 @@ def _calibrate_into(
     say = _Progress(quiet)
     start_maps = start_maps or {}
     # the heavy imports (arviz, scipy.optimize, emcee) only once the config is valid
-    from heritage_bayes.inference.idata import build_run_outputs
+    from heritage_bayes.calibration.outputs import build_run_outputs
     from heritage_bayes.prepare import prepare
 
     say.say(f"hbayes {__version__}: calibrating {cfg.name!r} -> {final}")
@@ -290,7 +290,7 @@ def _calibrate_into(
     )
     _say_segments(say, prep)
     end = None if cfg.sampler.max_seconds is None else t_start + cfg.sampler.max_seconds
-    # model: auto: the ladder's MAP screen chooses the model sampled (heritage_bayes.selection)
+    # model: auto: the ladder's MAP screen chooses the model sampled (calibration.selection)
     cfg, screens = _select_models(cfg, prep, say, end, rungs)
     models = {**models, **{k: v.models[v.choice["choice"]] for k, v in screens.items()}}
     maps = dict(start_maps or {})
@@ -392,8 +392,8 @@ def _sample_section(
     sampler's chain (checkpointed in ``out``), all stored on ``s`` with their timings.
     Section ``i`` of ``n_sections`` gets an equal share of the time left before ``end``
     and the seed ``cfg.seed + 101 i``."""
+    from heritage_bayes.calibration.outputs import CONVERGENCE
     from heritage_bayes.inference.coordinates import sampling_coordinates
-    from heritage_bayes.inference.idata import CONVERGENCE
     from heritage_bayes.inference.moves import unidentified_block
     from heritage_bayes.inference.optimize import seconds_left, share_deadline
     from heritage_bayes.inference.sampler import run_sampler
@@ -513,11 +513,11 @@ def _select_models(
 ) -> tuple[CalibrationConfig, dict]:
     """Every ``model: auto`` section screened (its built ``rungs``,
     :func:`heritage_bayes.models.auto_rungs`) and replaced by its choice: (the config
-    with the models chosen, section -> :class:`~heritage_bayes.selection.Screen`).
+    with the models chosen, section -> :class:`~heritage_bayes.calibration.selection.Screen`).
     Each screen may use a share of the time budget (``end``) of its own and of the
     sections still to sample."""
+    from heritage_bayes.calibration.selection import chosen_section, screen
     from heritage_bayes.inference.optimize import share_deadline
-    from heritage_bayes.selection import chosen_section, screen
 
     auto = [n for n in SECTIONS if getattr(cfg, n) is not None and getattr(cfg, n).model == AUTO]
     n_sections = sum(getattr(cfg, n) is not None for n in SECTIONS)

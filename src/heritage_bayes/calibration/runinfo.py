@@ -3,7 +3,7 @@ share of frozen draws.
 
 The true parameters and derived quantities of generated data (the demo), shown beside
 the posterior; the calibration and validation periods; the versions of the libraries
-that produced the run. Split from :mod:`heritage_bayes.inference.idata`, which calls them.
+that produced the run. Split from :mod:`heritage_bayes.calibration.outputs`, which calls them.
 """
 
 from __future__ import annotations

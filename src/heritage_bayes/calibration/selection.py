@@ -8,7 +8,7 @@ simulation from the MAP scored on the validation period by the paper's FIT [%]
 (Kramer, van Schijndel & Schellen 2013). A MAP costs seconds where a posterior costs
 minutes: only the model chosen is sampled.
 
-**The choice rule** (:mod:`heritage_bayes.selection_rule`: :func:`choose`,
+**The choice rule** (:mod:`heritage_bayes.calibration.selection_rule`: :func:`choose`,
 :func:`decide`): the score is the validation FIT of the section's
 output (without a validation period, the calibration FIT after the warm-up). Among the
 rungs scored, the simplest (fewest free parameters, then ladder order) whose score is
@@ -43,14 +43,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from heritage_bayes.config.options import ModelOptions
-from heritage_bayes.errors import ConfigError, InputError
-from heritage_bayes.inference.likelihoods import get_noise_model
-from heritage_bayes.inference.parameters import owned_priors
-from heritage_bayes.ladder import ladder_row, rung_log_posterior
-from heritage_bayes.models import AUTO, AUTO_LADDERS, rung_label
-from heritage_bayes.rc.model import RCModel
-from heritage_bayes.selection_rule import (
+from heritage_bayes.calibration.ladder import ladder_row, rung_log_posterior
+from heritage_bayes.calibration.selection_rule import (
     MARGIN_FIT,
     NEGLIGIBLE_ELPD,
     PARETO_K_MAX,
@@ -59,6 +53,12 @@ from heritage_bayes.selection_rule import (
     row_score,
     rule_text,
 )
+from heritage_bayes.config.options import ModelOptions
+from heritage_bayes.errors import ConfigError, InputError
+from heritage_bayes.inference.likelihoods import get_noise_model
+from heritage_bayes.inference.parameters import owned_priors
+from heritage_bayes.models import AUTO, AUTO_LADDERS, rung_label
+from heritage_bayes.rc.model import RCModel
 
 __all__ = [
     "MARGIN_FIT",
@@ -207,7 +207,7 @@ def screen_maps(
     Returns
     -------
     rows : list of dict
-        Per rung, in order: its ladder row (:func:`heritage_bayes.ladder.ladder_row`,
+        Per rung, in order: its ladder row (:func:`heritage_bayes.calibration.ladder.ladder_row`,
         with ``parent``, ``seeded_from``, ``map_seconds`` and ``score``, the FIT
         compared, :func:`row_score`), or ``model`` and ``error`` (why not screened: a
         configuration or data error of the rung, or the time budget).

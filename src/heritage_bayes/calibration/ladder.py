@@ -2,8 +2,8 @@
 MAP row (fit criteria over the calibration and validation periods, information criteria,
 structural identifiability at the MAP).
 
-Used by the calibration run's ladder (:func:`heritage_bayes.calibrate.model_ladder`),
-the automatic selection (:mod:`heritage_bayes.selection`) and ``hbayes compare``'s
+Used by the calibration run's ladder (:func:`heritage_bayes.calibration.calibrate.model_ladder`),
+the automatic selection (:mod:`heritage_bayes.calibration.selection`) and ``hbayes compare``'s
 screen. The fit criteria are those of the paper: FIT [%], MSE, MAE of the simulation
 from the MAP (Kramer, van Schijndel & Schellen 2013, Building and Environment 68, 87-99).
 """

@@ -18,6 +18,13 @@ import xarray as xr
 
 from heritage_bayes._arviz import az
 from heritage_bayes._version import __version__
+from heritage_bayes.calibration.runinfo import (
+    _frozen_share,
+    _hours,
+    _periods,
+    _truth_for,
+    _versions,
+)
 from heritage_bayes.climate.psychro import saturation_vapour_pressure
 from heritage_bayes.inference.interop import (
     VALIDATION_LPD,
@@ -34,7 +41,6 @@ from heritage_bayes.inference.predictive import (
     predictive_noise,
 )
 from heritage_bayes.inference.results import as_stored, coverage, fit_metrics
-from heritage_bayes.inference.runinfo import _frozen_share, _hours, _periods, _truth_for, _versions
 from heritage_bayes.rc.discretize import modal_form
 from heritage_bayes.rc.identify import derived_quantities, derived_units
 

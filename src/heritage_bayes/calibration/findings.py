@@ -3,7 +3,7 @@
 :func:`say_findings` warns (and the run keeps in its summary) what the MAP and the
 identifiability check show about the priors and the model: a noise parameter at its cap,
 a frozen node, a parameter on a prior bound, several separate optima, parameters the
-data do not pin. Split from :mod:`heritage_bayes.calibrate`, which calls it with each
+data do not pin. Split from :mod:`heritage_bayes.calibration.calibrate`, which calls it with each
 section (its model, log-posterior, MAP, identifiability and Laplace results).
 """
 

@@ -104,11 +104,12 @@ class DistributionName:
     (:class:`heritage_bayes.inference.priors.Prior` delegates to them).
 
     A family is flat or normal in its sampling coordinate :math:`y` (:math:`\\log\\theta`
-    for a log-scale family, else :math:`\\theta`), truncated to the bounds; a new family
-    of these shapes is one subclass and one entry of :data:`PRIOR_DISTRIBUTIONS` (the
-    sampler's vectorised log-prior,
-    :meth:`heritage_bayes.inference.parameters.ParameterSet.transform`, reads its
-    ``log_scale`` and ``centre``; another shape would change it too).
+    for a log-scale family, else :math:`\\theta`), truncated to the bounds. A new family
+    is one subclass and one entry of :data:`PRIOR_DISTRIBUTIONS`: its density in
+    parameter units (:meth:`logpdf`), the same density in the sampling coordinate
+    (:meth:`ylogpdf`, which the sampler's vectorised log-prior
+    :meth:`heritage_bayes.inference.parameters.ParameterSet.transform` and the MAP
+    search call per family), its draws and its default support.
     """
 
     #: Sampled in log θ: the parameter must be positive (``lower > 0``).
@@ -132,6 +133,14 @@ class DistributionName:
         checked), centre ``mu`` (median or mean) and ``sigma``."""
         raise NotImplementedError
 
+    def ylogpdf(self, y, m, s):
+        """Unnormalised log density in the sampling coordinate ``y``, column-wise:
+        ``y`` (K, c) the columns of this family, ``m`` and ``s`` (c,) their centres in
+        ``y`` and their ``sigma`` (1 where none). Equal to :meth:`logpdf` at
+        :math:`\\theta(y)` plus :math:`\\log|d\\theta/dy|` up to a constant; None for
+        a family flat in ``y`` (it adds nothing)."""
+        return None
+
     def sample(self, rng, a: float, b: float, m: float, sigma: float | None, size: int):
         """``size`` draws of the sampling coordinate y in [a, b] (flat in y; a normal
         family overrides), centre ``m`` in y."""
@@ -151,6 +160,10 @@ class DistributionName:
 
 class _Centred(DistributionName):
     """Normal in the sampling coordinate, truncated to the bounds."""
+
+    def ylogpdf(self, y, m, s):
+        z = (y - m) / s
+        return -(0.5 * z * z)
 
     def sample(self, rng, a, b, m, sigma, size):
         from scipy.stats import truncnorm

@@ -104,9 +104,17 @@ class ParameterSet:
         ab = np.array([p._ab() for p in priors])
         self._a, self._w = ab[:, 0], ab[:, 1] - ab[:, 0]
         self._log = np.array([p.log_scale for p in priors])
-        self._gauss = np.array([p.gaussian for p in priors])
         self._mu = np.array([p.centre for p in priors])
         self._sig = np.array([p.sigma or 1.0 for p in priors])
+        # the free columns of each prior family not flat in its sampling coordinate
+        # (DistributionName.ylogpdf None), with their centres and sigmas
+        fams = [p.family for p in priors]
+        self._families = []
+        for fam in dict.fromkeys(fams):
+            cols = np.array([k for k, f in enumerate(fams) if f is fam])
+            m, s = self._mu[cols], self._sig[cols]
+            if fam.ylogpdf(m[None, :], m, s) is not None:
+                self._families.append((fam, cols, m, s))
         # logit for quantities bounded on both sides by nature (fractions, AR(1) phi);
         # log θ (or θ) with the bounds as hard walls for the rest, so that the exactly
         # linear log-space ridges of RC models (the overall scale) stay straight lines,
@@ -178,12 +186,23 @@ class ParameterSet:
             np.where(inside, 0.0, -np.inf),
         )
         th = np.where(self._log, np.exp(np.clip(np.where(self._log, y, 0.0), -700, 700)), y)
-        # y is log θ for log-scale priors: the Jacobian gains dθ/dy = θ, and
-        # loguniform (∝ 1/θ) cancels it; lognormal keeps the normal term in y
-        z = (y - self._mu) / self._sig
-        logp = logj - np.where(self._gauss, 0.5 * z * z, 0.0)
+        # y is log θ for log-scale priors: the Jacobian gains dθ/dy = θ, which each
+        # family's density in y holds (loguniform's 1/θ cancels it)
+        logp = self._add_log_density_y(y, logj)
         theta[:, self._free_idx] = th
         return theta, logp.sum(axis=1)
+
+    def log_density_y(self, y: np.ndarray) -> np.ndarray:
+        """(K, d) unnormalised log prior density of each free parameter in its sampling
+        coordinate ``y`` (log θ or θ; bounds not checked), asked of each family
+        (:meth:`heritage_bayes.names.DistributionName.ylogpdf`); 0 where flat."""
+        return self._add_log_density_y(y, np.zeros_like(y))
+
+    def _add_log_density_y(self, y: np.ndarray, out: np.ndarray) -> np.ndarray:
+        """``out`` (K, d) plus :meth:`log_density_y` of ``y``, in place."""
+        for fam, cols, m, s in self._families:
+            out[:, cols] += fam.ylogpdf(y[:, cols], m, s)
+        return out
 
     def values(self, X: np.ndarray) -> np.ndarray:
         """Unconstrained (K, d) -> values (K, P)."""

@@ -630,3 +630,43 @@ def test_the_modes_finding_names_where_the_optima_differ():
     assert "Cw 1.2e+08" not in msg and "Gint 400" not in msg  # 0.02 apart: not named
     assert "multimodal" in msg and "(thermal.model: thermal_2c)" in msg
     assert "smaller model" not in modes_finding(s, None)
+
+
+def test_what_the_package_asks_of_a_noise_model_instead_of_its_name():
+    """The findings, the predictive bands, the projection and the report read these
+    answers of the noise model; none of them tests its name."""
+    from heritage_bayes.inference.likelihoods import (
+        AR1WhiteNoise,
+        ar1_innovations,
+        ar1_white_innovations,
+        find_noise_model,
+        noise_parameter_names,
+    )
+
+    white, kalman = get_noise_model("ar1_white"), get_noise_model("kalman")
+    assert white.capped_kinds == ("phi",) and kalman.capped_kinds == ()
+    # bands: ar1_white's own model unless phi sits at its cap; kalman's never
+    ps = parameters_for(hb.model("thermal_1c"), white, room_volume=400).parameters[-3:]
+    cap = ps[1].prior.upper
+    low, high = np.array([[0.3, 0.5, 0.1]] * 5), np.array([[0.3, cap, 0.1]] * 5)
+    assert white.free_run_reason(0, "Ti", low, ps) is None
+    assert white.free_run_reason(0, "Ti", high, ps).startswith(f"phi_Ti at its cap {cap:g}")
+    assert get_noise_model("ar1").free_run_reason(0, "Ti", low[:, :2], ps) is None
+    assert kalman.free_run_reason(0, "Ti", low, ps).startswith("process noise")
+    assert white.free_run_model() is white
+    assert isinstance(kalman.free_run_model(), AR1WhiteNoise)
+    # the report's residual check
+    e = np.random.default_rng(3).normal(size=50)
+    medians = {"sigma": 0.5, "phi": 0.8, "sigma_meas": 0.2}
+    view = white.residual_view(e, lambda k, absent=None: medians.get(k, absent))
+    np.testing.assert_array_equal(view.innovations, ar1_white_innovations(e, 0.5, 0.8, 0.2))
+    assert view.phi == 0.8 and view.acf_scale == pytest.approx(0.25 / 0.29)
+    ar1 = get_noise_model("ar1").residual_view(e, lambda k, absent=None: medians.get(k, absent))
+    np.testing.assert_array_equal(ar1.innovations, ar1_innovations(e, 0.8))
+    iid = get_noise_model("iid").residual_view(e, lambda k, absent=None: medians.get(k, absent))
+    assert iid.phi is None and np.array_equal(iid.innovations, e)
+    # the noise parameters of a run's section, by the noise model's own names
+    assert noise_parameter_names("kalman", ("Ti",), ("Ti", "Tw")) == {"sigma_Ti", "q_Ti", "q_Tw"}
+    assert noise_parameter_names("ar1", ("Ti",)) == {"sigma_Ti", "phi_Ti"}
+    assert find_noise_model("written_by_a_later_version") is None
+    assert noise_parameter_names("written_by_a_later_version", ("Ti",)) == frozenset()

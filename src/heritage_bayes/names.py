@@ -29,26 +29,16 @@ __all__ = [
     "DistributionName",
     "NoiseName",
     "declare_noise",
-    "noise_traits",
 ]
 
 
 class NoiseName(NamedTuple):
-    """What the package knows of a noise model without importing its numerics."""
+    """What the package knows of a noise model without importing its numerics (what
+    the rest of the package asks of a noise model, the class answers:
+    :class:`heritage_bayes.inference.likelihoods.NoiseModel`)."""
 
     #: One line for the references.
     description: str
-    #: Its model error is an AR(1) process with coefficient ``phi_<output>``: the
-    #: report shows the error's correlation time.
-    ar1: bool = False
-    #: Besides the AR(1) error, white sensor noise ``sigma_meas_<output>``.
-    white: bool = False
-    #: ``phi`` has a cap per time (the prior's upper bound from the time step): a
-    #: ``phi`` at its cap is a finding, not a prior bound.
-    capped_phi: bool = False
-    #: A state-space model (a Kalman filter on the stochastic RC model): the fit
-    #: figure shows its one-step-ahead band.
-    state_space: bool = False
 
 
 #: ``noise:`` choices, the default first.
@@ -71,19 +61,10 @@ def declare_noise(name: str, entry: NoiseName) -> NoiseName:
     return entry
 
 
-def noise_traits(name: str | None) -> NoiseName:
-    """The declaration of a noise model by name; a name not declared (a run written by
-    another version) has none of the traits."""
-    return NOISE_MODELS.get(name or "", NoiseName(""))
-
-
-declare_noise(
-    "ar1_white",
-    NoiseName("AR(1) model error + white sensor noise", ar1=True, white=True, capped_phi=True),
-)
-declare_noise("ar1", NoiseName("a single AR(1) error", ar1=True))
+declare_noise("ar1_white", NoiseName("AR(1) model error + white sensor noise"))
+declare_noise("ar1", NoiseName("a single AR(1) error"))
 declare_noise("iid", NoiseName("independent errors"))
-declare_noise("kalman", NoiseName("a Kalman filter on the stochastic RC model", state_space=True))
+declare_noise("kalman", NoiseName("a Kalman filter on the stochastic RC model"))
 
 #: ``sampler.moves`` choices, the default first (name -> description); the emcee
 #: mixtures are :data:`heritage_bayes.inference.monitor.MOVES`.

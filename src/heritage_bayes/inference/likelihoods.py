@@ -47,6 +47,8 @@ References
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
+from types import MappingProxyType
 from typing import NamedTuple
 
 import numpy as np
@@ -102,6 +104,14 @@ class NoiseModel:
     #: has its description there).
     description = ""
     kinds: tuple[str, ...] = ()
+    #: What a parameter of each kind is, for the tables (followed by its output).
+    descriptions: Mapping[str, str] = MappingProxyType(
+        {
+            "sigma": "marginal sd of the model error of",
+            "phi": "AR(1) coefficient (per time step) of the model error of",
+            "sigma_meas": "sd of the white measurement noise of",
+        }
+    )
     #: Parameter kinds whose prior's upper bound is a cap per time step: a MAP at the
     #: cap says the model misses a slow process (a finding, not a prior bound).
     capped_kinds: tuple[str, ...] = ()
@@ -111,6 +121,18 @@ class NoiseModel:
         " The noise model's own error model leaves out the slow misfit; the bands use "
         "the free-run error instead: "
     )
+
+    def unit(self, kind: str, output_unit: str, potential: str) -> str:
+        """The unit of a parameter of ``kind``: a standard deviation in its output's
+        unit ([K] or [Pa]), a coefficient per time step [-]. ``potential``: the
+        domain's ([K] or [Pa])."""
+        return output_unit if kind.startswith("sigma") else "-"
+
+    def priors_for(self, dt: float = 3600.0) -> dict:
+        """Default priors per (domain, kind) that differ from the package's
+        (:func:`~heritage_bayes.inference.priors.default_prior`), for time step ``dt``
+        [s]; a kind of its own needs one here."""
+        return {}
 
     def free_run_reason(self, o: int, name: str, noise: np.ndarray, params) -> str | None:
         """Why the predictive bands of output ``o`` (named ``name``) use the free-run

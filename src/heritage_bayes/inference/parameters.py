@@ -49,14 +49,6 @@ from heritage_bayes.rc.catalog import roles_of, solar_apertures
 
 __all__ = ["Parameter", "ParameterSet", "owned_priors", "parameters_for"]
 
-#: What the noise parameters are, by kind (for descriptions and units).
-_NOISE_DESCRIPTION = {
-    "sigma": "marginal sd of the model error of",
-    "phi": "AR(1) coefficient (per time step) of the model error of",
-    "sigma_meas": "sd of the white measurement noise of",
-    "diffusion": "process-noise diffusion (per square root of an hour) of node",
-}
-
 
 @dataclass(frozen=True)
 class Parameter:
@@ -328,14 +320,15 @@ def parameters_for(
     if apertures:
         _check_glazing(model, set(apertures.values()), survey.glazing_area)
     domain = model.domain
-    noise_priors = noise.priors_for(dt) if hasattr(noise, "priors_for") else {}
+    noise_priors = noise.priors_for(dt)
     roles = roles_of(model.name)
     params = []
-    for name, kind, unit, desc, is_noise in _entries(model, noise_specs):
-        prior = default_prior(domain, kind)
-        if is_noise:
-            prior = noise_priors.get((domain, kind), prior)
+    for name, kind, unit, desc, is_noise in _entries(model, noise, noise_specs):
+        if is_noise and (domain, kind) in noise_priors:
+            prior = noise_priors[(domain, kind)]
         else:
+            prior = default_prior(domain, kind)
+        if not is_noise:
             role = ROLE_PRIORS.get(roles.get(name, ""))
             prior = (role(survey, domain, kind) if role else None) or prior
             if name in apertures and kind == "gain":
@@ -377,9 +370,10 @@ def _check_glazing(model, surfaces: set[str], glazing: Mapping[str, float]) -> N
         )
 
 
-def _entries(model, noise_specs) -> list[tuple[str, str, str, str, bool]]:
+def _entries(model, noise, noise_specs) -> list[tuple[str, str, str, str, bool]]:
     """(name, kind, unit, description, is_noise) of the model's parameters, then of
-    the noise model's (units: the output's [K], [Pa], per √h for a diffusion)."""
+    the noise model's (unit and description its own: :meth:`~heritage_bayes.inference.
+    likelihoods.NoiseModel.unit`, ``descriptions``)."""
     potential = "K" if model.domain == "thermal" else "Pa"
     out_units = {
         o: model.network.input_unit(o) if o in model.input_names else potential
@@ -387,11 +381,8 @@ def _entries(model, noise_specs) -> list[tuple[str, str, str, str, bool]]:
     }
     entries = [(i.name, i.kind, i.unit, i.description, False) for i in model.parameters]
     for n, k, o in noise_specs:
-        if k.startswith("sigma"):
-            unit = out_units[o]
-        else:
-            unit = f"{potential}/√h" if k == "diffusion" else "-"
-        entries.append((n, k, unit, f"{_NOISE_DESCRIPTION.get(k, k)} {o}", True))
+        unit = noise.unit(k, out_units.get(o, potential), potential)
+        entries.append((n, k, unit, f"{noise.descriptions.get(k, k)} {o}", True))
     return entries
 
 

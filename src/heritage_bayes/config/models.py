@@ -90,8 +90,8 @@ class ModelSection(_Strict):
     noise: Annotated[str, Choices(NOISE_MODELS)] = key(
         DEFAULT_NOISE,
         unit=None,
-        description="noise model: AR(1) model error + white sensor noise, a single AR(1), "
-        "iid, or a Kalman filter on the stochastic RC model",
+        description="noise model: "
+        + ", ".join(f"{n} ({e.description})" for n, e in NOISE_MODELS.items()),
     )
     initial_state: Literal["estimate", "steady"] | dict[str, float] | None = key(
         None,

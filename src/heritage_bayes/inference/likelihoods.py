@@ -104,6 +104,10 @@ class NoiseModel:
     #: has its description there).
     description = ""
     kinds: tuple[str, ...] = ()
+    #: A state-space model (the stochastic RC model's own Kalman filter): the
+    #: log-posterior filters the model's states instead of its residuals, and the fit
+    #: section shows its one-step-ahead band.
+    statespace = False
     #: What a parameter of each kind is, for the tables (followed by its output).
     descriptions: Mapping[str, str] = MappingProxyType(
         {

@@ -372,8 +372,8 @@ def _check_glazing(model, surfaces: set[str], glazing: Mapping[str, float]) -> N
 
 def _entries(model, noise, noise_specs) -> list[tuple[str, str, str, str, bool]]:
     """(name, kind, unit, description, is_noise) of the model's parameters, then of
-    the noise model's (unit and description its own: :meth:`~heritage_bayes.inference.
-    likelihoods.NoiseModel.unit`, ``descriptions``)."""
+    the noise model's (their units and descriptions the noise model's own: its
+    ``unit`` and ``descriptions``)."""
     potential = "K" if model.domain == "thermal" else "Pa"
     out_units = {
         o: model.network.input_unit(o) if o in model.input_names else potential

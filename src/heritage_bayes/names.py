@@ -84,13 +84,13 @@ class DistributionName:
     command line without importing numpy, and its numerics, which import it when called
     (:class:`heritage_bayes.inference.priors.Prior` delegates to them).
 
-    A family is flat or normal in its sampling coordinate :math:`y` (:math:`\\log\\theta`
-    for a log-scale family, else :math:`\\theta`), truncated to the bounds. A new family
-    is one subclass and one entry of :data:`PRIOR_DISTRIBUTIONS`: its density in
-    parameter units (:meth:`logpdf`), the same density in the sampling coordinate
-    (:meth:`ylogpdf`, which the sampler's vectorised log-prior
-    :meth:`heritage_bayes.inference.parameters.ParameterSet.transform` and the MAP
-    search call per family), its draws and its default support.
+    The package's families are flat or normal in their sampling coordinate :math:`y`
+    (:math:`\\log\\theta` for a log-scale family, else :math:`\\theta`), truncated to
+    the bounds. A new family, of any shape, is one subclass and one entry of
+    :data:`PRIOR_DISTRIBUTIONS`: its density in parameter units (:meth:`logpdf`), the
+    same density in the sampling coordinate (:meth:`ylogpdf`, which the sampler's
+    vectorised log-prior :meth:`heritage_bayes.inference.parameters.ParameterSet.transform`
+    and the MAP search call per family), its draws and its default support.
     """
 
     #: Sampled in log θ: the parameter must be positive (``lower > 0``).

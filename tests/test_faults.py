@@ -384,6 +384,14 @@ USER_ERRORS = {
         _case_config(_tiny(**{"thermal.model": _CUSTOM})),
         "parameter name 'C/i'",
     ),
+    "custom-network-options": (
+        _case_config(
+            _tiny(
+                thermal={"model": {**_CUSTOM, "nodes": {"Ti": "Ci"}}, "options": {"ground": False}}
+            )
+        ),
+        "thermal.options.ground: a custom network",
+    ),
     "impossible-date": (
         _case_config(yaml.safe_dump(TINY).replace("end: '2019-01-16'", "end: 2019-13-02", 1)),
         "periods.calibration",

@@ -78,6 +78,37 @@ def test_vectorised_transform_matches_per_prior_path():
     assert out[0] == -np.inf
 
 
+def test_a_prior_family_of_a_new_shape_reaches_the_vectorised_log_prior(monkeypatch):
+    """A family that is neither flat nor normal in its sampling coordinate (a Laplace
+    in log θ) is one object: the sampler's vectorised log-prior and the MAP search's
+    ask it for its density, and agree with the per-prior path."""
+    from heritage_bayes.names import DistributionName
+
+    class _LogLaplace(DistributionName):
+        log_scale = True
+        centre = "median"
+        span = 8.0
+
+        def logpdf(self, theta, mu, sigma):
+            lt = np.log(theta)
+            return -lt - np.abs(lt - math.log(mu)) / sigma
+
+        def ylogpdf(self, y, m, s):
+            return -np.abs(y - m) / s
+
+    monkeypatch.setitem(PRIOR_DISTRIBUTIONS, "loglaplace", _LogLaplace("a toy"))
+    priors = [*PRIORS, Prior("loglaplace", 1e-3, 1e3, mu=2.0, sigma=0.5)]
+    ps = ParameterSet([Parameter(f"p{i}", "-", "x", p) for i, p in enumerate(priors)])
+    X = np.random.default_rng(2).normal(0, 2, (20, len(priors)))
+    theta, lp = ps.transform(X)
+    ref = sum(
+        p.logpdf(theta[:, j]) + p.from_unconstrained(X[:, j])[1] for j, p in enumerate(priors)
+    )
+    np.testing.assert_allclose(lp, ref, rtol=1e-12)
+    y = X[:, -1]
+    np.testing.assert_array_equal(ps.log_density_y(X)[:, -1], -np.abs(y - math.log(2.0)) / 0.5)
+
+
 def test_every_prior_family_is_tested_and_labelled():
     """The tests above cover each family of the registry; each describes itself."""
     assert {p.dist for p in PRIORS} == set(PRIOR_DISTRIBUTIONS)
@@ -599,3 +630,43 @@ def test_the_modes_finding_names_where_the_optima_differ():
     assert "Cw 1.2e+08" not in msg and "Gint 400" not in msg  # 0.02 apart: not named
     assert "multimodal" in msg and "(thermal.model: thermal_2c)" in msg
     assert "smaller model" not in modes_finding(s, None)
+
+
+def test_what_the_package_asks_of_a_noise_model_instead_of_its_name():
+    """The findings, the predictive bands, the projection and the report read these
+    answers of the noise model; none of them tests its name."""
+    from heritage_bayes.inference.likelihoods import (
+        AR1WhiteNoise,
+        ar1_innovations,
+        ar1_white_innovations,
+        find_noise_model,
+        noise_parameter_names,
+    )
+
+    white, kalman = get_noise_model("ar1_white"), get_noise_model("kalman")
+    assert white.capped_kinds == ("phi",) and kalman.capped_kinds == ()
+    # bands: ar1_white's own model unless phi sits at its cap; kalman's never
+    ps = parameters_for(hb.model("thermal_1c"), white, room_volume=400).parameters[-3:]
+    cap = ps[1].prior.upper
+    low, high = np.array([[0.3, 0.5, 0.1]] * 5), np.array([[0.3, cap, 0.1]] * 5)
+    assert white.free_run_reason(0, "Ti", low, ps) is None
+    assert white.free_run_reason(0, "Ti", high, ps).startswith(f"phi_Ti at its cap {cap:g}")
+    assert get_noise_model("ar1").free_run_reason(0, "Ti", low[:, :2], ps) is None
+    assert kalman.free_run_reason(0, "Ti", low, ps).startswith("process noise")
+    assert white.free_run_model() is white
+    assert isinstance(kalman.free_run_model(), AR1WhiteNoise)
+    # the report's residual check
+    e = np.random.default_rng(3).normal(size=50)
+    medians = {"sigma": 0.5, "phi": 0.8, "sigma_meas": 0.2}
+    view = white.residual_view(e, lambda k, absent=None: medians.get(k, absent))
+    np.testing.assert_array_equal(view.innovations, ar1_white_innovations(e, 0.5, 0.8, 0.2))
+    assert view.phi == 0.8 and view.acf_scale == pytest.approx(0.25 / 0.29)
+    ar1 = get_noise_model("ar1").residual_view(e, lambda k, absent=None: medians.get(k, absent))
+    np.testing.assert_array_equal(ar1.innovations, ar1_innovations(e, 0.8))
+    iid = get_noise_model("iid").residual_view(e, lambda k, absent=None: medians.get(k, absent))
+    assert iid.phi is None and np.array_equal(iid.innovations, e)
+    # the noise parameters of a run's section, by the noise model's own names
+    assert noise_parameter_names("kalman", ("Ti",), ("Ti", "Tw")) == {"sigma_Ti", "q_Ti", "q_Tw"}
+    assert noise_parameter_names("ar1", ("Ti",)) == {"sigma_Ti", "phi_Ti"}
+    assert find_noise_model("written_by_a_later_version") is None
+    assert noise_parameter_names("written_by_a_later_version", ("Ti",)) == frozenset()

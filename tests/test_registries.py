@@ -47,6 +47,7 @@ def _toy_network(surfaces=None, ground: bool = True) -> Network:
 
 class _ToyNoise(likelihoods.IIDNoise):
     name = "iid_toy"
+    description = "a toy: independent errors"
 
 
 def _register_toys() -> None:
@@ -61,8 +62,7 @@ def _register_toys() -> None:
             rungs=(({}, "thermal_4a"),),
         ),
     )
-    names.declare_noise("iid_toy", names.NoiseName("a toy: independent errors"))
-    likelihoods.register_noise(_ToyNoise)
+    likelihoods.register_noise(_ToyNoise)  # declares its name with its description
 
 
 def _config(**section):
@@ -73,6 +73,8 @@ def _config(**section):
 
 def test_a_registered_model_and_noise_model_show_up_everywhere(restore_registries, capsys):
     _register_toys()
+    with pytest.raises(ValueError, match="registered once"):
+        likelihoods.register_noise(_ToyNoise)
     # the ladders: the model-order ladder (run ladder, compare, findings) and auto's rungs
     assert LADDERS["thermal"][-1] == DEFAULT_MODELS["thermal"][-1] == "thermal_toy"
     assert AUTO_LADDERS["thermal"][-1] == ("thermal_toy", {}, "thermal_4a")
@@ -101,8 +103,13 @@ def test_an_unregistered_name_is_refused_with_the_registry_s_names():
         _config(noise="iid_toy")
     with pytest.raises(ConfigError, match=r"thermal\.model: unknown model 'thermal_toy'"):
         build_model(_config(model="thermal_toy"), "thermal")
-    with pytest.raises(ValueError, match="declare its name first"):
-        likelihoods.register_noise(_ToyNoise)
+
+    class Undescribed(likelihoods.IIDNoise):
+        name = "undescribed_toy"
+
+    with pytest.raises(ValueError, match="with a description or a name declared"):
+        likelihoods.register_noise(Undescribed)
+    assert "undescribed_toy" not in names.NOISE_MODELS
     with pytest.raises(ValueError, match="rung parent 'thermal_nope'"):
         catalog.register(
             "thermal_toy",

@@ -253,17 +253,26 @@ def _section_at_cap(noise="ar1_white"):
 
     import numpy as np
 
+    from heritage_bayes.inference.likelihoods import get_noise_model
+
     phi = Ns(name="phi_Ti", prior=Ns(upper=0.96))
     params = Ns(
         names=["Ci", "phi_Ti"],
         parameters=[Ns(name="Ci"), phi],
         at_bound=lambda x: [("phi_Ti", "upper")],
     )
-    logpost = Ns(params=params, dt=3600.0, noise=Ns(name=noise), n_model=1, record_seconds=1e7)
+    nm = get_noise_model(noise)
+    logpost = Ns(params=params, dt=3600.0, noise=nm, n_model=1, record_seconds=1e7)
     ident = Ns(has_scale_direction=False, identifiable={"Ci": True})
     return Ns(
         name="thermal",
-        model=Ns(name="thermal_1c", domain="thermal", parameter_names=["Ci"]),
+        model=Ns(
+            name="thermal_1c",
+            domain="thermal",
+            parameter_names=["Ci"],
+            output_names=("Ti",),
+            state_names=("Ti",),
+        ),
         logpost=logpost,
         map=Ns(x=np.zeros(2), theta=np.array([1e7, 0.96]), modes=[]),
         identifiability=ident,

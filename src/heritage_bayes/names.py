@@ -29,26 +29,16 @@ __all__ = [
     "DistributionName",
     "NoiseName",
     "declare_noise",
-    "noise_traits",
 ]
 
 
 class NoiseName(NamedTuple):
-    """What the package knows of a noise model without importing its numerics."""
+    """What the package knows of a noise model without importing its numerics (what
+    the rest of the package asks of a noise model, the class answers:
+    :class:`heritage_bayes.inference.likelihoods.NoiseModel`)."""
 
     #: One line for the references.
     description: str
-    #: Its model error is an AR(1) process with coefficient ``phi_<output>``: the
-    #: report shows the error's correlation time.
-    ar1: bool = False
-    #: Besides the AR(1) error, white sensor noise ``sigma_meas_<output>``.
-    white: bool = False
-    #: ``phi`` has a cap per time (the prior's upper bound from the time step): a
-    #: ``phi`` at its cap is a finding, not a prior bound.
-    capped_phi: bool = False
-    #: A state-space model (a Kalman filter on the stochastic RC model): the fit
-    #: figure shows its one-step-ahead band.
-    state_space: bool = False
 
 
 #: ``noise:`` choices, the default first.
@@ -71,19 +61,10 @@ def declare_noise(name: str, entry: NoiseName) -> NoiseName:
     return entry
 
 
-def noise_traits(name: str | None) -> NoiseName:
-    """The declaration of a noise model by name; a name not declared (a run written by
-    another version) has none of the traits."""
-    return NOISE_MODELS.get(name or "", NoiseName(""))
-
-
-declare_noise(
-    "ar1_white",
-    NoiseName("AR(1) model error + white sensor noise", ar1=True, white=True, capped_phi=True),
-)
-declare_noise("ar1", NoiseName("a single AR(1) error", ar1=True))
+declare_noise("ar1_white", NoiseName("AR(1) model error + white sensor noise"))
+declare_noise("ar1", NoiseName("a single AR(1) error"))
 declare_noise("iid", NoiseName("independent errors"))
-declare_noise("kalman", NoiseName("a Kalman filter on the stochastic RC model", state_space=True))
+declare_noise("kalman", NoiseName("a Kalman filter on the stochastic RC model"))
 
 #: ``sampler.moves`` choices, the default first (name -> description); the emcee
 #: mixtures are :data:`heritage_bayes.inference.monitor.MOVES`.
@@ -103,12 +84,13 @@ class DistributionName:
     command line without importing numpy, and its numerics, which import it when called
     (:class:`heritage_bayes.inference.priors.Prior` delegates to them).
 
-    A family is flat or normal in its sampling coordinate :math:`y` (:math:`\\log\\theta`
-    for a log-scale family, else :math:`\\theta`), truncated to the bounds; a new family
-    of these shapes is one subclass and one entry of :data:`PRIOR_DISTRIBUTIONS` (the
-    sampler's vectorised log-prior,
-    :meth:`heritage_bayes.inference.parameters.ParameterSet.transform`, reads its
-    ``log_scale`` and ``centre``; another shape would change it too).
+    The package's families are flat or normal in their sampling coordinate :math:`y`
+    (:math:`\\log\\theta` for a log-scale family, else :math:`\\theta`), truncated to
+    the bounds. A new family, of any shape, is one subclass and one entry of
+    :data:`PRIOR_DISTRIBUTIONS`: its density in parameter units (:meth:`logpdf`), the
+    same density in the sampling coordinate (:meth:`ylogpdf`, which the sampler's
+    vectorised log-prior :meth:`heritage_bayes.inference.parameters.ParameterSet.transform`
+    and the MAP search call per family), its draws and its default support.
     """
 
     #: Sampled in log θ: the parameter must be positive (``lower > 0``).
@@ -132,6 +114,14 @@ class DistributionName:
         checked), centre ``mu`` (median or mean) and ``sigma``."""
         raise NotImplementedError
 
+    def ylogpdf(self, y, m, s):
+        """Unnormalised log density in the sampling coordinate ``y``, column-wise:
+        ``y`` (K, c) the columns of this family, ``m`` and ``s`` (c,) their centres in
+        ``y`` and their ``sigma`` (1 where none). Equal to :meth:`logpdf` at
+        :math:`\\theta(y)` plus :math:`\\log|d\\theta/dy|` up to a constant; None for
+        a family flat in ``y`` (it adds nothing)."""
+        return None
+
     def sample(self, rng, a: float, b: float, m: float, sigma: float | None, size: int):
         """``size`` draws of the sampling coordinate y in [a, b] (flat in y; a normal
         family overrides), centre ``m`` in y."""
@@ -151,6 +141,10 @@ class DistributionName:
 
 class _Centred(DistributionName):
     """Normal in the sampling coordinate, truncated to the bounds."""
+
+    def ylogpdf(self, y, m, s):
+        z = (y - m) / s
+        return -(0.5 * z * z)
 
     def sample(self, rng, a, b, m, sigma, size):
         from scipy.stats import truncnorm

@@ -16,6 +16,7 @@ import pandas as pd
 from heritage_bayes.convert import format_timedelta
 from heritage_bayes.errors import ConfigError, DataError, InputError
 from heritage_bayes.inputs import add_slope_columns, calendar_inputs, ground_input
+from heritage_bayes.names import DEFAULT_NOISE
 from heritage_bayes.sources import OUTPUT_COLUMNS, _iso
 
 # -- periods ----------------------------------------------------------------------------
@@ -237,7 +238,7 @@ def demo_truth(cfg, monument, frame: pd.DataFrame, cal: slice, warmup_steps: int
     rows = frame.index[cal.start + warmup_steps : cal.stop]
     for sec, out in (("thermal", "Ti"), ("hygric", "Pi")):
         sec_cfg = getattr(cfg, sec)
-        kind = sec_cfg.noise if sec_cfg is not None else "ar1_white"
+        kind = sec_cfg.noise if sec_cfg is not None else DEFAULT_NOISE
         truth[sec].update(nominal_noise(monument, out, rows, noise=kind))
     return truth
 

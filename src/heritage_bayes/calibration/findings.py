@@ -13,7 +13,6 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from heritage_bayes.names import noise_traits
 from heritage_bayes.rc.catalog import DomainView, model_ladder
 from heritage_bayes.rc.derived import frozen_time_constant
 
@@ -33,10 +32,11 @@ def say_findings(say, s, priors: Mapping | tuple = ()) -> None:
     not warned, and one the data do not pin is not flagged (its prior closes it).
     """
     s.map_at_bound = s.logpost.params.at_bound(s.map.x)
-    capped = [n for n, side in s.map_at_bound if n.startswith("phi_") and side == "upper"]
-    told = (
-        {(n, "upper") for n in capped} if noise_traits(s.logpost.noise.name).capped_phi else set()
-    )
+    nm = s.logpost.noise
+    specs = nm.parameter_specs(s.model.output_names, s.model.state_names)
+    caps = {n for n, kind, _ in specs if kind in nm.capped_kinds}
+    capped = [n for n, side in s.map_at_bound if n in caps and side == "upper"]
+    told = {(n, "upper") for n in capped}
     if told:
         ph = s.logpost.params.parameters[s.logpost.params.names.index(capped[0])].prior.upper
         hours = -s.logpost.dt / 3600.0 / np.log(ph)

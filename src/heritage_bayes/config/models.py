@@ -14,7 +14,7 @@ import math
 from typing import Annotated, Any, Literal
 
 import pandas as pd
-from pydantic import PlainSerializer, PlainValidator, WithJsonSchema
+from pydantic import PlainSerializer, PlainValidator, WithJsonSchema, model_validator
 
 from heritage_bayes.config._base import DURATION_UNIT, Choices, _duration, _Strict, key
 from heritage_bayes.config.options import ModelOptions
@@ -90,8 +90,8 @@ class ModelSection(_Strict):
     noise: Annotated[str, Choices(NOISE_MODELS)] = key(
         DEFAULT_NOISE,
         unit=None,
-        description="noise model: AR(1) model error + white sensor noise, a single AR(1), "
-        "iid, or a Kalman filter on the stochastic RC model",
+        description="noise model: "
+        + ", ".join(f"{n} ({e.description})" for n, e in NOISE_MODELS.items()),
     )
     initial_state: Literal["estimate", "steady"] | dict[str, float] | None = key(
         None,
@@ -135,6 +135,17 @@ class ModelSection(_Strict):
     room_volume: float | None = key(
         None, unit="m³", description="this model's air volume (default: the top-level one)", gt=0
     )
+
+    @model_validator(mode="after")
+    def _custom_network_takes_no_options(self):
+        given = self.options.given() if isinstance(self.model, dict) else {}
+        if given:
+            raise ValueError(
+                f"options.{next(iter(given))}: a custom network (a mapping under 'model') "
+                "takes no options: its nodes, links, inputs and sources are the mapping "
+                f"(got options {sorted(given)}); remove 'options' or name a catalogue model"
+            )
+        return self
 
     def cap_seconds(self, domain: str) -> float:
         """``time_constant_cap`` in seconds (``inf`` for none); the default by domain:

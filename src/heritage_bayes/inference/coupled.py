@@ -22,7 +22,7 @@ import numba
 import numpy as np
 
 from heritage_bayes.inference import likelihoods
-from heritage_bayes.inference.likelihoods import ar1_predict
+from heritage_bayes.inference.noise_kernels import ar1_predict
 from heritage_bayes.rc import sorption
 from heritage_bayes.rc.sorption import BLOCK, coupled_block
 

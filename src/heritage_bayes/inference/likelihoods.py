@@ -26,6 +26,17 @@ Interface (what :class:`~heritage_bayes.inference.posterior.LogPosterior` calls)
 - ``filter_modal(mf, U, z0, Yobs, noise, basis=...)`` -> sufficient statistics straight
   from a modal form (the sampler's hot path), ``loglik_modal`` their log-likelihood.
 
+What the rest of the package asks of a noise model instead of testing its name (the
+findings, the predictive bands, the projection and the report):
+
+- ``capped_kinds``: the parameter kinds whose prior's upper bound is a cap per time
+  step (a MAP there is a finding about the model);
+- ``free_run_reason(o, name, noise, params)``: why output ``o``'s predictive bands
+  use the free-run error instead of this model, or None; ``free_run_model()`` the
+  noise model whose parameters that error fills; ``free_run_note`` what the report says;
+- ``residual_view(resid, median)``: what the model expects of an output's residuals
+  (the innovations that should be white, the expected lag-1 autocorrelation in words).
+
 References
 ----------
 .. [1] G.E.P. Box, G.M. Jenkins, G.C. Reinsel, *Time Series Analysis*, 4th ed., Wiley,
@@ -36,12 +47,16 @@ References
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
+from types import MappingProxyType
+from typing import NamedTuple
 
-import numba
 import numpy as np
 
+from heritage_bayes.inference.noise_kernels import _ar1_sample, _fused_kf, _kf_kernel
 from heritage_bayes.inference.priors import Prior
 from heritage_bayes.names import NOISE_MODELS as DECLARED
+from heritage_bayes.names import NoiseName, declare_noise
 
 __all__ = [
     "NOISE_MODELS",
@@ -49,220 +64,31 @@ __all__ = [
     "AR1WhiteNoise",
     "IIDNoise",
     "NoiseModel",
+    "ResidualView",
+    "ar1_innovations",
     "ar1_white_innovations",
+    "find_noise_model",
     "fit_free_run_error",
     "get_noise_model",
+    "noise_parameter_names",
     "register_noise",
 ]
 
-_LOG2PI = math.log(2.0 * math.pi)
 
+class ResidualView(NamedTuple):
+    """What a noise model expects of one output's residuals (the report's check)."""
 
-@numba.njit(cache=True, nogil=True)
-def _ar1_sample(z, phi, sigma, out):  # pragma: no cover
-    """AR(1) with marginal sd sigma from standard normals z (K, N) into out (K, N)."""
-    K, N = z.shape
-    for p in range(K):
-        ph = phi[p]
-        c = sigma[p] * math.sqrt(1.0 - ph * ph)
-        e = sigma[p] * z[p, 0]
-        out[p, 0] = e
-        for k in range(1, N):
-            e = ph * e + c * z[p, k]
-            out[p, k] = e
-
-
-@numba.njit(inline="always", cache=True, nogil=True)
-def ar1_predict(last, k, ph, P, s2):  # pragma: no cover - compiled
-    """Prediction of the AR(1) model error at step ``k`` from its filtered variance
-    ``P`` at the last observed step ``last`` (< 0: none yet): the factor
-    :math:`\\phi^d` on the filtered mean and the predicted variance
-    :math:`\\phi^{2d}P + \\sigma^2(1-\\phi^{2d})` (``s2`` = :math:`\\sigma^2`), exact across a gap
-    of ``d = k - last`` steps; the stationary variance for the first observation."""
-    if last < 0:
-        return 0.0, s2
-    d = k - last
-    phd = ph if d == 1 else ph**d
-    return phd, phd * phd * P + s2 * (1.0 - phd * phd)
-
-
-@numba.njit(cache=True, nogil=True)
-def _kf_kernel(Ysim, yobs, sigma, phi, w, point, want_point):  # pragma: no cover
-    """Exact log-likelihood of r = yobs - ysim for AR(1) model error + white noise.
-
-    The residual is :math:`r_k = \\eta_k + \\varepsilon_k` with :math:`\\eta` a stationary
-    AR(1) of marginal sd ``sigma`` and coefficient ``phi``, :math:`\\varepsilon` white with
-    sd ``w``: a scalar Kalman filter (prediction over d steps across a gap: mean
-    :math:`\\phi^d m`, variance :math:`\\phi^{2d}P + \\sigma^2(1-\\phi^{2d})`). With
-    ``w = 0`` it is exactly the AR(1) likelihood of ``_ar1_kernel``.
-    """
-    K, N = Ysim.shape
-    out = np.empty(K)
-    for p in range(K):
-        s2 = sigma[p] * sigma[p]
-        w2 = w[p] * w[p]
-        ph = phi[p]
-        tot = 0.0
-        m = 0.0
-        P = s2
-        last = -1
-        for k in range(N):
-            y = yobs[k]
-            if y != y:
-                if want_point:
-                    point[p, k] = np.nan
-                continue
-            phd, Pp = ar1_predict(last, k, ph, P, s2)
-            mp = phd * m
-            F = Pp + w2
-            e = (y - Ysim[p, k]) - mp
-            term = -0.5 * (_LOG2PI + math.log(F) + e * e / F)
-            tot += term
-            if want_point:
-                point[p, k] = term
-            g = Pp / F
-            m = mp + g * e
-            P = Pp * w2 / F
-            last = k
-        out[p] = tot
-    return out
-
-
-@numba.njit(cache=True, nogil=True)
-def _fused_kf(
-    ad, W, z, pw, Cz, yobs, k0, sigma, phi, w, mres, mbas, Pv, last, conv, act, acc
-):  # pragma: no cover
-    """Modal recursion + Gaussian noise filter + initial-state statistics, one pass.
-
-    Mode-major layout so that the loops over parameter sets are contiguous (SIMD):
-    ad, z, pw (n*K,) with index j*K + p (``pw`` = ad**k, the free response of a unit
-    modal initial perturbation); W (Nb, n*K) forcing rows k0..k0+Nb-1; Cz (n_out, n, K);
-    yobs (N, n_out) with NaN = excluded; sigma, phi, w, mres, Pv (n_out, K) noise
-    parameters, filter mean of the residual and filter variance; mbas (n_out, nb, K)
-    filter means of the nb basis series (nb = n when the initial state is estimated,
-    else 0); last (n_out,) previous observed row; conv (n_out, 3, K) the converged
-    filter (log 2 pi F, 1/F, gain) once the scalar Riccati recursion is stationary, with
-    conv[o, 0, 0] = nan until then (reset by a gap). ``acc`` (3 + nb + nb*nb, K)
-    collects sum log(2 pi F), sum e0²/F, (unused), g_j = sum e0 eb_j/F and the lower
-    triangle of H_ij = sum eb_i eb_j/F, where e0 are the innovations of the residual
-    with the mean initial state and eb_j those of basis series j, so that the
-    log-likelihood with modal initial offset dz is ``-0.5 (acc0 + acc1 - 2 g.dz +
-    dz.H.dz)`` (the gains do not depend on the data). ``act`` (1,) is the number of
-    basis series still alive: modes come sorted from slow to fast (``eigh``), and a fast
-    mode's free response and filter means decay within a few hundred steps (values below
-    1e-280 are flushed to zero), after which it adds nothing and is skipped.
-    """
-    Nb, Kn = W.shape
-    n_out, n, K = Cz.shape
-    nb = mbas.shape[1]
-    s2 = sigma * sigma
-    w2 = w * w
-    ysim = np.empty(K)
-    eb = np.empty((nb, K))
-    ph_b = np.empty(K)
-    g_b = np.empty(K)
-    iF_b = np.empty(K)
-    e_b = np.empty(K)
-    nba = act[0]
-    for k in range(Nb):
-        kk = k0 + k
-        for o in range(n_out):
-            y = yobs[kk, o]
-            if y != y:
-                continue
-            ysim[:] = 0.0
-            for j in range(n):
-                for p in range(K):
-                    ysim[p] += Cz[o, j, p] * z[j * K + p]
-            lk = last[o]
-            if lk >= 0 and kk - lk == 1 and conv[o, 0, 0] == conv[o, 0, 0]:
-                # stationary filter: constant variance, gain and log-determinant
-                if nba == 0:
-                    for p in range(K):
-                        ph = phi[o, p]
-                        e0 = (y - ysim[p]) - ph * mres[o, p]
-                        mres[o, p] = ph * mres[o, p] + conv[o, 2, p] * e0
-                        acc[0, p] += conv[o, 0, p]
-                        acc[1, p] += e0 * e0 * conv[o, 1, p]
-                else:
-                    for p in range(K):
-                        ph = phi[o, p]
-                        e0 = (y - ysim[p]) - ph * mres[o, p]
-                        mres[o, p] = ph * mres[o, p] + conv[o, 2, p] * e0
-                        acc[0, p] += conv[o, 0, p]
-                        acc[1, p] += e0 * e0 * conv[o, 1, p]
-                        ph_b[p] = ph
-                        g_b[p] = conv[o, 2, p]
-                        iF_b[p] = conv[o, 1, p]
-                        e_b[p] = e0 * conv[o, 1, p]
-            else:
-                d = kk - lk
-                stat = lk >= 0 and d == 1
-                for p in range(K):
-                    if lk < 0:
-                        phd = 0.0
-                        Pp = s2[o, p]
-                    else:
-                        phd = phi[o, p] if d == 1 else phi[o, p] ** d
-                        Pp = phd * phd * Pv[o, p] + s2[o, p] * (1.0 - phd * phd)
-                    F = Pp + w2[o, p]
-                    iF = 1.0 / F
-                    g = Pp * iF
-                    lF = _LOG2PI + math.log(F)
-                    e0 = (y - ysim[p]) - phd * mres[o, p]
-                    mres[o, p] = phd * mres[o, p] + g * e0
-                    Pnew = Pp * w2[o, p] * iF
-                    if abs(Pnew - Pv[o, p]) > 1e-13 * (Pnew + 1e-300):
-                        stat = False
-                    Pv[o, p] = Pnew
-                    acc[0, p] += lF
-                    acc[1, p] += e0 * e0 * iF
-                    ph_b[p] = phd
-                    g_b[p] = g
-                    iF_b[p] = iF
-                    e_b[p] = e0 * iF
-                    conv[o, 0, p] = lF
-                    conv[o, 1, p] = iF
-                    conv[o, 2, p] = g
-                if not stat:
-                    conv[o, 0, 0] = np.nan
-            for j in range(nba):
-                for p in range(K):
-                    e = Cz[o, j, p] * pw[j * K + p] - ph_b[p] * mbas[o, j, p]
-                    mbas[o, j, p] = ph_b[p] * mbas[o, j, p] + g_b[p] * e
-                    eb[j, p] = e
-                    acc[3 + j, p] += e_b[p] * e
-            for i in range(nba):
-                for j in range(i + 1):
-                    r = 3 + nb + i * nb + j
-                    for p in range(K):
-                        acc[r, p] += eb[i, p] * eb[j, p] * iF_b[p]
-            last[o] = kk
-        for i in range(Kn):
-            z[i] = ad[i] * z[i] + W[k, i]
-        if nba:
-            for i in range(nba * K):
-                pw[i] *= ad[i]
-            # a free response decays geometrically but sticks at the smallest subnormal
-            # (ad > 1/2 rounds it back up), where arithmetic is ~20x slower: below
-            # 1e-280 it adds nothing to the sums, so it is flushed to zero
-            j = nba - 1
-            dead = True
-            for p in range(K):
-                if abs(pw[j * K + p]) < 1e-280:
-                    pw[j * K + p] = 0.0
-                else:
-                    dead = False
-            if dead:
-                for o in range(n_out):
-                    for p in range(K):
-                        if abs(mbas[o, j, p]) < 1e-280:
-                            mbas[o, j, p] = 0.0
-                        else:
-                            dead = False
-            if dead:
-                nba -= 1
-    act[0] = nba
+    #: Posterior median of the AR(1) coefficient of the model error; None without one.
+    phi: float | None
+    #: What is white when the noise model is right (NaN where a value is missing).
+    innovations: np.ndarray
+    #: Share of the residual variance in the AR(1) part: the residuals' expected
+    #: autocorrelation at lag k >= 1 is ``acf_scale * phi**k``.
+    acf_scale: float
+    #: The lag-1 autocorrelation the model expects, in words.
+    expects: str
+    #: What ``innovations`` are, in words.
+    subject: str
 
 
 class NoiseModel:
@@ -274,7 +100,69 @@ class NoiseModel:
     """
 
     name = "base"
+    #: One line for the references (a name declared in :mod:`heritage_bayes.names`
+    #: has its description there).
+    description = ""
     kinds: tuple[str, ...] = ()
+    #: A state-space model (the stochastic RC model's own Kalman filter): the
+    #: log-posterior filters the model's states instead of its residuals, and the fit
+    #: section shows its one-step-ahead band.
+    statespace = False
+    #: What a parameter of each kind is, for the tables (followed by its output).
+    descriptions: Mapping[str, str] = MappingProxyType(
+        {
+            "sigma": "marginal sd of the model error of",
+            "phi": "AR(1) coefficient (per time step) of the model error of",
+            "sigma_meas": "sd of the white measurement noise of",
+        }
+    )
+    #: Parameter kinds whose prior's upper bound is a cap per time step: a MAP at the
+    #: cap says the model misses a slow process (a finding, not a prior bound).
+    capped_kinds: tuple[str, ...] = ()
+    #: What the report says when the predictive bands use the free-run error instead
+    #: of this model (:meth:`free_run_reason`).
+    free_run_note = (
+        " The noise model's own error model leaves out the slow misfit; the bands use "
+        "the free-run error instead: "
+    )
+
+    def unit(self, kind: str, output_unit: str, potential: str) -> str:
+        """The unit of a parameter of ``kind``: a standard deviation in its output's
+        unit ([K] or [Pa]), a coefficient per time step [-]. ``potential``: the
+        domain's ([K] or [Pa])."""
+        return output_unit if kind.startswith("sigma") else "-"
+
+    def priors_for(self, dt: float = 3600.0) -> dict:
+        """Default priors per (domain, kind) that differ from the package's
+        (:func:`~heritage_bayes.inference.priors.default_prior`), for time step ``dt``
+        [s]; a kind of its own needs one here."""
+        return {}
+
+    def free_run_reason(self, o: int, name: str, noise: np.ndarray, params) -> str | None:
+        """Why the predictive bands of output ``o`` (named ``name``) use the free-run
+        error (:func:`fit_free_run_error`) instead of this model's draws, or None to
+        keep them. ``noise`` (K, q): the noise values of the draws; ``params``: the
+        noise model's :class:`~heritage_bayes.inference.parameters.Parameter`, in the
+        same order (their priors)."""
+        return None
+
+    def free_run_model(self) -> NoiseModel:
+        """The noise model whose parameters (``sigma``, ``phi``, ``sigma_meas``) the
+        free-run error fills: AR(1) + white noise."""
+        return AR1WhiteNoise()
+
+    def residual_view(self, resid: np.ndarray, median) -> ResidualView:
+        """What this model expects of an output's residuals ``resid`` (NaN where
+        missing); ``median(kind, absent=None)``: the posterior median of the output's
+        noise parameter of that kind (``absent`` if the run has none). Here, and for a
+        model without an AR part: the residuals themselves are white."""
+        return ResidualView(
+            None,
+            ar1_innovations(resid, 0.0),
+            1.0,
+            f"the {self.name} noise model expects ≈ 0",
+            "the residuals",
+        )
 
     def parameter_specs(self, output_names, state_names=()) -> list[tuple[str, str, str]]:
         """[(parameter name, kind, output)] in the order of the noise vector.
@@ -416,6 +304,20 @@ class AR1Noise(NoiseModel):
     name = "ar1"
     kinds = ("sigma", "phi")
 
+    def residual_view(self, resid, median):
+        """The AR(1) innovations :math:`e_t - \\varphi e_{t-1}` at the median
+        :math:`\\varphi`."""
+        phi = median("phi")
+        if phi is None:
+            return super().residual_view(resid, median)
+        return ResidualView(
+            phi,
+            ar1_innovations(resid, phi),
+            1.0,
+            f"the AR(1) noise model expects ≈ φ = {phi:.2f}",
+            "the innovations left after the AR(1) model",
+        )
+
 
 class AR1WhiteNoise(NoiseModel):
     """Model error plus sensor noise: a latent stationary AR(1) process
@@ -450,10 +352,61 @@ class AR1WhiteNoise(NoiseModel):
     #: Override with a prior on ``phi_<output>``.
     TAU_MAX_H = 24.5
 
+    capped_kinds = ("phi",)
+    free_run_note = (
+        " The noise model's correlation sits at its cap (about a day), so its error "
+        "model leaves out the slow misfit; the bands use the free-run error instead: "
+    )
+
     def priors_for(self, dt: float = 3600.0) -> dict:
         """Default priors that depend on the time step ``dt`` [s]: phi's cap."""
         cap = round(math.exp(-dt / 3600.0 / self.TAU_MAX_H), 4)
         return {(dom, "phi"): Prior("uniform", 0.0, cap) for dom in ("thermal", "hygric")}
+
+    def free_run_reason(self, o, name, noise, params):
+        """The median ``phi`` within 5 % of its cap's distance to 1: the model error
+        describes only the misfit's fast part, and bands drawn from it would leave
+        out the slow misfit."""
+        i_phi = len(self.kinds) * o + self.kinds.index("phi")
+        cap = params[i_phi].prior.upper
+        if not np.median(noise[:, i_phi]) > cap - 0.05 * (1.0 - cap):
+            return None
+        return (
+            f"phi_{name} at its cap {cap:g}: bands use the free-run error (AR(1) + "
+            "white fitted to the calibration residuals of the posterior-median "
+            "simulation)"
+        )
+
+    def free_run_model(self):
+        return self
+
+    def residual_view(self, resid, median):
+        """The standardised one-step innovations of the AR(1) + white filter at the
+        median parameters (:func:`ar1_white_innovations`)."""
+        phi = median("phi")
+        sigma, ph, w = (median(k, 0.0) for k in self.kinds)
+        scale = sigma**2 / (sigma**2 + w**2)
+        return ResidualView(
+            phi,
+            ar1_white_innovations(resid, sigma, ph, w),
+            scale,
+            f"the AR(1) + white noise model expects about {phi * sigma**2 / (sigma**2 + w**2):.2f}",
+            "the standardised one-step innovations of the AR(1) + white model",
+        )
+
+
+def ar1_innovations(e: np.ndarray, phi: float) -> np.ndarray:
+    """AR(1) innovations :math:`w_t = e_t - \\varphi e_{t-1}` (NaN where either is missing).
+
+    The first value is NaN. ``phi = 0`` returns the residuals themselves (iid noise).
+    """
+    e = np.asarray(e, dtype=float)
+    w = np.full(e.shape, np.nan)
+    if e.size > 1:
+        w[1:] = e[1:] - phi * e[:-1]
+    if phi == 0:
+        w[0] = e[0]
+    return w
 
 
 def ar1_white_innovations(e: np.ndarray, sigma: float, phi: float, w: float) -> np.ndarray:
@@ -490,19 +443,27 @@ NOISE_MODELS: dict[str, type[NoiseModel]] = {}
 
 
 def register_noise(cls: type[NoiseModel]) -> type[NoiseModel]:
-    """Register a noise model class under its declared ``name`` (a class decorator).
+    """Register a noise model class under its ``name`` (a class decorator).
+
+    The package's own noise models are declared in
+    :data:`heritage_bayes.names.NOISE_MODELS`, so that the command line and the settings
+    know them without importing the numerics; a name declared nowhere is declared here
+    with the class's ``description`` (a noise model added from outside the package is
+    then this one class).
 
     Raises
     ------
     ValueError
-        ``cls.name`` is not declared in :data:`heritage_bayes.names.NOISE_MODELS`
-        (:func:`heritage_bayes.names.declare_noise`), or already has a class.
+        ``cls.name`` already has a class, or is declared nowhere and ``cls`` has no
+        ``description``.
     """
-    if cls.name not in DECLARED or cls.name in NOISE_MODELS:
+    if cls.name in NOISE_MODELS or (cls.name not in DECLARED and not cls.description):
         raise ValueError(
-            f"noise model {cls.name!r}: declare its name first "
-            "(heritage_bayes.names.declare_noise), once"
+            f"noise model {cls.name!r}: registered once, with a description or a name "
+            "declared in heritage_bayes.names (declare_noise)"
         )
+    if cls.name not in DECLARED:
+        declare_noise(cls.name, NoiseName(cls.description))
     NOISE_MODELS[cls.name] = cls
     return cls
 
@@ -558,6 +519,22 @@ def fit_free_run_error(residual: np.ndarray, phi_max: float = 0.999) -> dict[str
         "sigma_meas": float(w[0]),
         "log_likelihood": float(-best.fun),
     }
+
+
+def find_noise_model(name: str | None) -> NoiseModel | None:
+    """The noise model a run names, or None for a name this version does not know (a
+    run written by another version)."""
+    cls = NOISE_MODELS.get(name or "")
+    return None if cls is None else cls()
+
+
+def noise_parameter_names(name: str | None, output_names, state_names=()) -> frozenset[str]:
+    """The names of the noise parameters of noise model ``name`` for a model's outputs
+    and nodes (empty for a name this version does not know)."""
+    nm = find_noise_model(name)
+    if nm is None:
+        return frozenset()
+    return frozenset(n for n, _, _ in nm.parameter_specs(output_names, state_names))
 
 
 def get_noise_model(name: str) -> NoiseModel:

@@ -215,8 +215,7 @@ class _Objective:
         y = ps._a + ps._w * S
         theta = np.tile(ps._fixed, (S.shape[0], 1))
         theta[:, ps._free_idx] = np.where(ps._log, np.exp(np.where(ps._log, y, 0.0)), y)
-        z = (y - ps._mu) / ps._sig
-        lprior = -np.where(ps._gauss, 0.5 * z * z, 0.0).sum(axis=1)
+        lprior = ps.log_density_y(y).sum(axis=1)
         return theta, lprior
 
     def __call__(self, S: np.ndarray) -> np.ndarray:

@@ -49,14 +49,6 @@ from heritage_bayes.rc.catalog import roles_of, solar_apertures
 
 __all__ = ["Parameter", "ParameterSet", "owned_priors", "parameters_for"]
 
-#: What the noise parameters are, by kind (for descriptions and units).
-_NOISE_DESCRIPTION = {
-    "sigma": "marginal sd of the model error of",
-    "phi": "AR(1) coefficient (per time step) of the model error of",
-    "sigma_meas": "sd of the white measurement noise of",
-    "diffusion": "process-noise diffusion (per square root of an hour) of node",
-}
-
 
 @dataclass(frozen=True)
 class Parameter:
@@ -104,9 +96,17 @@ class ParameterSet:
         ab = np.array([p._ab() for p in priors])
         self._a, self._w = ab[:, 0], ab[:, 1] - ab[:, 0]
         self._log = np.array([p.log_scale for p in priors])
-        self._gauss = np.array([p.gaussian for p in priors])
         self._mu = np.array([p.centre for p in priors])
         self._sig = np.array([p.sigma or 1.0 for p in priors])
+        # the free columns of each prior family not flat in its sampling coordinate
+        # (DistributionName.ylogpdf None), with their centres and sigmas
+        fams = [p.family for p in priors]
+        self._families = []
+        for fam in dict.fromkeys(fams):
+            cols = np.array([k for k, f in enumerate(fams) if f is fam])
+            m, s = self._mu[cols], self._sig[cols]
+            if fam.ylogpdf(m[None, :], m, s) is not None:
+                self._families.append((fam, cols, m, s))
         # logit for quantities bounded on both sides by nature (fractions, AR(1) phi);
         # log θ (or θ) with the bounds as hard walls for the rest, so that the exactly
         # linear log-space ridges of RC models (the overall scale) stay straight lines,
@@ -178,12 +178,23 @@ class ParameterSet:
             np.where(inside, 0.0, -np.inf),
         )
         th = np.where(self._log, np.exp(np.clip(np.where(self._log, y, 0.0), -700, 700)), y)
-        # y is log θ for log-scale priors: the Jacobian gains dθ/dy = θ, and
-        # loguniform (∝ 1/θ) cancels it; lognormal keeps the normal term in y
-        z = (y - self._mu) / self._sig
-        logp = logj - np.where(self._gauss, 0.5 * z * z, 0.0)
+        # y is log θ for log-scale priors: the Jacobian gains dθ/dy = θ, which each
+        # family's density in y holds (loguniform's 1/θ cancels it)
+        logp = self._add_log_density_y(y, logj)
         theta[:, self._free_idx] = th
         return theta, logp.sum(axis=1)
+
+    def log_density_y(self, y: np.ndarray) -> np.ndarray:
+        """(K, d) unnormalised log prior density of each free parameter in its sampling
+        coordinate ``y`` (log θ or θ; bounds not checked), asked of each family
+        (:meth:`heritage_bayes.names.DistributionName.ylogpdf`); 0 where flat."""
+        return self._add_log_density_y(y, np.zeros_like(y))
+
+    def _add_log_density_y(self, y: np.ndarray, out: np.ndarray) -> np.ndarray:
+        """``out`` (K, d) plus :meth:`log_density_y` of ``y``, in place."""
+        for fam, cols, m, s in self._families:
+            out[:, cols] += fam.ylogpdf(y[:, cols], m, s)
+        return out
 
     def values(self, X: np.ndarray) -> np.ndarray:
         """Unconstrained (K, d) -> values (K, P)."""
@@ -309,14 +320,15 @@ def parameters_for(
     if apertures:
         _check_glazing(model, set(apertures.values()), survey.glazing_area)
     domain = model.domain
-    noise_priors = noise.priors_for(dt) if hasattr(noise, "priors_for") else {}
+    noise_priors = noise.priors_for(dt)
     roles = roles_of(model.name)
     params = []
-    for name, kind, unit, desc, is_noise in _entries(model, noise_specs):
-        prior = default_prior(domain, kind)
-        if is_noise:
-            prior = noise_priors.get((domain, kind), prior)
+    for name, kind, unit, desc, is_noise in _entries(model, noise, noise_specs):
+        if is_noise and (domain, kind) in noise_priors:
+            prior = noise_priors[(domain, kind)]
         else:
+            prior = default_prior(domain, kind)
+        if not is_noise:
             role = ROLE_PRIORS.get(roles.get(name, ""))
             prior = (role(survey, domain, kind) if role else None) or prior
             if name in apertures and kind == "gain":
@@ -358,9 +370,10 @@ def _check_glazing(model, surfaces: set[str], glazing: Mapping[str, float]) -> N
         )
 
 
-def _entries(model, noise_specs) -> list[tuple[str, str, str, str, bool]]:
+def _entries(model, noise, noise_specs) -> list[tuple[str, str, str, str, bool]]:
     """(name, kind, unit, description, is_noise) of the model's parameters, then of
-    the noise model's (units: the output's [K], [Pa], per √h for a diffusion)."""
+    the noise model's (their units and descriptions the noise model's own: its
+    ``unit`` and ``descriptions``)."""
     potential = "K" if model.domain == "thermal" else "Pa"
     out_units = {
         o: model.network.input_unit(o) if o in model.input_names else potential
@@ -368,11 +381,8 @@ def _entries(model, noise_specs) -> list[tuple[str, str, str, str, bool]]:
     }
     entries = [(i.name, i.kind, i.unit, i.description, False) for i in model.parameters]
     for n, k, o in noise_specs:
-        if k.startswith("sigma"):
-            unit = out_units[o]
-        else:
-            unit = f"{potential}/√h" if k == "diffusion" else "-"
-        entries.append((n, k, unit, f"{_NOISE_DESCRIPTION.get(k, k)} {o}", True))
+        unit = noise.unit(k, out_units.get(o, potential), potential)
+        entries.append((n, k, unit, f"{noise.descriptions.get(k, k)} {o}", True))
     return entries
 
 

@@ -116,68 +116,49 @@ def predictive_noise(s, prep, Ysim: np.ndarray, tn: np.ndarray):
     """Noise model and parameters of the predictive bands, and what was changed.
 
     Returns ``(noise_model, noise, info)``: the likelihood's own model and ``tn`` when
-    nothing is changed (``info`` None), else the free-run error model and its parameters
-    per draw, with ``info`` (output -> fitted parameters and the reason).
+    nothing is changed (``info`` None), else the free-run error's model
+    (:meth:`~heritage_bayes.inference.likelihoods.NoiseModel.free_run_model`) and its
+    parameters per draw, with ``info`` (output -> fitted parameters and the reason).
 
-    - ``ar1_white`` whose correlation sits at its cap: the noise model of the likelihood
-      describes only the misfit's fast part, and bands drawn from it would leave out the
-      slow misfit.
-    - ``kalman`` (a state-space noise model): its process noise is estimated for
-      one-step-ahead prediction; propagated without the data it is not the error of a
-      free run.
-
-    The coverage of such bands on real and generated rooms: docs/science/noise.md,
-    "Figures behind the code's choices".
+    The noise model says per output whether its bands need the free-run error
+    (:meth:`~heritage_bayes.inference.likelihoods.NoiseModel.free_run_reason`):
+    ``ar1_white`` whose correlation sits at its cap describes only the misfit's fast
+    part; ``kalman``'s process noise is estimated for one-step-ahead prediction, and
+    propagated without the data it is not the error of a free run. The coverage of such
+    bands on real and generated rooms: docs/science/noise.md, "Figures behind the
+    code's choices".
 
     The error of *prediction* is then the free-run error: AR(1) + white noise fitted by
     maximum likelihood (phi up to 0.999) to the calibration residuals of the
     posterior-median simulation (:func:`fit_free_run_error`), used for every draw's
-    predictive noise (``ar1_white``'s parameters). The posterior, the likelihood and
-    ``kalman``'s one-step-ahead band are unchanged.
+    predictive noise. The posterior, the likelihood and ``kalman``'s one-step-ahead
+    band are unchanged.
     """
-    from heritage_bayes.inference.likelihoods import AR1WhiteNoise, fit_free_run_error
+    from heritage_bayes.inference.likelihoods import fit_free_run_error
 
     nm = s.logpost.noise
-    statespace = getattr(nm, "statespace", False)
-    if not statespace and ("phi" not in nm.kinds or "sigma_meas" not in nm.kinds):
-        return nm, tn, None
-    q = len(nm.kinds)
     ps = s.logpost.params.parameters[s.logpost.n_model :]
+    reasons = {
+        o: r
+        for o, name in enumerate(s.model.output_names)
+        if (r := nm.free_run_reason(o, name, tn, ps)) is not None
+    }
+    if not reasons:
+        return nm, tn, None
+    band = nm.free_run_model()
+    width = len(band.kinds)
+    out = tn.copy() if band is nm else np.zeros((tn.shape[0], width * s.model.n_outputs))
     obs = np.asarray(prep.observed(s.name, s.model), dtype=float)
     cal = prep.calibration
     rows = slice(cal.start + prep.warmup_steps, cal.stop)
-    out, info = tn, {}
-    band = AR1WhiteNoise()
-    if statespace:
-        out = np.zeros((tn.shape[0], len(band.kinds) * s.model.n_outputs))
-    for o, name in enumerate(s.model.output_names):
-        if statespace:
-            reason = (
-                "process noise is estimated for one-step prediction: free-run bands use "
-                "the free-run error (AR(1) + white fitted to the calibration residuals of "
-                "the posterior-median simulation)"
-            )
-            kinds, width = band.kinds, len(band.kinds)
-        else:
-            i_phi = q * o + nm.kinds.index("phi")
-            cap = ps[i_phi].prior.upper
-            if not np.median(tn[:, i_phi]) > cap - 0.05 * (1.0 - cap):
-                continue
-            reason = (
-                f"phi_{name} at its cap {cap:g}: bands use the free-run error (AR(1) + "
-                "white fitted to the calibration residuals of the posterior-median "
-                "simulation)"
-            )
-            kinds, width = nm.kinds, q
+    info = {}
+    for o, reason in reasons.items():
         r = obs[rows, o] - np.median(Ysim[:, rows, o], axis=0)
         fit = fit_free_run_error(r)
-        out = out.copy() if out is tn else out
-        for kind in ("sigma", "phi", "sigma_meas"):
-            out[:, width * o + kinds.index(kind)] = fit[kind]
-        info[name] = {**fit, "reason": reason}
-    if statespace:
-        return band, out, info
-    return nm, out, (info or None)
+        for j, kind in enumerate(band.kinds):
+            out[:, width * o + j] = fit[kind]
+        info[s.model.output_names[o]] = {**fit, "reason": reason}
+    return band, out, info
 
 
 def initial_state_text(lp) -> str:

@@ -98,11 +98,6 @@ class Prior:
         return self.family.log_scale
 
     @property
-    def gaussian(self) -> bool:
-        """A normal density in the sampling coordinate (``normal``, ``lognormal``)."""
-        return self.family.centre is not None
-
-    @property
     def centre(self) -> float:
         """The centre in the sampling coordinate: log(median) or the mean (0 if flat)."""
         if self.mu is None:

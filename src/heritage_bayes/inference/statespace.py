@@ -41,6 +41,7 @@ References
 from __future__ import annotations
 
 import math
+from types import MappingProxyType
 
 import numba
 import numpy as np
@@ -180,6 +181,33 @@ class KalmanNoise(NoiseModel):
     name = "kalman"
     kinds = ("sigma",)
     statespace = True
+    descriptions = MappingProxyType(
+        {
+            **NoiseModel.descriptions,
+            "diffusion": "process-noise diffusion (per square root of an hour) of node",
+        }
+    )
+    free_run_note = (
+        " The process noise is estimated for one-step prediction (the one-step band "
+        "below); propagated without the data it is not the error of a free run, so "
+        "these bands use the free-run error: "
+    )
+
+    def unit(self, kind, output_unit, potential):
+        """The diffusion ``q_<node>`` in [potential/√h]; the measurement sd in the
+        output's unit."""
+        return (
+            f"{potential}/√h" if kind == "diffusion" else super().unit(kind, output_unit, potential)
+        )
+
+    def free_run_reason(self, o, name, noise, params):
+        """Always: the process noise is estimated for one-step-ahead prediction, and
+        propagated without the data it is not the error of a free run."""
+        return (
+            "process noise is estimated for one-step prediction: free-run bands use the "
+            "free-run error (AR(1) + white fitted to the calibration residuals of the "
+            "posterior-median simulation)"
+        )
 
     def parameter_specs(self, output_names, state_names=()) -> list[tuple[str, str, str]]:
         specs = [(f"sigma_{o}", "sigma_meas", o) for o in output_names]

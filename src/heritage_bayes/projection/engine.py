@@ -75,16 +75,17 @@ def select_draws(run, n: int | None, seed: int) -> Draws:
         P, _ = m.param_array({k: v[idx] for k, v in params.items()})
         model[section] = P
         nm = get_noise_model(getattr(run.config, section).noise)
-        # the bands' error model where it replaced the posterior's (kalman: for every output)
+        # the bands' error model where it replaced the posterior's (for every output:
+        # the free-run error's model, whose columns are all set from the fit below)
         info = run.run_summary.models.get(section)
         pred = {} if info is None else info.predictive_noise
-        if getattr(nm, "statespace", False) and pred and set(pred) >= set(m.output_names):
-            nm = get_noise_model("ar1_white")  # its columns: all set from the fit below
+        if pred and set(pred) >= set(m.output_names):
+            nm = nm.free_run_model()
         names = [f"{section}.{n}" for n, _, _ in nm.parameter_specs(m.output_names, m.state_names)]
         cols = [post[n].values.reshape(-1)[idx] if n in post else np.zeros(idx.size) for n in names]
         noise[section] = np.column_stack(cols) if cols else np.zeros((len(idx), 0))
         for out, fit in pred.items():
-            for kind in ("sigma", "phi", "sigma_meas"):
+            for kind in nm.free_run_model().kinds:
                 name = f"{section}.{kind}_{out}"
                 if name in names:
                     noise[section][:, names.index(name)] = getattr(fit, kind)

@@ -20,6 +20,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from heritage_bayes.inference.likelihoods import ar1_innovations as innovations
+
 __all__ = ["acf", "cumulative_periodogram", "innovations"]
 
 
@@ -61,20 +63,6 @@ def acf(e: np.ndarray, max_lag: int) -> tuple[np.ndarray, np.ndarray, int]:
         if both.any():
             rho[k] = float(np.sum(r[: e.size - k] * r[k:])) / denom
     return lags, rho, n
-
-
-def innovations(e: np.ndarray, phi: float) -> np.ndarray:
-    """AR(1) innovations :math:`w_t = e_t - \\varphi e_{t-1}` (NaN where either is missing).
-
-    The first value is NaN. ``phi = 0`` returns the residuals themselves (iid noise).
-    """
-    e = np.asarray(e, dtype=float)
-    w = np.full(e.shape, np.nan)
-    if e.size > 1:
-        w[1:] = e[1:] - phi * e[:-1]
-    if phi == 0:
-        w[0] = e[0]
-    return w
 
 
 def cumulative_periodogram(e: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:

@@ -11,6 +11,7 @@ search, missing chain files, synthetic data. The verdict itself is
 from __future__ import annotations
 
 from heritage_bayes.format import prior_text, quantity_name
+from heritage_bayes.inference.likelihoods import noise_parameter_names
 from heritage_bayes.rundir.summary import RunSummary, typed_summary
 
 __all__ = ["run_notes"]
@@ -148,7 +149,8 @@ def _model_notes(m: str, i) -> list[dict]:
             }
         )
     out += _frozen_notes(m, i)
-    flagged = [n for n in i.unidentified if not n.startswith(("sigma_", "phi_"))]
+    noise = noise_parameter_names(i.noise, i.output_names, i.state_names)
+    flagged = [n for n in i.unidentified if n not in noise]
     if flagged:
         out.append(
             {

@@ -19,7 +19,7 @@ import numpy as np
 
 from heritage_bayes.errors import InputError
 from heritage_bayes.format import OUT_UNITS, fmt_int, fmt_pct
-from heritage_bayes.names import noise_traits
+from heritage_bayes.inference.likelihoods import NoiseModel, find_noise_model
 from heritage_bayes.report.page import Section
 from heritage_bayes.report.rundata import RunData, parameter_set
 from heritage_bayes.report.sections._fragment import render_fragment
@@ -125,17 +125,14 @@ def _ranks(rd: RunData, m: str, info: ModelInfo) -> dict | None:
     }
 
 
-def _residual_check(
-    resid: np.ndarray, phi: float | None, dt_hours: float, white: tuple | None = None
-) -> dict:
-    """Whiteness of what the noise model leaves: AR(1) innovations, or with ``white``
-    = (sigma, phi, sigma_meas) the standardised Kalman innovations of ``ar1_white``."""
-    from heritage_bayes.inference.likelihoods import ar1_white_innovations
-    from heritage_bayes.report._diag import acf, cumulative_periodogram, innovations
+def _residual_check(resid: np.ndarray, view, dt_hours: float) -> dict:
+    """Whiteness of what the noise model leaves: the innovations of its
+    :class:`~heritage_bayes.inference.likelihoods.ResidualView` ``view``."""
+    from heritage_bayes.report._diag import acf, cumulative_periodogram
 
     max_lag = max(1, round(72 / dt_hours))
     _, rho, n = acf(resid, max_lag)
-    w = ar1_white_innovations(resid, *white) if white else innovations(resid, phi or 0.0)
+    w = view.innovations
     _, rho_w, n_w = acf(w, max_lag)
     band = 1.96 / math.sqrt(max(n_w, 1))
     out_share = float(np.mean(np.abs(rho_w[1:]) > band)) if rho_w.size > 1 else float("nan")
@@ -150,7 +147,7 @@ def _residual_check(
         "lag1_innovations": float(rho_w[1]) if rho_w.size > 1 else float("nan"),
         "worst_lag_h": worst * dt_hours,
         "worst_rho": float(rho_w[worst]) if worst else float("nan"),
-        "phi": phi,
+        "phi": view.phi,
         "out_share": out_share,
         "dev": dev,
         "band": kb,
@@ -225,23 +222,19 @@ def _residual_entry(s, fit: dict) -> dict | None:
     cal = fit["codes"] == 1
     if cal.sum() < 4:
         return None
-    phi, white = None, None
-    traits = noise_traits(noise)
-    if traits.ar1:
-        phi = _median(s, f"{m}.phi_{o}")
-    if traits.white:
-        white = tuple(_median(s, f"{m}.{k}_{o}", 0.0) for k in ("sigma", "phi", "sigma_meas"))
     resid = fit["resid"][cal]
-    check = _residual_check(resid, phi, dt_hours, white)
+    nm = find_noise_model(noise) or NoiseModel()
+    view = nm.residual_view(resid, lambda kind, absent=None: _median(s, f"{m}.{kind}_{o}", absent))
+    check = _residual_check(resid, view, dt_hours)
     fig = fig_residuals(
         fit["times"][cal],
         resid,
         output=o,
         unit=OUT_UNITS.get(o, ""),
-        phi=phi,
+        phi=view.phi,
         dt_hours=dt_hours,
         innov=check.pop("innovations"),
-        acf_scale=white[0] ** 2 / (white[0] ** 2 + white[2] ** 2) if white else 1.0,
+        acf_scale=view.acf_scale,
     )
     return {
         "id": f"fig-resid-{m}-{o}",
@@ -249,36 +242,19 @@ def _residual_entry(s, fit: dict) -> dict | None:
         "output": o,
         "model": fit["model"],
         "figure": fig,
-        "words": _residual_words(check, phi, white),
+        "words": _residual_words(check, view),
         "adequate": check["adequate"],
         "check": check,
     }
 
 
-def _residual_words(check: dict, phi: float | None, white: tuple | None) -> str:
+def _residual_words(check: dict, view) -> str:
     """The residual check in words: the lag-1 autocorrelation against the noise model's
     and whether what is left is white noise."""
-    if white is not None:
-        words = (
-            f"Lag-1 autocorrelation of the residuals {check['lag1']:.2f}; the "
-            f"AR(1) + white noise model expects about "
-            f"{phi * white[0] ** 2 / (white[0] ** 2 + white[2] ** 2):.2f}. "
-        )
-        subject = "the standardised one-step innovations of the AR(1) + white model"
-    elif phi is not None:
-        words = (
-            f"Lag-1 autocorrelation of the residuals {check['lag1']:.2f}; the "
-            f"AR(1) noise model expects ≈ φ = {phi:.2f}. "
-        )
-        subject = "the innovations left after the AR(1) model"
-    else:
-        words = (
-            f"Lag-1 autocorrelation of the residuals {check['lag1']:.2f}; the iid "
-            "noise model expects ≈ 0. "
-        )
-        subject = "the residuals"
+    words = f"Lag-1 autocorrelation of the residuals {check['lag1']:.2f}; {view.expects}. "
+    subject = view.subject
     share = fmt_pct(check["out_share"])
-    if phi is not None:
+    if view.phi is not None:
         words += f"Lag-1 autocorrelation of the innovations {check['lag1_innovations']:.2f}. "
     if check["adequate"]:
         words += (

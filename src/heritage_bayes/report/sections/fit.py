@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from heritage_bayes.format import OUT_WORDS
-from heritage_bayes.names import noise_traits
+from heritage_bayes.inference.likelihoods import NoiseModel, find_noise_model
 from heritage_bayes.report.page import Section
 from heritage_bayes.report.rundata import (
     RunData,
@@ -91,18 +91,9 @@ def fit_context(rd: RunData, outputs: list[dict]) -> list[dict]:
         pred = None if info is None else info.predictive_noise.get(o["output"])
         band_note = ""
         if pred:
-            kalman = noise_traits(info.noise).state_space
+            nm = find_noise_model(info.noise) or NoiseModel()
             band_note = (
-                (
-                    " The process noise is estimated for one-step prediction (the "
-                    "one-step band below); propagated without the data it is not the "
-                    "error of a free run, so these bands use the free-run error: "
-                    if kalman
-                    else " The noise model's correlation sits at its cap (about a day), "
-                    "so its error model leaves out the slow misfit; the bands use the "
-                    "free-run error instead: "
-                )
-                + f"AR(1) of sd {pred.sigma:.3g} with hourly coefficient "
+                nm.free_run_note + f"AR(1) of sd {pred.sigma:.3g} with hourly coefficient "
                 f"{pred.phi:.3f} plus white noise of sd {pred.sigma_meas:.3g}, fitted "
                 "to the calibration residuals of the posterior-median simulation."
             )

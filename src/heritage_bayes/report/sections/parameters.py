@@ -14,6 +14,7 @@ import math
 import numpy as np
 
 from heritage_bayes.format import fmt, fmt_int, fmt_interval, fmt_pct, prior_text, quantity_name
+from heritage_bayes.inference.likelihoods import noise_parameter_names
 from heritage_bayes.report.identifiable import mcse_cells, mcse_table, prior_density
 from heritage_bayes.report.page import Section
 from heritage_bayes.report.rundata import RunData, parameter_set, section_params
@@ -34,10 +35,11 @@ def parameter_tables(rd: RunData) -> list[dict]:
         params = [e for e in rs.parameters.values() if e.section == m]
         has_truth = any(e.truth is not None for e in params)
         mc = mcse_table(rd, [e.key for e in params if e.fixed is None])
+        noise = noise_parameter_names(info.noise, info.output_names, info.state_names)
         rows = []
         for e in params:
             if e.name not in idf.parameters:
-                id_text = "noise" if e.kind in ("sigma", "phi", "sigma_meas") else "—"
+                id_text = "noise" if e.name in noise else "—"
             elif e.name in idf.identifiable:
                 id_text = "yes"
             elif e.name in idf.identifiable_given_scale:

@@ -82,10 +82,10 @@ from heritage_bayes.rc.sorption import CoupledHygricModel, coupled_network
 
 __all__ = [
     "APERTURE_PREFIX",
-    "GROUND_CYCLE_INPUTS",
-    "GROUND_REFERENCE",
     "CATALOG",
     "DOMAINS",
+    "GROUND_CYCLE_INPUTS",
+    "GROUND_REFERENCE",
     "ROLES",
     "CatalogModel",
     "DomainView",

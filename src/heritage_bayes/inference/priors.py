@@ -180,7 +180,7 @@ _DEFAULTS: dict[tuple[str, str], Prior] = {
     # equivalent depth [m] of a ground temperature in clay/silt soil (option ground:
     # seasonal): median 1.5 m, a factor 2 per sd, from just under the floor (0.2 m:
     # the annual swing × 0.91, 5 days late) to deep and far below a large building
-    # (6 m: × 0.07, 137 days late); the damping depth is 2.24 m (ISO 13370, clay/silt)
+    # (6 m: × 0.07, 156 days late); the damping depth is 2.24 m (ISO 13370, clay/silt)
     ("thermal", "depth"): Prior("lognormal", 0.2, 6.0, 1.5, 0.7),
     # hygric capacities [kg/Pa]: air of 1 m³ is 7.5e-6 kg/Pa; buffering contents far more
     ("hygric", "capacity"): Prior("loguniform", 1e-6, 1e3),

@@ -47,11 +47,11 @@ def test_decomposition_reproduces_kusuda_achenbach_at_fixed_depths():
 
 def test_depth_prior_bounds_and_validity():
     p = default_prior("thermal", "depth")
-    assert (p.dist, p.lower, p.upper, p.mu) == ("lognormal", 0.2, 6.0, 1.5)
+    assert (p.dist, p.lower, p.upper, p.mu, p.sigma) == ("lognormal", 0.5, 6.0, 2.0, 0.5)
     assert p.log_scale  # sampled in log z
     draws = p.sample(np.random.default_rng(0), 2000)
-    assert draws.min() >= 0.2 and draws.max() <= 6.0
-    assert np.median(draws) == pytest.approx(1.5, rel=0.1)
+    assert draws.min() >= 0.5 and draws.max() <= 6.0
+    assert np.median(draws) == pytest.approx(2.0, rel=0.1)
     m = model("thermal_1c", surfaces=(), ground="seasonal")
     info = {i.name: i for i in m.parameters}["zf"]
     assert (info.kind, info.unit) == ("depth", "m")

@@ -49,7 +49,7 @@ class GroundTemperature(_Strict):
         unit="m",
         description="mode seasonal: depth of the ground temperature in clay/silt soil "
         "(1 m: the annual swing × 0.64, 26 days late). Default: estimated by the thermal "
-        "model (parameter zf, prior median 1.5 m within 0.2-6 m)",
+        "model (parameter zf, prior median 2 m within 0.5-6 m)",
         ge=0,
         le=20,
     )

@@ -125,3 +125,26 @@ def test_the_default_ground_of_files_estimates_its_depth():
     for gt in ({"mode": "seasonal", "depth": 1.0}, {"mode": "annual_mean"}):
         m = build_model(_config(**gt), "thermal")
         assert "zf" not in m.parameter_names and "Tf_cos" not in m.input_names
+
+
+def test_prepared_columns_move_tf_to_any_depth():
+    """Tf at 1 m (the files' default input) plus the depth-weighted cycle columns is the
+    seasonal ground at that depth; without a cycle to fit, zero columns, said so."""
+    from heritage_bayes.inputs import ground_cycle_inputs, seasonal_ground_temperature
+
+    idx = pd.date_range("2021-01-01", periods=400 * 24, freq="1h", tz="UTC")
+    w = 2 * np.pi / YEAR_DAYS
+    days = idx.as_unit("ns").asi8 / (86_400 * 10**9)
+    te = pd.Series(9.0 - 7.0 * np.cos(w * (days - T0)) + 3 * np.sin(2 * np.pi * idx.hour / 24), idx)
+    times = idx[::24] + pd.Timedelta("30min")
+    tf, _ = seasonal_ground_temperature(te, times)
+    cols, note = ground_cycle_inputs(te, times)
+    assert note.startswith("depth estimated (zf)")
+    a_r, b_r = depth_factors(GROUND_REFERENCE)
+    for z in (0.5, 2.0, 5.0):
+        a, b = depth_factors(z)
+        moved = tf + (a - a_r) * cols["Tf_cos"] + (b - b_r) * cols["Tf_sin"]
+        np.testing.assert_allclose(moved, seasonal_ground_temperature(te, times, z)[0], atol=1e-9)
+    short, note = ground_cycle_inputs(te.iloc[: 24 * 60], times)
+    assert not short["Tf_cos"].any() and not short["Tf_sin"].any()
+    assert note.startswith("depth not estimable; no seasonal cycle: Te spans 60 days")

@@ -319,7 +319,7 @@ def test_csv_sources(files):
     assert f["Tf"].nunique() == 1
     # ... nor the cycle's components: zeros, the depth has no effect, said so
     assert (f[["Tf_cos", "Tf_sin"]].to_numpy() == 0).all()
-    assert gt["depth"].startswith("depth not estimable; no seasonal cycle")
+    assert gt["estimated_depth"].startswith("depth not estimable; no seasonal cycle")
     # UTC+1 logger: the reading stamped 02-01-2020 01:00 is the row 2020-01-02 00:00 UTC
     logger = pd.read_csv(files / "logger.csv", sep=";")
     row = logger.index[logger["stamp"] == "02-01-2020 01:00"][0]

@@ -130,7 +130,10 @@ def complete_frame(cfg, aligned, weather, models, ground: bool, sources: dict):
         cols, note = ground_cycle_inputs(weather["Te"], frame.index + step / 2)
         for name, col in cols.items():
             frame[name], flags[name] = col, False
-        sources.setdefault("ground_temperature", {})["depth"] = note
+        gt_note = sources.setdefault("ground_temperature", {})
+        gt_note["estimated_depth"] = note
+        if "method" in gt_note and note.startswith("depth estimated"):
+            gt_note["method"] += "; the thermal model moves it to the depth zf it estimates"
     for name, col in calendar_inputs(models, frame.index, step.total_seconds()).items():
         frame[name] = col  # hours of use from a weekly calendar (thermostat.schedule)
         flags[name] = False

@@ -11,8 +11,8 @@ heat gone from 2018, its heating level moved by hand between the winters 2018/19
 periods: 2012 split 8/4 months without the constant gain (what init proposed when it
 took the first year), 2014 split 8/4, and 2014 / 2015 (the dehumidified years); and on
 init's periods each thermal model, the ground as the running annual mean, and the
-seasonal ground deeper than the default 1 m (2.24 m, a clay/silt soil's periodic
-penetration depth; 3 m).
+seasonal ground at fixed depths (1 m, 2.24 m: a clay/silt soil's periodic penetration
+depth, 3 m) and at the depth the calibration estimates (the default).
 
 Usage (from the repository root)::
 
@@ -56,6 +56,7 @@ def variants(init_cfg):
     iopts = dict(init_cfg.thermal.options)
     no_gain = {k: v for k, v in iopts.items() if k != "source"}
     annual = GroundTemperature(mode="annual_mean")
+    seasonal = GroundTemperature(mode="seasonal")
 
     def deep(depth):
         return GroundTemperature(mode="seasonal", depth=depth)
@@ -109,6 +110,19 @@ def variants(init_cfg):
         ),
         "init, thermal_2c, Tf 3 m deep": lambda: _with(
             init_cfg, thermal={"model": "thermal_2c"}, data={"ground_temperature": deep(3.0)}
+        ),
+        "init, thermal_2c, Tf 1 m deep": lambda: _with(
+            init_cfg, thermal={"model": "thermal_2c"}, data={"ground_temperature": deep(1.0)}
+        ),
+        # the default: the seasonal ground at a depth the calibration estimates (zf)
+        "init, thermal_1c, Tf depth estimated": lambda: _with(
+            init_cfg, thermal={"model": "thermal_1c"}, data={"ground_temperature": seasonal}
+        ),
+        "init, thermal_2c, Tf depth estimated": lambda: _with(
+            init_cfg, thermal={"model": "thermal_2c"}, data={"ground_temperature": seasonal}
+        ),
+        "init, thermal_4a, Tf depth estimated": lambda: _with(
+            init_cfg, thermal={"model": "thermal_4a"}, data={"ground_temperature": seasonal}
         ),
     }
 

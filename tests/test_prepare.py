@@ -319,10 +319,12 @@ def files(tmp_path) -> Path:
 def test_csv_sources(files):
     prep = prepare(_load(files, _csv_config(files)))
     f = prep.frame
-    inputs = ["Te", "I_S", "I_roof", "Tf", "Pe"]
+    # files' default ground: the seasonal Tf at 1 m and its cycle's components for the
+    # depth zf the calibration estimates
+    inputs = ["Te", "I_S", "I_roof", "Tf", "Tf_cos", "Tf_sin", "Pe"]
     # data.input_hold exact (files' default): each input's change over the step after
     # the inputs (the first-order hold); zero for interval means and the annual-mean Tf
-    slopes = [f"{c}_slope" for c in ("Te", "I_S", "I_roof", "Tf", "Pe")]
+    slopes = [f"{c}_slope" for c in inputs]
     assert list(f.columns) == [*inputs, *slopes, "Ti", "Pi", "RHi"]
     assert f.attrs["input_hold"] == "exact" and f.attrs["units"]["Te_slope"] == "°C per step"
     assert (f[["I_S_slope", "I_roof_slope", "Tf_slope"]].to_numpy() == 0).all()
@@ -337,6 +339,9 @@ def test_csv_sources(files):
     gt = prep.sources["ground_temperature"]
     assert gt["mode"] == "seasonal" and "no seasonal cycle: Te spans 60 days" in gt["method"]
     assert f["Tf"].nunique() == 1
+    # ... nor the cycle's components: zeros, the depth has no effect, said so
+    assert (f[["Tf_cos", "Tf_sin"]].to_numpy() == 0).all()
+    assert gt["estimated_depth"].startswith("depth not estimable; no seasonal cycle")
     # UTC+1 logger: the reading stamped 02-01-2020 01:00 is the row 2020-01-02 00:00 UTC
     logger = pd.read_csv(files / "logger.csv", sep=";")
     row = logger.index[logger["stamp"] == "02-01-2020 01:00"][0]

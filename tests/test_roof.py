@@ -153,10 +153,14 @@ def test_init_writes_the_roof_for_an_attic_and_not_for_the_room_below(shared_dat
     cfg = load_config(tmp_path / "a.yaml")
     assert cfg.data.surfaces == {"roof_N": (45.0, 0.0), "roof_S": (45.0, 180.0)}
     assert cfg.data.weather.columns["wind"] == "ws"  # FMI's wind speed: the sun on the roof
+    # no floor on the soil: Tf at a fixed 1 m, no depth to estimate
+    assert (cfg.data.ground_temperature.mode, cfg.data.ground_temperature.depth) == ("seasonal", 1)
     # the heated room below: neither its name nor its daily swing (0.2 of outdoors') says roof
     res = init_config(d / "indoor1.csv", d / "fmi.csv", output=tmp_path / "b.yaml", **site)
     assert "roof:" not in res.text
-    assert load_config(tmp_path / "b.yaml").data.surfaces == {"H": (0.0, 0.0)}
+    below = load_config(tmp_path / "b.yaml").data
+    assert below.surfaces == {"H": (0.0, 0.0)}
+    assert below.ground_temperature.depth is None  # its ground's depth is estimated
 
 
 def test_wind_weight_is_iso_6946s_share_reaching_the_attic():

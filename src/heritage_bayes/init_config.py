@@ -288,6 +288,12 @@ def _config_text(
         ]
     lines += [*_doc("data.step"), "  step: 1h", *_doc("data.max_gap"), f"  max_gap: {MAX_GAP_H}h"]
     lines += [*_doc("data.input_hold"), "  input_hold: exact"]
+    if attic:  # no floor on the soil: no soil depth to estimate
+        lines += [
+            "  # an attic has no floor on the soil: its ground node Tf stands in for the",
+            "  # storey below, so Tf stays the outdoor annual cycle at a fixed 1 m",
+            "  ground_temperature: {mode: seasonal, depth: 1}",
+        ]
     lines += ["", "periods:", *_wrap(per.why, "  # ", "  # ")]
     lines += [
         f"  calibration: {{start: {per.cs}, end: {per.ce}}}",
@@ -295,8 +301,10 @@ def _config_text(
         "",
         "# The model the data call for (what init measured over the periods):",
         *[x for f in prop.thermal_evidence for x in _wrap(f, "#   - ", "#     ")],
-        "# Tf, the fixed node, is the outdoor annual cycle 1 m deep in the soil (the ground",
-        "# under the floor). A room without a floor on the ground (an attic, an upper storey): set",
+        "# Tf, the fixed node, is the outdoor annual cycle in the soil under the floor, damped",
+        "# and delayed at a depth zf [m] the calibration estimates (Kusuda-Achenbach; a fixed",
+        "# depth: data.ground_temperature: {mode: seasonal, depth: ...}; an attic: 1 m). A",
+        "# room without a floor on the ground (an attic, an upper storey): set",
         "# options: {ground: false}, or give the neighbouring space's measured temperature",
         "# (data.ground_temperature: {mode: column, column: ..., source: {...}}).",
         "thermal:",

@@ -19,6 +19,7 @@ __all__ = [
     "annual_mean_temperature",
     "calendar_inputs",
     "fixed_node_temperature",
+    "ground_cycle_inputs",
     "ground_input",
     "seasonal_ground_temperature",
     "solar_inputs",
@@ -177,16 +178,11 @@ def seasonal_ground_temperature(
     from heritage_bayes.climate import ground
 
     depth = ground.GROUND_DEPTH if depth is None else float(depth)
-    valid = te.index[np.isfinite(np.asarray(te, dtype=float))]
-    span = (valid[-1] - valid[0]) / pd.Timedelta(days=1) if len(valid) else 0.0
-    if span < ground.MIN_SPAN_DAYS + 3:
+    cycle, short = _annual_cycle(te)
+    if cycle is None:
         values, info = annual_mean_temperature(te, times)
-        info["method"] += (
-            f"; no seasonal cycle: Te spans {span:.0f} days, the fit needs "
-            f"{ground.MIN_SPAN_DAYS + 3:.0f}"
-        )
+        info["method"] += short
         return values, info
-    cycle = ground.fit_annual_cycle(te)
     values = ground.kusuda_achenbach(
         times, cycle["mean"], cycle["amplitude"], cycle["t_min"], depth=depth
     )
@@ -206,6 +202,57 @@ def seasonal_ground_temperature(
         "max": float(np.max(values)) if len(values) else None,
     }
     return values, info
+
+
+def _annual_cycle(te: pd.Series) -> tuple[dict | None, str]:
+    """The annual cycle of ``te`` (:func:`heritage_bayes.climate.ground.fit_annual_cycle`),
+    or None and why (daily means spanning too few days)."""
+    from heritage_bayes.climate import ground
+
+    valid = te.index[np.isfinite(np.asarray(te, dtype=float))]
+    span = (valid[-1] - valid[0]) / pd.Timedelta(days=1) if len(valid) else 0.0
+    if span < ground.MIN_SPAN_DAYS + 3:
+        return None, (
+            f"; no seasonal cycle: Te spans {span:.0f} days, the fit needs "
+            f"{ground.MIN_SPAN_DAYS + 3:.0f}"
+        )
+    return ground.fit_annual_cycle(te), ""
+
+
+def ground_cycle_inputs(te: pd.Series, times: pd.DatetimeIndex) -> tuple[dict, str]:
+    """The surface's annual anomaly and its quadrature [K] at ``times``, the inputs
+    ``Tf_cos`` and ``Tf_sin`` of a ground at an estimated depth
+    (:class:`heritage_bayes.rc.network.GroundCycle`).
+
+    Parameters
+    ----------
+    te : pandas.Series
+        Outdoor air temperature [°C], tz-aware index: the **whole** weather record.
+    times : pandas.DatetimeIndex
+        Tz-aware instants.
+
+    Returns
+    -------
+    columns : dict
+        ``Tf_cos``, ``Tf_sin`` -> (N,) arrays [K]
+        (:func:`heritage_bayes.climate.ground.annual_components` of the cycle fitted as
+        in :func:`seasonal_ground_temperature`); zeros when ``te`` has no cycle to fit
+        (the depth then has no effect).
+    note : str
+        Plain words for the record of the inputs.
+    """
+    from heritage_bayes.climate import ground
+
+    cycle, short = _annual_cycle(te)
+    if cycle is None:
+        zeros = np.zeros(len(times))
+        return {"Tf_cos": zeros, "Tf_sin": zeros.copy()}, f"depth not estimable{short}"
+    c, s = ground.annual_components(times, cycle["amplitude"], cycle["t_min"])
+    note = (
+        f"depth estimated (zf): the ground follows the annual cycle of Te (amplitude "
+        f"{cycle['amplitude']:.2f} K) damped and delayed at the depth zf (Kusuda-Achenbach)"
+    )
+    return {"Tf_cos": c, "Tf_sin": s}, note
 
 
 def ground_input(

@@ -231,11 +231,25 @@ def default_warmup(cfg: CalibrationConfig, models: Mapping[str, RCModel]) -> pd.
 def catalog_options(cfg: CalibrationConfig, section: str, name: str) -> dict:
     """Network options of catalogue model ``name`` in a section: the configured ones,
     plus the solar surfaces from ``data.surfaces`` (none when ``data.irradiance:
-    none``)."""
+    none``) and, for a thermal model coupled to the ground (``ground`` true, the
+    default) whose ground temperature is ``data.ground_temperature: {mode: seasonal}``
+    without a ``depth``, the estimated depth (``ground: seasonal``,
+    :data:`heritage_bayes.rc.catalog.GROUND_CYCLE_INPUTS`)."""
     options = getattr(cfg, section).options.network_options()
     if CATALOG[name].solar and "surfaces" not in options:
         options["surfaces"] = tuple(cfg.data.surfaces) if cfg.data.irradiance != "none" else ()
+    if takes_option(name, "ground") and options.get("ground", True) is True:
+        if ground_depth_estimated(cfg):
+            options["ground"] = "seasonal"
     return options
+
+
+def ground_depth_estimated(cfg: CalibrationConfig) -> bool:
+    """Whether the thermal ground follows the season at an estimated depth: ``data.
+    ground_temperature`` in mode ``seasonal`` (the default for files) without a
+    ``depth``."""
+    gt = cfg.data.ground_temperature
+    return gt.mode == "seasonal" and gt.depth is None
 
 
 def model(name: str, **options) -> RCModel:

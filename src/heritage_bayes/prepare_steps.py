@@ -15,8 +15,14 @@ import pandas as pd
 
 from heritage_bayes.convert import format_timedelta
 from heritage_bayes.errors import ConfigError, DataError, InputError
-from heritage_bayes.inputs import add_slope_columns, calendar_inputs, ground_input
+from heritage_bayes.inputs import (
+    add_slope_columns,
+    calendar_inputs,
+    ground_cycle_inputs,
+    ground_input,
+)
 from heritage_bayes.names import DEFAULT_NOISE
+from heritage_bayes.rc.catalog import GROUND_CYCLE_INPUTS
 from heritage_bayes.sources import OUTPUT_COLUMNS, _iso
 
 # -- periods ----------------------------------------------------------------------------
@@ -121,6 +127,14 @@ def complete_frame(cfg, aligned, weather, models, ground: bool, sources: dict):
             tf, sources["ground_temperature"] = ground_input(gt.mode, weather["Te"], mids, gt.depth)
         frame["Tf"] = tf
         flags["Tf"] = False
+    if any(c in m.input_names for m in models for c in GROUND_CYCLE_INPUTS):
+        cols, note = ground_cycle_inputs(weather["Te"], frame.index + step / 2)
+        for name, col in cols.items():
+            frame[name], flags[name] = col, False
+        gt_note = sources.setdefault("ground_temperature", {})
+        gt_note["estimated_depth"] = note
+        if "method" in gt_note and note.startswith("depth estimated"):
+            gt_note["method"] += "; the thermal model moves it to the depth zf it estimates"
     for name, col in calendar_inputs(models, frame.index, step.total_seconds()).items():
         frame[name] = col  # hours of use from a weekly calendar (thermostat.schedule)
         flags[name] = False
@@ -137,7 +151,8 @@ def complete_frame(cfg, aligned, weather, models, ground: bool, sources: dict):
         frame["Pi"] = add_vapour_pressure(frame[["Ti", "RHi"]])["Pi"].to_numpy()
         flags["Pi"] = False
 
-    order = [c for c in ("Te", *[f"I_{k}" for k in surfaces], "Tf", "Pe") if c in frame]
+    known = ("Te", *[f"I_{k}" for k in surfaces], "Tf", *GROUND_CYCLE_INPUTS, "Pe")
+    order = [c for c in known if c in frame]
     order += [c for c in frame.columns if c not in order and c not in OUTPUT_COLUMNS]
     order += [c for c in ("Ti", "Pi", "RHi") if c in frame]
     frame = frame[order]
@@ -149,6 +164,7 @@ def complete_frame(cfg, aligned, weather, models, ground: bool, sources: dict):
         **frame.attrs.get("units", {}),
         **{c: "W/m²" for c in order if c.startswith("I_")},
         **{c: u for c, u in (("Tf", "°C"), ("Pi", "Pa")) if c in order},
+        **{c: "K" for c in GROUND_CYCLE_INPUTS if c in order},
         **{c: "-" for m in models for c in getattr(m, "calendar_inputs", {})},
     }
     add_slope_columns(frame, models, aligned.slopes, flags)  # the first-order hold

@@ -28,7 +28,10 @@ __all__ = [
     "GROUND_DEPTH",
     "SOIL_DIFFUSIVITY",
     "YEAR_DAYS",
+    "annual_components",
     "damping",
+    "damping_depth",
+    "depth_factors",
     "fit_annual_cycle",
     "kusuda_achenbach",
 ]
@@ -64,6 +67,41 @@ def damping(depth: float, diffusivity: float = SOIL_DIFFUSIVITY) -> tuple[float,
     omega = 2.0 * np.pi / YEAR_DAYS  # [1/d]
     d = np.sqrt(2.0 * alpha * 86_400.0 / omega)  # damping depth [m]
     return float(np.exp(-depth / d)), float(depth / d / omega)
+
+
+def damping_depth(diffusivity: float = SOIL_DIFFUSIVITY) -> float:
+    """Damping depth :math:`d = \\sqrt{2\\alpha/\\omega}` [m] of the annual cycle in a
+    soil of thermal ``diffusivity`` :math:`\\alpha` [m²/s] (2.24 m for clay/silt)."""
+    omega = 2.0 * np.pi / (YEAR_DAYS * 86_400.0)  # [1/s]
+    return float(np.sqrt(2.0 * float(diffusivity) / omega))
+
+
+def depth_factors(depth, diffusivity: float = SOIL_DIFFUSIVITY) -> tuple[np.ndarray, np.ndarray]:
+    """Weights of the surface cycle's components at ``depth`` [m] (scalar or array).
+
+    Returns :math:`(e^{-z/d}\\cos(z/d),\\ e^{-z/d}\\sin(z/d))` [-], so that the soil
+    temperature of :func:`kusuda_achenbach` is
+    :math:`T_m + a(z)\\,c(t) + b(z)\\,s(t)` with :math:`c, s` from
+    :func:`annual_components`: linear in two series that do not depend on the depth.
+    At :math:`z = 0`: (1, 0), the surface cycle itself.
+    """
+    x = np.asarray(depth, dtype=float) / damping_depth(diffusivity)
+    rho = np.exp(-x)
+    return rho * np.cos(x), rho * np.sin(x)
+
+
+def annual_components(
+    times: pd.DatetimeIndex, amplitude: float, t_min: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """The surface's annual anomaly and its quadrature [K] at ``times``.
+
+    :math:`c(t) = -A\\cos\\omega(t - t_0)` (the surface temperature minus its annual
+    mean) and :math:`s(t) = -A\\sin\\omega(t - t_0)` (the same cycle a quarter of a
+    year earlier), with ``amplitude`` :math:`A` [K] and ``t_min`` :math:`t_0` [d since
+    1970-01-01 UTC] as in :func:`kusuda_achenbach`; :math:`\\omega = 2\\pi/P`.
+    """
+    arg = 2.0 * np.pi / YEAR_DAYS * (_days(times) - float(t_min))
+    return -float(amplitude) * np.cos(arg), -float(amplitude) * np.sin(arg)
 
 
 def kusuda_achenbach(
@@ -107,11 +145,15 @@ def kusuda_achenbach(
 
     with :math:`P` = 365.2425 d. The amplitude ratio is :math:`e^{-z/d}` and the lag
     :math:`z/(d\\,\\omega)`; at :math:`z = 0` the surface cycle itself. With the defaults
-    :math:`d` = 2.24 m: ratio 0.64, lag 26 d at 1 m; 0.41 and 52 d at 2 m.
+    :math:`d` = 2.24 m: ratio 0.64, lag 26 d at 1 m; 0.41 and 52 d at 2 m. Expanding
+    the cosine, :math:`T = T_m + a(z)\\,c(t) + b(z)\\,s(t)`
+    (:func:`depth_factors`, :func:`annual_components`): a model can take :math:`c, s`
+    as inputs and estimate the depth.
     """
-    ratio, lag = damping(depth, diffusivity)
-    omega = 2.0 * np.pi / YEAR_DAYS  # [1/d]
-    return mean - amplitude * ratio * np.cos(omega * (_days(times) - t_min - lag))
+    damping(depth, diffusivity)  # checks the depth and the diffusivity
+    a, b = depth_factors(depth, diffusivity)
+    c, s = annual_components(times, amplitude, t_min)
+    return mean + a * c + b * s
 
 
 def fit_annual_cycle(te: pd.Series) -> dict:

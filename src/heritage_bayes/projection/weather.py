@@ -192,11 +192,13 @@ def model_inputs(run, pcfg, weather: pd.DataFrame, site: dict | None, where: str
     from heritage_bayes.inputs import (
         add_slope_columns,
         calendar_inputs,
+        ground_cycle_inputs,
         ground_input,
         weather_inputs,
     )
     from heritage_bayes.io import align
     from heritage_bayes.prepare import _extra_inputs
+    from heritage_bayes.rc.catalog import GROUND_CYCLE_INPUTS
 
     cfg = run.config
     data = cfg.data
@@ -220,17 +222,24 @@ def model_inputs(run, pcfg, weather: pd.DataFrame, site: dict | None, where: str
     frame = aligned.frame.copy()
     if thermal or any("Tf" in m.input_names for m in run.models.values()):
         gt = pcfg.ground_temperature or data.ground_temperature
+        cycle = any(c in m.input_names for m in run.models.values() for c in GROUND_CYCLE_INPUTS)
+        mids = frame.index + step / 2
         if gt.mode == "constant":
             frame["Tf"] = float(gt.value)
         elif gt.mode in ("seasonal", "annual_mean"):
-            mids = frame.index + step / 2
-            frame["Tf"], _ = ground_input(gt.mode, weather["Te"], mids, gt.depth)
+            # with a calibrated depth zf, Tf is the soil at the reference depth (1 m)
+            depth = None if cycle else gt.depth
+            frame["Tf"], _ = ground_input(gt.mode, weather["Te"], mids, depth)
         else:
             raise ConfigError(
                 "ground_temperature: the run measured its ground temperature (mode "
                 "'column'), which has no future; give ground_temperature: {mode: "
                 "seasonal} or {mode: constant, value: ...} in the projection file"
             )
+        # a ground at the calibrated depth zf: the future's own annual cycle (none for a
+        # constant or annual-mean ground, which has no cycle at any depth)
+        for name, col in (ground_cycle_inputs(weather["Te"], mids)[0] if cycle else {}).items():
+            frame[name] = col if gt.mode == "seasonal" else 0.0 * col
     # inputs the models make from a calendar (a thermostat's weekly hours of use): the
     # calibrated use goes on into the future, on the projection's own dates
     for name, col in calendar_inputs(

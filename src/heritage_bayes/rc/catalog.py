@@ -49,7 +49,12 @@ Options (keywords of :func:`model`): ``surfaces`` (sequence of surface names for
 thermal models with solar), ``ground`` (default True: ``Gf`` to the input column ``Tf``;
 False: no fixed node; ``"estimate"``: ``Tf`` [°C] is a constant to estimate, like the
 fixed vapour pressure ``Pf`` of hygric model 3: a ground or neighbouring space of
-unknown but steady temperature, or the net effect of minimal heating),
+unknown but steady temperature, or the net effect of minimal heating; ``"seasonal"``:
+``Tf`` is the soil temperature at 1 m under the annual cycle of the surface, and its
+equivalent depth ``zf`` [m] is estimated: a :class:`~heritage_bayes.rc.network.GroundCycle`
+with the inputs ``Tf_cos``, ``Tf_sin`` [K], the surface's annual anomaly and its
+quadrature, so that the ground follows the Kusuda-Achenbach temperature at depth
+``zf``, damped by :math:`e^{-z_f/d}` and delayed by :math:`z_f/(d\\omega)`),
 ``heating`` (bool, default False: an input ``Ph`` [W] of known gain 1 into the air node,
 e.g. measured heating power in a test cell; it makes the absolute scale of C and G
 identifiable).
@@ -68,16 +73,19 @@ import inspect
 from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from typing import NamedTuple
 
+from heritage_bayes.climate.ground import GROUND_DEPTH
 from heritage_bayes.rc.control import controlled
 from heritage_bayes.rc.control_spec import Control
 from heritage_bayes.rc.model import RCModel
-from heritage_bayes.rc.network import Link, Network, Node, Source
+from heritage_bayes.rc.network import GroundCycle, Link, Network, Node, Source
 from heritage_bayes.rc.sorption import CoupledHygricModel, coupled_network
 
 __all__ = [
     "APERTURE_PREFIX",
     "CATALOG",
     "DOMAINS",
+    "GROUND_CYCLE_INPUTS",
+    "GROUND_REFERENCE",
     "ROLES",
     "CatalogModel",
     "DomainView",
@@ -109,11 +117,21 @@ _DESCRIPTIONS = {
     "Tf": "fixed (ground) temperature",
     "Pe": "outdoor vapour pressure",
     "Ph": "heating power into the air node (known gain 1)",
+    "zf": "equivalent depth of the ground temperature in clay/silt soil",
+    "Tf_cos": "annual anomaly of the ground surface (fitted to the outdoor air)",
+    "Tf_sin": "quadrature of the ground surface's annual anomaly",
 }
+
+#: Input columns of the surface's annual cycle, :func:`heritage_bayes.climate.ground.
+#: annual_components` (anomaly, quadrature) [K], of option ``ground: seasonal``.
+GROUND_CYCLE_INPUTS = ("Tf_cos", "Tf_sin")
+#: Depth [m] at which the input ``Tf`` is given under option ``ground: seasonal``
+#: (:data:`heritage_bayes.climate.ground.GROUND_DEPTH`).
+GROUND_REFERENCE = GROUND_DEPTH
 
 
 def _thermal(
-    name: str, *, nodes: str, surfaces: Sequence[str] | None, ground: bool, heating: bool
+    name: str, *, nodes: str, surfaces: Sequence[str] | None, ground: bool | str, heating: bool
 ) -> Network:
     surfaces = tuple(surfaces) if surfaces else ()
     desc = dict(_DESCRIPTIONS)
@@ -129,16 +147,24 @@ def _thermal(
         if nodes == "3c":
             links.append(Link("Ti", "Tint", "Gint"))
         links.append(Link("Ti", "Te", "Gfast"))
-    if ground not in (True, False, "estimate"):
+    if ground not in (True, False, "estimate", "seasonal"):
         raise ValueError(
-            f"model {name!r}: option ground must be true, false or 'estimate' (got {ground!r})"
+            f"model {name!r}: option ground must be true, false, 'estimate' or 'seasonal' "
+            f"(got {ground!r})"
         )
     if ground:
         links.append(Link("Ti", "Tf", "Gf"))
     # ground="estimate": Tf is a constant potential to estimate [°C] (the thermal
     # counterpart of hygric model 3's fixed vapour-pressure node), not an input column
     constants = ("Tf",) if ground == "estimate" else ()
-    inputs = ["Te"] + [f"I_{s}" for s in surfaces] + (["Tf"] if ground is True else [])
+    inputs = (
+        ["Te"] + [f"I_{s}" for s in surfaces] + (["Tf"] if ground in (True, "seasonal") else [])
+    )
+    cycles, units = (), {}
+    if ground == "seasonal":  # Tf given at GROUND_REFERENCE, its depth zf estimated
+        inputs += list(GROUND_CYCLE_INPUTS)
+        cycles = (GroundCycle("Ti", "Gf", "zf", GROUND_CYCLE_INPUTS, GROUND_REFERENCE),)
+        units = dict.fromkeys(GROUND_CYCLE_INPUTS, "K")
     sources = []
     for s in surfaces:
         desc[f"fI_{s}"] = f"effective solar aperture of surface {s}"
@@ -148,7 +174,6 @@ def _thermal(
             sources.append(Source(f"I_{s}", "Tint", f"fI_{s}", "fsol"))
         else:
             sources.append(Source(f"I_{s}", "Ti", f"fI_{s}"))
-    units = {}
     if heating:
         inputs.append("Ph")
         sources.append(Source("Ph", "Ti", 1.0))
@@ -162,6 +187,7 @@ def _thermal(
         outputs=("Ti",),
         sources=tuple(sources),
         constants=constants,
+        cycles=cycles,
         descriptions=desc,
         input_units=units,
     )
@@ -201,7 +227,7 @@ def _hygric(name: str, *, nodes: str, fixed: bool) -> Network:
 
 def _thermal_factory(nodes: str, solar: bool, name: str) -> Callable[..., Network]:
     def build(
-        surfaces: Sequence[str] | None = None, ground: bool = True, heating: bool = False
+        surfaces: Sequence[str] | None = None, ground: bool | str = True, heating: bool = False
     ) -> Network:
         if not solar and surfaces:
             raise ValueError(f"model {name!r} has no solar input; do not pass surfaces")

@@ -26,6 +26,7 @@ _TRANSFORM = {
     "constant": "relative",
     "sorption_capacity": "log",
     "saturation": "relative",
+    "depth": "relative",
 }
 _SCALE_LABEL = "overall scale"
 

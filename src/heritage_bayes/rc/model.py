@@ -12,6 +12,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from heritage_bayes.climate.ground import depth_factors
 from heritage_bayes.rc.discretize import modal_form
 from heritage_bayes.rc.network import Network, ParameterInfo
 from heritage_bayes.rc.simulate import modal_simulate
@@ -204,6 +205,9 @@ class RCModel:
             if info.kind == "fraction" and np.any((col < 0) | (col > 1)):
                 bad = col[(col < 0) | (col > 1)][0]
                 raise ValueError(f"fraction {info.name} must be within [0, 1] (got {bad:g})")
+            if info.kind == "depth" and np.any(col < 0):
+                bad = col[col < 0][0]
+                raise ValueError(f"depth {info.name} must be >= 0 [m] (got {bad:g})")
 
     def valid_mask(self, P: np.ndarray) -> np.ndarray:
         """(K,) bool: parameter sets that are physically admissible."""
@@ -215,6 +219,8 @@ class RCModel:
                 ok &= P[:, j] >= 0
             elif info.kind == "fraction":
                 ok &= (P[:, j] >= 0) & (P[:, j] <= 1)
+            elif info.kind == "depth":
+                ok &= P[:, j] >= 0
         return ok
 
     # ------------------------------------------------------------------ matrices
@@ -260,6 +266,10 @@ class RCModel:
             if fi >= 0:
                 gain = gain * ((1.0 - P[:, fi]) if comp else P[:, fi])
             Gu[:, node, u] += gain
+        for node, g, zi, uc, us, ref in ix["cycle"]:
+            a, b = depth_factors(P[:, zi])
+            Gu[:, node, uc] += P[:, g] * (a - ref[0])
+            Gu[:, node, us] += P[:, g] * (b - ref[1])
         return cap, G, Gu, q
 
     def output_matrix(self) -> np.ndarray:
@@ -354,5 +364,16 @@ def as_index_arrays(net: Network):
         fp = s.fraction_param
         f_idx, comp = (pidx[fp[0]], fp[1]) if fp else (-1, False)
         src.append((nidx[s.node], uidx[s.input], gain_idx, gain_val, f_idx, comp))
+    cycle = [
+        (
+            nidx[cy.node],
+            pidx[cy.G],
+            pidx[cy.depth],
+            uidx[cy.inputs[0]],
+            uidx[cy.inputs[1]],
+            tuple(float(v) for v in depth_factors(cy.reference)),
+        )
+        for cy in net.cycles
+    ]
     out = np.array([nidx[o] for o in net.outputs])
-    return {"cap": cap, "nn": nn, "nu": nu, "nc": nc, "src": src, "out": out}
+    return {"cap": cap, "nn": nn, "nu": nu, "nc": nc, "src": src, "cycle": cycle, "out": out}

@@ -29,7 +29,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
-__all__ = ["DOMAINS", "Link", "Network", "Node", "ParameterInfo", "Source"]
+__all__ = ["DOMAINS", "GroundCycle", "Link", "Network", "Node", "ParameterInfo", "Source"]
 
 #: Units per domain: potential, capacity, conductance, source flow.
 DOMAINS: dict[str, dict[str, str]] = {
@@ -82,6 +82,30 @@ class Source:
 
 
 @dataclass(frozen=True)
+class GroundCycle:
+    """The annual cycle of a boundary at an estimable depth in the soil.
+
+    The boundary ``link`` (a :class:`Link` from ``node`` to an input column, e.g. the
+    ground temperature ``Tf`` given at ``reference`` depth [m]) is corrected to the
+    depth parameter ``depth`` [m] by the flow
+
+    .. math::
+        G\\,[a(z) - a(z_r)]\\,c(t) + G\\,[b(z) - b(z_r)]\\,s(t)
+
+    into ``node``, where :math:`c, s` are the input columns ``inputs`` (the surface's
+    annual anomaly and its quadrature [potential]) and :math:`a, b` the depth weights
+    of :func:`heritage_bayes.climate.ground.depth_factors` (Kusuda-Achenbach): the
+    boundary then follows the cycle at depth :math:`z`; at :math:`z = z_r` nothing changes.
+    """
+
+    node: str
+    G: str
+    depth: str
+    inputs: tuple[str, str]
+    reference: float
+
+
+@dataclass(frozen=True)
 class ParameterInfo:
     """Name, kind, unit and meaning of a network parameter."""
 
@@ -114,6 +138,9 @@ class Network:
         Injected flows.
     constants : sequence of str
         Boundaries whose potential is an estimable parameter (e.g. ``"Pf"`` [Pa]).
+    cycles : sequence of GroundCycle
+        Boundaries that follow an annual cycle at an estimable depth (parameter kind
+        ``depth`` [m]).
     descriptions : mapping
         Optional description per parameter or input name.
     input_units : mapping
@@ -129,11 +156,12 @@ class Network:
     outputs: tuple[str, ...]
     sources: tuple[Source, ...] = ()
     constants: tuple[str, ...] = ()
+    cycles: tuple[GroundCycle, ...] = ()
     descriptions: Mapping[str, str] = field(default_factory=dict)
     input_units: Mapping[str, str] = field(default_factory=dict)
 
     def __post_init__(self):
-        for attr in ("nodes", "links", "inputs", "outputs", "sources", "constants"):
+        for attr in ("nodes", "links", "inputs", "outputs", "sources", "constants", "cycles"):
             object.__setattr__(self, attr, tuple(getattr(self, attr)))
         self._validate()
 
@@ -182,7 +210,17 @@ class Network:
                 raise ValueError(f"{where}: output {out!r} is not a node; nodes are {names}")
         if not self.outputs:
             raise ValueError(f"{where}: needs at least one output node")
+        for cy in self.cycles:
+            if not any(lk.a == cy.node and lk.G == cy.G for lk in self.links):
+                raise ValueError(
+                    f"{where}: ground cycle at depth {cy.depth!r} needs a link {cy.G!r} "
+                    f"from node {cy.node!r}"
+                )
+            missing = [u for u in cy.inputs if u not in self.inputs]
+            if missing:
+                raise ValueError(f"{where}: ground cycle inputs {missing} are not inputs")
         used = {lk.b for lk in self.links} | {s.input for s in self.sources}
+        used |= {u for cy in self.cycles for u in cy.inputs}
         unused = [u for u in self.inputs if u not in used]
         if unused:
             raise ValueError(f"{where}: inputs {unused} are not connected to any node")
@@ -233,6 +271,8 @@ class Network:
                 yield fp[0], "fraction"
         for c in self.constants:
             yield c, "constant"
+        for cy in self.cycles:
+            yield cy.depth, "depth"
 
     # ------------------------------------------------------------------ metadata
     @property
@@ -262,6 +302,8 @@ class Network:
                 unit = "m²" if in_unit == "W/m²" else f"({units['flow']})/({in_unit})"
             elif kind == "fraction":
                 unit = "-"
+            elif kind == "depth":
+                unit = "m"
             else:
                 unit = units["potential"]
             seen[p] = ParameterInfo(p, kind, unit, self.descriptions.get(p, ""))
@@ -272,7 +314,7 @@ class Network:
         if name in self.input_units:
             return self.input_units[name]
         units = DOMAINS[self.domain]
-        if any(lk.b == name for lk in self.links):
+        if any(lk.b == name for lk in self.links) or any(name in c.inputs for c in self.cycles):
             return units["potential"]
         src = next(s for s in self.sources if s.input == name)
         if self.domain == "thermal" and isinstance(src.gain, str):

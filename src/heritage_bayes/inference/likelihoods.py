@@ -390,7 +390,7 @@ class AR1WhiteNoise(NoiseModel):
             phi,
             ar1_white_innovations(resid, sigma, ph, w),
             scale,
-            f"the AR(1) + white noise model expects about {phi * sigma**2 / (sigma**2 + w**2):.2f}",
+            f"the AR(1) + white noise model expects about {phi * scale:.2f}",
             "the standardised one-step innovations of the AR(1) + white model",
         )
 

@@ -84,8 +84,9 @@ def select_draws(run, n: int | None, seed: int) -> Draws:
         names = [f"{section}.{n}" for n, _, _ in nm.parameter_specs(m.output_names, m.state_names)]
         cols = [post[n].values.reshape(-1)[idx] if n in post else np.zeros(idx.size) for n in names]
         noise[section] = np.column_stack(cols) if cols else np.zeros((len(idx), 0))
+        kinds = nm.free_run_model().kinds  # the free-run error's parameters
         for out, fit in pred.items():
-            for kind in nm.free_run_model().kinds:
+            for kind in kinds:
                 name = f"{section}.{kind}_{out}"
                 if name in names:
                     noise[section][:, names.index(name)] = getattr(fit, kind)

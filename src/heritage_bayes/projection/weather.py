@@ -238,8 +238,12 @@ def model_inputs(run, pcfg, weather: pd.DataFrame, site: dict | None, where: str
             )
         # a ground at the calibrated depth zf: the future's own annual cycle (none for a
         # constant or annual-mean ground, which has no cycle at any depth)
-        for name, col in (ground_cycle_inputs(weather["Te"], mids)[0] if cycle else {}).items():
-            frame[name] = col if gt.mode == "seasonal" else 0.0 * col
+        if cycle and gt.mode == "seasonal":
+            for name, col in ground_cycle_inputs(weather["Te"], mids)[0].items():
+                frame[name] = col
+        elif cycle:
+            for name in GROUND_CYCLE_INPUTS:
+                frame[name] = 0.0
     # inputs the models make from a calendar (a thermostat's weekly hours of use): the
     # calibrated use goes on into the future, on the projection's own dates
     for name, col in calendar_inputs(

@@ -73,7 +73,7 @@ def section_parameters(cfg: CalibrationConfig, section: str, model: RCModel, pri
 
     sec_cfg = getattr(cfg, section)
     noise = get_noise_model(sec_cfg.noise)
-    if getattr(model, "time_varying", False) and getattr(noise, "statespace", False):
+    if model.time_varying and noise.statespace:
         raise ConfigError(
             f"{section}.noise: {sec_cfg.noise!r} filters a model with a constant modal "
             f"form; {model.name} is coupled to a temperature (time-varying): use "

@@ -157,9 +157,9 @@ class LogPosterior:
                 f"initial_state: expected 'estimate', 'steady' or a mapping node -> value "
                 f"(got {mode!r})"
             )
-        self._time_varying = bool(getattr(self.model, "time_varying", False))
+        self._time_varying = self.model.time_varying
         if self._time_varying:
-            if getattr(self.noise, "statespace", False):
+            if self.noise.statespace:
                 raise ValueError(
                     f"noise: {self.noise.name!r} filters a model with a constant modal form; "
                     f"{self.model.name!r} is time-varying (coupled to a temperature): use "
@@ -167,7 +167,7 @@ class LogPosterior:
                 )
             # the per-step series of the inputs (saturation ratios), once
             self._series = self.model.series(self.inputs)
-        if self.model.control is not None and getattr(self.noise, "statespace", False):
+        if self.model.control is not None and self.noise.statespace:
             raise ValueError(
                 f"noise: {self.noise.name!r} filters a model that is linear in its state; "
                 f"{self.model.name!r} is controlled (thermostat/humidistat): use ar1_white"
@@ -309,7 +309,7 @@ class LogPosterior:
             return ll
         with np.errstate(all="ignore"):
             mf = self._form(tm)
-            if getattr(self.noise, "statespace", False):
+            if self.noise.statespace:
                 ll = self.noise.filter(
                     self.model, mf, self.inputs, self.observed, tn, *self._x0_prior(mf)
                 )
@@ -486,7 +486,7 @@ class LogPosterior:
         with np.errstate(all="ignore"):
             mf = self._form(tm)
             x0 = self._x0_mean(mf)
-            if self.x0_free.size and getattr(self.noise, "statespace", False):
+            if self.x0_free.size and self.noise.statespace:
                 mean, cov = self._statespace_x0(mf, tn, x0)
                 if rng is not None:
                     Lc = np.linalg.cholesky(cov + 1e-12 * np.eye(cov.shape[-1]))
@@ -530,7 +530,7 @@ class LogPosterior:
         """(K, N, n_out) log-likelihood terms (NaN where excluded), for LOO."""
         theta = np.atleast_2d(theta)
         tm, tn = self.split(theta)
-        if getattr(self.noise, "statespace", False):  # one-step predictive densities
+        if self.noise.statespace:  # one-step predictive densities
             mf = modal_form(self.model, tm, self.dt)
             return self.noise.filter(
                 self.model, mf, self.inputs, self.observed, tn, *self._x0_prior(mf), True

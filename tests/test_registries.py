@@ -194,3 +194,21 @@ def test_a_registry_s_first_read_imports_its_home(tmp_path, monkeypatch):
     with pytest.raises(ValueError, match="'added': registered once"):
         toys.register("added", 3)
     assert dict(toys) == {"built_in": 1, "added": 2}
+
+
+def test_a_model_without_a_modal_form_is_offered_the_registered_residual_models(
+    restore_registries,
+):
+    """A state-space noise model cannot filter a time-varying model; the message offers
+    the registered noise models of the residuals, a newly registered one included."""
+    from heritage_bayes.run import section_parameters
+
+    _register_toys()
+    cfg = parse_config(
+        {**yaml.safe_load(open(DEMO, encoding="utf-8")), "thermal": None},
+        source="test",
+    )
+    cfg.hygric.model, cfg.hygric.noise = "hygric_2c_sorption", "kalman"
+    model = build_model(cfg, "hygric")
+    with pytest.raises(ConfigError, match=r"use one of ar1_white, ar1, iid, iid_toy$"):
+        section_parameters(cfg, "hygric", model)

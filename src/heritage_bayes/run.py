@@ -68,7 +68,7 @@ def section_parameters(cfg: CalibrationConfig, section: str, model: RCModel, pri
     -------
     (NoiseModel, ParameterSet)
     """
-    from heritage_bayes.inference.likelihoods import get_noise_model
+    from heritage_bayes.inference.likelihoods import get_noise_model, residual_noise_models
     from heritage_bayes.inference.parameters import parameters_for
 
     sec_cfg = getattr(cfg, section)
@@ -76,8 +76,8 @@ def section_parameters(cfg: CalibrationConfig, section: str, model: RCModel, pri
     if model.time_varying and noise.statespace:
         raise ConfigError(
             f"{section}.noise: {sec_cfg.noise!r} filters a model with a constant modal "
-            f"form; {model.name} is coupled to a temperature (time-varying): use "
-            "ar1_white (the default), ar1 or iid"
+            f"form; {model.name} is coupled to a temperature (time-varying): use one of "
+            f"{', '.join(residual_noise_models())}"
         )
     params = parameters_for(
         model,

@@ -71,6 +71,7 @@ __all__ = [
     "get_noise_model",
     "noise_parameter_names",
     "register_noise",
+    "residual_noise_models",
 ]
 
 
@@ -557,6 +558,13 @@ def noise_parameter_names(name: str | None, output_names, state_names=()) -> fro
     if nm is None:
         return frozenset()
     return frozenset(n for n, _, _ in nm.parameter_specs(output_names, state_names))
+
+
+def residual_noise_models() -> list[str]:
+    """The registered noise models of the residuals (not ``statespace``), in the
+    registry's order (the default first): those a model without a constant modal
+    form (controlled, or coupled to a temperature) can take."""
+    return [name for name, cls in NOISE_MODELS.items() if not cls.statespace]
 
 
 def get_noise_model(name: str) -> NoiseModel:

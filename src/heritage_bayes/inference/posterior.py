@@ -60,7 +60,7 @@ from typing import Any
 import numpy as np
 
 from heritage_bayes.inference.coupled import coupled_filter_stats
-from heritage_bayes.inference.likelihoods import NoiseModel
+from heritage_bayes.inference.likelihoods import NoiseModel, residual_noise_models
 from heritage_bayes.inference.parameters import ParameterSet
 from heritage_bayes.rc.discretize import modal_form
 from heritage_bayes.rc.model import RCModel
@@ -163,14 +163,15 @@ class LogPosterior:
                 raise ValueError(
                     f"noise: {self.noise.name!r} filters a model with a constant modal form; "
                     f"{self.model.name!r} is time-varying (coupled to a temperature): use "
-                    "ar1_white (the default), ar1 or iid"
+                    f"one of {', '.join(residual_noise_models())}"
                 )
             # the per-step series of the inputs (saturation ratios), once
             self._series = self.model.series(self.inputs)
         if self.model.control is not None and self.noise.statespace:
             raise ValueError(
                 f"noise: {self.noise.name!r} filters a model that is linear in its state; "
-                f"{self.model.name!r} is controlled (thermostat/humidistat): use ar1_white"
+                f"{self.model.name!r} is controlled (thermostat/humidistat): use one of "
+                f"{', '.join(residual_noise_models())}"
             )
         if free and self.model.control is not None:
             raise ValueError(

@@ -58,9 +58,9 @@ class Registry(Mapping[str, _T]):
         self._loaded = False
 
     def _load(self) -> dict[str, _T]:
-        if not self._loaded:
-            self._loaded = True
+        if not self._loaded:  # a read during home's import gets the entries so far
             importlib.import_module(self.home)
+            self._loaded = True
         return self._entries
 
     def register(self, name: str, entry: _T) -> _T:

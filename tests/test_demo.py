@@ -20,6 +20,7 @@ from heritage_bayes.demo import (
     virtual_monument,
 )
 from heritage_bayes.errors import ConfigError
+from heritage_bayes.names import NOISE_MODELS
 from heritage_bayes.prepare import prepare
 from heritage_bayes.rc.identify import time_constants
 
@@ -127,6 +128,20 @@ def test_observation_model(demo_room, prepared):
     # ar1_white: the model error and the reading error separately
     assert ref["phi_Ti"] == pytest.approx(0.9, abs=0.05)
     assert ref["sigma_meas_Ti"] == pytest.approx(np.sqrt(0.1**2 + 0.1**2 / 12), rel=0.1)
+
+
+def test_each_noise_model_names_its_own_nominal_values(demo_room):
+    """The truth of the demo's noise parameters comes from the noise model itself: a
+    white part describes the reading error, the AR(1) part the model error, and a model
+    without a white part the sum of both."""
+    got = {n: nominal_noise(demo_room, "Pi", noise=n) for n in NOISE_MODELS}
+    assert list(got["ar1_white"]) == ["sigma_Pi", "phi_Pi", "sigma_meas_Pi"]
+    assert list(got["ar1"]) == ["sigma_Pi", "phi_Pi"]
+    assert got["iid"] == {"sigma_Pi": got["ar1"]["sigma_Pi"]}
+    # kalman's sigma_Pi is its measurement noise (its process noise has no nominal value)
+    assert got["kalman"] == {"sigma_Pi": got["ar1_white"]["sigma_meas_Pi"]}
+    ti = {n: nominal_noise(demo_room, "Ti", noise=n)["sigma_Ti"] for n in NOISE_MODELS}
+    assert ti["kalman"] < ti["ar1_white"] < ti["ar1"]  # 0.1 K reading, 0.2 K model error
 
 
 def test_noise_free_settings_give_the_model_output():

@@ -3,6 +3,8 @@ everywhere a user meets the list (the CLI, the config, ``hbayes models``, the la
 
 from __future__ import annotations
 
+import sys
+
 import pytest
 import yaml
 
@@ -24,11 +26,13 @@ DEMO = "configs/demo.yaml"
 @pytest.fixture
 def restore_registries():
     """Whatever a test registers is gone after it."""
-    saved = [(d, dict(d)) for d in (catalog.CATALOG, names.NOISE_MODELS, likelihoods.NOISE_MODELS)]
+    catalogue, noise = dict(catalog.CATALOG), dict(names.NOISE_MODELS)
     yield
-    for d, before in saved:
-        d.clear()
-        d.update(before)
+    catalog.CATALOG.clear()
+    catalog.CATALOG.update(catalogue)
+    for name in set(names.NOISE_MODELS) - set(noise):
+        names.NOISE_MODELS.unregister(name)
+    assert dict(names.NOISE_MODELS) == noise
 
 
 def _toy_network(surfaces=None, ground: bool = True) -> Network:
@@ -62,7 +66,7 @@ def _register_toys() -> None:
             rungs=(({}, "thermal_4a"),),
         ),
     )
-    likelihoods.register_noise(_ToyNoise)  # declares its name with its description
+    likelihoods.register_noise(_ToyNoise)  # the one place its name is listed
 
 
 def _config(**section):
@@ -90,7 +94,12 @@ def test_a_registered_model_and_noise_model_show_up_everywhere(restore_registrie
     ]
     # the CLI: the --noise choices and `hbayes models`
     assert main(["models", "--help"]) == 0
-    assert "--noise {ar1_white,ar1,iid,kalman,iid_toy}" in capsys.readouterr().out
+    assert "noise model: ar1_white, ar1, iid, kalman, iid_toy (default" in " ".join(
+        capsys.readouterr().out.split()
+    )
+    from heritage_bayes.reference import config_reference
+
+    assert "iid_toy (a toy: independent errors)" in config_reference()
     assert main(["models"]) == 0
     assert "thermal_toy" in capsys.readouterr().out
     assert main(["models", "thermal_toy", "--noise", "iid_toy"]) == 0
@@ -107,9 +116,16 @@ def test_an_unregistered_name_is_refused_with_the_registry_s_names():
     class Undescribed(likelihoods.IIDNoise):
         name = "undescribed_toy"
 
-    with pytest.raises(ValueError, match="with a description or a name declared"):
+    with pytest.raises(ValueError, match="a description of its own is required"):
         likelihoods.register_noise(Undescribed)
     assert "undescribed_toy" not in names.NOISE_MODELS
+
+    class Taken(likelihoods.IIDNoise):
+        description = "registered twice"
+
+    with pytest.raises(ValueError, match="'iid': registered once"):
+        likelihoods.register_noise(Taken)
+    assert names.NOISE_MODELS["iid"] is likelihoods.IIDNoise
     with pytest.raises(ValueError, match="rung parent 'thermal_nope'"):
         catalog.register(
             "thermal_toy",
@@ -119,7 +135,8 @@ def test_an_unregistered_name_is_refused_with_the_registry_s_names():
 
 
 def test_every_declared_name_has_its_implementation_and_no_other():
-    assert set(likelihoods.NOISE_MODELS) == set(names.NOISE_MODELS)
+    assert likelihoods.NOISE_MODELS is names.NOISE_MODELS  # one registry
+    assert list(names.NOISE_MODELS) == ["ar1_white", "ar1", "iid", "kalman"]
     assert next(iter(names.NOISE_MODELS)) == names.DEFAULT_NOISE
     assert list(monitor.MOVES) == list(names.MOVES)
     for name, cls in likelihoods.NOISE_MODELS.items():
@@ -158,3 +175,40 @@ def test_a_model_s_own_parameter_roles_take_the_room_s_priors(restore_registries
     assert default.parameters[default.names.index("Ci")].prior == air_capacity_prior(
         "thermal", 80.0
     )
+
+
+def test_a_registry_s_first_read_imports_its_home(tmp_path, monkeypatch):
+    """The settings sit below the noise models: a config naming one is valid whoever
+    asks first, because the registry's first read imports the module that fills it."""
+    assert names.NOISE_MODELS.home == "heritage_bayes.inference"
+    toys = names.Registry("toy", "toy_home_for_the_registry_test")
+    (tmp_path / "toy_home_for_the_registry_test.py").write_text(
+        "from test_registries import TOYS\nTOYS.register('built_in', 1)\n"
+    )
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.setitem(sys.modules, "test_registries", sys.modules[__name__])
+    monkeypatch.setattr(sys.modules[__name__], "TOYS", toys, raising=False)
+    monkeypatch.delitem(sys.modules, "toy_home_for_the_registry_test", raising=False)
+    assert "built_in" in toys and list(toys) == ["built_in"]
+    toys.register("added", 2)
+    with pytest.raises(ValueError, match="'added': registered once"):
+        toys.register("added", 3)
+    assert dict(toys) == {"built_in": 1, "added": 2}
+
+
+def test_a_model_without_a_modal_form_is_offered_the_registered_residual_models(
+    restore_registries,
+):
+    """A state-space noise model cannot filter a time-varying model; the message offers
+    the registered noise models of the residuals, a newly registered one included."""
+    from heritage_bayes.run import section_parameters
+
+    _register_toys()
+    cfg = parse_config(
+        {**yaml.safe_load(open(DEMO, encoding="utf-8")), "thermal": None},
+        source="test",
+    )
+    cfg.hygric.model, cfg.hygric.noise = "hygric_2c_sorption", "kalman"
+    model = build_model(cfg, "hygric")
+    with pytest.raises(ConfigError, match=r"use one of ar1_white, ar1, iid, iid_toy$"):
+        section_parameters(cfg, "hygric", model)

@@ -116,8 +116,9 @@ def _add_model_commands(sub) -> None:
     mod.add_argument(
         "--noise",
         default=DEFAULT_NOISE,
-        choices=list(NOISE_MODELS),
-        help=f"noise model (default {DEFAULT_NOISE})",
+        choices=NOISE_MODELS,  # read when parsed or shown: a name registered later shows
+        metavar="NOISE",
+        help="noise model: %(choices)s (default %(default)s)",
     )
     mod.set_defaults(func=_cmd_models)
 

@@ -306,16 +306,6 @@ def _ar1(z: np.ndarray, phi: float, sd: float) -> np.ndarray:
     return lfilter([1.0], [1.0, -phi], e)
 
 
-def _ar1_stats(r: np.ndarray) -> tuple[float, float]:
-    """RMS and lag-1 autocorrelation (about zero) of a residual series with NaNs."""
-    ok = np.isfinite(r)
-    sigma = float(np.sqrt(np.mean(r[ok] ** 2)))
-    pair = ok[1:] & ok[:-1]
-    num = float(np.sum(r[1:][pair] * r[:-1][pair]))
-    den = float(np.sqrt(np.sum(r[1:][pair] ** 2) * np.sum(r[:-1][pair] ** 2)))
-    return sigma, (num / den if den > 0 else 0.0)
-
-
 def nominal_noise(
     monument: VirtualMonument, output: str, rows=None, noise: str = "ar1"
 ) -> dict[str, float]:
@@ -327,22 +317,27 @@ def nominal_noise(
     output : {"Ti", "Pi"}
     rows : pandas.DatetimeIndex, optional
         Instants to use (e.g. the calibration period after the warm-up); default all.
-    noise : {"ar1", "iid", "ar1_white"}
-        The noise model whose parameters are wanted.
+    noise : str
+        The noise model whose parameters are wanted (a name of
+        :data:`heritage_bayes.names.NOISE_MODELS`).
 
     Returns
     -------
     dict
-        ``ar1``/``iid``: ``{"sigma_<output>": RMS [K or Pa], "phi_<output>": lag-1
-        autocorrelation}`` of the residual *observed − noise-free model* at ``rows``
-        (missing readings skipped). They are **nominal**: the noise is AR(1) model error
-        plus white sensor noise plus rounding, not exactly AR(1); these are the AR(1)
-        parameters with the same variance and lag-1 autocorrelation. ``ar1_white``: the
-        realised model error *room − model* (RMS ``sigma``, lag-1 ``phi``) and the RMS of
-        the reading error *observed − room* (``sigma_meas``: sensor noise and rounding),
-        which that noise model describes exactly (up to rounding not being Gaussian).
+        The noise model's nominal values of its parameters of ``output``
+        (:meth:`heritage_bayes.inference.likelihoods.NoiseModel.nominal`) for the
+        monument's realised errors at ``rows`` (missing readings skipped): the model
+        error *room − noise-free model* and the reading error *observed − room*
+        (sensor noise and rounding). ``ar1``/``iid``: ``sigma_<output>`` (RMS [K or
+        Pa]) and ``phi_<output>`` (lag-1 autocorrelation) of their sum, the AR(1)
+        parameters with its variance and lag-1 autocorrelation (**nominal**: the noise
+        is AR(1) model error plus white sensor noise plus rounding, not exactly AR(1)).
+        ``ar1_white``: the model error's RMS and lag-1 autocorrelation and the reading
+        error's RMS (``sigma_meas``), which that noise model describes exactly (up to
+        rounding not being Gaussian).
     """
     from heritage_bayes.climate.psychro import vapour_pressure
+    from heritage_bayes.inference.likelihoods import get_noise_model
 
     if output not in ("Ti", "Pi"):
         raise ValueError(f"output must be 'Ti' or 'Pi' (got {output!r})")
@@ -353,20 +348,8 @@ def nominal_noise(
         obs = meas["Ti"].to_numpy()
     else:
         obs = vapour_pressure(meas["Ti"].to_numpy(), meas["RHi"].to_numpy())
-    r = obs - model.reindex(idx).to_numpy()
-    if noise == "ar1_white":
-        room = monument.info[f"{output}_room"].reindex(idx).to_numpy()
-        sigma, phi = _ar1_stats(room - model.reindex(idx).to_numpy())
-        meas_err = obs - room
-        ok = np.isfinite(meas_err)
-        return {
-            f"sigma_{output}": sigma,
-            f"phi_{output}": phi,
-            f"sigma_meas_{output}": float(np.sqrt(np.mean(meas_err[ok] ** 2))),
-        }
-    sigma, phi = _ar1_stats(r)
-    out = {f"sigma_{output}": sigma, f"phi_{output}": phi}
-    return {f"sigma_{output}": sigma} if noise == "iid" else out
+    room = monument.info[f"{output}_room"].reindex(idx).to_numpy()
+    return get_noise_model(noise).nominal(output, obs, room, model.reindex(idx).to_numpy())
 
 
 def virtual_monument(

@@ -1,14 +1,16 @@
-"""The name lists a user chooses from, declared once: noise models, sampler moves,
-prior families (each with its numerics, which import numpy only when called) and the
-controls of a room's air.
+"""The name lists a user chooses from: noise models, sampler moves, prior families (each
+with its numerics, which import numpy only when called) and the controls of a room's air.
 
 Layer 0, imported by the settings (the choices of ``noise:`` and ``sampler.moves``,
 :class:`heritage_bayes.config._base.Choices`), by the command line (``hbayes models
---noise``'s choices, without importing the numerics), by the generated references and
-by the report; the implementations register under a declared name
-(:func:`heritage_bayes.inference.likelihoods.register_noise`,
-:data:`heritage_bayes.inference.monitor.MOVES`), and a name declared here without an
-implementation, or the other way round, fails the tests.
+--noise``'s choices), by the generated references and by the report.
+
+The noise models are listed nowhere by hand: :data:`NOISE_MODELS` is a :class:`Registry`
+that each noise model's class fills where it is defined
+(:func:`heritage_bayes.inference.likelihoods.register_noise`), read from here by the
+layers below the numerics. The moves' names are declared here and implemented in
+:data:`heritage_bayes.inference.monitor.MOVES`; a name without its implementation, or
+the other way round, fails the tests.
 
 The catalogue of RC models is :data:`heritage_bayes.rc.catalog.CATALOG` (one entry
 per model, its ladder position and solar capability included).
@@ -16,8 +18,12 @@ per model, its ladder position and solar capability included).
 
 from __future__ import annotations
 
+import importlib
 import math
-from typing import NamedTuple
+from collections.abc import Iterator, Mapping
+from typing import Any, TypeVar
+
+_T = TypeVar("_T")
 
 __all__ = [
     "CONTROLS",
@@ -27,44 +33,72 @@ __all__ = [
     "NOISE_MODELS",
     "PRIOR_DISTRIBUTIONS",
     "DistributionName",
-    "NoiseName",
-    "declare_noise",
+    "Registry",
 ]
 
 
-class NoiseName(NamedTuple):
-    """What the package knows of a noise model without importing its numerics (what
-    the rest of the package asks of a noise model, the class answers:
-    :class:`heritage_bayes.inference.likelihoods.NoiseModel`)."""
+class Registry(Mapping[str, _T]):
+    """A name list a user chooses from (name -> entry), filled by the implementations
+    themselves: each registers under its name where it is defined, and nothing else
+    lists the names.
 
-    #: One line for the references.
-    description: str
+    The settings and the command line sit below the implementations and read the list
+    through this object. Its first read imports ``home``, the module whose import
+    registers the package's own entries, so that every name is known whoever asks
+    first (the numerics are imported then, not when the settings module is). The
+    entries keep the order of their registration.
+    """
+
+    def __init__(self, what: str, home: str):
+        #: What an entry is, for messages (``"noise model"``).
+        self.what = what
+        #: The module whose import registers the package's own entries.
+        self.home = home
+        self._entries: dict[str, _T] = {}
+        self._loaded = False
+
+    def _load(self) -> dict[str, _T]:
+        if not self._loaded:  # a read during home's import gets the entries so far
+            importlib.import_module(self.home)
+            self._loaded = True
+        return self._entries
+
+    def register(self, name: str, entry: _T) -> _T:
+        """Add ``entry`` under ``name``.
+
+        Raises
+        ------
+        ValueError
+            The name is taken or not a lowercase identifier.
+        """
+        if name in self._load() or not name.isidentifier() or name != name.lower():
+            raise ValueError(f"{self.what} {name!r}: registered once, under a lowercase identifier")
+        self._entries[name] = entry
+        return entry
+
+    def unregister(self, name: str) -> _T:
+        """Remove the entry of ``name`` (a test's or an example's) and return it."""
+        return self._load().pop(name)
+
+    def __getitem__(self, name: str) -> _T:
+        return self._load()[name]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._load())
+
+    def __len__(self) -> int:
+        return len(self._load())
+
+    def __repr__(self) -> str:
+        return f"Registry({self.what!r}, {list(self)!r})"
 
 
-#: ``noise:`` choices, the default first.
-NOISE_MODELS: dict[str, NoiseName] = {}
+#: ``noise:`` choices (name -> its class, a
+#: :class:`heritage_bayes.inference.likelihoods.NoiseModel`, registered by
+#: :func:`heritage_bayes.inference.likelihoods.register_noise` beside its definition).
+NOISE_MODELS: Registry[Any] = Registry("noise model", "heritage_bayes.inference")
 #: The noise model of a section that does not choose one.
 DEFAULT_NOISE = "ar1_white"
-
-
-def declare_noise(name: str, entry: NoiseName) -> NoiseName:
-    """Declare a noise model's name (then its class registers under it).
-
-    Raises
-    ------
-    ValueError
-        The name is taken or not a lowercase identifier.
-    """
-    if name in NOISE_MODELS or not name.isidentifier() or name != name.lower():
-        raise ValueError(f"noise model name {name!r}: taken, or not a lowercase identifier")
-    NOISE_MODELS[name] = entry
-    return entry
-
-
-declare_noise("ar1_white", NoiseName("AR(1) model error + white sensor noise"))
-declare_noise("ar1", NoiseName("a single AR(1) error"))
-declare_noise("iid", NoiseName("independent errors"))
-declare_noise("kalman", NoiseName("a Kalman filter on the stochastic RC model"))
 
 #: ``sampler.moves`` choices, the default first (name -> description); the emcee
 #: mixtures are :data:`heritage_bayes.inference.monitor.MOVES`.

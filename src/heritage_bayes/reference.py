@@ -112,7 +112,9 @@ def _bounds_text(field: FieldInfo) -> str:
 
 
 def _description_text(field: FieldInfo, unit: str | None) -> str:
-    text = " ".join((field.description or "").split())
+    from heritage_bayes.config.reference import field_description
+
+    text = " ".join(field_description(field).split())
     if unit and unit != "-" and f"[{unit}]" not in text:
         text = f"[{unit}] {text}".strip()
     examples = field.examples
@@ -219,7 +221,9 @@ def _action_help(parser: argparse.ArgumentParser, action: argparse.Action) -> st
         return ""
     text = parser._get_formatter()._expand_help(action)
     if action.choices and not isinstance(action, argparse._SubParsersAction):
-        choices = ", ".join(f"`{c}`" for c in action.choices)
+        names = [str(c) for c in action.choices]
+        choices = ", ".join(f"`{c}`" for c in names)
+        text = text.replace(", ".join(names), choices)  # a help listing %(choices)s
         if choices not in text:
             text += f" (one of {choices})"
     default = action.default

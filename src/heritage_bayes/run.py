@@ -68,16 +68,16 @@ def section_parameters(cfg: CalibrationConfig, section: str, model: RCModel, pri
     -------
     (NoiseModel, ParameterSet)
     """
-    from heritage_bayes.inference.likelihoods import get_noise_model
+    from heritage_bayes.inference.likelihoods import get_noise_model, residual_noise_models
     from heritage_bayes.inference.parameters import parameters_for
 
     sec_cfg = getattr(cfg, section)
     noise = get_noise_model(sec_cfg.noise)
-    if getattr(model, "time_varying", False) and getattr(noise, "statespace", False):
+    if model.time_varying and noise.statespace:
         raise ConfigError(
             f"{section}.noise: {sec_cfg.noise!r} filters a model with a constant modal "
-            f"form; {model.name} is coupled to a temperature (time-varying): use "
-            "ar1_white (the default), ar1 or iid"
+            f"form; {model.name} is coupled to a temperature (time-varying): use one of "
+            f"{', '.join(residual_noise_models())}"
         )
     params = parameters_for(
         model,

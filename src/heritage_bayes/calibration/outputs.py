@@ -122,7 +122,7 @@ def _validation_pointwise(s, prep, Ysim, tn, th=None) -> np.ndarray:
         Yobs[prep.breaks] = np.nan
     Yobs = np.ascontiguousarray(Yobs)
     lp = s.logpost
-    if getattr(lp.noise, "statespace", False) and th is not None:
+    if lp.noise.statespace and th is not None:
         mf = modal_form(s.model, th[:, : lp.n_model], prep.dt)
         U = np.ascontiguousarray(prep.model_inputs(s.name, s.model), dtype=float)
         return lp.noise.filter(s.model, mf, U, Yobs, tn, *lp._x0_prior(mf), True)[1]
@@ -288,7 +288,7 @@ def _predictive_draws(o: _Outputs, s, prep, rng, seed: int):
             )
     Ysim, _ = s.logpost.simulate_frame(th_sel, U, prep.calibration.start, x0=x0)
     band_nm, tn_pred, pred_info = predictive_noise(s, prep, Ysim, tn_sel)
-    if getattr(band_nm, "statespace", False):
+    if band_nm.statespace:
         mf = modal_form(s.model, th_sel[:, :n_model], prep.dt)
         noise = band_nm.sample_statespace(rng, mf, tn_pred, U.shape[0], s.model.n_outputs)
     else:
@@ -297,7 +297,7 @@ def _predictive_draws(o: _Outputs, s, prep, rng, seed: int):
     Ypp, noise = noise, None
     saturation = condensation_cap(s, prep, Ysim, Ypp, o.pp_outputs)
     Y1 = None
-    if getattr(s.logpost.noise, "statespace", False):
+    if s.logpost.noise.statespace:
         # its own stream: the free-run outputs above do not depend on it
         Y1 = _one_step_sample(s, prep, th_sel, np.random.default_rng([seed, 17]))
     for k, out in enumerate(s.model.output_names):

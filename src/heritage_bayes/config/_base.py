@@ -56,8 +56,18 @@ class Choices:
     A wrong name gets pydantic's own message for a ``Literal`` (``Input should be 'a',
     'b' or 'c'``); the JSON schema and the generated reference list the names."""
 
-    def __init__(self, registry: Mapping[str, Any]):
+    def __init__(self, registry: Mapping[str, Any], *, described: bool = False):
         self.registry = registry
+        #: The key's description in the references goes on with the names and their
+        #: entries' ``description`` (:meth:`describe`).
+        self.described = described
+
+    def describe(self, text: str) -> str:
+        """A key's description ``text``, followed when ``described`` by each name with
+        its entry's ``description``, read now (a name registered later shows too)."""
+        if not self.described:
+            return text
+        return f"{text}: " + ", ".join(f"{n} ({e.description})" for n, e in self.registry.items())
 
     @property
     def names(self) -> tuple[str, ...]:

@@ -87,11 +87,10 @@ class ModelSection(_Strict):
         "humidistat, source (hbayes models)",
         default_factory=ModelOptions,
     )
-    noise: Annotated[str, Choices(NOISE_MODELS)] = key(
+    noise: Annotated[str, Choices(NOISE_MODELS, described=True)] = key(
         DEFAULT_NOISE,
         unit=None,
-        description="noise model: "
-        + ", ".join(f"{n} ({e.description})" for n, e in NOISE_MODELS.items()),
+        description="noise model",
     )
     initial_state: Literal["estimate", "steady"] | dict[str, float] | None = key(
         None,

@@ -12,9 +12,10 @@ from typing import Any
 from pydantic import BaseModel
 from pydantic_core import PydanticUndefined
 
+from heritage_bayes.config._base import Choices
 from heritage_bayes.config._messages import _model_of
 
-__all__ = ["ConfigKey", "config_keys", "describe_key"]
+__all__ = ["ConfigKey", "config_keys", "describe_key", "field_description"]
 
 
 @dataclass(frozen=True)
@@ -45,6 +46,16 @@ class ConfigKey:
     unit: str | None
     description: str
     section: bool
+
+
+def field_description(field) -> str:
+    """A key's description, with the names of a registry and what each is when its
+    :class:`~heritage_bayes.config._base.Choices` asks for them (``noise:``)."""
+    text = field.description or ""
+    for meta in field.metadata:
+        if isinstance(meta, Choices):
+            text = meta.describe(text)
+    return text
 
 
 def _default(field) -> Any:
@@ -94,7 +105,7 @@ def config_keys(root: type[BaseModel] | None = None, prefix: str = "") -> list[C
                 required=field.is_required(),
                 default=_default(field),
                 unit=extra.get("unit"),
-                description=field.description or "",
+                description=field_description(field),
                 section=sub is not None,
             )
         )

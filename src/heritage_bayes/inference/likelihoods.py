@@ -55,8 +55,7 @@ import numpy as np
 
 from heritage_bayes.inference.noise_kernels import _ar1_sample, _fused_kf, _kf_kernel
 from heritage_bayes.inference.priors import Prior
-from heritage_bayes.names import NOISE_MODELS as DECLARED
-from heritage_bayes.names import NoiseName, declare_noise
+from heritage_bayes.names import NOISE_MODELS
 
 __all__ = [
     "NOISE_MODELS",
@@ -72,6 +71,7 @@ __all__ = [
     "get_noise_model",
     "noise_parameter_names",
     "register_noise",
+    "residual_noise_models",
 ]
 
 
@@ -99,14 +99,16 @@ class NoiseModel:
     filter: ``iid`` has no AR part, ``ar1`` no white part.
     """
 
+    #: The name a section's ``noise:`` chooses (:func:`register_noise`).
     name = "base"
-    #: One line for the references (a name declared in :mod:`heritage_bayes.names`
-    #: has its description there).
+    #: One line for the references, the command line and the settings.
     description = ""
     kinds: tuple[str, ...] = ()
     #: A state-space model (the stochastic RC model's own Kalman filter): the
     #: log-posterior filters the model's states instead of its residuals, and the fit
-    #: section shows its one-step-ahead band.
+    #: section shows its one-step-ahead band. Such a model provides ``filter``,
+    #: ``one_step`` and ``sample_statespace``
+    #: (:class:`~heritage_bayes.inference.statespace.KalmanNoise`).
     statespace = False
     #: What a parameter of each kind is, for the tables (followed by its output).
     descriptions: Mapping[str, str] = MappingProxyType(
@@ -163,6 +165,29 @@ class NoiseModel:
             f"the {self.name} noise model expects ≈ 0",
             "the residuals",
         )
+
+    def nominal(self, output: str, observed, room, model) -> dict[str, float]:
+        """The values of output ``output``'s noise parameters that describe a record's
+        realised errors (the truth a synthetic record is checked against).
+
+        ``observed`` the readings, ``room`` the room's true state and ``model`` the
+        noise-free model's output, (N,) arrays in the output's unit ([°C] or [Pa]),
+        NaN where missing: the model error is ``room - model``, the reading error
+        (sensor noise, rounding) ``observed - room``. A noise model with a white part
+        (a parameter of kind ``sigma_meas``) describes the two apart: ``sigma`` and
+        ``phi`` are the RMS and lag-1 autocorrelation of the model error, ``sigma_meas``
+        the RMS of the reading error. One without describes their sum, ``observed -
+        model``, by the AR(1) process of the same variance and lag-1 autocorrelation
+        (nominal values: the sum is not exactly AR(1)). A parameter of another kind
+        has no nominal value and is left out.
+        """
+        specs = self.parameter_specs((output,))
+        white = any(kind == "sigma_meas" for _, kind, _ in specs)
+        sigma, phi = _rms_lag1(room - model if white else observed - model)
+        values = {"sigma": sigma, "phi": phi}
+        if white:
+            values["sigma_meas"] = _rms_lag1(observed - room)[0]
+        return {name: values[kind] for name, kind, _ in specs if kind in values}
 
     def parameter_specs(self, output_names, state_names=()) -> list[tuple[str, str, str]]:
         """[(parameter name, kind, output)] in the order of the noise vector.
@@ -279,46 +304,25 @@ class NoiseModel:
         return out
 
 
-class IIDNoise(NoiseModel):
-    """Independent Gaussian errors with standard deviation ``sigma_<output>``.
+def register_noise(cls: type[NoiseModel]) -> type[NoiseModel]:
+    """Register a noise model class under its ``name`` (a class decorator): the one
+    place a noise model is listed. The command line's choices, the settings'
+    validation of ``noise:``, the references and :func:`get_noise_model` read
+    :data:`heritage_bayes.names.NOISE_MODELS`, which this fills.
 
-    Overconfident for hourly data with autocorrelated residuals: prefer ``ar1``.
+    Raises
+    ------
+    ValueError
+        ``cls.name`` is taken or not a lowercase identifier, or ``cls`` has no
+        ``description`` of its own (not one inherited from the class it extends).
     """
-
-    name = "iid"
-    kinds = ("sigma",)
-
-
-class AR1Noise(NoiseModel):
-    """Stationary Gaussian AR(1) errors: :math:`\\varepsilon_k = \\phi\\varepsilon_{k-1}
-    + \\eta_k`, parameterised by the *marginal* standard deviation ``sigma_<output>``
-    (:math:`\\mathrm{Var}\\,\\eta = \\sigma^2(1-\\phi^2)`) and ``phi_<output>``.
-
-    The exact likelihood (first observation from the stationary distribution) handles
-    gaps exactly: observations :math:`d` steps apart have conditional mean
-    :math:`\\phi^d r_{prev}` and variance :math:`\\sigma^2(1-\\phi^{2d})`. The default,
-    because hourly residuals of simple RC models are strongly autocorrelated and an iid
-    likelihood makes posteriors and predictive bands overconfident.
-    """
-
-    name = "ar1"
-    kinds = ("sigma", "phi")
-
-    def residual_view(self, resid, median):
-        """The AR(1) innovations :math:`e_t - \\varphi e_{t-1}` at the median
-        :math:`\\varphi`."""
-        phi = median("phi")
-        if phi is None:
-            return super().residual_view(resid, median)
-        return ResidualView(
-            phi,
-            ar1_innovations(resid, phi),
-            1.0,
-            f"the AR(1) noise model expects ≈ φ = {phi:.2f}",
-            "the innovations left after the AR(1) model",
-        )
+    if not vars(cls).get("description"):
+        raise ValueError(f"noise model {cls.name!r}: a description of its own is required")
+    NOISE_MODELS.register(cls.name, cls)
+    return cls
 
 
+@register_noise
 class AR1WhiteNoise(NoiseModel):
     """Model error plus sensor noise: a latent stationary AR(1) process
     :math:`\\eta_k` (marginal sd ``sigma_<output>``, coefficient ``phi_<output>``) plus
@@ -341,6 +345,7 @@ class AR1WhiteNoise(NoiseModel):
     """
 
     name = "ar1_white"
+    description = "AR(1) model error + white sensor noise"
     kinds = ("sigma", "phi", "sigma_meas")
     #: The model error's correlation time tau_e = -dt/ln(phi) is capped at about a day
     #: (24.5 h: phi <= 0.96 at hourly steps, 0.98 at half-hourly ones). Without a cap the
@@ -395,6 +400,60 @@ class AR1WhiteNoise(NoiseModel):
         )
 
 
+@register_noise
+class AR1Noise(NoiseModel):
+    """Stationary Gaussian AR(1) errors: :math:`\\varepsilon_k = \\phi\\varepsilon_{k-1}
+    + \\eta_k`, parameterised by the *marginal* standard deviation ``sigma_<output>``
+    (:math:`\\mathrm{Var}\\,\\eta = \\sigma^2(1-\\phi^2)`) and ``phi_<output>``.
+
+    The exact likelihood (first observation from the stationary distribution) handles
+    gaps exactly: observations :math:`d` steps apart have conditional mean
+    :math:`\\phi^d r_{prev}` and variance :math:`\\sigma^2(1-\\phi^{2d})`. Preferred to
+    ``iid`` because hourly residuals of simple RC models are strongly autocorrelated and an iid
+    likelihood makes posteriors and predictive bands overconfident.
+    """
+
+    name = "ar1"
+    description = "a single AR(1) error"
+    kinds = ("sigma", "phi")
+
+    def residual_view(self, resid, median):
+        """The AR(1) innovations :math:`e_t - \\varphi e_{t-1}` at the median
+        :math:`\\varphi`."""
+        phi = median("phi")
+        if phi is None:
+            return super().residual_view(resid, median)
+        return ResidualView(
+            phi,
+            ar1_innovations(resid, phi),
+            1.0,
+            f"the AR(1) noise model expects ≈ φ = {phi:.2f}",
+            "the innovations left after the AR(1) model",
+        )
+
+
+@register_noise
+class IIDNoise(NoiseModel):
+    """Independent Gaussian errors with standard deviation ``sigma_<output>``.
+
+    Overconfident for hourly data with autocorrelated residuals: prefer ``ar1``.
+    """
+
+    name = "iid"
+    description = "independent errors"
+    kinds = ("sigma",)
+
+
+def _rms_lag1(r: np.ndarray) -> tuple[float, float]:
+    """RMS and lag-1 autocorrelation (about zero) of a series with NaNs."""
+    ok = np.isfinite(r)
+    sigma = float(np.sqrt(np.mean(r[ok] ** 2)))
+    pair = ok[1:] & ok[:-1]
+    num = float(np.sum(r[1:][pair] * r[:-1][pair]))
+    den = float(np.sqrt(np.sum(r[1:][pair] ** 2) * np.sum(r[:-1][pair] ** 2)))
+    return sigma, (num / den if den > 0 else 0.0)
+
+
 def ar1_innovations(e: np.ndarray, phi: float) -> np.ndarray:
     """AR(1) innovations :math:`w_t = e_t - \\varphi e_{t-1}` (NaN where either is missing).
 
@@ -434,42 +493,6 @@ def ar1_white_innovations(e: np.ndarray, sigma: float, phi: float, w: float) -> 
         g = Pp / F
         m, P, last = mp + g * v, Pp * w2 / F, k
     return out
-
-
-#: The implementations of the noise models declared in
-#: :data:`heritage_bayes.names.NOISE_MODELS` (name -> class), filled by
-#: :func:`register_noise`.
-NOISE_MODELS: dict[str, type[NoiseModel]] = {}
-
-
-def register_noise(cls: type[NoiseModel]) -> type[NoiseModel]:
-    """Register a noise model class under its ``name`` (a class decorator).
-
-    The package's own noise models are declared in
-    :data:`heritage_bayes.names.NOISE_MODELS`, so that the command line and the settings
-    know them without importing the numerics; a name declared nowhere is declared here
-    with the class's ``description`` (a noise model added from outside the package is
-    then this one class).
-
-    Raises
-    ------
-    ValueError
-        ``cls.name`` already has a class, or is declared nowhere and ``cls`` has no
-        ``description``.
-    """
-    if cls.name in NOISE_MODELS or (cls.name not in DECLARED and not cls.description):
-        raise ValueError(
-            f"noise model {cls.name!r}: registered once, with a description or a name "
-            "declared in heritage_bayes.names (declare_noise)"
-        )
-    if cls.name not in DECLARED:
-        declare_noise(cls.name, NoiseName(cls.description))
-    NOISE_MODELS[cls.name] = cls
-    return cls
-
-
-for _cls in (IIDNoise, AR1Noise, AR1WhiteNoise):
-    register_noise(_cls)
 
 
 def fit_free_run_error(residual: np.ndarray, phi_max: float = 0.999) -> dict[str, float]:
@@ -537,11 +560,16 @@ def noise_parameter_names(name: str | None, output_names, state_names=()) -> fro
     return frozenset(n for n, _, _ in nm.parameter_specs(output_names, state_names))
 
 
+def residual_noise_models() -> list[str]:
+    """The registered noise models of the residuals (not ``statespace``), in the
+    registry's order (the default first): those a model without a constant modal
+    form (controlled, or coupled to a temperature) can take."""
+    return [name for name, cls in NOISE_MODELS.items() if not cls.statespace]
+
+
 def get_noise_model(name: str) -> NoiseModel:
     """Noise model by name (:data:`NOISE_MODELS`: ``"ar1_white"``, ``"ar1"``, ``"iid"``,
     ``"kalman"``, and any registered with :func:`register_noise`)."""
-    # "kalman" (inference/statespace.py) registers itself in NOISE_MODELS; the package
-    # imports that module, so no import back from here (no import cycle)
     try:
         return NOISE_MODELS[name]()
     except KeyError:

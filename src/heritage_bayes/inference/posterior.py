@@ -60,7 +60,7 @@ from typing import Any
 import numpy as np
 
 from heritage_bayes.inference.coupled import coupled_filter_stats
-from heritage_bayes.inference.likelihoods import NoiseModel
+from heritage_bayes.inference.likelihoods import NoiseModel, residual_noise_models
 from heritage_bayes.inference.parameters import ParameterSet
 from heritage_bayes.rc.discretize import modal_form
 from heritage_bayes.rc.model import RCModel
@@ -157,20 +157,21 @@ class LogPosterior:
                 f"initial_state: expected 'estimate', 'steady' or a mapping node -> value "
                 f"(got {mode!r})"
             )
-        self._time_varying = bool(getattr(self.model, "time_varying", False))
+        self._time_varying = self.model.time_varying
         if self._time_varying:
-            if getattr(self.noise, "statespace", False):
+            if self.noise.statespace:
                 raise ValueError(
                     f"noise: {self.noise.name!r} filters a model with a constant modal form; "
                     f"{self.model.name!r} is time-varying (coupled to a temperature): use "
-                    "ar1_white (the default), ar1 or iid"
+                    f"one of {', '.join(residual_noise_models())}"
                 )
             # the per-step series of the inputs (saturation ratios), once
             self._series = self.model.series(self.inputs)
-        if self.model.control is not None and getattr(self.noise, "statespace", False):
+        if self.model.control is not None and self.noise.statespace:
             raise ValueError(
                 f"noise: {self.noise.name!r} filters a model that is linear in its state; "
-                f"{self.model.name!r} is controlled (thermostat/humidistat): use ar1_white"
+                f"{self.model.name!r} is controlled (thermostat/humidistat): use one of "
+                f"{', '.join(residual_noise_models())}"
             )
         if free and self.model.control is not None:
             raise ValueError(
@@ -309,7 +310,7 @@ class LogPosterior:
             return ll
         with np.errstate(all="ignore"):
             mf = self._form(tm)
-            if getattr(self.noise, "statespace", False):
+            if self.noise.statespace:
                 ll = self.noise.filter(
                     self.model, mf, self.inputs, self.observed, tn, *self._x0_prior(mf)
                 )
@@ -486,7 +487,7 @@ class LogPosterior:
         with np.errstate(all="ignore"):
             mf = self._form(tm)
             x0 = self._x0_mean(mf)
-            if self.x0_free.size and getattr(self.noise, "statespace", False):
+            if self.x0_free.size and self.noise.statespace:
                 mean, cov = self._statespace_x0(mf, tn, x0)
                 if rng is not None:
                     Lc = np.linalg.cholesky(cov + 1e-12 * np.eye(cov.shape[-1]))
@@ -530,7 +531,7 @@ class LogPosterior:
         """(K, N, n_out) log-likelihood terms (NaN where excluded), for LOO."""
         theta = np.atleast_2d(theta)
         tm, tn = self.split(theta)
-        if getattr(self.noise, "statespace", False):  # one-step predictive densities
+        if self.noise.statespace:  # one-step predictive densities
             mf = modal_form(self.model, tm, self.dt)
             return self.noise.filter(
                 self.model, mf, self.inputs, self.observed, tn, *self._x0_prior(mf), True

@@ -174,11 +174,13 @@ def _kalman_modal(ad, W, Qd, Cz, yobs, R, z, P, point, pred, want_point):  # pra
     return out
 
 
+@register_noise
 class KalmanNoise(NoiseModel):
     """Process noise on every node of the RC model + white measurement noise (see the
     module docstring). Parameters: ``q_<node>`` per state node and ``sigma_<output>``."""
 
     name = "kalman"
+    description = "a Kalman filter on the stochastic RC model"
     kinds = ("sigma",)
     statespace = True
     descriptions = MappingProxyType(
@@ -290,6 +292,3 @@ class KalmanNoise(NoiseModel):
             out[:, k, :] = np.einsum("koj,kj->ko", mf.Cz, d)
             d = mf.ad * d + np.einsum("kij,kj->ki", L, rng.standard_normal((K, n)))
         return out + np.sqrt(R)[:, None, :] * rng.standard_normal((K, N, n_out))
-
-
-register_noise(KalmanNoise)  # get_noise_model("kalman")

@@ -61,7 +61,7 @@ def innovations_at(logpost, theta: np.ndarray) -> np.ndarray:
         for (a, b), part in zip(logpost.segments, logpost.parts, strict=True):
             out[a:b] = innovations_at(part, theta)
         return out
-    if getattr(logpost.noise, "statespace", False):
+    if logpost.noise.statespace:
         mean, var = logpost.noise.one_step(logpost, theta)
         return ((logpost.observed - mean[0]) / np.sqrt(var[0])).astype(float)
     tm, tn = logpost.split(theta)

@@ -105,7 +105,7 @@ def _noise(draws: Draws, sl: slice, N: int, seed: int, i: int, models=None, dt=3
     rng = np.random.default_rng([seed, i])
     out = {}
     for s, nm in draws.noise_models.items():
-        if getattr(nm, "statespace", False):
+        if nm.statespace:
             if models is None:
                 raise ValueError(f"section {s!r}: a state-space noise model needs its RC model")
             with np.errstate(all="ignore"):

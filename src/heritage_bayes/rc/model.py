@@ -38,6 +38,11 @@ class RCModel:
     #: free-running room.
     control = None
 
+    #: Linear in the state but time-varying (a hygric model coupled to a temperature,
+    #: :mod:`heritage_bayes.rc.sorption`): no constant modal form, simulated by its own
+    #: recursion (:meth:`forward`).
+    time_varying = False
+
     #: Network inputs discretised with the first-order hold (instantaneous readings,
     #: linear between samples); each adds the input column ``<name>_slope`` (see
     #: :meth:`with_slopes`).

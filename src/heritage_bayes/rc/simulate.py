@@ -182,7 +182,7 @@ def iter_simulate(
             x0s = np.asarray(x0)[sl]
         # a controlled room (heating, humidistat, sources) or one coupled to a
         # temperature (heritage_bayes.rc.sorption): no constant modal recursion
-        if model.control is not None or getattr(model, "time_varying", False):
+        if model.control is not None or model.time_varying:
             yield sl, model.forward(P[sl], U, dt, x0=x0s)[0]
             continue
         z0 = _initial_modal(mf, U, x0s)

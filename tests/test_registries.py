@@ -26,13 +26,15 @@ DEMO = "configs/demo.yaml"
 @pytest.fixture
 def restore_registries():
     """Whatever a test registers is gone after it."""
-    catalogue, noise = dict(catalog.CATALOG), dict(names.NOISE_MODELS)
+    catalogue = dict(catalog.CATALOG)
+    before = [(r, dict(r)) for r in (names.NOISE_MODELS, names.MOVES)]
     yield
     catalog.CATALOG.clear()
     catalog.CATALOG.update(catalogue)
-    for name in set(names.NOISE_MODELS) - set(noise):
-        names.NOISE_MODELS.unregister(name)
-    assert dict(names.NOISE_MODELS) == noise
+    for registry, entries in before:
+        for name in set(registry) - set(entries):
+            registry.unregister(name)
+        assert dict(registry) == entries
 
 
 def _toy_network(surfaces=None, ground: bool = True) -> Network:
@@ -138,11 +140,49 @@ def test_every_declared_name_has_its_implementation_and_no_other():
     assert likelihoods.NOISE_MODELS is names.NOISE_MODELS  # one registry
     assert list(names.NOISE_MODELS) == ["ar1_white", "ar1", "iid", "kalman"]
     assert next(iter(names.NOISE_MODELS)) == names.DEFAULT_NOISE
-    assert list(monitor.MOVES) == list(names.MOVES)
+    assert monitor.MOVES is names.MOVES  # one registry
+    assert list(names.MOVES) == [
+        "de_snooker",
+        "de_snooker_50",
+        "de",
+        "stretch",
+        "de_global",
+        "dime",
+    ]
+    assert next(iter(names.MOVES)) == names.DEFAULT_MOVE
+    for name, mixture in names.MOVES.items():
+        assert mixture.name == name
     for name, cls in likelihoods.NOISE_MODELS.items():
         assert cls.name == name
     for name, entry in catalog.CATALOG.items():
         assert catalog.model(name).domain == entry.domain
+
+
+def test_a_registered_move_shows_in_the_settings_and_an_unknown_one_is_refused(
+    restore_registries,
+):
+    """A move mixture registered in one place is a choice of ``sampler.moves`` (its
+    description in the reference) and builds its emcee moves; a name not registered is
+    refused with the registry's names."""
+    import emcee
+
+    from heritage_bayes.reference import config_reference
+
+    raw = {**yaml.safe_load(open(DEMO, encoding="utf-8")), "sampler": {"moves": "walk"}}
+    with pytest.raises(ConfigError, match=r"sampler\.moves: Input should be 'de_snooker', "):
+        parse_config(raw, source="test")
+    with pytest.raises(ValueError, match="sampler.moves must be one of .*'dime'.*'walk'"):
+        monitor.make_moves("walk")
+    monitor.register_move("walk", "a toy: the stretch move", (emcee.moves.StretchMove, 1.0))
+    assert parse_config(raw, source="test").sampler.moves == "walk"
+    assert "walk (a toy: the stretch move)" in config_reference()
+    (move, weight), block = monitor.make_moves("walk", [1], 0.25)
+    assert isinstance(move, emcee.moves.StretchMove) and weight == 0.75 and block[1] == 0.25
+    with pytest.raises(ValueError, match="sampler move 'walk': registered once"):
+        monitor.register_move("walk", "again", (emcee.moves.StretchMove, 1.0))
+    with pytest.raises(ValueError, match="shares sum to 1"):
+        monitor.register_move("half", "a toy", (emcee.moves.StretchMove, 0.5))
+    assert "half" not in names.MOVES
 
 
 def test_a_model_s_own_parameter_roles_take_the_room_s_priors(restore_registries):

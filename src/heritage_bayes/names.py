@@ -5,12 +5,11 @@ Layer 0, imported by the settings (the choices of ``noise:`` and ``sampler.moves
 :class:`heritage_bayes.config._base.Choices`), by the command line (``hbayes models
 --noise``'s choices), by the generated references and by the report.
 
-The noise models are listed nowhere by hand: :data:`NOISE_MODELS` is a :class:`Registry`
-that each noise model's class fills where it is defined
-(:func:`heritage_bayes.inference.likelihoods.register_noise`), read from here by the
-layers below the numerics. The moves' names are declared here and implemented in
-:data:`heritage_bayes.inference.monitor.MOVES`; a name without its implementation, or
-the other way round, fails the tests.
+The noise models and the moves are listed nowhere by hand: :data:`NOISE_MODELS` and
+:data:`MOVES` are each a :class:`Registry` that each implementation fills where it is
+defined (:func:`heritage_bayes.inference.likelihoods.register_noise` beside a noise
+model's class, :func:`heritage_bayes.inference.monitor.register_move` with a move
+mixture's description), read from here by the layers below the numerics.
 
 The catalogue of RC models is :data:`heritage_bayes.rc.catalog.CATALOG` (one entry
 per model, its ladder position and solar capability included).
@@ -27,6 +26,7 @@ _T = TypeVar("_T")
 
 __all__ = [
     "CONTROLS",
+    "DEFAULT_MOVE",
     "DEFAULT_NOISE",
     "HUMIDISTAT_MODES",
     "MOVES",
@@ -100,17 +100,12 @@ NOISE_MODELS: Registry[Any] = Registry("noise model", "heritage_bayes.inference"
 #: The noise model of a section that does not choose one.
 DEFAULT_NOISE = "ar1_white"
 
-#: ``sampler.moves`` choices, the default first (name -> description); the emcee
-#: mixtures are :data:`heritage_bayes.inference.monitor.MOVES`.
-MOVES: dict[str, str] = {
-    "de_snooker": "differential evolution 80 %, snooker 20 %",
-    "de_snooker_50": "differential evolution 50 %, snooker 50 %",
-    "de": "differential evolution",
-    "stretch": "the affine-invariant stretch move",
-    "de_global": "de_snooker whose DE part is replaced, for a walker in ten, by an "
-    "independent draw from a Student-t fitted to the chain so far",
-    "dime": "DE with those independent draws, no snooker",
-}
+#: ``sampler.moves`` choices, the default first (name -> its emcee move mixture, a
+#: :class:`heritage_bayes.inference.monitor.Mixture`, registered by
+#: :func:`heritage_bayes.inference.monitor.register_move` with its description).
+MOVES: Registry[Any] = Registry("sampler move", "heritage_bayes.inference.monitor")
+#: The moves of a sampler that does not choose them.
+DEFAULT_MOVE = "de_snooker"
 
 
 class DistributionName:

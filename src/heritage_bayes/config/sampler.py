@@ -9,7 +9,7 @@ from pydantic import PlainSerializer, PlainValidator, WithJsonSchema
 
 from heritage_bayes.config._base import DURATION_UNIT, Choices, _duration, _Strict, key
 from heritage_bayes.convert import format_timedelta
-from heritage_bayes.names import MOVES
+from heritage_bayes.names import DEFAULT_MOVE, MOVES
 
 #: ``optimizer.restarts`` of networks of :data:`BLOCK_MIN_NODES` or more capacity nodes
 #: where the config does not set it: on the demo's data thermal_4a has two optima of
@@ -94,14 +94,11 @@ class SamplerSettings(_Strict):
         ge=0,
         lt=1,
     )
-    moves: Annotated[str, Choices(MOVES)] = key(
-        "de_snooker",
+    moves: Annotated[str, Choices(MOVES, described=True)] = key(
+        DEFAULT_MOVE,
         unit=None,
-        description="emcee's proposal moves: de_snooker (differential evolution 80 %, "
-        "snooker 20 %), de_global (de_snooker whose DE part is replaced, for a walker in "
-        "ten, by an independent draw from a Student-t fitted to the chain so far), dime "
-        "(DE with those draws, no snooker), de, or stretch (their τ compared: "
-        'docs/science/benchmarks.md, "Global proposals")',
+        description="emcee's proposal moves, their τ compared in docs/science/benchmarks.md "
+        '("Global proposals")',
     )
     block_weight: float | None = key(
         None,

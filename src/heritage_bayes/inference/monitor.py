@@ -1,36 +1,115 @@
 """emcee's moves by name, and the schedule and τ estimate of the convergence monitor.
 
-:data:`MOVES` and :func:`make_moves` (the ``sampler.moves`` key), :func:`_next_check`
-(when the monitor estimates τ), :func:`_tau` (the integrated autocorrelation time
-per parameter, Goodman & Weare 2010; Foreman-Mackey et al. 2013) and
-:class:`ChainBuffer` (the chain in memory while it grows). Split from
-:mod:`heritage_bayes.inference.sampler`, which uses them.
+:class:`Mixture` and :func:`register_move` (the ``sampler.moves`` choices, each
+registered here with its description beside its moves), :func:`make_moves` (a
+choice's emcee moves), :func:`_next_check` (when the monitor estimates τ),
+:func:`_tau` (the integrated autocorrelation time per parameter, Goodman & Weare 2010;
+Foreman-Mackey et al. 2013) and :class:`ChainBuffer` (the chain in memory while it
+grows). Split from :mod:`heritage_bayes.inference.sampler`, which uses them.
 """
 
 from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
 
 import emcee
 import numpy as np
 
 from heritage_bayes.inference.moves import BlockDEMove, GlobalDEMove
+from heritage_bayes.names import MOVES
 
-#: ``sampler.moves``: name -> [(emcee move class, weight), ...] (emcee's defaults for
-#: each move: ``DEMove`` γ₀ = 2.38 / √(2 d), ``DESnookerMove`` γ = 1.7, ``StretchMove``
-#: a = 2).
-MOVES = {
-    "de_snooker": ((emcee.moves.DEMove, 0.8), (emcee.moves.DESnookerMove, 0.2)),
-    "de_snooker_50": ((emcee.moves.DEMove, 0.5), (emcee.moves.DESnookerMove, 0.5)),
-    "de": ((emcee.moves.DEMove, 1.0),),
-    "stretch": ((emcee.moves.StretchMove, 1.0),),
-    # DE with global independence proposals (heritage_bayes.inference.moves)
-    "de_global": ((GlobalDEMove, 0.8), (emcee.moves.DESnookerMove, 0.2)),
-    "dime": ((GlobalDEMove, 1.0),),
-}
+__all__ = ["MOVES", "ChainBuffer", "Mixture", "make_moves", "register_move"]
+
+
+@dataclass(frozen=True)
+class Mixture:
+    """A ``sampler.moves`` choice: emcee moves, each taking a share of the steps.
+
+    Attributes
+    ----------
+    name : str
+        The name ``sampler.moves`` chooses.
+    description : str
+        One line for the references and the settings' description.
+    parts : tuple of (callable, float)
+        Per move, what builds it (an :class:`emcee.moves.Move` class, or any callable
+        returning a move) and its share of the steps; the shares sum to 1.
+    """
+
+    name: str
+    description: str
+    parts: tuple[tuple[Callable[[], emcee.moves.Move], float], ...]
+
+    def build(self, share: float = 1.0) -> list[tuple[emcee.moves.Move, float]]:
+        """Fresh moves, as emcee's ``[(move, weight), ...]``, their weights scaled to sum
+        to ``share``."""
+        return [(make(), w * share) for make, w in self.parts]
+
+
+def register_move(
+    name: str, description: str, *parts: tuple[Callable[[], emcee.moves.Move], float]
+) -> Mixture:
+    """Register a ``sampler.moves`` choice: the one place a move mixture is listed. The
+    settings' validation and description of ``sampler.moves``, the references and
+    :func:`make_moves` read :data:`heritage_bayes.names.MOVES`, which this fills.
+
+    Parameters
+    ----------
+    name : str
+        A lowercase identifier, not yet taken.
+    description : str
+        What the mixture is, in one line.
+    *parts : (callable, float)
+        Per move, what builds it (no arguments) and its share of the steps.
+
+    Raises
+    ------
+    ValueError
+        The name is taken or not a lowercase identifier, the description is empty, or
+        the shares are not positive or do not sum to 1.
+    """
+    shares = [w for _, w in parts]
+    if not description or not shares or min(shares) <= 0 or not math.isclose(sum(shares), 1):
+        raise ValueError(
+            f"sampler move {name!r}: a description and moves whose positive shares sum "
+            f"to 1 are required (got {description!r}, shares {shares})"
+        )
+    return MOVES.register(name, Mixture(name, description, tuple(parts)))
+
+
+# The package's mixtures, the default first (emcee's defaults for each move: ``DEMove``
+# γ₀ = 2.38 / √(2 d), ``DESnookerMove`` γ = 1.7, ``StretchMove`` a = 2).
+register_move(
+    "de_snooker",
+    "differential evolution 80 %, snooker 20 %",
+    (emcee.moves.DEMove, 0.8),
+    (emcee.moves.DESnookerMove, 0.2),
+)
+register_move(
+    "de_snooker_50",
+    "differential evolution 50 %, snooker 50 %",
+    (emcee.moves.DEMove, 0.5),
+    (emcee.moves.DESnookerMove, 0.5),
+)
+register_move("de", "differential evolution", (emcee.moves.DEMove, 1.0))
+register_move("stretch", "the affine-invariant stretch move", (emcee.moves.StretchMove, 1.0))
+# DE with global independence proposals (heritage_bayes.inference.moves)
+register_move(
+    "de_global",
+    "de_snooker whose DE part is replaced, for a walker in ten, by an independent draw "
+    "from a Student-t fitted to the chain so far",
+    (GlobalDEMove, 0.8),
+    (emcee.moves.DESnookerMove, 0.2),
+)
+register_move("dime", "DE with those independent draws, no snooker", (GlobalDEMove, 1.0))
 
 
 def make_moves(name: str, block=(), block_weight: float = 0.0):
-    """emcee moves by name (:data:`MOVES`): ``de_snooker`` (default), ``de_snooker_50``,
-    ``de`` or ``stretch``, as emcee's ``[(move, weight), ...]``.
+    """emcee moves by name (:data:`MOVES`: ``de_snooker`` (default), ``de_snooker_50``,
+    ``de``, ``stretch``, ``de_global``, ``dime`` and any registered with
+    :func:`register_move`), as emcee's ``[(move, weight), ...]``.
 
     With a non-empty ``block`` (coordinate indices) and ``block_weight`` > 0, a
     :class:`~heritage_bayes.inference.moves.BlockDEMove` on those coordinates takes that
@@ -41,13 +120,12 @@ def make_moves(name: str, block=(), block_weight: float = 0.0):
     does not spread the ensemble (docs/science/benchmarks.md, "Figures behind the code's
     choices"), its proposals lie along lines through other walkers."""
     if name not in MOVES:
-        raise ValueError(f"sampler.moves must be one of {sorted(MOVES)} (got {name!r})")
+        raise ValueError(f"sampler.moves must be one of {list(MOVES)} (got {name!r})")
     if not 0.0 <= block_weight < 1.0:
         raise ValueError(f"sampler.block_weight must lie in [0, 1) (got {block_weight})")
     if len(block) == 0 or block_weight == 0.0:
-        return [(cls(), w) for cls, w in MOVES[name]]
-    rest = 1.0 - block_weight
-    return [(cls(), w * rest) for cls, w in MOVES[name]] + [(BlockDEMove(block), block_weight)]
+        return MOVES[name].build()
+    return MOVES[name].build(1.0 - block_weight) + [(BlockDEMove(block), block_weight)]
 
 
 def _next_check(done: int, check_every: int) -> int:

@@ -78,6 +78,7 @@ from heritage_bayes.inference.monitor import (
 )
 from heritage_bayes.inference.moves import refit_moves
 from heritage_bayes.inference.start import laplace_ensemble
+from heritage_bayes.names import DEFAULT_MOVE
 from heritage_bayes.rundir.signals import DeferSignals
 
 __all__ = [
@@ -196,7 +197,7 @@ def _run_sampler(
     *,
     seed: int,
     nwalkers: int | None = None,
-    moves: str = "de_snooker",
+    moves: str = DEFAULT_MOVE,
     block=(),
     block_weight: float = 0.0,
     max_steps: int = 200_000,

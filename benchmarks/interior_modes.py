@@ -152,7 +152,9 @@ def _jump(args) -> None:
 
     sampler.start_ensemble = split
     hop = functools.partial(emcee.moves.DEMove, gamma0=1.0)
-    monitor.MOVES["split"] = (
+    monitor.register_move(
+        "split",
+        "DE 80 % (less the jumps), snooker 20 %, DE jumps of γ₀ = 1 (--jump)",
         (emcee.moves.DEMove, 0.8 - args.jump),
         (emcee.moves.DESnookerMove, 0.2),
         *(((hop, args.jump),) if args.jump > 0 else ()),

@@ -143,7 +143,12 @@ def main() -> None:
     ap.add_argument("--inflate", type=float, default=MixtureDEMove.inflate)
     own, rest = ap.parse_known_args()
     MixtureDEMove.components, MixtureDEMove.inflate = own.components, own.inflate
-    monitor.MOVES["de_mix"] = ((MixtureDEMove, 0.8), (emcee.moves.DESnookerMove, 0.2))
+    monitor.register_move(
+        "de_mix",
+        "de_global with a Gaussian mixture fitted by EM in place of the Student-t",
+        (MixtureDEMove, 0.8),
+        (emcee.moves.DESnookerMove, 0.2),
+    )
     import bench_coordinates
 
     sys.argv = [sys.argv[0], *rest]

@@ -171,7 +171,7 @@ def test_a_registered_move_shows_in_the_settings_and_an_unknown_one_is_refused(
     raw = {**yaml.safe_load(open(DEMO, encoding="utf-8")), "sampler": {"moves": "walk"}}
     with pytest.raises(ConfigError, match=r"sampler\.moves: Input should be 'de_snooker', "):
         parse_config(raw, source="test")
-    with pytest.raises(ValueError, match="sampler.moves must be one of .*'dime'.*'walk'"):
+    with pytest.raises(ValueError, match=r"sampler\.moves must be one of .*'dime'.*'walk'"):
         monitor.make_moves("walk")
     monitor.register_move("walk", "a toy: the stretch move", (emcee.moves.StretchMove, 1.0))
     assert parse_config(raw, source="test").sampler.moves == "walk"

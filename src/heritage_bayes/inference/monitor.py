@@ -125,7 +125,7 @@ def make_moves(name: str, block=(), block_weight: float = 0.0):
         raise ValueError(f"sampler.block_weight must lie in [0, 1) (got {block_weight})")
     if len(block) == 0 or block_weight == 0.0:
         return MOVES[name].build()
-    return MOVES[name].build(1.0 - block_weight) + [(BlockDEMove(block), block_weight)]
+    return [*MOVES[name].build(1.0 - block_weight), (BlockDEMove(block), block_weight)]
 
 
 def _next_check(done: int, check_every: int) -> int:

@@ -252,3 +252,21 @@ def test_a_model_without_a_modal_form_is_offered_the_registered_residual_models(
     model = build_model(cfg, "hygric")
     with pytest.raises(ConfigError, match=r"use one of ar1_white, ar1, iid, iid_toy$"):
         section_parameters(cfg, "hygric", model)
+
+
+def test_the_settings_and_hbayes_version_leave_the_numerics_unimported():
+    """The registries are read lazily: defining the settings (whose ``noise:`` and
+    ``sampler.moves`` choose from them) and ``hbayes --version`` import no sampler."""
+    import subprocess
+
+    code = (
+        "import sys\n"
+        "from heritage_bayes.config import sampler, models\n"
+        "from heritage_bayes.cli import main\n"
+        "assert main(['--version']) == 0\n"
+        "print(sorted(m for m in ('emcee', 'heritage_bayes.inference') if m in sys.modules))\n"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True
+    ).stdout
+    assert out.splitlines()[-1] == "[]"

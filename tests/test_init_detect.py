@@ -428,11 +428,11 @@ def test_a_validation_warmer_than_the_calibration_is_named():
 
     utc, te, *_ = _climate("2010-11-15", "2011-07-26", HELSINKI["longitude"])
     s = pd.Series(te, index=utc)
-    note = extrapolated_seasons(s, "2010-11-15", "2011-05-02", "2011-07-26")
+    note = extrapolated_seasons(s, "2010-11-15", "2011-05-02", "2011-05-02", "2011-07-26")
     assert note is not None and "the calibration holds no summer" in note
     utc, te, *_ = _climate("2011-01-01", "2012-01-01", HELSINKI["longitude"])
     s = pd.Series(te, index=utc)
-    assert extrapolated_seasons(s, "2011-01-01", "2011-09-01", "2012-01-01") is None
+    assert extrapolated_seasons(s, "2011-01-01", "2011-09-01", "2011-09-01", "2012-01-01") is None
 
 
 def test_a_logger_on_a_fixed_clock_is_asked_which_fixed_clock(tmp_path):

@@ -52,6 +52,8 @@ import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import pandas as pd
+
 from heritage_bayes.errors import DataError, InputError
 from heritage_bayes.init_checks import MAX_GAP_H
 from heritage_bayes.init_model import propose_model
@@ -196,9 +198,9 @@ def init_config(
         wx.te_utc,
         per.rhi_utc if per.hygric else None,
         per.rhe_utc,
-        start=per.cs,
-        mid=per.ce,
-        end=per.ve,
+        start=per.span[0],
+        mid=pd.Timestamp(per.span[0]) + (pd.Timestamp(per.ce) - pd.Timestamp(per.cs)),
+        end=per.span[1],
         heated=per.floor,
     )
     findings += [f"model: {x}" for x in prop.thermal_evidence + prop.hygric_evidence]
@@ -210,7 +212,9 @@ def init_config(
         wx.latitude is not None and prop.daily_sun is not False
     )
     attic = (
-        attic_evidence((indoor.stem, name), log.ti_utc[per.cs : per.ve], wx.te_utc[per.cs : per.ve])
+        attic_evidence(
+            (indoor.stem, name), log.ti_utc[slice(*per.span)], wx.te_utc[slice(*per.span)]
+        )
         if sunlit
         else None
     )

@@ -25,7 +25,9 @@ docs/science/models.md, "Figures behind the code's choices"):
   most recent 12 months, with readings in 70 % of the hours from each file), within its
   most recent stretch run one way (:mod:`~heritage_bayes.init_regimes`: the RH band, the
   heating floor and the summer gain year by year), as
-  :func:`~heritage_bayes.init_periods.choose_periods` says; spanning gaps (the calibration splits
+  :func:`~heritage_bayes.init_periods.choose_periods` says (a record shorter than a
+  year validates on its first third where only then the calibration covers the
+  validation's outdoor conditions); spanning gaps (the calibration splits
   at those over ``data.max_gap``) but never starting or ending in one. While a clock is
   an open question they keep 14 h (the largest offset) inside the span, so that any
   answer keeps them inside the data.

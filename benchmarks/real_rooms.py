@@ -26,7 +26,9 @@ Usage (from the repository root)::
         [--calibrate --max-steps 1500] [--json FILE]
 
 ROOM: R2 R3 R4 R5 R6 R7 orholm annisse (default: the tuning rooms; ``--held-out`` adds
-the held-out ones).
+the held-out ones). ``--span START END`` cuts a TRH-1 room's logger and weather files to
+the rows stamped in ``[START, END)`` (the files' own clock; copies in the work folder,
+same layout): a user who holds a shorter record.
 """
 
 from __future__ import annotations
@@ -85,22 +87,45 @@ def _cpu() -> float:
     return own.ru_utime + own.ru_stime + kids.ru_utime + kids.ru_stime
 
 
-def run_init(room: str, data: Path, work: Path, weather: Path | None = None) -> tuple:
-    """init on a room's raw files; while it asks, init again with the next recorded
-    answer. Returns (config path, questions left, answers given)."""
+def run_init(
+    room: str, data: Path, work: Path, weather: Path | None = None, logger: Path | None = None
+) -> tuple:
+    """init on a room's raw files (``logger``, ``weather``: other copies of them); while
+    it asks, init again with the next recorded answer. Returns (config path, questions
+    left, answers given)."""
     from heritage_bayes.init_config import init_config
 
-    logger, wfile, (lat, lon), _, answers = ROOMS[room]
+    lfile, wfile, (lat, lon), _, answers = ROOMS[room]
+    logger, weather = logger or data / lfile, weather or data / wfile
     out = work / "config.yaml"
     kw = {"latitude": lat, "longitude": lon, "output": out, "force": True}
-    res = init_config(data / logger, weather or data / wfile, **kw)
+    res = init_config(logger, weather, **kw)
     given: dict = {}
     for answer in answers:
         if not res.questions:
             break
         given = answer
-        res = init_config(data / logger, weather or data / wfile, **kw, **given)
+        res = init_config(logger, weather, **kw, **given)
     return out, res.questions, given
+
+
+def cut_files(room: str, data: Path, work: Path, span: list[str]) -> tuple[Path, Path]:
+    """Copies of a TRH-1 room's logger and weather files in ``work`` with the rows
+    stamped in ``[span[0], span[1])`` only (the files' own clock, same layout)."""
+    out = []
+    for rel in ROOMS[room][:2]:
+        if not rel.startswith("trh1"):
+            raise SystemExit(f"--span: only the TRH-1 rooms' files can be cut ({room}: {rel})")
+        t = pd.read_csv(data / rel)
+        stamp = pd.to_datetime(t.iloc[:, 0])
+        keep = (stamp >= pd.Timestamp(span[0])) & (stamp < pd.Timestamp(span[1]))
+        if not keep.any():
+            raise SystemExit(f"--span: no row of {rel} in {span[0]} to {span[1]}")
+        path = work / room / "cut" / Path(rel).name
+        path.parent.mkdir(parents=True, exist_ok=True)
+        t[keep].to_csv(path, index=False)
+        out.append(path)
+    return out[0], out[1]
 
 
 def room_below(config: Path, logger: Path) -> Path:
@@ -245,10 +270,8 @@ def one(room, variant, config: Path, args, work: Path, extra: dict) -> dict:
     row = {"room": room, "variant": variant, "held_out": ROOMS[room][3], **extra}
     row["irradiance"] = cfg.data.irradiance
     row["models"] = _models(cfg)
-    row["periods"] = (
-        f"{cfg.periods.calibration.start}..{cfg.periods.calibration.end}"
-        f"|..{cfg.periods.validation.end}"
-    )
+    cal, val = cfg.periods.calibration, cfg.periods.validation
+    row["periods"] = f"cal {cal.start}..{cal.end}, val {val.start}..{val.end}"
     row.update(map_fits(cfg, args.maxiter, args.starts))
     secs = [sec for sec in ("thermal", "hygric") if getattr(cfg, sec, None) is not None]
     parts = row["models"].split("; ")
@@ -274,7 +297,7 @@ def _print(row: dict) -> None:
     )
     if "cal_Ti" in row:
         line += f" {f('cal_Ti')} | {f('cal_Pi')} | {f('cal_RH')} | {row.get('converged')} |"
-    line += f" {row['wall_s']:.0f} / {row['cpu_s']:.0f} |"
+    line += f" {row['wall_s']:.0f} / {row['cpu_s']:.0f} | {row['periods']} |"
     print(line, flush=True)
 
 
@@ -298,6 +321,12 @@ def main(argv=None) -> int:
         "--monthly", action="store_true", help="also the thermal MAP's residual by month"
     )
     ap.add_argument("--json", type=Path, help="write the rows here")
+    ap.add_argument(
+        "--span",
+        nargs=2,
+        metavar=("START", "END"),
+        help="cut the TRH-1 files to the rows stamped in [START, END) (copies in the work folder)",
+    )
     args = ap.parse_args(argv)
     rooms = args.rooms or TUNING + (HELD_OUT if args.held_out else [])
     if set(rooms) - set(ROOMS):
@@ -307,21 +336,25 @@ def main(argv=None) -> int:
     if args.calibrate:
         hdr += " cal Ti | cal Pi | cal RH | converged |"
     print(f"validation FIT [%] of the MAP (maxiter {args.maxiter}, starts {args.starts})")
-    print(hdr + " wall / CPU [s] |", flush=True)
+    print(hdr + " wall / CPU [s] | periods |", flush=True)
     rows = []
     for room in rooms:
         logger, wfile, *_ = ROOMS[room]
-        variants = {"as published": None}
+        lpath, wpath = args.data / logger, args.data / wfile
+        if args.span:
+            lpath, wpath = cut_files(room, args.data, work, args.span)
+        published = f"{args.span[0]} to {args.span[1]}" if args.span else "as published"
+        variants = {published: wpath}
         if wfile.startswith("trh1") and not args.no_bare:
             bare = work / room / "bare" / "fmi.csv"
             bare.parent.mkdir(parents=True, exist_ok=True)
-            pd.read_csv(args.data / wfile).drop(columns=["Rglob", "Rdif"]).to_csv(bare, index=False)
+            pd.read_csv(wpath).drop(columns=["Rglob", "Rdif"]).to_csv(bare, index=False)
             variants["no radiation"] = bare
         for variant, weather in variants.items():
-            w = work / room / ("init" if weather is None else "init_bare")
+            w = work / room / ("init" if weather == wpath else "init_bare")
             w.mkdir(parents=True, exist_ok=True)
             t0, c0 = time.perf_counter(), _cpu()
-            config, questions, given = run_init(room, args.data, w, weather)
+            config, questions, given = run_init(room, args.data, w, weather, lpath)
             init_s = {"init_wall_s": time.perf_counter() - t0, "init_cpu_s": _cpu() - c0}
             if questions:
                 print(f"| {room} | {variant}: open questions after the answers {given}: "

@@ -204,8 +204,11 @@ def test_periods_stay_inside_the_data_whatever_the_answer_to_an_open_clock(tmp_p
     assert any("a clock is still an open question" in f for f in res.findings)
     raw = yaml.safe_load(out.read_text(encoding="utf-8"))
     # the data start 2021-03-01 00:00 on the file's clock: 14 h margin, next midnight;
-    # the periods span the outage (a gap splits the record into segments)
-    assert str(raw["periods"]["calibration"]["start"]) == "2021-03-02"
+    # the periods span the outage (a gap splits the record into segments); a spring
+    # record: the first third (March) validates, as the rest covers its weather
+    per = raw["periods"]
+    assert str(per["validation"]["start"]) == "2021-03-02"
+    assert per["validation"]["end"] == per["calibration"]["start"]
     for answer in ("UTC-2", "UTC+12", "UTC-12"):
         raw["data"]["weather"]["timezone"] = answer
         prep = prepare(parse_config(raw, base_dir=str(out.parent), name="room"))
@@ -428,11 +431,11 @@ def test_a_validation_warmer_than_the_calibration_is_named():
 
     utc, te, *_ = _climate("2010-11-15", "2011-07-26", HELSINKI["longitude"])
     s = pd.Series(te, index=utc)
-    note = extrapolated_seasons(s, "2010-11-15", "2011-05-02", "2011-07-26")
+    note = extrapolated_seasons(s, "2010-11-15", "2011-05-02", "2011-05-02", "2011-07-26")
     assert note is not None and "the calibration holds no summer" in note
     utc, te, *_ = _climate("2011-01-01", "2012-01-01", HELSINKI["longitude"])
     s = pd.Series(te, index=utc)
-    assert extrapolated_seasons(s, "2011-01-01", "2011-09-01", "2012-01-01") is None
+    assert extrapolated_seasons(s, "2011-01-01", "2011-09-01", "2011-09-01", "2012-01-01") is None
 
 
 def test_a_logger_on_a_fixed_clock_is_asked_which_fixed_clock(tmp_path):

@@ -25,7 +25,9 @@ docs/science/models.md, "Figures behind the code's choices"):
   most recent 12 months, with readings in 70 % of the hours from each file), within its
   most recent stretch run one way (:mod:`~heritage_bayes.init_regimes`: the RH band, the
   heating floor and the summer gain year by year), as
-  :func:`~heritage_bayes.init_periods.choose_periods` says; spanning gaps (the calibration splits
+  :func:`~heritage_bayes.init_periods.choose_periods` says (a record shorter than a
+  year validates on its first third where only then the calibration covers the
+  validation's outdoor conditions); spanning gaps (the calibration splits
   at those over ``data.max_gap``) but never starting or ending in one. While a clock is
   an open question they keep 14 h (the largest offset) inside the span, so that any
   answer keeps them inside the data.
@@ -51,6 +53,8 @@ import datetime as _dt
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
+
+import pandas as pd
 
 from heritage_bayes.errors import DataError, InputError
 from heritage_bayes.init_checks import MAX_GAP_H
@@ -196,9 +200,9 @@ def init_config(
         wx.te_utc,
         per.rhi_utc if per.hygric else None,
         per.rhe_utc,
-        start=per.cs,
-        mid=per.ce,
-        end=per.ve,
+        start=per.span[0],
+        mid=pd.Timestamp(per.span[0]) + (pd.Timestamp(per.ce) - pd.Timestamp(per.cs)),
+        end=per.span[1],
         heated=per.floor,
     )
     findings += [f"model: {x}" for x in prop.thermal_evidence + prop.hygric_evidence]
@@ -210,7 +214,9 @@ def init_config(
         wx.latitude is not None and prop.daily_sun is not False
     )
     attic = (
-        attic_evidence((indoor.stem, name), log.ti_utc[per.cs : per.ve], wx.te_utc[per.cs : per.ve])
+        attic_evidence(
+            (indoor.stem, name), log.ti_utc[slice(*per.span)], wx.te_utc[slice(*per.span)]
+        )
         if sunlit
         else None
     )

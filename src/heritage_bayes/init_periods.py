@@ -2,6 +2,15 @@
 span of overlapping data (gaps inside it split the record), the calibration and
 validation periods in it, and a note when the validation holds weather the calibration
 does not.
+
+A record shorter than a year cannot hold every season in both periods. Split in time
+with the validation at the end, a record from November to July calibrates on a winter
+and validates on a summer: the model is then asked to extrapolate (the sun's gain on a
+roof free of snow, summer conditions it never saw). Such a record is split with the
+validation at its start instead when that puts the validation's outdoor conditions
+inside the calibration's (:func:`covered_share`): the calibration then spans both
+seasons, and the validation, simulated from the steady state of its own first inputs,
+tests an interpolation.
 """
 
 from __future__ import annotations
@@ -12,12 +21,16 @@ import pandas as pd
 from heritage_bayes.errors import DataError
 
 __all__ = [
+    "COVERED_SHARE",
     "MAX_GAP_H",
     "MIN_COVERAGE",
+    "RANGE_MARGIN",
     "VALIDATION_MONTHS",
     "WARMER_K",
     "YEAR_DAYS",
     "choose_periods",
+    "covered_share",
+    "daily_conditions",
     "extrapolated_seasons",
     "longest_stretch",
     "present_hours",
@@ -30,8 +43,15 @@ MAX_GAP_H = 6
 #: span init proposes: gaps inside it split the record (each segment its own start).
 MIN_COVERAGE = 0.7
 #: A stretch this long [days] or longer is split 8 months / 4 months (a year); shorter
-#: ones 2/3 / 1/3.
+#: ones 2/3 / 1/3, the validation's third at the end or at the start.
 YEAR_DAYS = 365
+#: Least share of the validation's days whose outdoor conditions lie inside the
+#: calibration's range (:func:`covered_share`) for a short record to keep its validation
+#: at the end.
+COVERED_SHARE = 0.9
+#: Share of the calibration's range of a daily condition by which a validation day may
+#: lie beyond it and still count as covered (:func:`covered_share`).
+RANGE_MARGIN = 0.1
 #: Months of data after a whole calendar year from which that year calibrates and what
 #: follows (up to a year) validates, rather than 8 and 4 months of one year.
 VALIDATION_MONTHS = 8
@@ -97,8 +117,8 @@ def usable_span(ti: pd.Series, te: pd.Series) -> tuple[pd.Timestamp, pd.Timestam
             "own initial state)"
         )
 
-    cs, _, _, ve, _ = choose_periods(lo, hi)
-    cov = coverage(pd.Timestamp(cs, tz="UTC"), pd.Timestamp(ve, tz="UTC"))
+    cs, ce, vs, ve, _ = choose_periods(lo, hi)
+    cov = coverage(pd.Timestamp(min(cs, vs), tz="UTC"), pd.Timestamp(max(ce, ve), tz="UTC"))
     if min(cov) >= MIN_COVERAGE:
         return lo, hi, what("the overlap of the files", cov), notes
     for end in pd.date_range(lo, hi, freq="D")[::-1]:  # the latest 12 months first
@@ -125,19 +145,25 @@ def choose_periods(
     e: pd.Timestamp,
     present: pd.DatetimeIndex | None = None,
     span: str = "the longest stretch",
+    daily: pd.DataFrame | None = None,
 ) -> tuple[str, str, str, str, str]:
-    """Calibration ``[start, mid)`` and validation ``[mid, end)`` in whole UTC days
+    """Calibration ``[cs, ce)`` and validation ``[vs, ve)`` in whole UTC days
     within the stretch ``[s, e)``, and why: the most recent whole calendar year followed
     by :data:`VALIDATION_MONTHS` or more to calibrate, and up to a year after it to
     validate (every season in both; the room as it is now, which a model for projections
     and interventions describes); else the most recent 12 whole months followed by as
     many; else the most recent whole calendar year (8 months to
-    calibrate, 4 to validate), else the first 12 whole months, else the
-    stretch's first 2/3 and the rest. With ``present`` (the hours with an input
-    reading), the start and the end are midnights with a reading: a period never starts
-    or ends inside an input gap (or after the last reading), which the simulation
-    cannot bridge. ``span`` says what ``[s, e)`` is, for ``why``. Returns ``(start, mid,
-    mid, end, why)`` as text."""
+    calibrate, 4 to validate), else the first 12 whole months, else (a record shorter
+    than a year) the stretch's first 2/3 to calibrate and the rest to validate, unless
+    with the outdoor conditions ``daily`` (:func:`daily_conditions`) fewer than
+    :data:`COVERED_SHARE` of the validation's days lie inside the calibration's range
+    (:func:`covered_share`) and more do with the validation's third at the start: then
+    the first 1/3 validates and the rest calibrates. With ``present`` (the hours with an
+    input reading), the start, the end and a calibration that follows the validation
+    start at midnights with a reading: a period never starts or ends inside an input gap
+    (or after the last reading), which the simulation cannot bridge. ``span`` says what
+    ``[s, e)`` is, for ``why``. Returns ``(cs, ce, vs, ve, why)`` as text: ``ce == vs``
+    (the validation after the calibration) or ``ve == cs`` (before it)."""
     day = pd.Timedelta(days=1)
     s0 = s.ceil("D")
     e0 = e.floor("D")
@@ -145,7 +171,7 @@ def choose_periods(
     jan = pd.Timestamp(year=s0.year + int((s0.month, s0.day) > (1, 1)), month=1, day=1, tz=s0.tz)
     if s0.day != 1 and (e - s0).days >= YEAR_DAYS + 31:
         s0 = (s0 + pd.offsets.MonthBegin(1)).normalize()
-    which = "first"
+    which, val_first = "first", False
     # a whole calendar year to calibrate and VALIDATION_MONTHS or more after it: the
     # most recent such year; every season in both periods
     cal_year = pd.Timestamp(year=e0.year - 1, month=1, day=1, tz=s0.tz)
@@ -186,8 +212,7 @@ def choose_periods(
             )
         else:
             end = e0
-            mid = s0 + day * round((e0 - s0).days * 2 / 3)
-            why = f"{span}: its first 2/3 to calibrate, the rest to validate"
+            mid, val_first, why = _short_split(s0, e0, daily, span)
     if present is not None and len(present):  # no start or end inside a short gap
         have = set(present)
         moved = s0
@@ -196,11 +221,76 @@ def choose_periods(
         end_moved = end
         while end_moved > mid and end_moved not in have:
             end_moved -= day
-        if (moved, end_moved) != (s0, end):
+        mid_moved = mid  # a calibration after the validation starts with a reading
+        while val_first and mid_moved < end_moved and mid_moved not in have:
+            mid_moved += day
+        if (moved, end_moved, mid_moved) != (s0, end, mid):
             why += "; start and end moved off gaps in the data"
-        s0, end = moved, end_moved
+        s0, end, mid = moved, end_moved, mid_moved
     f = "%Y-%m-%d"
-    return s0.strftime(f), mid.strftime(f), mid.strftime(f), end.strftime(f), why
+    a, m, b = s0.strftime(f), mid.strftime(f), end.strftime(f)
+    return (m, b, a, m, why) if val_first else (a, m, m, b, why)
+
+
+def _short_split(s0, e0, daily, span) -> tuple[pd.Timestamp, bool, str]:
+    """A record ``[s0, e0)`` shorter than a year: (the midnight between the periods,
+    whether the validation comes first, why), as :func:`choose_periods` says."""
+    day = pd.Timedelta(days=1)
+    n = (e0 - s0).days
+    late, early = s0 + day * round(n * 2 / 3), s0 + day * round(n / 3)
+    why = f"{span}: its first 2/3 to calibrate, the rest to validate"
+    if daily is None:
+        return late, False, why
+    at_end = covered_share(daily, (s0, late), (late, e0))
+    at_start = covered_share(daily, (early, e0), (s0, early))
+    what = "outdoor temperature" + (" and irradiance" if daily.shape[1] > 1 else "")
+    if at_end >= COVERED_SHARE or at_start <= at_end:
+        return late, False, (
+            f"{why} ({at_end:.0%} of the validation's days within the calibration's "
+            f"range of daily mean {what}, widened by {RANGE_MARGIN:.0%}; {at_start:.0%} "
+            "with the validation first)"
+        )  # fmt: skip
+    return early, True, (
+        f"{span}, shorter than a year: its first 1/3 to validate, the rest to calibrate, "
+        f"so that the calibration spans the validation's conditions ({at_start:.0%} of the "
+        f"validation's days within the calibration's range of daily mean {what}, widened "
+        f"by {RANGE_MARGIN:.0%}, "
+        f"against {at_end:.0%} with the validation at the end: a model calibrated on one "
+        "season would be validated on another it never saw); the validation starts from "
+        "the steady state of its own first inputs"
+    )  # fmt: skip
+
+
+def daily_conditions(te: pd.Series, irradiance: pd.Series | None = None) -> pd.DataFrame:
+    """Daily means [UTC days] of the outdoor temperature ``Te`` [°C] and, when measured,
+    of the global irradiance ``ghi`` [W/m²]: the conditions :func:`covered_share`
+    compares."""
+    cols = {"Te": te} | ({} if irradiance is None else {"ghi": irradiance})
+    d = pd.DataFrame({k: v.resample("1D").mean() for k, v in cols.items()})
+    d.index = d.index.tz_localize(None) if d.index.tz is not None else d.index
+    return d.dropna(how="all")
+
+
+def covered_share(daily: pd.DataFrame, cal: tuple, val: tuple) -> float:
+    """The share of the validation's days ``[val[0], val[1])`` whose every column of
+    ``daily`` (:func:`daily_conditions`) lies within the range (least to greatest daily
+    value) of the calibration's days ``[cal[0], cal[1])``, widened at both ends by
+    :data:`RANGE_MARGIN` of its width (a day a little darker or colder than any in the
+    calibration is not a new season): 1 when the calibration has seen every validation
+    day's weather, near 0 for a winter calibrating a summer. 1 when either period has no
+    day."""
+
+    def days(a, b):
+        a, b = (pd.Timestamp(x).tz_localize(None) if pd.Timestamp(x).tz else x for x in (a, b))
+        return daily[(daily.index >= pd.Timestamp(a)) & (daily.index < pd.Timestamp(b))]
+
+    c, v = days(*cal), days(*val)
+    if c.empty or v.empty:
+        return 1.0
+    margin = RANGE_MARGIN * (c.max() - c.min())
+    lo, hi = c.min() - margin, c.max() + margin
+    inside = ((v >= lo) & (v <= hi)) | v.isna() | (lo.isna() | hi.isna())
+    return float(inside.all(axis=1).mean())
 
 
 #: Validation's warm days [K] (95th percentile of the daily mean outdoor temperature)
@@ -208,8 +298,8 @@ def choose_periods(
 WARMER_K = 3.0
 
 
-def extrapolated_seasons(te: pd.Series, cs, ce, ve) -> str | None:
-    """A note when the validation ``[ce, ve)`` holds warmer weather than any in the
+def extrapolated_seasons(te: pd.Series, cs, ce, vs, ve) -> str | None:
+    """A note when the validation ``[vs, ve)`` holds warmer weather than any in the
     calibration ``[cs, ce)`` (a record shorter than a year, split in time: a winter to
     calibrate, a summer to validate): the 95th percentile of the daily mean outdoor
     temperature [°C] higher by :data:`WARMER_K` or more. The sun's gain and the summer's
@@ -220,7 +310,7 @@ def extrapolated_seasons(te: pd.Series, cs, ce, ve) -> str | None:
     d = te.resample("1D").mean().dropna()
     d.index = d.index.tz_localize(None) if d.index.tz is not None else d.index
     cal = d[(d.index >= pd.Timestamp(cs)) & (d.index < pd.Timestamp(ce))]
-    val = d[(d.index >= pd.Timestamp(ce)) & (d.index < pd.Timestamp(ve))]
+    val = d[(d.index >= pd.Timestamp(vs)) & (d.index < pd.Timestamp(ve))]
     if len(cal) < 10 or len(val) < 10:
         return None
     c95, v95 = float(np.percentile(cal, 95)), float(np.percentile(val, 95))

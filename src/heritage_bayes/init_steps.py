@@ -28,6 +28,7 @@ from heritage_bayes.init_checks import (
     weather_clock,
 )
 from heritage_bayes.init_columns import fahrenheit_column_check, rh_column_check, usable
+from heritage_bayes.init_periods import daily_conditions
 from heritage_bayes.init_regimes import regime_stretch
 from heritage_bayes.init_sources import timing_without_sun as _timing_without_sun
 from heritage_bayes.io import clock as _clock
@@ -113,6 +114,11 @@ class Periods:
     rhi_utc: pd.Series | None
     rhe_utc: pd.Series | None
     floor: tuple
+
+    @property
+    def span(self) -> tuple:
+        """The first and the last day of the periods (the validation may come first)."""
+        return min(self.cs, self.vs), max(self.ce, self.ve)
 
 
 def _weather_format(path: Path, given: str | None) -> str:
@@ -410,10 +416,14 @@ def choose_span(
             "`hbayes init` again (--timezone, --weather-timezone) chooses them on UTC"
         )
     # the inputs must hold a reading at both ends of the periods (the outputs need not)
-    cs, ce, vs, ve, why = choose_periods(s, e, present_hours(te_utc, te_utc), span)
+    ghi = None
+    if "ghi" in dw:
+        ghi = to_utc(dw["ghi"], wx.zone) if wx.layout is not None else dw["ghi"]
+    daily = daily_conditions(te_utc, ghi)
+    cs, ce, vs, ve, why = choose_periods(s, e, present_hours(te_utc, te_utc), span, daily)
     findings.append(f"periods: {why}")
     why += regime_why
-    if season := extrapolated_seasons(te_utc, cs, ce, ve):
+    if season := extrapolated_seasons(te_utc, cs, ce, vs, ve):
         findings.append(f"periods: {season}")
         why = f"{why}. Note: {season}"
     return Periods(cs, ce, vs, ve, why, hygric, rhi_utc, rhe_utc, floor)

@@ -297,7 +297,15 @@ def inspect_weather(
     )
     wcols, wunits = _pick(
         wlay,
-        {"Te": "T", "RHe": "RH", "ghi": "ghi", "dhi": "dhi", "dni": "dni", "wind": "wind"},
+        {
+            "Te": "T",
+            "RHe": "RH",
+            "ghi": "ghi",
+            "dhi": "dhi",
+            "dni": "dni",
+            "wind": "wind",
+            "precip": "precip",
+        },
         findings,
         "weather",
     )

@@ -453,7 +453,10 @@ def solar_inputs(
     if planes and {"precip", "Te"} <= set(weather.columns):
         from heritage_bayes.climate.snow import roof_snow_columns
 
-        irr, snow = roof_snow_columns(irr, weather["Te"], weather["precip"], planes)
+        try:
+            irr, snow = roof_snow_columns(irr, weather["Te"], weather["precip"], planes)
+        except InputError as exc:
+            raise DataError(f"{where}: column 'precip': {exc}") from None
         detail += f"; {snow}" if snow else ""
     if mode != "measured" and present:
         detail += f"; measured {present} ignored (data.irradiance: {mode})"

@@ -193,7 +193,7 @@ def roof_snow_columns(
     daily = te.groupby(te.index.floor("D")).mean()
     if not planes or not (daily < 0.0).any():
         return irr, None
-    hours = np.diff(te.index.asi8) / 3.6e12
+    hours = np.diff(te.index) / pd.Timedelta(hours=1)
     step = np.concatenate([[np.median(hours) if hours.size else 1.0], hours])
     swe = snowpack(te.to_numpy(float), precip.reindex(te.index).to_numpy(float), step)
     base = te.rolling("24h", min_periods=1).mean()

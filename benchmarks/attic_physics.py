@@ -28,6 +28,14 @@ variant of the roof planes' irradiance input:
 - ``snow0``: as ``snow`` but no sun through a covered roof (the absorbed sun melts the
   snow), and a record starting in frost (first week's mean Te below 0 °C) starts under
   20 mm of snow water;
+- ``nosnow``: init's config without ``weather.columns.precip``: the roof planes
+  without the package's snow (:mod:`heritage_bayes.climate.snow`; ``wind`` is the
+  package's default, with it);
+- ``snowsun``, ``snowswing``, ``snowcap``, ``snowyear``: the package's snowpack and
+  cover c, one part of its roof term at a time: the sun blocked only, (1 - c) I; the
+  daily swing only, I + c (h_e/α)(T_b - T_e); both with T_b capped at 0 °C (a melting
+  base); the swing term all year (c = 1, the sun kept: is it the snow?);
+- ``melt<a>``: the package's snow with the degree-day factor a [mm/(K d)];
 - ``phi<cap>``: the AR(1) model error's coefficient ``phi_Ti`` uniform on [0, cap]
   (default cap 0.96 at hourly steps): a likelihood that leaves less of the slow misfit
   to the error;

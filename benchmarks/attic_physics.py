@@ -28,6 +28,14 @@ variant of the roof planes' irradiance input:
 - ``snow0``: as ``snow`` but no sun through a covered roof (the absorbed sun melts the
   snow), and a record starting in frost (first week's mean Te below 0 °C) starts under
   20 mm of snow water;
+- ``nosnow``: init's config without ``weather.columns.precip``: the roof planes
+  without the package's snow (:mod:`heritage_bayes.climate.snow`; ``wind`` is the
+  package's default, with it);
+- ``snowsun``, ``snowswing``, ``snowcap``, ``snowyear``: the package's snowpack and
+  cover c, one part of its roof term at a time: the sun blocked only, (1 - c) I; the
+  daily swing only, I + c (h_e/α)(T_b - T_e); both with T_b capped at 0 °C (a melting
+  base); the swing term all year (c = 1, the sun kept: is it the snow?);
+- ``melt<a>``: the package's snow with the degree-day factor a [mm/(K d)];
 - ``phi<cap>``: the AR(1) model error's coefficient ``phi_Ti`` uniform on [0, cap]
   (default cap 0.96 at hourly steps): a likelihood that leaves less of the slow misfit
   to the error;
@@ -195,6 +203,41 @@ def _snow_factor(raw: pd.DataFrame, index, keep: float = 1 / 3, start: bool = Fa
     return 1.0 - (1.0 - keep) * c
 
 
+def _snow_variant(out: pd.DataFrame, weather: pd.DataFrame, roof, variant: str):
+    """The roof columns ``I_<plane>`` of the snow-free ``out`` under the variant's snow
+    (:mod:`heritage_bayes.climate.snow`; see the module docstring)."""
+    from heritage_bayes.climate import snow
+
+    cols = [f"I_{k}" for k in roof]
+    if variant.startswith("melt"):  # the package's snow at another degree-day factor
+        keep, snow.MELT_FACTOR = snow.MELT_FACTOR, float(variant[4:])
+        try:
+            return snow.roof_snow_columns(out, weather["Te"], weather["precip"], cols)[0]
+        finally:
+            snow.MELT_FACTOR = keep
+    te = weather["Te"]
+    c = snow.snow_cover(snow.snowpack(te.to_numpy(float), weather["precip"].to_numpy(float), 1.0))
+    base = te.rolling("24h", min_periods=1).mean()
+    if variant == "snowcap":
+        base = base.clip(upper=0.0)
+    on = pd.DataFrame({"c": c, "te": te, "tb": base}).reindex(out.index, method="nearest")
+    c, te, tb = (on[k].to_numpy() for k in ("c", "te", "tb"))
+    res = out.copy()
+    for k in cols:
+        i = out[k].to_numpy(float)
+        res[k] = {
+            "snowsun": (1 - c) * i,
+            "snowswing": snow.roof_under_snow(i, te, tb, c) + c * i,
+            "snowcap": snow.roof_under_snow(i, te, tb, c),
+            "snowyear": snow.roof_under_snow(i, te, tb, np.ones_like(c)) + i,
+        }[variant]
+    res.attrs = dict(out.attrs)
+    return res
+
+
+SNOW_VARIANTS = ("snowsun", "snowswing", "snowcap", "snowyear")
+
+
 def patched(variant: str, raw: pd.DataFrame):
     """The package's ``solar_inputs`` with the variant's change of the irradiance."""
     import heritage_bayes.inputs as inputs
@@ -213,6 +256,10 @@ def patched(variant: str, raw: pd.DataFrame):
             for k in roof:
                 out[f"I_{k}"] = out[f"I_{k}"].to_numpy() * w
             return out, label, detail
+        if variant in SNOW_VARIANTS or variant.startswith("melt"):
+            out, label, detail = orig(weather.drop(columns="precip"), site, surfaces, mode,
+                                      where=where, roof=roof, **kw)  # fmt: skip
+            return _snow_variant(out, weather, roof, variant), label, detail
         out, label, detail = orig(weather, site, surfaces, mode, where=where, roof=roof, **kw)
         if variant == "sky":
             table = weather if "ghi" in weather else _estimated(weather, site)
@@ -286,8 +333,9 @@ def _config(room, variant, model, bare, data, w):
     config, variant = _roof_edit(config, variant)
     cfg = load_config(config)
     d = cfg.data
-    if variant == "none":
-        cols = {k: v for k, v in d.weather.columns.items() if k != "wind"}
+    if variant in ("none", "nosnow"):  # without the wind weight / the snow on the roof
+        drop = {"none": "wind", "nosnow": "precip"}[variant]
+        cols = {k: v for k, v in d.weather.columns.items() if k != drop}
         d = d.model_copy(update={"weather": d.weather.model_copy(update={"columns": cols})})
     if variant.startswith("horizon"):
         roof = d.roof.model_copy(update={"horizon": float(variant[7:])})

@@ -153,6 +153,7 @@ def test_init_writes_the_roof_for_an_attic_and_not_for_the_room_below(shared_dat
     cfg = load_config(tmp_path / "a.yaml")
     assert cfg.data.surfaces == {"roof_N": (45.0, 0.0), "roof_S": (45.0, 180.0)}
     assert cfg.data.weather.columns["wind"] == "ws"  # FMI's wind speed: the sun on the roof
+    assert cfg.data.weather.columns["precip"] == "precip"  # and the snow on it
     # no floor on the soil: Tf at a fixed 1 m, no depth to estimate
     assert (cfg.data.ground_temperature.mode, cfg.data.ground_temperature.depth) == ("seasonal", 1)
     # the heated room below: neither its name nor its daily swing (0.2 of outdoors') says roof

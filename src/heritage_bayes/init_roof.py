@@ -124,7 +124,10 @@ def solar_surface_lines(attic: str | None) -> list[str]:
         "slopes along the slope] for a prior on the apertures. A mono-pitch or flat roof, or "
         "not an attic: replace 'roof' by surfaces (e.g. {H: [0, 0]}). With a wind speed in "
         "the weather (weather.columns.wind [m/s]) the slopes' sun is weighted by the wind "
-        "on the roof (a calm day's sun heats the attic more). The slopes are shaded while the "
+        "on the roof (a calm day's sun heats the attic more); with a precipitation "
+        "(weather.columns.precip [mm]) in a climate with frost, they are taken under the "
+        "snow a degree-day snowpack estimates (no sun, the daily swing damped). The slopes "
+        "are shaded while the "
         f"sun is below horizon: [°] (default {ROOF_HORIZON:g}: the houses and trees around); "
         "give 0 for a roof open to the horizon."
     )

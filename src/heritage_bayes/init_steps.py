@@ -303,7 +303,15 @@ def inspect_weather(
     )
     wcols, wunits = _pick(
         wlay,
-        {"Te": "T", "RHe": "RH", "ghi": "ghi", "dhi": "dhi", "dni": "dni", "wind": "wind"},
+        {
+            "Te": "T",
+            "RHe": "RH",
+            "ghi": "ghi",
+            "dhi": "dhi",
+            "dni": "dni",
+            "wind": "wind",
+            "precip": "precip",
+        },
         findings,
         "weather",
     )

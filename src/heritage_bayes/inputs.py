@@ -364,7 +364,10 @@ def solar_inputs(
         that reaches the attic at that wind
         (:func:`heritage_bayes.climate.solair.roof_wind_weight`; gaps in the wind
         interpolated in time); without it, or for other surfaces, unweighted (the
-        standard exterior resistance).
+        standard exterior resistance). When the weather has a precipitation ``precip``
+        [mm] and a day below 0 °C, they are also taken under the snow estimated from it
+        (:func:`heritage_bayes.climate.snow.roof_snow_columns`: no sun, the outer face
+        at the air's daily mean).
     roof_horizon : float, default 0
         Skyline [° of sun elevation] of the roof planes: while the sun is lower their
         beam is shaded (``horizon`` of
@@ -447,6 +450,14 @@ def solar_inputs(
     if planes and "wind" in weather.columns:
         irr = _wind_weighted(irr, weather["wind"], planes, where)
         detail += f"; roof planes {planes} weighted by the wind on the roof (ISO 6946 h_e)"
+    if planes and {"precip", "Te"} <= set(weather.columns):
+        from heritage_bayes.climate.snow import roof_snow_columns
+
+        try:
+            irr, snow = roof_snow_columns(irr, weather["Te"], weather["precip"], planes)
+        except InputError as exc:
+            raise DataError(f"{where}: column 'precip': {exc}") from None
+        detail += f"; {snow}" if snow else ""
     if mode != "measured" and present:
         detail += f"; measured {present} ignored (data.irradiance: {mode})"
     out = irr.rename(columns={k: f"I_{k}" for k in surfaces})

@@ -31,7 +31,7 @@ __all__ = [
 #: Standard columns that weather files may provide (model inputs and what they derive from).
 #: ("Ph": a known heat input [W], e.g. measured heating power of a test cell; "wind": wind
 #: speed [m/s], which weights the sun on roof planes.)
-INPUT_COLUMNS = ("Te", "RHe", "Pe", "ghi", "dni", "dhi", "Tdew", "Ph", "Isol", "wind")
+INPUT_COLUMNS = ("Te", "RHe", "Pe", "ghi", "dni", "dhi", "Tdew", "Ph", "Isol", "wind", "precip")
 #: Standard columns that measurement files may provide (model outputs).
 OUTPUT_COLUMNS = ("Ti", "RHi", "Pi")
 

@@ -51,6 +51,7 @@ STANDARD_COLUMNS: dict[str, tuple[str, str, tuple[float, float]]] = {
         (0.0, 1500.0),
     ),
     "wind": ("m/s", "wind speed (a weather station's, 10 m above the ground)", (0.0, 75.0)),
+    "precip": ("mm", "precipitation of the interval ending at the stamp (water)", (0.0, 500.0)),
 }
 
 #: Columns that are interval averages (stamped at the interval end) unless told otherwise.

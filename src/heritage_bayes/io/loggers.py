@@ -91,6 +91,7 @@ TIME_FORMATS = (
 # Column roles by header text (case-insensitive); order matters: first match wins.
 _ROLE_PATTERNS = (
     ("wind", r"wind.?(speed|spd)|^ws\d*$|^wind$|^ff$|^fh$|windsnelheid|tuulen ?nopeus"),
+    ("precip", r"precip|^rain|rainfall|neerslag|sademäärä|niederschlag"),
     (
         "skip",
         r"wind|precip|rain|press|batt|lux|\buv\b|co2|dew|^#$|logged|host|stopped|"
@@ -109,7 +110,7 @@ class ColumnGuess:
     """One column of the table and what it was taken for.
 
     ``kind``: ``"T"`` (temperature), ``"RH"``, ``"ghi"``, ``"dhi"``, ``"dni"``,
-    ``"wind"`` (wind speed) or None;
+    ``"wind"`` (wind speed), ``"precip"`` (precipitation [mm]) or None;
     ``unit``: the unit in the file (``"°C"``, ``"°F"``, ``"K"``, ``"%"``,
     ``"fraction"``, ``"W/m²"``); ``why``: the evidence; ``stats``: min, median, max of
     the sampled values; ``named``: the role its name suggests, also when the values
@@ -524,6 +525,11 @@ def _classify_values(name: str, label: str, stats) -> ColumnGuess:
                 name, None, why=f"name {label!r} but {rng}: not wind speed in m/s", stats=stats
             )
         return ColumnGuess(name, "wind", "m/s", f"name {label!r}; {rng} m/s", stats)
+    if kind == "precip":
+        if lo < 0 or hi > 500:
+            why = f"name {label!r} but {rng}: not precipitation in mm"
+            return ColumnGuess(name, None, why=why, stats=stats)
+        return ColumnGuess(name, "precip", "mm", f"name {label!r}; {rng} mm", stats)
     if kind == "RH":
         if hi <= 1.0 and lo >= 0:
             return ColumnGuess(

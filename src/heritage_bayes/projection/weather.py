@@ -28,7 +28,7 @@ from heritage_bayes.errors import ConfigError, DataError, InputError
 MAX_SITE_DISTANCE_KM = 50.0
 _EARTH_RADIUS_KM = 6371.0
 
-_WEATHER_COLUMNS = ("Te", "RHe", "Pe", "ghi", "dni", "dhi", "Tdew", "Ph", "wind")
+_WEATHER_COLUMNS = ("Te", "RHe", "Pe", "ghi", "dni", "dhi", "Tdew", "Ph", "wind", "precip")
 
 
 @dataclass

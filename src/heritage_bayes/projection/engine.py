@@ -11,10 +11,14 @@ The per-draw work is one compiled pass (:mod:`heritage_bayes.projection._stream`
 draws in parallel over the threads): the modal recursion of a free-running model, the
 RH, and every indicator of :func:`~heritage_bayes.climate.risk.assess_batch` by
 :mod:`heritage_bayes.climate.risk.fused` (the same values, to rounding; a series that
-function rejects or with a missing hour is handed to it). Peak memory is the noise of
+function rejects or with a missing hour is handed to it). A selected family without a
+compiled pass (registered at run time) is computed by its numpy ``compute`` on the
+series the compiled pass keeps for it (:class:`~heritage_bayes.climate.risk.fused.NumpyPass`:
+per chunk, over the whole weather and per complete year). Peak memory is the noise of
 two chunks (two arrays of ``chunk × hours`` doubles each: the next chunk's is drawn
 while this one is reduced) and nine arrays of the series length per thread, whatever
-the number of draws.
+the number of draws; with a family without a compiled pass, four more arrays of
+``chunk × hours`` (the kept series) and that family's numpy temporaries.
 
 The same parameter draws and the same noise realisations (seeded per chunk, drawn once
 per chunk and used for every case of the same length) are used for every case:
@@ -180,7 +184,8 @@ def simulate_cases(
     init_steps : int, optional
         Rows averaged for the steady-state initial state (default the calibration's).
     risk_options : dict, optional
-        Keywords of :func:`heritage_bayes.climate.risk.assess_batch`.
+        Keywords of :func:`heritage_bayes.climate.risk.assess_batch` (any registered
+        family's group and options).
     progress : callable, optional
         Called with one line of text per chunk.
     baseline : bool
@@ -203,7 +208,8 @@ def simulate_cases(
     -------
     list of CaseResult
         In the order of ``inputs``, with the per-complete-year values of
-        :data:`heritage_bayes.climate.risk.registry.ANNUAL` (``annual_*``) and, when the
+        :data:`heritage_bayes.climate.risk.registry.ANNUAL` and of the ``per_year``
+        columns of the families without a compiled pass (``annual_*``) and, when the
         EN 15757 group is computed and ``baseline``, the column
         ``en15757_outside_baseline`` (mean over the years). ``seconds``: ``simulate``
         (modal forms, and

@@ -423,8 +423,9 @@ def test_a_registered_family_is_projected_with_its_numpy_compute(setup):
     try:
         got = engine.simulate_cases(run, draws, [two, warm], seed=SEED, chunk=CHUNK)
         par, pred, _, _, series = reference(run, draws, two)  # assess_batch: toy included
+        toy_only = {"indicators": ["toy"], "toy": {"offset": 1.0}}  # its options too
         only = engine.simulate_case(run, draws, two, seed=SEED, chunk=CHUNK, noise=False,
-                                    risk_options={"indicators": ["toy"]})  # fmt: skip
+                                    risk_options=toy_only)  # fmt: skip
         summary = summarize(["now", "warm"], [None, 2050], got, "now", [], {})
         assert RiskOptions(indicators=["toy", "mould"]).indicators == ["toy", "mould"]
     finally:
@@ -445,7 +446,7 @@ def test_a_registered_family_is_projected_with_its_numpy_compute(setup):
     RHs = _relative_humidity(Ts, np.concatenate([p for _, p in series]))
     per_year = RHs.reshape(len(RHs), 2, 8760).mean(axis=-1)
     np.testing.assert_allclose(base.annual_parametric[..., -1], per_year, rtol=1e-9)
-    np.testing.assert_allclose(only.parametric["toy_rh_mean"], RHs.mean(axis=1), rtol=1e-9)
+    np.testing.assert_allclose(only.parametric["toy_rh_mean"], RHs.mean(axis=1) + 1.0, rtol=1e-9)
     assert list(only.parametric.columns) == ["toy_rh_mean", "toy_t_max"]
     entry = summary["indicators"]["toy_rh_mean"]
     assert entry["unit"] == "%" and entry["change"]["warm"]["q50"] < 0  # warmer: drier

@@ -369,3 +369,86 @@ def test_select_draws_of_a_kalman_run_use_its_free_run_error():
     d = engine.select_draws(run, None, 0)
     assert isinstance(d.noise_models["thermal"], AR1WhiteNoise)
     np.testing.assert_array_equal(d.noise["thermal"], np.tile([0.4, 0.97, 0.05], (6, 1)))
+
+
+def _toy_family():
+    """A family without a compiled pass: the mean RH (per year too) and the warmest hour."""
+    from heritage_bayes.climate.risk.indicators import Family, Indicator
+
+    def toy(T, RH, *, offset=0.0):
+        """Options of the toy family: ``offset`` added to the mean RH [%]."""
+
+    def compute(h, opts, nan_policy, seasonal):
+        return {"toy_rh_mean": h.RH.mean(axis=-1) + opts["toy"]["offset"],
+                "toy_t_max": h.T.max(axis=-1)}  # fmt: skip
+
+    return Family(
+        name="toy",
+        yearly=True,
+        indicators=(
+            Indicator(
+                "toy_rh_mean",
+                "Mean RH (toy)",
+                "%",
+                "Mean RH.",
+                "-",
+                "per year",
+                1,
+                "toy",
+                per_year=True,
+            ),
+            Indicator("toy_t_max", "Warmest hour (toy)", "°C", "Max T.", "-", "series", 1, "toy"),
+        ),
+        options={"toy": toy},
+        check=lambda func, opts: None,
+        columns=lambda opts: ["toy_rh_mean", "toy_t_max"],
+        compute=compute,
+    )
+
+
+def test_a_registered_family_is_projected_with_its_numpy_compute(setup):
+    """A family registered at run time (no compiled pass) appears in a projection's
+    indicators (after the compiled ones, as in assess_batch), in its per-year values and
+    in the summary, with the values its numpy ``compute`` gives on the projected series;
+    the compiled indicators are those of a projection without it."""
+    from pydantic import ValidationError
+
+    from heritage_bayes.climate.risk.registry import register, unregister
+    from heritage_bayes.projection.config import RiskOptions
+    from heritage_bayes.projection.summary import summarize
+
+    run, draws, (two, warm) = setup
+    plain = engine.simulate_cases(run, draws, [two, warm], seed=SEED, chunk=CHUNK)
+    register(_toy_family())
+    try:
+        got = engine.simulate_cases(run, draws, [two, warm], seed=SEED, chunk=CHUNK)
+        par, pred, _, _, series = reference(run, draws, two)  # assess_batch: toy included
+        toy_only = {"indicators": ["toy"], "toy": {"offset": 1.0}}  # its options too
+        only = engine.simulate_case(run, draws, two, seed=SEED, chunk=CHUNK, noise=False,
+                                    risk_options=toy_only)  # fmt: skip
+        summary = summarize(["now", "warm"], [None, 2050], got, "now", [], {})
+        assert RiskOptions(indicators=["toy", "mould"]).indicators == ["toy", "mould"]
+    finally:
+        unregister("toy")
+    with pytest.raises(ValidationError, match=r"unknown indicator group\(s\) \['toy'\]"):
+        RiskOptions(indicators=["toy"])  # a projection file names only known families
+    base = got[0]
+    assert_close(par, base.parametric)
+    assert_close(pred, base.predictive)
+    assert list(base.predictive.columns)[-2:] == ["toy_rh_mean", "toy_t_max"]
+    assert base.predictive.attrs["units"]["toy_t_max"] == "°C"
+    for p, g in zip(plain, got, strict=True):  # the compiled columns: bit for bit
+        pd.testing.assert_frame_equal(g.predictive.drop(columns=["toy_rh_mean", "toy_t_max"]),
+                                      p.predictive, check_like=False)  # fmt: skip
+        np.testing.assert_array_equal(g.annual_predictive[..., :-1], p.annual_predictive)
+    assert base.annual_names[-1] == "toy_rh_mean"
+    Ts = np.concatenate([t for t, _ in series])
+    RHs = _relative_humidity(Ts, np.concatenate([p for _, p in series]))
+    per_year = RHs.reshape(len(RHs), 2, 8760).mean(axis=-1)
+    np.testing.assert_allclose(base.annual_parametric[..., -1], per_year, rtol=1e-9)
+    np.testing.assert_allclose(only.parametric["toy_rh_mean"], RHs.mean(axis=1) + 1.0, rtol=1e-9)
+    assert list(only.parametric.columns) == ["toy_rh_mean", "toy_t_max"]
+    entry = summary["indicators"]["toy_rh_mean"]
+    assert entry["unit"] == "%" and entry["change"]["warm"]["q50"] < 0  # warmer: drier
+    split = summary["uncertainty_split"]["baseline"]["indicators"]["toy_rh_mean"]
+    assert split["basis"].startswith("one year's value")

@@ -34,7 +34,7 @@ def _section_blocks() -> list[str]:
 def test_the_docs_walk_through_runs_and_leaves_no_trace(capsys):
     before = ([f.name for f in FAMILIES], dict(INDICATORS), dict(risk.INDICATOR_GROUPS))
     blocks = _section_blocks()
-    assert len(blocks) == 3
+    assert len(blocks) == 4
     ns: dict = {}
     exec(compile("\n".join(blocks[:2]), str(DOC), "exec"), ns)
     out = capsys.readouterr().out
@@ -49,7 +49,13 @@ def test_the_docs_walk_through_runs_and_leaves_no_trace(capsys):
         fused_plan(8760, indicators=["salt"])
     with pytest.raises(InputError, match="clashes"):
         register(ns["SALT"])
+    # a projection offers it (numpy on the kept series): a year of weather, one per-year value
     exec(compile(blocks[2], str(DOC), "exec"), ns)
+    case = ns["case"]
+    assert list(case.predictive.columns)[-1] == "salt_cycles"
+    assert case.annual_names[-1] == "salt_cycles"
+    np.testing.assert_array_equal(case.annual_predictive[:, 0, -1], case.predictive["salt_cycles"])
+    exec(compile(blocks[3], str(DOC), "exec"), ns)
     after = ([f.name for f in FAMILIES], dict(INDICATORS), dict(risk.INDICATOR_GROUPS))
     assert after == before
     with pytest.raises(InputError, match="unknown option group"):

@@ -84,11 +84,11 @@ UNCONVERGED_TEXT = (
 def _check_thresholds(pcfg, n_hours: int, risk_opts: dict) -> None:
     """Refuse a probability statement on an indicator the projection does not compute
     (the message lists those it does)."""
-    from heritage_bayes.climate.risk.fused import fused_plan
+    from heritage_bayes.climate.risk.fused import projection_plan
     from heritage_bayes.climate.risk.registry import check_indicator_names
 
-    plan = fused_plan(n_hours, func="assess_batch", **risk_opts)
-    cols = [c for c in plan.columns if c != "ashrae_best_class"]
+    plan, numpy = projection_plan(n_hours, **risk_opts)
+    cols = [c for c in (*plan.columns, *numpy.columns) if c != "ashrae_best_class"]
     if "en15757_upper_offset" in cols:
         cols.insert(cols.index("en15757_upper_offset") + 1, "en15757_outside_baseline")
     check_indicator_names([t.indicator for t in pcfg.thresholds], cols, "thresholds")

@@ -8,7 +8,8 @@ chunk, on one thread (numba ``prange`` over work slots, one slot per thread):
    :func:`heritage_bayes.rc.simulate.modal_simulate`, one draw at a time), or copied from
    ``model.forward`` for a controlled one;
 2. the noise-free RH [%] (capped at saturation), and every risk indicator of that
-   series (:func:`heritage_bayes.climate.risk._fused.series_indicators`);
+   series (:func:`heritage_bayes.climate.risk._fused.series_indicators`; the series are
+   kept for the engine when a family without a compiled pass is selected);
 3. with noise: ``Ti + e_T``, the RH from ``Pi + e_P``, their indicators, and the monthly
    means of ``Ti`` and ``RHi`` (numpy's pairwise summation, as ``np.add.reduceat``).
 
@@ -251,7 +252,7 @@ def chunk_kernel(
     ea_r, fpar, ipar, kinds, cls, ws, tmp, btmp, hist, sbuf, zbuf, wbuf,
     par, pred, spar, spred, Tm, RHm,
     hoy, mode, en, en_col, bpar, bpred, apar, apred, mabuf, cbuf,
-    ctl, bdT, bdP, sig, spin, cost, par_on,
+    ctl, bdT, bdP, sig, spin, cost, par_on, kept,
 ):  # fmt: skip  # pragma: no cover - compiled
     """Indicators (noise-free → ``par``, predictive → ``pred``; status 0/1 in ``spar``,
     ``spred``) and monthly means (``Tm``, ``RHm``) of every draw of the chunk.
@@ -275,12 +276,16 @@ def chunk_kernel(
     :data:`~heritage_bayes.rc.control_kernels.N_COST`). ``par_on`` False (with ``noise``): the
     noise-free indicators are not computed (NaN; a measure is compared predictive
     with predictive).
+
+    ``kept`` (4, draws, hours), or (0, 0, 0) for none: the series reduced, kept for the
+    families without a compiled pass (noise-free ``T``, ``RH``, then predictive).
     """
     c = par.shape[0]
     N = sbuf.shape[2]
     slots = ws.shape[0]
     simT = YT.shape[0] == 0
     simP = YP.shape[0] == 0
+    keep = kept.shape[0] > 0
     for s in prange(slots):
         Ts, Ps, Tx, RHx = sbuf[s, 0], sbuf[s, 1], sbuf[s, 2], sbuf[s, 3]
         for i in range(s, c, slots):
@@ -311,6 +316,9 @@ def chunk_kernel(
                 spar[i] = _reduce(Ts, RHx, N, ea_r, fpar, ipar, kinds, cls, ws[s], tmp[s],
                                   btmp[s], hist[s], par[i], hoy, mode, en, en_col, bpar[i],
                                   apar[i], mabuf[s], cbuf[s])  # fmt: skip
+                if keep:
+                    kept[0, i, :] = Ts
+                    kept[1, i, :] = RHx
             else:
                 spar[i] = 0
                 par[i, :] = math.nan
@@ -325,6 +333,9 @@ def chunk_kernel(
                 spred[i] = _reduce(Tx, RHx, N, ea_r, fpar, ipar, kinds, cls, ws[s], tmp[s],
                                    btmp[s], hist[s], pred[i], hoy, mode, en, en_col, bpred[i],
                                    apred[i], mabuf[s], cbuf[s])  # fmt: skip
+                if keep:
+                    kept[2, i, :] = Tx
+                    kept[3, i, :] = RHx
                 _monthly(Tx, starts, Tm[i])
             else:
                 spred[i] = spar[i]

@@ -8,7 +8,7 @@ of it.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
@@ -73,6 +73,7 @@ class Case:
     hoy: np.ndarray  # (N,) hour of the year of each hour
     mode: int  # 1: the baseline (builds each draw's EN 15757 band), 2: judged by it, 0: none
     index: pd.DatetimeIndex | None = None  # time of each hour (an intervention's calendar)
+    numpy: object = None  # the families without a compiled pass (fused.NumpyPass)
 
     def en_params(self) -> tuple[np.ndarray, int]:
         """(en, en_col) of :func:`heritage_bayes.projection._stream.chunk_kernel`."""
@@ -100,6 +101,29 @@ class CaseOut:
     apar: np.ndarray
     apred: np.ndarray
     cost: np.ndarray  # (K, N_COST) running-cost sums of a measure's controllers
+    #: column -> (K,) values of the families without a compiled pass (predictive, noise-free)
+    xpred: dict = field(default_factory=dict)
+    xpar: dict = field(default_factory=dict)
+
+    def put_numpy(self, c: Case, sl, kept: np.ndarray, measured: bool, noise: bool) -> None:
+        """The families without a compiled pass on the series the compiled pass kept
+        (``kept``: noise-free ``T``, ``RH``, then predictive), draws ``sl``: their
+        columns and per-year values (after the compiled ones). ``measured`` with
+        ``noise``: no noise-free values (NaN, as the compiled pass)."""
+        n0 = self.apar.shape[2] - len(c.numpy.annual_columns)
+        for which, (T, RH), store, ann in (
+            ("par", (kept[0], kept[1]), self.xpar, self.apar),
+            ("pred", (kept[2], kept[3]) if noise else (kept[0], kept[1]), self.xpred, self.apred),
+        ):  # fmt: skip
+            skip = which == "par" and measured and noise
+            vals = {k: np.full(len(T), np.nan) for k in c.numpy.columns} if skip else None
+            for key, v in (vals or c.numpy.values(T, RH)).items():
+                v = np.asarray(v)
+                if key not in store:
+                    store[key] = np.full(self.par.shape[0], np.nan, v.dtype if v.dtype.kind
+                                         in "fO" else float)  # fmt: skip
+                store[key][sl] = v
+            ann[sl, :, n0:] = np.nan if skip else c.numpy.annual(T, RH)
 
     @classmethod
     def empty(cls, c: Case, K: int) -> CaseOut:
@@ -108,31 +132,41 @@ class CaseOut:
 
         nm = c.starts.size
         ny = years_of(c.N)
+        na = len(ANNUAL) + (len(c.numpy.annual_columns) if c.numpy else 0)
         return cls(
             par=np.empty((K, c.plan.width)),
             pred=np.empty((K, c.plan.width)),
             Tm=np.empty((K, nm), np.float32),
             RHm=np.empty((K, nm), np.float32),
             seconds={"simulate": 0.0, "noise": 0.0, "risk": 0.0},
-            apar=np.empty((K, ny, len(ANNUAL))),
-            apred=np.empty((K, ny, len(ANNUAL))),
+            apar=np.empty((K, ny, na)),
+            apred=np.empty((K, ny, na)),
             cost=np.zeros((K, N_COST)),
         )
 
     def result(self, c: Case, measure=None, dt: float = 3600.0, years: float = 1.0) -> CaseResult:
+        from heritage_bayes.climate.risk.registry import indicator_info
         from heritage_bayes.projection._stream import A_BAND, ANNUAL
 
         names = tuple(ANNUAL)
         if "hours_above_LIM" in names:  # the isopleth's own column name
             lim = [n for n in c.plan.columns if n.startswith("hours_above_LIM")]
             names = tuple(lim[0] if n == "hours_above_LIM" and lim else n for n in names)
+        extra = c.numpy.columns if c.numpy else ()
+        names += c.numpy.annual_columns if c.numpy else ()
         frames = []
-        for vals, ann in ((self.pred, self.apred), (self.par, self.apar)):
+        for vals, ann, xs in (
+            (self.pred, self.apred, self.xpred),
+            (self.par, self.apar, self.xpar),
+        ):
             df = c.plan.frame(vals)
             if c.mode and "en15757_lower_offset" in df.columns:
                 pos = list(df.columns).index("en15757_upper_offset") + 1
                 df.insert(pos, "en15757_outside_baseline", ann[:, :, A_BAND].mean(axis=1))
                 df.attrs["units"]["en15757_outside_baseline"] = "% of hours"
+            for key in extra:  # the families without a compiled pass, after the others
+                df[key] = xs[key]
+                df.attrs["units"][key] = indicator_info(key).unit
             frames.append(df)
         return CaseResult(
             predictive=frames[0],

@@ -151,15 +151,24 @@ class FutureFile(_Strict):
     weather: Source
 
 
-#: The indicator groups a projection computes (the compiled families).
-_GROUPS = tuple(f.name for f in FAMILIES if f.compiled)
-
-
 class RiskOptions(_Strict):
     """Options of :func:`heritage_bayes.climate.risk.assess_batch` (see there)."""
 
-    indicators: list[Literal[_GROUPS]] | None = None
+    indicators: list[str] | None = Field(
+        default=None,
+        description="indicator groups (families of heritage_bayes.climate.risk.indicators, "
+        "registered ones included); default all",
+    )
     chunk_draws: int = Field(default=50, ge=1, description="draws simulated together")
+
+    @field_validator("indicators")
+    @classmethod
+    def _known(cls, v):
+        known = [f.name for f in FAMILIES]  # read at validation: registered families too
+        bad = [g for g in v or () if g not in known]
+        if bad or v == []:
+            raise ValueError(f"unknown indicator group(s) {bad}; expected some of {known}")
+        return v
 
 
 class Threshold(_Strict):

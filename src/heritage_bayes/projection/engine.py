@@ -11,10 +11,14 @@ The per-draw work is one compiled pass (:mod:`heritage_bayes.projection._stream`
 draws in parallel over the threads): the modal recursion of a free-running model, the
 RH, and every indicator of :func:`~heritage_bayes.climate.risk.assess_batch` by
 :mod:`heritage_bayes.climate.risk.fused` (the same values, to rounding; a series that
-function rejects or with a missing hour is handed to it). Peak memory is the noise of
+function rejects or with a missing hour is handed to it). A selected family without a
+compiled pass (registered at run time) is computed by its numpy ``compute`` on the
+series the compiled pass keeps for it (:class:`~heritage_bayes.climate.risk.fused.NumpyPass`:
+per chunk, over the whole weather and per complete year). Peak memory is the noise of
 two chunks (two arrays of ``chunk × hours`` doubles each: the next chunk's is drawn
 while this one is reduced) and nine arrays of the series length per thread, whatever
-the number of draws.
+the number of draws; with a family without a compiled pass, four more arrays of
+``chunk × hours`` (the kept series) and that family's numpy temporaries.
 
 The same parameter draws and the same noise realisations (seeded per chunk, drawn once
 per chunk and used for every case of the same length) are used for every case:
@@ -180,7 +184,8 @@ def simulate_cases(
     init_steps : int, optional
         Rows averaged for the steady-state initial state (default the calibration's).
     risk_options : dict, optional
-        Keywords of :func:`heritage_bayes.climate.risk.assess_batch`.
+        Keywords of :func:`heritage_bayes.climate.risk.assess_batch` (any registered
+        family's group and options).
     progress : callable, optional
         Called with one line of text per chunk.
     baseline : bool
@@ -203,7 +208,8 @@ def simulate_cases(
     -------
     list of CaseResult
         In the order of ``inputs``, with the per-complete-year values of
-        :data:`heritage_bayes.climate.risk.registry.ANNUAL` (``annual_*``) and, when the
+        :data:`heritage_bayes.climate.risk.registry.ANNUAL` and of the ``per_year``
+        columns of the families without a compiled pass (``annual_*``) and, when the
         EN 15757 group is computed and ``baseline``, the column
         ``en15757_outside_baseline`` (mean over the years). ``seconds``: ``simulate``
         (modal forms, and
@@ -262,7 +268,7 @@ def _simulate(
     own baseline case (all cases of a variant are reduced before the next variant)."""
     import numba
 
-    from heritage_bayes.climate.risk.fused import fused_plan
+    from heritage_bayes.climate.risk.fused import projection_plan
 
     if set(run.models) != {"thermal", "hygric"}:
         raise ConfigError(
@@ -282,6 +288,7 @@ def _simulate(
         params.append(draws.model if v is None else v.params(run, draws.model))
     opts = dict(risk_options or {})
     plan_opts = {k: v for k, v in opts.items() if k not in ("nan_policy", "chunk_size")}
+    nan_policy = opts.get("nan_policy", "propagate")
     from heritage_bayes.climate.risk.registry import complete_year_hours
 
     cases = []
@@ -289,11 +296,12 @@ def _simulate(
         inp = inp.iloc[: complete_year_hours(len(inp))]  # the indicators' complete years
         U = case_inputs(run, inp)  # a column simulated by another model: NaN here
         starts, months = _month_starts(inp.index)
-        plan = fused_plan(len(inp), func="assess_batch", **plan_opts)  # checks options
+        plan, numpy = projection_plan(len(inp), nan_policy=nan_policy, **plan_opts)
         Ut = {s: np.ascontiguousarray(u.T) for s, u in U.items()}
         mode = (1 if not cases else 2) if baseline else 0
         hoy = hour_of_year(inp.index)
-        cases.append(Case(U, Ut, starts, months, plan, len(inp), hoy, mode, inp.index))
+        cases.append(Case(U, Ut, starts, months, plan, len(inp), hoy, mode, inp.index,
+                          numpy or None))  # fmt: skip
     K = draws.index.size
     out = [[CaseOut.empty(c, K) for c in cases] for _ in variants]
     sigs = [[_hours_of_use(v, c) for c in cases] for v in variants]
@@ -418,25 +426,29 @@ def _run_chunk(
     else:
         ctl, bdT, bdP, spin, _ = ctrl
     cost = o.cost[sl]
+    kept = np.empty((4, k, c.N)) if c.numpy else np.zeros((0, 0, 0))
     chunk_kernel(
         Y["thermal"], Y["hygric"], M["thermal"], M["hygric"], U["thermal"], U["hygric"],
         eT, eP, e is not None, c.starts, *c.plan.arrays, ws, tmp, btmp, hist, sbuf, zbuf, wbuf,
         o.par[sl], o.pred[sl], spar, spred, o.Tm[sl], o.RHm[sl],
         c.hoy, c.mode, en, en_col, bpar[:k], bpred[:k], o.apar[sl], o.apred[sl], mabuf, cbuf,
-        ctl, bdT, bdP, sig, spin, cost, measure is None,
+        ctl, bdT, bdP, sig, spin, cost, measure is None, kept,
     )  # fmt: skip
     o.cost[sl] = cost
     bad = np.flatnonzero((spar != 0) | (spred != 0))
     if bad.size:
-        _recompute(run, P, c, o, sl, bad, e, dt, w, opts, aw, modal, ctrl, sig, measure)
+        _recompute(run, P, c, o, sl, bad, e, dt, w, opts, aw, modal, ctrl, sig, measure, kept)
+    if c.numpy:  # the families without a compiled pass, with numpy on the same series
+        o.put_numpy(c, sl, kept, measure is not None, e is not None)
     o.seconds["risk"] += time.perf_counter() - t0
 
 
 def _recompute(
-    run, P, c: Case, o: CaseOut, sl, bad, e, dt, w, opts, aw, modal, ctrl, sig, measure
+    run, P, c: Case, o: CaseOut, sl, bad, e, dt, w, opts, aw, modal, ctrl, sig, measure, kept
 ):  # fmt: skip
     """Draws the compiled pass handed back (a missing hour, or a series that
-    :func:`assess_batch` rejects): the numpy path, with its NaN policy and its errors."""
+    :func:`assess_batch` rejects): the numpy path, with its NaN policy and its errors
+    (their series into ``kept`` when it holds any)."""
     from heritage_bayes.climate.risk import assess_batch
 
     rows = np.arange(sl.start, sl.stop)[bad]
@@ -461,6 +473,8 @@ def _recompute(
 
     Ts, Ps = ys["thermal"], ys["hygric"]
     RHs = _relative_humidity(Ts, Ps)
+    if kept.shape[0]:
+        kept[0, bad], kept[1, bad] = Ts, RHs
     o.par[rows] = c.plan.values(assess_batch(Ts, RHs, **opts))
     apar = o.apar[rows]
     annual(Ts, RHs, o.par[rows], bpar, apar)
@@ -472,6 +486,8 @@ def _recompute(
         return
     T = Ts + e["thermal"][bad]
     RH = _relative_humidity(T, Ps + e["hygric"][bad])
+    if kept.shape[0]:
+        kept[2, bad], kept[3, bad] = T, RH
     o.pred[rows] = c.plan.values(assess_batch(T, RH, **opts))
     apred = o.apred[rows]
     annual(T, RH, o.pred[rows], bpred, apred)

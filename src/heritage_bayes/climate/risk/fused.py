@@ -36,7 +36,7 @@ from numba import njit, prange
 from heritage_bayes.climate import _vecmath
 from heritage_bayes.climate._vecmath import stamp_cache
 from heritage_bayes.climate.risk import _fused as k
-from heritage_bayes.climate.risk._inputs import Hourly
+from heritage_bayes.climate.risk._inputs import HOURS_PER_YEAR, Hourly
 from heritage_bayes.climate.risk.assess import (
     _check_year,
     _prepare_assess,
@@ -46,11 +46,11 @@ from heritage_bayes.climate.risk.assess import (
 )
 from heritage_bayes.climate.risk.chemical import R_GAS
 from heritage_bayes.climate.risk.indicators import FAMILIES, LAYOUT, shared_seasonal
-from heritage_bayes.climate.risk.registry import resolve_options
+from heritage_bayes.climate.risk.registry import indicator_info, resolve_options, years_of
 from heritage_bayes.climate.risk.standards import _window_half
 from heritage_bayes.errors import InputError
 
-__all__ = ["FusedPlan", "assess_fused", "fused_plan"]
+__all__ = ["FusedPlan", "NumpyPass", "assess_fused", "fused_plan", "projection_plan"]
 
 
 @dataclass(frozen=True)
@@ -236,6 +236,90 @@ def fused_plan(
         )
     opts = resolve_options(func, options)
     return _plan(func, int(n_hours), groups, opts)
+
+
+@dataclass(frozen=True)
+class NumpyPass:
+    """The selected families without a compiled pass, computed with their numpy
+    ``compute`` on series a compiled caller kept (the projection).
+
+    Attributes
+    ----------
+    families : tuple of Family
+        In registry order (their columns follow the compiled ones).
+    opts : dict
+        The resolved options of every family.
+    nan_policy : str
+        As in :func:`~heritage_bayes.climate.risk.assess`.
+    """
+
+    families: tuple
+    opts: dict
+    nan_policy: str = "propagate"
+
+    def __bool__(self) -> bool:
+        return bool(self.families)
+
+    @property
+    def columns(self) -> tuple[str, ...]:
+        """Their columns, in order."""
+        return tuple(c for f in self.families for c in f.columns(self.opts))
+
+    @property
+    def annual_columns(self) -> tuple[str, ...]:
+        """Their columns a projection also reports per complete year (``per_year``)."""
+        return tuple(c for c in self.columns if indicator_info(c).per_year)
+
+    def values(self, T: np.ndarray, RH: np.ndarray) -> dict[str, np.ndarray]:
+        """Column → values (draws,) of the (draws, hours) series ``T`` [°C], ``RH`` [%]."""
+        h = Hourly(T=T, RH=RH, index=None, ndim=2)
+        out: dict = {}
+        for fam in self.families:
+            out.update(fam.compute(h, self.opts, self.nan_policy, None))
+        return out
+
+    def annual(self, T: np.ndarray, RH: np.ndarray) -> np.ndarray:
+        """(draws, years, len(annual_columns)): :attr:`annual_columns` of each complete
+        year (blocks of 8760 h from the start; one block of the whole series when it
+        holds 8736–8759 h, as the compiled per-year values)."""
+        n = T.shape[1]
+        ny, names = years_of(n), self.annual_columns
+        out = np.full((T.shape[0], ny, len(names)), np.nan)
+        L = min(n, HOURS_PER_YEAR)
+        for y in range(ny if names else 0):
+            sl = slice(y * L, (y + 1) * L)
+            v = self.values(T[:, sl], RH[:, sl])
+            for j, c in enumerate(names):
+                out[:, y, j] = v[c]
+        return out
+
+
+def projection_plan(
+    n_hours: int, *, indicators=None, nan_policy="propagate", func="assess_batch", **options
+) -> tuple[FusedPlan, NumpyPass]:
+    """The plan of the compiled families and the families without a compiled pass, for
+    series of ``n_hours`` hours (a caller that runs the compiled pass on its own series
+    and the numpy ``compute`` of the others on the same series).
+
+    Parameters are those of :func:`fused_plan`; ``indicators`` may name any family
+    (default: every registered one).
+
+    Returns
+    -------
+    FusedPlan, NumpyPass
+
+    Raises
+    ------
+    heritage_bayes.errors.InputError
+        As :func:`fused_plan`.
+    """
+    groups = _resolve_groups(func, indicators)
+    _check_year(func, groups, int(n_hours))
+    opts = resolve_options(func, options)
+    compiled = tuple(g for g in groups if g in _compiled())
+    plan = _plan(func, int(n_hours), compiled, opts)
+    rest = tuple(f for f in FAMILIES if f.name in groups and not f.compiled)
+    return plan, NumpyPass(rest, opts, nan_policy)
 
 
 def _compiled() -> list[str]:

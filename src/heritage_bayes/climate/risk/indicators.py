@@ -21,7 +21,8 @@ fused pass, the projection and the pages read (through
 :mod:`heritage_bayes.climate.risk.registry`). Adding an indicator to an existing family
 is an entry here (its value in ``compute`` and in the compiled pass); a new family is a
 :class:`Family` added with :func:`heritage_bayes.climate.risk.registry.register` (numpy
-only; the docs' page "Extending the package" walks through one).
+only, offered by ``assess``, the fused pass and the projection alike; the docs' page
+"Extending the package" walks through one).
 """
 
 from __future__ import annotations
@@ -162,8 +163,8 @@ class Family:
     compiled : bool
         The compiled pass (:mod:`heritage_bayes.climate.risk._fused`) computes it: the
         projection and :func:`~heritage_bayes.climate.risk.assess_fused` use the kernel.
-        Otherwise :func:`~heritage_bayes.climate.risk.assess_fused` computes it with
-        ``compute`` and a projection does not offer it.
+        Otherwise both compute it with ``compute``: the projection on the series the
+        compiled pass keeps (:class:`heritage_bayes.climate.risk.fused.NumpyPass`).
     """
 
     name: str

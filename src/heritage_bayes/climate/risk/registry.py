@@ -118,8 +118,9 @@ _PATTERNS = [(_pattern(key), key) for key in INDICATORS if "{}" in key]
 def register(family: Family) -> None:
     """Add an indicator family: its columns join :func:`~heritage_bayes.climate.risk.assess`,
     :func:`~heritage_bayes.climate.risk.assess_batch`,
-    :func:`~heritage_bayes.climate.risk.assess_fused` (with its ``compute``), this
-    registry and the generated reference.
+    :func:`~heritage_bayes.climate.risk.assess_fused` and a projection (with its
+    ``compute``; per complete year too for its ``per_year`` columns), this registry and
+    the generated reference.
 
     Raises
     ------

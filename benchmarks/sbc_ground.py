@@ -52,8 +52,10 @@ MODEL = ("thermal_1c", {"surfaces": (), "ground": "seasonal"})
 #: (scale-free), and the depth (through the ground's share of the balance, the gain
 #: from Tf = 1 - gain_Ti_Te, it moves the ground's level and phase over the record)
 IDENTIFIABLE = ("tau_1_h", "gain_Ti_Te", "zf")
-#: ranked for the record: absolute sizes pinned by the survey's priors only
-OTHERS = ("Gf", "Ci")
+#: ranked for the record: absolute sizes pinned by the survey's priors only, and the
+#: ground's mean offset ``dTf`` [K] (its truth: the generator's climate mean minus the
+#: mean of the cycle the package fits to the station's year, :func:`offset_truth`)
+OTHERS = ("dTf", "Gf", "Ci")
 VARIANT = "ar1_white:estimate:T=2"
 SEED = 2061
 CAL_DAYS = 120
@@ -70,10 +72,12 @@ def fit_model():
     return m.with_slopes(m.network.inputs)
 
 
-def fit_inputs(room: dict, model):
+def fit_inputs(room: dict, model, true_mean: bool = False):
     """The hourly inputs ``U`` (N, m) in ``model.input_names`` order and the observed
     ``Ti`` (N,) (NaN where lost), built as ``hbayes calibrate`` builds them (module
-    docstring); and the package's ground at 1 m (``Tf``) for the record."""
+    docstring), and the station's Te. ``true_mean`` (diagnosis, ``--true-mean``): the
+    ground's mean is the generator's climate mean instead of the mean of the cycle the
+    package fits to the station's year (``Tf`` shifted by their difference)."""
     import pandas as pd
 
     from heritage_bayes.inputs import add_slope_columns, ground_cycle_inputs, ground_input
@@ -96,10 +100,23 @@ def fit_inputs(room: dict, model):
     cols, _ = ground_cycle_inputs(te, mids)
     for c, v in cols.items():
         frame[c] = v
+    if true_mean:
+        from heritage_bayes.climate.ground import fit_annual_cycle
+
+        frame["Tf"] += room["climate"]["T_m"] - fit_annual_cycle(te)["mean"]
     add_slope_columns(frame, [model], aligned.slopes)
     assert len(frame) == n - 1 and frame.index[0] == index[0]
     U = np.column_stack([frame[c].to_numpy(float) for c in model.input_names])
     return U, frame["Ti"].to_numpy(float), te
+
+
+def offset_truth(room: dict, te) -> float:
+    """The truth of the ground's mean offset ``dTf`` [K]: the soil's mean (the
+    generator's climate mean) minus the mean of the cycle the package fits to the
+    station's Te (the fit's ``Tf`` input)."""
+    from heritage_bayes.climate.ground import fit_annual_cycle
+
+    return float(room["climate"]["T_m"] - fit_annual_cycle(te)["mean"])
 
 
 def ground_error(room: dict, te, model, U) -> dict:
@@ -136,25 +153,32 @@ def replicate(args) -> dict:
     rep, seed, max_steps, cal_days, without = args[:5]
     variant = args[5] if len(args) > 5 else VARIANT
     shift = args[6] if len(args) > 6 else {}
+    true_mean = bool(args[7]) if len(args) > 7 else False
     assert (VOLUME, ACH, FLOOR) == (rooms.VOLUME, rooms.ACH, rooms.FLOOR), "survey differs"
     room = rooms.generate([seed, rep], cal_days, without=without)
     model = fit_model()
-    U, y, te = fit_inputs(room, model)
+    U, y, te = fit_inputs(room, model, true_mean)
     rows = room["rows"]
-    truth = {k: float(v) * shift.get(k, 1.0) for k, v in rooms.quantities(room["truth"]).items()}
+    truth = rooms.quantities(room["truth"])
+    if "dTf" in model.parameter_names:  # the offset, against the input the fit was given
+        truth["dTf"] = 0.0 if true_mean else offset_truth(room, te)
+    truth = {k: float(v) * shift.get(k, 1.0) for k, v in truth.items()}
     names = model.parameter_names
 
     def extra(dq, theta, _names=names):
         p = {n: theta[:, j] for j, n in enumerate(_names)}
         q = rooms.quantities(p)
-        return {k: q[k] for k in ("zf", "Gf", "Ci")}
+        out = {k: q[k] for k in ("zf", "Gf", "Ci")}
+        if "dTf" in p:
+            out["dTf"] = p["dTf"]
+        return out
 
     return {
         "room": "ground",
         "model": MODEL[0],
         "rep": rep,
         "seed": seed,
-        "without": sorted(without),
+        "without": sorted(without) + (["ground_mean"] if true_mean else []),
         "variant": variant,
         "truth": truth,
         "truth_parameters": room["truth"],
@@ -238,6 +262,33 @@ def room_lines(results: list[dict]) -> list[str]:
     return lines
 
 
+def paired_lines(a: list[dict], b: list[dict]) -> list[str]:
+    """Two logs of the same rooms (e.g. the default and ``--true-mean``): per quantity
+    over the replicates in both, mean z in each, mean and sd of z_a - z_b and the
+    rooms inside the 90 % interval in each."""
+
+    def zs(r):
+        ranks = r["variants"][r["variant"]]["ranks"]
+        return {q: ((x["median"] - r["truth"][q]) / x["sd"], x["in90"]) for q, x in ranks.items()}
+
+    ra, rb = ({r["rep"]: zs(r) for r in log} for log in (a, b))
+    reps = sorted(set(ra) & set(rb))
+    lines = [f"{len(reps)} rooms in both (replicates {reps})"]
+    for q in IDENTIFIABLE + OTHERS:
+        pairs = [(ra[r][q], rb[r][q]) for r in reps if q in ra[r] and q in rb[r]]
+        if not pairs:
+            continue
+        za, zb = (np.array([p[i][0] for p in pairs]) for i in (0, 1))
+        d = za - zb
+        sd = f"{d.std(ddof=1):.2f}" if d.size > 1 else "—"
+        lines.append(
+            f"  {q:10s} mean z {za.mean():+.2f} / {zb.mean():+.2f}; z_a - z_b mean "
+            f"{d.mean():+.2f}, sd {sd}; in 90 %: {sum(p[0][1] for p in pairs)} / "
+            f"{sum(p[1][1] for p in pairs)} of {d.size}"
+        )
+    return lines
+
+
 def misfit_lines(reps, seed: int, cal_days: int, without: tuple) -> list[str]:
     """``--misfit``: the ground's error (:func:`ground_error`) of rooms ``reps``, no fit."""
     model = fit_model()
@@ -247,6 +298,45 @@ def misfit_lines(reps, seed: int, cal_days: int, without: tuple) -> list[str]:
         U, _, te = fit_inputs(room, model)
         g = ground_error(room, te, model, U)
         lines.append(f"{rep:3d}: " + ", ".join(f"{k} {v:+.2f}" for k, v in g.items()))
+    return lines
+
+
+def pseudo_lines(reps, seed: int, cal_days: int, without: tuple) -> list[str]:
+    """``--pseudo``: the fit's pseudo-truth without the noise (no fit of the posterior):
+    ``Ge``, ``Gf`` and ``zf`` by least squares of the package's model on the room's
+    noise-free hourly Ti over the calibration hours (``Ci`` at its truth, the start at
+    the generator's; the room's unmodelled gain left out unless ``without`` keeps it),
+    against the truths: what the ground's and the weather's structural error alone
+    does to the depth and the gain."""
+    from scipy.optimize import least_squares
+
+    from heritage_bayes import simulate
+
+    model = fit_model()
+    lines = ["rep: zf true -> least squares; gain from Tf true -> LS; ground error mean [K]"]
+    for rep in reps:
+        room = rooms.generate([seed, rep], cal_days, without=without)
+        U, _, te = fit_inputs(room, model)
+        t, rows = room["truth"], room["rows"]
+        target = room["hourly"]["Ti_true"][: U.shape[0]][rows]
+        x0 = np.array([room["hourly"]["Ti_true"][0]])
+
+        t = {**t, "dTf": offset_truth(room, te)} if "dTf" in model.parameter_names else t
+
+        def resid(x, _t=t, _u=U, _x0=x0, _y=target, _r=rows):
+            p = {**_t, "Ge": np.exp(x[0]), "Gf": np.exp(x[1]), "zf": np.exp(x[2])}
+            return simulate(model, p, _u, 3600.0, _x0)[_r, 0] - _y
+
+        start = np.log([t["Ge"], t["Gf"], t["zf"]])
+        lo, hi = np.log([1e-2, 1e-2, 0.5]), np.log([1e5, 1e5, 6.0])
+        fit = least_squares(resid, start, bounds=(lo, hi), x_scale=1.0)
+        ge, gf, zf = np.exp(fit.x)
+        g = ground_error(room, te, model, U)
+        lines.append(
+            f"{rep:3d}: zf {t['zf']:.2f} -> {zf:.2f} m; gain from Tf "
+            f"{t['Gf'] / (t['Ge'] + t['Gf']):.3f} -> {gf / (ge + gf):.3f}; ground error "
+            f"{g['tf_mean']:+.2f} K, cycle mean {g['cycle_mean']:+.2f} K"
+        )
     return lines
 
 
@@ -262,9 +352,14 @@ def main(argv=None) -> int:
     ap.add_argument("--variant", default=VARIANT, help="NOISE:INIT[:T=X] (bench_sbc)")
     ap.add_argument("--log", help="append each replicate's result as a JSON line")
     ap.add_argument("--without", default="", help=f"parts left out: {', '.join(PARTS)}")
+    ap.add_argument("--true-mean", action="store_true", help="diagnosis: the fit's ground "
+                    "at the generator's climate mean (fit_inputs)")  # fmt: skip
     ap.add_argument("--table", nargs="+", metavar="LOG", help="only tabulate logs")
     ap.add_argument("--markdown", action="store_true", help="with --table: markdown")
+    ap.add_argument("--paired", nargs=2, metavar="LOG", help="two logs of the same rooms")
     ap.add_argument("--misfit", action="store_true", help="no fit: the ground's error")
+    ap.add_argument("--pseudo", action="store_true", help="no posterior: least-squares "
+                    "depth and gain on noise-free rooms (pseudo_lines)")  # fmt: skip
     args = ap.parse_args(argv)
     without = tuple(w for w in args.without.split(",") if w)
     if set(without) - set(PARTS):
@@ -272,6 +367,12 @@ def main(argv=None) -> int:
     reps = range(args.first_rep, args.first_rep + args.reps)
     if args.only:
         reps = [int(r) for r in args.only.split(",")]
+    if args.paired:
+        from sbc_coupled import read_logs
+
+        for line in paired_lines(*(read_logs([p]) for p in args.paired)):
+            print(line)
+        return 0
     if args.table:
         from sbc_coupled import read_logs
 
@@ -280,13 +381,20 @@ def main(argv=None) -> int:
         for line in table_lines(results, args.markdown) + room_lines(results):
             print(line)
         return 0
+    if args.pseudo:
+        for line in pseudo_lines(reps, args.seed, args.cal_days, without):
+            print(line, flush=True)
+        return 0
     if args.misfit:
         for line in misfit_lines(reps, args.seed, args.cal_days, without):
             print(line, flush=True)
         return 0
     from bench_sbc import run_tasks
 
-    tasks = [(rep, args.seed, args.max_steps, args.cal_days, without, args.variant) for rep in reps]
+    tasks = [
+        (rep, args.seed, args.max_steps, args.cal_days, without, args.variant, {}, args.true_mean)
+        for rep in reps
+    ]
     t0 = time.perf_counter()
     results = run_tasks(replicate, tasks, args.jobs, args.log)
     print(

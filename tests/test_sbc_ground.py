@@ -68,8 +68,9 @@ def test_generator_and_package_agree_where_their_physics_is_the_same():
 
     room = rooms.generate([sbc.SEED, 5], cal_days=30, without=QUIET)
     model = sbc.fit_model()
-    U, y, _ = sbc.fit_inputs(room, model)
-    truth = room["truth"]
+    U, y, te = sbc.fit_inputs(room, model)
+    truth = {**room["truth"], "dTf": sbc.offset_truth(room, te)}
+    assert abs(truth["dTf"]) < 0.1  # without the synoptic weather: the year's mean
     rows = room["rows"]
     x0 = np.array([room["hourly"]["Ti_true"][0]])
 

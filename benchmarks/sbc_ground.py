@@ -218,7 +218,7 @@ def table_lines(results: list[dict], markdown: bool = False) -> list[str]:
         s = summary(results, "ground", q)
         if s is None:
             continue
-        tag = "" if q in IDENTIFIABLE else " (not identifiable)"
+        tag = " (not identifiable)" if q in ("Gf", "Ci") else ""
         ci = f"{s['c90']:.2f} ({s['c90_ci'][0]:.2f}-{s['c90_ci'][1]:.2f})"
         p = "—" if not np.isfinite(s["rank_p"]) else f"{s['rank_p']:.3f}"
         zz = f"{s['z_mean']:+.2f} / {s['z_sd']:.2f}"

@@ -20,7 +20,7 @@ from heritage_bayes.climate.ground import (
 )
 from heritage_bayes.config import parse_config
 from heritage_bayes.errors import ConfigError
-from heritage_bayes.inference.priors import check_fixed, default_prior
+from heritage_bayes.inference.priors import Prior, check_fixed, default_prior
 from heritage_bayes.models import build_model
 from heritage_bayes.rc.catalog import GROUND_CYCLE_INPUTS, GROUND_REFERENCE, model
 
@@ -72,32 +72,37 @@ def _inputs(times):
 
 
 def test_seasonal_ground_at_depth_equals_the_input_ground_at_that_depth():
+    """The model's ground at the depth zf with the mean offset dTf is the input ground
+    of that depth, dTf warmer (the offset's prior: normal about 0 K, sd 1 K)."""
     times = pd.date_range("2020-01-01", periods=730, freq="1D", tz="UTC")
     U = _inputs(times)
     seasonal = model("thermal_1c", surfaces=(), ground="seasonal")
     fixed = model("thermal_1c", surfaces=(), ground=True)
     assert seasonal.input_names == ("Te", "Tf", *GROUND_CYCLE_INPUTS)
-    for z in (GROUND_REFERENCE, 2.7):
-        tf = kusuda_achenbach(times, 9.0, 8.0, T0, depth=z)
-        P = np.array([[*PARAMS_1C.values(), z]])
+    for z, offset in ((GROUND_REFERENCE, 0.0), (2.7, 0.0), (2.7, -1.3)):
+        tf = kusuda_achenbach(times, 9.0, 8.0, T0, depth=z) + offset
+        P = np.array([[*PARAMS_1C.values(), z, offset]])
         y, ok = seasonal.forward(P, U, 86_400.0)
         y_ref, _ = fixed.forward(
             np.array([list(PARAMS_1C.values())]), np.column_stack([U[:, 0], tf]), 86_400.0
         )
         assert ok.all()
         np.testing.assert_allclose(y, y_ref, atol=1e-9)
+    offset = next(p for p in seasonal.parameters if p.name == "dTf")
+    assert (offset.kind, offset.unit) == ("offset", "K")
+    assert default_prior("thermal", "offset") == Prior("normal", -5.0, 5.0, 0.0, 1.0)
 
 
 def test_a_known_depth_is_recovered_from_a_small_synthetic_series():
     times = pd.date_range("2019-01-01", periods=3 * 365, freq="1D", tz="UTC")
     U = _inputs(times)
     m = model("thermal_1c", surfaces=(), ground="seasonal")
-    truth = np.array([[*PARAMS_1C.values(), 3.0]])
+    truth = np.array([[*PARAMS_1C.values(), 3.0, 0.0]])
     y = m.forward(truth, U, 86_400.0)[0][0, :, 0]
     y = y + np.random.default_rng(2).normal(0.0, 0.1, len(y))  # sensor noise [K]
 
     def resid(x):  # log Ge, log Gf, zf; Ci known
-        P = np.array([[PARAMS_1C["Ci"], np.exp(x[0]), np.exp(x[1]), x[2]]])
+        P = np.array([[PARAMS_1C["Ci"], np.exp(x[0]), np.exp(x[1]), x[2], 0.0]])
         return m.forward(P, U, 86_400.0)[0][0, :, 0] - y
 
     fit = least_squares(resid, [np.log(20.0), np.log(20.0), 1.0], bounds=([-5, -5, 0.2], [9, 9, 6]))

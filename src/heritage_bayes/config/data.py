@@ -29,7 +29,8 @@ class GroundTemperature(_Strict):
     ``seasonal``: the annual cycle of the outdoor temperature, damped and delayed at
     ``depth`` in the soil, see :func:`heritage_bayes.inputs.seasonal_ground_temperature`;
     without ``depth``, the thermal models estimate it (parameter ``zf`` [m], the inputs
-    of :func:`heritage_bayes.inputs.ground_cycle_inputs`);
+    of :func:`heritage_bayes.inputs.ground_cycle_inputs`) and the ground's annual mean
+    minus the outdoor air's (parameter ``dTf`` [K]);
     ``annual_mean``: the outdoor temperature averaged over a year, see
     :func:`heritage_bayes.inputs.annual_mean_temperature`; ``constant``: ``value``
     [°C]; ``column``: a measured series, the column ``column`` (name in the file) of the
@@ -49,7 +50,8 @@ class GroundTemperature(_Strict):
         unit="m",
         description="mode seasonal: depth of the ground temperature in clay/silt soil "
         "(1 m: the annual swing × 0.64, 26 days late). Default: estimated by the thermal "
-        "model (parameter zf, prior median 2 m within 0.5-6 m)",
+        "model (parameter zf, prior median 2 m within 0.5-6 m; and dTf, the ground's mean "
+        "minus the outdoor air's, prior 0 ± 1 K)",
         ge=0,
         le=20,
     )

@@ -179,6 +179,12 @@ _DEFAULTS: dict[tuple[str, str], Prior] = {
     # under the floor: median 2 m, a factor 1.65 per sd, from 0.5 m (the annual swing
     # × 0.80, 13 days late) to 6 m (× 0.07, 156 days late)
     ("thermal", "depth"): Prior("lognormal", 0.5, 6.0, 2.0, 0.5),
+    # the ground's annual mean minus that of the outdoor air its cycle is fitted to [K]
+    # (option ground: seasonal): one year's mean air temperature departs from the
+    # climate's, which the deep soil follows, by about half a kelvin (the year-to-year
+    # sd of an annual mean in north-west Europe), and the soil's mean sits above the
+    # air's by up to 1-2 K (snow, radiation, a building's heat): sd 1 K about 0, ±5 K
+    ("thermal", "offset"): Prior("normal", -5.0, 5.0, 0.0, 1.0),
     # hygric capacities [kg/Pa]: air of 1 m³ is 7.5e-6 kg/Pa; buffering contents far more
     ("hygric", "capacity"): Prior("loguniform", 1e-6, 1e3),
     # hygric conductances [kg/(s·Pa)]: 0.1 ACH in 10 m³ ~ 2e-9; 5 ACH in 1e4 m³ ~ 1e-4
@@ -237,6 +243,7 @@ FIXED_RANGE = {
     "gain": (0.0, math.inf, True),
     "fraction": (0.0, 1.0, True),
     "depth": (0.0, 20.0, True),
+    "offset": (-20.0, 20.0, True),
     "sorption_capacity": (0.0, math.inf, False),
     "saturation": (0.0, 1.5, True),
     "sigma": (0.0, math.inf, False),

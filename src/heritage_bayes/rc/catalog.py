@@ -118,6 +118,7 @@ _DESCRIPTIONS = {
     "Pe": "outdoor vapour pressure",
     "Ph": "heating power into the air node (known gain 1)",
     "zf": "equivalent depth of the ground temperature in clay/silt soil",
+    "dTf": "the ground's annual mean minus the outdoor air's (of its fitted cycle)",
     "Tf_cos": "annual anomaly of the ground surface (fitted to the outdoor air)",
     "Tf_sin": "quadrature of the ground surface's annual anomaly",
 }
@@ -163,7 +164,7 @@ def _thermal(
     cycles, units = (), {}
     if ground == "seasonal":  # Tf given at GROUND_REFERENCE, its depth zf estimated
         inputs += list(GROUND_CYCLE_INPUTS)
-        cycles = (GroundCycle("Ti", "Gf", "zf", GROUND_CYCLE_INPUTS, GROUND_REFERENCE),)
+        cycles = (GroundCycle("Ti", "Gf", "zf", GROUND_CYCLE_INPUTS, GROUND_REFERENCE, "dTf"),)
         units = dict.fromkeys(GROUND_CYCLE_INPUTS, "K")
     sources = []
     for s in surfaces:

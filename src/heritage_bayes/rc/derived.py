@@ -49,7 +49,7 @@ def _param_matrix(model, params) -> tuple[np.ndarray, bool]:
 
 
 def _constant_indices(model) -> list[int]:
-    return [j for j, info in enumerate(model.parameters) if info.kind == "constant"]
+    return [j for j, info in enumerate(model.parameters) if info.kind in ("constant", "offset")]
 
 
 def _diff_unit(model) -> str:

@@ -17,7 +17,7 @@ __all__ = ["IdentifiabilityResult", "NullDirection"]
 
 _LOG_KINDS = ("capacity", "conductance", "gain", "sorption_capacity")
 #: Kinds of constant boundary potentials (a vapour pressure, or a sink's RH [-]).
-_CONSTANT_KINDS = ("constant", "saturation")
+_CONSTANT_KINDS = ("constant", "saturation", "offset")
 _TRANSFORM = {
     "capacity": "log",
     "conductance": "log",
@@ -27,6 +27,7 @@ _TRANSFORM = {
     "sorption_capacity": "log",
     "saturation": "relative",
     "depth": "relative",
+    "offset": "relative",
 }
 _SCALE_LABEL = "overall scale"
 

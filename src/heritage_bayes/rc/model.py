@@ -271,10 +271,12 @@ class RCModel:
             if fi >= 0:
                 gain = gain * ((1.0 - P[:, fi]) if comp else P[:, fi])
             Gu[:, node, u] += gain
-        for node, g, zi, uc, us, ref in ix["cycle"]:
+        for node, g, zi, uc, us, ref, oi in ix["cycle"]:
             a, b = depth_factors(P[:, zi])
             Gu[:, node, uc] += P[:, g] * (a - ref[0])
             Gu[:, node, us] += P[:, g] * (b - ref[1])
+            if oi >= 0:  # the boundary's mean offset: a constant flow G ΔT
+                q[:, node] += P[:, g] * P[:, oi]
         return cap, G, Gu, q
 
     def output_matrix(self) -> np.ndarray:
@@ -377,6 +379,7 @@ def as_index_arrays(net: Network):
             uidx[cy.inputs[0]],
             uidx[cy.inputs[1]],
             tuple(float(v) for v in depth_factors(cy.reference)),
+            pidx[cy.offset] if cy.offset is not None else -1,
         )
         for cy in net.cycles
     ]

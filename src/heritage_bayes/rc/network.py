@@ -90,12 +90,15 @@ class GroundCycle:
     depth parameter ``depth`` [m] by the flow
 
     .. math::
-        G\\,[a(z) - a(z_r)]\\,c(t) + G\\,[b(z) - b(z_r)]\\,s(t)
+        G\\,[a(z) - a(z_r)]\\,c(t) + G\\,[b(z) - b(z_r)]\\,s(t) + G\\,\\Delta T
 
     into ``node``, where :math:`c, s` are the input columns ``inputs`` (the surface's
     annual anomaly and its quadrature [potential]) and :math:`a, b` the depth weights
     of :func:`heritage_bayes.climate.ground.depth_factors` (Kusuda-Achenbach): the
     boundary then follows the cycle at depth :math:`z`; at :math:`z = z_r` nothing changes.
+    ``offset`` (optional) names the parameter :math:`\\Delta T` (kind ``offset``, a
+    potential difference) by which the boundary's annual mean exceeds the input's (the
+    soil's mean is not the mean of one year's outdoor air).
     """
 
     node: str
@@ -103,6 +106,7 @@ class GroundCycle:
     depth: str
     inputs: tuple[str, str]
     reference: float
+    offset: str | None = None
 
 
 @dataclass(frozen=True)
@@ -273,6 +277,9 @@ class Network:
             yield c, "constant"
         for cy in self.cycles:
             yield cy.depth, "depth"
+        for cy in self.cycles:
+            if cy.offset is not None:
+                yield cy.offset, "offset"
 
     # ------------------------------------------------------------------ metadata
     @property
@@ -304,6 +311,8 @@ class Network:
                 unit = "-"
             elif kind == "depth":
                 unit = "m"
+            elif kind == "offset":
+                unit = "K" if self.domain == "thermal" else units["potential"]
             else:
                 unit = units["potential"]
             seen[p] = ParameterInfo(p, kind, unit, self.descriptions.get(p, ""))

@@ -1,0 +1,99 @@
+"""The simulation-based calibration of the ground at an estimated depth, in small (the
+study: ``benchmarks/sbc_ground.py``, its table in docs/science/sbc.md).
+
+The generator (``benchmarks/ground_rooms.py``) must share no code with the package and
+agree with it where their physics is the same; the runner must rank every quantity, and
+a deliberately wrong truth must fall outside its interval.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+BENCH = ROOT / "benchmarks"
+sys.path.insert(0, str(BENCH))
+
+rooms = pytest.importorskip("ground_rooms")
+sbc = pytest.importorskip("sbc_ground")
+
+QUIET = ("anomaly", "gain", "noise", "outage", "synoptic")
+
+
+def test_generator_imports_nothing_of_the_package():
+    code = (
+        f"import sys; sys.path.insert(0, {str(BENCH)!r}); import ground_rooms as r; "
+        "r.generate(3, cal_days=30); "
+        "bad = [m for m in sys.modules if m.startswith('heritage_bayes')]; "
+        "assert not bad, bad"
+    )
+    subprocess.run([sys.executable, "-c", code], check=True)
+    src = (BENCH / "ground_rooms.py").read_text()
+    assert not re.search(r"^\s*(from|import)\s+(heritage_bayes|bench_sbc|sbc_)", src, re.M)
+
+
+def test_soil_column_damps_and_delays_a_surface_wave_as_conduction_does():
+    """The finite-difference column of the surface's departures carries a 30-day wave
+    to 0.4 m damped by exp(-z/D) and late by z/(D ω), D = sqrt(2α/ω) (Carslaw and
+    Jaeger's periodic solution), within a few per cent."""
+    days, period, alpha, z = 240, 30.0, 0.5e-6, 0.4
+    t = np.arange(days * rooms.PER_DAY) / rooms.PER_DAY
+    wave = np.sin(2 * math.pi * t / period)
+    w = {"Te": 10.0 + wave, "season": np.full(t.size, 10.0), "day": t}
+    w.update(T_m=10.0, A=0.0, t_min=0.0)
+    got = rooms.soil_temperature(w, z, alpha) - 10.0
+    omega = 2 * math.pi / (period * 86400.0)
+    d = math.sqrt(2 * alpha / omega)
+    want = math.exp(-z / d) * np.sin(2 * math.pi * t / period - z / d)
+    late = t > 120  # the column's start has died out
+    # the column takes daily means (a 1-day box filter) applied at the day's end
+    lag = np.interp(t - 0.5, t, want)
+    assert np.abs(got[late] - lag[late]).max() < 0.05 * math.exp(-z / d) + 0.01
+
+
+def test_generator_and_package_agree_where_their_physics_is_the_same():
+    """Without the soil's departures, the heat gain, the synoptic weather and the
+    logger, the package's thermal_1c with the ground at the true equivalent depth (the
+    cycle it fits to the station's year) follows the generator's room within 0.02 K on
+    average; the ground at twice the depth (0.1 K colder in this room, whose ground
+    takes 5 % of the balance) does not."""
+    from heritage_bayes import simulate
+
+    room = rooms.generate([sbc.SEED, 5], cal_days=30, without=QUIET)
+    model = sbc.fit_model()
+    U, y, te = sbc.fit_inputs(room, model)
+    truth = {**room["truth"], "dTf": sbc.offset_truth(room, te)}
+    assert abs(truth["dTf"]) < 0.1  # without the synoptic weather: the year's mean
+    rows = room["rows"]
+    x0 = np.array([room["hourly"]["Ti_true"][0]])
+
+    def err(zf):
+        sim = simulate(model, {**truth, "zf": zf}, U, 3600.0, x0)[:, 0]
+        return (sim - room["hourly"]["Ti_true"][: sim.size])[rows]
+
+    good, bad = err(truth["zf"]), err(2.0 * truth["zf"])
+    # what is left: the weather within the hour, which the hourly readings do not see
+    assert abs(good.mean()) < 0.02 and good.std() < 0.1, (good.mean(), good.std())
+    assert abs(bad.mean()) > 0.08, bad.mean()
+
+
+def test_small_study_ranks_every_quantity_and_a_wrong_truth_fails():
+    """One room (30 days, a short chain): every quantity ranked with finite statistics,
+    the table printed; the depth's truth taken 20 times too deep (and the time
+    constant's ten times too long) outside its 90 % interval."""
+    r = sbc.replicate((0, sbc.SEED, 300, 30, (), sbc.VARIANT, {"zf": 20.0, "tau_1_h": 10.0}))
+    ranks = r["variants"][sbc.VARIANT]["ranks"]
+    assert set(sbc.IDENTIFIABLE + sbc.OTHERS) <= set(ranks), sorted(ranks)
+    for q in sbc.IDENTIFIABLE + sbc.OTHERS:
+        assert np.isfinite(ranks[q]["median"]) and ranks[q]["sd"] > 0, q
+    assert not ranks["zf"]["in90"] and not ranks["tau_1_h"]["in90"]
+    assert math.isfinite(r["ground_error"]["tf_sd"])
+    lines = sbc.table_lines([r], markdown=True) + sbc.room_lines([r])
+    assert any(line.startswith("| thermal_1c") and "tau_1_h" in line for line in lines)

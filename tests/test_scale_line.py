@@ -72,8 +72,14 @@ def test_a_fixed_conductance_breaks_the_symmetry_and_the_coordinates_stay():
     assert scale_line(lp, None, _x(lp)) is None  # ...but the likelihood changes along it
 
 
-def test_the_change_of_variables_is_exact(lp):
+LOGNORMAL_CI = {"Ci": {"dist": "lognormal", "median": 2e6, "sigma": 1.0}}
+
+
+@pytest.mark.parametrize("priors", [None, LOGNORMAL_CI], ids=["loguniform", "lognormal"])
+def test_the_change_of_variables_is_exact(lp, priors):
+    lp = lp if priors is None else _logpost(priors=priors)
     c = scale_line(lp, None, _x(lp))
+    assert c.cells == (1 if priors is None else 64)
     rng = np.random.default_rng(2)
     X = _x(lp) + 0.05 * rng.standard_normal((6, lp.ndim))
     Y = c.to_y(X)
@@ -84,6 +90,8 @@ def test_the_change_of_variables_is_exact(lp):
         [(c.to_x(y0 + h * e)[0] - c.to_x(y0 - h * e)[0]) / (2 * h) for e in np.eye(lp.ndim)]
     )
     assert c(Y[:1])[0] - lp(X[:1])[0] == pytest.approx(np.log(abs(np.linalg.det(J))), abs=1e-5)
+    if priors is not None:
+        return
     # log-uniform priors: the scale coordinate is logistic, whatever the other coordinates
     Y2 = c.spread(Y, rng)
     logistic = lambda v: -np.abs(v) - 2 * np.log1p(np.exp(-np.abs(v)))  # noqa: E731

@@ -24,7 +24,8 @@ conditional distribution function* along the line,
 
 with ``p`` the prior density in the log coordinates and ``r`` the point of the line at
 ``t = 0``. :math:`F` is computed on 64 cells between the prior bounds along the line
-(the prior taken constant within a cell: exact for log-uniform priors) and inverted
+(the prior taken constant within a cell; one cell, exact, where every member's prior is
+log-uniform) and inverted
 piecewise linearly; the log-density in ``y`` is the log-posterior plus
 :math:`\\log|dt/dv|` of that same map, so the target is exact whatever the grid. As the
 likelihood does not depend on ``t``, the posterior in ``y`` is
@@ -131,6 +132,11 @@ class ScaleLine:
         lo, hi = logpost.params.bounds
         on = self.s_x == 1
         self._on, self._lo, self._hi = on, lo[on], hi[on]
+        # log-uniform members only: the prior is constant along the line inside its
+        # bounds (the other parameters do not move), one cell is exact
+        free = [logpost.params.parameters[int(j)] for j in logpost.params._free_idx]
+        flat = all(p.prior.dist == "loguniform" for p, o in zip(free, on, strict=True) if o)
+        self.cells = 1 if flat else CELLS
 
     @property
     def ndim(self) -> int:
@@ -147,14 +153,16 @@ class ScaleLine:
         t_hi = np.min(self._hi - X0[:, self._on], axis=1)
         width = t_hi - t_lo
         ok = width > 0
-        frac = np.linspace(0.0, 1.0, CELLS + 1)
+        frac = np.linspace(0.0, 1.0, self.cells + 1)
         edges = t_lo[:, None] + width[:, None] * frac
         mids = 0.5 * (edges[:, 1:] + edges[:, :-1])
         F = np.full(edges.shape, np.nan)
-        if ok.any():
+        if self.cells == 1:
+            F[ok] = frac
+        elif ok.any():
             pts = X0[ok, None, :] + mids[ok, :, None] * self.s_x
             logp = self.logpost.params.transform(pts.reshape(-1, X0.shape[1]))[1]
-            logp = logp.reshape(-1, CELLS)
+            logp = logp.reshape(-1, self.cells)
             top = np.max(logp, axis=1, keepdims=True)
             good = np.isfinite(top[:, 0])
             mass = np.where(good[:, None], np.exp(logp - np.where(good[:, None], top, 0.0)), 0.0)
@@ -162,7 +170,7 @@ class ScaleLine:
             with np.errstate(invalid="ignore", divide="ignore"):
                 F[ok] = np.where(good[:, None], cum / cum[:, -1:], np.nan)
         with np.errstate(divide="ignore", invalid="ignore"):
-            return edges, F, np.log(width / CELLS)
+            return edges, F, np.log(width / self.cells)
 
     def _split(self, Y: np.ndarray):
         """(Z0: inner coordinates at t = 0, X0: the same in log coordinates, u)."""
@@ -176,7 +184,7 @@ class ScaleLine:
         edges, F, log_w = self._cells(X0)
         ok = np.isfinite(F[:, -1]) & (u > 0.0) & (u < 1.0)
         Fz = np.where(ok[:, None], F, 0.0)
-        c = np.clip(np.sum(Fz[:, 1:-1] <= u[:, None], axis=1), 0, CELLS - 1)
+        c = np.clip(np.sum(Fz[:, 1:-1] <= u[:, None], axis=1), 0, self.cells - 1)
         rows = np.arange(u.size)
         dF = Fz[rows, c + 1] - Fz[rows, c]
         ok &= dF > 0
@@ -204,8 +212,8 @@ class ScaleLine:
         ok = np.isfinite(F[:, -1])
         rows = np.arange(t.size)
         with np.errstate(invalid="ignore"):
-            pos = (t - edges[:, 0]) / (edges[:, -1] - edges[:, 0]) * CELLS
-            c = np.clip(np.floor(np.where(ok, pos, 0.0)).astype(int), 0, CELLS - 1)
+            pos = (t - edges[:, 0]) / (edges[:, -1] - edges[:, 0]) * self.cells
+            c = np.clip(np.floor(np.where(ok, pos, 0.0)).astype(int), 0, self.cells - 1)
             Fz = np.where(ok[:, None], F, 0.0)
             u = Fz[rows, c] + np.clip(pos - c, 0.0, 1.0) * (Fz[rows, c + 1] - Fz[rows, c])
         u = np.where(ok, u, np.nan)

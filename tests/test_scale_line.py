@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import heritage_bayes as hb
+from _chain_helpers import sunny_room_inputs
 from heritage_bayes.config import prior_specs
 from heritage_bayes.inference.coordinates import node_time_constants
 from heritage_bayes.inference.likelihoods import get_noise_model
@@ -24,13 +25,7 @@ def _logpost(priors=None, N=24 * 12, seed=0):
     through its air temperature only: no heat input in watts."""
     rng = np.random.default_rng(seed)
     m = hb.model("thermal_2c", surfaces=("S",))
-    t = np.arange(N)
-    cols = {
-        "Te": 5 + 4 * np.sin(2 * np.pi * (t - 14) / 24) + np.cumsum(rng.normal(0, 0.3, N)),
-        "I_S": np.clip(400 * np.sin(2 * np.pi * (t - 6) / 24), 0, None),
-        "Tf": np.full(N, 10.0),
-    }
-    U = np.column_stack([cols[c] for c in m.input_names])
+    U = sunny_room_inputs(m, N, rng)
     y = hb.simulate(m, {k: TRUTH[k] for k in m.parameter_names}, U)[:, 0]
     y = y + rng.normal(0, 0.1, N)
     noise = get_noise_model("ar1")

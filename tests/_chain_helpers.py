@@ -9,6 +9,18 @@ import pytest
 from heritage_bayes.inference.sampler import run_sampler
 
 
+def sunny_room_inputs(m, N: int, rng: np.random.Generator) -> np.ndarray:
+    """(N, m) hourly inputs of a room with one south surface: a daily outdoor cycle on a
+    random walk [°C], the sun on the surface [W/m²] and a ground at 10 °C."""
+    t = np.arange(N)
+    cols = {
+        "Te": 5 + 4 * np.sin(2 * np.pi * (t - 14) / 24) + np.cumsum(rng.normal(0, 0.3, N)),
+        "I_S": np.clip(400 * np.sin(2 * np.pi * (t - 6) / 24), 0, None),
+        "Tf": np.full(N, 10.0),
+    }
+    return np.column_stack([cols[c] for c in m.input_names])
+
+
 class Ridge:
     """A 3-d Gaussian with correlations 0.99 (a ridge: τ of tens of steps), vectorised."""
 

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import heritage_bayes as hb
+from _chain_helpers import sunny_room_inputs
 from heritage_bayes.config import prior_specs
 from heritage_bayes.inference.coordinates import NodeTimeConstants, node_time_constants
 from heritage_bayes.inference.likelihoods import get_noise_model
@@ -18,13 +19,7 @@ from heritage_bayes.inference.sampler import run_sampler
 def _logpost(name="thermal_2c", N=24 * 20, priors=None, seed=0):
     rng = np.random.default_rng(seed)
     m = hb.model(name, surfaces=("S",))
-    t = np.arange(N)
-    cols = {
-        "Te": 5 + 4 * np.sin(2 * np.pi * (t - 14) / 24) + np.cumsum(rng.normal(0, 0.3, N)),
-        "I_S": np.clip(400 * np.sin(2 * np.pi * (t - 6) / 24), 0, None),
-        "Tf": np.full(N, 10.0),
-    }
-    U = np.column_stack([cols[c] for c in m.input_names])
+    U = sunny_room_inputs(m, N, rng)
     truth = dict(Cw=5e7, Ci=2e6, Gw=150.0, Gi=300.0, Gfast=80.0, Gf=30.0, fI_S=3.0, Ge=230.0)
     y = hb.simulate(m, {k: truth[k] for k in m.parameter_names}, U)[:, 0]
     noise = get_noise_model("ar1")

@@ -397,6 +397,7 @@ def _sample_section(
     from heritage_bayes.inference.moves import unidentified_block
     from heritage_bayes.inference.optimize import seconds_left, share_deadline
     from heritage_bayes.inference.sampler import run_sampler
+    from heritage_bayes.inference.scale import scale_line
     from heritage_bayes.inference.start import start_hessian
 
     t0, deadline = time.perf_counter(), share_deadline(end, n_sections - i)
@@ -421,6 +422,8 @@ def _sample_section(
     t0 = time.perf_counter()
     update = say.sampler(s.name, cfg.sampler.max_steps)
     coords = sampling_coordinates(s.logpost, cfg.sampler.coordinates)
+    if cfg.sampler.coordinates == "auto":  # the exact scale direction on its own axis
+        coords = scale_line(s.logpost, coords, s.map.x)
     hessian = start_hessian(s.logpost, s.laplace, cfg.sampler.start)
     block = unidentified_block(s.logpost, s.laplace)
     s.block_move = {

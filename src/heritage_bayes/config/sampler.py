@@ -119,7 +119,10 @@ class SamplerSettings(_Strict):
         description="what the walkers move in: log (log C, log G), node_tau (log node time "
         "constants in place of log capacities, and a split solar fraction such as "
         "thermal_4a's fsol as log(1 - fsol)), or auto: node_tau for networks of three or "
-        "more nodes, log for smaller ones; the chain is stored in log coordinates either "
+        "more nodes, log for smaller ones, and where the likelihood is constant along the "
+        "overall scale of C, G and the gains in watts (no measured heat input) that scale "
+        "on an axis of its own, drawn from the priors along it "
+        "(heritage_bayes.inference.scale); the chain is stored in log coordinates either "
         "way",
     )
     start: Literal["auto", "ball", "laplace"] = key(

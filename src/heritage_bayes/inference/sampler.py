@@ -90,6 +90,10 @@ __all__ = [
 ]
 
 
+#: Share of the steps that redraw the scale coordinate of a scale line.
+SCALE_REDRAW_WEIGHT = 0.1
+
+
 def start_ensemble(
     logpost,
     x_map: np.ndarray,
@@ -290,7 +294,7 @@ def _run_sampler(
     """
     nwalkers, d = _walkers(x_map, nwalkers, max_rows, tau_discard)
     target = logpost if coordinates is None else coordinates
-    move_list = make_moves(moves, block, block_weight)
+    move_list = _with_scale_redraw(make_moves(moves, block, block_weight), coordinates)
     c = _Chain(
         emcee.EnsembleSampler(nwalkers, d, target, vectorize=True, moves=move_list),
         move_list,
@@ -371,6 +375,19 @@ def _run_sampler(
     if compact and c.ck is not None:
         compact_checkpoint(c.ck.path, tag, result, max_draws)
     return result
+
+
+def _with_scale_redraw(move_list: list, coordinates) -> list:
+    """The moves, plus the independence redraw of the scale coordinate
+    (:class:`~heritage_bayes.inference.scale.ScaleRedraw`, a share
+    :data:`SCALE_REDRAW_WEIGHT` of the steps) when the coordinates have one."""
+    index = getattr(coordinates, "index", None) if hasattr(coordinates, "spread") else None
+    if index is None:
+        return move_list
+    from heritage_bayes.inference.scale import ScaleRedraw
+
+    rest = 1.0 - SCALE_REDRAW_WEIGHT
+    return [(m, w * rest) for m, w in move_list] + [(ScaleRedraw(index), SCALE_REDRAW_WEIGHT)]
 
 
 def _walkers(x_map, nwalkers: int | None, max_rows: int | None, tau_discard: float):
@@ -509,10 +526,13 @@ def _start(c: _Chain, logpost, target, x_map, seed, start_hessian, bounds, init_
     p0, lp_init = got or start_ensemble(
         logpost, x_map, c.nwalkers, rng, init_ball=init_ball, bounds=bounds
     )
+    y0 = c.to_y(p0)
+    if hasattr(c.coordinates, "spread"):  # a coordinate drawn exactly (the scale line)
+        y0 = c.coordinates.spread(y0, rng)
     if c.coordinates is not None:  # the density emcee compares: in its own coordinates
-        lp_init = np.asarray(target(c.to_y(p0)), dtype=float)
+        lp_init = np.asarray(target(y0), dtype=float)
     c.sampler.random_state = np.random.RandomState(seed).get_state()
-    c.state = emcee.State(c.to_y(p0), log_prob=lp_init, random_state=c.sampler.random_state)
+    c.state = emcee.State(y0, log_prob=lp_init, random_state=c.sampler.random_state)
     if c.ck is not None:
         c.ck.create(c.nwalkers, c.d)
 

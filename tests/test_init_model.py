@@ -90,6 +90,10 @@ def test_a_dehumidified_heated_store(tmp_path):
     assert cfg.hygric.options.given() == {"humidistat": "band"}
     # the evidence, with the measured numbers, as comments above the keys
     assert "a heating floor: the indoor daily minimum sat at 9.9 °C" in text
+    # the set-point's prior at the measured floor: no "heating off" mode below every hour
+    tset = cfg.thermal.priors["Tset"]
+    assert (tset.dist, tset.mean, tset.sigma) == ("normal", 9.9, 1.0)
+    assert "a normal prior 9.9 ± 1 K" in text
     assert "held in a narrow band: a humidistat or dehumidifier" in text
     assert "RH band: indoors 47-51 % (4.5 points, 5-95 %)" in text
     assert "model: auto screens thermal_1c, thermal_2c and thermal_4a" in text

@@ -316,6 +316,7 @@ def _config_text(
         "thermal:",
         f"  model: {prop.thermal_model}",
         *([f"  options: {_yaml_value(prop.thermal_options)}"] if prop.thermal_options else []),
+        *([f"  priors: {_yaml_value(prop.thermal_priors)}"] if prop.thermal_priors else []),
     ]
     if per.hygric:
         lines += ["", *[x for f in prop.hygric_evidence for x in _wrap(f, "#   - ", "#     ")]]

@@ -63,6 +63,10 @@ BAND_RATIO = 0.4
 #: says a constant heat gain: a massive room without one sits at the outdoor mean or
 #: under it in its warmest month (it lags the season).
 GAIN_K = 1.5
+#: Standard deviation [K] of the set-point's prior around the measured heating floor: a
+#: thermostat holds its sensor, not the logger, at ``Tset``, and its dead band and the
+#: logger's place put the floor a kelvin or so from the set-point.
+TSET_SD_K = 1.0
 #: Median daily indoor over outdoor temperature range under which no daily sun shows.
 SUNLESS_RATIO = 0.3
 #: Mean indoor minus outdoor vapour pressure [Pa] at or below ``-SINK_PA``: a sink.
@@ -87,6 +91,8 @@ class ModelProposal:
     thermal_options: dict = field(default_factory=dict)
     hygric_model: str = "hygric_1c"
     hygric_options: dict = field(default_factory=dict)
+    #: Priors init measured (``thermal.priors``), e.g. the set-point at the heating floor.
+    thermal_priors: dict = field(default_factory=dict)
     thermal_evidence: list[str] = field(default_factory=list)
     hygric_evidence: list[str] = field(default_factory=list)
     #: The room's daily swing against the outdoor one: a daily sun (True), none (False)
@@ -122,10 +128,17 @@ def _thermal(p: ModelProposal, ti, te, heated: tuple[float, int, int], cal_days:
     floor, held, ndays = heated
     if held >= max(20, 0.05 * ndays):
         p.thermal_options["thermostat"] = True
+        p.thermal_priors["Tset"] = {
+            "dist": "normal",
+            "mean": round(floor, 1),
+            "sigma": TSET_SD_K,
+        }
         p.thermal_evidence.append(
             f"a heating floor: the indoor daily minimum sat at {floor:.1f} °C (within 0.5 K) "
             f"on {held} of {ndays} days while the outdoor air averaged 5 K colder: a "
-            "thermostat (thermostat: true, its set-point Tset estimated)"
+            "thermostat (thermostat: true, its set-point Tset estimated around the floor: "
+            f"thermal.priors.Tset, a normal prior {floor:.1f} ± {TSET_SD_K:g} K, so that the "
+            "fit cannot switch the heating off by a set-point below every measured hour)"
         )
         both = pd.concat([ti.rename("ti"), te.rename("te")], axis=1).dropna()
         monthly = both.resample("MS").mean()[both.resample("MS").count()["ti"] >= 24 * 20]

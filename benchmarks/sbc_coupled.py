@@ -66,7 +66,9 @@ IDENTIFIABLE = {
 }
 #: ranked too, for the record: absolute sizes pinned by the survey's priors only, or
 #: quantities the data hardly inform (the cellar's fast mode)
-OTHERS = {"attic": ("Cm",), "cellar": ("tau2_h",)}
+OTHERS = {"attic": ("Cm", "K_gab"), "cellar": ("tau2_h", "K_gab")}
+#: the fitted buffer's isotherms (``--isotherm``): the model's option ``isotherm``
+ISOTHERMS = ("linear", "gab")
 VARIANT = "ar1_white:estimate"
 SEED = 2049
 CAL_DAYS = 60
@@ -127,10 +129,14 @@ def replicate(args) -> dict:
     # a deliberately wrong truth (quantity -> factor), to show that the ranking can miss
     shift = args[6] if len(args) > 6 else {}
     variant = args[7] if len(args) > 7 else VARIANT
+    isotherm = args[8] if len(args) > 8 else "linear"
     assert (VOLUME, ACH) == (rooms.VOLUME, rooms.ACH), "the survey differs from the rooms'"
     room = rooms.generate(room_type, [seed, rooms.ROOMS.index(room_type), rep], cal_days,
                           without=without)  # fmt: skip
     name, opts = MODELS[room_type]
+    if isotherm != "linear":
+        opts = {**opts, "isotherm": isotherm}
+        room["truth"] = gab_truth(room)
     fit_model = hb.model(name, **opts).with_slopes(("Pe",))
     U, y = fit_inputs(room, fit_model)
     rows = room["rows"]
@@ -138,12 +144,15 @@ def replicate(args) -> dict:
     if "Tf" in fit_model.input_names:
         tf_fit = float(np.mean(U[rows, fit_model.input_names.index("Tf")]))
     truth = rooms.network_quantities(room_type, room["truth"], room.get("Tf_mean"))
+    if "K_gab" in room["truth"]:
+        truth["K_gab"] = room["truth"]["K_gab"]
     truth = {k: float(v) * shift.get(k, 1.0) for k, v in truth.items()}
     names = fit_model.parameter_names
 
     def extra(dq, theta, _names=names, _tf=tf_fit):
         p = {n: theta[:, j] for j, n in enumerate(_names)}
-        return rooms.network_quantities(room_type, p, _tf)
+        q = rooms.network_quantities(room_type, p, _tf)
+        return q | ({"K_gab": p["K_gab"]} if "K_gab" in p else {})
 
     cellar = room_type == "cellar"
     result = {
@@ -154,6 +163,7 @@ def replicate(args) -> dict:
         "without": sorted(without),
         "truth_shift": shift,
         "variant": variant,
+        "isotherm": isotherm,
         "capacity_means": room["capacity_means"],
         "truth": truth,
         "truth_parameters": room["truth"],
@@ -176,6 +186,28 @@ def replicate(args) -> dict:
         extra,
     )
     return result
+
+
+def gab_truth(room: dict) -> dict:
+    """The truths of a fit with ``isotherm: gab`` (:mod:`heritage_bayes.rc.isotherm`):
+    the buffer's capacity at the humidity ``PHI_REF`` expressed at 15 °C, i.e. at the
+    true RH ``PHI_REF p_sat(15 °C)/p_sat(T_w)`` (the cellar's wall at ``T_w``; the
+    attic's buffer is at its true RH), and the multilayer factor the same scaling makes
+    of the generator's K. The generator's C (5-10) is not the fit's fixed one: ``K_gab``
+    is the generator's K, not the fit's pseudo-true value (a few per cent apart)."""
+    from heritage_bayes.rc.isotherm import PHI_REF
+    from heritage_bayes.rc.sorption import P_REF
+
+    g, t = room["generator"], dict(room["truth"])
+    ps = room.get("wall_psat", P_REF)
+    phi = PHI_REF * P_REF / ps
+    cap = g["M"] * rooms.gab_slope(phi, g["um"], g["C"], g["K"])  # [kg per unit RH]
+    if "Cw" in t:
+        t["Cw"] = cap / ps
+    else:
+        t["Cm"] = cap
+    t["K_gab"] = g["K"] * P_REF / ps
+    return t
 
 
 def misfit(fit_model, room: dict, U: np.ndarray) -> dict:
@@ -472,6 +504,8 @@ def main(argv=None) -> int:
     ap.add_argument("--variant", default=VARIANT, help="the fit: NOISE:INIT[:T=X] "
                     "(bench_sbc.fit_and_rank; T=X a likelihood tempered by X)")  # fmt: skip
     ap.add_argument("--log", help="append each replicate's result as a JSON line")
+    ap.add_argument("--isotherm", default="linear", choices=ISOTHERMS, help="the fitted "
+                    "buffer's isotherm (the models' option; gab: K_gab estimated)")  # fmt: skip
     ap.add_argument("--without", default="", help="parts of the generator left out: "
                     "isotherm, source, noise, outage (coupled_rooms.generate)")  # fmt: skip
     ap.add_argument("--table", nargs="+", metavar="LOG", help="only tabulate logs")
@@ -524,7 +558,17 @@ def main(argv=None) -> int:
         reps = [int(r) for r in args.only.split(",")]
 
     tasks = [
-        (room, rep, args.seed, args.max_steps, args.cal_days, without, {}, args.variant)
+        (
+            room,
+            rep,
+            args.seed,
+            args.max_steps,
+            args.cal_days,
+            without,
+            {},
+            args.variant,
+            args.isotherm,
+        )
         for rep in reps
         for room in room_types
     ]

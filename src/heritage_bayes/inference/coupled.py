@@ -24,7 +24,7 @@ import numpy as np
 from heritage_bayes.inference import likelihoods
 from heritage_bayes.inference.noise_kernels import ar1_predict
 from heritage_bayes.rc import isotherm, sorption
-from heritage_bayes.rc.isotherm import gab_step
+from heritage_bayes.rc.isotherm import gab_constants, gab_step
 from heritage_bayes.rc.sorption import BLOCK, coupled_block
 
 __all__ = ["coupled_filter_stats"]
@@ -52,6 +52,7 @@ def _coupled_kf(kp, ks, sb, slope, dt, x0, yobs, sigma, phi, w, nb, acc):  # pra
     idt = 1.0 / dt
     for p in range(K):
         xp = x0[p, 0]  # the buffer's state a step earlier (the GAB capacity's)
+        gc = gab_constants(kp[p], ks[p] if gab else 0.0)
         s2 = sigma[p] * sigma[p]
         w2 = w[p] * w[p]
         ph = phi[p]
@@ -116,7 +117,7 @@ def _coupled_kf(kp, ks, sb, slope, dt, x0, yobs, sigma, phi, w, nb, acc):  # pra
                         hvv += ev * ev * iF
                     last = k
                 if gab:
-                    m0, m1, m2, m3, f0, f1 = gab_step(kp[p], ks[p], xw, xp, sb, k, dt, idt, slope)
+                    m0, m1, m2, m3, f0, f1 = gab_step(gc, xw, xp, sb, k, dt, idt, slope)
                     xp = xw
                 else:
                     m0, m1, m2, m3, f0, f1 = (

@@ -65,6 +65,8 @@ References
 
 from __future__ import annotations
 
+import math
+
 import numba
 import numpy as np
 
@@ -76,9 +78,9 @@ from heritage_bayes.rc.sorption import (
     N_SERIES,
     P_REF,
     CoupledHygricModel,
-    buffer_constants,
     fill_series,
     step_coefficients,
+    walker_constants,
 )
 
 __all__ = [
@@ -90,6 +92,7 @@ __all__ = [
     "IsothermHygricModel",
     "capacity_factor",
     "gab_capacity_factor",
+    "gab_constants",
     "gab_step",
 ]
 
@@ -136,15 +139,30 @@ def gab_capacity_factor(phi, k) -> np.ndarray:
 
 
 @numba.njit(inline="always", cache=True, nogil=True, error_model="numpy")
-def gab_step(kp, k, xw, xw_prev, sb, j, dt, idt, slope):  # pragma: no cover - compiled
+def gab_constants(kp, k):  # pragma: no cover - compiled
+    """The per-parameter-set constants of :func:`gab_step`: those of
+    :func:`~heritage_bayes.rc.sorption.walker_constants` at the capacity ``kp[0]``
+    [kg/Pa], the multilayer factor ``k`` [-] and ``1 / g(k φ_ref)``."""
+    return walker_constants(kp), k, 1.0 / _shape(k * PHI_REF)
+
+
+@numba.njit(inline="always", cache=True, nogil=True, error_model="numpy")
+def gab_step(gc, xw, xw_prev, sb, j, dt, idt, slope):  # pragma: no cover - compiled
     """:func:`~heritage_bayes.rc.sorption.step_coefficients` of step ``j`` with the
-    buffer's capacity ``kp[0]`` [kg/Pa] scaled by :func:`capacity_factor` at the
-    humidity extrapolated to the step's middle from the states ``xw`` (now) and
-    ``xw_prev`` (a step earlier) [Pa]."""
-    f = capacity_factor((1.5 * xw - 0.5 * xw_prev) * _IREF, k)
-    c = buffer_constants(kp[0] * f, kp)
+    buffer's capacity scaled by :func:`capacity_factor` ``f`` at the humidity
+    extrapolated to the step's middle from the states ``xw`` (now) and ``xw_prev`` (a
+    step earlier) [Pa]; ``gc`` from :func:`gab_constants`. The constants that depend on
+    the capacity scale with ``f^-1/2`` (``Cw^-1/2`` and the buffer's rows of ``S``):
+    one square root and two divisions per step."""
+    c, k, ig0 = gc
+    iw, s2, S22, A11, A12, D, iD, w_s, s_w, gw, gi, gfast, gfs = c
+    f = _shape(k * (1.5 * xw - 0.5 * xw_prev) * _IREF) * ig0
+    isf = 1.0 / math.sqrt(f)
+    if1 = isf * isf
+    cf = (iw * isf, s2, S22, A11 * if1, A12 * isf, D * if1, iD * f, w_s * isf, s_w * f * isf,
+          gw, gi, gfast, gfs)  # fmt: skip
     return step_coefficients(
-        c, sb[2, j], sb[3, j], sb[4, j], sb[5, j], sb[0, j], sb[1, j], sb[6, j], dt, idt, slope
+        cf, sb[2, j], sb[3, j], sb[4, j], sb[5, j], sb[0, j], sb[1, j], sb[6, j], dt, idt, slope
     )
 
 
@@ -161,12 +179,13 @@ def _simulate_gab(kp, ks, U, cols, slope, dt, x, out):  # pragma: no cover - com
         B = min(BLOCK, N - k0)
         fill_series(U, cols, k0, B, sb)
         for p in range(K):
+            gc = gab_constants(kp[p], ks[p])
             xw = x[p, 0]
             xi = x[p, 1]
             xp = prev[p]
             for b in range(B):
                 out[p, k0 + b] = xi
-                m0, m1, m2, m3, f0, f1 = gab_step(kp[p], ks[p], xw, xp, sb, b, dt, idt, slope)
+                m0, m1, m2, m3, f0, f1 = gab_step(gc, xw, xp, sb, b, dt, idt, slope)
                 xp = xw
                 xw, xi = m0 * xw + m1 * xi + f0, m2 * xw + m3 * xi + f1
             x[p, 0] = xw

@@ -438,14 +438,7 @@ def walker_constants(kp):  # pragma: no cover - compiled
     scalings ``iw = Cw^-1/2``, ``s2 = Ci^-1/2``, the symmetric
     ``S = [[A11 r, -A12 sqrt(r)], [-A12 sqrt(r), S22]]`` and its determinant ``r D``
     (``D`` from the conductances, without cancellation)."""
-    return buffer_constants(kp[0], kp)
-
-
-@numba.njit(inline="always", cache=True, nogil=True, error_model="numpy")
-def buffer_constants(cw, kp):  # pragma: no cover - compiled
-    """:func:`walker_constants` with the buffer's capacity ``cw`` [kg/Pa] in place of
-    ``kp[0]`` (a capacity that follows the buffer's state, evaluated per step)."""
-    ci, gw, gi, gfast, gf, sink = kp[1], kp[2], kp[3], kp[4], kp[5], kp[6]
+    cw, ci, gw, gi, gfast, gf, sink = kp[0], kp[1], kp[2], kp[3], kp[4], kp[5], kp[6]
     iw = 1.0 / math.sqrt(cw)
     s2 = 1.0 / math.sqrt(ci)
     S22 = (gi + gfast + gf) * s2 * s2

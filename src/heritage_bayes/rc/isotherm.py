@@ -4,7 +4,7 @@ The coupled hygric models (:mod:`heritage_bayes.rc.sorption`) give the buffer on
 capacity :math:`C_w` [kg/Pa at :math:`T_{ref}`]: a linearised isotherm. Hygroscopic
 materials follow a curved isotherm whose slope :math:`du/d\\varphi` grows towards
 saturation (multilayer sorption, then capillary condensation): over the buffer's
-relative humidities of a cellar wall (0.4-1.0) the slope changes by a factor 2-6. With
+relative humidities of a cellar wall the slope changes severalfold. With
 the option ``isotherm: gab`` the buffer's capacity is that of the
 Guggenheim-Anderson-de Boer (GAB) isotherm [1]_ [2]_,
 
@@ -19,9 +19,8 @@ Guggenheim-Anderson-de Boer (GAB) isotherm [1]_ [2]_,
 (:math:`g(K\\varphi) = du/d\\varphi / (u_m C K)`) with the capacity parameter
 :math:`C_w` (or ``Cm``) its value at the reference humidity :math:`\\varphi_{ref}` =
 :data:`PHI_REF`, the multilayer factor :math:`K` [-] (``K_gab``) the one shape parameter,
-and the energy constant :math:`C` fixed at :data:`GAB_C` (its effect on the slope's shape
-above 40 % RH is small: the normalised slope of C 5-10 is matched by C 8 with a
-refitted K to a few per cent). :math:`K = 0` is the linear model exactly
+and the energy constant :math:`C` fixed at :data:`GAB_C` (above 40 % RH the slope's
+shape is set by K; C moves its low-humidity knee). :math:`K = 0` is the linear model exactly
 (:math:`g(0) = 1`). The buffer's humidity is its state expressed at the reference
 temperature, :math:`\\varphi = P_w / p_{sat}(T_{ref})`: the surface RH of a sorbing
 buffer (``hygric_2c_sorption``); for a vapour-pressure buffer (``hygric_2c_fixed``), at
@@ -39,14 +38,16 @@ The buffer's balance :math:`C_w(\\varphi)\\,\\dot P_w = J` is nonlinear in its s
 Each step is the exact time-varying step of :mod:`heritage_bayes.rc.sorption` with the
 buffer's capacity held at :math:`C_w(\\varphi_{k+1/2})`, the humidity at the step's middle
 extrapolated from the last step, :math:`\\varphi_{k+1/2} = (3 P_{w,k} - P_{w,k-1}) /
-(2 p_{sat}(T_{ref}))` (:math:`P_{w,-1} = P_{w,0}`). **Error bound**: the capacity's
-relative error over a step is :math:`|d\\ln C_w/d\\varphi|` times the error of the
-midpoint humidity, :math:`O(\\Delta\\varphi_k^2)` (the change of the step's curvature),
-plus the variation of the capacity within the step about its middle, whose first
-order cancels; the local error of the state is therefore of second order in the step's
-change of humidity :math:`\\Delta\\varphi_k`, :math:`|e_k| \\le c\\,\\Delta\\varphi_k^2 P_w
-\\max|d^2 \\ln C_w/d\\varphi^2|` with c of order 1, and the global error first order in
-the step length (measured against a fine-step reference in
+(2 p_{sat}(T_{ref}))` (:math:`P_{w,-1} = P_{w,0}`). **Error bound**: with
+:math:`\\Delta\\varphi_k` the step's change of humidity, the held capacity differs from
+the mean the exact solution sees over the step by the extrapolation's error, of order
+:math:`|\\Delta\\varphi_k - \\Delta\\varphi_{k-1}|`, times :math:`\\lambda_1 =
+\\max|d\\ln C_w/d\\varphi|`, plus the capacity's curvature over the step,
+:math:`\\lambda_2 \\Delta\\varphi_k^2` with :math:`\\lambda_2 = \\max|C_w''|/C_w` (its
+first order cancels about the middle); the local error of the humidity is therefore
+:math:`|\\delta\\varphi_k| \\lesssim |\\Delta\\varphi_k|\\,(\\lambda_1 |\\Delta\\varphi_k -
+\\Delta\\varphi_{k-1}| + \\lambda_2 \\Delta\\varphi_k^2)`, of second order in the
+step's change (measured against a fine integration of the ODE in
 docs/science/models.md, "A capacity that follows the humidity"). The transitions now
 depend on the state: they are computed inside the recursion, and the initial state's
 free responses (with which the likelihood integrates it out) are propagated by the

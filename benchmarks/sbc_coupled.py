@@ -68,7 +68,10 @@ IDENTIFIABLE = {
 }
 #: ranked too, for the record: absolute sizes pinned by the survey's priors only, or
 #: quantities the data hardly inform (the cellar's fast mode)
-OTHERS = {"attic": ("Cm", "K_gab"), "cellar": ("tau2_h", "K_gab")}
+OTHERS = {"attic": ("Cm",), "cellar": ("tau2_h",)}
+#: ranked for a fit with ``--isotherm gab`` only: the multilayer factor, whose truth is
+#: the generator's K (its C differs from the fit's fixed one)
+GAB_ONLY = ("K_gab",)
 #: the fitted buffer's isotherms (``--isotherm``): the model's option ``isotherm``
 ISOTHERMS = ("linear", "gab")
 VARIANT = "ar1_white:estimate"
@@ -453,7 +456,7 @@ def table_lines(results: list[dict], markdown: bool = False) -> list[str]:
         if not markdown:
             mis = np.median([r["misfit_Pa"]["sd"] for r in rs])
             lines.append(f"{label}: {cpu:.0f} s CPU per fit; structural misfit sd {mis:.1f} Pa")
-        for q in IDENTIFIABLE[room] + OTHERS[room]:
+        for q in IDENTIFIABLE[room] + OTHERS[room] + GAB_ONLY:
             s = summary(rs, room, q)
             if s is None:
                 continue

@@ -26,7 +26,7 @@ temperature, :math:`\\varphi = P_w / p_{sat}(T_{ref})`: the surface RH of a sorb
 buffer (``hygric_2c_sorption``); for a vapour-pressure buffer (``hygric_2c_fixed``), at
 a temperature :math:`T_w` the model does not know, it is the RH scaled by
 :math:`p_{sat}(T_w)/p_{sat}(T_{ref})`, so that the fitted ``K_gab`` is the material's K
-times :math:`p_{sat}(T_{ref})/p_{sat}(T_w)` (× 1.0-1.4 for a wall at 10-15 °C). The
+times :math:`p_{sat}(T_{ref})/p_{sat}(T_w)` (× 1.0-2.0 for a wall at 5-15 °C). The
 literature's K of wood, lime plaster and brick lies at 0.6-0.9 ([2]_, [3]_); the
 prior (:mod:`heritage_bayes.inference.priors`, kind ``isotherm_shape``) is uniform on
 0-:data:`K_MAX`. ``K φ`` is capped at :data:`X_MAX` (the GAB slope is infinite at
@@ -104,7 +104,7 @@ GAB_C = 8.0
 #: Reference relative humidity [-] at which the capacity parameter is the buffer's.
 PHI_REF = 0.65
 #: Highest admissible multilayer factor ``K_gab`` [-].
-K_MAX = 1.3
+K_MAX = 2.0
 #: Cap on ``K φ`` (the GAB slope diverges at 1).
 X_MAX = 0.97
 _IREF = 1.0 / P_REF

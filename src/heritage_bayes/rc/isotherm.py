@@ -247,26 +247,12 @@ class IsothermHygricModel(CoupledHygricModel):
             )
         super().check_values(P)
 
-    def forward(self, P, U, dt, *, u_init=None, x0=None):
-        """Simulate a batch: outputs (K, N, 1) ``Pi`` [Pa] and validity (K,), by the
-        per-step recursion with the state's capacity (module docstring) from ``x0``
-        (n,) or (K, n) [Pa], or the steady state of ``u_init`` (default ``U[0]``)."""
-        P = np.atleast_2d(np.asarray(P, dtype=float))
-        U = np.ascontiguousarray(U, dtype=float)
-        K = P.shape[0]
-        valid = self.valid_mask(P)
-        kp = self.kernel_parameters(P)
-        ks = np.where(valid, self.shape(P), 0.0)
-        if x0 is None:
-            x = self.steady_state(P, U[0] if u_init is None else np.asarray(u_init, float))
-        else:
-            x = np.broadcast_to(np.asarray(x0, dtype=float), (K, 2))
-        x = np.ascontiguousarray(np.where(np.isfinite(x), x, 0.0))
-        out = np.empty((K, U.shape[0], 1))
+    def _recursion(self, P, kp, U, dt, x, out) -> None:
+        """The per-step recursion with the state's capacity (module docstring):
+        ``out`` (K, N) ``Pi`` [Pa]; invalid parameter sets run as linear buffers."""
+        ks = np.where(self.valid_mask(P), self.shape(P), 0.0)
         cols = self.input_columns()
-        _simulate_gab(kp, ks, U, cols, bool(cols[1] >= 0), float(dt), x, out[:, :, 0])
-        valid &= np.isfinite(out[:, -1, 0]) if U.shape[0] else valid
-        return out, valid
+        _simulate_gab(kp, ks, U, cols, bool(cols[1] >= 0), dt, x, out)
 
 
 sorption.stamp_cache(globals(), sorption, _vecmath)

@@ -51,6 +51,8 @@ from scipy import stats
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import coupled_rooms as rooms  # the generator (no heritage_bayes inside)
+from heritage_bayes.rc.isotherm import gab_capacity_factor
+from heritage_bayes.rc.sorption import P_REF
 
 #: the fitted model of each room type: (catalogue name, options)
 MODELS = {
@@ -67,6 +69,11 @@ IDENTIFIABLE = {
 #: ranked too, for the record: absolute sizes pinned by the survey's priors only, or
 #: quantities the data hardly inform (the cellar's fast mode)
 OTHERS = {"attic": ("Cm",), "cellar": ("tau2_h",)}
+#: ranked for a fit with ``--isotherm gab`` only: the multilayer factor, whose truth is
+#: the generator's K (its C differs from the fit's fixed one)
+GAB_ONLY = ("K_gab",)
+#: the fitted buffer's isotherms (``--isotherm``): the model's option ``isotherm``
+ISOTHERMS = ("linear", "gab")
 VARIANT = "ar1_white:estimate"
 SEED = 2049
 CAL_DAYS = 60
@@ -127,23 +134,36 @@ def replicate(args) -> dict:
     # a deliberately wrong truth (quantity -> factor), to show that the ranking can miss
     shift = args[6] if len(args) > 6 else {}
     variant = args[7] if len(args) > 7 else VARIANT
+    isotherm = args[8] if len(args) > 8 else "linear"
     assert (VOLUME, ACH) == (rooms.VOLUME, rooms.ACH), "the survey differs from the rooms'"
     room = rooms.generate(room_type, [seed, rooms.ROOMS.index(room_type), rep], cal_days,
                           without=without)  # fmt: skip
     name, opts = MODELS[room_type]
+    if isotherm != "linear":
+        opts = {**opts, "isotherm": isotherm}
+        room["truth"] = gab_truth(room)
     fit_model = hb.model(name, **opts).with_slopes(("Pe",))
     U, y = fit_inputs(room, fit_model)
     rows = room["rows"]
+    # a GAB buffer's capacity where it lives: at the record's mean indoor vapour pressure
+    phi_m = float(np.nanmean(y[rows])) / P_REF if isotherm != "linear" else None
     tf_fit = None
     if "Tf" in fit_model.input_names:
         tf_fit = float(np.mean(U[rows, fit_model.input_names.index("Tf")]))
-    truth = rooms.network_quantities(room_type, room["truth"], room.get("Tf_mean"))
+    at = gab_truth(room, phi_m) if phi_m is not None else room["truth"]
+    truth = rooms.network_quantities(room_type, at, room.get("Tf_mean"))
+    if "K_gab" in room["truth"]:
+        truth["K_gab"] = room["truth"]["K_gab"]
     truth = {k: float(v) * shift.get(k, 1.0) for k, v in truth.items()}
     names = fit_model.parameter_names
 
-    def extra(dq, theta, _names=names, _tf=tf_fit):
+    def extra(dq, theta, _names=names, _tf=tf_fit, _phi=phi_m):
         p = {n: theta[:, j] for j, n in enumerate(_names)}
-        return rooms.network_quantities(room_type, p, _tf)
+        if _phi is not None:  # the capacity at the record's mean humidity
+            cap = "Cw" if "Cw" in p else "Cm"
+            p[cap] = p[cap] * gab_capacity_factor(_phi, p["K_gab"])
+        q = rooms.network_quantities(room_type, p, _tf)
+        return q | ({"K_gab": p["K_gab"]} if "K_gab" in p else {})
 
     cellar = room_type == "cellar"
     result = {
@@ -154,6 +174,7 @@ def replicate(args) -> dict:
         "without": sorted(without),
         "truth_shift": shift,
         "variant": variant,
+        "isotherm": isotherm,
         "capacity_means": room["capacity_means"],
         "truth": truth,
         "truth_parameters": room["truth"],
@@ -178,6 +199,28 @@ def replicate(args) -> dict:
     return result
 
 
+def gab_truth(room: dict, phi_ref: float | None = None) -> dict:
+    """The truths of a fit with ``isotherm: gab`` (:mod:`heritage_bayes.rc.isotherm`):
+    the buffer's capacity at the humidity ``phi_ref`` (default the model's ``PHI_REF``)
+    expressed at 15 °C, i.e. at the true RH ``phi_ref p_sat(15 °C)/p_sat(T_w)`` (the
+    cellar's wall at ``T_w``; the attic's buffer is at its true RH), and the
+    multilayer factor the same scaling makes of the generator's K. The generator's C
+    (5-10) is not the fit's fixed one: ``K_gab`` is the generator's K, not the fit's
+    pseudo-true value (a few per cent apart)."""
+    from heritage_bayes.rc.isotherm import PHI_REF
+
+    g, t = room["generator"], dict(room["truth"])
+    ps = room.get("wall_psat", P_REF)
+    phi = (PHI_REF if phi_ref is None else phi_ref) * P_REF / ps
+    cap = g["M"] * rooms.gab_slope(phi, g["um"], g["C"], g["K"])  # [kg per unit RH]
+    if "Cw" in t:
+        t["Cw"] = cap / ps
+    else:
+        t["Cm"] = cap
+    t["K_gab"] = g["K"] * P_REF / ps
+    return t
+
+
 def misfit(fit_model, room: dict, U: np.ndarray) -> dict:
     """The generator's noise-free hourly ``Pi`` against the fitted model run with the
     room's true parameters (the buffer's capacity averaged over the calibration) on the
@@ -186,7 +229,6 @@ def misfit(fit_model, room: dict, U: np.ndarray) -> dict:
     model has to take up: the isotherm's curvature, sub-hourly weather, p_sat
     formulas, and the source when it is on)."""
     import heritage_bayes as hb
-    from heritage_bayes.rc.sorption import P_REF
 
     rows = room["rows"]
     pw = room["start"]["phi_w"] * room.get("wall_psat", P_REF)  # the buffer's state [Pa]
@@ -200,7 +242,9 @@ def misfit(fit_model, room: dict, U: np.ndarray) -> dict:
 def misfit_lines(room_types, reps, seed: int, cal_days: int) -> list[str]:
     """``--misfit``: the structural error (:func:`misfit`, no fit) of rooms ``reps``
     with every part of the generator and with each part left out (the same rooms and
-    draws): medians over the rooms of its |mean|, sd and sd of daily means [Pa]."""
+    draws), for the fitted buffer with each of :data:`ISOTHERMS` (``gab``: the truths of
+    :func:`gab_truth`): medians over the rooms of its |mean|, sd and sd of daily means
+    [Pa], then the sd per room without the source."""
     import heritage_bayes as hb
 
     cases = {
@@ -214,20 +258,62 @@ def misfit_lines(room_types, reps, seed: int, cal_days: int) -> list[str]:
         f"noise-free generator - fitted model with the true parameters, {len(reps)} rooms "
         "each (medians): |mean|, sd, sd of daily means [Pa]"
     ]
+    per_room = []
     for room_type in room_types:
-        name, opts = MODELS[room_type]
-        model = hb.model(name, **opts).with_slopes(("Pe",))
-        for label, without in cases.items():
-            m = []
-            for rep in reps:
-                room = rooms.generate(
-                    room_type, [seed, rooms.ROOMS.index(room_type), rep], cal_days,
-                    without=without,
-                )  # fmt: skip
-                m.append(misfit(model, room, fit_inputs(room, model)[0]))
-            med = [np.median([abs(x[k]) for x in m]) for k in ("mean", "sd", "daily_sd")]
-            lines.append(f"  {room_type:7s} {label:34s} {med[0]:6.1f} {med[1]:6.1f} {med[2]:6.1f}")
-    return lines
+        for iso in ISOTHERMS:
+            name, opts = MODELS[room_type]
+            opts = opts if iso == "linear" else {**opts, "isotherm": iso}
+            model = hb.model(name, **opts).with_slopes(("Pe",))
+            for label, without in cases.items():
+                if iso != "linear" and "isotherm" in without:
+                    continue  # gab_truth is the GAB generator's
+                m = []
+                for rep in reps:
+                    room = rooms.generate(
+                        room_type, [seed, rooms.ROOMS.index(room_type), rep], cal_days,
+                        without=without,
+                    )  # fmt: skip
+                    if iso != "linear":
+                        room["truth"] = gab_truth(room)
+                    m.append(misfit(model, room, fit_inputs(room, model)[0]))
+                    if without == ("source",):
+                        lo, hi = room["phi_w_range"]
+                        per_room.append(
+                            f"  {room_type} {rep:3d} {iso:6s} buffer RH {lo:.2f}-{hi:.2f}: "
+                            f"sd {m[-1]['sd']:5.1f}, mean {m[-1]['mean']:+5.1f} Pa"
+                        )
+                med = [np.median([abs(x[k]) for x in m]) for k in ("mean", "sd", "daily_sd")]
+                lines.append(
+                    f"  {room_type:7s} {iso:6s} {label:34s} {med[0]:6.1f} {med[1]:6.1f} "
+                    f"{med[2]:6.1f}"
+                )
+    return [*lines, "without the source, per room:", *per_room]
+
+
+def shape_lines() -> list[str]:
+    """The fit's GAB slope (C fixed, :data:`heritage_bayes.rc.isotherm.GAB_C`) against
+    the generator's (C 5-10, K 0.72-0.82), both normalised at the reference RH: the
+    least-squares K of the log slopes over RH 0.4-1.0 and the largest relative error."""
+    from scipy.optimize import minimize_scalar
+
+    from heritage_bayes.rc.isotherm import PHI_REF, gab_capacity_factor
+
+    phi = np.linspace(0.4, 1.0, 61)
+    out = []
+    for c in (5.0, 8.0, 10.0):
+        for k in (0.72, 0.77, 0.82):
+            t = rooms.gab_slope(phi, 1.0, c, k) / rooms.gab_slope(PHI_REF, 1.0, c, k)
+
+            def sse(kk, _t=t):
+                return float(np.sum(np.log(gab_capacity_factor(phi, kk) / _t) ** 2))
+
+            best = minimize_scalar(sse, bounds=(0.0, 0.99), method="bounded").x
+            err = np.max(np.abs(gab_capacity_factor(phi, best) / t - 1.0))
+            out.append(
+                f"generator C {c:4.1f} K {k:.2f}: slope {t.min():.2f}-{t.max():.2f} x; "
+                f"fit's K {best:.3f}, largest error {100 * err:.1f} %"
+            )
+    return out
 
 
 def capacity_lines(room_types, reps, seed: int, cal_days: int) -> list[str]:
@@ -242,7 +328,6 @@ def capacity_lines(room_types, reps, seed: int, cal_days: int) -> list[str]:
     from scipy.optimize import minimize_scalar
 
     import heritage_bayes as hb
-    from heritage_bayes.rc.sorption import P_REF
 
     lines = ["room rep: buffer RH range; harmonic / LS, arithmetic / LS; rms at LS [Pa]"]
     for room_type in room_types:
@@ -371,7 +456,7 @@ def table_lines(results: list[dict], markdown: bool = False) -> list[str]:
         if not markdown:
             mis = np.median([r["misfit_Pa"]["sd"] for r in rs])
             lines.append(f"{label}: {cpu:.0f} s CPU per fit; structural misfit sd {mis:.1f} Pa")
-        for q in IDENTIFIABLE[room] + OTHERS[room]:
+        for q in IDENTIFIABLE[room] + OTHERS[room] + GAB_ONLY:
             s = summary(rs, room, q)
             if s is None:
                 continue
@@ -472,6 +557,10 @@ def main(argv=None) -> int:
     ap.add_argument("--variant", default=VARIANT, help="the fit: NOISE:INIT[:T=X] "
                     "(bench_sbc.fit_and_rank; T=X a likelihood tempered by X)")  # fmt: skip
     ap.add_argument("--log", help="append each replicate's result as a JSON line")
+    ap.add_argument("--shape", action="store_true", help="no fit: the fit's GAB slope "
+                    "(C fixed) against the generator's (shape_lines)")  # fmt: skip
+    ap.add_argument("--isotherm", default="linear", choices=ISOTHERMS, help="the fitted "
+                    "buffer's isotherm (the models' option; gab: K_gab estimated)")  # fmt: skip
     ap.add_argument("--without", default="", help="parts of the generator left out: "
                     "isotherm, source, noise, outage (coupled_rooms.generate)")  # fmt: skip
     ap.add_argument("--table", nargs="+", metavar="LOG", help="only tabulate logs")
@@ -507,6 +596,10 @@ def main(argv=None) -> int:
         for line in mean_lines(read_logs(args.means)):
             print(line)
         return 0
+    if args.shape:
+        for line in shape_lines():
+            print(line)
+        return 0
     if args.capacity:
         reps = range(args.first_rep, args.first_rep + args.reps)
         for line in capacity_lines(room_types, reps, args.seed, args.cal_days):
@@ -514,6 +607,7 @@ def main(argv=None) -> int:
         return 0
     if args.misfit:
         reps = range(args.first_rep, args.first_rep + args.reps)
+        reps = [int(r) for r in args.only.split(",")] if args.only else reps
         for line in misfit_lines(room_types, reps, args.seed, args.cal_days):
             print(line, flush=True)
         return 0
@@ -524,7 +618,17 @@ def main(argv=None) -> int:
         reps = [int(r) for r in args.only.split(",")]
 
     tasks = [
-        (room, rep, args.seed, args.max_steps, args.cal_days, without, {}, args.variant)
+        (
+            room,
+            rep,
+            args.seed,
+            args.max_steps,
+            args.cal_days,
+            without,
+            {},
+            args.variant,
+            args.isotherm,
+        )
         for rep in reps
         for room in room_types
     ]

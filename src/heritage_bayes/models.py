@@ -383,7 +383,9 @@ def describe_model(name: str, noise: str = DEFAULT_NOISE) -> str:
             else [
                 "Options (under options:): sink (hygric_2c_fixed: constant | temperature; "
                 "hygric_2c_sorption: none | constant | temperature); a sink at a temperature "
-                "reads Tf, the thermal section's ground temperature (data.ground_temperature)."
+                "reads Tf, the thermal section's ground temperature (data.ground_temperature); "
+                "isotherm (linear | gab: the buffer's capacity follows its humidity along "
+                "the GAB isotherm, K_gab estimated)."
             ]
             if takes_option(name, "sink")
             else []

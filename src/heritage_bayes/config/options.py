@@ -42,7 +42,7 @@ __all__ = [
 ]
 
 #: The options that are the network's (keywords of a catalogue model's factory).
-NETWORK_OPTIONS = ("surfaces", "ground", "heating", "sink")
+NETWORK_OPTIONS = ("surfaces", "ground", "heating", "sink", "isotherm")
 
 
 class ThermostatOptions(_Strict):
@@ -164,6 +164,13 @@ class ModelOptions(_Strict):
         unit=None,
         description="hygric_2c_fixed: constant (default) or temperature (a vapour sink at "
         "phi_f·psat(Tf)); hygric_2c_sorption: none (default), constant or temperature",
+    )
+    isotherm: Literal["linear", "gab"] | None = key(
+        None,
+        unit=None,
+        description="hygric_2c_fixed, hygric_2c_sorption: the buffer's sorption isotherm, "
+        "linear (default: one capacity) or gab (a capacity that follows the buffer's "
+        "humidity, the GAB isotherm's slope with its multilayer factor K_gab estimated)",
     )
     thermostat: ThermostatOptions | None = key(
         None,

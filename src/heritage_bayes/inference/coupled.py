@@ -23,7 +23,8 @@ import numpy as np
 
 from heritage_bayes.inference import likelihoods
 from heritage_bayes.inference.noise_kernels import ar1_predict
-from heritage_bayes.rc import sorption
+from heritage_bayes.rc import isotherm, sorption
+from heritage_bayes.rc.isotherm import gab_constants, gab_step
 from heritage_bayes.rc.sorption import BLOCK, coupled_block
 
 __all__ = ["coupled_filter_stats"]
@@ -32,10 +33,12 @@ _LOG2PI = math.log(2.0 * math.pi)
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath={"contract"})
-def _coupled_kf(kp, sb, slope, dt, x0, yobs, sigma, phi, w, nb, acc):  # pragma: no cover
+def _coupled_kf(kp, ks, sb, slope, dt, x0, yobs, sigma, phi, w, nb, acc):  # pragma: no cover
     """Recursion + residual filter + initial-state statistics of every walker.
 
-    kp (K, 7) kernel parameters; sb, slope: the step series of
+    kp (K, 7) kernel parameters; ks (K,) the buffer's GAB multilayer factors
+    (:func:`heritage_bayes.rc.isotherm.gab_step`, its transitions per step from the
+    state) or an empty array (the linear buffer); sb, slope: the step series of
     :meth:`~heritage_bayes.rc.sorption.CoupledHygricModel.series`; x0 (K, 2) initial
     states [Pa]; yobs (N,) observed ``Pi`` (NaN = excluded); sigma, phi, w (K,) noise
     parameters; nb: 2 (basis of both nodes) or 0; acc (3 + nb + nb², K), zeros, as
@@ -45,7 +48,11 @@ def _coupled_kf(kp, sb, slope, dt, x0, yobs, sigma, phi, w, nb, acc):  # pragma:
     K = kp.shape[0]
     N = sb.shape[1]
     Mf = np.empty((6, BLOCK))
+    gab = ks.size > 0
+    idt = 1.0 / dt
     for p in range(K):
+        xp = x0[p, 0]  # the buffer's state a step earlier (the GAB capacity's)
+        gc = gab_constants(kp[p], ks[p] if gab else 0.0)
         s2 = sigma[p] * sigma[p]
         w2 = w[p] * w[p]
         ph = phi[p]
@@ -72,7 +79,8 @@ def _coupled_kf(kp, sb, slope, dt, x0, yobs, sigma, phi, w, nb, acc):  # pragma:
         alive = nb > 0
         for k0 in range(0, N, BLOCK):
             B = min(BLOCK, N - k0)
-            coupled_block(kp[p], sb, dt, slope, k0, B, Mf)
+            if not gab:
+                coupled_block(kp[p], sb, dt, slope, k0, B, Mf)
             # a free response that has decayed below 1e-280 Pa adds nothing: stop it
             # (else it sticks at the smallest subnormal, 20x slower arithmetic)
             if alive and max(abs(uw), abs(ui), abs(vw), abs(vi), abs(mu), abs(mv)) < 1e-280:
@@ -108,8 +116,19 @@ def _coupled_kf(kp, sb, slope, dt, x0, yobs, sigma, phi, w, nb, acc):  # pragma:
                         hvu += ev * eu * iF
                         hvv += ev * ev * iF
                     last = k
-                m0, m1, m2, m3 = Mf[0, b], Mf[1, b], Mf[2, b], Mf[3, b]
-                xw, xi = m0 * xw + m1 * xi + Mf[4, b], m2 * xw + m3 * xi + Mf[5, b]
+                if gab:
+                    m0, m1, m2, m3, f0, f1 = gab_step(gc, xw, xp, sb, k, dt, idt, slope)
+                    xp = xw
+                else:
+                    m0, m1, m2, m3, f0, f1 = (
+                        Mf[0, b],
+                        Mf[1, b],
+                        Mf[2, b],
+                        Mf[3, b],
+                        Mf[4, b],
+                        Mf[5, b],
+                    )
+                xw, xi = m0 * xw + m1 * xi + f0, m2 * xw + m3 * xi + f1
                 if alive:
                     uw, ui = m0 * uw + m1 * ui, m2 * uw + m3 * ui
                     vw, vi = m0 * vw + m1 * vi, m2 * vw + m3 * vi
@@ -153,8 +172,10 @@ def coupled_filter_stats(model, P, series, x0, Yobs, noise_model, noise, *, basi
     sigma, phi, w = noise_model._split(noise, 0)
     acc = np.zeros((3 + nb + nb * nb, K))
     x = np.ascontiguousarray(np.where(np.isfinite(x0), x0, 0.0))
+    ks = model.shape(P) if getattr(model, "isotherm", "linear") == "gab" else np.empty(0)
     _coupled_kf(
         model.kernel_parameters(P),
+        np.ascontiguousarray(ks, dtype=float),
         *series,
         float(dt),
         x,
@@ -168,4 +189,4 @@ def coupled_filter_stats(model, P, series, x0, Yobs, noise_model, noise, *, basi
     return acc
 
 
-sorption.stamp_cache(globals(), sorption, sorption._vecmath, likelihoods)
+sorption.stamp_cache(globals(), sorption, isotherm, sorption._vecmath, likelihoods)

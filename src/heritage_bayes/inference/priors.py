@@ -200,6 +200,11 @@ _DEFAULTS: dict[tuple[str, str], Prior] = {
     # relative humidity of a vapour sink at a temperature [-]: soil and wet walls sit
     # near saturation
     ("hygric", "saturation"): Prior("uniform", 0.7, 1.0),
+    # multilayer factor K of a buffer's GAB isotherm [-] (heritage_bayes.rc.isotherm):
+    # 0.6-0.9 for wood, lime plaster and brick at the material's temperature, × 1.0-2.0
+    # for a vapour-pressure buffer at 5-15 °C whose humidity is expressed at 15 °C;
+    # 0 is the linear isotherm
+    ("hygric", "isotherm_shape"): Prior("uniform", 0.0, 2.0),
     # control of the air node (heritage_bayes.rc.control): heating set-points [°C] from
     # frost protection to a warm church; heating power [W] from a radiator (1 kW) to a
     # cathedral's plant (10 MW); RH limits [-]; humidistat capacities [kg/s] from a
@@ -246,6 +251,7 @@ FIXED_RANGE = {
     "offset": (-20.0, 20.0, True),
     "sorption_capacity": (0.0, math.inf, False),
     "saturation": (0.0, 1.5, True),
+    "isotherm_shape": (0.0, 2.0, True),
     "sigma": (0.0, math.inf, False),
     "sigma_meas": (0.0, math.inf, False),
     "phi": (-1.0, 1.0, False),

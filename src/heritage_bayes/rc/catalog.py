@@ -40,6 +40,11 @@ vapour pressure [Pa]), output ``Pi``:
   ``temperature``) adds the fixed node of ``hygric_2c_fixed``. Linear time-varying given
   the temperature, simulated by an exact per-step recursion.
 
+Option ``isotherm`` of ``hygric_2c_fixed`` and ``hygric_2c_sorption``: ``linear`` (the
+default, one capacity) or ``gab``, a buffer whose capacity follows its humidity along
+the GAB isotherm's slope, with the multilayer factor ``K_gab`` [-] estimated
+(:mod:`heritage_bayes.rc.isotherm`; ``K_gab = 0`` is the linear buffer).
+
 Each model is one :class:`CatalogModel` entry of :data:`CATALOG` (its network factory,
 description, domain, solar surfaces, place on the model-order ladder, rungs of ``model:
 auto`` and parameter roles), from which the command line, the settings, the ladders and
@@ -76,6 +81,7 @@ from typing import NamedTuple
 from heritage_bayes.climate.ground import GROUND_DEPTH
 from heritage_bayes.rc.control import controlled
 from heritage_bayes.rc.control_spec import Control
+from heritage_bayes.rc.isotherm import ISOTHERMS, IsothermHygricModel
 from heritage_bayes.rc.model import RCModel
 from heritage_bayes.rc.network import GroundCycle, Link, Network, Node, Source
 from heritage_bayes.rc.sorption import CoupledHygricModel, coupled_network
@@ -242,25 +248,36 @@ def _hygric_factory(nodes: str, fixed: bool, name: str) -> Callable[..., Network
     def build() -> Network:
         return _hygric(name, nodes=nodes, fixed=fixed)
 
-    def build_fixed(sink: str = "constant") -> Network | RCModel:
-        if sink == "constant":
+    def build_fixed(sink: str = "constant", isotherm: str = "linear") -> Network | RCModel:
+        _check_isotherm(name, isotherm)
+        if sink == "constant" and isotherm == "linear":
             return _hygric(name, nodes=nodes, fixed=True)
-        if sink != "temperature":
+        if sink not in ("constant", "temperature"):
             raise ValueError(
                 f"model {name!r}: option sink must be 'constant' or 'temperature' (got {sink!r})"
             )
         net = coupled_network(name, sorption=False, outdoor=True, sink=sink)
-        return CoupledHygricModel(net, sorption=False, sink=sink)
+        cls = IsothermHygricModel if isotherm == "gab" else CoupledHygricModel
+        return cls(net, sorption=False, sink=sink)
 
     return build_fixed if fixed else build
 
 
 def _sorption_factory(name: str) -> Callable[..., RCModel]:
-    def build(sink: str = "none") -> RCModel:
+    def build(sink: str = "none", isotherm: str = "linear") -> RCModel:
+        _check_isotherm(name, isotherm)
         net = coupled_network(name, sorption=True, outdoor=False, sink=sink)
-        return CoupledHygricModel(net, sorption=True, sink=sink)
+        cls = IsothermHygricModel if isotherm == "gab" else CoupledHygricModel
+        return cls(net, sorption=True, sink=sink)
 
     return build
+
+
+def _check_isotherm(name: str, isotherm: str) -> None:
+    if isotherm not in ISOTHERMS:
+        raise ValueError(
+            f"model {name!r}: option isotherm must be one of {list(ISOTHERMS)} (got {isotherm!r})"
+        )
 
 
 class CatalogModel(NamedTuple):

@@ -350,10 +350,14 @@ class CoupledHygricModel(RCModel):
             x = np.broadcast_to(np.asarray(x0, dtype=float), (K, 2))
         x = np.ascontiguousarray(np.where(np.isfinite(x), x, 0.0))
         out = np.empty((K, U.shape[0], 1))
-        cols = self.input_columns()
-        _simulate(kp, U, cols, bool(cols[1] >= 0), float(dt), x, out[:, :, 0])
+        self._recursion(P, kp, U, float(dt), x, out[:, :, 0])
         valid &= np.isfinite(out[:, -1, 0]) if U.shape[0] else valid
         return out, valid
+
+    def _recursion(self, P, kp, U, dt, x, out) -> None:
+        """Run the compiled recursion of :meth:`forward`: ``out`` (K, N) ``Pi`` [Pa]."""
+        cols = self.input_columns()
+        _simulate(kp, U, cols, bool(cols[1] >= 0), dt, x, out)
 
 
 #: Kernel parameters of an invalid walker (a harmless stable network).

@@ -1,0 +1,138 @@
+"""A buffer whose capacity follows its humidity (``rc.isotherm``, option ``isotherm:
+gab``): the GAB slope, its linear limit, the recursion against a fine integration."""
+
+import numpy as np
+import pytest
+from scipy.integrate import quad, solve_ivp
+from scipy.optimize import brentq
+
+import heritage_bayes as hb
+from heritage_bayes.climate.psychro import saturation_vapour_pressure as psat
+from heritage_bayes.inference.likelihoods import get_noise_model
+from heritage_bayes.inference.parameters import parameters_for
+from heritage_bayes.inference.posterior import LogPosterior
+from heritage_bayes.rc.isotherm import GAB_C, PHI_REF, gab_capacity_factor
+from heritage_bayes.rc.sorption import P_REF, CoupledHygricModel
+
+DT = 3600.0
+CELLAR = dict(Cw=0.3, Ci=0.03, Gw=2e-8, Gi=8e-7, Gfast=4e-7, Gf=3e-8, phi_f=0.9)
+
+
+def _gab(phi, k, c=GAB_C):
+    """GAB moisture content per unit monolayer content (Anderson 1946)."""
+    x = k * phi
+    return c * x / ((1 - x) * (1 - x + c * x))
+
+
+def _inputs(N, seed=0):
+    rng = np.random.default_rng(seed)
+    t = np.arange(N)
+    pe = 1100 + 250 * np.sin(2 * np.pi * t / 24) + np.cumsum(rng.normal(0, 15, N))
+    tf = 10 + 2 * np.sin(2 * np.pi * t / 700)
+    return np.column_stack([pe, np.r_[np.diff(pe), 0.0], tf])
+
+
+def test_the_capacity_is_the_gab_isotherm_slope():
+    """C_w(φ)/C_w is du/dφ of the GAB isotherm (a central difference of u) over its value
+    at the reference RH; 1 at K = 0 and at the reference RH."""
+    phi = np.linspace(0.3, 1.0, 15)
+    for k in (0.6, 0.75, 0.9):
+        h = 1e-6
+        slope = (_gab(phi + h, k) - _gab(phi - h, k)) / (2 * h)
+        ref = (_gab(PHI_REF + h, k) - _gab(PHI_REF - h, k)) / (2 * h)
+        np.testing.assert_allclose(gab_capacity_factor(phi, k), slope / ref, rtol=1e-7)
+    assert np.all(gab_capacity_factor(phi, 0.0) == 1.0)
+    assert gab_capacity_factor(PHI_REF, 0.8) == pytest.approx(1.0, rel=1e-14)
+
+
+def test_a_closed_buffer_and_air_reach_the_gab_equilibrium():
+    """A buffer and the air with (almost) no other exchange: the moisture of both
+    (buffer along the GAB isotherm, the air's Ci·Pi) is conserved, so the equilibrium
+    is where the isotherm puts it (to 1e-3 of the change of the buffer's RH)."""
+    k = 0.8
+    m = hb.model("hygric_2c_fixed", sink="constant", isotherm="gab")
+    p = dict(Cw=0.2, Ci=0.15, Gw=0.0, Gi=3e-7, Gfast=1e-16, Gf=0.0, Pf=0.0, K_gab=k)
+    x0 = np.array([0.5 * P_REF, 0.95 * P_REF])  # the buffer at 50 %, the air at 95 %
+    N = 3000
+    U = np.full((N, 1), 0.95 * P_REF)
+    Y, valid = m.forward(np.array([[p[n] for n in m.parameter_names]]), U, DT, x0=x0)
+    assert valid[0]
+
+    def moisture(phi_w, pi):  # [kg], up to a constant
+        buf = p["Cw"] * P_REF * quad(lambda f: gab_capacity_factor(f, k), 0.5, phi_w)[0]
+        return buf + p["Ci"] * pi
+
+    total = moisture(0.5, x0[1])
+    eq = brentq(lambda f: moisture(f, f * P_REF) - total, 0.5, 0.95)
+    assert Y[0, -1, 0] / P_REF == pytest.approx(eq, abs=1e-3 * (0.95 - 0.5))
+    # the linear buffer's equilibrium differs by far more
+    lin = (0.2 * P_REF * 0.5 + 0.15 * x0[1]) / (0.2 * P_REF + 0.15 * P_REF)
+    assert abs(lin - eq) > 0.01
+
+
+def test_the_linear_limit_is_todays_model():
+    """K_gab = 0: the simulation and the log-likelihood (initial state integrated out) of
+    today's model to rounding; the default ``isotherm`` builds today's model."""
+    N = 1200
+    U = _inputs(N)
+    rng = np.random.default_rng(3)
+    obs = hb.simulate(hb.model("hygric_2c_fixed", sink="temperature"), CELLAR, U[:, [0, 2]], DT)
+    obs = obs[:, 0] + rng.normal(0, 20, N)
+    obs[300:350] = np.nan
+    lin = hb.model("hygric_2c_fixed", sink="temperature").with_slopes(["Pe"])
+    gab = hb.model("hygric_2c_fixed", sink="temperature", isotherm="gab").with_slopes(["Pe"])
+    assert type(lin) is CoupledHygricModel
+    assert type(hb.model("hygric_2c_fixed", sink="temperature", isotherm="linear")) is type(
+        hb.model("hygric_2c_fixed", sink="temperature")
+    )
+    P = np.array([[CELLAR[n] for n in lin.parameter_names]])
+    Pg = np.column_stack([P, [0.0]])
+    np.testing.assert_allclose(gab.forward(Pg, U, DT)[0], lin.forward(P, U, DT)[0], rtol=1e-12)
+    nm = get_noise_model("ar1_white")
+    kw = dict(warmup=0, init_window=48, initial_state="estimate")
+    lp = LogPosterior(lin, parameters_for(lin, nm), nm, U, obs, **kw)
+    lpg = LogPosterior(gab, parameters_for(gab, nm), nm, U, obs, **kw)
+    noise = [[20.0, 0.5, 5.0]]
+    np.testing.assert_allclose(
+        lpg.log_likelihood(np.column_stack([Pg, noise])),
+        lp.log_likelihood(np.column_stack([P, noise])),
+        rtol=1e-10,
+    )
+    with pytest.raises(ValueError, match="isotherm: Input should be 'linear' or 'gab'"):
+        hb.model("hygric_2c_sorption", isotherm="bet")
+
+
+def _fine(p, U, x0, k):
+    """Pi at every step's start by one solve_ivp of the nonlinear ODE over the record
+    (Pe linear within a step, Tf held): the buffer's capacity C_w(P_w / p_sat(T_ref))."""
+    sink = p["phi_f"] * psat(U[:, 2])
+
+    def f(t, x):
+        j = min(int(t // DT), U.shape[0] - 1)
+        u = U[j, 0] + U[j, 1] * (t / DT - j - 0.5)
+        cw = p["Cw"] * gab_capacity_factor(x[0] / P_REF, k)
+        fw = p["Gi"] * (x[1] - x[0]) + p["Gw"] * (u - x[0])
+        fi = p["Gfast"] * (u - x[1]) + p["Gi"] * (x[0] - x[1]) + p["Gf"] * (sink[j] - x[1])
+        return [fw / cw, fi / p["Ci"]]
+
+    t = np.arange(U.shape[0]) * DT
+    s = solve_ivp(f, (0, t[-1]), x0, t_eval=t, rtol=1e-10, atol=1e-6, max_step=DT / 8)
+    return s.y
+
+
+def test_recursion_error_against_a_fine_integration():
+    """Hourly steps of a fast buffer (τ about 10 h) whose capacity changes by a factor
+    of more than 1.5 along its path: within 0.1 Pa of the ODE's solution over swings of
+    more than 200 Pa."""
+    N = 200
+    U = _inputs(N, seed=5)
+    p = dict(CELLAR, Cw=0.05, Gi=1.5e-6)
+    k = 0.95
+    m = hb.model("hygric_2c_fixed", sink="temperature", isotherm="gab").with_slopes(["Pe"])
+    x0 = [0.6 * P_REF, 1000.0]
+    Y, valid = m.forward(np.array([[*[p[n] for n in m.parameter_names[:-1]], k]]), U, DT, x0=x0)
+    pw, ref = _fine(p, U, x0, k)
+    assert valid[0]
+    cap = gab_capacity_factor(pw / P_REF, k)
+    assert cap.max() / cap.min() > 1.5 and np.ptp(ref) > 200
+    assert np.max(np.abs(Y[0, :, 0] - ref)) < 0.1

@@ -448,6 +448,10 @@ def test_a_registered_family_is_projected_with_its_numpy_compute(setup):
     np.testing.assert_allclose(base.annual_parametric[..., -1], per_year, rtol=1e-9)
     np.testing.assert_allclose(only.parametric["toy_rh_mean"], RHs.mean(axis=1) + 1.0, rtol=1e-9)
     assert list(only.parametric.columns) == ["toy_rh_mean", "toy_t_max"]
+    # without the mould family no isopleth: no per-year column left without its name (the
+    # NetCDF writer reads every per-year column's unit by its name)
+    assert not any(n.startswith("hours_above_LIM") for n in only.annual_names)
+    assert only.annual_predictive.shape[-1] == len(only.annual_names)
     entry = summary["indicators"]["toy_rh_mean"]
     assert entry["unit"] == "%" and entry["change"]["warm"]["q50"] < 0  # warmer: drier
     split = summary["uncertainty_split"]["baseline"]["indicators"]["toy_rh_mean"]

@@ -154,6 +154,9 @@ class CaseOut:
             names = tuple(lim[0] if n == "hours_above_LIM" and lim else n for n in names)
         extra = c.numpy.columns if c.numpy else ()
         names += c.numpy.annual_columns if c.numpy else ()
+        # without the mould family there is no isopleth: its per-year column is not one
+        keep = [j for j, n in enumerate(names) if n != "hours_above_LIM"]
+        names = tuple(names[j] for j in keep)
         frames = []
         for vals, ann, xs in (
             (self.pred, self.apred, self.xpred),
@@ -175,8 +178,8 @@ class CaseOut:
             Ti_month=self.Tm,
             RHi_month=self.RHm,
             seconds=self.seconds,
-            annual_predictive=self.apred,
-            annual_parametric=self.apar,
+            annual_predictive=self.apred[..., keep],
+            annual_parametric=self.apar[..., keep],
             annual_names=names,
             costs=pd.DataFrame(
                 {} if measure is None else measure.costs(self.cost, dt, years),

@@ -554,18 +554,21 @@ def test_several_baseline_years_give_a_weather_year_share(run_dir, tmp_path):
 
 
 # ------------------------------------------------------------------ decisions first
-def test_degenerate_indicators_are_said_once_and_get_no_shares(proj):
+def test_degenerate_indicators_are_said_once_and_get_no_shares(run_dir, tmp_path, monkeypatch):
     """An indicator constant in every draw and case (here the EN 15757 band's offsets,
-    fixed by construction) is flagged, named once in the verdict at the top, and has no
-    row in the decision or variance-share tables; decompose() gives it no shares even
-    when rounding leaves a variance of 1e-30 (the "1250 %" of a 300-draw run)."""
+    held at a minimum band wider than the tiny room's fluctuations) is flagged, named once
+    in the verdict at the top, and has no row in the decision or variance-share tables;
+    decompose() gives it no shares even when rounding leaves a variance of 1e-30 (the "1250 %" of a 300-draw run)."""
     import html as html_mod
     import re
 
     from heritage_bayes.climate.risk.registry import indicator_info
+    from heritage_bayes.climate.risk.standards import en15757_band
     from heritage_bayes.projection.summary import decompose
 
-    p, out = proj
+    monkeypatch.setitem(en15757_band.__kwdefaults__, "min_band", 15.0)  # the option's default
+    out = tmp_path / "p"
+    p = project(run_dir, PROJ, out=out)
     s = json.loads((out / "projection.json").read_text())
     const = [n for n, e in s["indicators"].items() if e["degenerate"]]
     assert const, "the fixture has constant indicators (the EN 15757 offsets)"

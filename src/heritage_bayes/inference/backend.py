@@ -57,6 +57,7 @@ class _Saved:
     stride: int = 1  # steps per stored row (a thinned chain)
     steps: int | None = None  # steps of the chain (None: one per row)
     last: tuple | None = None  # (positions, log-probabilities) of its last step
+    internal: np.ndarray | None = None  # the last step in the sampler's own coordinates
 
 
 class _Checkpoint:
@@ -113,7 +114,10 @@ class _Checkpoint:
         :class:`heritage_bayes.inference.monitor.ChainBuffer`) also commits its length
         ``steps`` and ``last`` = (positions (walkers, d), log-probabilities (walkers,))
         of its last step, where ``--resume`` continues (the last step is not always a
-        stored row); at stride 1 the commit record is as before."""
+        stored row); at stride 1 the commit record is as before. ``internal``
+        (walkers, d): the last step's positions in the sampler's own coordinates when
+        they are not the stored ones (a transform whose round trip is exact only to
+        rounding), so that a resumed chain continues bit for bit."""
         from heritage_bayes.inference.results import ensure_free_space
 
         chunk = 64 * int(np.prod(chain.shape[1:])) * 8  # one HDF5 chunk [bytes]
@@ -138,6 +142,8 @@ class _Checkpoint:
                 ],
                 "tau_history": np.asarray(tau_history, dtype=float).reshape(-1, 2).tolist(),
             }
+            if thinned.get("internal") is not None:
+                commit["internal"] = np.asarray(thinned["internal"], dtype=float).tolist()
             if thinned.get("stride", 1) > 1:
                 commit["stride"] = int(thinned["stride"])
                 commit["steps"] = int(thinned["steps"])
@@ -229,7 +235,7 @@ class _Checkpoint:
                 )
             problem = None
             rs = None
-            stride, steps, last = 1, None, None
+            stride, steps, last, internal = 1, None, None, None
             try:
                 if "commit" in f.attrs:
                     c = json.loads(f.attrs["commit"])
@@ -246,6 +252,8 @@ class _Checkpoint:
                     hist = [tuple(r) for r in c["tau_history"]]
                     stride, steps = int(c.get("stride", 1)), c.get("steps")
                     last = c.get("last")
+                    if c.get("internal") is not None:
+                        internal = np.asarray(c["internal"], dtype=float)
                     if last is not None:
                         last = (np.asarray(last[0], dtype=float), np.asarray(last[1], dtype=float))
                 else:  # format 1 (before the commit attribute)
@@ -274,12 +282,21 @@ class _Checkpoint:
             problem = (
                 f"steps {bad} to {n} are damaged; kept the {chain.shape[0]} valid steps before them"
             )
-            rs = None  # the saved random state belongs to the end of the damaged part
+            rs = internal = None  # the saved state belongs to the end of the damaged part
             # a thinned chain continues from its last valid row
             steps = chain.shape[0] * stride
             last = (chain[-1], lp[-1]) if chain.shape[0] else None
         return _Saved(
-            chain, lp, accepted, rs, hist[: max(0, len(hist))], problem, stride, steps, last
+            chain,
+            lp,
+            accepted,
+            rs,
+            hist[: max(0, len(hist))],
+            problem,
+            stride,
+            steps,
+            last,
+            internal,
         )
 
 

@@ -77,6 +77,7 @@ from heritage_bayes.inference.monitor import (
     make_moves,
 )
 from heritage_bayes.inference.moves import refit_moves
+from heritage_bayes.inference.scale import with_scale_redraw
 from heritage_bayes.inference.start import laplace_ensemble
 from heritage_bayes.names import DEFAULT_MOVE
 from heritage_bayes.rundir.signals import DeferSignals
@@ -88,10 +89,6 @@ __all__ = [
     "run_sampler",
     "start_ensemble",
 ]
-
-
-#: Share of the steps that redraw the scale coordinate of a scale line.
-SCALE_REDRAW_WEIGHT = 0.1
 
 
 def start_ensemble(
@@ -294,7 +291,7 @@ def _run_sampler(
     """
     nwalkers, d = _walkers(x_map, nwalkers, max_rows, tau_discard)
     target = logpost if coordinates is None else coordinates
-    move_list = _with_scale_redraw(make_moves(moves, block, block_weight), coordinates)
+    move_list = with_scale_redraw(make_moves(moves, block, block_weight), coordinates)
     c = _Chain(
         emcee.EnsembleSampler(nwalkers, d, target, vectorize=True, moves=move_list),
         move_list,
@@ -377,19 +374,6 @@ def _run_sampler(
     return result
 
 
-def _with_scale_redraw(move_list: list, coordinates) -> list:
-    """The moves, plus the independence redraw of the scale coordinate
-    (:class:`~heritage_bayes.inference.scale.ScaleRedraw`, a share
-    :data:`SCALE_REDRAW_WEIGHT` of the steps) when the coordinates have one."""
-    index = getattr(coordinates, "index", None) if hasattr(coordinates, "spread") else None
-    if index is None:
-        return move_list
-    from heritage_bayes.inference.scale import ScaleRedraw
-
-    rest = 1.0 - SCALE_REDRAW_WEIGHT
-    return [(m, w * rest) for m, w in move_list] + [(ScaleRedraw(index), SCALE_REDRAW_WEIGHT)]
-
-
 def _walkers(x_map, nwalkers: int | None, max_rows: int | None, tau_discard: float):
     """(walkers, dimensions) of a chain, its settings checked (see :func:`_run_sampler`)."""
     if max_rows is not None and max_rows < 2:
@@ -432,6 +416,11 @@ class _Chain:
 
     def to_y(self, a: np.ndarray) -> np.ndarray:
         return a if self.coordinates is None else self.coordinates.to_y(a)
+
+    def internal(self, y_last: np.ndarray) -> dict:
+        """The last step in emcee's coordinates for the checkpoint (a resume starts
+        there; the stored positions' round trip is exact only to rounding)."""
+        return {} if self.coordinates is None else {"internal": np.array(y_last, dtype=float)}
 
 
 @dataclass(frozen=True)
@@ -509,8 +498,9 @@ def _resume(c: _Chain, seed: int, notice) -> None:
     c.buf = ChainBuffer(nwalkers, d, stride=saved.stride)
     c.buf.load(saved.chain, saved.log_prob, done)
     x_last, lp_last = saved.last or (c.buf.chain[-1], c.buf.log_prob[-1])
+    y_last = saved.internal if saved.internal is not None else c.to_y(x_last)
     del saved
-    c.state = emcee.State(c.to_y(x_last), log_prob=lp_last, random_state=rs)
+    c.state = emcee.State(y_last, log_prob=lp_last, random_state=rs)
     c.sampler.random_state = rs
 
 
@@ -562,6 +552,7 @@ def _chunk(c: _Chain, n: int, check_every: int, sig):
                 sampler.backend.random_state,
                 c.tau_hist,
                 **_thinned(c.buf, x[-1], lp[-1]),
+                **c.internal(sampler.get_chain()[-1]),
             )
         raise KeyboardInterrupt from None
     x, lp = c.to_x(sampler.get_chain()), sampler.get_log_prob()
@@ -588,7 +579,7 @@ def _bound_rows(buf: ChainBuffer, max_rows: int | None, tau_hist: list) -> bool:
 
 def _save_chunk(c: _Chain, x, lp, rows, halved: bool) -> None:
     """Checkpoint a chunk: its rows appended, or the whole buffer rewritten once thinned."""
-    thinned = _thinned(c.buf, x[-1], lp[-1])
+    thinned = _thinned(c.buf, x[-1], lp[-1]) | c.internal(c.state.coords)
     rs = c.state.random_state
     if halved:
         c.ck.rewrite(c.buf.chain, c.buf.log_prob, c.accepted, rs, c.tau_hist, **thinned)

@@ -56,7 +56,15 @@ import emcee
 import numpy as np
 from scipy.special import expit
 
-__all__ = ["SCALE_KINDS", "ScaleLine", "ScaleRedraw", "scale_direction", "scale_line"]
+__all__ = [
+    "SCALE_KINDS",
+    "SCALE_REDRAW_WEIGHT",
+    "ScaleLine",
+    "ScaleRedraw",
+    "scale_direction",
+    "scale_line",
+    "with_scale_redraw",
+]
 
 #: Parameter kinds scaled together by the symmetry (those carrying J/K, W/K, m², W or
 #: their hygric counterparts).
@@ -264,3 +272,18 @@ class ScaleRedraw(emcee.moves.MHMove):
         q[:, self.index] = np.log(u) - np.log1p(-u)
         old, new = coords[:, self.index], q[:, self.index]
         return q, self._log_logistic(old) - self._log_logistic(new)
+
+
+#: Share of the steps that redraw the scale coordinate of a scale line.
+SCALE_REDRAW_WEIGHT = 0.1
+
+
+def with_scale_redraw(move_list: list, coordinates) -> list:
+    """The moves ``[(move, weight), ...]``, plus the independence redraw of the scale
+    coordinate (:class:`ScaleRedraw`, a share :data:`SCALE_REDRAW_WEIGHT` of the steps)
+    when the coordinates are a :class:`ScaleLine`."""
+    index = getattr(coordinates, "index", None) if hasattr(coordinates, "spread") else None
+    if index is None:
+        return move_list
+    rest = 1.0 - SCALE_REDRAW_WEIGHT
+    return [(m, w * rest) for m, w in move_list] + [(ScaleRedraw(index), SCALE_REDRAW_WEIGHT)]

@@ -558,7 +558,8 @@ def test_degenerate_indicators_are_said_once_and_get_no_shares(run_dir, tmp_path
     """An indicator constant in every draw and case (here the EN 15757 band's offsets,
     held at a minimum band wider than the tiny room's fluctuations) is flagged, named once
     in the verdict at the top, and has no row in the decision or variance-share tables;
-    decompose() gives it no shares even when rounding leaves a variance of 1e-30 (the "1250 %" of a 300-draw run)."""
+    decompose() gives it no shares even when rounding leaves a variance of 1e-30 (the
+    "1250 %" of a 300-draw run)."""
     import html as html_mod
     import re
 

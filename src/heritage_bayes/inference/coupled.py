@@ -172,7 +172,7 @@ def coupled_filter_stats(model, P, series, x0, Yobs, noise_model, noise, *, basi
     sigma, phi, w = noise_model._split(noise, 0)
     acc = np.zeros((3 + nb + nb * nb, K))
     x = np.ascontiguousarray(np.where(np.isfinite(x0), x0, 0.0))
-    ks = model.shape(P) if getattr(model, "isotherm", "linear") == "gab" else np.empty(0)
+    ks = model.shape(P) if model.isotherm == "gab" else np.empty(0)
     _coupled_kf(
         model.kernel_parameters(P),
         np.ascontiguousarray(ks, dtype=float),

@@ -282,8 +282,8 @@ def with_scale_redraw(move_list: list, coordinates) -> list:
     """The moves ``[(move, weight), ...]``, plus the independence redraw of the scale
     coordinate (:class:`ScaleRedraw`, a share :data:`SCALE_REDRAW_WEIGHT` of the steps)
     when the coordinates are a :class:`ScaleLine`."""
-    index = getattr(coordinates, "index", None) if hasattr(coordinates, "spread") else None
-    if index is None:
+    if not isinstance(coordinates, ScaleLine):
         return move_list
     rest = 1.0 - SCALE_REDRAW_WEIGHT
-    return [(m, w * rest) for m, w in move_list] + [(ScaleRedraw(index), SCALE_REDRAW_WEIGHT)]
+    redraw = ScaleRedraw(coordinates.index)
+    return [(m, w * rest) for m, w in move_list] + [(redraw, SCALE_REDRAW_WEIGHT)]

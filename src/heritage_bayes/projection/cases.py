@@ -148,15 +148,13 @@ class CaseOut:
         from heritage_bayes.climate.risk.registry import indicator_info
         from heritage_bayes.projection._stream import A_BAND, ANNUAL
 
-        names = tuple(ANNUAL)
-        if "hours_above_LIM" in names:  # the isopleth's own column name
-            lim = [n for n in c.plan.columns if n.startswith("hours_above_LIM")]
-            names = tuple(lim[0] if n == "hours_above_LIM" and lim else n for n in names)
         extra = c.numpy.columns if c.numpy else ()
-        names += c.numpy.annual_columns if c.numpy else ()
-        # without the mould family there is no isopleth: its per-year column is not one
-        keep = [j for j, n in enumerate(names) if n != "hours_above_LIM"]
-        names = tuple(names[j] for j in keep)
+        names = tuple(ANNUAL) + (c.numpy.annual_columns if c.numpy else ())
+        # the isopleth's per-year column takes its own name; without the mould family
+        # there is no isopleth, and no column
+        lim = [n for n in c.plan.columns if n.startswith("hours_above_LIM")]
+        keep = [j for j, n in enumerate(names) if n != "hours_above_LIM" or lim]
+        names = tuple(lim[0] if names[j] == "hours_above_LIM" else names[j] for j in keep)
         frames = []
         for vals, ann, xs in (
             (self.pred, self.apred, self.xpred),

@@ -170,6 +170,8 @@ class CoupledHygricModel(RCModel):
 
     #: The simulator is linear in the state but time-varying: no constant modal form.
     time_varying = True
+    #: The buffer's isotherm (:data:`heritage_bayes.rc.isotherm.ISOTHERMS`): one capacity.
+    isotherm = "linear"
 
     def __init__(self, network: Network, *, sorption: bool, sink: str):
         super().__init__(network)

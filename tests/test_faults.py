@@ -635,12 +635,19 @@ def runs(tmp_path_factory):
     # damaged copies of the checkpoint saved by an interrupt during sampling
     snap = res["sampling-SIGINT"]["snap"]
 
+    # damaged before any thread forks: HDF5 locks the file it opens (flock), and a
+    # child forked by another thread holds that lock until it closes its inherited
+    # descriptors, so opening it again for writing in that window fails (EAGAIN)
+    prefixes = {}
+    for name in DAMAGE:
+        path = root / f"damaged-{name}" / ".run.partial" / "chain_thermal.h5"
+        shutil.copytree(snap, path.parent)
+        prefixes[name] = _committed(path)
+        DAMAGE[name](path)
+
     def damaged(name):
         d = root / f"damaged-{name}"
-        shutil.copytree(snap, d / ".run.partial")
-        path = d / ".run.partial" / "chain_thermal.h5"
-        prefix = _committed(path)
-        DAMAGE[name](path)
+        prefix = prefixes[name]
         c = cfg
         if name == "other-data":
             c = _write(d / "other.yaml", _tiny(**{"data.demo": {"seed": 8}}))

@@ -24,7 +24,7 @@ import numpy as np
 from heritage_bayes.inference import likelihoods
 from heritage_bayes.inference.noise_kernels import ar1_predict
 from heritage_bayes.rc import isotherm, sorption
-from heritage_bayes.rc.isotherm import gab_constants, gab_step
+from heritage_bayes.rc.isotherm import N_CELLS, ROW, gab_block, table_constants
 from heritage_bayes.rc.sorption import BLOCK, coupled_block
 
 __all__ = ["coupled_filter_stats"]
@@ -37,8 +37,8 @@ def _coupled_kf(kp, ks, sb, slope, dt, x0, yobs, sigma, phi, w, nb, acc):  # pra
     """Recursion + residual filter + initial-state statistics of every walker.
 
     kp (K, 7) kernel parameters; ks (K,) the buffer's GAB multilayer factors
-    (:func:`heritage_bayes.rc.isotherm.gab_step`, its transitions per step from the
-    state) or an empty array (the linear buffer); sb, slope: the step series of
+    (:func:`heritage_bayes.rc.isotherm.gab_block`, its transitions per step from the
+    state; 0: the linear buffer) or an empty array; sb, slope: the step series of
     :meth:`~heritage_bayes.rc.sorption.CoupledHygricModel.series`; x0 (K, 2) initial
     states [Pa]; yobs (N,) observed ``Pi`` (NaN = excluded); sigma, phi, w (K,) noise
     parameters; nb: 2 (basis of both nodes) or 0; acc (3 + nb + nb², K), zeros, as
@@ -48,11 +48,15 @@ def _coupled_kf(kp, ks, sb, slope, dt, x0, yobs, sigma, phi, w, nb, acc):  # pra
     K = kp.shape[0]
     N = sb.shape[1]
     Mf = np.empty((6, BLOCK))
-    gab = ks.size > 0
-    idt = 1.0 / dt
+    tab = np.empty((N_CELLS, ROW))  # reserved, its rows written when first reached
+    built = np.zeros(N_CELLS, dtype=np.bool_)
+    st = np.empty(3)  # the GAB buffer's recursion: Pw, Pi, Pw a step earlier
+    scratch = np.empty(BLOCK)
     for p in range(K):
-        xp = x0[p, 0]  # the buffer's state a step earlier (the GAB capacity's)
-        gc = gab_constants(kp[p], ks[p] if gab else 0.0)
+        gab = ks.size > 0 and ks[p] > 0.0
+        tc = table_constants(kp[p], ks[p] if gab else 0.0)
+        built[:] = False
+        st[0], st[1], st[2] = x0[p, 0], x0[p, 1], x0[p, 0]
         s2 = sigma[p] * sigma[p]
         w2 = w[p] * w[p]
         ph = phi[p]
@@ -79,7 +83,9 @@ def _coupled_kf(kp, ks, sb, slope, dt, x0, yobs, sigma, phi, w, nb, acc):  # pra
         alive = nb > 0
         for k0 in range(0, N, BLOCK):
             B = min(BLOCK, N - k0)
-            if not gab:
+            if gab:
+                gab_block(tc, tab, built, sb[:, k0:], B, dt, slope, st, Mf, scratch)
+            else:
                 coupled_block(kp[p], sb, dt, slope, k0, B, Mf)
             # a free response that has decayed below 1e-280 Pa adds nothing: stop it
             # (else it sticks at the smallest subnormal, 20x slower arithmetic)
@@ -116,18 +122,7 @@ def _coupled_kf(kp, ks, sb, slope, dt, x0, yobs, sigma, phi, w, nb, acc):  # pra
                         hvu += ev * eu * iF
                         hvv += ev * ev * iF
                     last = k
-                if gab:
-                    m0, m1, m2, m3, f0, f1 = gab_step(gc, xw, xp, sb, k, dt, idt, slope)
-                    xp = xw
-                else:
-                    m0, m1, m2, m3, f0, f1 = (
-                        Mf[0, b],
-                        Mf[1, b],
-                        Mf[2, b],
-                        Mf[3, b],
-                        Mf[4, b],
-                        Mf[5, b],
-                    )
+                m0, m1, m2, m3, f0, f1 = Mf[0, b], Mf[1, b], Mf[2, b], Mf[3, b], Mf[4, b], Mf[5, b]
                 xw, xi = m0 * xw + m1 * xi + f0, m2 * xw + m3 * xi + f1
                 if alive:
                     uw, ui = m0 * uw + m1 * ui, m2 * uw + m3 * ui

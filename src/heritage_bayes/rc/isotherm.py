@@ -72,6 +72,7 @@ import numba
 import numpy as np
 
 from heritage_bayes.climate import _vecmath
+from heritage_bayes.climate._vecmath import _as_double, _as_int
 from heritage_bayes.rc import sorption
 from heritage_bayes.rc.network import Network, ParameterInfo
 from heritage_bayes.rc.sorption import (
@@ -79,6 +80,8 @@ from heritage_bayes.rc.sorption import (
     N_SERIES,
     P_REF,
     CoupledHygricModel,
+    _gains,
+    coupled_block,
     fill_series,
     step_coefficients,
     walker_constants,
@@ -108,6 +111,8 @@ K_MAX = 2.0
 #: Cap on ``K φ`` (the GAB slope diverges at 1).
 X_MAX = 0.97
 _IREF = 1.0 / P_REF
+#: Walkers per call of the compiled simulation (their tables are reserved together).
+_CHUNK = 64
 
 
 @numba.njit(inline="always", cache=True, nogil=True, error_model="numpy")
@@ -167,31 +172,225 @@ def gab_step(gc, xw, xw_prev, sb, j, dt, idt, slope):  # pragma: no cover - comp
     )
 
 
+#: The transitions' table in ``ρ = r/f`` (:func:`gab_table`): 2**_CELL_BITS cells per
+#: octave, a polynomial of degree _DEG in each, octaves 2**-_OCT .. 2**_OCT.
+_CELL_BITS = 4
+_SHIFT = 52 - _CELL_BITS
+_DEG = 5
+_OCT = 40
+_J0 = (1023 - _OCT) << _CELL_BITS  # the first cell: the bits of 2**-_OCT, shifted
+N_CELLS = (2 * _OCT) << _CELL_BITS
+#: Functions of ρ per cell (:func:`_matrix_functions`) and the table's row length.
+_NF = 9
+ROW = _NF * (_DEG + 1)
+_LOW = (1 << _SHIFT) - 1
+_USCALE = 2.0 ** (1 - _SHIFT)
+_NODES = np.cos(np.pi * (2 * np.arange(_DEG + 1) + 1) / (2 * (_DEG + 1)))
+#: Values at the Chebyshev nodes -> monomial coefficients in the cell's u in [-1, 1].
+_FIT = np.linalg.inv(np.vander(_NODES, _DEG + 1, increasing=True))
+
+
+@numba.njit(inline="always", cache=True, nogil=True, error_model="numpy")
+def table_constants(kp, k):  # pragma: no cover - compiled
+    """Per-parameter-set constants of :func:`gab_table_step` from one row ``kp`` of
+    :meth:`~heritage_bayes.rc.sorption.CoupledHygricModel.kernel_parameters` and the
+    multilayer factor ``k`` [-]: with ``L`` the decay matrix of ``(Pw, Pi)`` at
+    ``ρ = r/f``, ``L = [[a ρ, -b/f], [-c r, d]]`` [1/s], its determinant ``ρ D``."""
+    cw, ci, gw, gi, gfast, gf, sink = kp[0], kp[1], kp[2], kp[3], kp[4], kp[5], kp[6]
+    gsum = gi + gfast + gf
+    D = (gw * gsum + gi * (gfast + gf)) / (cw * ci)
+    return (k, _shape(k * PHI_REF), (gw + gi) / cw, gi / cw, gi / ci, gsum / ci, D,
+            gw / cw, gfast / ci, gf * sink / ci, 1.5 * k * _IREF, 0.5 * k * _IREF)  # fmt: skip
+
+
+@numba.njit(inline="always", cache=True, nogil=True, error_model="numpy")
+def _matrix_functions(tc, rho, dt, idt):  # pragma: no cover - compiled
+    """The step's matrix functions of ``L`` at ``ρ`` (:func:`table_constants`), each
+    ``F(L) = F_m I + F_1 (L - m I)`` (``m`` the mean of the eigenvalues ``l1 <= l2``,
+    ``F_1 = (F(l2) - F(l1))/(l2 - l1)``, ``δ = (a ρ - d)/2``): the diagonal
+    ``F_m ± F_1 δ`` and ``F_1`` of the pole ``e^{-l dt}``, the zero-order-hold gain and
+    the first-order-hold slope gain of :func:`~heritage_bayes.rc.sorption._gains`;
+    smooth in ρ (symmetric in the eigenvalues). The smaller eigenvalue is the
+    determinant over the larger (no cancellation)."""
+    a, b, c, d, D = tc[2], tc[3], tc[4], tc[5], tc[6]
+    ar = a * rho
+    dl = 0.5 * (ar - d)
+    h = math.sqrt(dl * dl + b * c * rho)
+    l2 = 0.5 * (ar + d) + h
+    l1 = rho * D / l2
+    a1, p1, g1 = _gains(l1, 1.0 / l1, dt, idt, True)
+    a2, p2, g2 = _gains(l2, 1.0 / l2, dt, idt, True)
+    ih = 0.5 / max(h, 1e-300)
+    e1, q1, s1 = (a2 - a1) * ih, (p2 - p1) * ih, (g2 - g1) * ih
+    em, qm, sm = 0.5 * (a1 + a2), 0.5 * (p1 + p2), 0.5 * (g1 + g2)
+    return (em + e1 * dl, em - e1 * dl, e1, qm + q1 * dl, qm - q1 * dl, q1, sm + s1 * dl,
+            sm - s1 * dl, s1)  # fmt: skip
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _build_cell(tab, built, j, tc, dt, idt, fit):  # pragma: no cover - compiled
+    """Row ``j`` of the table: each function's degree-_DEG interpolant at the Chebyshev
+    nodes of the cell, as monomials in the cell's ``u``, degree-major."""
+    lo = _as_double(np.int64(j + _J0) << _SHIFT)
+    hi = _as_double(np.int64(j + _J0 + 1) << _SHIFT)
+    vals = np.empty((_DEG + 1, _NF))
+    for n in range(_DEG + 1):
+        v = _matrix_functions(tc, lo + 0.5 * (1.0 + _NODES[n]) * (hi - lo), dt, idt)
+        for i in range(_NF):
+            vals[n, i] = v[i]
+    for dg in range(_DEG + 1):
+        for i in range(_NF):
+            acc = 0.0
+            for n in range(_DEG + 1):
+                acc += fit[dg, n] * vals[n, i]
+            tab[j, dg * _NF + i] = acc
+    built[j] = True
+
+
+@numba.njit(inline="always", cache=True, nogil=True, error_model="numpy")
+def gab_cell(tc, xw, xp, r, ir):  # pragma: no cover - compiled
+    """The capacity of :func:`gab_step` as ``1/f`` [-] at the humidity extrapolated to
+    the step's middle from the buffer's states ``xw`` (now) and ``xp`` (a step earlier)
+    [Pa], ``ρ = r/f`` (``ir = 1/r``) and its cell of the table: the row ``j`` (16 per
+    octave of ρ, read from its bits, uniform in ρ within an octave) and ``u`` in [-1, 1)
+    across it. ``tc`` from :func:`table_constants`; one division, as
+    ``g(x) = (1 + (C-1) x²) / ((1 - x)² (1 + (C-1) x)²)``."""
+    x = min(max(tc[10] * xw - tc[11] * xp, 0.0), X_MAX)
+    c1 = GAB_C - 1.0
+    dd = (1.0 - x) * (1.0 + c1 * x)
+    rho = (r * tc[1]) * (dd * dd) / (1.0 + c1 * x * x)
+    bits = _as_int(rho)
+    j = min(max((bits >> _SHIFT) - _J0, 0), N_CELLS - 1)
+    return rho * ir, rho, j, np.float64(bits & _LOW) * _USCALE - 1.0
+
+
+@numba.njit(inline="always", cache=True, nogil=True, error_model="numpy")
+def _poly(t, j, i, u, u2, u4):  # pragma: no cover - compiled
+    """Function ``i`` of row ``j`` of the table at ``u`` (Estrin's scheme, degree 5)."""
+    lo = t[j, i] + t[j, i + _NF] * u
+    mid = t[j, i + 2 * _NF] + t[j, i + 3 * _NF] * u
+    return lo + u2 * mid + u4 * (t[j, i + 4 * _NF] + t[j, i + 5 * _NF] * u)
+
+
+@numba.njit(inline="always", cache=True, nogil=True, error_model="numpy")
+def gab_table_step(tc, tab, cell, r, dr, pe, dpe, xs, slope):  # pragma: no cover - compiled
+    """:func:`gab_step` from the table ``tab`` (N_CELLS, ROW) of the step's matrix
+    functions in ``ρ = r/f`` (:func:`_matrix_functions`, each cell a Chebyshev
+    interpolant of degree 5): ``cell`` from :func:`gab_cell` (its row built), ``r``,
+    ``dr``, ``pe``, ``dpe``, ``xs`` the rows 2, 5, 0, 1, 6 of the step series."""
+    iF, rho, j, u = cell
+    b, c = tc[3], tc[4]
+    u2 = u * u
+    u4 = u2 * u2
+    T0, T1, T2 = (
+        _poly(tab, j, 0, u, u2, u4),
+        _poly(tab, j, 1, u, u2, u4),
+        _poly(tab, j, 2, u, u2, u4),
+    )
+    T3, T4, T5 = (
+        _poly(tab, j, 3, u, u2, u4),
+        _poly(tab, j, 4, u, u2, u4),
+        _poly(tab, j, 5, u, u2, u4),
+    )
+    T6, T7, T8 = (
+        _poly(tab, j, 6, u, u2, u4),
+        _poly(tab, j, 7, u, u2, u4),
+        _poly(tab, j, 8, u, u2, u4),
+    )
+    bi = b * iF
+    cr = c * r
+    q0 = tc[7] * pe * iF
+    q1 = tc[8] * pe + tc[9] * xs
+    f0 = T3 * q0 - T5 * bi * q1
+    f1 = T4 * q1 - T5 * cr * q0
+    if slope:
+        d0 = tc[7] * dpe * iF
+        d1 = tc[8] * dpe
+        f0 += T6 * d0 - T8 * bi * d1
+        f1 += T7 * d1 - T8 * cr * d0
+    # r's change over the step: a flow Gi·dr·(t/dt - 1/2)·Pw[k] from the buffer to the air
+    m0 = T0 - bi * dr * (T6 + T8 * c)
+    m2 = c * dr * (T8 * b * rho + T7) - T2 * cr
+    return m0, -T2 * bi, m2, T1, f0, f1
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath={"contract"})
+def _gab_run(tc, tab, built, sb, b0, B, slope, x, Mf, out):  # pragma: no cover - compiled
+    """Steps ``b0 ..`` of the block ``sb`` (``x`` = [Pw, Pi, Pw a step earlier], in
+    place; each step's transition and forcing into ``Mf[:, b]``, ``Pi`` at its start
+    into ``out[b]``) until the end of the
+    block or a cell of the table not yet built: returns the step reached and that cell
+    (-1: none). No call in the loop, so that the compiler keeps the state in registers."""
+    xw, xi, xp = x[0], x[1], x[2]
+    b = b0
+    j = -1
+    while b < B:
+        cell = gab_cell(tc, xw, xp, sb[2, b], sb[4, b] * sb[4, b])
+        if not built[cell[2]]:
+            j = cell[2]
+            break
+        m0, m1, m2, m3, f0, f1 = gab_table_step(
+            tc, tab, cell, sb[2, b], sb[5, b], sb[0, b], sb[1, b], sb[6, b], slope
+        )
+        Mf[0, b], Mf[1, b], Mf[2, b], Mf[3, b], Mf[4, b], Mf[5, b] = m0, m1, m2, m3, f0, f1
+        out[b] = xi
+        xp = xw
+        xw, xi = m0 * xw + m1 * xi + f0, m2 * xw + m3 * xi + f1
+        b += 1
+    x[0], x[1], x[2] = xw, xi, xp
+    return b, j
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def gab_block(tc, tab, built, sb, B, dt, slope, x, Mf, out):  # pragma: no cover - compiled
+    """The transitions and forcings (into ``Mf[:, :B]``, as
+    :func:`~heritage_bayes.rc.sorption.coupled_block`) of the ``B`` steps of the block
+    ``sb`` (the step series) with the capacity of :func:`gab_step` at the states of the
+    recursion: ``x`` = [Pw, Pi, Pw a step earlier] [Pa], advanced in place, ``out[:B]``
+    the ``Pi`` at each step's start. ``tc``
+    from :func:`table_constants`; the cells of the table ``tab`` (one per parameter
+    set, ``built`` marking them) are built when first reached."""
+    b = 0
+    idt = 1.0 / dt
+    while b < B:
+        b, j = _gab_run(tc, tab, built, sb, b, B, slope, x, Mf, out)
+        if j >= 0:
+            _build_cell(tab, built, j, tc, dt, idt, _FIT)
+
+
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath={"contract"})
 def _simulate_gab(kp, ks, U, cols, slope, dt, x, out):  # pragma: no cover - compiled
     """Outputs ``out[p, k] = Pi[k]`` of every walker (``x`` (K, 2) start, in place)
-    with the capacity of :func:`gab_step`, ``ks`` (K,) the multilayer factors."""
+    with the capacity of :func:`gab_block`, ``ks`` (K,) the multilayer factors (a
+    walker with ``K_gab = 0`` runs the linear buffer's step)."""
     K = kp.shape[0]
     N = U.shape[0]
     sb = np.empty((N_SERIES, BLOCK))
-    prev = x[:, 0].copy()
-    idt = 1.0 / dt
+    Mf = np.empty((6, BLOCK))
+    tab = np.empty((K, N_CELLS, ROW))
+    built = np.zeros((K, N_CELLS), dtype=np.bool_)
+    st = np.empty((K, 3))
+    st[:, :2] = x
+    st[:, 2] = x[:, 0]
     for k0 in range(0, N, BLOCK):
         B = min(BLOCK, N - k0)
         fill_series(U, cols, k0, B, sb)
         for p in range(K):
-            gc = gab_constants(kp[p], ks[p])
-            xw = x[p, 0]
-            xi = x[p, 1]
-            xp = prev[p]
+            if ks[p] > 0.0:
+                tc = table_constants(kp[p], ks[p])
+                gab_block(tc, tab[p], built[p], sb, B, dt, slope, st[p], Mf, out[p, k0:])
+                continue
+            coupled_block(kp[p], sb, dt, slope, 0, B, Mf)
+            xw = st[p, 0]
+            xi = st[p, 1]
             for b in range(B):
                 out[p, k0 + b] = xi
-                m0, m1, m2, m3, f0, f1 = gab_step(gc, xw, xp, sb, b, dt, idt, slope)
-                xp = xw
-                xw, xi = m0 * xw + m1 * xi + f0, m2 * xw + m3 * xi + f1
-            x[p, 0] = xw
-            x[p, 1] = xi
-            prev[p] = xp
+                xw, xi = (
+                    Mf[0, b] * xw + Mf[1, b] * xi + Mf[4, b],
+                    Mf[2, b] * xw + Mf[3, b] * xi + Mf[5, b],
+                )
+            st[p, 0], st[p, 1] = xw, xi
+    x[:, :] = st[:, :2]
 
 
 class IsothermHygricModel(CoupledHygricModel):
@@ -252,7 +451,9 @@ class IsothermHygricModel(CoupledHygricModel):
         ``out`` (K, N) ``Pi`` [Pa]; invalid parameter sets run as linear buffers."""
         ks = np.where(self.valid_mask(P), self.shape(P), 0.0)
         cols = self.input_columns()
-        _simulate_gab(kp, ks, U, cols, bool(cols[1] >= 0), dt, x, out)
+        for s in range(0, P.shape[0], _CHUNK):  # each walker's table: 0.5 MB reserved
+            c = slice(s, s + _CHUNK)
+            _simulate_gab(kp[c], ks[c], U, cols, bool(cols[1] >= 0), dt, x[c], out[c])
 
 
 sorption.stamp_cache(globals(), sorption, _vecmath)

@@ -1,5 +1,6 @@
 """A buffer whose capacity follows its humidity (``rc.isotherm``, option ``isotherm:
-gab``): the GAB slope, its linear limit, the recursion against a fine integration."""
+gab``): the GAB slope, its linear limit, the recursion against a fine integration, its
+tabulated transitions against the exact step."""
 
 import numpy as np
 import pytest
@@ -11,7 +12,13 @@ from heritage_bayes.climate.psychro import saturation_vapour_pressure as psat
 from heritage_bayes.inference.likelihoods import get_noise_model
 from heritage_bayes.inference.parameters import parameters_for
 from heritage_bayes.inference.posterior import LogPosterior
-from heritage_bayes.rc.isotherm import GAB_C, PHI_REF, gab_capacity_factor
+from heritage_bayes.rc.isotherm import (
+    GAB_C,
+    PHI_REF,
+    gab_capacity_factor,
+    gab_constants,
+    gab_step,
+)
 from heritage_bayes.rc.sorption import P_REF, CoupledHygricModel
 
 DT = 3600.0
@@ -136,3 +143,44 @@ def test_recursion_error_against_a_fine_integration():
     cap = gab_capacity_factor(pw / P_REF, k)
     assert cap.max() / cap.min() > 1.5 and np.ptp(ref) > 200
     assert np.max(np.abs(Y[0, :, 0] - ref)) < 0.1
+
+
+def _exact(m, P, U, x0):
+    """Pi at every step's start by the exact step (:func:`gab_step`: the closed-form
+    eigen-decomposition and exponentials of each step), one step at a time."""
+    sb, slope = m.series(U)
+    kp, ks = m.kernel_parameters(P), m.shape(P)
+    out = np.empty((P.shape[0], U.shape[0]))
+    for p in range(P.shape[0]):
+        gc = gab_constants(kp[p], ks[p])
+        (xw, xi), xp = x0[p], x0[p, 0]
+        for k in range(U.shape[0]):
+            out[p, k] = xi
+            m0, m1, m2, m3, f0, f1 = gab_step(gc, xw, xp, sb, k, DT, 1 / DT, slope)
+            xp = xw
+            xw, xi = m0 * xw + m1 * xi + f0, m2 * xw + m3 * xi + f1
+    return out
+
+
+def test_the_tabulated_transitions_equal_the_exact_step():
+    """The simulation's transitions read from the table of the step's matrix functions
+    (Chebyshev interpolants in ρ = r/f) equal the exact step's to 1e-10 relative: a
+    sorbing buffer at a varying Ti with a sink at Tf, 8 parameter sets spread by e^±2
+    around an attic's, K_gab over its prior range."""
+    N = 600
+    rng = np.random.default_rng(11)
+    U = _inputs(N, seed=2)
+    t = np.arange(N)
+    ti = 12 + 8 * np.sin(2 * np.pi * (t - 15) / 24) + rng.normal(0, 0.5, N)
+    U = np.column_stack([U[:, :2], ti, U[:, 2]])
+    m = hb.model("hygric_2c_sorption", sink="temperature", isotherm="gab").with_slopes(["Pe"])
+    assert m.input_names == ("Pe", "Pe_slope", "Ti", "Tf")
+    base = dict(Cm=40.0, Ci=1.4e-3, Gi=1.2e-7, Gfast=2.5e-7, Gf=3e-8, phi_f=0.9, K_gab=0.75)
+    P = np.array([base[n] for n in m.parameter_names]) * np.exp(rng.uniform(-2, 2, (8, 7)))
+    P[:, -2] = rng.uniform(0.5, 1.0, 8)
+    P[:, -1] = np.r_[0.75, rng.uniform(0.05, 1.9, 7)]
+    x0 = np.column_stack([rng.uniform(0.3, 0.9, 8) * P_REF, np.full(8, 1000.0)])
+    Y, valid = m.forward(P, U, DT, x0=x0)
+    assert valid.all()
+    ref = _exact(m, P, U, x0)
+    np.testing.assert_allclose(Y[:, :, 0], ref, rtol=1e-10, atol=0)

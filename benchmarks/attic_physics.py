@@ -39,6 +39,11 @@ variant of the roof planes' irradiance input:
 - ``phi<cap>``: the AR(1) model error's coefficient ``phi_Ti`` uniform on [0, cap]
   (default cap 0.96 at hourly steps): a likelihood that leaves less of the slow misfit
   to the error;
+- ``lag<h>``: the roof planes' columns (as the package builds them: shaded, weighted
+  by the wind, under the snow) through a first-order store of time constant ``h`` [h]
+  (a roof deck whose capacity delays the sun's heat on its way to the attic air);
+- ``snowbase<h>``: the package's snow with the snow base at the air's trailing mean
+  over ``h`` hours (24 in the package: a deeper pack's longer memory);
 - ``from<date>``: the calibration starts at the date (e.g. ``from2011-04-20``: after the
   snow), its end and the validation as init chose them.
 
@@ -261,7 +266,9 @@ def patched(variant: str, raw: pd.DataFrame):
                                       where=where, roof=roof, **kw)  # fmt: skip
             return _snow_variant(out, weather, roof, variant), label, detail
         out, label, detail = orig(weather, site, surfaces, mode, where=where, roof=roof, **kw)
-        if variant == "sky":
+        if variant.startswith("lag"):  # the roof's columns through a store of tau [h]
+            out = _lagged(out, [f"I_{k}" for k in roof], float(variant[3:]))
+        elif variant == "sky":
             table = weather if "ghi" in weather else _estimated(weather, site)
             cols = {f"I_{k}": v for k, v in surfaces.items()}
             out = _sky_loss(out, weather, dict(site), cols, table)
@@ -271,8 +278,40 @@ def patched(variant: str, raw: pd.DataFrame):
             out = out.mul(_snow_factor(raw, out.index, keep=0.0, start=True), axis=0)
         return out, label, detail
 
+    if variant.startswith("snowbase"):  # the snow base: the air's mean over N hours
+        return _snow_base(int(variant[8:]))
     inputs.solar_inputs = solar_inputs
     return functools.partial(setattr, inputs, "solar_inputs", orig)
+
+
+def _snow_base(window_hours: int):
+    """The package's snow with the base at the air's trailing mean over
+    ``window_hours`` (24 in the package, :func:`heritage_bayes.climate.snow.
+    roof_snow_columns`, its only 24-hour rolling mean); returns the undo."""
+    orig = pd.Series.rolling
+
+    def rolling(self, window, *a, **kw):
+        if window == "24h":
+            window = f"{window_hours}h"
+        return orig(self, window, *a, **kw)
+
+    pd.Series.rolling = rolling
+    return functools.partial(setattr, pd.Series, "rolling", orig)
+
+
+def _lagged(out: pd.DataFrame, cols, tau_hours: float) -> pd.DataFrame:
+    """``out`` with ``cols`` through a first-order store of time constant ``tau_hours``
+    (unit steady gain, exact for a piecewise-constant input at the table's step)."""
+    from scipy.signal import lfilter
+
+    step = out.index.to_series().diff().median() / pd.Timedelta(hours=1)
+    a = np.exp(-step / tau_hours)
+    res = out.copy()
+    for k in cols:
+        x = res[k].interpolate(limit_direction="both").to_numpy(float)
+        res[k] = lfilter([1 - a], [1, -a], x, zi=[a * x[0]])[0]
+    res.attrs = dict(out.attrs)
+    return res
 
 
 def _estimated(weather, site):

@@ -44,6 +44,8 @@ variant of the roof planes' irradiance input:
   (a roof deck whose capacity delays the sun's heat on its way to the attic air);
 - ``snowbase<h>``: the package's snow with the snow base at the air's trailing mean
   over ``h`` hours (24 in the package: a deeper pack's longer memory);
+  ``snowwarm<w>``: the base ``w`` of the way from the air's 24-hour mean to 0 °C (a
+  melting base over a warm attic: w = 1);
 - ``from<date>``: the calibration starts at the date (e.g. ``from2011-04-20``: after the
   snow), its end and the validation as init chose them.
 
@@ -280,19 +282,29 @@ def patched(variant: str, raw: pd.DataFrame):
 
     if variant.startswith("snowbase"):  # the snow base: the air's mean over N hours
         return _snow_base(int(variant[8:]))
+    if variant.startswith("snowwarm"):  # the snow base w of the way to 0 °C
+        return _snow_base(24, float(variant[8:]))
     inputs.solar_inputs = solar_inputs
     return functools.partial(setattr, inputs, "solar_inputs", orig)
 
 
-def _snow_base(window_hours: int):
-    """The package's snow with the base at the air's trailing mean over
-    ``window_hours`` (24 in the package, :func:`heritage_bayes.climate.snow.
-    roof_snow_columns`, its only 24-hour rolling mean); returns the undo."""
+def _snow_base(window_hours: int, warm: float = 0.0):
+    """The package's snow with the base at ``1 - warm`` times the air's trailing mean
+    over ``window_hours`` (24 and 0 in the package, :func:`heritage_bayes.climate.snow.
+    roof_snow_columns`, its only 24-hour rolling mean): ``warm`` of the way to a
+    melting base at 0 °C; returns the undo."""
     orig = pd.Series.rolling
+
+    class _Scaled:
+        def __init__(self, roll):
+            self.roll = roll
+
+        def mean(self):
+            return (1.0 - warm) * self.roll.mean()
 
     def rolling(self, window, *a, **kw):
         if window == "24h":
-            window = f"{window_hours}h"
+            return _Scaled(orig(self, f"{window_hours}h", *a, **kw))
         return orig(self, window, *a, **kw)
 
     pd.Series.rolling = rolling

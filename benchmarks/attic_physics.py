@@ -43,9 +43,10 @@ variant of the roof planes' irradiance input:
   by the wind, under the snow) through a first-order store of time constant ``h`` [h]
   (a roof deck whose capacity delays the sun's heat on its way to the attic air);
 - ``snowbase<h>``: the package's snow with the snow base at the air's trailing mean
-  over ``h`` hours (24 in the package: a deeper pack's longer memory);
-  ``snowwarm<w>``: the base ``w`` of the way from the air's 24-hour mean to 0 °C (a
-  melting base over a warm attic: w = 1);
+  over ``h`` hours (24 in the package: a deeper pack's longer memory), not drawn
+  towards 0 °C; ``snowwarm<w>``: the base ``w`` of the way from the air's 24-hour mean
+  to 0 °C (the package's ``BASE_WARMTH``; 0: the package before it, a melting base
+  over a warm attic: 1);
 - ``from<date>``: the calibration starts at the date (e.g. ``from2011-04-20``: after the
   snow), its end and the validation as init chose them.
 
@@ -290,25 +291,21 @@ def patched(variant: str, raw: pd.DataFrame):
 
 def _snow_base(window_hours: int, warm: float = 0.0):
     """The package's snow with the base at ``1 - warm`` times the air's trailing mean
-    over ``window_hours`` (24 and 0 in the package, :func:`heritage_bayes.climate.snow.
-    roof_snow_columns`, its only 24-hour rolling mean): ``warm`` of the way to a
-    melting base at 0 °C; returns the undo."""
-    orig = pd.Series.rolling
+    over ``window_hours`` (:func:`heritage_bayes.climate.snow.roof_snow_columns`, its
+    only rolling mean; 24 h and :data:`~heritage_bayes.climate.snow.BASE_WARMTH` in the
+    package): ``warm`` of the way to a melting base at 0 °C; returns the undo."""
+    from heritage_bayes.climate import snow
 
-    class _Scaled:
-        def __init__(self, roll):
-            self.roll = roll
-
-        def mean(self):
-            return (1.0 - warm) * self.roll.mean()
+    orig, keep = pd.Series.rolling, snow.BASE_WARMTH
 
     def rolling(self, window, *a, **kw):
-        if window == "24h":
-            return _Scaled(orig(self, f"{window_hours}h", *a, **kw))
-        return orig(self, window, *a, **kw)
+        return orig(self, f"{window_hours}h" if window == "24h" else window, *a, **kw)
 
-    pd.Series.rolling = rolling
-    return functools.partial(setattr, pd.Series, "rolling", orig)
+    def undo():
+        pd.Series.rolling, snow.BASE_WARMTH = orig, keep
+
+    pd.Series.rolling, snow.BASE_WARMTH = rolling, warm
+    return undo
 
 
 def _lagged(out: pd.DataFrame, cols, tau_hours: float) -> pd.DataFrame:

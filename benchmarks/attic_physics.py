@@ -111,6 +111,7 @@ from _common import config_map  # noqa: E402
 from real_rooms import ROOMS, run_init  # noqa: E402
 
 TUNING = ["R2", "R4", "R6"]
+SEED = None  # the MAP's seed when not init's (--seed)
 SIGMA = 5.670374419e-8  # Stefan-Boltzmann [W/(m² K⁴)]
 DECK_PRIOR = {"Cr": {"dist": "loguniform", "lower": 1e4, "upper": 1e7}}  # [J/K]
 #: candidate -> catalogue name, options, priors (see the module docstring)
@@ -408,7 +409,9 @@ def _config(room, variant, model, bare, data, w):
         cal = periods.calibration.model_copy(update={"start": variant[4:]})
         periods = periods.model_copy(update={"calibration": cal})
     opt = cfg.optimizer.model_copy(update={"maxiter": 100, "starts": 2})
+    seed = cfg.seed if SEED is None else SEED
     return cfg.model_copy(update={"data": d, "optimizer": opt, "thermal": th, "hygric": None,
+                                  "seed": seed,
                                   "periods": periods})  # fmt: skip
 
 
@@ -452,7 +455,10 @@ def main(argv=None) -> int:
     ap.add_argument("--models", nargs="+", default=["thermal_1c"], choices=list(MODELS))
     ap.add_argument("--hours", action="store_true", help="residual by season and hour")
     ap.add_argument("--measured", action="store_true", help="measured radiation only")
+    ap.add_argument("--seed", type=int, default=None, help="the MAP's seed (init's: 1)")
     args = ap.parse_args(argv)
+    global SEED
+    SEED = args.seed
     if set(args.rooms) - set(TUNING):
         ap.error(f"tuning attics only: {TUNING} (the others are held out)")
     work = Path(tempfile.mkdtemp(prefix="attic_physics_"))

@@ -39,6 +39,14 @@ variant of the roof planes' irradiance input:
 - ``phi<cap>``: the AR(1) model error's coefficient ``phi_Ti`` uniform on [0, cap]
   (default cap 0.96 at hourly steps): a likelihood that leaves less of the slow misfit
   to the error;
+- ``lag<h>``: the roof planes' columns (as the package builds them: shaded, weighted
+  by the wind, under the snow) through a first-order store of time constant ``h`` [h]
+  (a roof deck whose capacity delays the sun's heat on its way to the attic air);
+- ``snowbase<h>``: the package's snow with the snow base at the air's trailing mean
+  over ``h`` hours (24 in the package: a deeper pack's longer memory), not drawn
+  towards 0 °C; ``snowwarm<w>``: the base ``w`` of the way from the air's 24-hour mean
+  to 0 °C (the package's ``BASE_WARMTH``; 0: the package before it, a melting base
+  over a warm attic: 1);
 - ``from<date>``: the calibration starts at the date (e.g. ``from2011-04-20``: after the
   snow), its end and the validation as init chose them.
 
@@ -103,6 +111,7 @@ from _common import config_map  # noqa: E402
 from real_rooms import ROOMS, run_init  # noqa: E402
 
 TUNING = ["R2", "R4", "R6"]
+SEED = None  # the MAP's seed when not init's (--seed)
 SIGMA = 5.670374419e-8  # Stefan-Boltzmann [W/(m² K⁴)]
 DECK_PRIOR = {"Cr": {"dist": "loguniform", "lower": 1e4, "upper": 1e7}}  # [J/K]
 #: candidate -> catalogue name, options, priors (see the module docstring)
@@ -261,7 +270,9 @@ def patched(variant: str, raw: pd.DataFrame):
                                       where=where, roof=roof, **kw)  # fmt: skip
             return _snow_variant(out, weather, roof, variant), label, detail
         out, label, detail = orig(weather, site, surfaces, mode, where=where, roof=roof, **kw)
-        if variant == "sky":
+        if variant.startswith("lag"):  # the roof's columns through a store of tau [h]
+            out = _lagged(out, [f"I_{k}" for k in roof], float(variant[3:]))
+        elif variant == "sky":
             table = weather if "ghi" in weather else _estimated(weather, site)
             cols = {f"I_{k}": v for k, v in surfaces.items()}
             out = _sky_loss(out, weather, dict(site), cols, table)
@@ -271,8 +282,46 @@ def patched(variant: str, raw: pd.DataFrame):
             out = out.mul(_snow_factor(raw, out.index, keep=0.0, start=True), axis=0)
         return out, label, detail
 
+    if variant.startswith("snowbase"):  # the snow base: the air's mean over N hours
+        return _snow_base(int(variant[8:]))
+    if variant.startswith("snowwarm"):  # the snow base w of the way to 0 °C
+        return _snow_base(24, float(variant[8:]))
     inputs.solar_inputs = solar_inputs
     return functools.partial(setattr, inputs, "solar_inputs", orig)
+
+
+def _snow_base(window_hours: int, warm: float = 0.0):
+    """The package's snow with the base at ``1 - warm`` times the air's trailing mean
+    over ``window_hours`` (:func:`heritage_bayes.climate.snow.roof_snow_columns`, its
+    only rolling mean; 24 h and :data:`~heritage_bayes.climate.snow.BASE_WARMTH` in the
+    package): ``warm`` of the way to a melting base at 0 °C; returns the undo."""
+    from heritage_bayes.climate import snow
+
+    orig, keep = pd.Series.rolling, snow.BASE_WARMTH
+
+    def rolling(self, window, *a, **kw):
+        return orig(self, f"{window_hours}h" if window == "24h" else window, *a, **kw)
+
+    def undo():
+        pd.Series.rolling, snow.BASE_WARMTH = orig, keep
+
+    pd.Series.rolling, snow.BASE_WARMTH = rolling, warm
+    return undo
+
+
+def _lagged(out: pd.DataFrame, cols, tau_hours: float) -> pd.DataFrame:
+    """``out`` with ``cols`` through a first-order store of time constant ``tau_hours``
+    (unit steady gain, exact for a piecewise-constant input at the table's step)."""
+    from scipy.signal import lfilter
+
+    step = out.index.to_series().diff().median() / pd.Timedelta(hours=1)
+    a = np.exp(-step / tau_hours)
+    res = out.copy()
+    for k in cols:
+        x = res[k].interpolate(limit_direction="both").to_numpy(float)
+        res[k] = lfilter([1 - a], [1, -a], x, zi=[a * x[0]])[0]
+    res.attrs = dict(out.attrs)
+    return res
 
 
 def _estimated(weather, site):
@@ -360,7 +409,9 @@ def _config(room, variant, model, bare, data, w):
         cal = periods.calibration.model_copy(update={"start": variant[4:]})
         periods = periods.model_copy(update={"calibration": cal})
     opt = cfg.optimizer.model_copy(update={"maxiter": 100, "starts": 2})
+    seed = cfg.seed if SEED is None else SEED
     return cfg.model_copy(update={"data": d, "optimizer": opt, "thermal": th, "hygric": None,
+                                  "seed": seed,
                                   "periods": periods})  # fmt: skip
 
 
@@ -404,7 +455,10 @@ def main(argv=None) -> int:
     ap.add_argument("--models", nargs="+", default=["thermal_1c"], choices=list(MODELS))
     ap.add_argument("--hours", action="store_true", help="residual by season and hour")
     ap.add_argument("--measured", action="store_true", help="measured radiation only")
+    ap.add_argument("--seed", type=int, default=None, help="the MAP's seed (init's: 1)")
     args = ap.parse_args(argv)
+    global SEED
+    SEED = args.seed
     if set(args.rooms) - set(TUNING):
         ap.error(f"tuning attics only: {TUNING} (the others are held out)")
     work = Path(tempfile.mkdtemp(prefix="attic_physics_"))

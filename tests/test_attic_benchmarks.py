@@ -1,6 +1,6 @@
 """The attic benchmarks' checks on synthetic data: a known stamp shift, phase and gain
 are found (benchmarks/attic_diagnostics.py), the roof's answers are parsed
-(benchmarks/attic_physics.py)."""
+(benchmarks/attic_physics.py), a slow sun path is found (benchmarks/attic_response.py)."""
 
 import sys
 from pathlib import Path
@@ -60,3 +60,23 @@ def test_roof_answers_parse():
     assert ap._roof_answers("ridge45+pitch30") == ({"ridge_azimuth": 45.0, "pitch": 30.0}, "wind")
     assert ap._roof_answers("ridge0+snow0") == ({"ridge_azimuth": 0.0}, "snow0")
     assert ap._roof_answers("phi0.8") == ({}, "phi0.8")
+
+
+def test_attic_response_finds_a_slow_sun_beside_a_fast_air():
+    """A synthetic attic whose sun passes a store of 2.5 h before the air (τ 1 h): the
+    cascade finds both time constants and fits better than one node
+    (benchmarks/attic_response.py)."""
+    import attic_response as ar
+
+    rng = np.random.default_rng(1)
+    hours = np.arange(24 * 15)
+    te = 5 * np.sin(2 * np.pi * (hours - 9) / 24) + np.cumsum(rng.normal(0, 0.3, hours.size))
+    noon = np.clip(np.sin(2 * np.pi * (hours - 6) / 24), 0, None)
+    sun = np.column_stack([300 * noon, 500 * noon * rng.uniform(0.3, 1, hours.size)])
+    truth = [np.log(1.0), 8.0, 4.0, 0.5, np.log(2.5)]
+    obs = ar.simulate(truth, "cascade", te, sun) + rng.normal(0, 0.05, hours.size)
+    mask = np.ones(hours.size, bool)
+    p, fit = ar.best("cascade", te, sun, obs, mask)
+    assert np.exp(p[0]) == pytest.approx(1.0, rel=0.1)
+    assert np.exp(p[4]) == pytest.approx(2.5, rel=0.1)
+    assert fit > ar.best("1c", te, sun, obs, mask)[1] + 1.0

@@ -63,7 +63,8 @@ def test_the_roof_planes_under_snow_and_nothing_without_precipitation_or_frost()
     noon = 10  # day 1 at 10 UTC: covered, in sun
     assert plain["I_roof_S"].iloc[noon] > 100
     day_mean = pd.Series(te, weather.index).rolling("24h", min_periods=1).mean()
-    want = 25.0 / snow.ROOF_ABSORPTANCE * (day_mean.iloc[noon] - te[noon])
+    base = (1.0 - snow.BASE_WARMTH) * day_mean.iloc[noon]  # drawn towards 0 °C
+    want = 25.0 / snow.ROOF_ABSORPTANCE * (base - te[noon])
     assert got["I_roof_S"].iloc[noon] == pytest.approx(want, rel=1e-6)  # no sun, the swing
     # thawed (8 °C melts 1 mm/h): the bare roof again by the last day
     np.testing.assert_allclose(got["I_roof_S"].iloc[-24:], plain["I_roof_S"].iloc[-24:])
@@ -90,3 +91,24 @@ def test_init_reads_a_precipitation_column(tmp_path):
     p.write_text(text, encoding="utf-8")
     lay = inspect_table(p)
     assert lay.first("precip").name == "precip" and lay.first("precip").unit == "mm"
+
+
+def test_the_snow_base_lies_between_the_air_and_a_melting_base(monkeypatch):
+    """The cover's outer face under snow: the air's 24-hour mean drawn BASE_WARMTH of the
+    way to 0 °C; 0 leaves the air's mean, 1 a melting base at 0 °C."""
+    assert 0.0 < snow.BASE_WARMTH < 1.0
+    n = 72
+    te = -10.0 + 4.0 * np.sin(np.arange(n) / 24 * 2 * np.pi)  # a cold spell, frost all along
+    weather = _weather(te, np.where(np.arange(n) < 4, 3.0, 0.0))
+    k, late = 25.0 / snow.ROOF_ABSORPTANCE, slice(24, None)  # covered from the first hours
+    day_mean = pd.Series(te, weather.index).rolling("24h", min_periods=1).mean().to_numpy()
+    cols, w = {}, snow.BASE_WARMTH
+    for warm in (0.0, w, 1.0):
+        monkeypatch.setattr(snow, "BASE_WARMTH", warm)
+        got = solar_inputs(weather, SITE, SURFACES, "measured", roof=ROOF)[0]["I_roof_N"]
+        cols[warm] = got.to_numpy()[late]
+    np.testing.assert_allclose(cols[0.0], k * (day_mean - te)[late], rtol=1e-9)
+    np.testing.assert_allclose(cols[1.0], k * (0.0 - te)[late], rtol=1e-9)
+    # in frost the drawn base is warmer than the air's mean, colder than 0 °C
+    np.testing.assert_allclose(cols[w], (1 - w) * cols[0.0] + w * cols[1.0], rtol=1e-9)
+    assert (cols[0.0] < cols[w]).all() and (cols[w] < cols[1.0]).all()

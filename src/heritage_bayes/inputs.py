@@ -367,7 +367,7 @@ def solar_inputs(
         standard exterior resistance). When the weather has a precipitation ``precip``
         [mm] and a day below 0 °C, they are also taken under the snow estimated from it
         (:func:`heritage_bayes.climate.snow.roof_snow_columns`: no sun, the outer face
-        at the air's daily mean).
+        at the snow's base, the air's daily mean drawn towards 0 °C).
     roof_horizon : float, default 0
         Skyline [° of sun elevation] of the roof planes: while the sun is lower their
         beam is shaded (``horizon`` of

@@ -25,8 +25,17 @@ absorbed melts the snow, :math:`T \\le 0` °C at its base), and its outer face n
 sees the outdoor air's daily swing but the snow's base, whose temperature is the air's
 damped through the snow (the daily damping depth of snow [5]_, :math:`\\sqrt{2\\kappa/\\omega}`
 with :math:`\\kappa \\approx 3 \\cdot 10^{-7}` m²/s, is about 9 cm): the air's mean
-over the last 24 hours (not capped at the 0 °C of a melting base: the term stands for
-the snow's damping of the daily swing, and a cover lasts only days above 0 °C). With
+over the last 24 hours drawn a share :math:`w` (:data:`BASE_WARMTH`) of the way to
+the 0 °C of a melting base, :math:`T_b = (1 - w)\\,\\overline{T_e}^{\\,24 h}`. The pack
+insulates the cover: its base sits between the air above the snow and the attic below,
+which the house keeps warmer than the air, and it cannot rise above 0 °C, where the
+pack melts from below (the warm base behind ice dams [6]_). Under a pack of resistance
+:math:`R_s` on a cover of :math:`R_r` the base is the attic's temperature weighted
+:math:`R_s/(R_s + R_r)`, about 0.8 for 10 cm of snow (:math:`k \\approx 0.15` W/(m K))
+on a tile cover (:math:`R_r` 0.2 m² K/W), so an attic 1-4 K above the air in a cold
+spell lifts the base by some 0.15-0.3 of the air's distance below 0 °C. The attic's
+temperature is the model's state; 0 °C stands for it, so the term stays a known
+input. With
 the bare cover's aperture :math:`f = \\alpha A U_r / (h_e + U_r)` and its conductance
 between the outdoor air and the attic :math:`A h_e U_r / (h_e + U_r) = f h_e /
 \\alpha`, the cover's outer temperature :math:`T_b` instead of :math:`T_e` adds
@@ -57,6 +66,8 @@ References
 .. [5] M. Sturm, J. Holmgren, M. König and K. Morris, "The thermal conductivity of
    seasonal snow", Journal of Glaciology 43 (1997) 26-41 (:math:`k` 0.1-0.3 W/(m K) at
    :math:`\\rho` 200-350 kg/m³).
+.. [6] W. Tobiasson, J. Buska and A. Greatorex, "Ventilating attics to minimize icings
+   at eaves", Energy and Buildings 21 (1994) 229-234.
 """
 
 from __future__ import annotations
@@ -67,6 +78,7 @@ import pandas as pd
 from heritage_bayes.errors import InputError
 
 __all__ = [
+    "BASE_WARMTH",
     "FULL_COVER",
     "MELT_FACTOR",
     "ROOF_ABSORPTANCE",
@@ -83,6 +95,9 @@ SNOW_THRESHOLD = 1.0
 MELT_FACTOR = 3.0
 #: Snow water equivalent [mm] from which a roof counts as fully covered.
 FULL_COVER = 5.0
+#: Share [-] of the way from the air's 24-hour mean to 0 °C at which the snow's base
+#: sits (a pack insulating a cover over a warmer attic; at most a melting base).
+BASE_WARMTH = 0.3
 #: Solar absorptance of a roof's cover [-] (dark tile, felt, painted sheet metal 0.8-0.9).
 ROOF_ABSORPTANCE = 0.9
 #: Standard exterior surface coefficient [W/(m² K)] (ISO 6946, R_se 0.04 m² K/W).
@@ -151,8 +166,9 @@ def roof_under_snow(irradiance, temperature, daily_mean, cover) -> np.ndarray:
     irradiance : array_like
         The plane's column as the snow-free roof's [W/m²] (transposed, shaded, weighted).
     temperature, daily_mean : array_like
-        Outdoor air temperature [°C] and its trailing 24-hour mean [°C] (the snow base
-        temperature :math:`T_b`), of the same steps.
+        Outdoor air temperature [°C] and the snow base's temperature :math:`T_b` [°C]
+        (:func:`roof_snow_columns`: the air's 24-hour mean drawn towards 0 °C by
+        :data:`BASE_WARMTH`), of the same steps.
     cover : array_like
         Snow cover [-] of the same steps (:func:`snow_cover`).
 
@@ -196,7 +212,7 @@ def roof_snow_columns(
     hours = np.diff(te.index) / pd.Timedelta(hours=1)
     step = np.concatenate([[np.median(hours) if hours.size else 1.0], hours])
     swe = snowpack(te.to_numpy(float), precip.reindex(te.index).to_numpy(float), step)
-    base = te.rolling("24h", min_periods=1).mean()
+    base = (1.0 - BASE_WARMTH) * te.rolling("24h", min_periods=1).mean()
     weather = pd.DataFrame({"c": snow_cover(swe), "d": (base - te).to_numpy()}, index=te.index)
     on = weather.reindex(weather.index.union(irr.index)).interpolate("time", limit_area="inside")
     on = on.reindex(irr.index).fillna(0.0)  # outside the weather's span: no snow

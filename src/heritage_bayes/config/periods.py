@@ -29,29 +29,6 @@ class Period(_Strict):
         check_dates(self.start, self.end)
         return self
 
-    def _check_inside(self, cs, ce, vs, ve) -> None:
-        """A validation overlapping the calibration must lie inside it, with calibration
-        data on both sides and the warm-up before it."""
-        spans = (
-            f"(calibration {self.calibration.start} to {self.calibration.end}, validation "
-            f"{self.validation.start} to {self.validation.end})"
-        )
-        if not (cs < vs and ve < ce):
-            edge = cs >= vs and ve >= ce
-            raise ValueError(
-                "validation: "
-                + ("covers" if edge else "overlaps")
-                + f" the calibration period {spans}; the validation lies before the "
-                "calibration, after it, or inside it with calibration data on both sides"
-                + ("" if edge else " (to validate at an end, let it start or end where the "
-                   "calibration ends or starts)")
-            )  # fmt: skip
-        if self.warmup is not None and cs + self.warmup >= vs:
-            raise ValueError(
-                f"warmup: {format_timedelta(self.warmup)} reaches the validation inside "
-                f"the calibration period {spans}; the warm-up must end before it"
-            )
-
 
 class Periods(_Strict):
     """Calibration and validation periods, warm-up and initial-state window.
@@ -120,3 +97,26 @@ class Periods(_Strict):
                     f"calibration period ({self.calibration.start} to {self.calibration.end})"
                 )
         return self
+
+    def _check_inside(self, cs, ce, vs, ve) -> None:
+        """A validation overlapping the calibration must lie inside it, with calibration
+        data on both sides and the warm-up before it."""
+        spans = (
+            f"(calibration {self.calibration.start} to {self.calibration.end}, validation "
+            f"{self.validation.start} to {self.validation.end})"
+        )
+        if not (cs < vs and ve < ce):
+            edge = cs >= vs and ve >= ce
+            raise ValueError(
+                "validation: "
+                + ("covers" if edge else "overlaps")
+                + f" the calibration period {spans}; the validation lies before the "
+                "calibration, after it, or inside it with calibration data on both sides"
+                + ("" if edge else " (to validate at an end, let it start or end where the "
+                   "calibration ends or starts)")
+            )  # fmt: skip
+        if self.warmup is not None and cs + self.warmup >= vs:
+            raise ValueError(
+                f"warmup: {format_timedelta(self.warmup)} reaches the validation inside "
+                f"the calibration period {spans}; the warm-up must end before it"
+            )

@@ -115,3 +115,38 @@ def test_the_likelihood_holds_out_the_validation_hours(inside):
     )
     codes = _period_codes(prep)
     assert (codes[val] == 2).all() and (codes[val.stop : cal.stop] == 1).all()
+
+
+def test_a_run_with_the_validation_inside_reports_it(tmp_path):
+    """``hbayes calibrate``'s whole path (tiny budgets): the summary's periods, the
+    validation figures of the hours held out, the report's header and ``hb.load_run``."""
+    import heritage_bayes as hb
+    from heritage_bayes.calibration.calibrate import run_calibration
+    from heritage_bayes.report.build import build_context
+
+    cfg = {
+        "name": "inside",
+        "seed": 3,
+        "data": {"demo": {"seed": 7, "thermal_model": "thermal_2c"}, "irradiance": "none"},
+        "periods": {
+            "calibration": {"start": "2019-04-01", "end": "2019-04-15"},
+            "validation": {"start": "2019-04-06", "end": "2019-04-09"},
+        },
+        "thermal": {"model": "thermal_1c"},
+        "ladder": False,
+        "sampler": {"max_steps": 100, "check_every": 50, "n_predictive": 20},
+        "optimizer": {"maxiter": 15, "starts": 1, "popsize": 4},
+    }
+    out = tmp_path / "run"
+    run_calibration(parse_config(cfg), out_dir=out, report=False, quiet=True)
+    run = hb.load_run(out)
+    per = {p.name: p for p in run.run_summary.periods}
+    assert per["validation"].start.startswith("2019-04-06") and per["validation"].steps == 72
+    assert per["calibration"].steps == 336
+    codes = np.asarray(run.idata.constant_data["period"].values)
+    assert (codes == 2).sum() == 72 and (codes == 1).sum() == 264
+    val, cal = (run.run_summary.metric("thermal", "Ti", p) for p in ("validation", "calibration"))
+    assert val.n == 72 and cal.n == 264 and np.isfinite(val.FIT), (val, cal)
+    header = build_context(out)["header"]
+    cal = next(p for p in header["periods"] if p["name"] == "calibration")
+    assert "the validation inside it is held out of the fit" in cal["length"]

@@ -65,6 +65,7 @@ from heritage_bayes.prepare_steps import (
     check_outputs,
     complete_frame,
     demo_truth,
+    fitted_mask,
     period_rows,
 )
 from heritage_bayes.sources import INPUT_COLUMNS, OUTPUT_COLUMNS, _ground_column, read_sources
@@ -200,11 +201,7 @@ class Prepared:
     def fitted_rows(self) -> np.ndarray:
         """(N,) bool: the rows whose observations the calibration fits: the calibration
         period after its warm-up, without the validation rows inside it."""
-        rows = np.zeros(self.n_rows, dtype=bool)
-        rows[self.calibration.start + self.warmup_steps : self.calibration.stop] = True
-        if self.validation_inside:
-            rows[self.validation] = False
-        return rows
+        return fitted_mask(self.n_rows, self.calibration, self.validation, self.warmup_steps)
 
     def calibration_observed(self, section: str, model) -> np.ndarray:
         """:meth:`observed` over the calibration rows, NaN (missing, as a logger gap) on

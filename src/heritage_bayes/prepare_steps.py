@@ -247,6 +247,16 @@ def period_rows(cfg, frame: pd.DataFrame, models):
     return cal, val, note, warmup_steps, init_steps
 
 
+def fitted_mask(n: int, cal: slice, val: slice | None, warmup_steps: int) -> np.ndarray:
+    """(n,) bool: the rows whose observations the calibration fits: the calibration
+    period after its warm-up, without the rows of a validation inside it."""
+    rows = np.zeros(n, dtype=bool)
+    rows[cal.start + warmup_steps : cal.stop] = True
+    if val is not None and cal.start <= val.start < cal.stop:
+        rows[val] = False
+    return rows
+
+
 def demo_truth(cfg, monument, frame: pd.DataFrame, cal: slice, warmup_steps: int, val=None):
     """The demo monument's true parameters per section, with the nominal noise parameters
     of its outputs over the fitted rows of the calibration period (without a validation
@@ -254,11 +264,7 @@ def demo_truth(cfg, monument, frame: pd.DataFrame, cal: slice, warmup_steps: int
     from heritage_bayes.demo import nominal_noise
 
     truth = {sec: dict(vals) for sec, vals in monument.truth.items()}
-    keep = np.zeros(len(frame), dtype=bool)
-    keep[cal.start + warmup_steps : cal.stop] = True
-    if val is not None and cal.start <= val.start < cal.stop:
-        keep[val] = False
-    rows = frame.index[keep]
+    rows = frame.index[fitted_mask(len(frame), cal, val, warmup_steps)]
     for sec, out in (("thermal", "Ti"), ("hygric", "Pi")):
         sec_cfg = getattr(cfg, sec)
         kind = sec_cfg.noise if sec_cfg is not None else DEFAULT_NOISE
@@ -271,14 +277,12 @@ def demo_truth(cfg, monument, frame: pd.DataFrame, cal: slice, warmup_steps: int
 
 def _check_observations(frame, cal, val, warmup_steps, thermal, hygric, step) -> None:
     needed = (["Ti"] if thermal else []) + (["Pi"] if hygric else [])
-    fitted = np.zeros(len(frame), dtype=bool)
-    fitted[cal.start + warmup_steps : cal.stop] = True
+    fitted = fitted_mask(len(frame), cal, val, warmup_steps)
     periods = [("calibration (after the warm-up)", slice(cal.start + warmup_steps, cal.stop))]
     if val is not None:
         if val.stop <= val.start:
             raise ConfigError("periods.validation: has no rows on the grid")
         periods.append(("validation", val))
-        fitted[val] = False  # a validation inside the calibration is not fitted
     for what, sl in periods:
         hours = MIN_OBSERVED_HOURS[what.split()[0]]
         n_min = max(2, math.ceil(pd.Timedelta(hours=hours) / step))

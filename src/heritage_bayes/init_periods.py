@@ -215,10 +215,8 @@ def choose_periods(
             )
         else:
             end = e0
-            mid, where, why = _short_split(s0, e0, daily, span)
+            mid, inside, where, why = _short_split(s0, e0, daily, span)
             val_first = where == "first"
-            if where == "middle":
-                mid, inside = mid
     if present is not None and len(present):  # no start or end inside a short gap
         have = set(present)
         moved = s0
@@ -241,10 +239,11 @@ def choose_periods(
 
 
 def _short_split(s0, e0, daily, span) -> tuple:
-    """A record ``[s0, e0)`` shorter than a year: ``(mid, where, why)``, where the
-    validation goes (``"end"``, ``"first"`` or ``"middle"``) as :func:`choose_periods`
-    says; ``mid`` the midnight between the periods, for ``"middle"`` the validation's
-    ``(start, end)``. The validation's third stays at the end when
+    """A record ``[s0, e0)`` shorter than a year: ``(mid, inside, where, why)``, where
+    the validation goes (``"end"``, ``"first"`` or ``"middle"``) as
+    :func:`choose_periods` says; ``mid`` the midnight between the periods (for
+    ``"middle"`` the validation's start), ``inside`` the validation's end for
+    ``"middle"``, else None. The validation's third stays at the end when
     :data:`COVERED_SHARE` of its days are covered or no other third covers more; else
     the middle or the first third, whichever covers more (the middle on a tie: the
     calibration then holds both ends of the record)."""
@@ -253,7 +252,7 @@ def _short_split(s0, e0, daily, span) -> tuple:
     late, early = s0 + day * round(n * 2 / 3), s0 + day * round(n / 3)
     why = f"{span}: its first 2/3 to calibrate, the rest to validate"
     if daily is None:
-        return late, "end", why
+        return late, None, "end", why
     at_end = covered_share(daily, (s0, late), (late, e0))
     at_start = covered_share(daily, (early, e0), (s0, early))
     at_middle = covered_share(daily, [(s0, early), (late, e0)], (early, late))
@@ -264,16 +263,16 @@ def _short_split(s0, e0, daily, span) -> tuple:
         f"{at_middle:.0%} in the middle; {at_start:.0%} first"
     )
     if at_end >= COVERED_SHARE or max(at_start, at_middle) <= at_end:
-        return late, "end", f"{why} ({shares})"
+        return late, None, "end", f"{why} ({shares})"
     if at_middle >= at_start:
-        return (early, late), "middle", (
+        return early, late, "middle", (
             f"{span}, shorter than a year: its middle third to validate, held out of the "
             "fit, the rest on both sides to calibrate, so that the calibration spans the "
             f"validation's conditions and both ends of the record ({shares}: a model "
             "calibrated on one season would be validated on another it never saw); the "
             "validation is simulated through from the calibration's start"
         )  # fmt: skip
-    return early, "first", (
+    return early, None, "first", (
         f"{span}, shorter than a year: its first 1/3 to validate, the rest to calibrate, "
         f"so that the calibration spans the validation's conditions ({shares}: a model "
         "calibrated on one season would be validated on another it never saw); the "

@@ -97,15 +97,19 @@ def test_a_dehumidified_heated_store(tmp_path):
     assert "held in a narrow band: a humidistat or dehumidifier" in text
     assert "RH band: indoors 47-51 % (4.5 points, 5-95 %)" in text
     assert "model: auto screens thermal_1c, thermal_2c and thermal_4a" in text
-    assert any(f.startswith("model: 160 days of calibration data") for f in res.findings)
+    # 240 days, the middle third validates (held out): 159 days calibrate around it
+    assert any(f.startswith("model: 159 days of calibration data") for f in res.findings)
 
 
 def test_a_short_record_keeps_the_one_node_models(tmp_path):
     ti, rhi, w = _store(45)
     _, cfg, text = _init(tmp_path, ti, rhi, w)
     assert (cfg.thermal.model, cfg.hygric.model) == ("thermal_1c", "hygric_1c")
-    cal = cfg.periods.calibration  # 45 days: a third validates (first, as it warms)
-    days = (pd.Timestamp(cal.end) - pd.Timestamp(cal.start)).days
+    # 45 days: a third validates (the middle, held out of the calibration around it)
+    cal, val = cfg.periods.calibration, cfg.periods.validation
+    t = pd.Timestamp
+    assert t(cal.start) < t(val.start) < t(val.end) < t(cal.end)
+    days = (t(cal.end) - t(cal.start) - (t(val.end) - t(val.start))).days
     assert 28 <= days <= 31
     assert f"{days} days of calibration data (< 60): the one-node model" in text
     assert cfg.hygric.options.given() == {"humidistat": "band"}  # the control, whatever the length

@@ -35,16 +35,19 @@ def _utc(day: str) -> pd.Timestamp:
     return pd.Timestamp(day, tz="UTC")
 
 
-def test_a_winter_to_summer_record_validates_on_its_start():
+def test_a_winter_to_summer_record_validates_in_its_middle():
     """November to July (the TRH-1 R5 attic's span): the end would validate a summer on a
-    winter's calibration; the first third validates, the rest (late winter to summer)
-    calibrates and covers it. A record whose end the calibration covers keeps it."""
+    winter's calibration; the middle third validates, held out of a calibration on both
+    sides of it (winter and summer), which covers it (so does the first third: the
+    middle wins the tie). A record whose end the calibration covers keeps it."""
     s, e = _utc("2010-11-15"), _utc("2011-07-26")
     daily = _daily("2010-11-15", "2011-07-26")
     cs, ce, vs, ve, why = choose_periods(s, e, daily=daily)
-    assert (vs, ve, cs, ce) == ("2010-11-15", "2011-02-07", "2011-02-07", "2011-07-26")
-    assert "first 1/3 to validate" in why and "calibration spans the validation" in why
-    assert covered_share(daily, (cs, ce), (vs, ve)) >= 0.9
+    assert (cs, vs, ve, ce) == ("2010-11-15", "2011-02-07", "2011-05-03", "2011-07-26")
+    assert "middle third to validate" in why and "calibration spans the validation" in why
+    around = [(cs, vs), (ve, ce)]
+    assert covered_share(daily, around, (vs, ve)) >= 0.9
+    assert covered_share(daily, ("2011-02-07", ce), (cs, "2011-02-07")) >= 0.9
     assert covered_share(daily, ("2010-11-15", "2011-05-03"), ("2011-05-03", "2011-07-26")) < 0.6
     # without the weather: today's split; spring to autumn, whose end the calibration
     # covers (a summer calibrating an early autumn): the end, as before
@@ -64,9 +67,19 @@ def test_a_year_or_more_is_split_as_without_the_weather(start, end):
     assert choose_periods(s, e, daily=_daily(start, end)) == choose_periods(s, e)
 
 
-def test_init_writes_the_validation_first_with_its_reason(tmp_path):
-    """init on a winter-to-summer attic record: the written validation precedes the
-    calibration, its comment says why, and the config prepares."""
+def test_a_record_whose_middle_is_new_weather_validates_first():
+    """A record whose middle third holds the coldest days (September to May, mid-winter
+    in the middle) and whose first third is covered by the rest: the first third."""
+    s, e = _utc("2010-09-01"), _utc("2011-05-20")
+    daily = _daily("2010-09-01", "2011-05-20")
+    cs, ce, vs, ve, why = choose_periods(s, e, daily=daily)
+    assert ve == cs and "first 1/3 to validate" in why, why
+
+
+def test_init_writes_the_validation_inside_with_its_reason(tmp_path):
+    """init on a winter-to-summer attic record: the written validation lies inside the
+    calibration, its comment says why, and the config prepares with the validation held
+    out of the fit."""
     from heritage_bayes.config import load_config
     from heritage_bayes.init_config import init_config
     from heritage_bayes.models import models_of
@@ -87,9 +100,10 @@ def test_init_writes_the_validation_first_with_its_reason(tmp_path):
     )
     assert res.questions == []
     per = yaml.safe_load(out.read_text(encoding="utf-8"))["periods"]
-    assert str(per["validation"]["start"]) == "2012-11-01"
-    assert per["validation"]["end"] == per["calibration"]["start"]
-    assert "first 1/3 to validate" in res.text and "warmer than any" not in res.text
+    assert str(per["calibration"]["start"]) == "2012-11-01"
+    assert per["calibration"]["start"] < per["validation"]["start"]
+    assert per["validation"]["end"] < per["calibration"]["end"]
+    assert "middle third to validate" in res.text and "warmer than any" not in res.text
     cfg = load_config(out)
     prep = prepare(cfg, models_of(cfg)[0])
-    assert prep.validation.stop <= prep.calibration.start
+    assert prep.validation_inside and not prep.fitted_rows()[prep.validation].any()

@@ -235,7 +235,9 @@ def test_kalman_free_run_bands_use_the_free_run_error():
     ysim = np.full((3, 400, 1), 12.0)  # three draws, the same simulation
     obs = 12.0 + np.cumsum(rng.normal(0, 0.1, 400))[:, None]  # a slow free-run misfit
     s = SimpleNamespace(name="thermal", model=lp.model, logpost=lp)
-    prep = SimpleNamespace(observed=lambda name, m: obs, calibration=slice(0, 300), warmup_steps=20)
+    fitted = np.zeros(400, dtype=bool)
+    fitted[20:300] = True  # the calibration after its warm-up
+    prep = SimpleNamespace(observed=lambda name, m: obs, fitted_rows=lambda: fitted)
     tn = np.repeat(theta[None, lp.n_model :], 3, 0)
     keep = tn.copy()
     nm, noise, info = predictive_noise(s, prep, ysim, tn)

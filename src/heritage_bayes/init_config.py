@@ -26,8 +26,8 @@ docs/science/models.md, "Figures behind the code's choices"):
   most recent stretch run one way (:mod:`~heritage_bayes.init_regimes`: the RH band, the
   heating floor and the summer gain year by year), as
   :func:`~heritage_bayes.init_periods.choose_periods` says (a record shorter than a
-  year validates on its first third where only then the calibration covers the
-  validation's outdoor conditions); spanning gaps (the calibration splits
+  year validates on its middle or first third where only then the calibration covers
+  the validation's outdoor conditions); spanning gaps (the calibration splits
   at those over ``data.max_gap``) but never starting or ending in one. While a clock is
   an open question they keep 14 h (the largest offset) inside the span, so that any
   answer keeps them inside the data.
@@ -201,7 +201,7 @@ def init_config(
         per.rhi_utc if per.hygric else None,
         per.rhe_utc,
         start=per.span[0],
-        mid=pd.Timestamp(per.span[0]) + (pd.Timestamp(per.ce) - pd.Timestamp(per.cs)),
+        mid=pd.Timestamp(per.span[0]) + per.calibration_length,
         end=per.span[1],
         heated=per.floor,
     )

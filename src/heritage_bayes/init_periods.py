@@ -6,11 +6,12 @@ does not.
 A record shorter than a year cannot hold every season in both periods. Split in time
 with the validation at the end, a record from November to July calibrates on a winter
 and validates on a summer: the model is then asked to extrapolate (the sun's gain on a
-roof free of snow, summer conditions it never saw). Such a record is split with the
-validation at its start instead when that puts the validation's outdoor conditions
-inside the calibration's (:func:`covered_share`): the calibration then spans both
-seasons, and the validation, simulated from the steady state of its own first inputs,
-tests an interpolation.
+roof free of snow, summer conditions it never saw). Such a record validates on its
+middle third instead (the calibration on both sides of it, the validation held out of
+the fit and simulated through) or on its first third, whichever puts more of the
+validation's outdoor conditions inside the calibration's (:func:`covered_share`), the
+middle on a tie: the calibration then spans both seasons, and the validation tests an
+interpolation.
 """
 
 from __future__ import annotations
@@ -157,13 +158,15 @@ def choose_periods(
     than a year) the stretch's first 2/3 to calibrate and the rest to validate, unless
     with the outdoor conditions ``daily`` (:func:`daily_conditions`) fewer than
     :data:`COVERED_SHARE` of the validation's days lie inside the calibration's range
-    (:func:`covered_share`) and more do with the validation's third at the start: then
-    the first 1/3 validates and the rest calibrates. With ``present`` (the hours with an
-    input reading), the start, the end and a calibration that follows the validation
-    start at midnights with a reading: a period never starts or ends inside an input gap
-    (or after the last reading), which the simulation cannot bridge. ``span`` says what
-    ``[s, e)`` is, for ``why``. Returns ``(cs, ce, vs, ve, why)`` as text: ``ce == vs``
-    (the validation after the calibration) or ``ve == cs`` (before it)."""
+    (:func:`covered_share`) and more do with the validation's third in the middle or at
+    the start (:func:`_short_split`): then that third validates and the rest calibrates.
+    With ``present`` (the hours with an input reading), the start, the end and a
+    calibration that follows the validation start at midnights with a reading: a period
+    never starts or ends inside an input gap (or after the last reading), which the
+    simulation cannot bridge; a validation inside the calibration may (it is simulated
+    through). ``span`` says what ``[s, e)`` is, for ``why``. Returns ``(cs, ce, vs, ve,
+    why)`` as text: ``ce == vs`` (the validation after the calibration), ``ve == cs``
+    (before it) or ``cs < vs < ve < ce`` (inside it)."""
     day = pd.Timedelta(days=1)
     s0 = s.ceil("D")
     e0 = e.floor("D")
@@ -171,7 +174,7 @@ def choose_periods(
     jan = pd.Timestamp(year=s0.year + int((s0.month, s0.day) > (1, 1)), month=1, day=1, tz=s0.tz)
     if s0.day != 1 and (e - s0).days >= YEAR_DAYS + 31:
         s0 = (s0 + pd.offsets.MonthBegin(1)).normalize()
-    which, val_first = "first", False
+    which, val_first, inside = "first", False, None
     # a whole calendar year to calibrate and VALIDATION_MONTHS or more after it: the
     # most recent such year; every season in both periods
     cal_year = pd.Timestamp(year=e0.year - 1, month=1, day=1, tz=s0.tz)
@@ -212,14 +215,15 @@ def choose_periods(
             )
         else:
             end = e0
-            mid, val_first, why = _short_split(s0, e0, daily, span)
+            mid, inside, where, why = _short_split(s0, e0, daily, span)
+            val_first = where == "first"
     if present is not None and len(present):  # no start or end inside a short gap
         have = set(present)
         moved = s0
         while moved < mid and moved not in have:
             moved += day
         end_moved = end
-        while end_moved > mid and end_moved not in have:
+        while end_moved > (inside or mid) and end_moved not in have:
             end_moved -= day
         mid_moved = mid  # a calibration after the validation starts with a reading
         while val_first and mid_moved < end_moved and mid_moved not in have:
@@ -229,35 +233,50 @@ def choose_periods(
         s0, end, mid = moved, end_moved, mid_moved
     f = "%Y-%m-%d"
     a, m, b = s0.strftime(f), mid.strftime(f), end.strftime(f)
+    if inside is not None:  # the validation in the middle: the calibration around it
+        return a, b, m, inside.strftime(f), why
     return (m, b, a, m, why) if val_first else (a, m, m, b, why)
 
 
-def _short_split(s0, e0, daily, span) -> tuple[pd.Timestamp, bool, str]:
-    """A record ``[s0, e0)`` shorter than a year: (the midnight between the periods,
-    whether the validation comes first, why), as :func:`choose_periods` says."""
+def _short_split(s0, e0, daily, span) -> tuple:
+    """A record ``[s0, e0)`` shorter than a year: ``(mid, inside, where, why)``, where
+    the validation goes (``"end"``, ``"first"`` or ``"middle"``) as
+    :func:`choose_periods` says; ``mid`` the midnight between the periods (for
+    ``"middle"`` the validation's start), ``inside`` the validation's end for
+    ``"middle"``, else None. The validation's third stays at the end when
+    :data:`COVERED_SHARE` of its days are covered or no other third covers more; else
+    the middle or the first third, whichever covers more (the middle on a tie: the
+    calibration then holds both ends of the record)."""
     day = pd.Timedelta(days=1)
     n = (e0 - s0).days
     late, early = s0 + day * round(n * 2 / 3), s0 + day * round(n / 3)
     why = f"{span}: its first 2/3 to calibrate, the rest to validate"
     if daily is None:
-        return late, False, why
+        return late, None, "end", why
     at_end = covered_share(daily, (s0, late), (late, e0))
     at_start = covered_share(daily, (early, e0), (s0, early))
+    at_middle = covered_share(daily, [(s0, early), (late, e0)], (early, late))
     what = "outdoor temperature" + (" and irradiance" if daily.shape[1] > 1 else "")
-    if at_end >= COVERED_SHARE or at_start <= at_end:
-        return late, False, (
-            f"{why} ({at_end:.0%} of the validation's days within the calibration's "
-            f"range of daily mean {what}, widened by {RANGE_MARGIN:.0%}; {at_start:.0%} "
-            "with the validation first)"
+    shares = (
+        f"{at_end:.0%} of the validation's days within the calibration's range of daily "
+        f"mean {what}, widened by {RANGE_MARGIN:.0%}, with the validation at the end; "
+        f"{at_middle:.0%} in the middle; {at_start:.0%} first"
+    )
+    if at_end >= COVERED_SHARE or max(at_start, at_middle) <= at_end:
+        return late, None, "end", f"{why} ({shares})"
+    if at_middle >= at_start:
+        return early, late, "middle", (
+            f"{span}, shorter than a year: its middle third to validate, held out of the "
+            "fit, the rest on both sides to calibrate, so that the calibration spans the "
+            f"validation's conditions and both ends of the record ({shares}: a model "
+            "calibrated on one season would be validated on another it never saw); the "
+            "validation is simulated through from the calibration's start"
         )  # fmt: skip
-    return early, True, (
+    return early, None, "first", (
         f"{span}, shorter than a year: its first 1/3 to validate, the rest to calibrate, "
-        f"so that the calibration spans the validation's conditions ({at_start:.0%} of the "
-        f"validation's days within the calibration's range of daily mean {what}, widened "
-        f"by {RANGE_MARGIN:.0%}, "
-        f"against {at_end:.0%} with the validation at the end: a model calibrated on one "
-        "season would be validated on another it never saw); the validation starts from "
-        "the steady state of its own first inputs"
+        f"so that the calibration spans the validation's conditions ({shares}: a model "
+        "calibrated on one season would be validated on another it never saw); the "
+        "validation starts from the steady state of its own first inputs"
     )  # fmt: skip
 
 
@@ -271,10 +290,11 @@ def daily_conditions(te: pd.Series, irradiance: pd.Series | None = None) -> pd.D
     return d.dropna(how="all")
 
 
-def covered_share(daily: pd.DataFrame, cal: tuple, val: tuple) -> float:
+def covered_share(daily: pd.DataFrame, cal, val: tuple) -> float:
     """The share of the validation's days ``[val[0], val[1])`` whose every column of
     ``daily`` (:func:`daily_conditions`) lies within the range (least to greatest daily
-    value) of the calibration's days ``[cal[0], cal[1])``, widened at both ends by
+    value) of the calibration's days ``[cal[0], cal[1])`` (or of the days of a list of
+    such ranges: a calibration around the validation), widened at both ends by
     :data:`RANGE_MARGIN` of its width (a day a little darker or colder than any in the
     calibration is not a new season): 1 when the calibration has seen every validation
     day's weather, near 0 for a winter calibrating a summer. 1 when either period has no
@@ -284,7 +304,8 @@ def covered_share(daily: pd.DataFrame, cal: tuple, val: tuple) -> float:
         a, b = (pd.Timestamp(x).tz_localize(None) if pd.Timestamp(x).tz else x for x in (a, b))
         return daily[(daily.index >= pd.Timestamp(a)) & (daily.index < pd.Timestamp(b))]
 
-    c, v = days(*cal), days(*val)
+    ranges = cal if isinstance(cal, list) else [cal]
+    c, v = pd.concat([days(*r) for r in ranges]), days(*val)
     if c.empty or v.empty:
         return 1.0
     margin = RANGE_MARGIN * (c.max() - c.min())
@@ -300,8 +321,9 @@ WARMER_K = 3.0
 
 def extrapolated_seasons(te: pd.Series, cs, ce, vs, ve) -> str | None:
     """A note when the validation ``[vs, ve)`` holds warmer weather than any in the
-    calibration ``[cs, ce)`` (a record shorter than a year, split in time: a winter to
-    calibrate, a summer to validate): the 95th percentile of the daily mean outdoor
+    calibration ``[cs, ce)`` (without the days of a validation inside it; a record
+    shorter than a year, split in time: a winter to calibrate, a summer to validate):
+    the 95th percentile of the daily mean outdoor
     temperature [°C] higher by :data:`WARMER_K` or more. The sun's gain and the summer's
     conditions (a roof free of snow) are then learned from a season they do not hold;
     None otherwise (what it costs on a real attic: docs/science/real_rooms.md, "Figures
@@ -309,8 +331,9 @@ def extrapolated_seasons(te: pd.Series, cs, ce, vs, ve) -> str | None:
     """
     d = te.resample("1D").mean().dropna()
     d.index = d.index.tz_localize(None) if d.index.tz is not None else d.index
-    cal = d[(d.index >= pd.Timestamp(cs)) & (d.index < pd.Timestamp(ce))]
-    val = d[(d.index >= pd.Timestamp(vs)) & (d.index < pd.Timestamp(ve))]
+    in_val = (d.index >= pd.Timestamp(vs)) & (d.index < pd.Timestamp(ve))
+    cal = d[(d.index >= pd.Timestamp(cs)) & (d.index < pd.Timestamp(ce)) & ~in_val]
+    val = d[in_val]
     if len(cal) < 10 or len(val) < 10:
         return None
     c95, v95 = float(np.percentile(cal, 95)), float(np.percentile(val, 95))

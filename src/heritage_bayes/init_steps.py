@@ -120,6 +120,12 @@ class Periods:
         """The first and the last day of the periods (the validation may come first)."""
         return min(self.cs, self.vs), max(self.ce, self.ve)
 
+    @property
+    def calibration_length(self) -> pd.Timedelta:
+        """The calibration's length, without a validation inside it."""
+        cs, ce, vs, ve = (pd.Timestamp(x) for x in (self.cs, self.ce, self.vs, self.ve))
+        return ce - cs - (ve - vs if cs < vs and ve < ce else pd.Timedelta(0))
+
 
 def _weather_format(path: Path, given: str | None) -> str:
     if given is not None:

@@ -65,6 +65,7 @@ from heritage_bayes.prepare_steps import (
     check_outputs,
     complete_frame,
     demo_truth,
+    fitted_mask,
     period_rows,
 )
 from heritage_bayes.sources import INPUT_COLUMNS, OUTPUT_COLUMNS, _ground_column, read_sources
@@ -104,7 +105,9 @@ class Prepared:
     calibration : slice
         Row positions ``[start, stop)`` of the calibration period in ``frame``.
     validation : slice or None
-        Row positions of the validation period.
+        Row positions of the validation period: before, after or inside the calibration
+        period (:attr:`validation_inside`: its rows are held out of the fit,
+        :meth:`calibration_observed`).
     warmup_steps, init_steps : int
         Rows of ``periods.warmup`` and ``periods.init_window``.
     irradiance_source : str
@@ -187,6 +190,27 @@ class Prepared:
                 f"{[c for c in self.frame.columns if c in OUTPUT_COLUMNS]}"
             )
         return np.ascontiguousarray(self.frame.loc[:, list(names)].to_numpy(dtype=float))
+
+    @property
+    def validation_inside(self) -> bool:
+        """The validation period lies inside the calibration period: the model is
+        simulated through it, its observations are not fitted."""
+        v, c = self.validation, self.calibration
+        return v is not None and c.start <= v.start < c.stop
+
+    def fitted_rows(self) -> np.ndarray:
+        """(N,) bool: the rows whose observations the calibration fits: the calibration
+        period after its warm-up, without the validation rows inside it."""
+        return fitted_mask(self.n_rows, self.calibration, self.validation, self.warmup_steps)
+
+    def calibration_observed(self, section: str, model) -> np.ndarray:
+        """:meth:`observed` over the calibration rows, NaN (missing, as a logger gap) on
+        the rows of a validation inside it: what the likelihood fits."""
+        obs = self.observed(section, model)[self.calibration].copy()
+        if self.validation_inside:
+            c, v = self.calibration.start, self.validation
+            obs[v.start - c : v.stop - c] = np.nan
+        return obs
 
     def period_index(self, which: str) -> pd.DatetimeIndex:
         """Timestamps of the ``"calibration"`` or ``"validation"`` rows."""
@@ -358,7 +382,7 @@ def prepare(cfg, models: Mapping | None = None) -> Prepared:
     _check_plausible(frame, cfg)
 
     if monument is not None:
-        truth = demo_truth(cfg, monument, frame, cal, warmup_steps)
+        truth = demo_truth(cfg, monument, frame, cal, warmup_steps, val)
     if cfg.fixed_node_temperature is None and any("Pf" in m.parameter_names for m in ordered):
         te, const = weather.get("Te"), (gt.value if gt.mode == "constant" else None)
         sources["fixed_node_temperature"] = fixed_node_temperature(frame, cal, te, const)

@@ -216,12 +216,14 @@ def period_rows(cfg, frame: pd.DataFrame, models):
     warmup = per.warmup if per.warmup is not None else default_warmup(cfg, models)
     warmup_steps = math.ceil(warmup / step - 1e-9)
     init_steps = math.ceil(per.init_window / step - 1e-9)
-    cal_rows = cal.stop - cal.start
+    cal_rows, before = cal.stop - cal.start, ""
+    if val is not None and cal.start <= val.start < cal.stop:  # the warm-up ends before it
+        cal_rows, before = val.start - cal.start, " before the validation inside it"
     if warmup_steps >= cal_rows:
+        a, b = frame.index[cal.start], frame.index[cal.start + cal_rows - 1] + step
         raise ConfigError(
             f"periods.warmup: {format_timedelta(warmup)} ({warmup_steps} rows) is not shorter "
-            f"than the calibration period ({cal_rows} rows, {_iso(frame.index[cal.start])} to "
-            f"{_iso(frame.index[cal.stop - 1] + step)})"
+            f"than the calibration period{before} ({cal_rows} rows, {_iso(a)} to {_iso(b)})"
         )
 
     def _span(sl):
@@ -245,13 +247,24 @@ def period_rows(cfg, frame: pd.DataFrame, models):
     return cal, val, note, warmup_steps, init_steps
 
 
-def demo_truth(cfg, monument, frame: pd.DataFrame, cal: slice, warmup_steps: int) -> dict:
+def fitted_mask(n: int, cal: slice, val: slice | None, warmup_steps: int) -> np.ndarray:
+    """(n,) bool: the rows whose observations the calibration fits: the calibration
+    period after its warm-up, without the rows of a validation inside it."""
+    rows = np.zeros(n, dtype=bool)
+    rows[cal.start + warmup_steps : cal.stop] = True
+    if val is not None and cal.start <= val.start < cal.stop:
+        rows[val] = False
+    return rows
+
+
+def demo_truth(cfg, monument, frame: pd.DataFrame, cal: slice, warmup_steps: int, val=None):
     """The demo monument's true parameters per section, with the nominal noise parameters
-    of its outputs over the fitted rows of the calibration period."""
+    of its outputs over the fitted rows of the calibration period (without a validation
+    ``val`` inside it)."""
     from heritage_bayes.demo import nominal_noise
 
     truth = {sec: dict(vals) for sec, vals in monument.truth.items()}
-    rows = frame.index[cal.start + warmup_steps : cal.stop]
+    rows = frame.index[fitted_mask(len(frame), cal, val, warmup_steps)]
     for sec, out in (("thermal", "Ti"), ("hygric", "Pi")):
         sec_cfg = getattr(cfg, sec)
         kind = sec_cfg.noise if sec_cfg is not None else DEFAULT_NOISE
@@ -264,6 +277,7 @@ def demo_truth(cfg, monument, frame: pd.DataFrame, cal: slice, warmup_steps: int
 
 def _check_observations(frame, cal, val, warmup_steps, thermal, hygric, step) -> None:
     needed = (["Ti"] if thermal else []) + (["Pi"] if hygric else [])
+    fitted = fitted_mask(len(frame), cal, val, warmup_steps)
     periods = [("calibration (after the warm-up)", slice(cal.start + warmup_steps, cal.stop))]
     if val is not None:
         if val.stop <= val.start:
@@ -272,8 +286,9 @@ def _check_observations(frame, cal, val, warmup_steps, thermal, hygric, step) ->
     for what, sl in periods:
         hours = MIN_OBSERVED_HOURS[what.split()[0]]
         n_min = max(2, math.ceil(pd.Timedelta(hours=hours) / step))
+        rows = fitted[sl] if what.startswith("calibration") else slice(None)
         for col in needed:
-            n_obs = int(np.isfinite(frame[col].to_numpy()[sl]).sum())
+            n_obs = int(np.isfinite(frame[col].to_numpy()[sl][rows]).sum())
             if n_obs < n_min:
                 a = frame.index[sl.start] if sl.start < len(frame) else frame.index[-1]
                 b = frame.index[max(sl.stop - 1, 0)] + step

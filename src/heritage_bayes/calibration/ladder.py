@@ -40,13 +40,16 @@ def section_log_posterior(
 
         kind = SegmentedLogPosterior
         extra = {"segments": tuple(calibration_segments(prep)[0]), "frame_breaks": prep.breaks}
+        if prep.validation_inside:
+            v = prep.validation
+            extra["held_out"] = slice(v.start - cal.start, v.stop - cal.start)
     try:
         return kind(
             model,
             params,
             noise,
             prep.model_inputs(section, model)[cal],
-            prep.observed(section, model)[cal],
+            prep.calibration_observed(section, model),
             dt=prep.dt,
             warmup=prep.warmup_steps,
             init_window=prep.init_steps,
@@ -99,15 +102,11 @@ def ladder_row(prep, section: str, model: RCModel, lp: LogPosterior, mp, *, labe
     ysim = lp.simulate_frame(mp.theta[None], U, prep.calibration.start)[0][0]
     obs = prep.observed(section, model)
     fit = {}
-    for period in ("calibration", "validation"):
-        sl = getattr(prep, period)
+    rows = {"calibration": prep.fitted_rows(), "validation": prep.validation}
+    for period, sl in rows.items():
         if sl is None:
             continue
-        start = sl.start + (prep.warmup_steps if period == "calibration" else 0)
-        fit[period] = {
-            o: fit_metrics(obs[start : sl.stop, k], ysim[start : sl.stop, k])
-            for k, o in enumerate(out)
-        }
+        fit[period] = {o: fit_metrics(obs[sl, k], ysim[sl, k]) for k, o in enumerate(out)}
     ll = float(lp.log_likelihood(mp.theta[None])[0])
     n_obs = int(np.isfinite(lp.observed).sum())
     k = lp.ndim

@@ -13,7 +13,7 @@ sets them side by side:
 - the expected log predictive density of the validation hours, ``elpd_val`` =
   :math:`\\sum_t \\log \\frac{1}{S}\\sum_s p(y_t \\mid \\theta_s, y_{t-1})`: with AR(1)
   noise each term is the one-step-ahead predictive density of the hour given the
-  previous residual, from the simulation continued past the calibration period (the
+  previous residual, from the simulation continued past (or through) the calibration (the
   ``log_predictive_density_validation`` group of ``posterior.nc`` holds each hour's
   inner term; older runs, without that group, the terms per draw,
   ``log_likelihood_validation``);

@@ -38,6 +38,12 @@ class Periods(_Strict):
     than ``data.max_gap`` splits the calibration into segments, each with its own
     initial state, and nothing is simulated inside it.
 
+    The validation lies before the calibration, after it, or inside it with calibration
+    data on both sides (a record shorter than a year, whose seasons the calibration
+    should all hold). Inside it, its hours are held out of the fit as a logger gap is:
+    the model is simulated through them from the calibration's initial state, and its
+    observations enter neither the likelihood nor the calibration's fit figures.
+
     ``warmup``: the first part of the calibration period simulated but excluded from the
     likelihood. Default: none when every model estimates its initial state
     (``initial_state: estimate``, the default of linear models), 14 days when one starts
@@ -56,7 +62,9 @@ class Periods(_Strict):
     validation: Period | None = key(
         None,
         unit=None,
-        description="{start, end} of the validation period (default: the rest)",
+        description="{start, end} of the validation period (default: the rest): before "
+        "or after the calibration period, or inside it (held out of the fit, the "
+        "calibration on both sides)",
     )
     warmup: NonNegativeDuration | None = key(
         None,
@@ -80,11 +88,7 @@ class Periods(_Strict):
             cs, ce = utc(self.calibration.start), utc(self.calibration.end)
             vs, ve = utc(self.validation.start), utc(self.validation.end)
             if vs < ce and cs < ve:
-                raise ValueError(
-                    f"validation: overlaps the calibration period (calibration "
-                    f"{self.calibration.start} to {self.calibration.end}, validation "
-                    f"{self.validation.start} to {self.validation.end})"
-                )
+                self._check_inside(cs, ce, vs, ve)
         if self.calibration is not None:
             length = utc(self.calibration.end) - utc(self.calibration.start)
             if self.warmup is not None and self.warmup >= length:
@@ -93,3 +97,26 @@ class Periods(_Strict):
                     f"calibration period ({self.calibration.start} to {self.calibration.end})"
                 )
         return self
+
+    def _check_inside(self, cs, ce, vs, ve) -> None:
+        """A validation overlapping the calibration must lie inside it, with calibration
+        data on both sides and the warm-up before it."""
+        spans = (
+            f"(calibration {self.calibration.start} to {self.calibration.end}, validation "
+            f"{self.validation.start} to {self.validation.end})"
+        )
+        if not (cs < vs and ve < ce):
+            edge = cs >= vs and ve >= ce
+            raise ValueError(
+                "validation: "
+                + ("covers" if edge else "overlaps")
+                + f" the calibration period {spans}; the validation lies before the "
+                "calibration, after it, or inside it with calibration data on both sides"
+                + ("" if edge else " (to validate at an end, let it start or end where the "
+                   "calibration ends or starts)")
+            )  # fmt: skip
+        if self.warmup is not None and cs + self.warmup >= vs:
+            raise ValueError(
+                f"warmup: {format_timedelta(self.warmup)} reaches the validation inside "
+                f"the calibration period {spans}; the warm-up must end before it"
+            )

@@ -148,9 +148,10 @@ def predictive_noise(s, prep, Ysim: np.ndarray, tn: np.ndarray):
     band = nm.free_run_model()
     width = len(band.kinds)
     out = tn.copy() if band is nm else np.zeros((tn.shape[0], width * s.model.n_outputs))
-    obs = np.asarray(prep.observed(s.name, s.model), dtype=float)
-    cal = prep.calibration
-    rows = slice(cal.start + prep.warmup_steps, cal.stop)
+    obs = np.array(prep.observed(s.name, s.model), dtype=float)
+    fitted = prep.fitted_rows()
+    obs[~fitted] = np.nan  # a validation inside the calibration: a gap in the residuals
+    rows = slice(int(np.argmax(fitted)), fitted.size - int(np.argmax(fitted[::-1])))
     info = {}
     for o, reason in reasons.items():
         r = obs[rows, o] - np.median(Ysim[:, rows, o], axis=0)

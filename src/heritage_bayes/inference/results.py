@@ -22,7 +22,7 @@ Run directory (``hbayes calibrate``):
     rebuilds ``<model>.<output>`` from ``all_outputs``);
   - ``log_predictive_density_validation`` (not an arviz group): per output, the log of
     the posterior-mean predictive density of each validation hour [nats] (over the
-    saved draws, from the simulation continued past calibration; their sum is the
+    saved draws, from the simulation continued past (or through) calibration; their sum is the
     expected log predictive density of new data). Older runs, without this group, hold
     the terms per draw instead (``log_likelihood_validation``); both are read by
     ``heritage_bayes.compare.scores.elpd_validation``;

@@ -25,7 +25,10 @@ Simulation over a whole frame (:meth:`SegmentedLogPosterior.simulate_frame`): ea
 calibration segment from its own estimated start; no value inside a gap (NaN). The
 validation period, which has no data to estimate a start from, continues from the
 state the simulation carries across its gaps (on the interpolated inputs), as across
-the short gaps that are bridged; only the values inside the gap are withheld.
+the short gaps that are bridged; only the values inside the gap are withheld. A
+validation inside the calibration period is held out of the fit (its observations
+missing) and simulated likewise, from the segment before it or, after a gap inside it,
+from the next segment's start, which its later calibration data estimate.
 """
 
 from __future__ import annotations
@@ -77,10 +80,16 @@ class SegmentedLogPosterior(LogPosterior):
         state and its own warm-up; rows outside them are not fitted.
     frame_breaks : (N_frame,) bool array, optional
         Rows of the whole frame inside an input gap: NaN in :meth:`simulate_frame`.
+    held_out : slice, optional
+        Rows of ``inputs`` of a validation inside the calibration period (its
+        observations NaN in ``observed``): simulated by :meth:`simulate_frame` as the
+        validation after a calibration is, outside an input gap, even where no segment
+        holds them.
     """
 
     segments: tuple = ()
     frame_breaks: np.ndarray | None = None
+    held_out: slice | None = None
 
     def __post_init__(self):
         self.inputs = np.ascontiguousarray(self.inputs, dtype=float)
@@ -173,6 +182,8 @@ class SegmentedLogPosterior(LogPosterior):
         outside = np.ones(self.inputs.shape[0], dtype=bool)
         for a, b in self.segments:
             outside[a:b] = False
+        if self.held_out is not None:
+            outside[self.held_out] = False
         rows = np.zeros(U.shape[0], dtype=bool)
         rows[start : start + outside.size] = outside
         if self.frame_breaks is not None and self.frame_breaks.size == U.shape[0]:

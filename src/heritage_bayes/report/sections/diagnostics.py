@@ -222,12 +222,15 @@ def _residual_entry(s, fit: dict) -> dict | None:
     cal = fit["codes"] == 1
     if cal.sum() < 4:
         return None
-    resid = fit["resid"][cal]
+    # first to last calibration hour; a validation inside it is a gap (NaN), not a join
+    idx = np.flatnonzero(cal)
+    span = slice(idx[0], idx[-1] + 1)
+    resid = np.where(cal[span], fit["resid"][span], np.nan)
     nm = find_noise_model(noise) or NoiseModel()
     view = nm.residual_view(resid, lambda kind, absent=None: _median(s, f"{m}.{kind}_{o}", absent))
     check = _residual_check(resid, view, dt_hours)
     fig = fig_residuals(
-        fit["times"][cal],
+        fit["times"][span],
         resid,
         output=o,
         unit=OUT_UNITS.get(o, ""),

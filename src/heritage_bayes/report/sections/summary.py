@@ -6,6 +6,8 @@ section, above its heading: the first thing a reader sees.
 
 from __future__ import annotations
 
+import pandas as pd
+
 from heritage_bayes.format import fmt_time
 from heritage_bayes.report.page import Section
 from heritage_bayes.report.rundata import RunData
@@ -27,15 +29,14 @@ def header_context(rd: RunData) -> dict:
         for m, info in s.models.items()
     ]
     periods = []
+    inside = _validation_inside(s.periods)
     for p in s.periods:
         hours = p.steps * s.dt / 3600.0
+        length = f"{hours / 24:.1f} d" if hours >= 48 else f"{hours:g} h"
+        if inside and p.name == "calibration":
+            length += "; the validation inside it is held out of the fit"
         periods.append(
-            {
-                "name": p.name,
-                "start": fmt_time(p.start),
-                "end": fmt_time(p.end),
-                "length": f"{hours / 24:.1f} d" if hours >= 48 else f"{hours:g} h",
-            }
+            {"name": p.name, "start": fmt_time(p.start), "end": fmt_time(p.end), "length": length}
         )
     warmup_h = s.warmup_steps * s.dt / 3600.0
     return {
@@ -54,6 +55,17 @@ def header_context(rd: RunData) -> dict:
         "config_hash": s.config_hash or "?",
         "irradiance": s.irradiance_source or "?",
     }
+
+
+def _validation_inside(periods) -> bool:
+    """The validation period lies inside the calibration period (``summary.json``'s
+    periods, ISO instants in UTC)."""
+    by = {p.name: p for p in periods}
+    cal, val = by.get("calibration"), by.get("validation")
+    if cal is None or val is None or None in (cal.start, cal.end, val.start, val.end):
+        return False
+    t = pd.Timestamp
+    return t(cal.start) < t(val.start) and t(val.end) < t(cal.end)
 
 
 def section(ctx: dict) -> Section:

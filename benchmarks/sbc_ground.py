@@ -376,8 +376,8 @@ def main(argv=None) -> int:
                     "at the generator's climate mean (fit_inputs)")  # fmt: skip
     ap.add_argument("--reading", choices=("instant", "step_start"), default="instant",
                     help="the station's reading at the hour: the weather at that instant "
-                    "(default), or the 5-minute step's that starts there (the generator "
-                    "before session 56)")  # fmt: skip
+                    "(default), or the 5-minute step's that starts there (the old "
+                    "generator, for paired diagnosis)")  # fmt: skip
     ap.add_argument("--table", nargs="+", metavar="LOG", help="only tabulate logs")
     ap.add_argument("--markdown", action="store_true", help="with --table: markdown")
     ap.add_argument("--paired", nargs=2, metavar="LOG", help="two logs of the same rooms")

@@ -23,6 +23,7 @@ nodes).
     python benchmarks/sbc_ground.py --reps 24 --jobs 2 --log ground.jsonl
     python benchmarks/sbc_ground.py --table ground.jsonl [--markdown]
     python benchmarks/sbc_ground.py --misfit --reps 8        # the ground's error, no fit
+    python benchmarks/sbc_ground.py --pseudo --only 1,6 --without gain   # least squares, no noise
 
 Each replicate is a function of ``(seed, replicate)``; one JSON line per replicate is
 appended to ``--log`` as soon as it is done, ``--first-rep``/``--only`` extend a study
@@ -415,20 +416,8 @@ def main(argv=None) -> int:
         return 0
     from bench_sbc import run_tasks
 
-    tasks = [
-        (
-            rep,
-            args.seed,
-            args.max_steps,
-            args.cal_days,
-            without,
-            args.variant,
-            {},
-            args.true_mean,
-            args.reading,
-        )
-        for rep in reps
-    ]
+    opts = (args.variant, {}, args.true_mean, args.reading)
+    tasks = [(rep, args.seed, args.max_steps, args.cal_days, without, *opts) for rep in reps]
     t0 = time.perf_counter()
     results = run_tasks(replicate, tasks, args.jobs, args.log)
     print(

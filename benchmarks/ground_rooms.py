@@ -25,7 +25,12 @@ Physics (SI units; temperatures [°C], capacities [J/K], conductances [W/K]):
   inputs held.
 - **logger**: Ti at every full hour with white sensor noise (sd 0.05-0.15 K), rounded
   to 0.1 °C, 1 % of single readings lost and one outage of 3-10 days; the station's Te
-  at the full hour rounded to 0.1 °C.
+  at the full hour rounded to 0.1 °C. Both are readings at an instant: the room's state
+  at the hour, and the weather at the hour, which the 5-minute grid holds over the
+  steps either side of it (the mean of the two). Taking the value of the step that
+  starts at the hour instead (``reading="step_start"``) would read a weather that the
+  room sees on average half a step (2.5 min) later than the reading says, a delay a fit
+  takes up in its time constant.
 
 The truths: the fit's parameters, the depth expressed as the **equivalent depth in the
 fit's clay/silt soil** (α_ref 0.5e-6 m²/s, ISO 13370): ``z_f = z sqrt(α_ref/α)``, the
@@ -106,8 +111,17 @@ def weather(rng, days: int, doy0: float) -> dict:
     t_m, amp, t_min = rng.uniform(8.0, 12.0), rng.uniform(6.0, 10.0), rng.uniform(5.0, 35.0)
     season = t_m - amp * np.cos(2 * math.pi * (t_day - t_min) / YEAR)
     daily = rng.uniform(2.0, 5.0) * np.sin(2 * math.pi * ((t_day % 1.0) * 24.0 - 9.0) / 24.0)
-    te = season + _ar1(rng, n, 3.0, 4 * 86400.0) + daily + _ar1(rng, n, 0.3, 1800.0)
-    return {"Te": te, "day": t_day, "T_m": t_m, "A": amp, "t_min": t_min, "season": season}
+    within = _ar1(rng, n, 0.3, 1800.0)
+    te = season + _ar1(rng, n, 3.0, 4 * 86400.0) + daily + within
+    return {
+        "Te": te,
+        "day": t_day,
+        "T_m": t_m,
+        "A": amp,
+        "t_min": t_min,
+        "season": season,
+        "within": within,
+    }
 
 
 def soil_temperature(w: dict, depth: float, alpha: float, anomaly: bool = True) -> np.ndarray:
@@ -154,14 +168,19 @@ def simulate(p: dict, te: np.ndarray, tf: np.ndarray, q: np.ndarray, ti0: float)
     return out
 
 
-def generate(seed, cal_days: int = 120, without: tuple = ()) -> dict:
+def generate(seed, cal_days: int = 120, without: tuple = (), reading: str = "instant") -> dict:
     """One room: truths, the station's and the logger's hourly records.
 
     ``without``: parts left out (diagnosis): ``"anomaly"`` (the soil follows only the
     annual harmonic), ``"gain"`` (no unmodelled heat gain), ``"noise"`` (no sensor
     noise, rounding or lost readings; the outage stays), ``"outage"``, ``"synoptic"``
-    (no synoptic weather: the air's annual cycle is the harmonic plus the daily cycle).
-    Leaving parts out keeps every random draw of the room.
+    (no synoptic weather nor daily cycle: the harmonic plus the within-hour
+    fluctuation), ``"within_hour"`` (no within-hour fluctuation), ``"subhourly"`` (the
+    weather linear between the full hours, what the fit's first-order hold assumes),
+    ``"rounding"`` (readings not rounded). Leaving parts out keeps every random draw of
+    the room. ``reading``: ``"instant"`` (the station reads the weather at the hour) or
+    ``"step_start"`` (the 5-minute step's value that starts at the hour; the generator
+    before the reading was corrected, for paired diagnosis).
 
     Returns a dict: ``truth`` (``Ci``, ``Ge``, ``Gf``, ``zf``), ``soil`` (``alpha``,
     ``depth_m``), ``climate`` (the harmonic's ``T_m``, ``A``, ``t_min``), ``hourly``
@@ -176,7 +195,13 @@ def generate(seed, cal_days: int = 120, without: tuple = ()) -> dict:
     w = weather(rng, spin + RECORD_DAYS + 1, doy0 - spin)
     if "synoptic" in without:
         rng2 = np.random.default_rng([*np.atleast_1d(seed), 7])
-        w["Te"] = w["season"] + _ar1(rng2, w["Te"].size, 0.3, 1800.0)
+        w["within"] = _ar1(rng2, w["Te"].size, 0.3, 1800.0)
+        w["Te"] = w["season"] + w["within"]
+    if "within_hour" in without:
+        w["Te"] = w["Te"] - w["within"]
+    if "subhourly" in without:  # linear between the full hours (what the fit assumes):
+        k = np.arange(w["Te"].size)  # each step holds the line's mean over it
+        w["Te"] = np.interp(k + 0.5, k[::PER_HOUR], w["Te"][::PER_HOUR])
     tf = soil_temperature(w, p["depth_m"], p["alpha"], "anomaly" not in without)
     g = p["Ge"] + p["Gf"]
     q = _ar1(rng, w["Te"].size, rng.uniform(0.2, 0.5) * g, 6 * 3600.0)
@@ -187,6 +212,8 @@ def generate(seed, cal_days: int = 120, without: tuple = ()) -> dict:
     at = at[at < w["Te"].size]
     hours = at.size
     ti_true, te = ti[at], w["Te"][at]
+    if reading == "instant":  # the weather at the hour: between the steps either side
+        te = 0.5 * (w["Te"][at - 1] + w["Te"][at])
     sd = rng.uniform(0.05, 0.15)
     e = rng.normal(0.0, sd, hours)
     lost = rng.random(hours) < 0.01
@@ -196,7 +223,7 @@ def generate(seed, cal_days: int = 120, without: tuple = ()) -> dict:
     g0 = rows.start + int(rng.integers(7 * 24, cal_days * 24 - g_len - 7 * 24))
     ti_obs = ti_true.copy()
     if "noise" not in without:
-        ti_obs = np.round(ti_true + e, 1)
+        ti_obs = ti_true + e if "rounding" in without else np.round(ti_true + e, 1)
         lost[[0, -1]] = False
         ti_obs[lost] = np.nan
     if "outage" not in without:
@@ -206,7 +233,12 @@ def generate(seed, cal_days: int = 120, without: tuple = ()) -> dict:
         "truth": truth,
         "soil": {"alpha": p["alpha"], "depth_m": p["depth_m"]},
         "climate": {"T_m": w["T_m"], "A": w["A"], "t_min": w["t_min"]},
-        "hourly": {"Te": np.round(te, 1), "Ti": ti_obs, "Ti_true": ti_true, "Tf_true": tf[at]},
+        "hourly": {
+            "Te": te if "rounding" in without else np.round(te, 1),
+            "Ti": ti_obs,
+            "Ti_true": ti_true,
+            "Tf_true": tf[at],
+        },
         "rows": rows,
         "start_doy": doy0,
         "sensor_sd": sd,

@@ -23,6 +23,7 @@ nodes).
     python benchmarks/sbc_ground.py --reps 24 --jobs 2 --log ground.jsonl
     python benchmarks/sbc_ground.py --table ground.jsonl [--markdown]
     python benchmarks/sbc_ground.py --misfit --reps 8        # the ground's error, no fit
+    python benchmarks/sbc_ground.py --pseudo --only 1,6 --without gain   # least squares, no noise
 
 Each replicate is a function of ``(seed, replicate)``; one JSON line per replicate is
 appended to ``--log`` as soon as it is done, ``--first-rep``/``--only`` extend a study
@@ -59,7 +60,7 @@ OTHERS = ("dTf", "Gf", "Ci")
 VARIANT = "ar1_white:estimate:T=2"
 SEED = 2061
 CAL_DAYS = 120
-PARTS = ("anomaly", "gain", "noise", "outage", "synoptic")
+PARTS = ("anomaly", "gain", "noise", "outage", "synoptic", "within_hour", "subhourly", "rounding")
 
 
 def fit_model():
@@ -154,8 +155,9 @@ def replicate(args) -> dict:
     variant = args[5] if len(args) > 5 else VARIANT
     shift = args[6] if len(args) > 6 else {}
     true_mean = bool(args[7]) if len(args) > 7 else False
+    reading = args[8] if len(args) > 8 else "instant"
     assert (VOLUME, ACH, FLOOR) == (rooms.VOLUME, rooms.ACH, rooms.FLOOR), "survey differs"
-    room = rooms.generate([seed, rep], cal_days, without=without)
+    room = rooms.generate([seed, rep], cal_days, without=without, reading=reading)
     model = fit_model()
     U, y, te = fit_inputs(room, model, true_mean)
     rows = room["rows"]
@@ -179,6 +181,7 @@ def replicate(args) -> dict:
         "rep": rep,
         "seed": seed,
         "without": sorted(without) + (["ground_mean"] if true_mean else []),
+        "reading": reading,
         "variant": variant,
         "truth": truth,
         "truth_parameters": room["truth"],
@@ -289,53 +292,71 @@ def paired_lines(a: list[dict], b: list[dict]) -> list[str]:
     return lines
 
 
-def misfit_lines(reps, seed: int, cal_days: int, without: tuple) -> list[str]:
+def misfit_lines(reps, seed: int, cal_days: int, without: tuple, reading: str) -> list[str]:
     """``--misfit``: the ground's error (:func:`ground_error`) of rooms ``reps``, no fit."""
     model = fit_model()
     lines = ["rep: ground - package's at true zf: mean, sd [K]; cycle errors"]
     for rep in reps:
-        room = rooms.generate([seed, rep], cal_days, without=without)
+        room = rooms.generate([seed, rep], cal_days, without=without, reading=reading)
         U, _, te = fit_inputs(room, model)
         g = ground_error(room, te, model, U)
         lines.append(f"{rep:3d}: " + ", ".join(f"{k} {v:+.2f}" for k, v in g.items()))
     return lines
 
 
-def pseudo_lines(reps, seed: int, cal_days: int, without: tuple) -> list[str]:
-    """``--pseudo``: the fit's pseudo-truth without the noise (no fit of the posterior):
-    ``Ge``, ``Gf`` and ``zf`` by least squares of the package's model on the room's
-    noise-free hourly Ti over the calibration hours (``Ci`` at its truth, the start at
-    the generator's; the room's unmodelled gain left out unless ``without`` keeps it),
-    against the truths: what the ground's and the weather's structural error alone
-    does to the depth and the gain."""
+def pseudo_fit(room: dict, model) -> dict:
+    """The fit's pseudo-truth of one room without the posterior: ``Ge``, ``Gf`` and
+    ``zf`` by least squares of the package's model on the room's noise-free hourly Ti
+    over the calibration hours (``Ci`` and ``dTf`` at their truths, the start at the
+    generator's). Returns the least-squares and true ``tau_1_h`` [h], ``zf`` [m] and
+    gain from Tf [-] (``*_true``), and the ground's error (:func:`ground_error`)."""
     from scipy.optimize import least_squares
 
     from heritage_bayes import simulate
 
+    U, _, te = fit_inputs(room, model)
+    t, rows = room["truth"], room["rows"]
+    target = room["hourly"]["Ti_true"][: U.shape[0]][rows]
+    x0 = np.array([room["hourly"]["Ti_true"][0]])
+    t = {**t, "dTf": offset_truth(room, te)} if "dTf" in model.parameter_names else t
+
+    def resid(x):
+        p = {**t, "Ge": np.exp(x[0]), "Gf": np.exp(x[1]), "zf": np.exp(x[2])}
+        return simulate(model, p, U, 3600.0, x0)[rows, 0] - target
+
+    start = np.log([t["Ge"], t["Gf"], t["zf"]])
+    lo, hi = np.log([1e-2, 1e-2, 0.5]), np.log([1e5, 1e5, 6.0])
+    ge, gf, zf = np.exp(least_squares(resid, start, bounds=(lo, hi), x_scale=1.0).x)
+    return {
+        "tau_1_h": t["Ci"] / (ge + gf) / 3600.0,
+        "tau_1_h_true": t["Ci"] / (t["Ge"] + t["Gf"]) / 3600.0,
+        "zf": zf,
+        "zf_true": t["zf"],
+        "gain_f": gf / (ge + gf),
+        "gain_f_true": t["Gf"] / (t["Ge"] + t["Gf"]),
+        "ground": ground_error(room, te, model, U),
+    }
+
+
+def pseudo_lines(reps, seed: int, cal_days: int, without: tuple, reading: str) -> list[str]:
+    """``--pseudo``: :func:`pseudo_fit` of rooms ``reps`` against their truths (the
+    room's unmodelled gain stays unless ``without`` leaves it out): what the ground's
+    and the weather's structural error alone do to the time constant, the depth and
+    the gain."""
     model = fit_model()
-    lines = ["rep: zf true -> least squares; gain from Tf true -> LS; ground error mean [K]"]
+    lines = [
+        "rep: tau true [h], least squares - true [min]; zf true -> LS; gain from Tf "
+        "true -> LS; ground error mean [K]"
+    ]
     for rep in reps:
-        room = rooms.generate([seed, rep], cal_days, without=without)
-        U, _, te = fit_inputs(room, model)
-        t, rows = room["truth"], room["rows"]
-        target = room["hourly"]["Ti_true"][: U.shape[0]][rows]
-        x0 = np.array([room["hourly"]["Ti_true"][0]])
-
-        t = {**t, "dTf": offset_truth(room, te)} if "dTf" in model.parameter_names else t
-
-        def resid(x, _t=t, _u=U, _x0=x0, _y=target, _r=rows):
-            p = {**_t, "Ge": np.exp(x[0]), "Gf": np.exp(x[1]), "zf": np.exp(x[2])}
-            return simulate(model, p, _u, 3600.0, _x0)[_r, 0] - _y
-
-        start = np.log([t["Ge"], t["Gf"], t["zf"]])
-        lo, hi = np.log([1e-2, 1e-2, 0.5]), np.log([1e5, 1e5, 6.0])
-        fit = least_squares(resid, start, bounds=(lo, hi), x_scale=1.0)
-        ge, gf, zf = np.exp(fit.x)
-        g = ground_error(room, te, model, U)
+        room = rooms.generate([seed, rep], cal_days, without=without, reading=reading)
+        f = pseudo_fit(room, model)
+        g = f["ground"]
         lines.append(
-            f"{rep:3d}: zf {t['zf']:.2f} -> {zf:.2f} m; gain from Tf "
-            f"{t['Gf'] / (t['Ge'] + t['Gf']):.3f} -> {gf / (ge + gf):.3f}; ground error "
-            f"{g['tf_mean']:+.2f} K, cycle mean {g['cycle_mean']:+.2f} K"
+            f"{rep:3d}: tau {f['tau_1_h_true']:.2f} h, "
+            f"{60 * (f['tau_1_h'] - f['tau_1_h_true']):+.1f} min; zf {f['zf_true']:.2f} -> "
+            f"{f['zf']:.2f} m; gain from Tf {f['gain_f_true']:.3f} -> {f['gain_f']:.3f}; "
+            f"ground error {g['tf_mean']:+.2f} K, cycle mean {g['cycle_mean']:+.2f} K"
         )
     return lines
 
@@ -354,6 +375,10 @@ def main(argv=None) -> int:
     ap.add_argument("--without", default="", help=f"parts left out: {', '.join(PARTS)}")
     ap.add_argument("--true-mean", action="store_true", help="diagnosis: the fit's ground "
                     "at the generator's climate mean (fit_inputs)")  # fmt: skip
+    ap.add_argument("--reading", choices=("instant", "step_start"), default="instant",
+                    help="the station's reading at the hour: the weather at that instant "
+                    "(default), or the 5-minute step's that starts there (the old "
+                    "generator, for paired diagnosis)")  # fmt: skip
     ap.add_argument("--table", nargs="+", metavar="LOG", help="only tabulate logs")
     ap.add_argument("--markdown", action="store_true", help="with --table: markdown")
     ap.add_argument("--paired", nargs=2, metavar="LOG", help="two logs of the same rooms")
@@ -382,19 +407,17 @@ def main(argv=None) -> int:
             print(line)
         return 0
     if args.pseudo:
-        for line in pseudo_lines(reps, args.seed, args.cal_days, without):
+        for line in pseudo_lines(reps, args.seed, args.cal_days, without, args.reading):
             print(line, flush=True)
         return 0
     if args.misfit:
-        for line in misfit_lines(reps, args.seed, args.cal_days, without):
+        for line in misfit_lines(reps, args.seed, args.cal_days, without, args.reading):
             print(line, flush=True)
         return 0
     from bench_sbc import run_tasks
 
-    tasks = [
-        (rep, args.seed, args.max_steps, args.cal_days, without, args.variant, {}, args.true_mean)
-        for rep in reps
-    ]
+    opts = (args.variant, {}, args.true_mean, args.reading)
+    tasks = [(rep, args.seed, args.max_steps, args.cal_days, without, *opts) for rep in reps]
     t0 = time.perf_counter()
     results = run_tasks(replicate, tasks, args.jobs, args.log)
     print(

@@ -1,0 +1,101 @@
+"""The cellar's slow quantities on the record's own path of the wall (``sbc_coupled --path``).
+
+With a capacity that follows the wall's humidity, ``tau1_h`` and ``buffer_hours`` of
+:func:`coupled_rooms.network_quantities` depend on where on the isotherm the capacity is
+taken. ``sbc_coupled`` ranks them at one point (the record's mean indoor vapour pressure);
+here they are taken where the record's wall actually was: at the **harmonic mean of the
+capacity along the wall's trajectory over the calibration period**, the one constant
+capacity a linear wall needs to follow a varying one to first order (its RH's rate is
+``J / C_w(φ)``: the time mean of ``1/C_w``; :mod:`coupled_rooms`'s docstring).
+
+- the truth: the generator's ``M u'(φ_w(t))`` along its own wall's RH, harmonic mean over
+  the calibration hours (``capacity_means["harmonic"]``), over ``p_sat`` at the wall;
+- each posterior draw: ``C_w g(K φ(t))/g(K φ_ref)`` along that draw's own wall state
+  ``φ(t) = P_w(t)/p_sat(15 °C)``, simulated by the fitted model's recursion from the
+  draw's conditional posterior mean start state (the one the likelihood integrates out),
+  harmonic mean over the same hours.
+
+The ranks are appended to a copy of the log (``tau1_path_h``, ``buffer_hours_path``), so
+that ``--table`` and ``--paired`` read them as any other quantity.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+import coupled_rooms as rooms
+
+#: the quantities this module adds, and the ones they stand for
+PATH_QUANTITIES = {"tau1_path_h": "tau1_h", "buffer_hours_path": "buffer_hours"}
+
+
+def wall_paths(model, P: np.ndarray, U: np.ndarray, x0: np.ndarray) -> np.ndarray:
+    """(K, N) the buffer's state [Pa] at the start of every step of ``U`` (N, m) for
+    parameter sets ``P`` (K, n) from ``x0`` (K, 2), by the model's own compiled
+    recursion one step at a time (the state is what the recursion leaves in ``x``;
+    each call restarts the GAB capacity's extrapolation from the present state, a
+    second-order difference in the step's change). A cellar's model takes no ``Ti``:
+    each step needs its own input row only."""
+    P = np.atleast_2d(P)
+    kp = model.kernel_parameters(P)
+    x = np.ascontiguousarray(x0, dtype=float).copy()
+    out = np.empty((P.shape[0], 1))
+    path = np.empty((P.shape[0], U.shape[0]))
+    U = np.ascontiguousarray(U, dtype=float)
+    for k in range(U.shape[0]):
+        path[:, k] = x[:, 0]
+        model._recursion(P, kp, U[k : k + 1], 3600.0, x, out)
+    return path
+
+
+def rank(d: np.ndarray, t: float) -> dict:
+    """The rank entry of ``bench_sbc.fit_and_rank`` for draws ``d`` and truth ``t``."""
+    lo90, lo50, hi50, hi90 = np.quantile(d, [0.05, 0.25, 0.75, 0.95])
+    return {
+        "in50": bool(lo50 <= t <= hi50),
+        "in90": bool(lo90 <= t <= hi90),
+        "rank": float(np.mean(d < t)),
+        "median": float(np.median(d)),
+        "sd": float(np.std(d)),
+    }
+
+
+def path_ranks(r: dict, theta: np.ndarray, fit_inputs, models: dict) -> tuple[dict, dict]:
+    """Ranks of :data:`PATH_QUANTITIES` for one logged cellar ``r`` whose posterior
+    draws are ``theta`` (model then noise parameters), and their truths."""
+    import heritage_bayes as hb
+    from bench_sbc import log_posterior
+    from heritage_bayes.inference.likelihoods import get_noise_model
+    from heritage_bayes.rc.isotherm import gab_capacity_factor
+    from heritage_bayes.rc.sorption import P_REF
+    from sbc_coupled import fit_of
+
+    without = tuple(r["without"])
+    room = rooms.generate("cellar", [r["seed"], rooms.ROOMS.index("cellar"), r["rep"]],
+                          r.get("cal_days", 60), without=without)  # fmt: skip
+    name, opts = models["cellar"]
+    model = hb.model(name, **{**opts, "isotherm": r["isotherm"]}).with_slopes(("Pe",))
+    U, y = fit_inputs(room, model)
+    rows = room["rows"]
+    noise_name, init = r.get("variant", "ar1_white:estimate").split(":")[:2]
+    _, lp = log_posterior(model, get_noise_model(noise_name), U[rows], y[rows], {},
+                          rooms.FLOOR, rooms.ENVELOPE, init)  # fmt: skip
+    x0 = lp.initial_states(theta)
+    n = lp.n_model
+    P = theta[:, :n]
+    pw = wall_paths(model, P, U[rows], x0)
+    p = {nm: P[:, j] for j, nm in enumerate(model.parameter_names)}
+    k_gab = p.get("K_gab", np.zeros(P.shape[0]))
+    factor = gab_capacity_factor(pw / P_REF, k_gab[:, None])
+    p["Cw"] = p["Cw"] / np.mean(1.0 / factor, axis=1)  # the harmonic mean along the path
+    tf = float(np.mean(U[rows, model.input_names.index("Tf")]))
+    q = rooms.network_quantities("cellar", p, tf)
+    t = dict(r["truth_parameters"])
+    t["Cw"] = room["capacity_means"]["harmonic"] / room["wall_psat"]
+    qt = rooms.network_quantities("cellar", t, room["Tf_mean"])
+    ranks, truths = {}, {}
+    for new, old in PATH_QUANTITIES.items():
+        truths[new] = float(qt[old])
+        ranks[new] = rank(np.asarray(q[old], float), truths[new])
+    assert fit_of(r)["ranks"], "a logged fit without ranks"
+    return ranks, truths

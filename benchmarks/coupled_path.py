@@ -99,3 +99,54 @@ def path_ranks(r: dict, theta: np.ndarray, fit_inputs, models: dict) -> tuple[di
         ranks[new] = rank(np.asarray(q[old], float), truths[new])
     assert fit_of(r)["ranks"], "a logged fit without ranks"
     return ranks, truths
+
+
+def start_lines(reps, seed: int, cal_days: int, fit_inputs, models: dict, gab_truth) -> list[str]:
+    """``sbc_coupled --start``: per cellar (GAB wall, no fit) the wall's highest K·RH
+    over the calibration (the GAB slope's cap acts above 0.97) and, at the true
+    parameters with the noise's at their maximum, the start's prior mean, its
+    conditional mean and the log-likelihood with the start's quadratic form taken once
+    (about the prior mean's trajectory) and twice (then about the conditional mean's)."""
+    from scipy.optimize import minimize
+
+    import heritage_bayes as hb
+    from bench_sbc import log_posterior
+    from heritage_bayes.inference.likelihoods import get_noise_model
+
+    lines = ["cellar: K*RH max; prior mean, start once / twice [Pa]; log L once / twice; "
+             "sigma_Pi once / twice"]  # fmt: skip
+    for rep in reps:
+        room = rooms.generate("cellar", [seed, rooms.ROOMS.index("cellar"), rep], cal_days)
+        kx = room["generator"]["K"] * room["phi_w_range"][1]
+        room["truth"] = gab_truth(room)
+        name, opts = models["cellar"]
+        m = hb.model(name, **opts, isotherm="gab").with_slopes(("Pe",))
+        U, y = fit_inputs(room, m)
+        rows = room["rows"]
+        _, lp = log_posterior(m, get_noise_model("ar1_white"), U[rows], y[rows], {},
+                              rooms.FLOOR, rooms.ENVELOPE, "estimate")  # fmt: skip
+        tm = np.array([room["truth"][n] for n in m.parameter_names])
+
+        def theta(v, _tm=tm):
+            return np.concatenate([_tm, np.exp(v[:1]), np.tanh(v[1:2]), np.exp(v[2:])])[None]
+
+        out = []
+        for twice in (False, True):
+            lp._relinearise = twice
+
+            def nll(v, _lp=lp):
+                r = _lp.log_likelihood(theta(v))[0]
+                return -r if np.isfinite(r) else 1e12
+
+            starts = ([np.log(10.0), 1.5, np.log(3.0)], [np.log(5.0), 0.5, 0.0])
+            fits = [
+                minimize(nll, s, method="Nelder-Mead", options={"maxiter": 400}) for s in starts
+            ]
+            best = min(fits, key=lambda r: r.fun)
+            th = theta(best.x)
+            out.append((-best.fun, lp.initial_states(th)[0, 0], th[0, lp.n_model]))
+        xm = lp._x0_mean(lp._form(th[:, : lp.n_model]))[0, 0]
+        (l1, s1, g1), (l2, s2, g2) = out
+        lines.append(f"{rep:3d}: {kx:.2f}; {xm:.0f}, {s1:.0f} / {s2:.0f}; {l1:.1f} / {l2:.1f}; "
+                     f"{g1:.1f} / {g2:.1f}")  # fmt: skip
+    return lines

@@ -601,6 +601,8 @@ def main(argv=None) -> int:
                     "what a part left out moves (paired_lines)")  # fmt: skip
     ap.add_argument("--path", metavar="LOG", help="with --draws and --log: rank the "
                     "cellar's slow quantities along each draw's wall (coupled_path)")  # fmt: skip
+    ap.add_argument("--start", action="store_true", help="no fit: the GAB wall's start "
+                    "and log L at the truth, linearised once and twice (coupled_path)")  # fmt: skip
     ap.add_argument("--misfit", action="store_true", help="no fit: the structural error "
                     "of rooms --first-rep.. with each part of the generator left out")  # fmt: skip
     ap.add_argument("--means", nargs="+", metavar="LOG", help="mean z with the "
@@ -628,6 +630,14 @@ def main(argv=None) -> int:
         return 0
     if args.path:
         return path_log(args.path, args.draws, args.log)
+    if args.start:
+        from coupled_path import start_lines
+
+        reps = range(args.first_rep, args.first_rep + args.reps)
+        reps = [int(r) for r in args.only.split(",")] if args.only else reps
+        for line in start_lines(reps, args.seed, args.cal_days, fit_inputs, MODELS, gab_truth):
+            print(line, flush=True)
+        return 0
     if args.means:
         for line in mean_lines(read_logs(args.means)):
             print(line)

@@ -72,6 +72,9 @@ OTHERS = {"attic": ("Cm",), "cellar": ("tau2_h",)}
 #: ranked for a fit with ``--isotherm gab`` only: the multilayer factor, whose truth is
 #: the generator's K (its C differs from the fit's fixed one)
 GAB_ONLY = ("K_gab",)
+#: ranked after the fit from the saved draws (``--path``, :mod:`coupled_path`): the
+#: cellar's slow quantities at the capacity along the record's own path of the wall
+PATH = ("tau1_path_h", "buffer_hours_path")
 #: the fitted buffer's isotherms (``--isotherm``): the model's option ``isotherm``
 ISOTHERMS = ("linear", "gab")
 VARIANT = "ar1_white:estimate"
@@ -135,6 +138,7 @@ def replicate(args) -> dict:
     shift = args[6] if len(args) > 6 else {}
     variant = args[7] if len(args) > 7 else VARIANT
     isotherm = args[8] if len(args) > 8 else "linear"
+    draws_dir = args[9] if len(args) > 9 else None
     assert (VOLUME, ACH) == (rooms.VOLUME, rooms.ACH), "the survey differs from the rooms'"
     room = rooms.generate(room_type, [seed, rooms.ROOMS.index(room_type), rep], cal_days,
                           without=without)  # fmt: skip
@@ -158,6 +162,9 @@ def replicate(args) -> dict:
     names = fit_model.parameter_names
 
     def extra(dq, theta, _names=names, _tf=tf_fit, _phi=phi_m):
+        if draws_dir:  # the posterior draws, for quantities derived after the fit
+            tag = "-".join([room_type, str(rep), *sorted(without), variant, isotherm])
+            np.save(Path(draws_dir) / f"{tag.replace(':', '_')}.npy", theta)
         p = {n: theta[:, j] for j, n in enumerate(_names)}
         if _phi is not None:  # the capacity at the record's mean humidity
             cap = "Cw" if "Cw" in p else "Cm"
@@ -456,11 +463,11 @@ def table_lines(results: list[dict], markdown: bool = False) -> list[str]:
         if not markdown:
             mis = np.median([r["misfit_Pa"]["sd"] for r in rs])
             lines.append(f"{label}: {cpu:.0f} s CPU per fit; structural misfit sd {mis:.1f} Pa")
-        for q in IDENTIFIABLE[room] + OTHERS[room] + GAB_ONLY:
+        for q in IDENTIFIABLE[room] + PATH + OTHERS[room] + GAB_ONLY:
             s = summary(rs, room, q)
             if s is None:
                 continue
-            tag = "" if q in IDENTIFIABLE[room] else " (not identifiable)"
+            tag = "" if q in IDENTIFIABLE[room] + PATH else " (not identifiable)"
             ci = f"{s['c90']:.2f} ({s['c90_ci'][0]:.2f}-{s['c90_ci'][1]:.2f})"
             p = "—" if not np.isfinite(s["rank_p"]) else f"{s['rank_p']:.3f}"
             zz = f"{s['z_mean']:+.2f} / {s['z_sd']:.2f}"
@@ -524,7 +531,7 @@ def paired_lines(a: list[dict], b: list[dict]) -> list[str]:
         if not reps:
             continue
         lines.append(f"{room}: {len(reps)} rooms in both (replicates {reps})")
-        for q in IDENTIFIABLE[room] + OTHERS[room]:
+        for q in IDENTIFIABLE[room] + PATH + OTHERS[room] + GAB_ONLY:
             za, zb, ia, ib = [], [], 0, 0
             for r in reps:
                 xa = fit_of(ra[r])["ranks"].get(q)
@@ -543,6 +550,29 @@ def paired_lines(a: list[dict], b: list[dict]) -> list[str]:
     return lines
 
 
+def path_log(log: str, draws: str, out: str) -> int:
+    """``--path``: the replicates of ``log`` (cellars fitted with ``--isotherm gab
+    --draws``) with the ranks of :data:`PATH` added from their saved draws, written to
+    ``out`` (:mod:`coupled_path`)."""
+    from coupled_path import path_ranks
+
+    if not (draws and out):
+        raise SystemExit("--path needs --draws DIR (the fit's draws) and --log OUT")
+    with open(out, "a") as f:
+        for r in read_logs([log]):
+            tag = "-".join([r["room"], str(r["rep"]), *r["without"], r["variant"], r["isotherm"]])
+            theta = np.load(Path(draws) / f"{tag.replace(':', '_')}.npy")
+            ranks, truths = path_ranks(r, theta, fit_inputs, MODELS)
+            fit_of(r)["ranks"].update(ranks)
+            r["truth"].update(truths)
+            f.write(json.dumps(r) + "\n")
+            zs = ", ".join(
+                f"{q} z {(x['median'] - truths[q]) / x['sd']:+.2f}" for q, x in ranks.items()
+            )
+            print(f"cellar {r['rep']}: {zs}", flush=True)
+    return 0
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--reps", type=int, default=40)
@@ -557,6 +587,8 @@ def main(argv=None) -> int:
     ap.add_argument("--variant", default=VARIANT, help="the fit: NOISE:INIT[:T=X] "
                     "(bench_sbc.fit_and_rank; T=X a likelihood tempered by X)")  # fmt: skip
     ap.add_argument("--log", help="append each replicate's result as a JSON line")
+    ap.add_argument("--draws", help="a directory: save each replicate's posterior draws "
+                    "(model then noise parameters, .npy) for --path")  # fmt: skip
     ap.add_argument("--shape", action="store_true", help="no fit: the fit's GAB slope "
                     "(C fixed) against the generator's (shape_lines)")  # fmt: skip
     ap.add_argument("--isotherm", default="linear", choices=ISOTHERMS, help="the fitted "
@@ -567,6 +599,10 @@ def main(argv=None) -> int:
     ap.add_argument("--markdown", action="store_true", help="with --table: markdown")
     ap.add_argument("--paired", nargs=2, metavar="LOG", help="two logs of the same rooms: "
                     "what a part left out moves (paired_lines)")  # fmt: skip
+    ap.add_argument("--path", metavar="LOG", help="with --draws and --log: rank the "
+                    "cellar's slow quantities along each draw's wall (coupled_path)")  # fmt: skip
+    ap.add_argument("--start", action="store_true", help="no fit: the GAB wall's start "
+                    "and log L at the truth, linearised once and twice (coupled_path)")  # fmt: skip
     ap.add_argument("--misfit", action="store_true", help="no fit: the structural error "
                     "of rooms --first-rep.. with each part of the generator left out")  # fmt: skip
     ap.add_argument("--means", nargs="+", metavar="LOG", help="mean z with the "
@@ -591,6 +627,16 @@ def main(argv=None) -> int:
         print(f"SBC of the coupled models, {' '.join(args.table)}: {len(results)} rooms")
         for line in table_lines(results, args.markdown):
             print(line)
+        return 0
+    if args.path:
+        return path_log(args.path, args.draws, args.log)
+    if args.start:
+        from coupled_path import start_lines
+
+        reps = range(args.first_rep, args.first_rep + args.reps)
+        reps = [int(r) for r in args.only.split(",")] if args.only else reps
+        for line in start_lines(reps, args.seed, args.cal_days, fit_inputs, MODELS, gab_truth):
+            print(line, flush=True)
         return 0
     if args.means:
         for line in mean_lines(read_logs(args.means)):
@@ -628,6 +674,7 @@ def main(argv=None) -> int:
             {},
             args.variant,
             args.isotherm,
+            args.draws,
         )
         for rep in reps
         for room in room_types

@@ -184,3 +184,31 @@ def test_the_tabulated_transitions_equal_the_exact_step():
     assert valid.all()
     ref = _exact(m, P, U, x0)
     np.testing.assert_allclose(Y[:, :, 0], ref, rtol=1e-10, atol=0)
+
+
+def test_a_start_far_from_the_prior_mean_is_found_along_its_own_path():
+    """A slow GAB wall that starts 400 Pa below the prior mean (the steady state of the
+    first inputs): the start's quadratic form taken about the prior mean's trajectory
+    (whose capacity is not the one the wall crosses) misplaces the conditional mean of
+    the start and costs log-likelihood at the true parameters; taken once more about
+    the trajectory from that conditional mean, the start is found to within 5 % of its
+    offset, and the true parameters' likelihood is that of their own path."""
+    N = 720
+    U = _inputs(N, seed=2)
+    p = dict(CELLAR, Cw=1.5, K_gab=1.0)
+    m = hb.model("hygric_2c_fixed", sink="temperature", isotherm="gab").with_slopes(["Pe"])
+    P = np.array([[p[n] for n in m.parameter_names]])
+    steady = m.steady_state(P, U[:48].mean(axis=0))[0]
+    x0 = steady - [400.0, 150.0]
+    obs = m.forward(P, U, DT, x0=x0)[0][0] + np.random.default_rng(4).normal(0, 2.0, (N, 1))
+    nm = get_noise_model("ar1_white")
+    kw = dict(warmup=0, init_window=48, initial_state="estimate")
+    lp = LogPosterior(m, parameters_for(m, nm), nm, U, obs, **kw)
+    theta = np.column_stack([P, [[2.0, 0.5, 2.0]]])
+    found = lp.initial_states(theta)[0]
+    ll = lp.log_likelihood(theta)[0]
+    lp._relinearise = False  # the quadratic form about the prior mean's trajectory only
+    once = lp.initial_states(theta)[0]
+    assert np.all(np.abs(found - x0) < 0.05 * 400.0), (found, x0)
+    assert np.abs(once - x0).max() > 4 * np.abs(found - x0).max(), (once, found, x0)
+    assert ll > lp.log_likelihood(theta)[0] + 100.0

@@ -168,3 +168,28 @@ def test_fit_leaves_out_readings_at_the_sensor_ceiling():
     assert np.array_equal(np.isnan(y), ~(rh < RH_SENSOR_CEILING))
     quiet = rooms.generate("attic", [sbc.SEED, 0, 9], cal_days=30, without=("noise",))
     assert quiet["gap"] == room["gap"] and quiet["truth"] == room["truth"]
+
+
+def test_wall_path_steps_the_models_own_recursion():
+    """``coupled_path.wall_paths``: the buffer's state one step at a time starts at the
+    start and ends where one call of the recursion over the record leaves it (exactly
+    for the linear wall; for the GAB wall each call restarts the capacity's
+    extrapolation, a second-order difference)."""
+    import coupled_path
+    import heritage_bayes as hb
+
+    rng = np.random.default_rng(1)
+    n = 200
+    pe = 1100 + 200 * np.sin(np.arange(n) / 24 * 2 * np.pi) + rng.normal(0, 20, n)
+    U = np.column_stack([pe, np.r_[np.diff(pe), 0.0], 10 + np.zeros(n)])
+    p = dict(Cw=0.3, Ci=0.03, Gw=2e-8, Gi=8e-7, Gfast=4e-7, Gf=3e-8, phi_f=0.9, K_gab=0.9)
+    for iso, tol in (("linear", 1e-9), ("gab", 0.5)):
+        m = hb.model("hygric_2c_fixed", sink="temperature", isotherm=iso).with_slopes(["Pe"])
+        P = np.array([[p[k] for k in m.parameter_names]])
+        x0 = np.array([[700.0, 1000.0]])
+        path = coupled_path.wall_paths(m, P, U, x0)
+        x = x0.copy()
+        m._recursion(P, m.kernel_parameters(P), U, 3600.0, x, np.empty((1, n)))
+        assert path[0, 0] == 700.0 and np.ptp(path) > 50.0
+        full = coupled_path.wall_paths(m, P, np.vstack([U, U[-1:]]), x0)[0, -1]
+        assert abs(full - x[0, 0]) < tol, (iso, full, x[0, 0])

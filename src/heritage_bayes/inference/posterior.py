@@ -158,6 +158,8 @@ class LogPosterior:
                 f"(got {mode!r})"
             )
         self._time_varying = self.model.time_varying
+        # transitions that follow the state: the start's quadratic form re-centred
+        self._relinearise = self._time_varying and self.model.isotherm != "linear"
         if self._time_varying:
             if self.noise.statespace:
                 raise ValueError(
@@ -416,19 +418,39 @@ class LogPosterior:
     def _marginal(self, mf, tn: np.ndarray, conditional: bool = False):
         """(K,) log-likelihood with the initial-state deviation integrated out, and with
         ``conditional`` its conditional posterior mean (K, nf) and covariance
-        (K, nf, nf) [°C or Pa] for the estimated nodes ``x0_free``."""
+        (K, nf, nf) [°C or Pa] for the estimated nodes ``x0_free``.
+
+        A model whose transitions follow its state (``isotherm: gab``) is linear in the
+        start only about one trajectory: the quadratic form is taken about the
+        trajectory from the prior mean, then once more about the one from the
+        conditional mean it gives (a Gauss-Newton step on the start, the prior still
+        centred on the prior mean), so that the free responses follow the capacity
+        along the path the data put the buffer on."""
         xm = self._x0_mean(mf)
+        out = self._integrate(mf, tn, xm, xm, conditional or self._relinearise)
+        if self._relinearise and self.x0_free.size:
+            at = xm.copy()
+            at[:, self.x0_free] = np.where(np.isfinite(out[1]), out[1], xm[:, self.x0_free])
+            out = self._integrate(mf, tn, at, xm, conditional)
+        return out
+
+    def _integrate(self, mf, tn, at: np.ndarray, xm: np.ndarray, conditional: bool):
+        """:meth:`_marginal` with the filter's quadratic form in the start taken about
+        the trajectory from ``at`` (K, n) and the start's prior centred on ``xm``
+        [°C or Pa]: with e = x0 - at, μ = xm - at and b = g + P0⁻¹μ the integral
+        adds ½ bᵀM⁻¹b - ½ μᵀP0⁻¹μ - ½ log det M - ½ log det P0; the conditional mean
+        is ``at + M⁻¹b``."""
         free = self.x0_free
         nf = free.size
         if self._time_varying:  # the basis in physical coordinates
             acc = coupled_filter_stats(
-                self.model, mf.theta, self._series, xm, self.observed, self.noise, tn,
+                self.model, mf.theta, self._series, at, self.observed, self.noise, tn,
                 basis=nf > 0, dt=self.dt,
             )  # fmt: skip
-            Tinv = np.broadcast_to(np.eye(xm.shape[1]), mf.Tinv.shape)
+            Tinv = np.broadcast_to(np.eye(at.shape[1]), mf.Tinv.shape)
         else:
             acc = self.noise.filter_modal(
-                mf, self.inputs, mf.to_modal(xm), self.observed, tn, basis=nf > 0
+                mf, self.inputs, mf.to_modal(at), self.observed, tn, basis=nf > 0
             )
             Tinv = mf.Tinv
         ll = -0.5 * (acc[0] + acc[1])
@@ -448,7 +470,11 @@ class LogPosterior:
         P = self._x0_cov(mf)
         sgn, logdet_p = np.linalg.slogdet(P)
         Pinv = np.linalg.inv(P)
-        M = Hx + 0.5 * (Pinv + np.swapaxes(Pinv, 1, 2))
+        Pinv = 0.5 * (Pinv + np.swapaxes(Pinv, 1, 2))
+        M = Hx + Pinv
+        mu = (xm - at)[:, free]
+        gx = gx + np.einsum("kij,kj->ki", Pinv, mu)
+        ll = ll - 0.5 * np.einsum("ki,kij,kj->k", mu, Pinv, mu)
         ok = np.all(np.isfinite(M), axis=(1, 2)) & np.isfinite(ll) & (sgn > 0)
         M[~ok] = np.eye(nf)
         gx[~ok] = 0.0
@@ -470,7 +496,7 @@ class LogPosterior:
             return ll, None, None
         Minv = np.linalg.inv(M)
         mean = np.einsum("kij,kj->ki", Minv, gx)
-        return ll, xm[:, free] + mean, Minv
+        return ll, at[:, free] + mean, Minv
 
     def initial_states(
         self, theta: np.ndarray, rng: np.random.Generator | None = None

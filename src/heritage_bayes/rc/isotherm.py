@@ -51,7 +51,9 @@ step's change (measured against a fine integration of the ODE in
 docs/science/models.md, "A capacity that follows the humidity"). The transitions now
 depend on the state: they are computed inside the recursion, and the initial state's
 free responses (with which the likelihood integrates it out) are propagated by the
-transitions of the trajectory from the prior mean, a linearisation about it.
+transitions of the trajectory from the prior mean, then once more by those of the
+trajectory from the conditional mean start that gives (a linearisation about the
+path the data put the buffer on; :class:`heritage_bayes.inference.posterior.LogPosterior`).
 
 Tabulated transitions
 ---------------------

@@ -66,6 +66,7 @@ from heritage_bayes.prepare_steps import (
     complete_frame,
     demo_truth,
     fitted_mask,
+    inside,
     period_rows,
 )
 from heritage_bayes.sources import INPUT_COLUMNS, OUTPUT_COLUMNS, _ground_column, read_sources
@@ -195,8 +196,16 @@ class Prepared:
     def validation_inside(self) -> bool:
         """The validation period lies inside the calibration period: the model is
         simulated through it, its observations are not fitted."""
-        v, c = self.validation, self.calibration
-        return v is not None and c.start <= v.start < c.stop
+        return inside(self.calibration, self.validation)
+
+    @property
+    def held_out(self) -> slice | None:
+        """The rows of a validation inside the calibration period, counted from the
+        calibration's start (None when the validation lies outside it)."""
+        if not self.validation_inside:
+            return None
+        c, v = self.calibration.start, self.validation
+        return slice(v.start - c, v.stop - c)
 
     def fitted_rows(self) -> np.ndarray:
         """(N,) bool: the rows whose observations the calibration fits: the calibration
@@ -207,9 +216,8 @@ class Prepared:
         """:meth:`observed` over the calibration rows, NaN (missing, as a logger gap) on
         the rows of a validation inside it: what the likelihood fits."""
         obs = self.observed(section, model)[self.calibration].copy()
-        if self.validation_inside:
-            c, v = self.calibration.start, self.validation
-            obs[v.start - c : v.stop - c] = np.nan
+        if self.held_out is not None:
+            obs[self.held_out] = np.nan
         return obs
 
     def period_index(self, which: str) -> pd.DatetimeIndex:

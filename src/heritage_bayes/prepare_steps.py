@@ -217,7 +217,7 @@ def period_rows(cfg, frame: pd.DataFrame, models):
     warmup_steps = math.ceil(warmup / step - 1e-9)
     init_steps = math.ceil(per.init_window / step - 1e-9)
     cal_rows, before = cal.stop - cal.start, ""
-    if val is not None and cal.start <= val.start < cal.stop:  # the warm-up ends before it
+    if inside(cal, val):  # the warm-up ends before it
         cal_rows, before = val.start - cal.start, " before the validation inside it"
     if warmup_steps >= cal_rows:
         a, b = frame.index[cal.start], frame.index[cal.start + cal_rows - 1] + step
@@ -247,12 +247,18 @@ def period_rows(cfg, frame: pd.DataFrame, models):
     return cal, val, note, warmup_steps, init_steps
 
 
+def inside(cal: slice, val: slice | None) -> bool:
+    """The validation rows ``val`` start inside the calibration rows ``cal`` (the
+    configuration puts them inside with calibration rows on both sides)."""
+    return val is not None and cal.start <= val.start < cal.stop
+
+
 def fitted_mask(n: int, cal: slice, val: slice | None, warmup_steps: int) -> np.ndarray:
     """(n,) bool: the rows whose observations the calibration fits: the calibration
     period after its warm-up, without the rows of a validation inside it."""
     rows = np.zeros(n, dtype=bool)
     rows[cal.start + warmup_steps : cal.stop] = True
-    if val is not None and cal.start <= val.start < cal.stop:
+    if inside(cal, val):
         rows[val] = False
     return rows
 

@@ -39,10 +39,11 @@ def section_log_posterior(
         from heritage_bayes.inference.segments import SegmentedLogPosterior, calibration_segments
 
         kind = SegmentedLogPosterior
-        extra = {"segments": tuple(calibration_segments(prep)[0]), "frame_breaks": prep.breaks}
-        if prep.validation_inside:
-            v = prep.validation
-            extra["held_out"] = slice(v.start - cal.start, v.stop - cal.start)
+        extra = {
+            "segments": tuple(calibration_segments(prep)[0]),
+            "frame_breaks": prep.breaks,
+            "held_out": prep.held_out,
+        }
     try:
         return kind(
             model,

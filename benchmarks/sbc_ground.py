@@ -53,10 +53,13 @@ MODEL = ("thermal_1c", {"surfaces": (), "ground": "seasonal"})
 #: (scale-free), and the depth (through the ground's share of the balance, the gain
 #: from Tf = 1 - gain_Ti_Te, it moves the ground's level and phase over the record)
 IDENTIFIABLE = ("tau_1_h", "gain_Ti_Te", "zf")
-#: ranked for the record: absolute sizes pinned by the survey's priors only, and the
-#: ground's mean offset ``dTf`` [K] (its truth: the generator's climate mean minus the
-#: mean of the cycle the package fits to the station's year, :func:`offset_truth`)
-OTHERS = ("dTf", "Gf", "Ci")
+#: ranked for the record: the ground's mean offset ``dTf`` [K] (its truth: the offset of
+#: the package's ground closest to the generator's soil, :func:`ground_truth`; and
+#: ``dTf_climate``, the same draws against the study's earlier truth,
+#: :func:`climate_offset`), the depth against that ground's depth (``zf_lsq``; ``zf``
+#: above is ranked against the generator's), and absolute sizes pinned by the survey's
+#: priors only
+OTHERS = ("dTf", "dTf_climate", "zf_lsq", "Gf", "Ci")
 VARIANT = "ar1_white:estimate:T=2"
 SEED = 2061
 CAL_DAYS = 120
@@ -111,10 +114,54 @@ def fit_inputs(room: dict, model, true_mean: bool = False):
     return U, frame["Ti"].to_numpy(float), te
 
 
-def offset_truth(room: dict, te) -> float:
-    """The truth of the ground's mean offset ``dTf`` [K]: the soil's mean (the
-    generator's climate mean) minus the mean of the cycle the package fits to the
-    station's Te (the fit's ``Tf`` input)."""
+def package_ground(U, model, zf, dtf=0.0) -> np.ndarray:
+    """The package's ground ``Tf(t; zf, dTf)`` [°C] over the fit's steps: the input
+    ``Tf`` (the fitted cycle at 1 m) carried to the equivalent depth ``zf`` [m] through
+    ``Tf_cos``, ``Tf_sin`` and raised by the offset ``dtf`` [K], as the fit's
+    ``GroundCycle`` does (``heritage_bayes.rc.network.GroundCycle``)."""
+    from heritage_bayes.climate.ground import depth_factors
+
+    a, b = depth_factors(zf)
+    a1, b1 = depth_factors(1.0)
+    names = model.input_names
+    tf = U[:, names.index("Tf")] + (a - a1) * U[:, names.index("Tf_cos")]
+    return tf + (b - b1) * U[:, names.index("Tf_sin")] + dtf
+
+
+def ground_truth(room: dict, model, U) -> dict:
+    """The ground the fit can express closest to the generator's soil: ``zf`` [m] and
+    ``dTf`` [K] of :func:`package_ground` by least squares against the soil's
+    temperature at the room's depth over the calibration hours with a reading (within
+    the fit's prior bounds, 0.5-6 m and ±5 K).
+
+    ``dTf``'s truth: the soil's departures from its annual harmonic (the synoptic
+    weather conducted down) and the fitted cycle's errors do not average out over the
+    calibration window, and the package's ground, a cycle plus a constant, takes them
+    up in its offset and its depth together; the offset's truth is the one that goes
+    with that depth. The generator's climate mean minus the fitted cycle's
+    (:func:`climate_offset`) is the offset of a ground that followed the harmonic only.
+    Returns ``{"zf": ..., "dTf": ...}``."""
+    from scipy.optimize import least_squares
+
+    n = U.shape[0]
+    seen = np.zeros(n, bool)
+    seen[room["rows"]] = True
+    seen &= np.isfinite(room["hourly"]["Ti"][:n])
+    soil = room["hourly"]["Tf_true"][:n][seen]
+
+    def resid(x):
+        return package_ground(U, model, np.exp(x[0]), x[1])[seen] - soil
+
+    zf0 = room["truth"]["zf"]
+    x0 = [np.log(zf0), float(np.mean(soil - package_ground(U, model, zf0)[seen]))]
+    lo, hi = [np.log(rooms.ZF_BOUNDS[0]), -5.0], [np.log(rooms.ZF_BOUNDS[1]), 5.0]
+    x = least_squares(resid, np.clip(x0, lo, hi), bounds=(lo, hi)).x
+    return {"zf": float(np.exp(x[0])), "dTf": float(x[1])}
+
+
+def climate_offset(room: dict, te) -> float:
+    """The generator's climate mean minus the mean of the cycle the package fits to the
+    station's Te [K] (the study's truth of ``dTf`` before :func:`ground_truth`)."""
     from heritage_bayes.climate.ground import fit_annual_cycle
 
     return float(room["climate"]["T_m"] - fit_annual_cycle(te)["mean"])
@@ -124,14 +171,10 @@ def ground_error(room: dict, te, model, U) -> dict:
     """The package's ground at the true equivalent depth against the generator's soil
     over the calibration hours (mean, sd [K]), and the package's fitted surface cycle
     against the generator's harmonic (mean [°C], amplitude [K], coldest day [d])."""
-    from heritage_bayes.climate.ground import depth_factors, fit_annual_cycle
+    from heritage_bayes.climate.ground import fit_annual_cycle
 
     rows = room["rows"]
-    a, b = depth_factors(room["truth"]["zf"])
-    a1, b1 = depth_factors(1.0)
-    names = model.input_names
-    tf = U[:, names.index("Tf")] + (a - a1) * U[:, names.index("Tf_cos")]
-    tf = tf + (b - b1) * U[:, names.index("Tf_sin")]
+    tf = package_ground(U, model, room["truth"]["zf"])
     d = (room["hourly"]["Tf_true"][: tf.size] - tf)[rows]
     c = fit_annual_cycle(te)
     cl = room["climate"]
@@ -162,8 +205,9 @@ def replicate(args) -> dict:
     U, y, te = fit_inputs(room, model, true_mean)
     rows = room["rows"]
     truth = rooms.quantities(room["truth"])
-    if "dTf" in model.parameter_names:  # the offset, against the input the fit was given
-        truth["dTf"] = 0.0 if true_mean else offset_truth(room, te)
+    lsq = ground_truth(room, model, U)  # against the input the fit was given
+    climate = 0.0 if true_mean else climate_offset(room, te)
+    truth.update(dTf=lsq["dTf"], dTf_climate=climate, zf_lsq=lsq["zf"])
     truth = {k: float(v) * shift.get(k, 1.0) for k, v in truth.items()}
     names = model.parameter_names
 
@@ -171,9 +215,7 @@ def replicate(args) -> dict:
         p = {n: theta[:, j] for j, n in enumerate(_names)}
         q = rooms.quantities(p)
         out = {k: q[k] for k in ("zf", "Gf", "Ci")}
-        if "dTf" in p:
-            out["dTf"] = p["dTf"]
-        return out
+        return out | {"zf_lsq": q["zf"], "dTf": p["dTf"], "dTf_climate": p["dTf"]}
 
     return {
         "room": "ground",
@@ -240,16 +282,17 @@ def table_lines(results: list[dict], markdown: bool = False) -> list[str]:
 
 
 def room_lines(results: list[dict]) -> list[str]:
-    """Per room: z of each identifiable quantity (``*`` outside the 90 % interval), the
-    truths' depth and ground share, and the ground's error (:func:`ground_error`)."""
+    """Per room: z of each identifiable quantity and of ``dTf`` (``*`` outside the 90 %
+    interval), the truths' depth and ground share, and the ground's error
+    (:func:`ground_error`)."""
     lines = [
-        "rep: z tau, gain, zf | zf true, gain from Tf | ground - package's at true zf: "
+        "rep: z tau, gain, zf, dTf | zf true, gain from Tf | ground - package's at true zf: "
         "mean, sd [K] | cycle: mean, amplitude error [K], coldest day [d]"
     ]
     for r in sorted(results, key=lambda r: r["rep"]):
         ranks = r["variants"][r["variant"]]["ranks"]
         zs = []
-        for q in IDENTIFIABLE:
+        for q in (*IDENTIFIABLE, "dTf"):
             x = ranks.get(q)
             if x is None:
                 zs.append("   —  ")
@@ -305,11 +348,13 @@ def misfit_lines(reps, seed: int, cal_days: int, without: tuple, reading: str) -
 
 
 def pseudo_fit(room: dict, model) -> dict:
-    """The fit's pseudo-truth of one room without the posterior: ``Ge``, ``Gf`` and
-    ``zf`` by least squares of the package's model on the room's noise-free hourly Ti
-    over the calibration hours (``Ci`` and ``dTf`` at their truths, the start at the
-    generator's). Returns the least-squares and true ``tau_1_h`` [h], ``zf`` [m] and
-    gain from Tf [-] (``*_true``), and the ground's error (:func:`ground_error`)."""
+    """The fit's pseudo-truth of one room without the posterior: ``Ge``, ``Gf``, ``zf``
+    and ``dTf`` by least squares of the package's model on the room's noise-free hourly
+    Ti over the calibration hours (``Ci`` at its truth, the start at the generator's).
+    Returns the least-squares and true ``tau_1_h`` [h], ``zf`` [m], gain from Tf [-]
+    and ``dTf`` [K] (``*_true``; ``zf_lsq`` and ``dTf_true`` of :func:`ground_truth`,
+    ``dTf_climate`` of :func:`climate_offset`), and the ground's error
+    (:func:`ground_error`)."""
     from scipy.optimize import least_squares
 
     from heritage_bayes import simulate
@@ -318,22 +363,27 @@ def pseudo_fit(room: dict, model) -> dict:
     t, rows = room["truth"], room["rows"]
     target = room["hourly"]["Ti_true"][: U.shape[0]][rows]
     x0 = np.array([room["hourly"]["Ti_true"][0]])
-    t = {**t, "dTf": offset_truth(room, te)} if "dTf" in model.parameter_names else t
+    lsq = ground_truth(room, model, U)
 
     def resid(x):
-        p = {**t, "Ge": np.exp(x[0]), "Gf": np.exp(x[1]), "zf": np.exp(x[2])}
+        p = {**t, "Ge": np.exp(x[0]), "Gf": np.exp(x[1]), "zf": np.exp(x[2]), "dTf": x[3]}
         return simulate(model, p, U, 3600.0, x0)[rows, 0] - target
 
-    start = np.log([t["Ge"], t["Gf"], t["zf"]])
-    lo, hi = np.log([1e-2, 1e-2, 0.5]), np.log([1e5, 1e5, 6.0])
-    ge, gf, zf = np.exp(least_squares(resid, start, bounds=(lo, hi), x_scale=1.0).x)
+    start = [*np.log([t["Ge"], t["Gf"], t["zf"]]), lsq["dTf"]]
+    lo, hi = [*np.log([1e-2, 1e-2, 0.5]), -5.0], [*np.log([1e5, 1e5, 6.0]), 5.0]
+    x = least_squares(resid, start, bounds=(lo, hi), x_scale=1.0).x
+    ge, gf, zf = np.exp(x[:3])
     return {
         "tau_1_h": t["Ci"] / (ge + gf) / 3600.0,
         "tau_1_h_true": t["Ci"] / (t["Ge"] + t["Gf"]) / 3600.0,
         "zf": zf,
         "zf_true": t["zf"],
+        "zf_lsq": lsq["zf"],
         "gain_f": gf / (ge + gf),
         "gain_f_true": t["Gf"] / (t["Ge"] + t["Gf"]),
+        "dTf": float(x[3]),
+        "dTf_true": lsq["dTf"],
+        "dTf_climate": climate_offset(room, te),
         "ground": ground_error(room, te, model, U),
     }
 
@@ -341,22 +391,22 @@ def pseudo_fit(room: dict, model) -> dict:
 def pseudo_lines(reps, seed: int, cal_days: int, without: tuple, reading: str) -> list[str]:
     """``--pseudo``: :func:`pseudo_fit` of rooms ``reps`` against their truths (the
     room's unmodelled gain stays unless ``without`` leaves it out): what the ground's
-    and the weather's structural error alone do to the time constant, the depth and
-    the gain."""
+    and the weather's structural error alone do to the time constant, the depth, the
+    gain and the ground's offset."""
     model = fit_model()
     lines = [
-        "rep: tau true [h], least squares - true [min]; zf true -> LS; gain from Tf "
-        "true -> LS; ground error mean [K]"
+        "rep: tau true [h], least squares - true [min]; zf true (ground's LS) -> LS; gain "
+        "from Tf true -> LS; dTf true (climate's) -> LS [K]"
     ]
     for rep in reps:
         room = rooms.generate([seed, rep], cal_days, without=without, reading=reading)
         f = pseudo_fit(room, model)
-        g = f["ground"]
         lines.append(
             f"{rep:3d}: tau {f['tau_1_h_true']:.2f} h, "
-            f"{60 * (f['tau_1_h'] - f['tau_1_h_true']):+.1f} min; zf {f['zf_true']:.2f} -> "
-            f"{f['zf']:.2f} m; gain from Tf {f['gain_f_true']:.3f} -> {f['gain_f']:.3f}; "
-            f"ground error {g['tf_mean']:+.2f} K, cycle mean {g['cycle_mean']:+.2f} K"
+            f"{60 * (f['tau_1_h'] - f['tau_1_h_true']):+.1f} min; zf {f['zf_true']:.2f} "
+            f"({f['zf_lsq']:.2f}) -> {f['zf']:.2f} m; gain from Tf {f['gain_f_true']:.3f} "
+            f"-> {f['gain_f']:.3f}; dTf {f['dTf_true']:+.2f} ({f['dTf_climate']:+.2f}) -> "
+            f"{f['dTf']:+.2f} K"
         )
     return lines
 

@@ -47,6 +47,11 @@ variant of the roof planes' irradiance input:
   towards 0 °C; ``snowwarm<w>``: the base ``w`` of the way from the air's 24-hour mean
   to 0 °C (the package's ``BASE_WARMTH``; 0: the package before it, a melting base
   over a warm attic: 1);
+- ``lw``: the long-wave loss to the sky as ``sky``, but the night's cloud from the
+  clearness of the two days around it (each day's at its solar noon, interpolated in
+  time), subtracted before the wind's weight and the snow (the loss leaves the cover
+  as its absorbed sun does; no loss reaches the attic through a snow cover);
+  ``lwc``: the same loss less its mean over the record (its variation only);
 - ``from<date>``: the calibration starts at the date (e.g. ``from2011-04-20``: after the
   snow), its end and the validation as init chose them.
 
@@ -197,6 +202,64 @@ def _sky_loss(irr, weather, site, surfaces, table):
     return out
 
 
+def _clearness(idx, site, table) -> np.ndarray:
+    """Each step's clearness [-]: the solar day's global radiation over a cloudless
+    sky's (days whose cloudless sky sums under 150 W/m² over their steps left out),
+    placed at solar noon and interpolated in time (a night: between its two days)."""
+    from heritage_bayes.climate.solar import clear_sky_weather
+
+    cs = clear_sky_weather(idx, site, interval=table.attrs.get("interval"))["ghi"].to_numpy()
+    shift = pd.Timedelta(hours=site["longitude"] / 15.0)
+    day = (idx + shift).floor("D")
+    g = pd.DataFrame({"g": table["ghi"].reindex(idx).to_numpy(float), "c": cs}, index=day)
+    sums = g.groupby(level=0).sum()
+    k = (sums["g"] / sums["c"]).clip(0, 1).where(sums["c"] > 150.0).dropna()
+    k.index = k.index + pd.Timedelta(hours=12) - shift
+    on = k.reindex(k.index.union(idx)).interpolate("time", limit_direction="both")
+    return on.reindex(idx).to_numpy(float)
+
+
+def _long_wave(out, weather, site, planes, surfaces, table, centred=False):
+    """The roof planes' columns less their long-wave loss to the sky, in the sun's
+    units (ε/α = 1): :math:`F_{sky}\\,\\sigma(1 - \\varepsilon_{sky})T_e^4`, the sky's
+    emissivity the clear sky's from the dew point (Berdahl and Martin 1984) raised by
+    the cloud fraction 1 - clearness (Crawford and Duchon 1999); ``centred``: less its
+    mean over the record (the loss's variation only)."""
+    from heritage_bayes.climate.psychro import dew_point
+
+    idx = out.index
+    te = weather["Te"].reindex(idx).interpolate(limit_direction="both").to_numpy(float)
+    rhe = weather["RHe"].reindex(idx).interpolate(limit_direction="both").to_numpy(float)
+    tdp = dew_point(te, rhe) / 100.0
+    clear = _clearness(idx, site, table)
+    eps = (1.0 - clear) + clear * (0.711 + 0.56 * tdp + 0.73 * tdp**2)
+    loss = SIGMA * (1.0 - eps) * (te + 273.15) ** 4
+    loss = loss - np.nanmean(loss) if centred else loss
+    res = out.copy()
+    for k in planes:
+        res[f"I_{k}"] = out[f"I_{k}"] - (1 + np.cos(np.radians(surfaces[k][0]))) / 2 * loss
+    res.attrs = dict(out.attrs)
+    return res
+
+
+def _lw_variant(orig, weather, site, surfaces, mode, where, roof, kw, variant):
+    """The package's roof columns with the long-wave loss subtracted before the wind's
+    weight and the snow (the loss leaves the cover as its absorbed sun does)."""
+    from heritage_bayes import inputs
+    from heritage_bayes.climate import snow
+
+    bare = weather.drop(columns=[c for c in ("wind", "precip") if c in weather])
+    out, label, detail = orig(bare, site, surfaces, mode, where=where, roof=roof, **kw)
+    table = weather if "ghi" in weather else _estimated(weather, site)
+    out = _long_wave(out, weather, dict(site), roof, surfaces, table, variant == "lwc")
+    planes = [f"I_{k}" for k in roof]
+    if "wind" in weather:
+        out = inputs._wind_weighted(out, weather["wind"], planes, where)
+    if "precip" in weather:
+        out = snow.roof_snow_columns(out, weather["Te"], weather["precip"], planes)[0]
+    return out, label, detail
+
+
 def _snow_factor(raw: pd.DataFrame, index, keep: float = 1 / 3, start: bool = False):
     """1 - (1 - keep) of the roof's snow cover [-] from a degree-day snowpack; ``start``:
     a record starting in frost (its first week's mean Te below 0 °C) starts under 20 mm
@@ -265,6 +328,8 @@ def patched(variant: str, raw: pd.DataFrame):
             for k in roof:
                 out[f"I_{k}"] = out[f"I_{k}"].to_numpy() * w
             return out, label, detail
+        if variant in ("lw", "lwc"):
+            return _lw_variant(orig, weather, site, surfaces, mode, where, roof, kw, variant)
         if variant in SNOW_VARIANTS or variant.startswith("melt"):
             out, label, detail = orig(weather.drop(columns="precip"), site, surfaces, mode,
                                       where=where, roof=roof, **kw)  # fmt: skip
@@ -415,10 +480,10 @@ def _config(room, variant, model, bare, data, w):
                                   "periods": periods})  # fmt: skip
 
 
-def run(room, variant, bare, data, work, hours, model="thermal_1c"):
-    from heritage_bayes.inference.results import fit_metrics
-
-    w = work / room / ("bare" if bare else "meas") / model
+def simulated(room, variant, bare, data, work, model="thermal_1c"):
+    """The variant's MAP: its config, prepared data, model, log-posterior, MAP, and
+    the observed and simulated Ti [°C] on the prepared frame."""
+    w = work / room / ("bare" if bare else "meas") / model / variant
     (w / "wx").mkdir(parents=True, exist_ok=True)
     cfg = _config(room, variant, model, bare, data, w)
     undo = patched(_roof_answers(variant)[1], _fmi(room, data))
@@ -428,7 +493,13 @@ def run(room, variant, bare, data, work, hours, model="thermal_1c"):
         undo()
     u = prep.model_inputs("thermal", m)
     y = lp.simulate_frame(mp.theta[None], u, prep.calibration.start)[0][0][:, 0]
-    obs = prep.observed("thermal", m)[:, 0]
+    return cfg, prep, m, lp, mp, prep.observed("thermal", m)[:, 0], y
+
+
+def run(room, variant, bare, data, work, hours, model="thermal_1c"):
+    from heritage_bayes.inference.results import fit_metrics
+
+    _, prep, m, lp, mp, obs, y = simulated(room, variant, bare, data, work, model)
     v = prep.validation
     fit = fit_metrics(obs[v], y[v])["FIT"]
     if hours:

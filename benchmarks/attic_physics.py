@@ -52,6 +52,9 @@ variant of the roof planes' irradiance input:
   time), subtracted before the wind's weight and the snow (the loss leaves the cover
   as its absorbed sun does; no loss reaches the attic through a snow cover);
   ``lwc``: the same loss less its mean over the record (its variation only);
+  ``lwd``, ``lwdc``: ``lw``, ``lwc`` with the cover no colder than the dew point (the
+  latent heat of the vapour condensing on it): the loss at most
+  :math:`h_e (T_e - T_d)/\\alpha`;
 - ``from<date>``: the calibration starts at the date (e.g. ``from2011-04-20``: after the
   snow), its end and the validation as init chose them.
 
@@ -219,25 +222,31 @@ def _clearness(idx, site, table) -> np.ndarray:
     return on.reindex(idx).to_numpy(float)
 
 
-def _long_wave(out, weather, site, planes, surfaces, table, centred=False):
+def _long_wave(out, weather, site, planes, surfaces, table, centred=False, dew=False):
     """The roof planes' columns less their long-wave loss to the sky, in the sun's
     units (ε/α = 1): :math:`F_{sky}\\,\\sigma(1 - \\varepsilon_{sky})T_e^4`, the sky's
     emissivity the clear sky's from the dew point (Berdahl and Martin 1984) raised by
     the cloud fraction 1 - clearness (Crawford and Duchon 1999); ``centred``: less its
-    mean over the record (the loss's variation only)."""
+    mean over the record (the loss's variation only); ``dew``: at most
+    :math:`h_e (T_e - T_d)/\\alpha` (the cover no colder than the dew point)."""
     from heritage_bayes.climate.psychro import dew_point
+    from heritage_bayes.climate.snow import ROOF_ABSORPTANCE
+    from heritage_bayes.climate.solair import REFERENCE_WIND, exterior_surface_coefficient
 
     idx = out.index
     te = weather["Te"].reindex(idx).interpolate(limit_direction="both").to_numpy(float)
     rhe = weather["RHe"].reindex(idx).interpolate(limit_direction="both").to_numpy(float)
-    tdp = dew_point(te, rhe) / 100.0
+    td = dew_point(te, rhe)
     clear = _clearness(idx, site, table)
-    eps = (1.0 - clear) + clear * (0.711 + 0.56 * tdp + 0.73 * tdp**2)
+    eps = (1.0 - clear) + clear * (0.711 + 0.56 * td / 100 + 0.73 * (td / 100) ** 2)
     loss = SIGMA * (1.0 - eps) * (te + 273.15) ** 4
-    loss = loss - np.nanmean(loss) if centred else loss
+    # dew: the cover no lower than the dew point (condensing vapour's latent heat)
+    cap = exterior_surface_coefficient(REFERENCE_WIND) / ROOF_ABSORPTANCE * np.maximum(te - td, 0)
     res = out.copy()
     for k in planes:
-        res[f"I_{k}"] = out[f"I_{k}"] - (1 + np.cos(np.radians(surfaces[k][0]))) / 2 * loss
+        lw = (1 + np.cos(np.radians(surfaces[k][0]))) / 2 * loss
+        lw = np.minimum(lw, cap) if dew else lw
+        res[f"I_{k}"] = out[f"I_{k}"] - (lw - np.nanmean(lw) if centred else lw)
     res.attrs = dict(out.attrs)
     return res
 
@@ -251,7 +260,8 @@ def _lw_variant(orig, weather, site, surfaces, mode, where, roof, kw, variant):
     bare = weather.drop(columns=[c for c in ("wind", "precip") if c in weather])
     out, label, detail = orig(bare, site, surfaces, mode, where=where, roof=roof, **kw)
     table = weather if "ghi" in weather else _estimated(weather, site)
-    out = _long_wave(out, weather, dict(site), roof, surfaces, table, variant == "lwc")
+    out = _long_wave(out, weather, dict(site), roof, surfaces, table, variant.endswith("c"),
+                     variant.startswith("lwd"))  # fmt: skip
     planes = [f"I_{k}" for k in roof]
     if "wind" in weather:
         out = inputs._wind_weighted(out, weather["wind"], planes, where)
@@ -328,7 +338,7 @@ def patched(variant: str, raw: pd.DataFrame):
             for k in roof:
                 out[f"I_{k}"] = out[f"I_{k}"].to_numpy() * w
             return out, label, detail
-        if variant in ("lw", "lwc"):
+        if variant in ("lw", "lwc", "lwd", "lwdc"):
             return _lw_variant(orig, weather, site, surfaces, mode, where, roof, kw, variant)
         if variant in SNOW_VARIANTS or variant.startswith("melt"):
             out, label, detail = orig(weather.drop(columns="precip"), site, surfaces, mode,
@@ -421,6 +431,15 @@ def _roof_answers(variant: str) -> tuple[dict, str]:
     return edits, "+".join(rest) or "wind"
 
 
+def _aperture_cap(variant: str) -> tuple[float | None, str]:
+    """The roof apertures' prior cap [m²] of a variant joined by ``+cap<N>`` (the
+    package's: 200), and the variant left."""
+    parts = variant.split("+")
+    caps = [float(p[3:]) for p in parts if p.startswith("cap")]
+    rest = "+".join(p for p in parts if not p.startswith("cap")) or "wind"
+    return (caps[0] if caps else None), rest
+
+
 def _roof_edit(config: Path, variant: str) -> tuple[Path, str]:
     """init's config with the variant's roof answers written in, and the variant left."""
     import yaml
@@ -444,6 +463,7 @@ def _config(room, variant, model, bare, data, w):
     config = run_init(room, data, w, _weather(room, data, w, bare, model == "below_measured"))[0]
     if model == "ground_measured":
         config = room_below(config, data / ROOMS[room][0])
+    cap, variant = _aperture_cap(variant)
     config, variant = _roof_edit(config, variant)
     cfg = load_config(config)
     d = cfg.data
@@ -461,6 +481,11 @@ def _config(room, variant, model, bare, data, w):
     from heritage_bayes.config.priors import PriorSpec
 
     name, options, priors = MODELS[model]
+    if cap is not None:
+        roof = {
+            f"fI_{k}": {"dist": "loguniform", "lower": 1e-3, "upper": cap} for k in d.roof.planes()
+        }
+        priors = {**priors, **roof}
     typed = {k: PriorSpec.model_validate(v) for k, v in priors.items()}
     th = cfg.thermal.model_copy(
         update={"model": name, "options": ModelOptions.model_validate(options), "priors": typed}
@@ -486,7 +511,7 @@ def simulated(room, variant, bare, data, work, model="thermal_1c"):
     w = work / room / ("bare" if bare else "meas") / model / variant
     (w / "wx").mkdir(parents=True, exist_ok=True)
     cfg = _config(room, variant, model, bare, data, w)
-    undo = patched(_roof_answers(variant)[1], _fmi(room, data))
+    undo = patched(_roof_answers(_aperture_cap(variant)[1])[1], _fmi(room, data))
     try:
         prep, m, lp, mp = config_map(cfg, "thermal")
     finally:

@@ -244,7 +244,7 @@ def test_the_first_pass_ends_where_the_start_is_forgotten():
         first, whole = (
             coupled_filter_stats(
                 m, tm, lp._series, xm, lp.observed, nm, tn, basis=True, dt=DT, stop=stop
-            )  # fmt: skip
+            )
             for stop in (FIRST_PASS_STOP, 0.0)
         )
         assert np.all(first[2, :3] < N) and first[2, 1] > first[2, 0], first[2]

@@ -37,6 +37,9 @@ _LOG2PI = math.log(2.0 * math.pi)
 #: steps after it would add to the start's gradient and curvature terms of at most
 #: this size times the innovations' weights, decaying at the buffer's own rate.
 FIRST_PASS_STOP = 1e-15
+#: Steps per block of a recursion with a ``stop``: its free responses are checked at
+#: each block's start (the transitions of the block's later steps are already computed).
+STOP_BLOCK = 256
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath={"contract"})
@@ -49,14 +52,15 @@ def _coupled_kf(kp, ks, sb, slope, dt, x0, yobs, sigma, phi, w, nb, stop, acc): 
     :meth:`~heritage_bayes.rc.sorption.CoupledHygricModel.series`; x0 (K, 2) initial
     states [Pa]; yobs (N,) observed ``Pi`` (NaN = excluded); sigma, phi, w (K,) noise
     parameters; nb: 2 (basis of both nodes) or 0; stop: 0, or end a walker's
-    recursion at the first block where its free responses have all fallen below
-    ``stop`` [Pa per Pa] (the start's statistics g, H complete; the log-likelihood then
-    covers only the steps run); acc (3 + nb + nb², K), zeros, as
+    recursion at the first block (of :data:`STOP_BLOCK` steps) where its free
+    responses have all fallen below ``stop`` [Pa per Pa] (the start's g, H complete;
+    the log-likelihood then covers only the steps run); acc (3 + nb + nb², K), zeros, as
     :meth:`NoiseModel.filter_modal` (rows: sum log 2πF, sum e²/F, the steps run, g,
     lower triangle of H), in physical coordinates.
     """
     K = kp.shape[0]
     N = sb.shape[1]
+    span = BLOCK if stop <= 0.0 else STOP_BLOCK  # steps between checks of the responses
     Mf = np.empty((6, BLOCK))
     tab = np.empty((N_CELLS, ROW))  # reserved, its rows written when first reached
     built = np.zeros(N_CELLS, dtype=np.bool_)
@@ -92,8 +96,8 @@ def _coupled_kf(kp, ks, sb, slope, dt, x0, yobs, sigma, phi, w, nb, stop, acc): 
         hvv = 0.0
         alive = nb > 0
         run = N
-        for k0 in range(0, N, BLOCK):
-            B = min(BLOCK, N - k0)
+        for k0 in range(0, N, span):
+            B = min(span, N - k0)
             if gab:
                 gab_block(tc, tab, built, sb[:, k0:], B, dt, slope, st, Mf, scratch)
             else:

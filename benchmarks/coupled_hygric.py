@@ -28,11 +28,22 @@ years: a cost per step that grows with the record is a stall (a dying free respo
 stuck at a subnormal number was one).
 
     python benchmarks/coupled_hygric.py
+    python benchmarks/coupled_hygric.py --second-pass 12,8,0
+
+``--second-pass REPS``: instead, what the second pass changes, on the SBC cellars
+(``benchmarks/sbc_coupled.py``'s rooms, seed 2049, 60 days, the fit with ``isotherm:
+gab``): at the truth (noise sigma 8 Pa, phi 0.9, measurement 3 Pa) and at 120 parameter
+sets about it (unconstrained coordinates spread by sd 0.05, 0.2, 0.5, 1: 30 each), the
+log-likelihood with the start's quadratic form taken twice minus once, the
+Gauss-Newton step on the wall's start, its squared size in the start's posterior sd
+(z², all nodes) and the wall's capacity change between the two starts (r = |C(φ at the
+conditional mean) / C(φ at the prior mean) - 1|).
 """
 
 from __future__ import annotations
 
 import os
+import sys
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 os.environ.setdefault("OMP_NUM_THREADS", "1")
@@ -156,5 +167,55 @@ def main() -> None:
     print(f"machine: {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}")
 
 
+def second_pass_lines(reps: list[int]) -> list[str]:
+    """``--second-pass``: per cellar the change of the log-likelihood from the second
+    pass and the candidate measures of the start's distance (module docstring)."""
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    import coupled_rooms as rooms
+    from bench_sbc import log_posterior
+    from heritage_bayes.rc.isotherm import gab_capacity_factor
+    from sbc_coupled import MODELS, fit_inputs, gab_truth
+
+    rng = np.random.default_rng(5)
+    lines = ["cellar: sets; |twice - once| < 0.01 / 0.1 / 1 nat; median; at the truth "
+             "(step on Pw [Pa]); smallest z2*r where the change is >= 0.01 nat"]  # fmt: skip
+    for rep in reps:
+        room = rooms.generate("cellar", [2049, rooms.ROOMS.index("cellar"), rep], 60)
+        room["truth"] = gab_truth(room)
+        name, opts = MODELS["cellar"]
+        m = hb.model(name, **opts, isotherm="gab").with_slopes(("Pe",))
+        U, y = fit_inputs(room, m)
+        r = room["rows"]
+        _, lp = log_posterior(m, get_noise_model("ar1_white"), U[r], y[r], {},
+                              rooms.FLOOR, rooms.ENVELOPE, "estimate")  # fmt: skip
+        th0 = np.r_[[room["truth"][n] for n in m.parameter_names], 8.0, 0.9, 3.0][None]
+        X0 = lp.params.to_unconstrained(th0)
+        X = [X0] + [X0 + s * rng.standard_normal((30, X0.shape[1])) for s in (0.05, 0.2, 0.5, 1)]
+        th, lpr = lp.params.transform(np.vstack(X))
+        tm, tn = lp.split(th[np.isfinite(lpr)])
+        mf = lp._form(tm)
+        xm = lp._x0_mean(mf)
+        once, mean, cov = lp._integrate(mf, tn, xm, xm, True)
+        at = xm.copy()
+        at[:, lp.x0_free] = mean
+        dll = lp._integrate(mf, tn, at, xm, False)[0] - once
+        step = mean - xm[:, lp.x0_free]
+        z2 = np.einsum("ki,kij,kj->k", step, np.linalg.inv(cov), step)
+        k = tm[:, m.parameter_names.index("K_gab")]
+        cap = np.abs(
+            gab_capacity_factor(at[:, 0] / P_REF, k) / gab_capacity_factor(xm[:, 0] / P_REF, k) - 1
+        )
+        d = np.abs(dll[np.isfinite(dll)])
+        far = (np.abs(dll) >= 0.01) & np.isfinite(dll)
+        lines.append(f"{rep:3d}: {d.size}; {(d < 0.01).sum()} / {(d < 0.1).sum()} / "
+                     f"{(d < 1).sum()}; {np.median(d):.2f}; {dll[0]:+.2f} ({step[0, 0]:+.0f}); "
+                     f"{np.min(z2[far] * cap[far]):.3f}")  # fmt: skip
+    return lines
+
+
 if __name__ == "__main__":
-    main()
+    if sys.argv[1:2] == ["--second-pass"]:
+        for line in second_pass_lines([int(r) for r in sys.argv[2].split(",")]):
+            print(line, flush=True)
+    else:
+        main()

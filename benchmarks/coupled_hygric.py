@@ -171,8 +171,7 @@ def second_pass_lines(reps: list[int]) -> list[str]:
     """``--second-pass``: per cellar the change of the log-likelihood from the second
     pass and the candidate measures of the start's distance (module docstring)."""
     sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-    import coupled_rooms as rooms
-    from bench_sbc import log_posterior
+    from coupled_path import gab_cellar
     from heritage_bayes.rc.isotherm import gab_capacity_factor
     from sbc_coupled import MODELS, fit_inputs, gab_truth
 
@@ -180,14 +179,7 @@ def second_pass_lines(reps: list[int]) -> list[str]:
     lines = ["cellar: sets; |twice - once| < 0.01 / 0.1 / 1 nat; median; at the truth "
              "(step on Pw [Pa]); smallest z2*r where the change is >= 0.01 nat"]  # fmt: skip
     for rep in reps:
-        room = rooms.generate("cellar", [2049, rooms.ROOMS.index("cellar"), rep], 60)
-        room["truth"] = gab_truth(room)
-        name, opts = MODELS["cellar"]
-        m = hb.model(name, **opts, isotherm="gab").with_slopes(("Pe",))
-        U, y = fit_inputs(room, m)
-        r = room["rows"]
-        _, lp = log_posterior(m, get_noise_model("ar1_white"), U[r], y[r], {},
-                              rooms.FLOOR, rooms.ENVELOPE, "estimate")  # fmt: skip
+        room, m, lp = gab_cellar(rep, 2049, 60, fit_inputs, MODELS, gab_truth)
         th0 = np.r_[[room["truth"][n] for n in m.parameter_names], 8.0, 0.9, 3.0][None]
         X0 = lp.params.to_unconstrained(th0)
         X = [X0] + [X0 + s * rng.standard_normal((30, X0.shape[1])) for s in (0.05, 0.2, 0.5, 1)]

@@ -34,8 +34,9 @@ _LOG2PI = math.log(2.0 * math.pi)
 #: Size [Pa per Pa of offset] of the initial state's free responses (and their filter
 #: means) below which the first of the likelihood's two passes about a GAB buffer's
 #: trajectory ends a walker's recursion (``stop`` of :func:`coupled_filter_stats`): the
-#: steps after it would add to the start's gradient and curvature terms of at most
-#: this size times the innovations' weights, decaying at the buffer's own rate.
+#: steps after it would add to the start's gradient and curvature terms each below
+#: this size relative to the first steps' and decaying at the buffer's own rate, so
+#: that their sum is of that order times the steps the tail takes to decay.
 FIRST_PASS_STOP = 1e-15
 #: Steps per block of a recursion with a ``stop``: its free responses are checked at
 #: each block's start (the transitions of the block's later steps are already computed).

@@ -429,8 +429,8 @@ class LogPosterior:
         along the path the data put the buffer on. Of the first pass only that mean is
         kept: each walker's recursion ends once the start's free responses have decayed
         below :data:`~heritage_bayes.inference.coupled.FIRST_PASS_STOP` (the rest of
-        the record adds to the start's gradient and curvature only terms of that
-        relative size)."""
+        the record would add to the start's gradient and curvature only terms below
+        that relative size, decaying)."""
         xm = self._x0_mean(mf)
         twice = self._relinearise and self.x0_free.size > 0
         stop = self._first_pass_stop if twice else 0.0

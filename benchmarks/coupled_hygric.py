@@ -14,7 +14,12 @@ temperature: an exact 2x2 recursion per step, :mod:`heritage_bayes.rc.sorption`)
 The same for ``hygric_2c_sorption`` with ``isotherm: gab`` (a capacity that follows the
 buffer's humidity, its transitions computed per step from the state:
 :mod:`heritage_bayes.rc.isotherm`), its ratio to the linear-isotherm coupled model and
-to ``hygric_2c``.
+to ``hygric_2c``. Its log-likelihood takes two passes (the start's quadratic form about
+the trajectory from the prior mean, then about the one from the conditional mean it
+gives, :meth:`LogPosterior._marginal`), the first ending where the start's free
+responses have died (here, a buffer of τ about 60 h, within the first months; the
+steps it ran are printed): the row ``gab, pass 1 whole`` is the cost where they last the
+whole record (a slow wall over a short record: the SBC cellars), both passes in full.
 
 Wall and CPU times, best of 7 with the two models' repeats interleaved (a change of the
 machine's load falls on both sides of a ratio), BLAS single-threaded; the ratios beside
@@ -23,11 +28,22 @@ years: a cost per step that grows with the record is a stall (a dying free respo
 stuck at a subnormal number was one).
 
     python benchmarks/coupled_hygric.py
+    python benchmarks/coupled_hygric.py --second-pass 12,8,0
+
+``--second-pass REPS``: instead, what the second pass changes, on the SBC cellars
+(``benchmarks/sbc_coupled.py``'s rooms, seed 2049, 60 days, the fit with ``isotherm:
+gab``): at the truth (noise sigma 8 Pa, phi 0.9, measurement 3 Pa) and at 120 parameter
+sets about it (unconstrained coordinates spread by sd 0.05, 0.2, 0.5, 1: 30 each), the
+log-likelihood with the start's quadratic form taken twice minus once, the
+Gauss-Newton step on the wall's start, its squared size in the start's posterior sd
+(z², all nodes) and the wall's capacity change between the two starts (r = |C(φ at the
+conditional mean) / C(φ at the prior mean) - 1|).
 """
 
 from __future__ import annotations
 
 import os
+import sys
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 os.environ.setdefault("OMP_NUM_THREADS", "1")
@@ -37,6 +53,7 @@ import time
 import numpy as np
 
 import heritage_bayes as hb
+from heritage_bayes.inference.coupled import coupled_filter_stats
 from heritage_bayes.inference.likelihoods import get_noise_model
 from heritage_bayes.inference.parameters import parameters_for
 from heritage_bayes.inference.posterior import LogPosterior
@@ -71,6 +88,17 @@ def paired(fs: list, repeat: int = 7) -> list[tuple[float, float]]:
     return [tuple(b) for b in best]
 
 
+def first_pass_steps(lp: LogPosterior, theta: np.ndarray) -> np.ndarray:
+    """(K,) steps the likelihood's first pass ran per parameter set before the start's
+    free responses died (the record's length: they never did)."""
+    tm, tn = lp.split(theta)
+    mf = lp._form(tm)
+    acc = coupled_filter_stats(lp.model, mf.theta, lp._series, lp._x0_mean(mf), lp.observed,
+                               lp.noise, tn, basis=True, dt=lp.dt,
+                               stop=lp._first_pass_stop)  # fmt: skip
+    return acc[2]
+
+
 def main() -> None:
     cols = inputs(N100)
     obs = cols["Pe"] + 100.0
@@ -80,10 +108,13 @@ def main() -> None:
         ("hygric_2c", {}, LINEAR),
         ("hygric_2c_sorption", {}, SORPTION),
         ("hygric_2c_sorption", {"isotherm": "gab"}, {**SORPTION, "K_gab": 0.75}),
+        ("hygric_2c_sorption", {"isotherm": "gab", "whole": True}, {**SORPTION, "K_gab": 0.75}),
     )
+    runs = {}  # model -> steps the first pass ran, 100 years and each set of the batch
     for name, opts, p in cases:
+        whole = opts.pop("whole", False)
         m = hb.model(name, **opts).with_slopes(["Pe"])
-        name = f"{name} (gab)" if opts else name
+        name = f"{name} ({'gab, pass 1 whole' if whole else 'gab'})" if opts else name
         U = np.column_stack([cols[c] for c in m.input_names])
         P = np.array([[p[n] for n in m.parameter_names]])
         theta = np.array([[*P[0], *NOISE]])
@@ -95,6 +126,10 @@ def main() -> None:
                                 init_window=720, initial_state="estimate")  # fmt: skip
 
         l100, l1, l10 = lp(N100), lp(8760), lp(N100 // 10)
+        for lpk in (l100, l1, l10):
+            lpk._first_pass_stop = 0.0 if whole else lpk._first_pass_stop
+        if opts and not whole:
+            runs[name] = (first_pass_steps(l100, theta), first_pass_steps(l1, batch))
         jobs[name] = {
             "sim": lambda m=m, P=P, U=U: m.forward(P, U, 3600.0),
             "ll": lambda l100=l100, theta=theta: l100.log_likelihood(theta),
@@ -113,10 +148,17 @@ def main() -> None:
         print(f"{what} (target: {target})")
         for name, (w, c) in zip(names, res[key], strict=True):
             print(f"  {name:<26s} {w * 1e3:8.1f} ms wall {c * 1e3:8.1f} ms CPU")
-        (w0, c0), (w1, c1), (w2, c2) = res[key]
+        (w0, c0), (w1, c1), (w2, c2), (w3, c3) = res[key]
         print(f"  ratio coupled / linear: {w1 / w0:.2f} wall, {c1 / c0:.2f} CPU")
         print(f"  ratio gab / coupled: {w2 / w1:.2f} wall, {c2 / c1:.2f} CPU; "
               f"gab / linear: {w2 / w0:.2f} wall, {c2 / c0:.2f} CPU")  # fmt: skip
+        if key != "sim":
+            print(f"  ratio gab, pass 1 whole / linear: {w3 / w0:.2f} wall, {c3 / c0:.2f} CPU")
+    for name, (one, many) in runs.items():
+        print(
+            f"{name}: the first pass ran {one[0]:.0f} of {N100} steps (100 years); "
+            f"{np.min(many):.0f}-{np.max(many):.0f} of 8760 (1 year, 32 sets)"
+        )
     print("log-likelihood per step, one parameter set, 10 / 100 years (CPU)")
     for name, ten, hundred in zip(names, res["ten"], res["ll"], strict=True):
         print(
@@ -125,5 +167,47 @@ def main() -> None:
     print(f"machine: {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}")
 
 
+def second_pass_lines(reps: list[int]) -> list[str]:
+    """``--second-pass``: per cellar the change of the log-likelihood from the second
+    pass and the candidate measures of the start's distance (module docstring)."""
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    from coupled_path import gab_cellar
+    from heritage_bayes.rc.isotherm import gab_capacity_factor
+    from sbc_coupled import MODELS, fit_inputs, gab_truth
+
+    rng = np.random.default_rng(5)
+    lines = ["cellar: sets; |twice - once| < 0.01 / 0.1 / 1 nat; median; at the truth "
+             "(step on Pw [Pa]); smallest z2*r where the change is >= 0.01 nat"]  # fmt: skip
+    for rep in reps:
+        room, m, lp = gab_cellar(rep, 2049, 60, fit_inputs, MODELS, gab_truth)
+        th0 = np.r_[[room["truth"][n] for n in m.parameter_names], 8.0, 0.9, 3.0][None]
+        X0 = lp.params.to_unconstrained(th0)
+        X = [X0] + [X0 + s * rng.standard_normal((30, X0.shape[1])) for s in (0.05, 0.2, 0.5, 1)]
+        th, lpr = lp.params.transform(np.vstack(X))
+        tm, tn = lp.split(th[np.isfinite(lpr)])
+        mf = lp._form(tm)
+        xm = lp._x0_mean(mf)
+        once, mean, cov = lp._integrate(mf, tn, xm, xm, True)
+        at = xm.copy()
+        at[:, lp.x0_free] = mean
+        dll = lp._integrate(mf, tn, at, xm, False)[0] - once
+        step = mean - xm[:, lp.x0_free]
+        z2 = np.einsum("ki,kij,kj->k", step, np.linalg.inv(cov), step)
+        k = tm[:, m.parameter_names.index("K_gab")]
+        cap = np.abs(
+            gab_capacity_factor(at[:, 0] / P_REF, k) / gab_capacity_factor(xm[:, 0] / P_REF, k) - 1
+        )
+        d = np.abs(dll[np.isfinite(dll)])
+        far = (np.abs(dll) >= 0.01) & np.isfinite(dll)
+        lines.append(f"{rep:3d}: {d.size}; {(d < 0.01).sum()} / {(d < 0.1).sum()} / "
+                     f"{(d < 1).sum()}; {np.median(d):.2f}; {dll[0]:+.2f} ({step[0, 0]:+.0f}); "
+                     f"{np.min(z2[far] * cap[far]):.3f}")  # fmt: skip
+    return lines
+
+
 if __name__ == "__main__":
-    main()
+    if sys.argv[1:2] == ["--second-pass"]:
+        for line in second_pass_lines([int(r) for r in sys.argv[2].split(",")]):
+            print(line, flush=True)
+    else:
+        main()

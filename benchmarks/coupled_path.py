@@ -101,6 +101,25 @@ def path_ranks(r: dict, theta: np.ndarray, fit_inputs, models: dict) -> tuple[di
     return ranks, truths
 
 
+def gab_cellar(rep: int, seed: int, cal_days: int, fit_inputs, models: dict, gab_truth):
+    """One SBC cellar (its ``truth`` under the fit's names) and the log-posterior of its
+    fit with a GAB wall (``hbayes calibrate``'s defaults, ``noise: ar1_white``, the start
+    estimated): ``(room, model, LogPosterior)``."""
+    import heritage_bayes as hb
+    from bench_sbc import log_posterior
+    from heritage_bayes.inference.likelihoods import get_noise_model
+
+    room = rooms.generate("cellar", [seed, rooms.ROOMS.index("cellar"), rep], cal_days)
+    room["truth"] = gab_truth(room)
+    name, opts = models["cellar"]
+    m = hb.model(name, **opts, isotherm="gab").with_slopes(("Pe",))
+    U, y = fit_inputs(room, m)
+    rows = room["rows"]
+    _, lp = log_posterior(m, get_noise_model("ar1_white"), U[rows], y[rows], {},
+                          rooms.FLOOR, rooms.ENVELOPE, "estimate")  # fmt: skip
+    return room, m, lp
+
+
 def start_lines(reps, seed: int, cal_days: int, fit_inputs, models: dict, gab_truth) -> list[str]:
     """``sbc_coupled --start``: per cellar (GAB wall, no fit) the wall's highest K·RH
     over the calibration (the GAB slope's cap acts above 0.97) and, at the true
@@ -109,22 +128,11 @@ def start_lines(reps, seed: int, cal_days: int, fit_inputs, models: dict, gab_tr
     (about the prior mean's trajectory) and twice (then about the conditional mean's)."""
     from scipy.optimize import minimize
 
-    import heritage_bayes as hb
-    from bench_sbc import log_posterior
-    from heritage_bayes.inference.likelihoods import get_noise_model
-
     lines = ["cellar: K*RH max; prior mean, start once / twice [Pa]; log L once / twice; "
              "sigma_Pi once / twice"]  # fmt: skip
     for rep in reps:
-        room = rooms.generate("cellar", [seed, rooms.ROOMS.index("cellar"), rep], cal_days)
+        room, m, lp = gab_cellar(rep, seed, cal_days, fit_inputs, models, gab_truth)
         kx = room["generator"]["K"] * room["phi_w_range"][1]
-        room["truth"] = gab_truth(room)
-        name, opts = models["cellar"]
-        m = hb.model(name, **opts, isotherm="gab").with_slopes(("Pe",))
-        U, y = fit_inputs(room, m)
-        rows = room["rows"]
-        _, lp = log_posterior(m, get_noise_model("ar1_white"), U[rows], y[rows], {},
-                              rooms.FLOOR, rooms.ENVELOPE, "estimate")  # fmt: skip
         tm = np.array([room["truth"][n] for n in m.parameter_names])
 
         def theta(v, _tm=tm):

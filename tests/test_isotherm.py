@@ -9,6 +9,7 @@ from scipy.optimize import brentq
 
 import heritage_bayes as hb
 from heritage_bayes.climate.psychro import saturation_vapour_pressure as psat
+from heritage_bayes.inference.coupled import FIRST_PASS_STOP, coupled_filter_stats
 from heritage_bayes.inference.likelihoods import get_noise_model
 from heritage_bayes.inference.parameters import parameters_for
 from heritage_bayes.inference.posterior import LogPosterior
@@ -212,3 +213,46 @@ def test_a_start_far_from_the_prior_mean_is_found_along_its_own_path():
     assert np.all(np.abs(found - x0) < 0.05 * 400.0), (found, x0)
     assert np.abs(once - x0).max() > 4 * np.abs(found - x0).max(), (once, found, x0)
     assert ll > lp.log_likelihood(theta)[0] + 100.0
+
+
+def test_the_first_pass_ends_where_the_start_is_forgotten():
+    """The likelihood's first pass about a GAB wall's prior-mean trajectory keeps only the
+    start's conditional mean, and ends each walker where the start's free responses have
+    died. On a record 60 to 150 times the fast walls' time constants: their first pass
+    stops before the record's end (a slow wall's runs it all), the start's gradient and
+    curvature it gives equal those of the whole record to 1e-10, and so do the
+    log-likelihood and the start's conditional mean, for walkers whose start lies near
+    and 400 Pa away from the prior mean; the far start does take the second pass (it
+    moves the likelihood)."""
+    N = 8760
+    U = _inputs(N, seed=3)
+    m = hb.model("hygric_2c_fixed", sink="temperature", isotherm="gab").with_slopes(["Pe"])
+    cw = np.array([0.005, 0.015, 0.0035, 1.5])  # the last a slow wall
+    P = np.array([[dict(CELLAR, Cw=c, K_gab=0.9)[n] for n in m.parameter_names] for c in cw])
+    nm = get_noise_model("ar1_white")
+    theta = np.column_stack([P, np.tile([2.0, 0.5, 2.0], (4, 1))])
+    steady = m.steady_state(P[:1], U[:48].mean(axis=0))[0]
+    rng = np.random.default_rng(6)
+    for offset in (0.0, 400.0):
+        x0 = steady - [offset, 0.0]
+        obs = m.forward(P[:1], U, DT, x0=x0)[0][0] + rng.normal(0, 2.0, (N, 1))
+        lp = LogPosterior(m, parameters_for(m, nm), nm, U, obs, warmup=0, init_window=48,
+                          initial_state="estimate")  # fmt: skip
+        ll, start = lp.log_likelihood(theta), lp.initial_states(theta)
+        tm, tn = lp.split(theta)
+        xm = lp._x0_mean(lp._form(tm))
+        first, whole = (
+            coupled_filter_stats(
+                m, tm, lp._series, xm, lp.observed, nm, tn, basis=True, dt=DT, stop=stop
+            )
+            for stop in (FIRST_PASS_STOP, 0.0)
+        )
+        assert np.all(first[2, :3] < N) and first[2, 1] > first[2, 0], first[2]
+        assert first[2, 3] == N
+        np.testing.assert_allclose(first[3:], whole[3:], rtol=1e-10, atol=0)
+        lp._first_pass_stop = 0.0
+        np.testing.assert_allclose(ll, lp.log_likelihood(theta), rtol=1e-10, atol=0)
+        np.testing.assert_allclose(start, lp.initial_states(theta), rtol=1e-10, atol=0)
+        if offset:
+            lp._relinearise = False
+            assert ll[0] > lp.log_likelihood(theta)[0] + 1.0

@@ -27,13 +27,24 @@ from heritage_bayes.rc import isotherm, sorption
 from heritage_bayes.rc.isotherm import N_CELLS, ROW, gab_block, table_constants
 from heritage_bayes.rc.sorption import BLOCK, coupled_block
 
-__all__ = ["coupled_filter_stats"]
+__all__ = ["FIRST_PASS_STOP", "coupled_filter_stats"]
 
 _LOG2PI = math.log(2.0 * math.pi)
 
+#: Size [Pa per Pa of offset] of the initial state's free responses (and their filter
+#: means) below which the first of the likelihood's two passes about a GAB buffer's
+#: trajectory ends a walker's recursion (``stop`` of :func:`coupled_filter_stats`): the
+#: steps after it would add to the start's gradient and curvature terms each below
+#: this size relative to the first steps' and decaying at the buffer's own rate, so
+#: that their sum is of that order times the steps the tail takes to decay.
+FIRST_PASS_STOP = 1e-15
+#: Steps per block of a recursion with a ``stop``: its free responses are checked at
+#: each block's start (the transitions of the block's later steps are already computed).
+STOP_BLOCK = 256
+
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath={"contract"})
-def _coupled_kf(kp, ks, sb, slope, dt, x0, yobs, sigma, phi, w, nb, acc):  # pragma: no cover
+def _coupled_kf(kp, ks, sb, slope, dt, x0, yobs, sigma, phi, w, nb, stop, acc):  # pragma: no cover
     """Recursion + residual filter + initial-state statistics of every walker.
 
     kp (K, 7) kernel parameters; ks (K,) the buffer's GAB multilayer factors
@@ -41,12 +52,16 @@ def _coupled_kf(kp, ks, sb, slope, dt, x0, yobs, sigma, phi, w, nb, acc):  # pra
     state; 0: the linear buffer) or an empty array; sb, slope: the step series of
     :meth:`~heritage_bayes.rc.sorption.CoupledHygricModel.series`; x0 (K, 2) initial
     states [Pa]; yobs (N,) observed ``Pi`` (NaN = excluded); sigma, phi, w (K,) noise
-    parameters; nb: 2 (basis of both nodes) or 0; acc (3 + nb + nb², K), zeros, as
-    :meth:`NoiseModel.filter_modal` (rows: sum log 2πF, sum e²/F, unused, g, lower
-    triangle of H), in physical coordinates.
+    parameters; nb: 2 (basis of both nodes) or 0; stop: 0, or end a walker's
+    recursion at the first block (of :data:`STOP_BLOCK` steps) where its free
+    responses have all fallen below ``stop`` [Pa per Pa] (the start's g, H complete;
+    the log-likelihood then covers only the steps run); acc (3 + nb + nb², K), zeros, as
+    :meth:`NoiseModel.filter_modal` (rows: sum log 2πF, sum e²/F, the steps run, g,
+    lower triangle of H), in physical coordinates.
     """
     K = kp.shape[0]
     N = sb.shape[1]
+    span = BLOCK if stop <= 0.0 else STOP_BLOCK  # steps between checks of the responses
     Mf = np.empty((6, BLOCK))
     tab = np.empty((N_CELLS, ROW))  # reserved, its rows written when first reached
     built = np.zeros(N_CELLS, dtype=np.bool_)
@@ -81,16 +96,22 @@ def _coupled_kf(kp, ks, sb, slope, dt, x0, yobs, sigma, phi, w, nb, acc):  # pra
         hvu = 0.0
         hvv = 0.0
         alive = nb > 0
-        for k0 in range(0, N, BLOCK):
-            B = min(BLOCK, N - k0)
+        run = N
+        for k0 in range(0, N, span):
+            B = min(span, N - k0)
             if gab:
                 gab_block(tc, tab, built, sb[:, k0:], B, dt, slope, st, Mf, scratch)
             else:
                 coupled_block(kp[p], sb, dt, slope, k0, B, Mf)
-            # a free response that has decayed below 1e-280 Pa adds nothing: stop it
-            # (else it sticks at the smallest subnormal, 20x slower arithmetic)
-            if alive and max(abs(uw), abs(ui), abs(vw), abs(vi), abs(mu), abs(mv)) < 1e-280:
-                alive = False
+            if alive:
+                size = max(abs(uw), abs(ui), abs(vw), abs(vi), abs(mu), abs(mv))
+                if size < stop:
+                    run = k0
+                    break
+                # a free response that has decayed below 1e-280 Pa adds nothing: stop
+                # it (else it sticks at the smallest subnormal, 20x slower arithmetic)
+                if size < 1e-280:
+                    alive = False
             for b in range(B):
                 k = k0 + b
                 y = yobs[k]
@@ -129,6 +150,7 @@ def _coupled_kf(kp, ks, sb, slope, dt, x0, yobs, sigma, phi, w, nb, acc):  # pra
                     vw, vi = m0 * vw + m1 * vi, m2 * vw + m3 * vi
         acc[0, p] = a0
         acc[1, p] = a1
+        acc[2, p] = run
         if nb > 0:  # g (2), then the lower triangle of H (row-major 2 x 2)
             acc[3, p] = gu
             acc[4, p] = gv
@@ -137,7 +159,7 @@ def _coupled_kf(kp, ks, sb, slope, dt, x0, yobs, sigma, phi, w, nb, acc):  # pra
             acc[8, p] = hvv
 
 
-def coupled_filter_stats(model, P, series, x0, Yobs, noise_model, noise, *, basis, dt):
+def coupled_filter_stats(model, P, series, x0, Yobs, noise_model, noise, *, basis, dt, stop=0.0):
     """Sufficient statistics of the log-likelihood of a coupled model (the layout of
     :meth:`~heritage_bayes.inference.likelihoods.NoiseModel.filter_modal`, the basis in
     physical coordinates: the node order of ``model.state_names``).
@@ -161,6 +183,13 @@ def coupled_filter_stats(model, P, series, x0, Yobs, noise_model, noise, *, basi
         Also the statistics of the initial state's free responses.
     dt : float
         Time step [s].
+    stop : float
+        0 (the whole record), or the size [Pa per Pa of offset] of the initial state's
+        free responses and their filter means below which a walker's recursion ends:
+        its gradient and curvature (rows ``3..``) are then complete to terms of that
+        relative size, its log-likelihood (rows 0, 1) covers only the steps run (row 2:
+        their number). For the first of two passes, of which only the conditional
+        mean of the start is kept.
     """
     K = P.shape[0]
     nb = 2 if basis else 0
@@ -179,6 +208,7 @@ def coupled_filter_stats(model, P, series, x0, Yobs, noise_model, noise, *, basi
         phi,
         w,
         nb,
+        float(stop),
         acc,
     )
     return acc

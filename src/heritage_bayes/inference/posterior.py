@@ -59,7 +59,7 @@ from typing import Any
 
 import numpy as np
 
-from heritage_bayes.inference.coupled import coupled_filter_stats
+from heritage_bayes.inference.coupled import FIRST_PASS_STOP, coupled_filter_stats
 from heritage_bayes.inference.likelihoods import NoiseModel, residual_noise_models
 from heritage_bayes.inference.parameters import ParameterSet
 from heritage_bayes.rc.discretize import modal_form
@@ -160,6 +160,7 @@ class LogPosterior:
         self._time_varying = self.model.time_varying
         # transitions that follow the state: the start's quadratic form re-centred
         self._relinearise = self._time_varying and self.model.isotherm != "linear"
+        self._first_pass_stop = FIRST_PASS_STOP  # 0: the first pass over the whole record
         if self._time_varying:
             if self.noise.statespace:
                 raise ValueError(
@@ -425,27 +426,34 @@ class LogPosterior:
         trajectory from the prior mean, then once more about the one from the
         conditional mean it gives (a Gauss-Newton step on the start, the prior still
         centred on the prior mean), so that the free responses follow the capacity
-        along the path the data put the buffer on."""
+        along the path the data put the buffer on. Of the first pass only that mean is
+        kept: each walker's recursion ends once the start's free responses have decayed
+        below :data:`~heritage_bayes.inference.coupled.FIRST_PASS_STOP` (the rest of
+        the record would add to the start's gradient and curvature only terms below
+        that relative size, decaying)."""
         xm = self._x0_mean(mf)
-        out = self._integrate(mf, tn, xm, xm, conditional or self._relinearise)
-        if self._relinearise and self.x0_free.size:
+        twice = self._relinearise and self.x0_free.size > 0
+        stop = self._first_pass_stop if twice else 0.0
+        out = self._integrate(mf, tn, xm, xm, conditional or twice, stop)
+        if twice:
             at = xm.copy()
             at[:, self.x0_free] = np.where(np.isfinite(out[1]), out[1], xm[:, self.x0_free])
             out = self._integrate(mf, tn, at, xm, conditional)
         return out
 
-    def _integrate(self, mf, tn, at: np.ndarray, xm: np.ndarray, conditional: bool):
+    def _integrate(self, mf, tn, at, xm, conditional: bool, stop: float = 0.0):
         """:meth:`_marginal` with the filter's quadratic form in the start taken about
         the trajectory from ``at`` (K, n) and the start's prior centred on ``xm``
         [°C or Pa]: with e = x0 - at, μ = xm - at and b = g + P0⁻¹μ the integral
         adds ½ bᵀM⁻¹b - ½ μᵀP0⁻¹μ - ½ log det M - ½ log det P0; the conditional mean
-        is ``at + M⁻¹b``."""
+        is ``at + M⁻¹b``. ``stop``: :func:`coupled_filter_stats`'s (a time-varying
+        model; its log-likelihood then covers only the steps run)."""
         free = self.x0_free
         nf = free.size
         if self._time_varying:  # the basis in physical coordinates
             acc = coupled_filter_stats(
                 self.model, mf.theta, self._series, at, self.observed, self.noise, tn,
-                basis=nf > 0, dt=self.dt,
+                basis=nf > 0, dt=self.dt, stop=stop,
             )  # fmt: skip
             Tinv = np.broadcast_to(np.eye(at.shape[1]), mf.Tinv.shape)
         else:

@@ -23,12 +23,15 @@ R3, R5, R7 and Annisse. Tuned on: R2, R4, R6 and Ørholm.
 Usage (from the repository root)::
 
     python benchmarks/real_rooms.py [ROOM ...] [--out DIR] [--maxiter 100] [--starts 2]
-        [--calibrate --max-steps 1500] [--json FILE]
+        [--calibrate --max-steps 1500] [--whole-record] [--json FILE]
 
 ROOM: R2 R3 R4 R5 R6 R7 orholm annisse (default: the tuning rooms; ``--held-out`` adds
 the held-out ones). ``--span START END`` cuts a TRH-1 room's logger and weather files to
 the rows stamped in ``[START, END)`` (the files' own clock; copies in the work folder,
-same layout): a user who holds a shorter record.
+same layout): a user who holds a shorter record. ``--whole-record`` also runs each
+config with ``periods.calibration`` widened to the whole usable stretch init names (the
+validation unchanged, inside it). Beside the validation FIT, the calibration FIT over
+the fitted rows (each config's own calibration, without a validation inside it).
 """
 
 from __future__ import annotations
@@ -147,6 +150,27 @@ def room_below(config: Path, logger: Path) -> Path:
     return out
 
 
+def whole_record(config: Path) -> Path:
+    """init's config with ``periods.calibration`` widened to the whole usable stretch
+    init names in its comment (``overlap: ... START to END UTC``), the validation
+    unchanged (now inside the calibration, held out of the fit)."""
+    import re
+
+    import yaml
+
+    text = config.read_text(encoding="utf-8")
+    notes = " ".join(ln.lstrip("#").strip() for ln in text.splitlines() if ln.startswith("#"))
+    day = r"(\d{4}-\d\d-\d\d)\s+\d\d:\d\d"
+    m = re.search(rf"- overlap: .*?{day}\s+to\s+{day}\s+UTC", notes)
+    if m is None:
+        raise SystemExit(f"--whole-record: no overlap found in the comment of {config}")
+    raw = yaml.safe_load(text)
+    raw["periods"]["calibration"] = {"start": m[1], "end": m[2]}
+    out = config.with_name("config_whole_record.yaml")
+    out.write_text(yaml.safe_dump(raw, sort_keys=False, allow_unicode=True), encoding="utf-8")
+    return out
+
+
 def screen_auto(cfg) -> tuple:
     """Each ``model: auto`` section replaced by the model its ladder screen chooses, as
     ``hbayes calibrate`` does (its own screen, same seeds, no time budget); returns the
@@ -193,6 +217,8 @@ def map_fits(cfg, maxiter: int, starts: int) -> dict:
         v = prep.validation
         obs = prep.observed(sec, model)[:, 0]
         out[name] = fit_metrics(obs[v.start : v.stop], y[v.start : v.stop])["FIT"]
+        fitted = prep.fitted_rows() & np.isfinite(obs)
+        out[f"fit_{name}"] = fit_metrics(obs[fitted], y[fitted])["FIT"]
         sims[name] = (y[v.start : v.stop], obs[v.start : v.stop])
         out[f"{sec}_model"] = model.name if hasattr(model, "name") else getattr(cfg, sec).model
     if len(sims) == 2:
@@ -293,7 +319,7 @@ def _print(row: dict) -> None:
     ho = "held out" if row["held_out"] else "tuning"
     line = (
         f"| {row['room']} | {ho} | {row['variant']} | {row['irradiance']} | {row['models']} | "
-        f"{f('Ti')} | {f('Pi')} | {f('RH')} |"
+        f"{f('Ti')} | {f('Pi')} | {f('RH')} | {f('fit_Ti')} | {f('fit_Pi')} |"
     )
     if "cal_Ti" in row:
         line += f" {f('cal_Ti')} | {f('cal_Pi')} | {f('cal_RH')} | {row.get('converged')} |"
@@ -320,6 +346,11 @@ def main(argv=None) -> int:
     ap.add_argument(
         "--monthly", action="store_true", help="also the thermal MAP's residual by month"
     )
+    ap.add_argument(
+        "--whole-record",
+        action="store_true",
+        help="also with periods.calibration widened to the whole usable stretch (same validation)",
+    )
     ap.add_argument("--json", type=Path, help="write the rows here")
     ap.add_argument(
         "--span",
@@ -332,7 +363,10 @@ def main(argv=None) -> int:
     if set(rooms) - set(ROOMS):
         ap.error(f"unknown room(s) {sorted(set(rooms) - set(ROOMS))}; choose from {list(ROOMS)}")
     work = args.out or Path(tempfile.mkdtemp(prefix="real_rooms_"))
-    hdr = "| room | held out? | weather | irradiance | models init chose | Ti | Pi | RH |"
+    hdr = (
+        "| room | held out? | weather | irradiance | models init chose | Ti | Pi | RH |"
+        " calibration Ti | calibration Pi |"
+    )
     if args.calibrate:
         hdr += " cal Ti | cal Pi | cal RH | converged |"
     print(f"validation FIT [%] of the MAP (maxiter {args.maxiter}, starts {args.starts})")
@@ -367,6 +401,11 @@ def main(argv=None) -> int:
                 from heritage_bayes.config import load_config
 
                 print(monthly_residuals(load_config(config), args.maxiter, args.starts))
+            if args.whole_record:
+                whole = whole_record(config)
+                row = one(room, variant + ", whole record", whole, args, w, {"answers": given})
+                rows.append(row)
+                _print(row)
             if args.room_below and logger.startswith("trh1"):
                 below = room_below(config, args.data / logger)
                 row = one(room, variant + ", room below", below, args, w, {"answers": given})

@@ -153,14 +153,15 @@ def start_lines(reps, seed: int, cal_days: int, fit_inputs, models: dict, gab_tr
 
 
 def source_lines(reps, source_seeds, seed: int, cal_days: int, fit_inputs, models: dict,
-                 gab_truth) -> list[str]:  # fmt: skip
+                 gab_truth, without: tuple = ()) -> list[str]:  # fmt: skip
     """``sbc_coupled --source-seeds``: per cellar (GAB wall, no posterior) the MAP of the
     fit (``bench_sbc.fit_and_rank``'s search: differential evolution, the replicate as
     its seed) under several realisations of the room's moisture source, every other draw
     of the room kept (:func:`coupled_rooms.generate`'s ``source_seed``; ``-`` the room's
-    own source): τ1, the static gain and the buffer hours at the MAP over their truths,
-    the AR(1) error's coefficient at the MAP, and the long-run variance ratio κ of the
-    MAP's standardised innovations (Bartlett window of a week,
+    own source; ``without``: parts of the generator left out, as ``--without``): τ1, the
+    static gain and the buffer hours at the MAP over their truths, the AR(1) error's
+    coefficient at the MAP, and the long-run variance ratio κ of the MAP's standardised
+    innovations (Bartlett window of a week,
     :func:`heritage_bayes.inference.tempering.likelihood_temperature`); last, the sd of
     log τ1 at the MAP over the realisations: the spread the source alone gives the
     estimate, to set against the posterior's sd of τ1."""
@@ -179,7 +180,7 @@ def source_lines(reps, source_seeds, seed: int, cal_days: int, fit_inputs, model
         logs = []
         for s in source_seeds:
             room = rooms.generate("cellar", [seed, rooms.ROOMS.index("cellar"), rep], cal_days,
-                                  source_seed=s)  # fmt: skip
+                                  without=without, source_seed=s)  # fmt: skip
             U, y = fit_inputs(room, m)
             rows = room["rows"]
             phi_m = float(np.nanmean(y[rows])) / P_REF

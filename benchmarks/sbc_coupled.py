@@ -648,7 +648,7 @@ def main(argv=None) -> int:
         reps = [int(r) for r in args.only.split(",")] if args.only else reps
         seeds = [None if s == "-" else int(s) for s in args.source_seeds.split(",")]
         for line in source_lines(reps, seeds, args.seed, args.cal_days, fit_inputs, MODELS,
-                                 gab_truth):  # fmt: skip
+                                 gab_truth, without):  # fmt: skip
             print(line, flush=True)
         return 0
     if args.means:

@@ -157,7 +157,7 @@ def source_lines(reps, source_seeds, seed: int, cal_days: int, fit_inputs, model
     """``sbc_coupled --source-seeds``: per cellar (GAB wall, no posterior) the MAP of the
     fit (``bench_sbc.fit_and_rank``'s search: differential evolution, the replicate as
     its seed) under several realisations of the room's moisture source, every other draw
-    of the room kept (:func:`coupled_rooms.generate`'s ``source_seed``; ``-`` the room's
+    of the room kept (:func:`coupled_rooms.generate`'s ``source_seed``; ``own`` the room's
     own source; ``without``: parts of the generator left out, as ``--without``): τ1, the
     static gain and the buffer hours at the MAP over their truths, the AR(1) error's
     coefficient at the MAP, and the long-run variance ratio κ of the MAP's standardised
@@ -196,7 +196,7 @@ def source_lines(reps, source_seeds, seed: int, cal_days: int, fit_inputs, model
             logs.append(np.log(r["tau1_h"]))
             kappa = likelihood_temperature(lp, np.asarray(mp.theta), 168)
             lines.append(
-                f"{rep:3d} {'-' if s is None else s}: {r['tau1_h']:.3f}, {r['gain_Pe']:.3f}, "
+                f"{rep:3d} {'own' if s is None else s}: {r['tau1_h']:.3f}, {r['gain_Pe']:.3f}, "
                 f"{r['buffer_hours']:.3f}; {p['phi_Pi']:.2f}; {kappa:.2f}"
             )
         if len(logs) > 1:

@@ -605,7 +605,7 @@ def main(argv=None) -> int:
                     "and log L at the truth, linearised once and twice (coupled_path)")  # fmt: skip
     ap.add_argument("--source-seeds", metavar="S,S", help="no posterior: the MAP of "
                     "cellars --only/--first-rep.. under other realisations of their moisture "
-                    "source ('-': the room's own; coupled_path.source_lines)")  # fmt: skip
+                    "source ('own': the room's own; coupled_path.source_lines)")  # fmt: skip
     ap.add_argument("--misfit", action="store_true", help="no fit: the structural error "
                     "of rooms --first-rep.. with each part of the generator left out")  # fmt: skip
     ap.add_argument("--means", nargs="+", metavar="LOG", help="mean z with the "
@@ -646,7 +646,7 @@ def main(argv=None) -> int:
 
         reps = range(args.first_rep, args.first_rep + args.reps)
         reps = [int(r) for r in args.only.split(",")] if args.only else reps
-        seeds = [None if s == "-" else int(s) for s in args.source_seeds.split(",")]
+        seeds = [None if s == "own" else int(s) for s in args.source_seeds.split(",")]
         for line in source_lines(reps, seeds, args.seed, args.cal_days, fit_inputs, MODELS,
                                  gab_truth, without):  # fmt: skip
             print(line, flush=True)

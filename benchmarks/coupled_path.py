@@ -21,6 +21,8 @@ that ``--table`` and ``--paired`` read them as any other quantity.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+
 import numpy as np
 
 import coupled_rooms as rooms
@@ -153,7 +155,7 @@ def start_lines(reps, seed: int, cal_days: int, fit_inputs, models: dict, gab_tr
 
 
 def source_lines(reps, source_seeds, seed: int, cal_days: int, fit_inputs, models: dict,
-                 gab_truth, without: tuple = ()) -> list[str]:  # fmt: skip
+                 gab_truth, without: tuple = ()) -> Iterator[str]:  # fmt: skip
     """``sbc_coupled --source-seeds``: per cellar (GAB wall, no posterior) the MAP of the
     fit (``bench_sbc.fit_and_rank``'s search: differential evolution, the replicate as
     its seed) under several realisations of the room's moisture source, every other draw
@@ -164,7 +166,7 @@ def source_lines(reps, source_seeds, seed: int, cal_days: int, fit_inputs, model
     innovations (Bartlett window of a week,
     :func:`heritage_bayes.inference.tempering.likelihood_temperature`); last, the sd of
     log τ1 at the MAP over the realisations: the spread the source alone gives the
-    estimate, to set against the posterior's sd of τ1."""
+    estimate, to set against the posterior's sd of τ1 (lines as they come)."""
     import heritage_bayes as hb
     from bench_sbc import log_posterior
     from heritage_bayes.inference.likelihoods import get_noise_model
@@ -175,7 +177,7 @@ def source_lines(reps, source_seeds, seed: int, cal_days: int, fit_inputs, model
 
     name, opts = models["cellar"]
     m = hb.model(name, **opts, isotherm="gab").with_slopes(("Pe",))
-    lines = ["cellar source: MAP / truth of tau1_h, gain_Pe, buffer_hours; phi_Pi; kappa 168 h"]
+    yield "cellar source: MAP / truth of tau1_h, gain_Pe, buffer_hours; phi_Pi; kappa 168 h"
     for rep in reps:
         logs = []
         for s in source_seeds:
@@ -195,12 +197,11 @@ def source_lines(reps, source_seeds, seed: int, cal_days: int, fit_inputs, model
             r = {k: float(q[k]) / float(truth[k]) for k in ("tau1_h", "gain_Pe", "buffer_hours")}
             logs.append(np.log(r["tau1_h"]))
             kappa = likelihood_temperature(lp, np.asarray(mp.theta), 168)
-            lines.append(
+            yield (
                 f"{rep:3d} {'own' if s is None else s}: {r['tau1_h']:.3f}, {r['gain_Pe']:.3f}, "
                 f"{r['buffer_hours']:.3f}; {p['phi_Pi']:.2f}; {kappa:.2f}"
             )
         if len(logs) > 1:
-            lines.append(
+            yield (
                 f"{rep:3d}: sd of log tau1 at the MAP over the sources {np.std(logs, ddof=1):.3f}"
             )
-    return lines

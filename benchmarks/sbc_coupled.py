@@ -541,6 +541,8 @@ def paired_lines(a: list[dict], b: list[dict]) -> list[str]:
                 za.append((xa["median"] - ra[r]["truth"][q]) / xa["sd"])
                 zb.append((xb["median"] - rb[r]["truth"][q]) / xb["sd"])
                 ia, ib = ia + xa["in90"], ib + xb["in90"]
+            if not za:  # ranked in neither log (e.g. the --path quantities)
+                continue
             d = np.subtract(za, zb)
             sd = f"{d.std(ddof=1):.2f}" if d.size > 1 else "—"
             lines.append(

@@ -25,11 +25,14 @@ model's temperature input with its gaps interpolated linearly, the survey's room
     python benchmarks/sbc_coupled.py --table coupled.jsonl [--markdown]
     python benchmarks/sbc_coupled.py --reps 10 --rooms attic --without outage --log no.jsonl
     python benchmarks/sbc_coupled.py --paired coupled.jsonl no.jsonl
+    python benchmarks/sbc_coupled.py --source-seeds own,1,2,3 --only 0,2 --rooms cellar
 
 Each replicate is a function of ``(seed, room, replicate)``; one JSON line per replicate
 is appended to ``--log`` as soon as it is done, ``--first-rep`` extends a study, and
 ``--table`` merges logs. ``--without`` leaves parts of the generator out (diagnosis:
-``isotherm``, ``source``, ``noise``, ``outage``; :func:`coupled_rooms.generate`).
+``isotherm``, ``source``, ``noise``, ``outage``; :func:`coupled_rooms.generate`);
+``--source-seeds`` finds the MAP of cellars under other realisations of their moisture
+source (no chain; :func:`coupled_path.source_lines`).
 """
 
 from __future__ import annotations

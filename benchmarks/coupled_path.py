@@ -21,6 +21,8 @@ that ``--table`` and ``--paired`` read them as any other quantity.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+
 import numpy as np
 
 import coupled_rooms as rooms
@@ -158,3 +160,56 @@ def start_lines(reps, seed: int, cal_days: int, fit_inputs, models: dict, gab_tr
         lines.append(f"{rep:3d}: {kx:.2f}; {xm:.0f}, {s1:.0f} / {s2:.0f}; {l1:.1f} / {l2:.1f}; "
                      f"{g1:.1f} / {g2:.1f}")  # fmt: skip
     return lines
+
+
+def source_lines(reps, source_seeds, seed: int, cal_days: int, fit_inputs, models: dict,
+                 gab_truth, without: tuple = ()) -> Iterator[str]:  # fmt: skip
+    """``sbc_coupled --source-seeds``: per cellar (GAB wall, no posterior) the MAP of the
+    fit (``bench_sbc.fit_and_rank``'s search: differential evolution, the replicate as
+    its seed) under several realisations of the room's moisture source, every other draw
+    of the room kept (:func:`coupled_rooms.generate`'s ``source_seed``; ``own`` the room's
+    own source; ``without``: parts of the generator left out, as ``--without``): τ1, the
+    static gain and the buffer hours at the MAP over their truths, the AR(1) error's
+    coefficient at the MAP, and the long-run variance ratio κ of the MAP's standardised
+    innovations (Bartlett window of a week,
+    :func:`heritage_bayes.inference.tempering.likelihood_temperature`); last, the sd of
+    log τ1 at the MAP over the realisations: the spread the source alone gives the
+    estimate, to set against the posterior's sd of τ1 (lines as they come)."""
+    import heritage_bayes as hb
+    from bench_sbc import log_posterior
+    from heritage_bayes.inference.likelihoods import get_noise_model
+    from heritage_bayes.inference.optimize import find_map
+    from heritage_bayes.inference.tempering import likelihood_temperature
+    from heritage_bayes.rc.isotherm import gab_capacity_factor
+    from heritage_bayes.rc.sorption import P_REF
+
+    name, opts = models["cellar"]
+    m = hb.model(name, **opts, isotherm="gab").with_slopes(("Pe",))
+    yield "cellar source: MAP / truth of tau1_h, gain_Pe, buffer_hours; phi_Pi; kappa 168 h"
+    for rep in reps:
+        logs = []
+        for s in source_seeds:
+            room = rooms.generate("cellar", [seed, rooms.ROOMS.index("cellar"), rep], cal_days,
+                                  without=without, source_seed=s)  # fmt: skip
+            U, y = fit_inputs(room, m)
+            rows = room["rows"]
+            phi_m = float(np.nanmean(y[rows])) / P_REF
+            truth = rooms.network_quantities("cellar", gab_truth(room, phi_m), room["Tf_mean"])
+            ps, lp = log_posterior(m, get_noise_model("ar1_white"), U[rows], y[rows], {},
+                                   rooms.FLOOR, rooms.ENVELOPE, "estimate")  # fmt: skip
+            mp = find_map(lp, seed=rep, method="differential_evolution", popsize=15, maxiter=200)
+            p = dict(zip(ps.names, map(float, mp.theta), strict=True))
+            p["Cw"] *= float(gab_capacity_factor(phi_m, p["K_gab"]))
+            tf = float(np.mean(U[rows, m.input_names.index("Tf")]))
+            q = rooms.network_quantities("cellar", p, tf)
+            r = {k: float(q[k]) / float(truth[k]) for k in ("tau1_h", "gain_Pe", "buffer_hours")}
+            logs.append(np.log(r["tau1_h"]))
+            kappa = likelihood_temperature(lp, np.asarray(mp.theta), 168)
+            yield (
+                f"{rep:3d} {'own' if s is None else s}: {r['tau1_h']:.3f}, {r['gain_Pe']:.3f}, "
+                f"{r['buffer_hours']:.3f}; {p['phi_Pi']:.2f}; {kappa:.2f}"
+            )
+        if len(logs) > 1:
+            yield (
+                f"{rep:3d}: sd of log tau1 at the MAP over the sources {np.std(logs, ddof=1):.3f}"
+            )

@@ -269,7 +269,12 @@ def simulate(room: str, p: dict, w: dict, ti, tf, source, linear=None) -> dict:
 
 
 def generate(
-    room: str, seed, cal_days: int = 90, max_spin_days: int = 28, without: tuple = ()
+    room: str,
+    seed,
+    cal_days: int = 90,
+    max_spin_days: int = 28,
+    without: tuple = (),
+    source_seed=None,
 ) -> dict:
     """One room: truths, the station's and the logger's hourly records.
 
@@ -277,7 +282,9 @@ def generate(
     out (diagnosis): ``"isotherm"`` (a linear isotherm through the GAB's 65 % RH point:
     the fitted model's own buffer), ``"source"`` (no moisture source), ``"noise"`` (no
     sensor noise, rounding or lost readings; the outage stays), ``"outage"`` (no
-    outage). Leaving parts out keeps every random draw of the room.
+    outage). Leaving parts out keeps every random draw of the room. ``source_seed``
+    (diagnosis): the moisture source redrawn from its own generator with this seed, every
+    other draw of the room kept (the same room under another realisation of its source).
 
     Returns a dict: ``truth`` (the fit's parameters by name, the buffer's capacity
     the harmonic mean of ``M u'(φ_w)`` over the calibration period; module docstring),
@@ -306,6 +313,8 @@ def generate(
     g_all = p["Gfast"] + p["Gi"] + p.get("Gf", 0.0)
     src_sd = rng.uniform(10.0, 25.0) * g_all  # [kg/s]: 10-25 Pa at the air node
     source = _ar1(rng, w["Pe"].size, src_sd, 7200.0)
+    if source_seed is not None:  # drawn after the room's own: its later draws are kept
+        source = _ar1(np.random.default_rng(source_seed), w["Pe"].size, src_sd, 7200.0)
     if "source" in without:
         source[:] = 0.0
     sim = simulate(room, p, w, ti, tf, source, lin if "isotherm" in without else None)

@@ -25,11 +25,14 @@ model's temperature input with its gaps interpolated linearly, the survey's room
     python benchmarks/sbc_coupled.py --table coupled.jsonl [--markdown]
     python benchmarks/sbc_coupled.py --reps 10 --rooms attic --without outage --log no.jsonl
     python benchmarks/sbc_coupled.py --paired coupled.jsonl no.jsonl
+    python benchmarks/sbc_coupled.py --source-seeds own,1,2,3 --only 0,2 --rooms cellar
 
 Each replicate is a function of ``(seed, room, replicate)``; one JSON line per replicate
 is appended to ``--log`` as soon as it is done, ``--first-rep`` extends a study, and
 ``--table`` merges logs. ``--without`` leaves parts of the generator out (diagnosis:
-``isotherm``, ``source``, ``noise``, ``outage``; :func:`coupled_rooms.generate`).
+``isotherm``, ``source``, ``noise``, ``outage``; :func:`coupled_rooms.generate`);
+``--source-seeds`` finds the MAP of cellars under other realisations of their moisture
+source (no chain; :func:`coupled_path.source_lines`).
 """
 
 from __future__ import annotations
@@ -541,6 +544,8 @@ def paired_lines(a: list[dict], b: list[dict]) -> list[str]:
                 za.append((xa["median"] - ra[r]["truth"][q]) / xa["sd"])
                 zb.append((xb["median"] - rb[r]["truth"][q]) / xb["sd"])
                 ia, ib = ia + xa["in90"], ib + xb["in90"]
+            if not za:  # ranked in neither log (e.g. the --path quantities)
+                continue
             d = np.subtract(za, zb)
             sd = f"{d.std(ddof=1):.2f}" if d.size > 1 else "—"
             lines.append(
@@ -603,6 +608,9 @@ def main(argv=None) -> int:
                     "cellar's slow quantities along each draw's wall (coupled_path)")  # fmt: skip
     ap.add_argument("--start", action="store_true", help="no fit: the GAB wall's start "
                     "and log L at the truth, linearised once and twice (coupled_path)")  # fmt: skip
+    ap.add_argument("--source-seeds", metavar="S,S", help="no posterior: the MAP of "
+                    "cellars --only/--first-rep.. under other realisations of their moisture "
+                    "source ('own': the room's own; coupled_path.source_lines)")  # fmt: skip
     ap.add_argument("--misfit", action="store_true", help="no fit: the structural error "
                     "of rooms --first-rep.. with each part of the generator left out")  # fmt: skip
     ap.add_argument("--means", nargs="+", metavar="LOG", help="mean z with the "
@@ -636,6 +644,16 @@ def main(argv=None) -> int:
         reps = range(args.first_rep, args.first_rep + args.reps)
         reps = [int(r) for r in args.only.split(",")] if args.only else reps
         for line in start_lines(reps, args.seed, args.cal_days, fit_inputs, MODELS, gab_truth):
+            print(line, flush=True)
+        return 0
+    if args.source_seeds:
+        from coupled_path import source_lines
+
+        reps = range(args.first_rep, args.first_rep + args.reps)
+        reps = [int(r) for r in args.only.split(",")] if args.only else reps
+        seeds = [None if s == "own" else int(s) for s in args.source_seeds.split(",")]
+        for line in source_lines(reps, seeds, args.seed, args.cal_days, fit_inputs, MODELS,
+                                 gab_truth, without):  # fmt: skip
             print(line, flush=True)
         return 0
     if args.means:

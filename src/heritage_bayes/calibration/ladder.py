@@ -59,7 +59,10 @@ def section_log_posterior(
             initial_state_horizon=getattr(cfg, section).horizon_seconds,
             time_constant_cap=getattr(cfg, section).cap_seconds(model.domain),
             temperature=getattr(cfg, section).temperature(
-                model.domain, model.n_states, getattr(model, "sorption", False)
+                model.domain,
+                model.n_states,
+                getattr(model, "sorption", False),
+                getattr(model, "sink", "none"),
             ),
             **extra,
         )

@@ -24,6 +24,7 @@ from heritage_bayes.names import DEFAULT_NOISE, NOISE_MODELS
 
 __all__ = [
     "DEFAULT_LIKELIHOOD_TEMPERATURE",
+    "SINK_LIKELIHOOD_TEMPERATURE",
     "SORPTION_LIKELIHOOD_TEMPERATURE",
     "TEMPERED_MAX_NODES",
     "DurationOrNone",
@@ -46,6 +47,14 @@ TEMPERED_MAX_NODES = 2
 #: generate (the isotherm's curvature, the hourly weather), which the innovations do
 #: not show (docs/science/sbc.md, the coupled hygric models).
 SORPTION_LIKELIHOOD_TEMPERATURE = 2.0
+#: ``likelihood_temperature`` of a hygric model with a vapour sink at a temperature
+#: (``sink: temperature``, a cellar's or a crawlspace's ground) whose buffer does not
+#: sorb at the materials' temperature, where the section does not set it: an
+#: unmodelled moisture source at the air node is stored in the buffer and released on
+#: its slow time constant (days), an error the AR(1) model error counts as many
+#: independent ones, so the slow quantities' intervals are too narrow by a factor that
+#: varies from room to room (docs/science/sbc.md, the coupled hygric models).
+SINK_LIKELIHOOD_TEMPERATURE = 3.0
 
 
 def _duration_or_none(v: Any) -> pd.Timedelta | str | None:
@@ -119,7 +128,8 @@ class ModelSection(_Strict):
         description="divide the log-likelihood by this (a tempered likelihood: posterior "
         "sd about √T times wider); 1: none (default: 2 for thermal models of one or two "
         "capacity nodes, chosen by simulation-based calibration on rooms the package did "
-        "not generate, and for hygric_2c_sorption; 1 for other hygric models and richer "
+        "not generate, and for hygric_2c_sorption; 3 for other hygric models with a vapour "
+        "sink at a temperature (sink: temperature); 1 for other hygric models and richer "
         "networks such as thermal_4a; docs: "
         "Simulation-based calibration)",
         ge=1,
@@ -154,19 +164,26 @@ class ModelSection(_Strict):
             return 365 * 86400.0 if domain == "thermal" else math.inf
         return _seconds(self.time_constant_cap)
 
-    def temperature(self, domain: str, n_nodes: int = 1, sorption: bool = False) -> float:
+    def temperature(
+        self, domain: str, n_nodes: int = 1, sorption: bool = False, sink: str = "none"
+    ) -> float:
         """``likelihood_temperature``; the default by domain: 2 for thermal models of
         at most :data:`TEMPERED_MAX_NODES` capacity nodes (``thermal_2c``'s 90 %
         intervals on 50 rooms the package did not generate cover 0.88-0.92 with it,
         0.74-0.82 without), 1 for richer ones and for hygric models
-        (``hygric_2c_fixed`` covers 0.86-0.90 untempered) except those whose buffer
-        sorbs at a temperature (``sorption``: :data:`SORPTION_LIKELIHOOD_TEMPERATURE`).
-        ``n_nodes``: the model's capacity nodes (``RCModel.n_states``)."""
+        (``hygric_2c_fixed`` with a constant fixed node covers 0.86-0.90 untempered)
+        except those whose buffer sorbs at a temperature (``sorption``:
+        :data:`SORPTION_LIKELIHOOD_TEMPERATURE`) and, otherwise, those with a vapour
+        sink at a temperature (``sink == "temperature"``:
+        :data:`SINK_LIKELIHOOD_TEMPERATURE`). ``n_nodes``: the model's capacity nodes
+        (``RCModel.n_states``)."""
         if self.likelihood_temperature is None:
             if n_nodes > TEMPERED_MAX_NODES:
                 return 1.0
             if sorption:
                 return SORPTION_LIKELIHOOD_TEMPERATURE
+            if domain == "hygric" and sink == "temperature":
+                return SINK_LIKELIHOOD_TEMPERATURE
             return DEFAULT_LIKELIHOOD_TEMPERATURE.get(domain, 1.0)
         return float(self.likelihood_temperature)
 

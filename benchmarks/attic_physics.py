@@ -55,6 +55,11 @@ variant of the roof planes' irradiance input:
   ``lwd``, ``lwdc``: ``lw``, ``lwc`` with the cover no colder than the dew point (the
   latent heat of the vapour condensing on it): the loss at most
   :math:`h_e (T_e - T_d)/\\alpha`;
+- ``lwo``, ``lwdo``: the package's roof columns unchanged, and beside them the loss of
+  ``lw``, ``lwd`` (as it reaches the attic: the wind's weight, none through the snow)
+  as its own column ``L_<plane>``, for the models ``sky`` and ``sky_below20`` (other
+  models ignore it); ``lwdon``: ``lwdo`` at night only (the cloudless sky's global
+  irradiance 0);
 - ``from<date>``: the calibration starts at the date (e.g. ``from2011-04-20``: after the
   snow), its end and the validation as init chose them.
 
@@ -81,6 +86,12 @@ here for the run:
 - ``below_measured``: the same with the room below's measured temperature
   (``indoor1.csv``) instead of 20 °C, beside the ground (it enters through the
   weather's one free column, ``Ph``, as a temperature);
+- ``sky``: ``thermal_1c`` with the sky's long-wave loss (the ``L_<plane>`` columns of
+  ``lwo``, ``lwdo``, ``lwdon``) through each slope's solar aperture times a fraction
+  ``r_lw`` [-], uniform on [0, 1]: the cover's ratio ε/α = 1.5 ``r_lw`` in [0, 1.5]
+  estimated (``lw``, ``lwd`` are ε/α = 1 fixed);
+- ``sky_below20``: ``sky`` plus ``below20``'s conductance ``Gb`` to 20 °C (the heat
+  that balances the loss's mean);
 - ``ground_measured``: ``thermal_1c`` with ``Tf`` = the room below's measured
   temperature, replacing the ground (init's written advice for a room without a floor
   on the ground).
@@ -135,10 +146,21 @@ MODELS = {
     "below20": ("x_below_constant", {}, {"Tb": {"fixed": 20.0}}),
     "below_measured": ("x_below_column", {}, {}),
     "ground_measured": ("thermal_1c", {}, {}),
+    "sky": ("x_sky", {}, {"r_lw": {"dist": "uniform", "lower": 0.0, "upper": 1.0}}),
+    "sky_below20": (
+        "x_sky_below",
+        {},
+        {"r_lw": {"dist": "uniform", "lower": 0.0, "upper": 1.0}, "Tb": {"fixed": 20.0}},
+    ),
 }
+#: ε/α of the roof's long-wave aperture at ``r_lw`` = 1: the ``L_<plane>`` columns are
+#: this times the loss (``r_lw`` a fraction in [0, 1], so ε/α in [0, 1.5])
+LW_CAP = 1.5
 
 
-def _candidate(name, surfaces=None, ground=True, deck=True, heavy=False, below=None, split=False):
+def _candidate(
+    name, surfaces=None, ground=True, deck=True, heavy=False, below=None, split=False, sky=False
+):
     """The candidates' networks: [°C], [J/K], [W/K], apertures [m²]."""
     from heritage_bayes.rc.network import Link, Network, Node, Source
 
@@ -153,6 +175,10 @@ def _candidate(name, surfaces=None, ground=True, deck=True, heavy=False, below=N
     sources = [Source(f"I_{s}", "Tr" if deck else "Ti", f"fI_{s}", "fsol" if split else None)
                for s in surfaces or ()]  # fmt: skip
     sources += [Source(f"I_{s}", "Ti", f"fI_{s}", "1-fsol") for s in surfaces or ()] * split
+    # the sky's long-wave loss through each slope's aperture times r_lw (ε/α = LW_CAP r_lw)
+    roofs = [s for s in surfaces or () if s.startswith("roof")] if sky else []
+    sources += [Source(f"L_{s}", "Ti", f"fI_{s}", "r_lw") for s in roofs]
+    inputs += [f"L_{s}" for s in roofs]
     return Network(name=name, domain="thermal", nodes=tuple(nodes), links=tuple(links),
                    inputs=tuple(inputs), outputs=("Ti",), sources=tuple(sources),
                    constants=("Tb",) * (below == "constant"))  # fmt: skip
@@ -165,7 +191,10 @@ def _register() -> None:
                         ("x_deck_split", {"split": True}),
                         ("x_air_mass", {"deck": False, "heavy": True}),
                         ("x_below_constant", {"deck": False, "below": "constant"}),
-                        ("x_below_column", {"deck": False, "below": "column"})):  # fmt: skip
+                        ("x_below_column", {"deck": False, "below": "column"}),
+                        ("x_sky", {"deck": False, "sky": True}),
+                        ("x_sky_below", {"deck": False, "below": "constant",
+                                         "sky": True})):  # fmt: skip
         if name in CATALOG:
             continue
 
@@ -271,6 +300,29 @@ def _lw_variant(orig, weather, site, surfaces, mode, where, roof, kw, variant):
     return out, label, detail
 
 
+def _lw_own(orig, weather, site, surfaces, mode, where, roof, kw, variant):
+    """The package's roof columns and beside them each slope's long-wave loss to the sky
+    as it reaches the attic (``_lw_variant``'s change: the wind's weight, none through
+    the snow), times -:data:`LW_CAP`, as its own column ``L_<plane>`` [W/m²] for the
+    candidates ``sky`` and ``sky_below20``; a variant ending in ``n``: at night only
+    (the cloudless sky's global irradiance 0)."""
+    from heritage_bayes.climate.solar import clear_sky_weather
+
+    out, label, detail = orig(weather, site, surfaces, mode, where=where, roof=roof, **kw)
+    base = "lwd" if variant.startswith("lwd") else "lw"
+    lw = _lw_variant(orig, weather, site, surfaces, mode, where, roof, kw, base)[0]
+    night = np.ones(len(out))
+    if variant.endswith("n"):
+        cs = clear_sky_weather(out.index, dict(site), interval=weather.attrs.get("interval"))
+        night = (cs["ghi"].to_numpy() <= 0.0).astype(float)
+    attrs = dict(out.attrs)
+    for k in roof:
+        out[f"L_{k}"] = LW_CAP * night * (lw[f"I_{k}"] - out[f"I_{k}"]).to_numpy(float)
+    attrs["units"] = {**attrs.get("units", {}), **{f"L_{k}": "W/m²" for k in roof}}
+    out.attrs = attrs
+    return out, label, detail
+
+
 def _snow_factor(raw: pd.DataFrame, index, keep: float = 1 / 3, start: bool = False):
     """1 - (1 - keep) of the roof's snow cover [-] from a degree-day snowpack; ``start``:
     a record starting in frost (its first week's mean Te below 0 °C) starts under 20 mm
@@ -339,6 +391,8 @@ def patched(variant: str, raw: pd.DataFrame):
             for k in roof:
                 out[f"I_{k}"] = out[f"I_{k}"].to_numpy() * w
             return out, label, detail
+        if variant in ("lwo", "lwdo", "lwdon"):  # the loss as its own column
+            return _lw_own(orig, weather, site, surfaces, mode, where, roof, kw, variant)
         if variant in ("lw", "lwc", "lwd", "lwdc"):
             return _lw_variant(orig, weather, site, surfaces, mode, where, roof, kw, variant)
         if variant in SNOW_VARIANTS or variant.startswith("melt"):
@@ -530,7 +584,10 @@ def run(room, variant, bare, data, work, hours, model="thermal_1c"):
     fit = fit_metrics(obs[v], y[v])["FIT"]
     CAL_FITS.append(fit_metrics(obs[cal], y[cal])["FIT"])
     if hours:
-        print(" ".join(f"{k}={x:.3g}" for k, x in zip(lp.params.names, mp.theta, strict=True)))
+        print(
+            " ".join(f"{k}={x:.3g}" for k, x in zip(lp.params.names, mp.theta, strict=True)),
+            f"log_post={mp.log_post:.1f} (starts agreed {mp.n_agreed}/{mp.n_starts})",
+        )
         sl = slice(prep.calibration.start, v.stop)
         e = pd.Series(obs[sl] - y[sl], index=prep.frame.index[sl] + pd.Timedelta(hours=2))
         season = np.array(["DJF", "DJF", "MAM", "MAM", "MAM", "JJA", "JJA", "JJA", "SON",

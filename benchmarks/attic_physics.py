@@ -131,6 +131,7 @@ from real_rooms import ROOMS, run_init  # noqa: E402
 
 TUNING = ["R2", "R4", "R6"]
 SEED = None  # the MAP's seed when not init's (--seed)
+BUDGET = {"maxiter": 100, "starts": 2}  # the MAP's generations and starts (--maxiter, --starts)
 CAL_FITS: list[float] = []  # the calibration FIT [%] of each run, in order
 SIGMA = 5.670374419e-8  # Stefan-Boltzmann [W/(m² K⁴)]
 DECK_PRIOR = {"Cr": {"dist": "loguniform", "lower": 1e4, "upper": 1e7}}  # [J/K]
@@ -319,6 +320,9 @@ def _lw_own(orig, weather, site, surfaces, mode, where, roof, kw, variant):
     for k in roof:
         out[f"L_{k}"] = LW_CAP * night * (lw[f"I_{k}"] - out[f"I_{k}"]).to_numpy(float)
     attrs["units"] = {**attrs.get("units", {}), **{f"L_{k}": "W/m²" for k in roof}}
+    # held in time as its plane's column is (nested: lwd is r_lw = 1/LW_CAP exactly)
+    averaged = tuple(attrs.get("averaged", ()))
+    attrs["averaged"] = averaged + tuple(f"L_{k}" for k in roof if f"I_{k}" in averaged)
     out.attrs = attrs
     return out, label, detail
 
@@ -553,7 +557,7 @@ def _config(room, variant, model, bare, data, w):
     if variant.startswith("from"):  # the calibration from a later date (e.g. after the snow)
         cal = periods.calibration.model_copy(update={"start": variant[4:]})
         periods = periods.model_copy(update={"calibration": cal})
-    opt = cfg.optimizer.model_copy(update={"maxiter": 100, "starts": 2})
+    opt = cfg.optimizer.model_copy(update=BUDGET)
     seed = cfg.seed if SEED is None else SEED
     return cfg.model_copy(update={"data": d, "optimizer": opt, "thermal": th, "hygric": None,
                                   "seed": seed,
@@ -611,14 +615,18 @@ def main(argv=None) -> int:
     ap.add_argument("--hours", action="store_true", help="residual by season and hour")
     ap.add_argument("--measured", action="store_true", help="measured radiation only")
     ap.add_argument("--seed", type=int, default=None, help="the MAP's seed (init's: 1)")
+    ap.add_argument("--maxiter", type=int, default=100, help="the MAP's generations")
+    ap.add_argument("--starts", type=int, default=2, help="the MAP's starts")
     args = ap.parse_args(argv)
     global SEED
     SEED = args.seed
+    BUDGET.update(maxiter=args.maxiter, starts=args.starts)
     if set(args.rooms) - set(TUNING):
         ap.error(f"tuning attics only: {TUNING} (the others are held out)")
     work = Path(tempfile.mkdtemp(prefix="attic_physics_"))
     _register()
-    print("validation FIT of Ti [%] (calibration FIT), MAP (100 generations, 2 starts)")
+    print(f"validation FIT of Ti [%] (calibration FIT), MAP ({args.maxiter} generations, "
+          f"{args.starts} starts)")  # fmt: skip
     print("| room | variant | model | measured radiation | estimated |")
     for room in args.rooms:
         for model in args.models:

@@ -1,9 +1,10 @@
 """Where the attics' autumn validation misses: the residual by weather regime.
 
-The validation residual (measured - simulated Ti) of ``thermal_1c``'s MAP on init's
-config (``attic_physics.py``'s ``wind``: the package; or one of its ``--variant``s),
-tuning attics R2, R4, R6 only (the held-out ones are refused), against the weather of
-each local day (UTC+2, FMI's file):
+The validation residual (measured - simulated Ti) of ``thermal_1c``'s MAP (or of
+``attic_physics.py``'s candidate ``--model``) on init's config (``attic_physics.py``'s
+``wind``: the package; or one of its ``--variant``s), tuning attics R2, R4, R6 only
+(the held-out ones are refused), against the weather of each local day (UTC+2, FMI's
+file):
 
 - the day's clearness index ``K`` (measured global radiation over a cloudless sky's,
   pvlib Ineichen-Perez, :func:`heritage_bayes.climate.solar.clear_sky_weather`; days
@@ -25,7 +26,7 @@ regime with the number of days; ``--figures DIR`` writes one figure per attic.
 Usage (from the repository root)::
 
     python benchmarks/attic_autumn.py [ROOM ...] [--estimated] [--variant sky]
-        [--figures docs/assets]
+        [--model sky] [--figures docs/assets]
 """
 
 from __future__ import annotations
@@ -49,12 +50,12 @@ CLEAR, OVERCAST = 0.5, 0.25  # the night's bracketing days' clearness [-]
 SIGMA = 5.670374419e-8  # [W/(m² K⁴)]
 
 
-def days(room: str, variant: str, bare: bool, data: Path, work: Path):
+def days(room: str, variant: str, bare: bool, data: Path, work: Path, model="thermal_1c"):
     """Hourly residual [K] of the validation (local time) and a table of its days."""
     from heritage_bayes.climate.psychro import dew_point
     from heritage_bayes.climate.solar import clear_sky_weather
 
-    cfg, prep, _, _, _, obs, y = ap.simulated(room, variant, bare, data, work)
+    cfg, prep, _, _, _, obs, y = ap.simulated(room, variant, bare, data, work, model)
     v = prep.validation
     e = pd.Series(obs[v] - y[v], index=prep.frame.index[v] + LOCAL)
     o = pd.Series(obs[v], index=e.index)
@@ -173,7 +174,7 @@ def figure(room: str, d: pd.DataFrame, out: Path, label: str) -> None:
     ax.axhline(0, color="0.6", lw=0.8)
     ax.legend(fontsize=7)
     ax.tick_params(axis="x", labelrotation=45, labelsize=7)
-    fig.suptitle(f"{room}: validation residual (measured − simulated Ti), thermal_1c MAP, {label}")
+    fig.suptitle(f"{room}: validation residual (measured − simulated Ti), MAP, {label}")
     fig.savefig(out / f"attic_autumn_{room}.png", dpi=80)
     plt.close(fig)
 
@@ -184,6 +185,8 @@ def main(argv=None) -> int:
     p.add_argument("--data", type=Path, default=ROOT.parent / "shared" / "data")
     p.add_argument("--variant", default="wind", help="attic_physics.py's (default: the package)")
     p.add_argument("--estimated", action="store_true", help="without the radiation columns")
+    p.add_argument("--model", default="thermal_1c", choices=list(ap.MODELS),
+                   help="attic_physics.py's candidate (default: thermal_1c)")  # fmt: skip
     p.add_argument("--figures", type=Path, default=None, help="folder for the figures")
     args = p.parse_args(argv)
     if set(args.rooms) - set(TUNING):
@@ -191,10 +194,11 @@ def main(argv=None) -> int:
     work = Path(tempfile.mkdtemp(prefix="attic_autumn_"))
     ap._register()
     for room in args.rooms:
-        e, o, d = days(room, args.variant, args.estimated, args.data, work)
+        e, o, d = days(room, args.variant, args.estimated, args.data, work, args.model)
         summary(room, e, o, d)
         if args.figures:
             label = ("estimated" if args.estimated else "measured") + f" radiation, {args.variant}"
+            label += f", {args.model}"
             figure(room, d, args.figures, label)
     return 0
 

@@ -91,7 +91,8 @@ here for the run:
   ``r_lw`` [-], uniform on [0, 1]: the cover's ratio ε/α = 1.5 ``r_lw`` in [0, 1.5]
   estimated (``lw``, ``lwd`` are ε/α = 1 fixed);
 - ``sky_below20``: ``sky`` plus ``below20``'s conductance ``Gb`` to 20 °C (the heat
-  that balances the loss's mean);
+  that balances the loss's mean); ``sky_below``: the same with the room's constant
+  temperature ``Tb`` estimated, uniform on [10, 30] °C;
 - ``ground_measured``: ``thermal_1c`` with ``Tf`` = the room below's measured
   temperature, replacing the ground (init's written advice for a room without a floor
   on the ground).
@@ -152,6 +153,14 @@ MODELS = {
         "x_sky_below",
         {},
         {"r_lw": {"dist": "uniform", "lower": 0.0, "upper": 1.0}, "Tb": {"fixed": 20.0}},
+    ),
+    "sky_below": (
+        "x_sky_below",
+        {},
+        {
+            "r_lw": {"dist": "uniform", "lower": 0.0, "upper": 1.0},
+            "Tb": {"dist": "uniform", "lower": 10.0, "upper": 30.0},
+        },
     ),
 }
 #: ε/α of the roof's long-wave aperture at ``r_lw`` = 1: the ``L_<plane>`` columns are

@@ -1,6 +1,7 @@
 """The attic benchmarks' checks on synthetic data: a known stamp shift, phase and gain
-are found (benchmarks/attic_diagnostics.py), the roof's answers are parsed
-(benchmarks/attic_physics.py), a slow sun path is found (benchmarks/attic_response.py)."""
+are found (benchmarks/attic_diagnostics.py), the roof's answers are parsed and the sky's
+loss with its own weight nests the fixed one (benchmarks/attic_physics.py), a slow sun
+path is found (benchmarks/attic_response.py)."""
 
 import sys
 from pathlib import Path
@@ -60,6 +61,23 @@ def test_roof_answers_parse():
     assert ap._roof_answers("ridge45+pitch30") == ({"ridge_azimuth": 45.0, "pitch": 30.0}, "wind")
     assert ap._roof_answers("ridge0+snow0") == ({"ridge_azimuth": 0.0}, "snow0")
     assert ap._roof_answers("phi0.8") == ({}, "phi0.8")
+
+
+def test_sky_loss_with_its_own_weight_nests_the_fixed_one():
+    """The candidate ``sky``: each slope's loss column ``L_<plane>`` (LW_CAP times the
+    loss, negative) enters through the slope's aperture times ``r_lw``; at r_lw =
+    1/LW_CAP it is ``lwd``'s I - loss through the aperture, at 0 ``thermal_1c``."""
+    from heritage_bayes.rc.model import RCModel
+
+    planes = ["roof_N", "roof_S"]
+    m = RCModel(ap._candidate("x_sky", planes, deck=False, sky=True))
+    assert "r_lw" in m.parameter_names and m.input_names[-2:] == ("L_roof_N", "L_roof_S")
+    p = {"Ci": 1e6, "Ge": 100.0, "Gf": 5.0, "fI_roof_N": 3.0, "fI_roof_S": 7.0}
+    for r in (0.0, 1.0 / ap.LW_CAP, 1.0):
+        B = m.state_space({**p, "r_lw": r})[1]
+        col = {k: B[:, m.input_names.index(k)] for k in m.input_names}
+        for k in planes:
+            np.testing.assert_allclose(col[f"L_{k}"], r * col[f"I_{k}"], rtol=1e-12)
 
 
 def test_attic_response_finds_a_slow_sun_beside_a_fast_air():

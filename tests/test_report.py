@@ -872,7 +872,8 @@ def test_every_convergence_number_of_the_report_is_az_summary_of_posterior_nc(re
     summary = json.loads((run_dir / "summary.json").read_text())
     idata = az.from_netcdf(run_dir / "posterior.nc")
     free = [k for k, v in summary["parameters"].items() if v.get("fixed") is None]
-    diag = az.summary(idata, var_names=free, kind="diagnostics", round_to="none")
+    retained = idata["posterior_retained"]  # every retained draw: what R-hat/ESS are on
+    diag = az.summary(retained, var_names=free, kind="diagnostics", round_to="none")
     for m in ("thermal", "hygric"):
         table = html[html.index(f'id="table-params-{m}"') :]
         table = table[: table.index("</table>")]
@@ -883,12 +884,15 @@ def test_every_convergence_number_of_the_report_is_az_summary_of_posterior_nc(re
             assert f">{fmt_int(eb)} / {fmt_int(et)}<" in row, (key, eb, et)
         # the slowest time constant in the identifiability section
         key = f"{m}.tau_1_h"
-        d = az.summary(idata, var_names=[key], kind="diagnostics", round_to="none")
+        d = az.summary(retained, var_names=[key], kind="diagnostics", round_to="none")
         assert summary["derived"][key]["ess_bulk"] == pytest.approx(d.loc[key, "ess_bulk"])
         assert summary["derived"][key]["r_hat"] == pytest.approx(d.loc[key, "r_hat"])
     verdict = html[: html.index('<section id="data">')]
     assert f"max R-hat {diag['r_hat'].max():.3f}" in verdict
     assert f"min bulk ESS {fmt_int(diag['ess_bulk'].min())}" in verdict
+    # the thinned draws of the posterior group are named beside, with their own figure
+    saved = az.summary(idata, var_names=free, kind="diagnostics", round_to="none")
+    assert f"give max R-hat {saved['r_hat'].max():.3f}" in verdict
 
 
 def test_summary_json_is_what_arviz_computes_from_posterior_nc_bit_for_bit(run_dir):
@@ -902,6 +906,7 @@ def test_summary_json_is_what_arviz_computes_from_posterior_nc_bit_for_bit(run_d
     summary = json.loads((run_dir / "summary.json").read_text())
     idata = az.from_netcdf(run_dir / "posterior.nc")
     n_draws = idata.posterior.sizes["draw"]
+    retained = idata["posterior_retained"]
     rows = {**summary["parameters"], **summary["derived"]}
     checked = {"r_hat": 0, "quantiles": 0}
     for key, entry in rows.items():
@@ -911,17 +916,34 @@ def test_summary_json_is_what_arviz_computes_from_posterior_nc_bit_for_bit(run_d
         assert (entry["q05"], entry["median"], entry["q95"]) == (q05, q50, q95), key
         assert entry["mean"] == np.mean(flat) and entry["sd"] == np.std(flat), key
         checked["quantiles"] += 1
+        if key in retained:  # the posterior group's draws are marked among the retained
+            sub = retained[key].isel(draw=retained["in_posterior"].values)
+            assert np.array_equal(sub.values, x), key
         if "r_hat" in entry:
-            d = az.summary(idata, var_names=[key], kind="diagnostics", round_to="none")
+            # R-hat and ESS are those of every retained draw
+            d = az.summary(retained, var_names=[key], kind="diagnostics", round_to="none")
             assert entry["r_hat"] == d.loc[key, "r_hat"], (key, entry["r_hat"], d.loc[key])
             assert entry["ess_bulk"] == d.loc[key, "ess_bulk"], key
             if "ess_tail" in entry:
                 assert entry["ess_tail"] == d.loc[key, "ess_tail"], key
             checked["r_hat"] += 1
     # every free parameter and the varying derived quantities carry diagnostics
-    n_free = sum(v.get("fixed") is None for v in summary["parameters"].values())
-    assert checked["r_hat"] >= n_free > 0 and checked["quantiles"] == len(rows)
+    free = [k for k, v in summary["parameters"].items() if v.get("fixed") is None]
+    assert checked["r_hat"] >= len(free) > 0 and checked["quantiles"] == len(rows)
     assert n_draws > 0
+    # the run's figures, and those of the thinned draws recorded beside them
+    d = az.summary(retained, var_names=free, kind="diagnostics", round_to="none")
+    assert (summary["max_rhat"], summary["min_ess_bulk"]) == (
+        d["r_hat"].max(),
+        d["ess_bulk"].min(),
+    )
+    cd = summary["convergence_draws"]
+    assert (cd["walkers"], cd["draws_per_walker"]) == tuple(retained[free[0]].shape)
+    d = az.summary(idata, var_names=free, kind="diagnostics", round_to="none")
+    assert (cd["saved_max_rhat"], cd["saved_min_ess_bulk"]) == (
+        d["r_hat"].max(),
+        d["ess_bulk"].min(),
+    )
 
 
 def test_convergence_stats_is_az_summary_where_az_rhat_differs():

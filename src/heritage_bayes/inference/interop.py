@@ -7,7 +7,9 @@
   ``log_predictive_density_validation`` group, expected log predictive density);
 - :func:`convergence_stats`: R-hat and bulk/tail ESS by ``az.summary`` itself on the
   draws as the file stores them (:func:`as_saved`), so that the report's figures are
-  reproduced bit for bit by ``az.summary(az.from_netcdf("posterior.nc"))``.
+  reproduced bit for bit by ``az.summary`` of the group they were computed on;
+- :func:`convergence_record`: the run's convergence figures, on the retained draws
+  (group :data:`RETAINED`), beside those of the thinned draws of the ``posterior`` group.
 """
 
 from __future__ import annotations
@@ -19,8 +21,10 @@ from heritage_bayes._arviz import az
 
 __all__ = [
     "JOINT_LOGLIK",
+    "RETAINED",
     "VALIDATION_LPD",
     "as_saved",
+    "convergence_record",
     "convergence_stats",
     "log_mean_exp",
     "loglik_groups",
@@ -31,6 +35,10 @@ __all__ = [
 JOINT_LOGLIK = "all_outputs"
 #: Group of ``posterior.nc`` holding the log predictive density of each validation hour.
 VALIDATION_LPD = "log_predictive_density_validation"
+#: Group of ``posterior.nc`` holding every retained draw (walkers × draws after burn-in
+#: and thinning, common to the run's models) of the free parameters and of the varying
+#: derived quantities: the draws the run's R-hat and ESS are computed on.
+RETAINED = "posterior_retained"
 
 
 def loglik_groups(loglik: dict[str, xr.DataArray], coords: dict, attrs: dict) -> dict:
@@ -110,19 +118,15 @@ def log_mean_exp(a) -> np.ndarray:
 
 
 def convergence_stats(post: dict[str, xr.DataArray], names: list[str]):
-    """Rank-normalised split R-hat, bulk and tail ESS of the saved draws ``names``.
+    """Rank-normalised split R-hat, bulk and tail ESS of the draws ``names`` of ``post``.
 
     Computed by ``az.summary(..., kind="diagnostics", round_to="none")`` itself
     (Vehtari et al. 2021 [1]_) on the very arrays ``posterior.nc`` stores (walkers as
-    chains, float64, C order), so that ``az.summary(az.from_netcdf("posterior.nc"))``
+    chains, float64, C order), so that ``az.summary`` of the group they are stored in
     reproduces every figure bit for bit. arviz has two R-hat paths that differ:
     ``az.rhat`` folds the draws about the median of the *split* chains (dropping the
     middle draw of an odd-length chain), ``az.summary`` about the median of all draws;
-    the summary's is the one a reader runs, so it is the one used here. The sampler's
-    stopping rule checks all its retained draws
-    (:func:`heritage_bayes.inference.sampler.run_sampler`); the saved draws are an evenly
-    thinned subset, nearly independent, so their bulk ESS is close to their number when
-    the chain has converged.
+    the summary's is the one a reader runs, so it is the one used here.
 
     Returns
     -------
@@ -139,6 +143,61 @@ def convergence_stats(post: dict[str, xr.DataArray], names: list[str]):
     ds = xr.Dataset({v: as_saved(post[v]) for v in names})
     diag = az.summary(ds, kind="diagnostics", round_to="none")
     return diag["r_hat"], diag["ess_bulk"], diag["ess_tail"]
+
+
+def convergence_record(
+    retained: dict[str, xr.DataArray], saved: np.ndarray, names: list[str]
+) -> dict:
+    """The run's convergence figures for the free parameters ``names``: on every
+    retained draw, and on the thinned draws the ``posterior`` group keeps.
+
+    ``retained`` holds each name's retained draws (chain = walker, draw; the arrays of
+    group :data:`RETAINED`), ``saved`` the ``draw`` indices the ``posterior`` group
+    keeps of them. The run's criteria (R-hat and bulk ESS) are judged on the retained
+    draws, the same draws the sampler's stopping rule checked: the rank-normalised split
+    R-hat compares the walkers' means with the spread within them, and for independent
+    draws its excess over 1 is about (χ²_{M-1}/(M-1) - 1)/(2N) for M half-chains of N
+    draws (the between-chain variance of Gelman & Rubin [1]_), a noise that shrinks as
+    1/N. On the few draws per walker the ``posterior`` group keeps (sized by the
+    log-likelihood group) the largest R-hat of a handful of well-mixed parameters lies
+    above 1.01 in most runs, so those figures are recorded (``saved_*``) but decide
+    nothing (docs/science/benchmarks.md, "Which draws the convergence figures are on").
+
+    Returns
+    -------
+    dict
+        ``r_hat``, ``ess_bulk``, ``ess_tail`` (name -> float, retained draws),
+        ``max_rhat`` and ``min_ess_bulk`` over the names (retained draws), and
+        ``convergence_draws``: ``on`` (``"retained"``), ``group`` (:data:`RETAINED`),
+        ``walkers``, ``draws_per_walker``, ``saved_draws_per_walker``,
+        ``saved_max_rhat`` and ``saved_min_ess_bulk`` (what ``az.summary`` of the
+        ``posterior`` group gives).
+
+    References
+    ----------
+    .. [1] A. Gelman, D. B. Rubin, "Inference from iterative simulation using multiple
+       sequences", *Statistical Science* 7 (1992) 457-472. doi:10.1214/ss/1177011136
+    """
+    r, eb, et = convergence_stats(retained, names)
+    thinned = {k: retained[k].isel(draw=np.asarray(saved)) for k in names}
+    rs, ebs, _ = convergence_stats(thinned, names)
+    first = retained[names[0]]
+    return {
+        "r_hat": {k: float(r[k]) for k in names},
+        "ess_bulk": {k: float(eb[k]) for k in names},
+        "ess_tail": {k: float(et[k]) for k in names},
+        "max_rhat": float(np.max(r.to_numpy())),
+        "min_ess_bulk": float(np.min(eb.to_numpy())),
+        "convergence_draws": {
+            "on": "retained",
+            "group": RETAINED,
+            "walkers": int(first.sizes["chain"]),
+            "draws_per_walker": int(first.sizes["draw"]),
+            "saved_draws_per_walker": len(saved),
+            "saved_max_rhat": float(np.max(rs.to_numpy())),
+            "saved_min_ess_bulk": float(np.min(ebs.to_numpy())),
+        },
+    }
 
 
 def as_saved(da: xr.DataArray) -> xr.DataArray:

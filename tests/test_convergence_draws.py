@@ -13,18 +13,22 @@ import pytest
 import xarray as xr
 
 from heritage_bayes.calibration.convergence import unconverged_reasons
-from heritage_bayes.inference.interop import RETAINED, convergence_record
+from heritage_bayes.inference.interop import convergence_record, retained_dataset, retained_group
 from heritage_bayes.inference.predictive import _saved_index
 from heritage_bayes.report.verdict import convergence_verdict
 from heritage_bayes.rundir.summary import RunSummary
 
 W, D, N_SAVED = 32, 124, 1000  # 32 walkers × 124 retained draws; about 1 000 saved
 NAMES = [f"thermal.p{i}" for i in range(10)]
+GROUP = retained_group("thermal")
 
 
-def _retained(x: np.ndarray) -> dict[str, xr.DataArray]:
-    """(params, walkers, draws) -> the retained group's variables."""
-    return {k: xr.DataArray(x[i], dims=("chain", "draw")) for i, k in enumerate(NAMES)}
+def _record(x: np.ndarray) -> dict:
+    """The convergence record of retained draws ``x`` (params, walkers, draws), the
+    ``posterior`` group keeping about :data:`N_SAVED` of them as a run does."""
+    variables = {k: xr.DataArray(x[i], dims=("chain", "draw")) for i, k in enumerate(NAMES)}
+    ds = retained_dataset(variables, _saved_index(W, D, N_SAVED))
+    return convergence_record({GROUP: ds}, NAMES)
 
 
 def _summary(rec: dict, *, converged: bool, retained: bool = True) -> dict:
@@ -62,8 +66,7 @@ def mixed() -> dict:
     seed is one whose thinned subset (32 draws per walker) scatters above R-hat 1.01,
     as most seeds' do (docs/science/benchmarks.md, "Which draws the convergence
     figures are on")."""
-    x = np.random.default_rng(0).standard_normal((len(NAMES), W, D))
-    return convergence_record(_retained(x), _saved_index(W, D, N_SAVED), NAMES)
+    return _record(np.random.default_rng(0).standard_normal((len(NAMES), W, D)))
 
 
 def test_a_converged_chain_is_converged_though_its_thinned_subset_scatters(mixed):
@@ -71,14 +74,17 @@ def test_a_converged_chain_is_converged_though_its_thinned_subset_scatters(mixed
     # the premise: the retained draws meet the criteria, the thinned subset does not
     assert mixed["max_rhat"] <= 1.01 and mixed["min_ess_bulk"] >= 400
     assert cd["saved_max_rhat"] > 1.01
-    assert (cd["walkers"], cd["draws_per_walker"], cd["saved_draws_per_walker"]) == (W, D, 32)
-    assert cd["on"] == "retained" and cd["group"] == RETAINED
+    assert (cd["walkers"], cd["groups"], cd["saved_draws_per_walker"]) == (W, {GROUP: D}, 32)
+    assert cd["on"] == "retained"
     s = _summary(mixed, converged=True)
     v = convergence_verdict(s)
     assert (v["level"], v["status"], v["title"]) == ("green", "converged", "Converged")
     assert "of the retained draws" in v["stats"] and f"{mixed['max_rhat']:.3f}" in v["stats"]
     # the rule names the draws judged and the thinned draws' figure beside, deciding nothing
-    assert "the 3 968 retained draws (32 walkers × 124" in v["rule"]
+    assert (
+        "the 3 968 retained draws (32 walkers × 124; group `posterior_retained_thermal`"
+        in (v["rule"])
+    )
     assert f"max R-hat {cd['saved_max_rhat']:.3f}" in v["rule"] and "decide nothing" in v["rule"]
     assert v["models"] == ["thermal model (`thermal_1c`): all criteria met."]
     assert unconverged_reasons(s) == []
@@ -104,7 +110,7 @@ def _unmixed(spread: float) -> dict:
     rng = np.random.default_rng(3)
     x = rng.standard_normal((len(NAMES), W, D))
     x += spread * rng.standard_normal((len(NAMES), W, 1))
-    return convergence_record(_retained(x), _saved_index(W, D, N_SAVED), NAMES)
+    return _record(x)
 
 
 def test_an_unconverged_chain_is_still_amber_or_red():

@@ -3,10 +3,11 @@
 See :mod:`heritage_bayes.inference.results` for the layout. Thermal and hygric models are
 sampled independently; their retained draws share the (chain, draw) grid so that draw
 *i* of one pairs with draw *i* of the other, which is how the combined indoor RH
-(:math:`RH = P_i / P_{sat}(T_i)`) is predicted. R-hat and ESS are those of every
-retained draw (group :data:`~heritage_bayes.inference.interop.RETAINED`); the
-quantiles, bands and log-likelihoods those of the thinned draws of the ``posterior``
-group (:func:`~heritage_bayes.inference.interop.convergence_record`).
+(:math:`RH = P_i / P_{sat}(T_i)`) is predicted. R-hat and ESS are those of every draw
+a model's sampler retained (its group ``posterior_retained_<model>``: the draws its
+stopping rule checked); the quantiles, bands and log-likelihoods those of the thinned
+draws of the ``posterior`` group
+(:func:`~heritage_bayes.inference.interop.convergence_record`).
 """
 
 from __future__ import annotations
@@ -31,12 +32,13 @@ from heritage_bayes.calibration.runinfo import (
 )
 from heritage_bayes.climate.psychro import saturation_vapour_pressure
 from heritage_bayes.inference.interop import (
-    RETAINED,
     VALIDATION_LPD,
     convergence_record,
     convergence_stats,
     log_mean_exp,
     loglik_groups,
+    retained_dataset,
+    retained_group,
 )
 from heritage_bayes.inference.predictive import (
     _saved_index,
@@ -187,7 +189,8 @@ class _Outputs:
     times: np.ndarray
     codes: np.ndarray
     post: dict = field(default_factory=dict)
-    #: every retained draw of the free parameters and varying derived quantities
+    #: section -> every retained draw of its free parameters and varying derived
+    #: quantities (:func:`retained_dataset`)
     retained: dict = field(default_factory=dict)
     stats: dict = field(default_factory=dict)
     loglik: dict = field(default_factory=dict)
@@ -244,9 +247,12 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
 
 
 def _posterior_draws(o: _Outputs, s) -> tuple[dict, dict]:
-    """The saved draws of a section's parameters and derived quantities, and its sampler
-    statistics; returns (derived quantity -> its (W, D) kept draws, -> its unit)."""
+    """The saved draws of a section's parameters and derived quantities, its retained
+    draws and its sampler statistics; returns (derived quantity -> its (W, D) draws
+    common to the sections, -> its unit)."""
     ps, W, D = s.logpost.params, o.W, o.D
+    kept = s.theta_kept  # (W, n, p); s.theta is its last D draws
+    retained = {}
     for j, p in enumerate(ps.parameters):
         attrs = {"unit": p.unit, "kind": p.kind, "description": p.description}
         o.post[f"{s.name}.{p.name}"] = xr.DataArray(
@@ -255,27 +261,27 @@ def _posterior_draws(o: _Outputs, s) -> tuple[dict, dict]:
             attrs=attrs,
         )
         if p.free:
-            o.retained[f"{s.name}.{p.name}"] = xr.DataArray(
-                np.ascontiguousarray(s.theta[..., j], dtype=np.float64), dims=_CDIMS, attrs=attrs
+            retained[f"{s.name}.{p.name}"] = xr.DataArray(
+                np.ascontiguousarray(kept[..., j], dtype=np.float64), dims=_CDIMS, attrs=attrs
             )
-    tm = s.theta[..., : s.logpost.n_model]
+    tm = kept[..., : s.logpost.n_model]
     dq = derived_quantities(s.model, tm.reshape(-1, tm.shape[-1]))
     units = derived_units(s.model)
     dq_all = {}
     for k, v in dq.items():
-        arr = np.broadcast_to(np.asarray(v, dtype=float), (W * D,)).reshape(W, D)
-        dq_all[k] = arr
+        full = np.broadcast_to(np.asarray(v, dtype=float), (tm.shape[0] * tm.shape[1],))
+        full = full.reshape(tm.shape[:2])
+        dq_all[k] = arr = full[:, -D:]
+        attrs = {"unit": units.get(k, "")}
         o.post[f"{s.name}.{k}"] = xr.DataArray(
-            np.ascontiguousarray(arr[:, o.sel], dtype=np.float64),
-            dims=_CDIMS,
-            attrs={"unit": units.get(k, "")},
+            np.ascontiguousarray(arr[:, o.sel], dtype=np.float64), dims=_CDIMS, attrs=attrs
         )
-        if np.all(np.isfinite(arr)) and np.ptp(arr) > 0:  # R-hat and ESS are defined
-            o.retained[f"{s.name}.{k}"] = xr.DataArray(
-                np.ascontiguousarray(arr, dtype=np.float64),
-                dims=_CDIMS,
-                attrs={"unit": units.get(k, "")},
+        if np.all(np.isfinite(full)) and np.ptp(full) > 0:  # R-hat and ESS are defined
+            retained[f"{s.name}.{k}"] = xr.DataArray(
+                np.ascontiguousarray(full, dtype=np.float64), dims=_CDIMS, attrs=attrs
             )
+    if retained:  # the posterior group's draws: the last D, thinned to o.sel
+        o.retained[s.name] = retained_dataset(retained, kept.shape[1] - D + o.sel)
     o.stats[f"{s.name}.lp"] = xr.DataArray(s.lp[:, o.sel], dims=_CDIMS)
     o.stats[f"{s.name}.acceptance_rate"] = xr.DataArray(
         np.broadcast_to(s.chain.acceptance[:, None], (W, len(o.sel))).copy(), dims=_CDIMS
@@ -341,13 +347,14 @@ def _parameter_summaries(o: _Outputs, cfg, prep, s, seed: int, dq_units: dict) -
     posterior correlations of its free parameters.
 
     Quantiles are those of the ``posterior`` group's draws, R-hat and ESS those of the
-    retained draws (group :data:`RETAINED`), each as ``posterior.nc`` holds them, so
-    that a reader of the file reproduces every digit; contraction, bounds and
+    section's retained draws (:func:`retained_group`), each as ``posterior.nc`` holds
+    them, so that a reader of the file reproduces every digit; contraction, bounds and
     correlations are taken on all draws the sampler kept."""
     ps = s.logpost.params
     kept = s.theta_kept
     free_vars = [f"{s.name}.{n}" for n in ps.free_names]
-    rhat, ess_b, ess_t = convergence_stats(o.retained, free_vars)
+    retained = o.retained.get(s.name, {})
+    rhat, ess_b, ess_t = convergence_stats(retained, free_vars) if free_vars else ({},) * 3
     tau = dict(zip(ps.free_names, s.chain.tau, strict=True))
     truth, truth_dq = _truth_for(cfg, prep, s)
     mapv = dict(zip(ps.names, s.map.theta, strict=True))
@@ -388,8 +395,8 @@ def _parameter_summaries(o: _Outputs, cfg, prep, s, seed: int, dq_units: dict) -
         key = f"{s.name}.{k}"
         x = o.post[key].values.reshape(-1)
         o.derived[key] = {"unit": unit, **_summ(x), "truth": truth_dq.get(k)}
-        if key in o.retained:
-            r, e, _ = convergence_stats(o.retained, [key])
+        if key in retained:
+            r, e, _ = convergence_stats(retained, [key])
             o.derived[key]["r_hat"] = float(r[key])
             o.derived[key]["ess_bulk"] = float(e[key])
     # posterior correlations of the free parameters (log scale where the prior is)
@@ -514,8 +521,9 @@ def _inference_data(o: _Outputs, prep, sections, attrs: dict):
     coords = {"chain": np.arange(o.W), "draw": np.arange(len(o.sel))}
     groups = {
         "posterior": xr.Dataset(o.post, coords=coords, attrs=attrs),
-        # every retained draw (a superset of the posterior group's): the R-hat and ESS
-        RETAINED: xr.Dataset(o.retained, coords=_retained_coords(o), attrs=attrs),
+        # every retained draw of each model (a superset of the posterior group's): the
+        # R-hat and ESS
+        **{retained_group(k): ds.assign_attrs(attrs) for k, ds in o.retained.items()},
         "sample_stats": xr.Dataset(o.stats, coords=coords, attrs=attrs),
         **loglik_groups(o.loglik, coords, attrs),
         # a bounded number of draws, the bands over all of them (the predictive was 75 %
@@ -537,21 +545,13 @@ def _inference_data(o: _Outputs, prep, sections, attrs: dict):
     return az.InferenceData(**groups)
 
 
-def _retained_coords(o: _Outputs) -> dict:
-    """Coordinates of the retained draws' group: ``in_posterior`` marks the draws the
-    ``posterior`` group keeps (in order: its ``draw`` 0, 1, ...)."""
-    mask = np.zeros(o.D, dtype=bool)
-    mask[o.sel] = True
-    return {"chain": np.arange(o.W), "draw": np.arange(o.D), "in_posterior": ("draw", mask)}
-
-
 def _summary(o: _Outputs, cfg, prep, sections, attrs: dict) -> dict:
     """The run's ``summary.json`` from the gathered entries."""
     free = [k for k, v in o.params.items() if "r_hat" in v]
     # the decision is the sampler's stopping rule: 50 τ with a stable τ, and R-hat/ESS
     # within CONVERGENCE on every retained draw; max_rhat/min_ess below are those of the
     # same retained draws in the parameters' own coordinates (the saved ones' beside)
-    conv = convergence_record(o.retained, o.sel, free)
+    conv = convergence_record({retained_group(k): v for k, v in o.retained.items()}, free)
     tau_ok = all(s.chain.converged for s in sections)
     return {
         "name": cfg.name,

@@ -8,8 +8,9 @@
 - :func:`convergence_stats`: R-hat and bulk/tail ESS by ``az.summary`` itself on the
   draws as the file stores them (:func:`as_saved`), so that the report's figures are
   reproduced bit for bit by ``az.summary`` of the group they were computed on;
-- :func:`convergence_record`: the run's convergence figures, on the retained draws
-  (group :data:`RETAINED`), beside those of the thinned draws of the ``posterior`` group.
+- :func:`retained_dataset`, :func:`convergence_record`: a model's retained draws (group
+  ``posterior_retained_<model>``, :func:`retained_group`) and the run's convergence
+  figures on them, beside those of the thinned draws of the ``posterior`` group.
 """
 
 from __future__ import annotations
@@ -21,13 +22,14 @@ from heritage_bayes._arviz import az
 
 __all__ = [
     "JOINT_LOGLIK",
-    "RETAINED",
     "VALIDATION_LPD",
     "as_saved",
     "convergence_record",
     "convergence_stats",
     "log_mean_exp",
     "loglik_groups",
+    "retained_dataset",
+    "retained_group",
     "split_outputs",
 ]
 
@@ -35,10 +37,33 @@ __all__ = [
 JOINT_LOGLIK = "all_outputs"
 #: Group of ``posterior.nc`` holding the log predictive density of each validation hour.
 VALIDATION_LPD = "log_predictive_density_validation"
-#: Group of ``posterior.nc`` holding every retained draw (walkers × draws after burn-in
-#: and thinning, common to the run's models) of the free parameters and of the varying
-#: derived quantities: the draws the run's R-hat and ESS are computed on.
-RETAINED = "posterior_retained"
+
+
+def retained_group(section: str) -> str:
+    """The group of ``posterior.nc`` holding model ``section``'s retained draws."""
+    return f"posterior_retained_{section}"
+
+
+def retained_dataset(
+    variables: dict[str, xr.DataArray], saved: np.ndarray, attrs: dict | None = None
+) -> xr.Dataset:
+    """One model's retained draws as ``posterior.nc`` stores them (a group
+    :func:`retained_group`): every draw its sampler retained (walkers × draws after
+    burn-in and thinning by τ, at most ``sampler.max_draws``) of the free parameters and
+    of the varying derived quantities, the draws its stopping rule checked and the run's
+    R-hat and ESS are computed on. The coordinate ``in_posterior`` marks, in order, the
+    draws the ``posterior`` group keeps (``saved``: their positions along ``draw``).
+    """
+    first = next(iter(variables.values()))
+    n_chain, n_draw = first.shape[:2]
+    mask = np.zeros(n_draw, dtype=bool)
+    mask[np.asarray(saved)] = True
+    coords = {
+        "chain": np.arange(n_chain),
+        "draw": np.arange(n_draw),
+        "in_posterior": ("draw", mask),
+    }
+    return xr.Dataset(variables, coords=coords, attrs=attrs or {})
 
 
 def loglik_groups(loglik: dict[str, xr.DataArray], coords: dict, attrs: dict) -> dict:
@@ -145,59 +170,61 @@ def convergence_stats(post: dict[str, xr.DataArray], names: list[str]):
     return diag["r_hat"], diag["ess_bulk"], diag["ess_tail"]
 
 
-def convergence_record(
-    retained: dict[str, xr.DataArray], saved: np.ndarray, names: list[str]
-) -> dict:
+def convergence_record(groups: dict[str, xr.Dataset], names: list[str]) -> dict:
     """The run's convergence figures for the free parameters ``names``: on every
     retained draw, and on the thinned draws the ``posterior`` group keeps.
 
-    ``retained`` holds each name's retained draws (chain = walker, draw; the arrays of
-    group :data:`RETAINED`), ``saved`` the ``draw`` indices the ``posterior`` group
-    keeps of them. The run's criteria (R-hat and bulk ESS) are judged on the retained
-    draws, the same draws the sampler's stopping rule checked: the rank-normalised split
-    R-hat compares the walkers' means with the spread within them, and for independent
-    draws its excess over 1 is about (χ²_{M-1}/(M-1) - 1)/(2N) for M half-chains of N
-    draws (the between-chain variance of Gelman & Rubin [1]_), a noise that shrinks as
-    1/N. On the few draws per walker the ``posterior`` group keeps (sized by the
-    log-likelihood group) the largest R-hat of a handful of well-mixed parameters lies
-    above 1.01 in most runs, so those figures are recorded (``saved_*``) but decide
-    nothing (docs/science/benchmarks.md, "Which draws the convergence figures are on").
+    ``groups`` maps a group's name to a model's retained draws
+    (:func:`retained_dataset`; each name in one of them). The run's criteria (R-hat and
+    bulk ESS) are judged on the retained draws, the same draws the sampler's stopping
+    rule checked: the rank-normalised split R-hat compares the walkers' means with the
+    spread within them, and for independent draws its excess over 1 is about
+    (χ²_{M-1}/(M-1) - 1)/(2N) for M half-chains of N draws (the between-chain variance
+    of Gelman & Rubin [1]_), a noise that shrinks as 1/N. On the few draws per walker
+    the ``posterior`` group keeps (sized by the log-likelihood group) the largest R-hat
+    of a handful of well-mixed parameters lies above 1.01 in most runs, so those figures
+    are recorded (``saved_*``) but decide nothing (docs/science/benchmarks.md, "Which
+    draws the convergence figures are on").
 
     Returns
     -------
     dict
         ``r_hat``, ``ess_bulk``, ``ess_tail`` (name -> float, retained draws),
         ``max_rhat`` and ``min_ess_bulk`` over the names (retained draws), and
-        ``convergence_draws``: ``on`` (``"retained"``), ``group`` (:data:`RETAINED`),
-        ``walkers``, ``draws_per_walker``, ``saved_draws_per_walker``,
-        ``saved_max_rhat`` and ``saved_min_ess_bulk`` (what ``az.summary`` of the
-        ``posterior`` group gives).
+        ``convergence_draws``: ``on`` (``"retained"``), ``walkers``, ``groups`` (group
+        -> its draws per walker), ``saved_draws_per_walker``, ``saved_max_rhat`` and
+        ``saved_min_ess_bulk`` (what ``az.summary`` of the ``posterior`` group gives).
 
     References
     ----------
     .. [1] A. Gelman, D. B. Rubin, "Inference from iterative simulation using multiple
        sequences", *Statistical Science* 7 (1992) 457-472. doi:10.1214/ss/1177011136
     """
-    r, eb, et = convergence_stats(retained, names)
-    thinned = {k: retained[k].isel(draw=np.asarray(saved)) for k in names}
-    rs, ebs, _ = convergence_stats(thinned, names)
-    first = retained[names[0]]
-    return {
-        "r_hat": {k: float(r[k]) for k in names},
-        "ess_bulk": {k: float(eb[k]) for k in names},
-        "ess_tail": {k: float(et[k]) for k in names},
-        "max_rhat": float(np.max(r.to_numpy())),
-        "min_ess_bulk": float(np.min(eb.to_numpy())),
-        "convergence_draws": {
-            "on": "retained",
-            "group": RETAINED,
-            "walkers": int(first.sizes["chain"]),
-            "draws_per_walker": int(first.sizes["draw"]),
-            "saved_draws_per_walker": len(saved),
-            "saved_max_rhat": float(np.max(rs.to_numpy())),
-            "saved_min_ess_bulk": float(np.min(ebs.to_numpy())),
-        },
+    out: dict = {"r_hat": {}, "ess_bulk": {}, "ess_tail": {}}
+    saved_r, saved_e, sizes = [], [], {}
+    for group, ds in groups.items():
+        mine = [k for k in names if k in ds.data_vars]
+        if not mine:
+            continue
+        stats = convergence_stats(ds, mine)
+        for key, stat in zip(("r_hat", "ess_bulk", "ess_tail"), stats, strict=True):
+            out[key].update({k: float(stat[k]) for k in mine})
+        r, e, _ = convergence_stats(ds.isel(draw=ds["in_posterior"].values), mine)
+        saved_r.append(float(r.max()))
+        saved_e.append(float(e.min()))
+        sizes[group] = int(ds.sizes["draw"])
+        walkers, n_saved = int(ds.sizes["chain"]), int(ds["in_posterior"].sum())
+    out["max_rhat"] = max(out["r_hat"].values())
+    out["min_ess_bulk"] = min(out["ess_bulk"].values())
+    out["convergence_draws"] = {
+        "on": "retained",
+        "walkers": walkers,
+        "groups": sizes,
+        "saved_draws_per_walker": n_saved,
+        "saved_max_rhat": max(saved_r),
+        "saved_min_ess_bulk": min(saved_e),
     }
+    return out
 
 
 def as_saved(da: xr.DataArray) -> xr.DataArray:

@@ -5,15 +5,15 @@ Run directory (``hbayes calibrate``):
 - ``posterior.nc``: arviz InferenceData (NetCDF4/HDF5). Variables are qualified by the
   calibrated model: ``thermal.Cw``, ``hygric.Ci``, ``thermal.tau_1_h``, ...
 
-  Every group but ``posterior_retained`` holds the same draws: ``sampler.n_predictive``
+  Every group but ``posterior_retained_<model>`` holds the same draws: ``sampler.n_predictive``
   (default 1000) evenly spaced retained draws over all walkers (``chain``), with the
   same ``draw`` labels.
 
   - ``posterior``: parameters (fixed ones included as constants) and derived
     identifiable quantities (time constants [h], static gains);
-  - ``posterior_retained`` (not an arviz group): every retained draw (after burn-in and
-    thinning by τ, up to ``sampler.max_draws``, common to the run's models) of the free
-    parameters and of the varying derived quantities, ``draw`` labels of its own (the
+  - ``posterior_retained_<model>`` (not an arviz group): every draw the model's sampler
+    retained (after burn-in and thinning by τ, up to ``sampler.max_draws``) of its free
+    parameters and of its varying derived quantities, ``draw`` labels of its own (the
     coordinate ``in_posterior`` marks, in order, the draws ``posterior`` keeps): the
     draws the run's R-hat and ESS are computed on. Older runs do not have it;
   - ``sample_stats``: ``<model>.lp`` (log-posterior), ``<model>.acceptance_rate``;
@@ -52,7 +52,7 @@ Run directory (``hbayes calibrate``):
 
 - ``summary.json``: per parameter median, 5 %, 95 % (of the ``posterior`` group's
   draws), r_hat, ess_bulk, ess_tail (of every retained draw: ``az.summary`` of the
-  group ``posterior_retained`` gives the same), τ; fit metrics; convergence verdict;
+  group ``posterior_retained_<model>`` gives the same), τ; fit metrics; convergence verdict;
   MAP; identifiability.
 - ``config.yaml``: the resolved config.
 

@@ -246,7 +246,7 @@ def convergence_verdict(
     ``summary["converged"]`` is the stopping rule's decision, the one ``hbayes
     calibrate`` prints and its exit code follows. ``max_rhat`` and ``min_ess_bulk``
     are those of every retained draw in the parameters' own coordinates (group
-    ``posterior_retained`` of ``posterior.nc``: ``az.summary`` of it gives them), the
+    ``posterior_retained_<model>`` of ``posterior.nc``: ``az.summary`` of it gives them), the
     draws the rule checked and the parameter table's R-hat and ESS describe; the thinned
     draws of the ``posterior`` group (what the quantiles and bands use) are too few per
     walker for R-hat to mean much and are named beside, deciding nothing. In a run

@@ -207,9 +207,10 @@ class Convergence:
 
     ``max_rhat`` and ``min_ess_bulk`` are the largest rank-normalised split R-hat and
     the smallest bulk ESS over the free parameters (walkers as chains, ``az.summary``)
-    on the draws ``draws`` names: ``"retained"``, every draw the sampler retained
-    (``walkers`` × ``draws_per_walker``, the group ``posterior_retained`` of
-    ``posterior.nc``), the draws its stopping rule checked; or ``"saved"``, the
+    on the draws ``draws`` names: ``"retained"``, every draw each model's sampler
+    retained (``walkers`` × the draws per walker of each group
+    ``posterior_retained_<model>`` of ``posterior.nc``, ``groups``), the draws its
+    stopping rule checked; or ``"saved"``, the
     thinned draws of the ``posterior`` group (runs written before the retained draws
     were stored). ``saved_max_rhat`` and ``saved_min_ess_bulk`` are the thinned draws'
     figures, recorded beside the retained ones and deciding nothing: on a few draws per
@@ -229,7 +230,8 @@ class Convergence:
     tau_rtol: float | None = None
     draws: str = "saved"
     walkers: int | None = None
-    draws_per_walker: int | None = None
+    #: (group, draws per walker) of each model's retained draws
+    groups: tuple[tuple[str, int], ...] = ()
     saved_draws_per_walker: int | None = None
     saved_max_rhat: float | None = None
     saved_min_ess_bulk: float | None = None
@@ -251,7 +253,9 @@ class Convergence:
             tau_rtol=finite_float(crit.get("tau_rtol")),
             draws=on,
             walkers=_count(cd.get("walkers")),
-            draws_per_walker=_count(cd.get("draws_per_walker")),
+            groups=tuple(
+                (str(g), n) for g, n in (cd.get("groups") or {}).items() if _count(n) is not None
+            ),
             saved_draws_per_walker=_count(cd.get("saved_draws_per_walker")),
             saved_max_rhat=finite_float(cd.get("saved_max_rhat")),
             saved_min_ess_bulk=finite_float(cd.get("saved_min_ess_bulk")),
@@ -283,11 +287,14 @@ class Convergence:
         """The judged draws in words, with their number and where a reader finds them."""
         if self.draws != "retained":
             return "the draws saved in posterior.nc"
-        n = (self.walkers or 0) * (self.draws_per_walker or 0)
-        return (
-            f"the {fmt_int(n)} retained draws ({self.walkers} walkers × "
-            f"{self.draws_per_walker}; group `posterior_retained` of `posterior.nc`)"
-        )
+        if len(self.groups) == 1:
+            (group, n), w = self.groups[0], self.walkers or 0
+            return (
+                f"the {fmt_int(w * n)} retained draws ({w} walkers × {n}; group "
+                f"`{group}` of `posterior.nc`)"
+            )
+        each = ", × ".join(f"{n} in `{g}`" for g, n in self.groups)
+        return f"the retained draws ({self.walkers} walkers × {each} of `posterior.nc`)"
 
     @property
     def draws_text(self) -> str:

@@ -210,13 +210,13 @@ class Convergence:
     on the draws ``draws`` names: ``"retained"``, every draw each model's sampler
     retained (``walkers`` × the draws per walker of each group
     ``posterior_retained_<model>`` of ``posterior.nc``, ``groups``), the draws its
-    stopping rule checked; or ``"saved"``, the
-    thinned draws of the ``posterior`` group (runs written before the retained draws
-    were stored). ``saved_max_rhat`` and ``saved_min_ess_bulk`` are the thinned draws'
-    figures, recorded beside the retained ones and deciding nothing: on a few draws per
-    walker R-hat is mostly noise (docs/science/benchmarks.md, "Which draws the
-    convergence figures are on"). ``converged`` is the sampler's stopping rule (chains
-    of ``tau_factor`` τ with a stable τ, R-hat and ESS on the retained draws).
+    stopping rule checked; or ``"saved"``, the thinned draws of the ``posterior`` group
+    (runs written before the retained draws were stored). ``saved_max_rhat`` and
+    ``saved_min_ess_bulk`` are the thinned draws' figures, recorded beside the retained
+    ones and deciding nothing: on a few draws per walker R-hat is mostly noise
+    (docs/science/benchmarks.md, "Which draws the convergence figures are on").
+    ``converged`` is the sampler's stopping rule (chains of ``tau_factor`` τ with a
+    stable τ, R-hat and ESS on the retained draws).
     """
 
     max_rhat: float | None

@@ -318,7 +318,7 @@ class Convergence:
             f"× {self.saved_draws_per_walker}, what the quantiles and bands use) give max "
             f"R-hat {self.saved_max_rhat:.3f} and min bulk ESS "
             f"{fmt_int(self.saved_min_ess_bulk)}; with so few draws per walker R-hat "
-            "scatters above the target even for independent draws, so they decide nothing"
+            "can lie above the target even for independent draws, so they decide nothing"
         )
 
     @property

@@ -24,6 +24,7 @@ from heritage_bayes.cli import main
 from heritage_bayes.config import parse_config
 from heritage_bayes.errors import InputError
 from heritage_bayes.format import fmt, fmt_int, prior_text, prose_html, tick_names
+from heritage_bayes.inference.interop import retained_group
 from heritage_bayes.report import write_report
 from heritage_bayes.report._browser import PHONE_OVERFLOW_JS, find_chromium, open_page
 from heritage_bayes.report._diag import acf, cumulative_periodogram, innovations
@@ -378,8 +379,14 @@ def test_not_a_directory_and_damaged_summary(tmp_path, run_dir):
 
 
 def test_cli_on_a_run_without_ladder_and_chain_file(run_dir, tmp_path, capsys):
-    """``hbayes report`` on an older/partial run: no ladder, a chain file deleted."""
+    """``hbayes report`` on an older/partial run: no ladder, a chain file deleted, the
+    R-hat and ESS of the saved draws and no group of retained draws (an hbayes before
+    they were stored): it loads, and its figures are named as the saved draws'."""
     import matplotlib
+
+    import heritage_bayes as hb
+    from heritage_bayes._arviz import az
+    from heritage_bayes.inference.results import write_inference_data
 
     backend = matplotlib.get_backend()
     d = _copy_run(run_dir, tmp_path / "partial")
@@ -388,10 +395,23 @@ def test_cli_on_a_run_without_ladder_and_chain_file(run_dir, tmp_path, capsys):
     s.pop("ladder", None)
     s.pop("verdict", None)
     s.pop("schema_version")  # a version-1 summary (hbayes before the typed summary)
+    idata = az.from_netcdf(d / "posterior.nc")
+    groups = {g: idata[g].load() for g in idata.groups() if not g.startswith("posterior_ret")}
+    write_inference_data(az.InferenceData(**groups), d / "older.nc")  # the file is open
+    (d / "older.nc").replace(d / "posterior.nc")
+    cd = s.pop("convergence_draws")
+    s["max_rhat"], s["min_ess_bulk"] = cd["saved_max_rhat"], cd["saved_min_ess_bulk"]
+    free = [k for k, v in s["parameters"].items() if "r_hat" in v]
+    diag = az.summary(groups["posterior"], var_names=free, kind="diagnostics", round_to="none")
+    for k in free:
+        s["parameters"][k]["r_hat"] = float(diag.loc[k, "r_hat"])
     (d / "summary.json").write_text(json.dumps(s))
+    assert hb.load_run(d).run_summary.convergence.draws == "saved"
     assert main(["report", str(d)]) == 0
     assert capsys.readouterr().out.strip() == str(d / "report.html")
     html = (d / "report.html").read_text(encoding="utf-8")
+    assert f"max R-hat {cd['saved_max_rhat']:.3f} (target ≤ 1.01), min bulk ESS" in html
+    assert "of the saved draws" in html and "posterior_retained" not in html
     figs = _figures(html)
     assert "fig-ladder" not in figs and "fig-trace-hygric" not in figs
     assert "fig-trace-thermal" in figs
@@ -872,7 +892,7 @@ def test_every_convergence_number_of_the_report_is_az_summary_of_posterior_nc(re
     summary = json.loads((run_dir / "summary.json").read_text())
     idata = az.from_netcdf(run_dir / "posterior.nc")
     free = [k for k, v in summary["parameters"].items() if v.get("fixed") is None]
-    diag = az.summary(idata, var_names=free, kind="diagnostics", round_to="none")
+    diag = _retained_diagnostics(idata, free)  # every retained draw: what R-hat/ESS are on
     for m in ("thermal", "hygric"):
         table = html[html.index(f'id="table-params-{m}"') :]
         table = table[: table.index("</table>")]
@@ -883,12 +903,29 @@ def test_every_convergence_number_of_the_report_is_az_summary_of_posterior_nc(re
             assert f">{fmt_int(eb)} / {fmt_int(et)}<" in row, (key, eb, et)
         # the slowest time constant in the identifiability section
         key = f"{m}.tau_1_h"
-        d = az.summary(idata, var_names=[key], kind="diagnostics", round_to="none")
+        d = _retained_diagnostics(idata, [key])
         assert summary["derived"][key]["ess_bulk"] == pytest.approx(d.loc[key, "ess_bulk"])
         assert summary["derived"][key]["r_hat"] == pytest.approx(d.loc[key, "r_hat"])
     verdict = html[: html.index('<section id="data">')]
     assert f"max R-hat {diag['r_hat'].max():.3f}" in verdict
     assert f"min bulk ESS {fmt_int(diag['ess_bulk'].min())}" in verdict
+    # the thinned draws of the posterior group are named beside, with their own figure
+    saved = az.summary(idata, var_names=free, kind="diagnostics", round_to="none")
+    assert f"give max R-hat {saved['r_hat'].max():.3f}" in verdict
+
+
+def _retained_diagnostics(idata, keys: list[str]):
+    """``az.summary`` diagnostics of ``keys`` on their models' retained draws."""
+    import arviz as az
+    import pandas as pd
+
+    return pd.concat(
+        [
+            az.summary(idata[retained_group(m)], var_names=ks, kind="diagnostics", round_to="none")
+            for m in dict.fromkeys(k.split(".")[0] for k in keys)
+            if (ks := [k for k in keys if k.startswith(m + ".")])
+        ]
+    )
 
 
 def test_summary_json_is_what_arviz_computes_from_posterior_nc_bit_for_bit(run_dir):
@@ -911,17 +948,37 @@ def test_summary_json_is_what_arviz_computes_from_posterior_nc_bit_for_bit(run_d
         assert (entry["q05"], entry["median"], entry["q95"]) == (q05, q50, q95), key
         assert entry["mean"] == np.mean(flat) and entry["sd"] == np.std(flat), key
         checked["quantiles"] += 1
+        retained = idata[retained_group(key.split(".")[0])]
+        if key in retained:  # the posterior group's draws are marked among the retained
+            sub = retained[key].isel(draw=retained["in_posterior"].values)
+            assert np.array_equal(sub.values, x), key
         if "r_hat" in entry:
-            d = az.summary(idata, var_names=[key], kind="diagnostics", round_to="none")
+            # R-hat and ESS are those of every retained draw
+            d = _retained_diagnostics(idata, [key])
             assert entry["r_hat"] == d.loc[key, "r_hat"], (key, entry["r_hat"], d.loc[key])
             assert entry["ess_bulk"] == d.loc[key, "ess_bulk"], key
             if "ess_tail" in entry:
                 assert entry["ess_tail"] == d.loc[key, "ess_tail"], key
             checked["r_hat"] += 1
     # every free parameter and the varying derived quantities carry diagnostics
-    n_free = sum(v.get("fixed") is None for v in summary["parameters"].values())
-    assert checked["r_hat"] >= n_free > 0 and checked["quantiles"] == len(rows)
+    free = [k for k, v in summary["parameters"].items() if v.get("fixed") is None]
+    assert checked["r_hat"] >= len(free) > 0 and checked["quantiles"] == len(rows)
     assert n_draws > 0
+    # the run's figures, and those of the thinned draws recorded beside them
+    d = _retained_diagnostics(idata, free)
+    assert (summary["max_rhat"], summary["min_ess_bulk"]) == (
+        d["r_hat"].max(),
+        d["ess_bulk"].min(),
+    )
+    cd = summary["convergence_draws"]
+    assert set(cd["groups"]) == {retained_group(m) for m in summary["models"]}
+    for group, n in cd["groups"].items():
+        assert (idata[group].sizes["chain"], idata[group].sizes["draw"]) == (cd["walkers"], n)
+    d = az.summary(idata, var_names=free, kind="diagnostics", round_to="none")
+    assert (cd["saved_max_rhat"], cd["saved_min_ess_bulk"]) == (
+        d["r_hat"].max(),
+        d["ess_bulk"].min(),
+    )
 
 
 def test_convergence_stats_is_az_summary_where_az_rhat_differs():

@@ -58,7 +58,7 @@ def test_a_version_1_summary_loads_typed(tmp_path):
     assert s.seeds == {"calibration": 1, "synthetic data": 7}
     c = s.convergence
     assert c.converged and not c.saved_draws_ok  # 1.0119 > 1.01
-    assert "max R-hat 1.012 and min bulk ESS 944" in c.saved_draws_text
+    assert "max R-hat 1.012 and min bulk ESS 944" in c.draws_text
     assert s.to_dict()["schema_version"] == SCHEMA_VERSION
     assert "schema_version" not in V1  # to_dict copies
 

@@ -271,8 +271,8 @@ def _converged_or_3(run_dir) -> int:
             file=sys.stderr,
         )
     if conv.converged:
-        if not conv.saved_draws_ok:  # the report's verdict is amber
-            print(f"hbayes: note: {conv.saved_draws_text}", file=sys.stderr)
+        if not conv.draws_ok:  # the report's verdict is amber
+            print(f"hbayes: note: {conv.draws_text}", file=sys.stderr)
         return 0
     print(
         f"hbayes: finished but NOT converged (exit code {EXIT_UNCONVERGED}): {run_dir}",

@@ -54,11 +54,11 @@ def unconverged_reasons(summary: Mapping[str, Any]) -> list[str]:
     """Why a run did not converge, one sentence per failed criterion (empty: converged).
 
     A run the sampler's rule declared converged (``summary["converged"]`` true: τ, R-hat
-    and ESS on all retained draws) has no reasons, even where the R-hat of the ~1 000
-    draws saved in ``posterior.nc`` (``parameters``, what ``az.summary`` reads) scatters
-    above 1.01 (32 walkers × ~31 saved draws; measured: docs/science/benchmarks.md,
-    "Figures behind the code's choices"): the portfolio's "why not converged" column
-    then stays empty for it.
+    and ESS on all retained draws) has no reasons: the portfolio's "why not converged"
+    column then stays empty for it. Otherwise the parameters' R-hat and bulk ESS
+    (``parameters``: those of every retained draw; of the thinned draws saved in the
+    ``posterior`` group in runs written before, docs/science/benchmarks.md, "Which draws
+    the convergence figures are on") are checked against the criteria.
 
     Parameters
     ----------

@@ -3,7 +3,11 @@
 See :mod:`heritage_bayes.inference.results` for the layout. Thermal and hygric models are
 sampled independently; their retained draws share the (chain, draw) grid so that draw
 *i* of one pairs with draw *i* of the other, which is how the combined indoor RH
-(:math:`RH = P_i / P_{sat}(T_i)`) is predicted.
+(:math:`RH = P_i / P_{sat}(T_i)`) is predicted. R-hat and ESS are those of every draw
+a model's sampler retained (its group ``posterior_retained_<model>``: the draws its
+stopping rule checked); the quantiles, bands and log-likelihoods those of the thinned
+draws of the ``posterior`` group
+(:func:`~heritage_bayes.inference.interop.convergence_record`).
 """
 
 from __future__ import annotations
@@ -21,6 +25,7 @@ from heritage_bayes._version import __version__
 from heritage_bayes.calibration.runinfo import (
     _frozen_share,
     _hours,
+    _metrics_for,
     _periods,
     _truth_for,
     _versions,
@@ -28,9 +33,12 @@ from heritage_bayes.calibration.runinfo import (
 from heritage_bayes.climate.psychro import saturation_vapour_pressure
 from heritage_bayes.inference.interop import (
     VALIDATION_LPD,
+    convergence_record,
     convergence_stats,
     log_mean_exp,
     loglik_groups,
+    retained_dataset,
+    retained_group,
 )
 from heritage_bayes.inference.predictive import (
     _saved_index,
@@ -40,7 +48,6 @@ from heritage_bayes.inference.predictive import (
     predictive_bands,
     predictive_noise,
 )
-from heritage_bayes.inference.results import as_stored, coverage, fit_metrics
 from heritage_bayes.rc.discretize import modal_form
 from heritage_bayes.rc.identify import derived_quantities, derived_units
 
@@ -182,6 +189,9 @@ class _Outputs:
     times: np.ndarray
     codes: np.ndarray
     post: dict = field(default_factory=dict)
+    #: section -> every retained draw of its free parameters and varying derived
+    #: quantities (:func:`retained_dataset`)
+    retained: dict = field(default_factory=dict)
     stats: dict = field(default_factory=dict)
     loglik: dict = field(default_factory=dict)
     loglik_val: dict = field(default_factory=dict)
@@ -237,27 +247,41 @@ def build_run_outputs(cfg, prep, sections, *, chash: str, seed: int):
 
 
 def _posterior_draws(o: _Outputs, s) -> tuple[dict, dict]:
-    """The saved draws of a section's parameters and derived quantities, and its sampler
-    statistics; returns (derived quantity -> its (W, D) kept draws, -> its unit)."""
+    """The saved draws of a section's parameters and derived quantities, its retained
+    draws and its sampler statistics; returns (derived quantity -> its (W, D) draws
+    common to the sections, -> its unit)."""
     ps, W, D = s.logpost.params, o.W, o.D
+    kept = s.theta_kept  # (W, n, p); s.theta is its last D draws
+    retained = {}
     for j, p in enumerate(ps.parameters):
+        attrs = {"unit": p.unit, "kind": p.kind, "description": p.description}
         o.post[f"{s.name}.{p.name}"] = xr.DataArray(
             np.ascontiguousarray(s.theta[:, o.sel, j], dtype=np.float64),
             dims=_CDIMS,
-            attrs={"unit": p.unit, "kind": p.kind, "description": p.description},
+            attrs=attrs,
         )
-    tm = s.theta[..., : s.logpost.n_model]
+        if p.free:
+            retained[f"{s.name}.{p.name}"] = xr.DataArray(
+                np.ascontiguousarray(kept[..., j], dtype=np.float64), dims=_CDIMS, attrs=attrs
+            )
+    tm = kept[..., : s.logpost.n_model]
     dq = derived_quantities(s.model, tm.reshape(-1, tm.shape[-1]))
     units = derived_units(s.model)
     dq_all = {}
     for k, v in dq.items():
-        arr = np.broadcast_to(np.asarray(v, dtype=float), (W * D,)).reshape(W, D)
-        dq_all[k] = arr
+        full = np.broadcast_to(np.asarray(v, dtype=float), (tm.shape[0] * tm.shape[1],))
+        full = full.reshape(tm.shape[:2])
+        dq_all[k] = arr = full[:, -D:]
+        attrs = {"unit": units.get(k, "")}
         o.post[f"{s.name}.{k}"] = xr.DataArray(
-            np.ascontiguousarray(arr[:, o.sel], dtype=np.float64),
-            dims=_CDIMS,
-            attrs={"unit": units.get(k, "")},
+            np.ascontiguousarray(arr[:, o.sel], dtype=np.float64), dims=_CDIMS, attrs=attrs
         )
+        if np.all(np.isfinite(full)) and np.ptp(full) > 0:  # R-hat and ESS are defined
+            retained[f"{s.name}.{k}"] = xr.DataArray(
+                np.ascontiguousarray(full, dtype=np.float64), dims=_CDIMS, attrs=attrs
+            )
+    if retained:  # the posterior group's draws: the last D, thinned to o.sel
+        o.retained[s.name] = retained_dataset(retained, kept.shape[1] - D + o.sel)
     o.stats[f"{s.name}.lp"] = xr.DataArray(s.lp[:, o.sel], dims=_CDIMS)
     o.stats[f"{s.name}.acceptance_rate"] = xr.DataArray(
         np.broadcast_to(s.chain.acceptance[:, None], (W, len(o.sel))).copy(), dims=_CDIMS
@@ -322,13 +346,15 @@ def _parameter_summaries(o: _Outputs, cfg, prep, s, seed: int, dq_units: dict) -
     """The summary's entries of a section's parameters and derived quantities, and the
     posterior correlations of its free parameters.
 
-    Quantiles, R-hat and ESS are those of the draws ``posterior.nc`` holds, as it holds
+    Quantiles are those of the ``posterior`` group's draws, R-hat and ESS those of the
+    section's retained draws (:func:`retained_group`), each as ``posterior.nc`` holds
     them, so that a reader of the file reproduces every digit; contraction, bounds and
     correlations are taken on all draws the sampler kept."""
     ps = s.logpost.params
     kept = s.theta_kept
     free_vars = [f"{s.name}.{n}" for n in ps.free_names]
-    rhat, ess_b, ess_t = convergence_stats(o.post, free_vars)
+    retained = o.retained.get(s.name, {})
+    rhat, ess_b, ess_t = convergence_stats(retained, free_vars) if free_vars else ({},) * 3
     tau = dict(zip(ps.free_names, s.chain.tau, strict=True))
     truth, truth_dq = _truth_for(cfg, prep, s)
     mapv = dict(zip(ps.names, s.map.theta, strict=True))
@@ -369,8 +395,8 @@ def _parameter_summaries(o: _Outputs, cfg, prep, s, seed: int, dq_units: dict) -
         key = f"{s.name}.{k}"
         x = o.post[key].values.reshape(-1)
         o.derived[key] = {"unit": unit, **_summ(x), "truth": truth_dq.get(k)}
-        if np.all(np.isfinite(x)) and np.ptp(x) > 0:
-            r, e, _ = convergence_stats(o.post, [key])
+        if key in retained:
+            r, e, _ = convergence_stats(retained, [key])
             o.derived[key]["r_hat"] = float(r[key])
             o.derived[key]["ess_bulk"] = float(e[key])
     # posterior correlations of the free parameters (log scale where the prior is)
@@ -495,6 +521,9 @@ def _inference_data(o: _Outputs, prep, sections, attrs: dict):
     coords = {"chain": np.arange(o.W), "draw": np.arange(len(o.sel))}
     groups = {
         "posterior": xr.Dataset(o.post, coords=coords, attrs=attrs),
+        # every retained draw of each model (a superset of the posterior group's): the
+        # R-hat and ESS
+        **{retained_group(k): ds.assign_attrs(attrs) for k, ds in o.retained.items()},
         "sample_stats": xr.Dataset(o.stats, coords=coords, attrs=attrs),
         **loglik_groups(o.loglik, coords, attrs),
         # a bounded number of draws, the bands over all of them (the predictive was 75 %
@@ -518,11 +547,11 @@ def _inference_data(o: _Outputs, prep, sections, attrs: dict):
 
 def _summary(o: _Outputs, cfg, prep, sections, attrs: dict) -> dict:
     """The run's ``summary.json`` from the gathered entries."""
-    free_rhat = [v["r_hat"] for v in o.params.values() if "r_hat" in v]
-    free_ess = [v["ess_bulk"] for v in o.params.values() if "ess_bulk" in v]
+    free = [k for k, v in o.params.items() if "r_hat" in v]
     # the decision is the sampler's stopping rule: 50 τ with a stable τ, and R-hat/ESS
     # within CONVERGENCE on every retained draw; max_rhat/min_ess below are those of the
-    # ~1000 saved draws (what az.summary of posterior.nc gives), a noisier diagnostic
+    # same retained draws in the parameters' own coordinates (the saved ones' beside)
+    conv = convergence_record({retained_group(k): v for k, v in o.retained.items()}, free)
     tau_ok = all(s.chain.converged for s in sections)
     return {
         "name": cfg.name,
@@ -535,8 +564,9 @@ def _summary(o: _Outputs, cfg, prep, sections, attrs: dict) -> dict:
         "created_at": attrs["created_at"],
         "converged": bool(tau_ok),
         "converged_tau": tau_ok,
-        "max_rhat": float(np.max(free_rhat)),
-        "min_ess_bulk": float(np.min(free_ess)),
+        "max_rhat": conv["max_rhat"],
+        "min_ess_bulk": conv["min_ess_bulk"],
+        "convergence_draws": conv["convergence_draws"],
         "criteria": {
             **CONVERGENCE,
             "tau_factor": cfg.sampler.tau_factor,
@@ -557,39 +587,3 @@ def _summary(o: _Outputs, cfg, prep, sections, attrs: dict) -> dict:
         "truth": prep.truth or None,
         "versions": _versions(),
     }
-
-
-def _metrics_for(prep, codes, outputs, pp_outputs, one_step=None) -> dict:
-    """Fit criteria of the posterior-median simulation and band coverage per period;
-    with ``one_step`` (output -> (K, N) one-step-ahead samples of a state-space noise
-    model) also the coverage of the one-step bands (``coverage50_1step``,
-    ``coverage90_1step``).
-
-    The bands are taken from the draws as ``posterior.nc`` stores them
-    (:func:`~heritage_bayes.inference.results.as_stored`: float32, packed to 0.01 °C,
-    0.1 Pa, 0.01 %RH), so that the coverage read back from the file is the same to the
-    last hour: a measurement on a band's edge would otherwise count on one side here and
-    on the other in the file."""
-    res: dict[str, dict] = {}
-    for out in outputs:
-        if out not in prep.frame:
-            continue
-        meas = prep.frame[out].to_numpy(dtype=float)
-        ypp, ysim = pp_outputs[out]
-        unit = _OUT_UNITS.get(out, "")
-        ypp = as_stored(ypp, unit)
-        med = np.median(ysim, axis=0)
-        res[out] = {}
-        for pname, code in (("calibration", 1), ("validation", 2)):
-            rows = codes == code
-            if not rows.any():
-                continue
-            m = fit_metrics(meas[rows], med[rows])
-            m["coverage50"] = coverage(meas[rows], ypp[:, rows], 0.5)
-            m["coverage90"] = coverage(meas[rows], ypp[:, rows], 0.9)
-            if one_step and out in one_step:
-                y1 = as_stored(one_step[out][:, rows], unit)
-                m["coverage50_1step"] = coverage(meas[rows], y1, 0.5)
-                m["coverage90_1step"] = coverage(meas[rows], y1, 0.9)
-            res[out][pname] = m
-    return res

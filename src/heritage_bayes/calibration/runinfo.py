@@ -1,5 +1,5 @@
 """What a run's summary records beside the posterior: truths, periods, versions, the
-share of frozen draws.
+share of frozen draws, the fit metrics and band coverage.
 
 The true parameters and derived quantities of generated data (the demo), shown beside
 the posterior; the calibration and validation periods; the versions of the libraries
@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from heritage_bayes.format import OUT_UNITS
+from heritage_bayes.inference.results import as_stored, coverage, fit_metrics
 from heritage_bayes.rc.identify import derived_quantities
 
 
@@ -109,3 +111,39 @@ def _frozen_share(tau_h, lp) -> float | None:
         return None
     record_h = lp.record_seconds / 3600.0
     return float(np.mean(np.asarray(tau_h).reshape(-1) > FROZEN_RECORDS * record_h))
+
+
+def _metrics_for(prep, codes, outputs, pp_outputs, one_step=None) -> dict:
+    """Fit criteria of the posterior-median simulation and band coverage per period;
+    with ``one_step`` (output -> (K, N) one-step-ahead samples of a state-space noise
+    model) also the coverage of the one-step bands (``coverage50_1step``,
+    ``coverage90_1step``).
+
+    The bands are taken from the draws as ``posterior.nc`` stores them
+    (:func:`~heritage_bayes.inference.results.as_stored`: float32, packed to 0.01 °C,
+    0.1 Pa, 0.01 %RH), so that the coverage read back from the file is the same to the
+    last hour: a measurement on a band's edge would otherwise count on one side here and
+    on the other in the file."""
+    res: dict[str, dict] = {}
+    for out in outputs:
+        if out not in prep.frame:
+            continue
+        meas = prep.frame[out].to_numpy(dtype=float)
+        ypp, ysim = pp_outputs[out]
+        unit = OUT_UNITS.get(out, "")
+        ypp = as_stored(ypp, unit)
+        med = np.median(ysim, axis=0)
+        res[out] = {}
+        for pname, code in (("calibration", 1), ("validation", 2)):
+            rows = codes == code
+            if not rows.any():
+                continue
+            m = fit_metrics(meas[rows], med[rows])
+            m["coverage50"] = coverage(meas[rows], ypp[:, rows], 0.5)
+            m["coverage90"] = coverage(meas[rows], ypp[:, rows], 0.9)
+            if one_step and out in one_step:
+                y1 = as_stored(one_step[out][:, rows], unit)
+                m["coverage50_1step"] = coverage(meas[rows], y1, 0.5)
+                m["coverage90_1step"] = coverage(meas[rows], y1, 0.9)
+            res[out][pname] = m
+    return res

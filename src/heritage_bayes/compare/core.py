@@ -123,9 +123,9 @@ def compare_runs(
             "run_dir": str(run.path),
             "noise": info.noise if info else None,
             "periods": {p.name: p.to_dict() for p in rs.periods} or None,
-            # the report's rule: the stopping rule met and the saved draws within the
+            # the report's rule: the stopping rule met and the judged draws within the
             # stated criteria
-            "converged": rs.convergence.converged and rs.convergence.saved_draws_ok,
+            "converged": rs.convergence.converged and rs.convergence.draws_ok,
             "max_rhat": rs.convergence.max_rhat,
             "min_ess_bulk": rs.convergence.min_ess_bulk,
             "n_draws": int(run.idata.posterior.sizes["chain"] * run.idata.posterior.sizes["draw"]),

@@ -7,7 +7,10 @@
   ``log_predictive_density_validation`` group, expected log predictive density);
 - :func:`convergence_stats`: R-hat and bulk/tail ESS by ``az.summary`` itself on the
   draws as the file stores them (:func:`as_saved`), so that the report's figures are
-  reproduced bit for bit by ``az.summary(az.from_netcdf("posterior.nc"))``.
+  reproduced bit for bit by ``az.summary`` of the group they were computed on;
+- :func:`retained_dataset`, :func:`convergence_record`: a model's retained draws (group
+  ``posterior_retained_<model>``, :func:`retained_group`) and the run's convergence
+  figures on them, beside those of the thinned draws of the ``posterior`` group.
 """
 
 from __future__ import annotations
@@ -21,9 +24,12 @@ __all__ = [
     "JOINT_LOGLIK",
     "VALIDATION_LPD",
     "as_saved",
+    "convergence_record",
     "convergence_stats",
     "log_mean_exp",
     "loglik_groups",
+    "retained_dataset",
+    "retained_group",
     "split_outputs",
 ]
 
@@ -31,6 +37,33 @@ __all__ = [
 JOINT_LOGLIK = "all_outputs"
 #: Group of ``posterior.nc`` holding the log predictive density of each validation hour.
 VALIDATION_LPD = "log_predictive_density_validation"
+
+
+def retained_group(section: str) -> str:
+    """The group of ``posterior.nc`` holding model ``section``'s retained draws."""
+    return f"posterior_retained_{section}"
+
+
+def retained_dataset(
+    variables: dict[str, xr.DataArray], saved: np.ndarray, attrs: dict | None = None
+) -> xr.Dataset:
+    """One model's retained draws as ``posterior.nc`` stores them (a group
+    :func:`retained_group`): every draw its sampler retained (walkers × draws after
+    burn-in and thinning by τ, at most ``sampler.max_draws``) of the free parameters and
+    of the varying derived quantities, the draws its stopping rule checked and the run's
+    R-hat and ESS are computed on. The coordinate ``in_posterior`` marks, in order, the
+    draws the ``posterior`` group keeps (``saved``: their positions along ``draw``).
+    """
+    first = next(iter(variables.values()))
+    n_chain, n_draw = first.shape[:2]
+    mask = np.zeros(n_draw, dtype=bool)
+    mask[np.asarray(saved)] = True
+    coords = {
+        "chain": np.arange(n_chain),
+        "draw": np.arange(n_draw),
+        "in_posterior": ("draw", mask),
+    }
+    return xr.Dataset(variables, coords=coords, attrs=attrs or {})
 
 
 def loglik_groups(loglik: dict[str, xr.DataArray], coords: dict, attrs: dict) -> dict:
@@ -110,19 +143,15 @@ def log_mean_exp(a) -> np.ndarray:
 
 
 def convergence_stats(post: dict[str, xr.DataArray], names: list[str]):
-    """Rank-normalised split R-hat, bulk and tail ESS of the saved draws ``names``.
+    """Rank-normalised split R-hat, bulk and tail ESS of the draws ``names`` of ``post``.
 
     Computed by ``az.summary(..., kind="diagnostics", round_to="none")`` itself
     (Vehtari et al. 2021 [1]_) on the very arrays ``posterior.nc`` stores (walkers as
-    chains, float64, C order), so that ``az.summary(az.from_netcdf("posterior.nc"))``
+    chains, float64, C order), so that ``az.summary`` of the group they are stored in
     reproduces every figure bit for bit. arviz has two R-hat paths that differ:
     ``az.rhat`` folds the draws about the median of the *split* chains (dropping the
     middle draw of an odd-length chain), ``az.summary`` about the median of all draws;
-    the summary's is the one a reader runs, so it is the one used here. The sampler's
-    stopping rule checks all its retained draws
-    (:func:`heritage_bayes.inference.sampler.run_sampler`); the saved draws are an evenly
-    thinned subset, nearly independent, so their bulk ESS is close to their number when
-    the chain has converged.
+    the summary's is the one a reader runs, so it is the one used here.
 
     Returns
     -------
@@ -139,6 +168,63 @@ def convergence_stats(post: dict[str, xr.DataArray], names: list[str]):
     ds = xr.Dataset({v: as_saved(post[v]) for v in names})
     diag = az.summary(ds, kind="diagnostics", round_to="none")
     return diag["r_hat"], diag["ess_bulk"], diag["ess_tail"]
+
+
+def convergence_record(groups: dict[str, xr.Dataset], names: list[str]) -> dict:
+    """The run's convergence figures for the free parameters ``names``: on every
+    retained draw, and on the thinned draws the ``posterior`` group keeps.
+
+    ``groups`` maps a group's name to a model's retained draws
+    (:func:`retained_dataset`; each name in one of them). The run's criteria (R-hat and
+    bulk ESS) are judged on the retained draws, the same draws the sampler's stopping
+    rule checked: the rank-normalised split R-hat compares the walkers' means with the
+    spread within them, and for independent draws its excess over 1 is about
+    (χ²_{M-1}/(M-1) - 1)/(2N) for M half-chains of N draws (the between-chain variance
+    of Gelman & Rubin [1]_), a noise that shrinks as 1/N. On the few draws per walker
+    the ``posterior`` group keeps (sized by the log-likelihood group) the largest R-hat
+    of a handful of well-mixed parameters lies above 1.01 in most runs, so those figures
+    are recorded (``saved_*``) but decide nothing (docs/science/benchmarks.md, "Which
+    draws the convergence figures are on").
+
+    Returns
+    -------
+    dict
+        ``r_hat``, ``ess_bulk``, ``ess_tail`` (name -> float, retained draws),
+        ``max_rhat`` and ``min_ess_bulk`` over the names (retained draws), and
+        ``convergence_draws``: ``on`` (``"retained"``), ``walkers``, ``groups`` (group
+        -> its draws per walker), ``saved_draws_per_walker``, ``saved_max_rhat`` and
+        ``saved_min_ess_bulk`` (what ``az.summary`` of the ``posterior`` group gives).
+
+    References
+    ----------
+    .. [1] A. Gelman, D. B. Rubin, "Inference from iterative simulation using multiple
+       sequences", *Statistical Science* 7 (1992) 457-472. doi:10.1214/ss/1177011136
+    """
+    out: dict = {"r_hat": {}, "ess_bulk": {}, "ess_tail": {}}
+    saved_r, saved_e, sizes = [], [], {}
+    for group, ds in groups.items():
+        mine = [k for k in names if k in ds.data_vars]
+        if not mine:
+            continue
+        stats = convergence_stats(ds, mine)
+        for key, stat in zip(("r_hat", "ess_bulk", "ess_tail"), stats, strict=True):
+            out[key].update({k: float(stat[k]) for k in mine})
+        r, e, _ = convergence_stats(ds.isel(draw=ds["in_posterior"].values), mine)
+        saved_r.append(float(r.max()))
+        saved_e.append(float(e.min()))
+        sizes[group] = int(ds.sizes["draw"])
+        walkers, n_saved = int(ds.sizes["chain"]), int(ds["in_posterior"].sum())
+    out["max_rhat"] = max(out["r_hat"].values())
+    out["min_ess_bulk"] = min(out["ess_bulk"].values())
+    out["convergence_draws"] = {
+        "on": "retained",
+        "walkers": walkers,
+        "groups": sizes,
+        "saved_draws_per_walker": n_saved,
+        "saved_max_rhat": max(saved_r),
+        "saved_min_ess_bulk": min(saved_e),
+    }
+    return out
 
 
 def as_saved(da: xr.DataArray) -> xr.DataArray:

@@ -5,11 +5,17 @@ Run directory (``hbayes calibrate``):
 - ``posterior.nc``: arviz InferenceData (NetCDF4/HDF5). Variables are qualified by the
   calibrated model: ``thermal.Cw``, ``hygric.Ci``, ``thermal.tau_1_h``, ...
 
-  Every group holds the same draws: ``sampler.n_predictive`` (default 1000) evenly
-  spaced retained draws over all walkers (``chain``), with the same ``draw`` labels.
+  Every group but ``posterior_retained_<model>`` holds the same draws: ``sampler.n_predictive``
+  (default 1000) evenly spaced retained draws over all walkers (``chain``), with the
+  same ``draw`` labels.
 
   - ``posterior``: parameters (fixed ones included as constants) and derived
     identifiable quantities (time constants [h], static gains);
+  - ``posterior_retained_<model>`` (not an arviz group): every draw the model's sampler
+    retained (after burn-in and thinning by τ, up to ``sampler.max_draws``) of its free
+    parameters and of its varying derived quantities, ``draw`` labels of its own (the
+    coordinate ``in_posterior`` marks, in order, the draws ``posterior`` keeps): the
+    draws the run's R-hat and ESS are computed on. Older runs do not have it;
   - ``sample_stats``: ``<model>.lp`` (log-posterior), ``<model>.acceptance_rate``;
   - ``log_likelihood``: the pointwise terms of the calibration likelihood, only the
     hours that enter it (no warm-up, no gap), so ``az.loo(idata)``, ``az.waic(idata)``
@@ -44,9 +50,10 @@ Run directory (``hbayes calibrate``):
   float32 rounded to 12 mantissa bits (relative error at most 1.2e-4, i.e. below 1e-3
   nats per hour). See :func:`write_inference_data` for the demo's sizes.
 
-- ``summary.json``: per parameter median, 5 %, 95 %, r_hat, ess_bulk, ess_tail (those
-  of the saved draws: ``az.summary`` of ``posterior.nc`` gives the same), τ; fit
-  metrics; convergence verdict; MAP; identifiability.
+- ``summary.json``: per parameter median, 5 %, 95 % (of the ``posterior`` group's
+  draws), r_hat, ess_bulk, ess_tail (of every retained draw: ``az.summary`` of the
+  group ``posterior_retained_<model>`` gives the same), τ; fit metrics; convergence verdict;
+  MAP; identifiability.
 - ``config.yaml``: the resolved config.
 
 All files are written to a temporary name in the same folder and renamed into place.

@@ -152,7 +152,8 @@ def room_row(run_dir: str | Path) -> dict:
 
     Read through the typed summary (:func:`heritage_bayes.rundir.summary.load_summary`).
     Columns: convergence (``converged``: the stopping rule; ``saved_draws_ok``: the
-    saved draws within the stated R-hat/ESS criteria; ``max_rhat``, ``min_ess_bulk``,
+    draws the R-hat and ESS are on (:attr:`~heritage_bayes.rundir.summary.Convergence.draws`)
+    within the stated criteria; ``max_rhat``, ``min_ess_bulk``,
     ``wall_seconds``), per measured output ``<section>.<output>.FIT_cal`` /
     ``FIT_val`` [%] and ``coverage90_val`` [-], the slowest time constant and the
     outdoor-temperature gain of each section, and conservation-risk indicators of the
@@ -171,7 +172,7 @@ def room_row(run_dir: str | Path) -> dict:
         "building": s.building,
         "room_description": s.room,
         "converged": conv.converged,
-        "saved_draws_ok": conv.saved_draws_ok,
+        "saved_draws_ok": conv.draws_ok,
         "unconverged_reasons": "; ".join(conv.reasons),
         "max_rhat": nan if conv.max_rhat is None else conv.max_rhat,
         "min_ess_bulk": nan if conv.min_ess_bulk is None else conv.min_ess_bulk,

@@ -227,11 +227,12 @@ def convergence_verdict(
     dict
         ``level`` (``"red"`` when the model does not reproduce the room; else
         ``"green"``: the stopping rule met — 50 τ with a stable τ, R-hat and bulk ESS
-        within the run's criteria on the sampler's retained draws — *and* the draws
-        saved in ``posterior.nc`` within the same criteria, and the residual,
-        coverage and truth checks pass; ``"amber"``: the rule met but the saved draws
-        or a check fail, or close to converged — max R-hat ≤ 1.05 and min bulk ESS ≥
-        100; ``"red"``: not converged), ``status`` (one of
+        within the run's criteria on the sampler's retained draws — *and* the run's
+        R-hat and ESS (:attr:`~heritage_bayes.rundir.summary.Convergence.draws`) within
+        the same criteria, and the residual, coverage and truth checks pass;
+        ``"amber"``: the rule met but those figures or a check fail, or close to
+        converged — max R-hat ≤ 1.05 and min bulk ESS ≥ 100; ``"red"``: not
+        converged), ``status`` (one of
         :data:`~heritage_bayes.rundir.summary.STATUSES`: *converged* when green,
         *checks failed* when the stopping rule was met and the headline does not say
         otherwise, else *not converged*), ``title``, ``text``, ``rule`` (the rule
@@ -244,12 +245,14 @@ def convergence_verdict(
     -----
     ``summary["converged"]`` is the stopping rule's decision, the one ``hbayes
     calibrate`` prints and its exit code follows. ``max_rhat`` and ``min_ess_bulk``
-    are those of the ~1 000 draws saved in ``posterior.nc`` (what ``az.summary``
-    gives): a thinned subset, common to the run's models, in the parameters' own
-    coordinates, whose R-hat scatters about the rule's (1.013-1.020 seen on converged
-    runs). Every figure of the pages comes from those saved draws, and a reader
-    recomputes their R-hat and ESS with arviz: a run whose saved draws miss the
-    stated criteria is therefore amber, never green, and the page states the rule.
+    are those of every retained draw in the parameters' own coordinates (group
+    ``posterior_retained_<model>`` of ``posterior.nc``: ``az.summary`` of it gives them), the
+    draws the rule checked and the parameter table's R-hat and ESS describe; the thinned
+    draws of the ``posterior`` group (what the quantiles and bands use) are too few per
+    walker for R-hat to mean much and are named beside, deciding nothing. In a run
+    written before the retained draws were stored the figures are the thinned draws'
+    and decide as they did. A run whose figures miss the stated criteria is amber,
+    never green, and the page states the rule and which draws.
     """
     rs = typed_summary(summary)
     conv = rs.convergence
@@ -257,24 +260,23 @@ def convergence_verdict(
     max_rhat = _nan_low(conv.max_rhat)
     min_ess = _nan_high(conv.min_ess_bulk)
     within_amber = max_rhat <= AMBER["max_rhat"] and min_ess >= AMBER["min_ess_bulk"]
-    # the run's decision (the stopping rule), with the saved draws within the amber limits
+    # the run's decision (the stopping rule), with its R-hat/ESS within the amber limits
     rule_ok = conv.converged and conv.converged_tau and within_amber
-    # green also needs the saved draws (what the pages and arviz on posterior.nc read)
-    # within the stated criteria
-    saved_ok = conv.saved_draws_ok
+    # green also needs the R-hat/ESS the parameter tables show within the criteria
+    saved_ok = conv.draws_ok
     lines = _model_lines(rs, rule_ok)
     stats = (
         f"max R-hat {max_rhat:.3f} (target ≤ {r_ok:g}), min bulk ESS "
-        f"{fmt_int(min_ess)} (target ≥ {e_ok:g}) of the saved draws, chain length ≥ "
-        f"{tf:g} τ: {'yes' if conv.converged_tau else 'no'}; stopping rule "
+        f"{fmt_int(min_ess)} (target ≥ {e_ok:g}) of the {conv.draws_name}, chain length "
+        f"≥ {tf:g} τ: {'yes' if conv.converged_tau else 'no'}; stopping rule "
         f"met: {'yes' if conv.converged else 'no'}"
     )
     rule = (
         "Rule applied: green only when the sampler's stopping rule is met (chains of "
-        f"at least {tf:g} τ with a stable τ) and the draws saved in `posterior.nc`, which "
-        f"every figure on this page uses, meet the stated criteria (R-hat ≤ {r_ok:g}, "
+        f"at least {tf:g} τ with a stable τ), the R-hat and bulk ESS of {conv.draws_where}, "
+        f"which the parameter tables show, meet the stated criteria (R-hat ≤ {r_ok:g}, "
         f"bulk ESS ≥ {e_ok:g}, as arviz recomputes them from the file) and the checks "
-        "pass."
+        "pass." + (f" Beside them, {conv.saved_text}." if conv.saved_text else "")
     )
     checks = model_checks(summary, residuals)
     level, title, text, advice = _sampling_verdict(
@@ -314,8 +316,8 @@ def convergence_verdict(
 
 
 def _model_lines(rs, rule_ok: bool) -> list[str]:
-    """One plain-words line per model: its chain length against τ and the saved draws'
-    R-hat and bulk ESS against the run's criteria."""
+    """One plain-words line per model: its chain length against τ and the R-hat and bulk
+    ESS (of the draws the run's figures are on) against the run's criteria."""
     conv = rs.convergence
     r_ok, e_ok, tf = conv.target_rhat, conv.target_ess, conv.tau_factor
     lines = []
@@ -332,7 +334,7 @@ def _model_lines(rs, rule_ok: bool) -> list[str]:
                 )
             else:
                 problems.append("the autocorrelation-time (τ) criterion was not met")
-        rhat_text = ess_text = None  # the saved draws' R-hat / ESS beyond the targets
+        rhat_text = ess_text = None  # the judged draws' R-hat / ESS beyond the targets
         if pr:
             worst_r = max(pr, key=lambda e: _nan_low(e.r_hat))
             worst_e = min(pr, key=lambda e: _nan_high(e.ess_bulk))
@@ -346,7 +348,7 @@ def _model_lines(rs, rule_ok: bool) -> list[str]:
         if rule_ok and not problems and saved:
             lines.append(
                 f"{name}: the stopping rule is met on the sampler's retained draws, but "
-                "the draws saved in posterior.nc give "
+                f"{conv.draws_where} give "
                 + " and ".join(saved)
                 + f" (criteria R-hat ≤ {r_ok:g}, bulk ESS ≥ {e_ok:g})."
             )
@@ -367,10 +369,13 @@ def _sampling_verdict(summary, rs, rule_ok: bool, saved_ok: bool, within_amber: 
     the accuracy rule (see :func:`convergence_verdict`)."""
     green = rule_ok and saved_ok
     if rule_ok and not saved_ok:
-        level, title = "amber", "Stopping rule met, but the saved draws miss the criteria"
+        level, title = (
+            "amber",
+            f"Stopping rule met, but the {rs.convergence.draws_name} miss the criteria",
+        )
         text = (
             f"The sampler's stopping rule was met on its retained draws, but "
-            f"{rs.convergence.saved_draws_text}. Medians are usable; treat the intervals, "
+            f"{rs.convergence.draws_text}. Medians are usable; treat the intervals, "
             "bands and tail values as approximate."
         )
         advice = (

@@ -10,8 +10,9 @@ no consumer pokes at nested dicts:
   quantiles, mean, sd [its unit], its plain-words label, prior, sampler statistics;
 - :class:`FitMetrics` — fit criteria and band coverage of one output over one period;
 - :class:`Convergence` — the criteria the run states (max R-hat, min bulk ESS, chain
-  length in τ), the figures of the draws saved in ``posterior.nc`` and the stopping
-  rule's decision;
+  length in τ), the figures of the draws they are judged on (every retained draw; the
+  thinned draws of ``posterior.nc``'s ``posterior`` group in runs written before) and
+  the stopping rule's decision;
 - :class:`ModelInfo` — one section's model, noise model, chain and MAP findings
   (:class:`Identifiability`, :class:`FrozenNode`);
 - :class:`Period` — the calibration and validation periods;
@@ -101,7 +102,9 @@ class Estimate:
 
     ``median``, ``q05``, ``q95`` [``unit``] are the quantiles of the draws saved in
     ``posterior.nc`` (a reader recomputing them from the file gets the same digits);
-    ``fixed`` holds the value of a parameter the config fixed (no posterior).
+    ``r_hat``, ``ess_bulk``, ``ess_tail`` those of the draws
+    :attr:`Convergence.draws` names; ``fixed`` holds the value of a parameter the
+    config fixed (no posterior).
     """
 
     key: str  # "<section>.<name>"
@@ -200,12 +203,20 @@ class FitMetrics:
 
 @dataclass(frozen=True)
 class Convergence:
-    """The run's convergence: criteria stated, figures of the saved draws, decision.
+    """The run's convergence: criteria stated, figures of the draws judged, decision.
 
-    ``max_rhat`` and ``min_ess_bulk`` are those of the draws saved in ``posterior.nc``
-    over the free parameters (what ``arviz.rhat`` / ``arviz.ess`` of the file give);
+    ``max_rhat`` and ``min_ess_bulk`` are the largest rank-normalised split R-hat and
+    the smallest bulk ESS over the free parameters (walkers as chains, ``az.summary``)
+    on the draws ``draws`` names: ``"retained"``, every draw each model's sampler
+    retained (``walkers`` × the draws per walker of each group
+    ``posterior_retained_<model>`` of ``posterior.nc``, ``groups``), the draws its
+    stopping rule checked; or ``"saved"``, the thinned draws of the ``posterior`` group
+    (runs written before the retained draws were stored). ``saved_max_rhat`` and
+    ``saved_min_ess_bulk`` are the thinned draws' figures, recorded beside the retained
+    ones and deciding nothing: on a few draws per walker R-hat is mostly noise
+    (docs/science/benchmarks.md, "Which draws the convergence figures are on").
     ``converged`` is the sampler's stopping rule (chains of ``tau_factor`` τ with a
-    stable τ, R-hat and ESS on the sampler's retained draws).
+    stable τ, R-hat and ESS on the retained draws).
     """
 
     max_rhat: float | None
@@ -217,10 +228,43 @@ class Convergence:
     converged_tau: bool
     reasons: tuple[str, ...] = ()
     tau_rtol: float | None = None
+    draws: str = "saved"
+    walkers: int | None = None
+    #: (group, draws per walker) of each model's retained draws
+    groups: tuple[tuple[str, int], ...] = ()
+    saved_draws_per_walker: int | None = None
+    saved_max_rhat: float | None = None
+    saved_min_ess_bulk: float | None = None
+
+    @classmethod
+    def from_dict(cls, d: dict, crit: dict) -> Convergence:
+        """The convergence of a ``summary.json`` object, its criteria ``crit``."""
+        cd = d.get("convergence_draws") if isinstance(d.get("convergence_draws"), dict) else {}
+        on = "retained" if cd.get("on") == "retained" else "saved"
+        return cls(
+            max_rhat=finite_float(d.get("max_rhat")),
+            min_ess_bulk=finite_float(d.get("min_ess_bulk")),
+            target_rhat=float(crit["max_rhat"]),
+            target_ess=float(crit["min_ess_bulk"]),
+            tau_factor=float(crit["tau_factor"]),
+            converged=bool(d.get("converged", False)),
+            converged_tau=bool(d.get("converged_tau", d.get("converged", False))),
+            reasons=tuple(str(r) for r in d.get("unconverged_reasons") or ()),
+            tau_rtol=finite_float(crit.get("tau_rtol")),
+            draws=on,
+            walkers=_count(cd.get("walkers")),
+            groups=tuple(
+                (str(g), n) for g, n in (cd.get("groups") or {}).items() if _count(n) is not None
+            ),
+            saved_draws_per_walker=_count(cd.get("saved_draws_per_walker")),
+            saved_max_rhat=finite_float(cd.get("saved_max_rhat")),
+            saved_min_ess_bulk=finite_float(cd.get("saved_min_ess_bulk")),
+        )
 
     @property
-    def saved_draws_ok(self) -> bool:
-        """Whether the saved draws meet the stated R-hat and ESS criteria."""
+    def draws_ok(self) -> bool:
+        """Whether the judged draws (:attr:`draws`) meet the stated R-hat and ESS
+        criteria."""
         return (
             self.max_rhat is not None
             and self.min_ess_bulk is not None
@@ -229,13 +273,52 @@ class Convergence:
         )
 
     @property
-    def saved_draws_text(self) -> str:
-        """The saved draws' R-hat and ESS against the criteria, in words."""
+    def saved_draws_ok(self) -> bool:
+        """:attr:`draws_ok` under its earlier name (scripts written before)."""
+        return self.draws_ok
+
+    @property
+    def draws_name(self) -> str:
+        """``"retained draws"`` or ``"saved draws"``: what the figures are on."""
+        return f"{self.draws} draws"
+
+    @property
+    def draws_where(self) -> str:
+        """The judged draws in words, with their number and where a reader finds them."""
+        if self.draws != "retained":
+            return "the draws saved in posterior.nc"
+        if len(self.groups) == 1:
+            (group, n), w = self.groups[0], self.walkers or 0
+            return (
+                f"the {fmt_int(w * n)} retained draws ({w} walkers × {n}; group "
+                f"`{group}` of `posterior.nc`)"
+            )
+        each = ", × ".join(f"{n} in `{g}`" for g, n in self.groups)
+        return f"the retained draws ({self.walkers} walkers × {each} of `posterior.nc`)"
+
+    @property
+    def draws_text(self) -> str:
+        """The judged draws' R-hat and ESS against the criteria, in words."""
         r = "—" if self.max_rhat is None else f"{self.max_rhat:.3f}"
         return (
-            f"the draws saved in posterior.nc give max R-hat {r} and min bulk ESS "
+            f"{self.draws_where} give max R-hat {r} and min bulk ESS "
             f"{fmt_int(self.min_ess_bulk)} against the criteria R-hat ≤ {self.target_rhat:g} "
             f"and ESS ≥ {self.target_ess:g}"
+        )
+
+    @property
+    def saved_text(self) -> str:
+        """What the thinned draws of the ``posterior`` group give, when the figures are
+        on the retained draws ("" otherwise): a reader's ``az.summary`` of that group."""
+        if self.draws != "retained" or self.saved_max_rhat is None:
+            return ""
+        n = (self.walkers or 0) * (self.saved_draws_per_walker or 0)
+        return (
+            f"the {fmt_int(n)} thinned draws of the posterior group ({self.walkers} walkers "
+            f"× {self.saved_draws_per_walker}, what the quantiles and bands use) give max "
+            f"R-hat {self.saved_max_rhat:.3f} and min bulk ESS "
+            f"{fmt_int(self.saved_min_ess_bulk)}; with so few draws per walker R-hat "
+            "can lie above the target even for independent draws, so they decide nothing"
         )
 
     @property
@@ -243,8 +326,13 @@ class Convergence:
         """The stated criteria in words."""
         return (
             f"R-hat ≤ {self.target_rhat:g} and bulk ESS ≥ {self.target_ess:g} on the "
-            f"saved draws, chains of at least {self.tau_factor:g} τ with a stable τ"
+            f"{self.draws_name}, chains of at least {self.tau_factor:g} τ with a stable τ"
         )
+
+
+def _count(v) -> int | None:
+    """A positive count of ``summary.json`` (None: absent or not a count)."""
+    return v if isinstance(v, int) and not isinstance(v, bool) and v > 0 else None
 
 
 @dataclass(frozen=True)
@@ -381,17 +469,7 @@ class RunSummary:
                             coverage90_1step=finite_float(m.get("coverage90_1step")),
                         )
                     )
-        conv = Convergence(
-            max_rhat=finite_float(d.get("max_rhat")),
-            min_ess_bulk=finite_float(d.get("min_ess_bulk")),
-            target_rhat=float(crit["max_rhat"]),
-            target_ess=float(crit["min_ess_bulk"]),
-            tau_factor=float(crit["tau_factor"]),
-            converged=bool(d.get("converged", False)),
-            converged_tau=bool(d.get("converged_tau", d.get("converged", False))),
-            reasons=tuple(str(r) for r in d.get("unconverged_reasons") or ()),
-            tau_rtol=finite_float(crit.get("tau_rtol")),
-        )
+        conv = Convergence.from_dict(d, crit)
         return cls(
             schema_version=version,
             name=str(d.get("name") or ""),

@@ -3,9 +3,9 @@
 Rank plots (Vehtari et al. 2021, doi:10.1214/20-BA1221) are drawn for the slowest time
 constant, the static gains and the scale coordinate (the coordinates of
 :mod:`heritage_bayes.report.identifiable`: a raw C or G would only show the scale ridge
-again). They use the draws of ``posterior.nc``, the thinned post-burn-in draws the
-tables' R-hat, ESS and MCSE come from, rather than the chain file: the same draws as
-every number beside them, and no second read of a large file. Its ``chain`` dimension
+again). They use the draws of ``posterior.nc``'s ``posterior`` group, the thinned
+post-burn-in draws the tables' quantiles and MCSE come from, rather than the chain
+file: no second read of a large file. Its ``chain`` dimension
 holds the emcee walkers, each with about 30 draws, too few for a histogram of its own:
 the walkers are grouped into 4 blocks (:func:`~heritage_bayes.report.identifiable.rank_groups`).
 """

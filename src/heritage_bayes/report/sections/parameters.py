@@ -20,7 +20,7 @@ from heritage_bayes.report.page import Section
 from heritage_bayes.report.rundata import RunData, parameter_set, section_params
 from heritage_bayes.report.sections._fragment import render_fragment
 from heritage_bayes.report.verdict import ess_class, rhat_class
-from heritage_bayes.rundir.summary import ModelInfo
+from heritage_bayes.rundir.summary import Convergence, ModelInfo
 
 ID, TITLE = "parameters", "5. Parameters"
 
@@ -29,6 +29,7 @@ def parameter_tables(rd: RunData) -> list[dict]:
     """One table per model, every figure from the typed run summary."""
     rs = rd.summary
     r_ok, e_ok = rs.convergence.target_rhat, rs.convergence.target_ess
+    draws_note = draws_sentence(rs.convergence)
     tables = []
     for m, info in rs.models.items():
         idf = info.identifiability
@@ -76,6 +77,7 @@ def parameter_tables(rd: RunData) -> list[dict]:
                 "model": info.model,
                 "noise": info.noise or "?",
                 "rows": rows,
+                "draws_note": draws_note,
                 "has_truth": has_truth,
                 "map_lp": fmt(info.map_log_posterior),
                 "map_agreed": f"{info.map_agreed} of {info.map_starts}",
@@ -90,6 +92,17 @@ def parameter_tables(rd: RunData) -> list[dict]:
             }
         )
     return tables
+
+
+def draws_sentence(conv: Convergence) -> str:
+    """Which draws the tables' figures are on, in one sentence."""
+    if conv.draws != "retained":
+        return "Every figure of the tables is that of the draws saved in posterior.nc."
+    return (
+        f"R-hat and ESS are those of {conv.draws_where}, the draws the sampler's "
+        "stopping rule checked; median, interval and MCSE those of the thinned draws of "
+        "the posterior group."
+    )
 
 
 def _prior_figure(rd: RunData, m: str, info: ModelInfo):

@@ -8,7 +8,6 @@ from scipy.linalg import expm
 from scipy.stats import multivariate_normal
 
 import heritage_bayes as hb
-from heritage_bayes.climate.psychro import saturation_vapour_pressure as psat
 from heritage_bayes.inference.likelihoods import get_noise_model
 from heritage_bayes.inference.parameters import parameters_for
 from heritage_bayes.inference.posterior import LogPosterior
@@ -130,8 +129,3 @@ def test_a_record_with_gaps_gives_the_dense_gaussian_likelihood():
     for k in (0, 17, 40):
         Q = _process_noise(p, sb[2, k], qs)
         np.testing.assert_allclose(Qb[:, k], [Q[0, 0], Q[0, 1], Q[1, 1]], rtol=1e-9)
-
-
-def test_psat_of_the_reference_is_the_package_constant():
-    """The equality above holds to rounding only if psat(T_ref) is P_REF."""
-    assert psat(T_REF) == pytest.approx(P_REF, rel=1e-14)

@@ -12,18 +12,17 @@ from heritage_bayes.inference.likelihoods import get_noise_model
 from heritage_bayes.inference.parameters import parameters_for
 from heritage_bayes.inference.posterior import LogPosterior
 from heritage_bayes.rc.sorption import BLOCK, P_REF, T_REF, coupled_block
+from test_sorption import _weather as sorption_weather
 
 DT = 3600.0
 KALMAN = get_noise_model("kalman")
 
 
 def _weather(N, seed=0):
-    rng = np.random.default_rng(seed)
-    t = np.arange(N)
-    pe = 1000 + 300 * np.sin(2 * np.pi * t / 24) + np.cumsum(rng.normal(0, 20, N))
-    ti = 15 + 8 * np.sin(2 * np.pi * (t - 15) / 24) + rng.normal(0, 1, N)
-    tf = 8 + 3 * np.sin(2 * np.pi * t / 500)
-    obs = pe + rng.normal(0, 30, N)
+    """test_sorption's weather, the change of Pe over each step and Pe observed with
+    30 Pa of noise."""
+    pe, ti, tf = sorption_weather(N, seed)
+    obs = pe + np.random.default_rng([seed, 1]).normal(0, 30, N)
     return pe, np.r_[np.diff(pe), 0.0], ti, tf, obs
 
 

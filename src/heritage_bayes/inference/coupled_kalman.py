@@ -30,10 +30,10 @@ step's mean, the model's exact step): in the step's symmetric coordinates
 
 mapped back by :math:`V` and the coordinates' scalings (the modal discretisation of
 :func:`heritage_bayes.inference.statespace.modal_process_noise`, per step). The
-first-order coupling term of the temperature's change within the step
-(:mod:`heritage_bayes.rc.sorption`) enters :math:`M_k` but not :math:`Q_k` (its
-effect on the noise is of second order). With constant temperatures the transitions are
-constant and the filter is the LTI one of ``noise: kalman``.
+temperature's change within the step enters :math:`M_k` to first order
+(:mod:`heritage_bayes.rc.sorption`), :math:`Q_k` not at all: :math:`Q_k` is that of
+the step with :math:`r` held at its mean. With constant temperatures the transitions
+are constant and the filter is the LTI one of ``noise: kalman``.
 
 The filter runs the full 2×2 covariance recursion at every step (no steady state: the
 transitions change with the temperature); a missing ``Pi`` is a prediction-only step,

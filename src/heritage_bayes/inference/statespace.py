@@ -293,7 +293,9 @@ class KalmanNoise(NoiseModel):
 
     def sample_statespace(self, rng, mf, noise, N: int, n_out: int) -> np.ndarray:
         """(K, N, n_out) free-run predictive noise: the process noise propagated through
-        the model's modes, plus measurement noise (added to a noise-free simulation)."""
+        the model's modes, plus measurement noise (added to a noise-free simulation).
+        A time-varying model's ``mf`` is its network's at the reference temperature
+        (:meth:`LogPosterior._form`): its modes stand for the per-step ones."""
         K, n = mf.lam.shape
         R, q = self.split_statespace(noise, n_out)
         Qd = modal_process_noise(mf, q)

@@ -11,6 +11,11 @@ temperature: an exact 2x2 recursion per step, :mod:`heritage_bayes.rc.sorption`)
    ``ar1_white``), one parameter set (target: coupled <= 2x linear);
 3. one year hourly, a batch of 32 parameter sets (an emcee ensemble): the log-likelihood.
 
+Beside them, ``hygric_2c_sorption`` with ``noise: kalman`` (a Kalman filter over the
+per-step transitions, :mod:`heritage_bayes.inference.coupled_kalman`; initial state
+from its prior inside the filter): its log-likelihood's ratio to ``hygric_2c``'s (with
+``ar1_white``) in the same run.
+
 The same for ``hygric_2c_sorption`` with ``isotherm: gab`` (a capacity that follows the
 buffer's humidity, its transitions computed per step from the state:
 :mod:`heritage_bayes.rc.isotherm`), its ratio to the linear-isotherm coupled model and
@@ -64,6 +69,7 @@ N100 = 100 * 8760
 SORPTION = dict(Cm=40.0, Ci=1.4e-3, Gi=1.2e-7, Gfast=2.5e-7)
 LINEAR = dict(Cw=40.0 / P_REF, Ci=1.4e-3, Gw=1e-9, Gi=1.2e-7, Gfast=2.5e-7)
 NOISE = (40.0, 0.8, 5.0)  # sigma_Pi [Pa], phi_Pi [-], sigma_meas_Pi [Pa]
+KALMAN = (5.0, 3.0, 40.0)  # sigma_Pi [Pa], q_Pw, q_Pi [Pa/√h]
 
 
 def inputs(n: int, seed: int = 0) -> dict[str, np.ndarray]:
@@ -102,26 +108,30 @@ def first_pass_steps(lp: LogPosterior, theta: np.ndarray) -> np.ndarray:
 def main() -> None:
     cols = inputs(N100)
     obs = cols["Pe"] + 100.0
-    nm = get_noise_model("ar1_white")
     jobs = {}  # model -> {what: callable}
     cases = (
         ("hygric_2c", {}, LINEAR),
         ("hygric_2c_sorption", {}, SORPTION),
         ("hygric_2c_sorption", {"isotherm": "gab"}, {**SORPTION, "K_gab": 0.75}),
         ("hygric_2c_sorption", {"isotherm": "gab", "whole": True}, {**SORPTION, "K_gab": 0.75}),
+        ("hygric_2c_sorption", {"kalman": True}, SORPTION),
     )
     runs = {}  # model -> steps the first pass ran, 100 years and each set of the batch
     for name, opts, p in cases:
         whole = opts.pop("whole", False)
+        kalman = opts.pop("kalman", False)
+        nm = get_noise_model("kalman" if kalman else "ar1_white")
         m = hb.model(name, **opts).with_slopes(["Pe"])
         name = f"{name} ({'gab, pass 1 whole' if whole else 'gab'})" if opts else name
+        name = f"{name} (kalman)" if kalman else name
         U = np.column_stack([cols[c] for c in m.input_names])
         P = np.array([[p[n] for n in m.parameter_names]])
-        theta = np.array([[*P[0], *NOISE]])
+        theta = np.array([[*P[0], *(KALMAN if kalman else NOISE)]])
         batch = theta * np.random.default_rng(1).lognormal(0, 0.1, (32, theta.shape[1]))
-        batch[:, -2] = NOISE[1]
+        if not kalman:
+            batch[:, -2] = NOISE[1]
 
-        def lp(n, m=m, U=U):
+        def lp(n, m=m, U=U, nm=nm):
             return LogPosterior(m, parameters_for(m, nm), nm, U[:n], obs[:n], warmup=0,
                                 init_window=720, initial_state="estimate")  # fmt: skip
 
@@ -148,12 +158,14 @@ def main() -> None:
         print(f"{what} (target: {target})")
         for name, (w, c) in zip(names, res[key], strict=True):
             print(f"  {name:<26s} {w * 1e3:8.1f} ms wall {c * 1e3:8.1f} ms CPU")
-        (w0, c0), (w1, c1), (w2, c2), (w3, c3) = res[key]
+        (w0, c0), (w1, c1), (w2, c2), (w3, c3), (w4, c4) = res[key]
         print(f"  ratio coupled / linear: {w1 / w0:.2f} wall, {c1 / c0:.2f} CPU")
         print(f"  ratio gab / coupled: {w2 / w1:.2f} wall, {c2 / c1:.2f} CPU; "
               f"gab / linear: {w2 / w0:.2f} wall, {c2 / c0:.2f} CPU")  # fmt: skip
         if key != "sim":
             print(f"  ratio gab, pass 1 whole / linear: {w3 / w0:.2f} wall, {c3 / c0:.2f} CPU")
+            print(f"  ratio coupled kalman / linear: {w4 / w0:.2f} wall, {c4 / c0:.2f} CPU; "
+                  f"/ coupled: {w4 / w1:.2f} wall, {c4 / c1:.2f} CPU")  # fmt: skip
     for name, (one, many) in runs.items():
         print(
             f"{name}: the first pass ran {one[0]:.0f} of {N100} steps (100 years); "

@@ -26,6 +26,7 @@ model's temperature input with its gaps interpolated linearly, the survey's room
     python benchmarks/sbc_coupled.py --reps 10 --rooms attic --without outage --log no.jsonl
     python benchmarks/sbc_coupled.py --paired coupled.jsonl no.jsonl
     python benchmarks/sbc_coupled.py --source-seeds own,1,2,3 --only 0,2 --rooms cellar
+    python benchmarks/sbc_coupled.py --rooms cellar --variant kalman:estimate --log kalman.jsonl
 
 Each replicate is a function of ``(seed, room, replicate)``; one JSON line per replicate
 is appended to ``--log`` as soon as it is done, ``--first-rep`` extends a study, and
@@ -590,7 +591,9 @@ def main(argv=None) -> int:
     ap.add_argument("--max-steps", type=int, default=4000)
     ap.add_argument("--cal-days", type=int, default=CAL_DAYS)
     ap.add_argument("--variant", default=VARIANT, help="the fit: NOISE:INIT[:T=X] "
-                    "(bench_sbc.fit_and_rank; T=X a likelihood tempered by X)")  # fmt: skip
+                    "(bench_sbc.fit_and_rank; T=X a likelihood tempered by X; "
+                    "kalman:estimate: the Kalman filter over the linear wall's "
+                    "transitions, process noise at the nodes)")  # fmt: skip
     ap.add_argument("--log", help="append each replicate's result as a JSON line")
     ap.add_argument("--draws", help="a directory: save each replicate's posterior draws "
                     "(model then noise parameters, .npy) for --path")  # fmt: skip

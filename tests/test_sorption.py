@@ -147,7 +147,9 @@ def test_a_warm_buffer_gives_moisture_back_to_the_air():
     assert Y[0, 110, 0] > 1100.0 and Y[0, -1, 0] < Y[0, 110, 0]
 
 
-def test_kalman_noise_is_refused_with_a_config_error():
+def test_kalman_noise_on_a_gab_buffer_is_refused_with_a_config_error():
+    """A linear buffer takes ``noise: kalman`` (tests/test_coupled_kalman.py); a GAB
+    buffer, whose transitions follow its state, is refused, naming the key."""
     from heritage_bayes.config import parse_config
     from heritage_bayes.run import section_parameters
 
@@ -157,8 +159,11 @@ def test_kalman_noise_is_refused_with_a_config_error():
             "hygric": {"model": "hygric_2c_sorption", "noise": "kalman"},
         }
     )
-    with pytest.raises(ConfigError, match=r"hygric.noise: 'kalman'.*ar1_white"):
-        section_parameters(cfg, "hygric", hb.model("hygric_2c_sorption"))
+    gab = hb.model("hygric_2c_sorption", isotherm="gab")
+    with pytest.raises(ConfigError, match=r"hygric.noise: 'kalman'.*'gab'.*ar1_white"):
+        section_parameters(cfg, "hygric", gab)
+    noise, params = section_parameters(cfg, "hygric", hb.model("hygric_2c_sorption"))
+    assert noise.name == "kalman" and "q_Pw" in params.names
 
 
 # ------------------------------------------------------------------ independent data

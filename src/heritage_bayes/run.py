@@ -73,11 +73,11 @@ def section_parameters(cfg: CalibrationConfig, section: str, model: RCModel, pri
 
     sec_cfg = getattr(cfg, section)
     noise = get_noise_model(sec_cfg.noise)
-    if model.time_varying and noise.statespace:
+    if model.time_varying and model.isotherm != "linear" and noise.statespace:
         raise ConfigError(
-            f"{section}.noise: {sec_cfg.noise!r} filters a model with a constant modal "
-            f"form; {model.name} is coupled to a temperature (time-varying): use one of "
-            f"{', '.join(residual_noise_models())}"
+            f"{section}.noise: {sec_cfg.noise!r} filters a model linear in its state; "
+            f"{model.name} has the {model.isotherm!r} isotherm (transitions that follow the "
+            f"state): use one of {', '.join(residual_noise_models())}"
         )
     params = parameters_for(
         model,

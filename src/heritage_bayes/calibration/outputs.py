@@ -130,7 +130,7 @@ def _validation_pointwise(s, prep, Ysim, tn, th=None) -> np.ndarray:
     Yobs = np.ascontiguousarray(Yobs)
     lp = s.logpost
     if lp.noise.statespace and th is not None:
-        mf = modal_form(s.model, th[:, : lp.n_model], prep.dt)
+        mf = lp._form(th[:, : lp.n_model])
         U = np.ascontiguousarray(prep.model_inputs(s.name, s.model), dtype=float)
         return lp.noise.filter(s.model, mf, U, Yobs, tn, *lp._x0_prior(mf), True)[1]
     return lp.noise.pointwise(Ysim, Yobs, tn)
@@ -150,7 +150,7 @@ def _one_step_sample(s, prep, th, rng) -> np.ndarray:
     """
     lp = s.logpost
     obs = np.ascontiguousarray(prep.observed(s.name, s.model), dtype=float)
-    mf = modal_form(s.model, th[:, : lp.n_model], prep.dt)
+    mf = lp._form(th[:, : lp.n_model])
     U = np.ascontiguousarray(prep.model_inputs(s.name, s.model), dtype=float)
     tn = th[:, lp.n_model :]
     with np.errstate(all="ignore"):

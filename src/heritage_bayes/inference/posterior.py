@@ -161,15 +161,14 @@ class LogPosterior:
         # transitions that follow the state: the start's quadratic form re-centred
         self._relinearise = self._time_varying and self.model.isotherm != "linear"
         self._first_pass_stop = FIRST_PASS_STOP  # 0: the first pass over the whole record
-        if self._time_varying:
-            if self.noise.statespace:
-                raise ValueError(
-                    f"noise: {self.noise.name!r} filters a model with a constant modal form; "
-                    f"{self.model.name!r} is time-varying (coupled to a temperature): use "
-                    f"one of {', '.join(residual_noise_models())}"
-                )
-            # the per-step series of the inputs (saturation ratios), once
-            self._series = self.model.series(self.inputs)
+        if self._relinearise and self.noise.statespace:
+            raise ValueError(
+                f"noise: {self.noise.name!r} filters a model linear in its state; the "
+                f"{self.model.isotherm!r} isotherm of {self.model.name!r} follows its state: "
+                f"use one of {', '.join(residual_noise_models())}"
+            )
+        # the per-step series of the inputs (saturation ratios), once
+        self._series = self.model.series(self.inputs) if self._time_varying else None
         if self.model.control is not None and self.noise.statespace:
             raise ValueError(
                 f"noise: {self.noise.name!r} filters a model that is linear in its state; "
@@ -315,8 +314,9 @@ class LogPosterior:
             mf = self._form(tm)
             if self.noise.statespace:
                 ll = self.noise.filter(
-                    self.model, mf, self.inputs, self.observed, tn, *self._x0_prior(mf)
-                )
+                    self.model, mf, self.inputs, self.observed, tn, *self._x0_prior(mf),
+                    series=self._series,
+                )  # fmt: skip
             else:
                 ll = self._marginal(mf, tn)[0]
         ll[~mf.valid] = -np.inf
@@ -391,8 +391,9 @@ class LogPosterior:
 
         def ll(offset):
             return self.noise.filter(
-                self.model, mf, self.inputs, self.observed, tn, xm + offset, zero
-            )
+                self.model, mf, self.inputs, self.observed, tn, xm + offset, zero,
+                series=self._series,
+            )  # fmt: skip
 
         def unit(*idx):
             d = np.zeros((K, n))
@@ -566,9 +567,10 @@ class LogPosterior:
         theta = np.atleast_2d(theta)
         tm, tn = self.split(theta)
         if self.noise.statespace:  # one-step predictive densities
-            mf = modal_form(self.model, tm, self.dt)
+            mf = self._form(tm)
             return self.noise.filter(
-                self.model, mf, self.inputs, self.observed, tn, *self._x0_prior(mf), True
-            )[1]
+                self.model, mf, self.inputs, self.observed, tn, *self._x0_prior(mf), True,
+                self._series,
+            )[1]  # fmt: skip
         Y, _ = self.simulate(tm, x0=self.initial_states(theta))
         return self.noise.pointwise(Y, self.observed, tn)

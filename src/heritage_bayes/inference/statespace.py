@@ -46,8 +46,8 @@ from types import MappingProxyType
 import numba
 import numpy as np
 
+from heritage_bayes.inference.coupled_kalman import coupled_kalman
 from heritage_bayes.inference.likelihoods import NoiseModel, register_noise
-from heritage_bayes.rc.discretize import modal_form
 
 __all__ = ["KalmanNoise", "modal_process_noise"]
 
@@ -221,7 +221,7 @@ class KalmanNoise(NoiseModel):
         q = noise[:, n_out:] / math.sqrt(3600.0)  # [potential/√h] -> [potential/√s]
         return sig * sig, q
 
-    def filter(self, model, mf, U, Yobs, noise, x0_mean, P0, want_point=False):
+    def filter(self, model, mf, U, Yobs, noise, x0_mean, P0, want_point=False, series=None):
         """(K,) log-likelihood from a modal form, inputs ``U`` (N, m), initial mean
         ``x0_mean`` (K, n) and covariance ``P0`` (K, n, n) in physical coordinates.
 
@@ -229,7 +229,18 @@ class KalmanNoise(NoiseModel):
         log predictive densities (NaN where missing) and the one-step-ahead predictive
         mean and variance of each output given the observations before it (the
         measurement noise included; defined at missing rows too).
+
+        A time-varying model (:class:`~heritage_bayes.rc.sorption.CoupledHygricModel`):
+        the filter over its per-step transitions
+        (:func:`~heritage_bayes.inference.coupled_kalman.coupled_kalman`), its
+        parameters ``mf.theta`` (:meth:`LogPosterior._form`), ``series`` the model's
+        :meth:`series` of ``U`` (computed here when None).
         """
+        if model.time_varying:
+            series = model.series(U) if series is None else series
+            return coupled_kalman(
+                self, model, mf.theta, series, mf.dt, Yobs, noise, x0_mean, P0, want_point
+            )
         K, n = mf.lam.shape
         n_out = mf.Cz.shape[1]
         R, q = self.split_statespace(noise, n_out)
@@ -266,7 +277,7 @@ class KalmanNoise(NoiseModel):
         theta = np.atleast_2d(np.asarray(theta, dtype=float))
         tm, tn = logpost.split(theta)
         with np.errstate(all="ignore"):
-            mf = modal_form(logpost.model, tm, logpost.dt)
+            mf = logpost._form(tm)
             _, _, mean, var = self.filter(
                 logpost.model,
                 mf,
@@ -275,13 +286,16 @@ class KalmanNoise(NoiseModel):
                 tn,
                 *logpost._x0_prior(mf),
                 True,
+                getattr(logpost, "_series", None),
             )
         mean[~mf.valid], var[~mf.valid] = np.nan, np.nan
         return mean, var
 
     def sample_statespace(self, rng, mf, noise, N: int, n_out: int) -> np.ndarray:
         """(K, N, n_out) free-run predictive noise: the process noise propagated through
-        the model's modes, plus measurement noise (added to a noise-free simulation)."""
+        the model's modes, plus measurement noise (added to a noise-free simulation).
+        A time-varying model's ``mf`` is its network's at the reference temperature
+        (:meth:`LogPosterior._form`): its modes stand for the per-step ones."""
         K, n = mf.lam.shape
         R, q = self.split_statespace(noise, n_out)
         Qd = modal_process_noise(mf, q)

@@ -456,22 +456,13 @@ def walker_constants(kp):  # pragma: no cover - compiled
 
 
 @numba.njit(inline="always", cache=True, nogil=True, error_model="numpy")
-def step_coefficients(c, r, sr, isr, dr, pe, dpe, xs, dt, idt, slope):  # pragma: no cover
-    """Transition ``(M0, M1, M2, M3)`` and forcing ``(f0, f1)`` of one step:
-    ``(Pw, Pi)[k+1] = [[M0, M1], [M2, M3]] (Pw, Pi)[k] + (f0, f1)`` (module docstring).
-    ``c``: :func:`walker_constants`; ``r``, ``sr``, ``isr``, ``dr``: the step mean of
-    ``r = p_sat(Tw)/p_sat(T_ref)``, its square root, the inverse of that and r's change
-    over the step; ``pe``, ``dpe`` the vapour pressure's mean and change (the latter
-    used with ``slope``); ``xs`` the sink's ``p_sat(Tf)`` (1 for a constant node);
-    ``idt = 1/dt``. Branch-free, two divisions and one square root.
-
-    The eigen-decomposition of the 2×2 symmetric ``S`` in closed form: with
-    ``δ = (S11 - S22)/2``, ``b = -S12 >= 0``, ``h = sqrt(δ² + b²)``, the eigenvalue
-    that continues ``S11`` is ``l1 = (S11 + S22)/2 + sign(δ) h``, and
-    ``V = [[c, s], [-s, c]]`` with ``c² = (1 + |δ|/h)/2``, ``s² = 1 - c²``,
-    ``cs = sign(δ) b/(2h)``; the smaller eigenvalue is the determinant over the larger
-    (no cancellation), and ``1/l`` of each follows from ``1/det``."""
-    iw, s2, S22, A11, A12, D, iD, w_s, s_w, gw, gi, gfast, gfs = c
+def step_modes(c, r, sr, isr):  # pragma: no cover - compiled
+    """The modes of one step (:func:`step_coefficients`): ``(cc, ss, cs, l1, l2, il1,
+    il2)``, the rotation ``V = [[c, s], [-s, c]]`` of ``S = V diag(l1, l2) V^T`` by
+    ``c²``, ``s²`` and ``cs``, the decay rates [1/s] and their inverses [s]. ``c``:
+    :func:`walker_constants`; ``r``, ``sr``, ``isr``: the step mean of
+    ``r = p_sat(Tw)/p_sat(T_ref)``, its square root and the inverse of that."""
+    S22, A11, A12, D, iD = c[2], c[3], c[4], c[5], c[6]
     S11 = A11 * r
     b = A12 * sr
     dl = 0.5 * (S11 - S22)
@@ -492,6 +483,27 @@ def step_coefficients(c, r, sr, isr, dr, pe, dpe, xs, dt, idt, slope):  # pragma
     l2 = ls if up else lb
     il1 = ilb if up else ils
     il2 = ils if up else ilb
+    return cc, ss, cs, l1, l2, il1, il2
+
+
+@numba.njit(inline="always", cache=True, nogil=True, error_model="numpy")
+def step_coefficients(c, r, sr, isr, dr, pe, dpe, xs, dt, idt, slope):  # pragma: no cover
+    """Transition ``(M0, M1, M2, M3)`` and forcing ``(f0, f1)`` of one step:
+    ``(Pw, Pi)[k+1] = [[M0, M1], [M2, M3]] (Pw, Pi)[k] + (f0, f1)`` (module docstring).
+    ``c``: :func:`walker_constants`; ``r``, ``sr``, ``isr``, ``dr``: the step mean of
+    ``r = p_sat(Tw)/p_sat(T_ref)``, its square root, the inverse of that and r's change
+    over the step; ``pe``, ``dpe`` the vapour pressure's mean and change (the latter
+    used with ``slope``); ``xs`` the sink's ``p_sat(Tf)`` (1 for a constant node);
+    ``idt = 1/dt``. Branch-free, two divisions and one square root.
+
+    The eigen-decomposition of the 2×2 symmetric ``S`` in closed form: with
+    ``δ = (S11 - S22)/2``, ``b = -S12 >= 0``, ``h = sqrt(δ² + b²)``, the eigenvalue
+    that continues ``S11`` is ``l1 = (S11 + S22)/2 + sign(δ) h``, and
+    ``V = [[c, s], [-s, c]]`` with ``c² = (1 + |δ|/h)/2``, ``s² = 1 - c²``,
+    ``cs = sign(δ) b/(2h)``; the smaller eigenvalue is the determinant over the larger
+    (no cancellation), and ``1/l`` of each follows from ``1/det``."""
+    iw, s2, S22, A11, A12, D, iD, w_s, s_w, gw, gi, gfast, gfs = c
+    cc, ss, cs, l1, l2, il1, il2 = step_modes(c, r, sr, isr)
     a1, p1, g1 = _gains(l1, il1, dt, idt, True)
     a2, p2, g2 = _gains(l2, il2, dt, idt, True)
     h11 = cc * g1 + ss * g2

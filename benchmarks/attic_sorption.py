@@ -15,14 +15,19 @@ give it back:
   (``hygric_2c_sorption``) takes up, :math:`L\\,C_m\\,\\dot P_w / p_{sat}(T_{ref})` [W]
   (:mod:`heritage_bayes.rc.sorption`: the buffer's state :math:`P_w = \\varphi_w
   p_{sat}(T_{ref})`, its moisture :math:`C_m \\varphi_w`), at the hygric MAP with the
-  buffer at the measured Ti; ``Qs``: the same with the buffer at the thermal MAP's
-  simulated Ti (no measured indoor quantity in the validation).
+  buffer at the measured Ti; ``Qm``, ``Qe``: the same with the buffer at the simulated
+  Ti of the thermal MAP with measured radiation, estimated (no measured indoor
+  quantity in the validation).
 
 Printed: the correlation of the daily mean (local days with at least 20 hours) and of
 the hourly residual with each, calibration and validation. ``--fit``: the MAP of
-``thermal_1c`` with ``Qs`` as a known heat input into the air node, its gain ``kq``
-[-] estimated (uniform 0-10: 1 is the hygric model's own magnitude), and with the gain
-fixed at 1; validation and calibration FIT of Ti [%], measured radiation and estimated.
+``thermal_1c`` with ``Qm`` (``Qe``) over its standard deviation in the calibration as a known
+input into the air node, its gain ``kq`` [W] estimated (uniform 0-10 kW: the heat of
+one standard deviation of uptake; the hygric model's own magnitude is no guide: the
+scale of its capacities and conductances is not identified by Pi, only their
+ratios); validation and calibration FIT of Ti [%], measured radiation and estimated,
+and the log-likelihood's change with ``kq`` at :data:`PROFILE`, the rest at the MAP;
+``--negative``: the same with the heat's sign turned (the physics' opposite).
 
 Usage (from the repository root)::
 
@@ -51,7 +56,9 @@ LOCAL = pd.Timedelta(hours=2)  # FMI's and the loggers' clock, UTC+2
 #: Heat released per kg of vapour adsorbed [J/kg]: the latent heat of vaporisation
 #: (2.45 MJ/kg near 20 °C) plus a differential heat of sorption of wood at mid RH.
 HEAT_OF_SORPTION = 2.6e6
-KQ_PRIOR = {"kq": {"dist": "uniform", "lower": 0.0, "upper": 1e4}}
+#: The gain's values [W] at which the log-likelihood is printed, the rest at the MAP.
+PROFILE = np.array([1e-5, 30.0, 100.0, 300.0, 1000.0])
+KQ_PRIOR = {"kq": {"dist": "uniform", "lower": 0.0, "upper": 1e4}}  # [W]
 
 
 def buffer_path(m, theta, U, dt, x0) -> tuple[np.ndarray, np.ndarray]:
@@ -137,18 +144,20 @@ def correlations(room, label, e, wx, rows) -> None:
     print(f"| {room} | {label} | {len(daily)} | {cells} |", flush=True)
 
 
-def with_heat(room, bare, q: pd.Series, data: Path, work: Path, gain: str):
-    """The thermal MAP of ``thermal_1c`` with the known heat input ``q`` [W] (a copy of
-    the weather with it as column ``Qs``, read as ``Ph``) into the air node, of gain
-    ``kq`` (estimated) or 1 (``gain == "1"``); returns validation and calibration FIT."""
+def with_heat(room, bare, q: pd.Series, data: Path, work: Path):
+    """The thermal MAP of ``x_sorption_heat``: ``thermal_1c`` with the known input ``q``
+    [-] (a copy of the weather with it as column ``Qs``, read as ``Ph``) into the air
+    node through the estimated gain ``kq`` [W]; returns validation and calibration FIT
+    of Ti [%] and ``kq``."""
     from heritage_bayes.config.options import ModelOptions
     from heritage_bayes.config.priors import PriorSpec
     from heritage_bayes.inference.results import fit_metrics
 
-    w = work / room / ("bare" if bare else "meas") / f"q{gain}"
+    w = work / room / ("bare" if bare else "meas") / "q"
     (w / "wx").mkdir(parents=True, exist_ok=True)
     cfg = ap._config(room, "wind", "thermal_1c", bare, data, w)
     src = Path(cfg.data.weather.path)
+    src = src if src.is_absolute() else w / src
     fmi = pd.read_csv(src)
     stamp = (q.index + LOCAL).tz_localize(None).strftime("%Y-%m-%d %H:%M:%S")
     qs = pd.Series(q.to_numpy(), index=stamp).fillna(0.0)
@@ -159,10 +168,11 @@ def with_heat(room, bare, q: pd.Series, data: Path, work: Path, gain: str):
         update={"path": w / "wx" / "fmi_q.csv", "columns": {**wc.columns, "Ph": "Qs"}}
     )
     d = cfg.data.model_copy(update={"weather": wc})
-    name = "thermal_1c" if gain == "1" else "x_sorption_heat"
-    priors = {} if gain == "1" else {k: PriorSpec.model_validate(v) for k, v in KQ_PRIOR.items()}
-    opts = ModelOptions.model_validate({"heating": True} if gain == "1" else {})
-    th = cfg.thermal.model_copy(update={"model": name, "options": opts, "priors": priors})
+    priors = {k: PriorSpec.model_validate(v) for k, v in KQ_PRIOR.items()}
+    opts = ModelOptions.model_validate({})
+    th = cfg.thermal.model_copy(
+        update={"model": "x_sorption_heat", "options": opts, "priors": priors}
+    )
     cfg = cfg.model_copy(update={"data": d, "thermal": th})
     undo = ap.patched("wind", ap._fmi(room, data))
     try:
@@ -173,13 +183,17 @@ def with_heat(room, bare, q: pd.Series, data: Path, work: Path, gain: str):
     y = lp.simulate_frame(mp.theta[None], u, prep.calibration.start)[0][0][:, 0]
     obs = prep.observed("thermal", m)[:, 0]
     v, cal = prep.validation, prep.fitted_rows()
-    kq = dict(zip(lp.params.names, mp.theta, strict=True)).get("kq", 1.0)
-    return fit_metrics(obs[v], y[v])["FIT"], fit_metrics(obs[cal], y[cal])["FIT"], kq
+    names = list(lp.params.names)
+    th = np.repeat(mp.theta[None], len(PROFILE), axis=0)
+    th[:, names.index("kq")] = PROFILE
+    prof = lp.log_likelihood(th) - lp.log_likelihood(mp.theta[None])[0]
+    kq = mp.theta[names.index("kq")]
+    return fit_metrics(obs[v], y[v])["FIT"], fit_metrics(obs[cal], y[cal])["FIT"], kq, prof
 
 
 def _register() -> None:
     """``x_sorption_heat``: ``thermal_1c`` with the input ``Ph`` [W] into the air node
-    through an estimated gain ``kq`` [-]."""
+    through an estimated gain ``kq`` [W per unit of the input]."""
     import dataclasses
 
     from heritage_bayes.rc.catalog import CATALOG, CatalogModel, register
@@ -203,6 +217,7 @@ def main(argv=None) -> int:
     p.add_argument("rooms", nargs="*", default=TUNING)
     p.add_argument("--data", type=Path, default=ROOT.parent / "shared" / "data")
     p.add_argument("--fit", action="store_true", help="thermal_1c with the uptake heat")
+    p.add_argument("--negative", action="store_true", help="--fit with the heat's sign turned")
     args = p.parse_args(argv)
     if set(args.rooms) - set(TUNING):
         p.error(f"tuning attics only: {TUNING} (the others are held out)")
@@ -228,11 +243,13 @@ def main(argv=None) -> int:
                 correlations(room, f"{label}, {irr}", res[key], wx, rows)
         if args.fit:
             for bare, key in ((False, "m"), (True, "e")):
-                for gain in ("k", "1"):
-                    fv, fc, kq = with_heat(room, bare, wx[f"Q{key}"], args.data, work, gain)
-                    irr = "estimated" if bare else "measured"
-                    print(f"| {room} | {irr} | gain {gain} | {fv:.1f} (cal {fc:.1f}) | "
-                          f"kq={kq:.3g} |", flush=True)  # fmt: skip
+                q = wx[f"Q{key}"]
+                sign = -1.0 if args.negative else 1.0
+                fv, fc, kq, prof = with_heat(room, bare, sign * q / q[cal].std(), args.data, work)
+                irr = "estimated" if bare else "measured"
+                pr = ", ".join(f"{k:.3g}: {d:+.1f}" for k, d in zip(PROFILE, prof, strict=True))
+                print(f"| {room} | {irr} | {fv:.1f} (cal {fc:.1f}) | kq={kq:.3g} W | {pr} |",
+                      flush=True)  # fmt: skip
     return 0
 
 

@@ -56,8 +56,9 @@ LOCAL = pd.Timedelta(hours=2)  # FMI's and the loggers' clock, UTC+2
 #: Heat released per kg of vapour adsorbed [J/kg]: the latent heat of vaporisation
 #: (2.45 MJ/kg near 20 °C) plus a differential heat of sorption of wood at mid RH.
 HEAT_OF_SORPTION = 2.6e6
-#: The gain's values [W] at which the log-likelihood is printed, the rest at the MAP.
-PROFILE = np.array([1e-5, 30.0, 100.0, 300.0, 1000.0])
+#: The gain's steady warming [K] per standard deviation of the uptake (``kq`` over the
+#: air node's conductances) at which the log-likelihood is printed, the rest at the MAP.
+PROFILE = np.array([0.0, 0.02, 0.05, 0.1, 0.2])
 KQ_PRIOR = {"kq": {"dist": "uniform", "lower": 0.0, "upper": 1e4}}  # [W]
 
 
@@ -148,7 +149,8 @@ def with_heat(room, bare, q: pd.Series, data: Path, work: Path):
     """The thermal MAP of ``x_sorption_heat``: ``thermal_1c`` with the known input ``q``
     [-] (a copy of the weather with it as column ``Qs``, read as ``Ph``) into the air
     node through the estimated gain ``kq`` [W]; returns validation and calibration FIT
-    of Ti [%] and ``kq``."""
+    of Ti [%], ``kq`` [W] and its steady warming [K] (over the air node's conductances
+    ``Ge + Gf``), and the log-likelihood's change at :data:`PROFILE`."""
     from heritage_bayes.config.options import ModelOptions
     from heritage_bayes.config.priors import PriorSpec
     from heritage_bayes.inference.results import fit_metrics
@@ -184,10 +186,11 @@ def with_heat(room, bare, q: pd.Series, data: Path, work: Path):
     obs = prep.observed("thermal", m)[:, 0]
     v, cal = prep.validation, prep.fitted_rows()
     names = list(lp.params.names)
+    g = sum(mp.theta[names.index(k)] for k in ("Ge", "Gf") if k in names)  # [W/K]
     th = np.repeat(mp.theta[None], len(PROFILE), axis=0)
-    th[:, names.index("kq")] = PROFILE
+    th[:, names.index("kq")] = np.maximum(PROFILE * g, 1e-5)
     prof = lp.log_likelihood(th) - lp.log_likelihood(mp.theta[None])[0]
-    kq = mp.theta[names.index("kq")]
+    kq = mp.theta[names.index("kq")], mp.theta[names.index("kq")] / g  # [W], [K]
     return fit_metrics(obs[v], y[v])["FIT"], fit_metrics(obs[cal], y[cal])["FIT"], kq, prof
 
 
@@ -247,9 +250,9 @@ def main(argv=None) -> int:
                 sign = -1.0 if args.negative else 1.0
                 fv, fc, kq, prof = with_heat(room, bare, sign * q / q[cal].std(), args.data, work)
                 irr = "estimated" if bare else "measured"
-                pr = ", ".join(f"{k:.3g}: {d:+.1f}" for k, d in zip(PROFILE, prof, strict=True))
-                print(f"| {room} | {irr} | {fv:.1f} (cal {fc:.1f}) | kq={kq:.3g} W | {pr} |",
-                      flush=True)  # fmt: skip
+                pr = ", ".join(f"{k:g} K: {d:+.1f}" for k, d in zip(PROFILE, prof, strict=True))
+                print(f"| {room} | {irr} | {fv:.1f} (cal {fc:.1f}) | kq {kq[0]:.3g} W "
+                      f"({kq[1]:.3g} K) | {pr} |", flush=True)  # fmt: skip
     return 0
 
 

@@ -20,7 +20,8 @@ give it back:
   quantity in the validation).
 
 Printed: the correlation of the daily mean (local days with at least 20 hours) and of
-the hourly residual with each, calibration and validation. ``--fit``: the MAP of
+the hourly residual with each, calibration and validation, and of ``Qm``, ``Qe`` with
+the rate of change of the simulated Ti they follow. ``--fit``: the MAP of
 ``thermal_1c`` with ``Qm`` (``Qe``) over its standard deviation in the calibration as a known
 input into the air node, its gain ``kq`` [W] estimated (uniform 0-10 kW: the heat of
 one standard deviation of uptake; the hygric model's own magnitude is no guide: the
@@ -244,6 +245,10 @@ def main(argv=None) -> int:
         for label, rows in (("calibration", cal), ("validation", val)):
             for key, irr in (("m", "measured"), ("e", "estimated")):
                 correlations(room, f"{label}, {irr}", res[key], wx, rows)
+        for key in ("m", "e"):  # the uptake against the simulated Ti's rate of change
+            dy = np.gradient(sims[key])
+            r = pd.DataFrame({"q": wx[f"Q{key}"], "dy": dy})[cal | val].corr().iloc[0, 1]
+            print(f"{room}: hourly correlation of Q{key} with dTi/dt of its Ti: {r:+.2f}")
         if args.fit:
             for bare, key in ((False, "m"), (True, "e")):
                 q = wx[f"Q{key}"]

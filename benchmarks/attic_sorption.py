@@ -177,14 +177,7 @@ def with_heat(room, bare, q: pd.Series, data: Path, work: Path):
         update={"model": "x_sorption_heat", "options": opts, "priors": priors}
     )
     cfg = cfg.model_copy(update={"data": d, "thermal": th})
-    undo = ap.patched("wind", ap._fmi(room, data))
-    try:
-        prep, m, lp, mp = config_map(cfg, "thermal")
-    finally:
-        undo()
-    u = prep.model_inputs("thermal", m)
-    y = lp.simulate_frame(mp.theta[None], u, prep.calibration.start)[0][0][:, 0]
-    obs = prep.observed("thermal", m)[:, 0]
+    prep, m, lp, mp, obs, y = ap.thermal_map(cfg, room, data)
     v, cal = prep.validation, prep.fitted_rows()
     names = list(lp.params.names)
     g = sum(mp.theta[names.index(k)] for k in ("Ge", "Gf") if k in names)  # [W/K]

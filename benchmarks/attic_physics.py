@@ -579,14 +579,20 @@ def simulated(room, variant, bare, data, work, model="thermal_1c"):
     w = work / room / ("bare" if bare else "meas") / model / variant
     (w / "wx").mkdir(parents=True, exist_ok=True)
     cfg = _config(room, variant, model, bare, data, w)
-    undo = patched(_roof_answers(_aperture_cap(variant)[1])[1], _fmi(room, data))
+    return (cfg, *thermal_map(cfg, room, data, _roof_answers(_aperture_cap(variant)[1])[1]))
+
+
+def thermal_map(cfg, room, data, variant="wind"):
+    """The thermal MAP of ``cfg`` with the variant's roof columns: prepared data, model,
+    log-posterior, MAP, and the observed and simulated Ti [°C] on the prepared frame."""
+    undo = patched(variant, _fmi(room, data))
     try:
         prep, m, lp, mp = config_map(cfg, "thermal")
     finally:
         undo()
     u = prep.model_inputs("thermal", m)
     y = lp.simulate_frame(mp.theta[None], u, prep.calibration.start)[0][0][:, 0]
-    return cfg, prep, m, lp, mp, prep.observed("thermal", m)[:, 0], y
+    return prep, m, lp, mp, prep.observed("thermal", m)[:, 0], y
 
 
 def run(room, variant, bare, data, work, hours, model="thermal_1c"):

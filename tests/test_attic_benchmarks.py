@@ -1,7 +1,8 @@
 """The attic benchmarks' checks on synthetic data: a known stamp shift, phase and gain
 are found (benchmarks/attic_diagnostics.py), the roof's answers are parsed and the sky's
 loss with its own weight nests the fixed one (benchmarks/attic_physics.py), a slow sun
-path is found (benchmarks/attic_response.py)."""
+path is found (benchmarks/attic_response.py), the sorbing buffer's path and uptake heat
+(benchmarks/attic_sorption.py)."""
 
 import sys
 from pathlib import Path
@@ -14,6 +15,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
 
 import attic_diagnostics as ad
 import attic_physics as ap
+import attic_sorption as aso
 
 SITE = (60.21, 24.66)
 
@@ -98,3 +100,25 @@ def test_attic_response_finds_a_slow_sun_beside_a_fast_air():
     assert np.exp(p[0]) == pytest.approx(1.0, rel=0.1)
     assert np.exp(p[4]) == pytest.approx(2.5, rel=0.1)
     assert fit > ar.best("1c", te, sun, obs, mask)[1] + 1.0
+
+
+def test_buffer_path_is_the_package_recursion_and_its_uptake_heats():
+    """The buffer path's Pi is the model's own output; a step up of the outdoor vapour
+    pressure fills the buffer (uptake heat > 0), and the heat is L Cm dPw/dt / psat."""
+    import heritage_bayes as hb
+    from heritage_bayes.rc.sorption import P_REF
+
+    m = hb.model("hygric_2c_sorption")
+    theta = np.array([50.0, 3e-3, 1e-6, 2e-6])  # Cm [kg], Ci [kg/Pa], Gi, Gfast [kg/(s Pa)]
+    n, dt = 200, 3600.0
+    pe = np.where(np.arange(n) < 50, 800.0, 1200.0)
+    ti = 12.0 + 4.0 * np.sin(np.arange(n) * 2 * np.pi / 24)
+    U = np.column_stack([pe, ti])
+    x0 = np.array([800.0, 800.0])
+    pw, pi = aso.buffer_path(m, theta, U, dt, x0)
+    ref = m.forward(theta[None], U, dt, x0=x0)[0][0, :, 0]
+    np.testing.assert_allclose(pi, ref, rtol=1e-12)
+    q = aso.uptake_heat(pw, theta[0], dt)
+    assert q[55:80].mean() > 0.0 and abs(q[:45].mean()) < q[55:80].mean()
+    ramp = aso.uptake_heat(np.linspace(0.0, 10.0, 11), 2.0, 10.0)
+    np.testing.assert_allclose(ramp, aso.HEAT_OF_SORPTION * 2.0 / P_REF * 0.1)  # 0.1 Pa/s

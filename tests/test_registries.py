@@ -239,8 +239,10 @@ def test_a_registry_s_first_read_imports_its_home(tmp_path, monkeypatch):
 def test_a_model_without_a_modal_form_is_offered_the_registered_residual_models(
     restore_registries,
 ):
-    """A state-space noise model cannot filter a time-varying model; the message offers
-    the registered noise models of the residuals, a newly registered one included."""
+    """A state-space noise model cannot filter a model whose transitions follow its
+    state (a GAB buffer); the message offers the registered noise models of the
+    residuals, a newly registered one included."""
+    import heritage_bayes as hb
     from heritage_bayes.run import section_parameters
 
     _register_toys()
@@ -249,7 +251,7 @@ def test_a_model_without_a_modal_form_is_offered_the_registered_residual_models(
         source="test",
     )
     cfg.hygric.model, cfg.hygric.noise = "hygric_2c_sorption", "kalman"
-    model = build_model(cfg, "hygric")
+    model = hb.model("hygric_2c_sorption", isotherm="gab")
     with pytest.raises(ConfigError, match=r"use one of ar1_white, ar1, iid, iid_toy$"):
         section_parameters(cfg, "hygric", model)
 

@@ -133,3 +133,13 @@ def test_an_unconverged_chain_is_still_amber_or_red():
     for converged in (False, True):
         v = convergence_verdict(_summary(rec, converged=converged))
         assert (v["level"], v["status"]) == ("red", "not converged"), converged
+
+
+def test_record_without_any_named_parameter_says_which():
+    """A record whose names are in no retained group is refused with the names and the
+    groups, not an empty ``max()``'s bare error."""
+    x = np.random.default_rng(3).normal(size=(len(NAMES), W, D))
+    variables = {k: xr.DataArray(x[i], dims=("chain", "draw")) for i, k in enumerate(NAMES)}
+    ds = retained_dataset(variables, _saved_index(W, D, N_SAVED))
+    with pytest.raises(ValueError, match=r"hygric\.Cw.*posterior_retained_thermal"):
+        convergence_record({GROUP: ds}, ["hygric.Cw"])

@@ -202,6 +202,7 @@ def convergence_record(groups: dict[str, xr.Dataset], names: list[str]) -> dict:
     """
     out: dict = {"r_hat": {}, "ess_bulk": {}, "ess_tail": {}}
     saved_r, saved_e, sizes = [], [], {}
+    walkers, n_saved = 0, 0
     for group, ds in groups.items():
         mine = [k for k in names if k in ds.data_vars]
         if not mine:
@@ -214,6 +215,11 @@ def convergence_record(groups: dict[str, xr.Dataset], names: list[str]) -> dict:
         saved_e.append(float(e.min()))
         sizes[group] = int(ds.sizes["draw"])
         walkers, n_saved = int(ds.sizes["chain"]), int(ds["in_posterior"].sum())
+    if not sizes:
+        raise ValueError(
+            f"convergence_record: none of the parameters {names} is in a retained group "
+            f"({sorted(groups)})"
+        )
     out["max_rhat"] = max(out["r_hat"].values())
     out["min_ess_bulk"] = min(out["ess_bulk"].values())
     out["convergence_draws"] = {

@@ -286,7 +286,7 @@ class KalmanNoise(NoiseModel):
                 tn,
                 *logpost._x0_prior(mf),
                 True,
-                getattr(logpost, "_series", None),
+                logpost._series,
             )
         mean[~mf.valid], var[~mf.valid] = np.nan, np.nan
         return mean, var

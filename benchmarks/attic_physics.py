@@ -112,7 +112,8 @@ The three roof-input candidates are not in the package (only the wind weight pai
 ``docs/science/real_rooms.md``, "The wind on the roof"); they are written here as
 changes of the irradiance table before alignment. ``--hours``: the MAP's residual
 (measured - simulated Ti) by season and hour of day, calibration and validation, and
-the correlation of its daily mean with FMI's daily mean wind speed.
+the correlation of its daily mean with FMI's daily mean wind speed; ``--theta``: the
+MAP's parameters and log posterior (``--hours`` prints them too).
 
 Usage (from the repository root)::
 

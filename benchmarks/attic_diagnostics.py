@@ -23,6 +23,8 @@ checked against the data"):
   squared): the June-August noon residual left.
 - ``--variant``: the MAP of one of ``attic_physics.py``'s variants (default ``wind``,
   init's config) for the three above and the one below.
+- ``--model``, ``--estimated``: another of ``attic_physics.py``'s candidate models
+  (``--seasons``, ``--sun``; e.g. ``air_feed``), the weather without its radiation.
 - ``--validation``: the validation residual by month and hour, its worst days, and the
   validation FIT a correction by one more input would reach (a ceiling: fitted on the
   validation itself).
@@ -141,16 +143,25 @@ def _sky_on(cs, index, mask, shift_min):
     return sky_as_read(cs, index, None, shift_min)[mask]
 
 
-def _map_frame(room: str, data: Path, work: Path, variant: str = "wind") -> tuple:
-    """thermal_1c's MAP simulation beside the measured attic, the roof's irradiance and
-    the boundary temperatures, calibration and validation (``val``), on the file clock
-    (UTC+2); and the MAP's parameters."""
+def _map_frame(
+    room: str,
+    data: Path,
+    work: Path,
+    variant: str = "wind",
+    model: str = "thermal_1c",
+    bare: bool = False,
+) -> tuple:
+    """The MAP simulation of ``model`` (an ``attic_physics.py`` candidate; thermal_1c by
+    default) beside the measured attic, the roof's irradiance and the boundary
+    temperatures, calibration and validation (``val``), on the file clock (UTC+2); and
+    the MAP's parameters. ``bare``: the weather without its radiation (estimated sun)."""
     import attic_physics as ap
     from _common import config_map
 
-    w = work / room
+    w = work / room / model / ("bare" if bare else "meas")
     (w / "wx").mkdir(parents=True, exist_ok=True)
-    cfg = ap._config(room, variant, "thermal_1c", False, data, w)
+    ap._register()
+    cfg = ap._config(room, variant, model, bare, data, w)
     undo = ap.patched(ap._roof_answers(variant)[1], ap._fmi(room, data))
     try:
         prep, m, lp, mp = config_map(cfg, "thermal")
@@ -291,7 +302,12 @@ def main(argv=None) -> int:
     ap.add_argument("--variant", default="wind", help="an attic_physics.py variant")
     ap.add_argument("--slopes", action="store_true", help="the residual on each slope's sun")
     ap.add_argument("--validation", action="store_true", help="the validation residual")
+    ap.add_argument("--model", default="thermal_1c", help="an attic_physics.py candidate "
+                    "(--seasons, --sun only)")  # fmt: skip
+    ap.add_argument("--estimated", action="store_true", help="the weather without radiation")
     args = ap.parse_args(argv)
+    if args.model != "thermal_1c" and (args.slopes or args.validation):
+        ap.error("--slopes and --validation read thermal_1c's parameters")
     if set(args.rooms) - set(TUNING):
         ap.error(f"tuning attics only: {TUNING} (the others are held out)")
     if args.clock:
@@ -301,7 +317,8 @@ def main(argv=None) -> int:
     if args.seasons or args.sun or args.slopes or args.validation:
         work = Path(tempfile.mkdtemp(prefix="attic_diagnostics_"))
         for room in args.rooms:
-            f, theta = _map_frame(room, args.data, work, args.variant)
+            f, theta = _map_frame(room, args.data, work, args.variant, args.model,
+                                  args.estimated)  # fmt: skip
             print(f"{room}: MAP " + " ".join(f"{k}={x:.3g}" for k, x in theta.items()))
             if args.seasons:
                 print(f"{room}: by month\n{season_table(f).T.to_string()}")

@@ -96,12 +96,24 @@ here for the run:
 - ``ground_measured``: ``thermal_1c`` with ``Tf`` = the room below's measured
   temperature, replacing the ground (init's written advice for a room without a floor
   on the ground).
+- ``air_feed``: a measured air node on a roof store (Bacher and Madsen 2011: a sensor
+  or air node beside a medium node): ``thermal_2c``'s network with the slopes' sun on
+  the store ``Tw`` (``Cw``; ``Gw`` to ``Te``, ``Gi`` to the air) and the air ``Ti``
+  near massless (``Ci`` fixed at :data:`AIR_MASSLESS`; ``Gfast`` to ``Te``, ``Gf`` to
+  ``Tf``): ``Ti = (Gfast Te + Gi Tw + Gf Tf)/(Gfast + Gi + Gf)``, an instantaneous share
+  of the outdoor air (the first-order hold makes it exact at the stamps) beside a sun
+  lagged by the store; ``air_feed_light``: ``Ci`` fixed at the prior's floor
+  :data:`AIR_FLOOR` (its time constant then follows the conductances' scale);
+  ``air_feed_free``: ``Ci`` under the default prior (``thermal_2c`` with the sun on
+  ``Tw``); ``air_feed_split``: ``air_feed`` with ``fsol`` of the sun on the store, the
+  rest on the air (nests ``thermal_1c``'s sun on the air).
 
 The three roof-input candidates are not in the package (only the wind weight paid, see
 ``docs/science/real_rooms.md``, "The wind on the roof"); they are written here as
 changes of the irradiance table before alignment. ``--hours``: the MAP's residual
 (measured - simulated Ti) by season and hour of day, calibration and validation, and
-the correlation of its daily mean with FMI's daily mean wind speed.
+the correlation of its daily mean with FMI's daily mean wind speed; ``--theta``: the
+MAP's parameters and log posterior (``--hours`` prints them too).
 
 Usage (from the repository root)::
 
@@ -133,8 +145,13 @@ from real_rooms import ROOMS, run_init  # noqa: E402
 TUNING = ["R2", "R4", "R6"]
 SEED = None  # the MAP's seed when not init's (--seed)
 BUDGET = {"maxiter": 100, "starts": 2}  # the MAP's generations and starts (--maxiter, --starts)
+THETA = False  # print the MAP's parameters (--theta; --hours prints them too)
 CAL_FITS: list[float] = []  # the calibration FIT [%] of each run, in order
 SIGMA = 5.670374419e-8  # Stefan-Boltzmann [W/(m² K⁴)]
+AIR_FLOOR = 1e4  # [J/K]: the thermal capacity prior's floor, a few m³ of air
+#: [J/K] the air node of ``air_feed``: quasi-steady, its time constant under 100 s at
+#: any conductances the prior allows (each ≥ 0.01 W/K), under 1 s above 1 W/K
+AIR_MASSLESS = 1.0
 DECK_PRIOR = {"Cr": {"dist": "loguniform", "lower": 1e4, "upper": 1e7}}  # [J/K]
 #: candidate -> catalogue name, options, priors (see the module docstring)
 MODELS = {
@@ -148,6 +165,10 @@ MODELS = {
     "below20": ("x_below_constant", {}, {"Tb": {"fixed": 20.0}}),
     "below_measured": ("x_below_column", {}, {}),
     "ground_measured": ("thermal_1c", {}, {}),
+    "air_feed": ("x_air_feed", {}, {"Ci": {"fixed": AIR_MASSLESS}}),
+    "air_feed_light": ("x_air_feed", {}, {"Ci": {"fixed": AIR_FLOOR}}),
+    "air_feed_free": ("x_air_feed", {}, {}),
+    "air_feed_split": ("x_air_feed_split", {}, {"Ci": {"fixed": AIR_MASSLESS}}),
     "sky": ("x_sky", {}, {"r_lw": {"dist": "uniform", "lower": 0.0, "upper": 1.0}}),
     "sky_below20": (
         "x_sky_below",
@@ -194,6 +215,26 @@ def _candidate(
                    constants=("Tb",) * (below == "constant"))  # fmt: skip
 
 
+def _air_feed(name, surfaces=None, ground=True, split=False):
+    """A measured air node on a roof store: ``thermal_2c``'s network (``Tw``: ``Cw``,
+    ``Gw`` to ``Te``, ``Gi`` to the air; the air ``Ti``: ``Ci``, ``Gfast`` to ``Te``,
+    ``Gf`` to ``Tf``) with the slopes' sun on the store ``Tw`` (``split``: ``fsol`` on
+    the store, ``1 - fsol`` on the air). With ``Ci`` at :data:`AIR_MASSLESS` the air is
+    quasi-steady, ``Ti = (Gfast Te + Gi Tw + Gf Tf)/(Gfast + Gi + Gf)``: an instantaneous
+    share of the outdoor air beside a lagged sun (Bacher and Madsen 2011)."""
+    from heritage_bayes.rc.network import Link, Network, Node, Source
+
+    links = [Link("Tw", "Te", "Gw"), Link("Tw", "Ti", "Gi"), Link("Ti", "Te", "Gfast")]
+    links += [Link("Ti", "Tf", "Gf")] * bool(ground)
+    surfaces = tuple(surfaces or ())
+    sources = [Source(f"I_{s}", "Tw", f"fI_{s}", "fsol" if split else None) for s in surfaces]
+    sources += [Source(f"I_{s}", "Ti", f"fI_{s}", "1-fsol") for s in surfaces] * split
+    inputs = ("Te", *(f"I_{s}" for s in surfaces), *["Tf"] * bool(ground))
+    nodes = (Node("Tw", "Cw"), Node("Ti", "Ci"))
+    return Network(name=name, domain="thermal", nodes=nodes, links=tuple(links),
+                   inputs=inputs, outputs=("Ti",), sources=tuple(sources))  # fmt: skip
+
+
 def _register() -> None:
     from heritage_bayes.rc.catalog import CATALOG, CatalogModel, register
 
@@ -212,6 +253,13 @@ def _register() -> None:
             return _candidate(_n, surfaces, ground, **_f)
 
         register(name, CatalogModel(build, "a candidate of attic_physics.py", "thermal", True))
+    for name, split in (("x_air_feed", False), ("x_air_feed_split", True)):
+        if name not in CATALOG:
+
+            def build(surfaces=None, ground=True, heating=False, _n=name, _s=split):
+                return _air_feed(_n, surfaces, ground, _s)
+
+            register(name, CatalogModel(build, "a candidate of attic_physics.py", "thermal", True))
 
 
 def _fmi(room: str, data: Path) -> pd.DataFrame:
@@ -602,11 +650,12 @@ def run(room, variant, bare, data, work, hours, model="thermal_1c"):
     v, cal = prep.validation, prep.fitted_rows()
     fit = fit_metrics(obs[v], y[v])["FIT"]
     CAL_FITS.append(fit_metrics(obs[cal], y[cal])["FIT"])
-    if hours:
+    if hours or THETA:
         print(
             " ".join(f"{k}={x:.3g}" for k, x in zip(lp.params.names, mp.theta, strict=True)),
             f"log_post={mp.log_post:.1f} (starts agreed {mp.n_agreed}/{mp.n_starts})",
         )
+    if hours:
         sl = slice(prep.calibration.start, v.stop)
         e = pd.Series(obs[sl] - y[sl], index=prep.frame.index[sl] + pd.Timedelta(hours=2))
         season = np.array(["DJF", "DJF", "MAM", "MAM", "MAM", "JJA", "JJA", "JJA", "SON",
@@ -629,12 +678,13 @@ def main(argv=None) -> int:
     ap.add_argument("--models", nargs="+", default=["thermal_1c"], choices=list(MODELS))
     ap.add_argument("--hours", action="store_true", help="residual by season and hour")
     ap.add_argument("--measured", action="store_true", help="measured radiation only")
+    ap.add_argument("--theta", action="store_true", help="print the MAP's parameters")
     ap.add_argument("--seed", type=int, default=None, help="the MAP's seed (init's: 1)")
     ap.add_argument("--maxiter", type=int, default=100, help="the MAP's generations")
     ap.add_argument("--starts", type=int, default=2, help="the MAP's starts")
     args = ap.parse_args(argv)
-    global SEED
-    SEED = args.seed
+    global SEED, THETA
+    SEED, THETA = args.seed, args.theta
     BUDGET.update(maxiter=args.maxiter, starts=args.starts)
     if set(args.rooms) - set(TUNING):
         ap.error(f"tuning attics only: {TUNING} (the others are held out)")

@@ -2,7 +2,8 @@
 are found (benchmarks/attic_diagnostics.py), the roof's answers are parsed and the sky's
 loss with its own weight nests the fixed one (benchmarks/attic_physics.py), a slow sun
 path is found (benchmarks/attic_response.py), the sorbing buffer's path and uptake heat
-(benchmarks/attic_sorption.py)."""
+(benchmarks/attic_sorption.py), the massless air node on a roof store is the quasi-steady
+mix (benchmarks/attic_physics.py)."""
 
 import sys
 from pathlib import Path
@@ -74,7 +75,7 @@ def test_sky_loss_with_its_own_weight_nests_the_fixed_one():
     planes = ["roof_N", "roof_S"]
     m = RCModel(ap._candidate("x_sky", planes, deck=False, sky=True))
     assert "r_lw" in m.parameter_names and m.input_names[-2:] == ("L_roof_N", "L_roof_S")
-    p = {"Ci": 1e6, "Ge": 100.0, "Gf": 5.0, "fI_roof_N": 3.0, "fI_roof_S": 7.0}
+    p = {"Ci": ap.AIR_MASSLESS, "Ge": 100.0, "Gf": 5.0, "fI_roof_N": 3.0, "fI_roof_S": 7.0}
     for r in (0.0, 1.0 / ap.LW_CAP, 1.0):
         B = m.state_space({**p, "r_lw": r})[1]
         col = {k: B[:, m.input_names.index(k)] for k in m.input_names}
@@ -122,3 +123,38 @@ def test_buffer_path_is_the_package_recursion_and_its_uptake_heats():
     assert q[55:80].mean() > 0.0 and abs(q[:45].mean()) < q[55:80].mean()
     ramp = aso.uptake_heat(np.linspace(0.0, 10.0, 11), 2.0, 10.0)
     np.testing.assert_allclose(ramp, aso.HEAT_OF_SORPTION * 2.0 / P_REF * 0.1)  # 0.1 Pa/s
+
+
+def test_air_feed_is_a_store_seen_through_a_massless_air_node():
+    """The candidate ``air_feed`` (benchmarks/attic_physics.py) with its air node at
+    AIR_MASSLESS, under the package's first-order hold: the simulated air is the
+    quasi-steady mix (Gfast Te + Gi Tw + Gf Tf)/(Gfast + Gi + Gf) of the outdoor air at
+    the stamp and a one-node store Tw (conductance Gw + Gi Gfast/S to Te, Gi Gf/S to Tf,
+    the sun on it): an instantaneous share of Te, the sun only through the store."""
+    from heritage_bayes.rc import simulate
+    from heritage_bayes.rc.catalog import model
+    from heritage_bayes.rc.model import RCModel
+
+    rng = np.random.default_rng(3)
+    n = 24 * 10
+    hours = np.arange(n + 1)
+    te = 8 * np.sin(2 * np.pi * (hours - 9) / 24) + np.cumsum(rng.normal(0, 0.5, n + 1))
+    sun = 400 * np.clip(np.sin(2 * np.pi * (hours - 6) / 24), 0, None)
+    tf = np.full(n + 1, 5.0)
+    p = {"Cw": 5e6, "Ci": ap.AIR_MASSLESS, "Gw": 200.0, "Gi": 1500.0, "Gfast": 1200.0,
+         "Gf": 3.0, "fI_roof_N": 10.0, "fI_roof_S": 6.0}  # fmt: skip
+
+    def frame(cols):  # the interval means and the steps' changes (first-order hold)
+        out = {k: (v[:-1] + v[1:]) / 2 for k, v in cols.items()}
+        return pd.DataFrame({**out, **{f"{k}_slope": np.diff(v) for k, v in cols.items()}})
+
+    cols = {"Te": te, "I_roof_N": sun, "I_roof_S": 0.5 * sun, "Tf": tf}
+    feed = RCModel(ap._air_feed("x", ["roof_N", "roof_S"])).with_slopes(tuple(cols))
+    ti = simulate(feed, p, frame(cols))[:, 0]
+    s = p["Gfast"] + p["Gi"] + p["Gf"]
+    one = model("thermal_1c", surfaces=["roof_N", "roof_S"]).with_slopes(tuple(cols))
+    q = {"Ci": p["Cw"], "Ge": p["Gw"] + p["Gi"] * p["Gfast"] / s, "Gf": p["Gi"] * p["Gf"] / s,
+         "fI_roof_N": 10.0, "fI_roof_S": 6.0}  # fmt: skip
+    tw = simulate(one, q, frame(cols))[:, 0]
+    mix = (p["Gfast"] * te[:-1] + p["Gi"] * tw + p["Gf"] * tf[:-1]) / s
+    np.testing.assert_allclose(ti[24:], mix[24:], atol=1e-4)

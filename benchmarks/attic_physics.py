@@ -578,12 +578,17 @@ def likelihood(th, variant: str):
     """The thermal section ``th`` under the variant's likelihood: ``phi<cap>``, the AR(1)
     model error's coefficient ``phi_Ti`` uniform on [0, cap]; ``phifix<v>``, fixed at v
     (0: the free-run error, white); ``noise<name>``, the section's ``noise:`` (``iid``,
-    ``ar1``, ...; ``phi_Ti`` fixes dropped where the noise has no AR part). Other
+    ``ar1``, ...; priors on noise parameters it lacks dropped). Other
     variants: ``th`` unchanged."""
     from heritage_bayes.config.priors import PriorSpec
 
-    if variant.startswith("noise"):
-        return th.model_copy(update={"noise": variant[5:]})
+    if variant.startswith("noise"):  # priors on noise parameters the model lacks dropped
+        from heritage_bayes.names import NOISE_MODELS
+
+        kinds = NOISE_MODELS[variant[5:]].kinds
+        gone = [k for k in ("phi", "sigma_meas") if k not in kinds]
+        priors = {k: v for k, v in th.priors.items() if k.rsplit("_", 1)[0] not in gone}
+        return th.model_copy(update={"noise": variant[5:], "priors": priors})
     if variant.startswith("phifix"):  # the AR(1) error's coefficient held at a value
         spec = {"fixed": float(variant[6:])}
     elif variant.startswith("phi"):  # the AR(1) error's coefficient capped lower

@@ -39,6 +39,10 @@ variant of the roof planes' irradiance input:
 - ``phi<cap>``: the AR(1) model error's coefficient ``phi_Ti`` uniform on [0, cap]
   (default cap 0.96 at hourly steps): a likelihood that leaves less of the slow misfit
   to the error;
+- ``phifix<v>``: ``phi_Ti`` fixed at v (``phifix0``: a model error without memory,
+  the MAP an output-error fit of the free run); ``noise<name>``: the thermal section's
+  ``noise:`` set to a registered noise model (``noiseiid``: independent errors,
+  ``noisear1``: AR(1) without the sensor's white part);
 - ``lag<h>``: the roof planes' columns (as the package builds them: shaded, weighted
   by the wind, under the snow) through a first-order store of time constant ``h`` [h]
   (a roof deck whose capacity delays the sun's heat on its way to the attic air);
@@ -606,10 +610,7 @@ def _config(room, variant, model, bare, data, w):
     th = cfg.thermal.model_copy(
         update={"model": name, "options": ModelOptions.model_validate(options), "priors": typed}
     )
-    if variant.startswith("phi"):  # the AR(1) error's coefficient capped lower
-        cap = {"phi_Ti": PriorSpec.model_validate({"dist": "uniform", "lower": 0.0,
-                                                   "upper": float(variant[3:])})}  # fmt: skip
-        th = th.model_copy(update={"priors": {**th.priors, **cap}})
+    th = likelihood(th, variant)
     periods = cfg.periods
     if variant.startswith("from"):  # the calibration from a later date (e.g. after the snow)
         cal = periods.calibration.model_copy(update={"start": variant[4:]})
@@ -619,6 +620,30 @@ def _config(room, variant, model, bare, data, w):
     return cfg.model_copy(update={"data": d, "optimizer": opt, "thermal": th, "hygric": None,
                                   "seed": seed,
                                   "periods": periods})  # fmt: skip
+
+
+def likelihood(th, variant: str):
+    """The thermal section ``th`` under the variant's likelihood: ``phi<cap>``, the AR(1)
+    model error's coefficient ``phi_Ti`` uniform on [0, cap]; ``phifix<v>``, fixed at v
+    (0: the free-run error, white); ``noise<name>``, the section's ``noise:`` (``iid``,
+    ``ar1``, ...; priors on noise parameters it lacks dropped). Other
+    variants: ``th`` unchanged."""
+    from heritage_bayes.config.priors import PriorSpec
+
+    if variant.startswith("noise"):  # priors on noise parameters the model lacks dropped
+        from heritage_bayes.names import NOISE_MODELS
+
+        kinds = NOISE_MODELS[variant[5:]].kinds
+        gone = [k for k in ("phi", "sigma_meas") if k not in kinds]
+        priors = {k: v for k, v in th.priors.items() if k.rsplit("_", 1)[0] not in gone}
+        return th.model_copy(update={"noise": variant[5:], "priors": priors})
+    if variant.startswith("phifix"):  # the AR(1) error's coefficient held at a value
+        spec = {"fixed": float(variant[6:])}
+    elif variant.startswith("phi"):  # the AR(1) error's coefficient capped lower
+        spec = {"dist": "uniform", "lower": 0.0, "upper": float(variant[3:])}
+    else:
+        return th
+    return th.model_copy(update={"priors": {**th.priors, "phi_Ti": PriorSpec.model_validate(spec)}})
 
 
 def simulated(room, variant, bare, data, work, model="thermal_1c"):

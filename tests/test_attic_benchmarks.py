@@ -60,6 +60,33 @@ def test_season_table_gain_and_phase():
     assert t.gain.tolist() == pytest.approx([np.cos(2 * np.pi / 24) / 2] * 2, abs=0.01)
 
 
+@pytest.mark.parametrize(
+    ("variant", "noise", "phi"),
+    [("phifix0.5", "ar1_white", 0.5), ("phifix0", "ar1_white", 0.0), ("noiseiid", "iid", None)],
+)
+def test_likelihood_variants_reach_the_parameter_set(variant, noise, phi):
+    """``phifix<v>`` holds ``phi_Ti`` at v in the section's parameters (not free);
+    ``noise<name>`` sets the noise model (``iid``: no ``phi_Ti`` at all); ``phi<cap>``
+    caps its prior; the roof's variants leave the section as it was."""
+    from heritage_bayes.config import load_config
+    from heritage_bayes.models import models_of
+    from heritage_bayes.run import section_parameters
+
+    root = Path(__file__).resolve().parents[1]
+    cfg = load_config(root / "configs" / "trh1_attic.yaml")
+    assert ap.likelihood(cfg.thermal, "wind") is cfg.thermal
+    assert ap.likelihood(cfg.thermal, "phi0.8").priors["phi_Ti"].upper == 0.8
+    cfg = cfg.model_copy(update={"thermal": ap.likelihood(cfg.thermal, variant)})
+    model = models_of(cfg)[0]["thermal"]
+    used, params = section_parameters(cfg, "thermal", model, cfg.thermal.priors)
+    assert used.name == noise
+    found = {p.name: p for p in params.parameters}
+    if phi is None:
+        assert "phi_Ti" not in found
+    else:
+        assert found["phi_Ti"].fixed == phi and not found["phi_Ti"].free
+
+
 def test_roof_answers_parse():
     assert ap._roof_answers("ridge45+pitch30") == ({"ridge_azimuth": 45.0, "pitch": 30.0}, "wind")
     assert ap._roof_answers("ridge0+snow0") == ({"ridge_azimuth": 0.0}, "snow0")

@@ -426,6 +426,36 @@ def default_section(model):
     return ModelSection(model=model.name, options=options)
 
 
+def default_noise(model) -> tuple[str, list[float]]:
+    """``hbayes calibrate``'s noise model and likelihood temperature (as ``[T]``) for
+    ``model`` (:func:`default_section`)."""
+    from heritage_bayes.calibration.ladder import section_temperature
+
+    section = default_section(model)
+    return section.noise, [section_temperature(section, model)]
+
+
+def idle_link_fixed(lp, mp, priors, fit):
+    """``hbayes calibrate``'s rule at the MAP ``mp`` (``calibration.wall``): ``(lp, mp,
+    finding)``, the log-posterior and MAP with an idle buffer link fixed at its floor
+    where the rule fires (finding None, ``lp`` and ``mp`` as given, where not). ``fit``:
+    ``(model, noise, U, y, floor, envelope, init)`` of :func:`log_posterior`."""
+    from heritage_bayes.calibration.wall import decoupled_wall, fix_decoupled_wall
+    from heritage_bayes.config import prior_specs
+
+    if (wall := decoupled_wall(lp, mp.theta, priors)) is None:
+        return lp, mp, None
+    model, noise, U, y, floor, envelope, init = fit
+
+    def rebuild(pr, _t=lp.temperature):
+        lpw = log_posterior(model, noise, U, y, pr, floor, envelope, init)[1]
+        lpw.temperature = _t
+        return lpw
+
+    lp, mp, _ = fix_decoupled_wall(wall, rebuild, prior_specs(priors), mp)
+    return lp, mp, wall
+
+
 def fit_and_rank(
     model,
     U,
@@ -453,9 +483,6 @@ def fit_and_rank(
     package's 50; larger: a longer chain than the rule asks for, ``--tau-factor``).
     Returns ``{variant: {ranks, converged, map, steps, cpu}}``.
     """
-    from heritage_bayes.calibration.ladder import section_temperature
-    from heritage_bayes.calibration.wall import decoupled_wall, fix_decoupled_wall
-    from heritage_bayes.config import prior_specs
     from heritage_bayes.inference.likelihoods import get_noise_model
     from heritage_bayes.inference.optimize import find_map
     from heritage_bayes.inference.sampler import run_sampler
@@ -472,28 +499,21 @@ def fit_and_rank(
         slow = [o for o in opts if o.startswith("tau1=")]
         fixed_t = [float(o.removeprefix("T=")) for o in opts if o.startswith("T=")]
         t0 = time.process_time()
-        section = None
-        if noise_name == "default":  # hbayes calibrate's noise, temperature and Gw rule
-            section = default_section(model)
-            noise_name = section.noise
-            fixed_t = [section_temperature(section, model)]
+        calibrate = noise_name == "default"  # hbayes calibrate's noise, T and Gw rule
+        if calibrate:
+            noise_name, fixed_t = default_noise(model)
         noise = get_noise_model(noise_name)
         ps, lp = log_posterior(model, noise, U, y, priors, floor, envelope, init)
-        if section is not None:  # the MAP of the tempered posterior, as in calibrate
+        if calibrate:  # the MAP of the tempered posterior, as in calibrate
             lp.temperature = fixed_t[0]
         if slow:  # NOISE:INIT:tau1=MEDIAN_H/SIGMA: a log-normal prior on the slowest τ
             median_h, sigma = map(float, slow[0].removeprefix("tau1=").split("/"))
             slow_time_constant_prior(lp, median_h * 3600.0, sigma)
         mp = find_map(lp, seed=rep, method="differential_evolution", popsize=15, maxiter=200)
         wall = None
-        if section is not None and (wall := decoupled_wall(lp, mp.theta, priors)) is not None:
-
-            def rebuild(pr, _n=noise, _t=fixed_t[0], _i=init):
-                lpw = log_posterior(model, _n, U, y, pr, floor, envelope, _i)[1]
-                lpw.temperature = _t
-                return lpw
-
-            lp, mp, _ = fix_decoupled_wall(wall, rebuild, prior_specs(priors), mp)
+        if calibrate:
+            fit = (model, noise, U, y, floor, envelope, init)
+            lp, mp, wall = idle_link_fixed(lp, mp, priors, fit)
             ps = lp.params
         kappas = {}
         if fixed_t:  # NOISE:INIT:T=2: log L divided by a fixed temperature

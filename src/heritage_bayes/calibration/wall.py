@@ -6,9 +6,9 @@ buffer node does what the buffer's own link to the outdoors (``Gw``, the conduct
 between the buffer ``Cw`` and the outdoor vapour pressure) would do. Where the data
 leave that link idle, its conductance is a flat direction of the posterior from the
 prior's floor up to where the link starts to move the buffer within the record, and an
-ensemble sampler wanders along it without mixing (the Ørholm store under ``kalman``:
-τ 1 782 after 98 000 steps; the same room with ``Gw`` fixed at its floor converges:
-docs/science/sbc.md, "`kalman` at `T=2`, and a real cellar's check").
+ensemble sampler wanders along it without mixing (the Ørholm store, whose
+chain converges with ``Gw`` fixed at its floor: docs/science/sbc.md, "`kalman` at
+`T=2`, and a real cellar's check", "The cellars' default").
 
 :func:`decoupled_wall` decides at the MAP: the link is idle when the buffer's exchange
 time through it, ``Cw/Gw``, is at least :data:`DECOUPLED_RECORDS` calibration records

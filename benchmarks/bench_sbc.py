@@ -415,6 +415,47 @@ def slow_time_constant_prior(lp, median_s: float, sigma: float) -> None:
     lp.time_constant_log_prior = with_slow
 
 
+def default_section(model):
+    """The config section ``hbayes calibrate`` reads for a catalogue ``model`` with its
+    network options and nothing else set (``--variant default:INIT``: the package's
+    default noise model and likelihood temperature for it)."""
+    from heritage_bayes.config import ModelSection
+
+    options = {"sink": getattr(model, "sink", "none"), "isotherm": model.isotherm}
+    options = {k: v for k, v in options.items() if v not in (None, "none")}
+    return ModelSection(model=model.name, options=options)
+
+
+def default_noise(model) -> tuple[str, list[float]]:
+    """``hbayes calibrate``'s noise model and likelihood temperature (as ``[T]``) for
+    ``model`` (:func:`default_section`)."""
+    from heritage_bayes.calibration.ladder import section_temperature
+
+    section = default_section(model)
+    return section.noise, [section_temperature(section, model)]
+
+
+def idle_link_fixed(lp, mp, priors, fit):
+    """``hbayes calibrate``'s rule at the MAP ``mp`` (``calibration.wall``): ``(lp, mp,
+    finding)``, the log-posterior and MAP with an idle buffer link fixed at its floor
+    where the rule fires (finding None, ``lp`` and ``mp`` as given, where not). ``fit``:
+    ``(model, noise, U, y, floor, envelope, init)`` of :func:`log_posterior`."""
+    from heritage_bayes.calibration.wall import decoupled_wall, fix_decoupled_wall
+    from heritage_bayes.config import prior_specs
+
+    if (wall := decoupled_wall(lp, mp.theta, priors)) is None:
+        return lp, mp, None
+    model, noise, U, y, floor, envelope, init = fit
+
+    def rebuild(pr, _t=lp.temperature):
+        lpw = log_posterior(model, noise, U, y, pr, floor, envelope, init)[1]
+        lpw.temperature = _t
+        return lpw
+
+    lp, mp, _ = fix_decoupled_wall(wall, rebuild, prior_specs(priors), mp)
+    return lp, mp, wall
+
+
 def fit_and_rank(
     model,
     U,
@@ -449,7 +490,8 @@ def fit_and_rank(
 
     out = {}
     for variant in variants:
-        # NOISE:INIT[:OPTION...]: temper=L (the likelihood tempered by the long-run
+        # NOISE:INIT[:OPTION...] (NOISE default: hbayes calibrate's, default_section),
+        # temper=L (the likelihood tempered by the long-run
         # variance ratio of the MAP's innovations, Bartlett window of L hours), T=X (by a
         # fixed temperature X), tau1=MEDIAN_H/SIGMA (slow_time_constant_prior)
         noise_name, init, *opts = variant.split(":")
@@ -457,12 +499,22 @@ def fit_and_rank(
         slow = [o for o in opts if o.startswith("tau1=")]
         fixed_t = [float(o.removeprefix("T=")) for o in opts if o.startswith("T=")]
         t0 = time.process_time()
+        calibrate = noise_name == "default"  # hbayes calibrate's noise, T and Gw rule
+        if calibrate:
+            noise_name, fixed_t = default_noise(model)
         noise = get_noise_model(noise_name)
         ps, lp = log_posterior(model, noise, U, y, priors, floor, envelope, init)
+        if calibrate:  # the MAP of the tempered posterior, as in calibrate
+            lp.temperature = fixed_t[0]
         if slow:  # NOISE:INIT:tau1=MEDIAN_H/SIGMA: a log-normal prior on the slowest τ
             median_h, sigma = map(float, slow[0].removeprefix("tau1=").split("/"))
             slow_time_constant_prior(lp, median_h * 3600.0, sigma)
         mp = find_map(lp, seed=rep, method="differential_evolution", popsize=15, maxiter=200)
+        wall = None
+        if calibrate:
+            fit = (model, noise, U, y, floor, envelope, init)
+            lp, mp, wall = idle_link_fixed(lp, mp, priors, fit)
+            ps = lp.params
         kappas = {}
         if fixed_t:  # NOISE:INIT:T=2: log L divided by a fixed temperature
             lp.temperature = fixed_t[0]
@@ -536,6 +588,9 @@ def fit_and_rank(
                 zip([q.name for q in ps.parameters if q.free], map(float, chain.tau), strict=True)
             ),
             "cpu": time.process_time() - t0,
+            "noise": noise.name,
+            "temperature": float(lp.temperature),
+            "decoupled_wall": wall and wall.to_dict(),
         }
         if temper:
             out[variant].update(temperature=lp.temperature, kappa_by_bandwidth=kappas)

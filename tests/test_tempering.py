@@ -136,14 +136,20 @@ def test_likelihood_temperature_config_reaches_the_posterior():
     m_s = build_model(cfg_s, "hygric")
     assert m_s.sorption and cfg_s.hygric.likelihood_temperature is None
     assert _log_posterior(cfg_s, prepare(cfg_s), "hygric", m_s, {}).temperature == 2.0
-    # ... 3 for one with a vapour sink at a temperature (a cellar's ground), 1 with a
+    # ... 2 for one with a vapour sink at a temperature (a cellar's ground) and a linear
+    # wall (under its default noise, kalman), 3 with a GAB wall (ar1_white), 1 with a
     # constant fixed node
-    for sink, want in (("temperature", 3.0), ("constant", 1.0)):
-        hyg = {"model": "hygric_2c_fixed", "options": {"sink": sink}}
+    for sink, iso, want in (
+        ("temperature", "linear", ("kalman", 2.0)),
+        ("temperature", "gab", ("ar1_white", 3.0)),
+        ("constant", "linear", ("ar1_white", 1.0)),
+    ):
+        hyg = {"model": "hygric_2c_fixed", "options": {"sink": sink, "isotherm": iso}}
         cfg_k = parse_config({**raw, "hygric": hyg})
         m_k = build_model(cfg_k, "hygric")
         lp_k = _log_posterior(cfg_k, prepare(cfg_k), "hygric", m_k, {})
-        assert (getattr(m_k, "sink", "constant"), lp_k.temperature) == (sink, want)
+        got = (lp_k.noise.name, lp_k.temperature)
+        assert (getattr(m_k, "sink", "constant"), got) == (sink, want)
     # ... and 1 for a thermal network of more than two capacity nodes (thermal_4a),
     # unless the config sets it
     cfg_4a = parse_config({**raw, "thermal": {"model": "thermal_4a"}})

@@ -30,6 +30,7 @@ from heritage_bayes.calibration.ladder import (  # structural_at_map: re-exporte
     section_log_posterior,
     structural_at_map,
 )
+from heritage_bayes.calibration.wall import config_with_fixed_walls, fix_section_wall
 from heritage_bayes.config import MAX_SEED, CalibrationConfig, chain_tag, config_hash
 from heritage_bayes.convert import format_timedelta
 from heritage_bayes.errors import InputError
@@ -131,6 +132,8 @@ class _Section:
     block_move: dict = field(default_factory=dict)  # the block move's parameters, weight
     map_at_bound: list = field(default_factory=list)  # (name, "lower"/"upper")
     frozen_node: dict | None = None  # the MAP's slowest mode, when many records long
+    decoupled_wall: object = None  # calibration.wall.DecoupledWall (fixed_priors: its)
+    fixed_priors: dict | None = None
     lp: np.ndarray | None = None
     timings: dict = field(default_factory=dict)
     deadline: float | None = None  # time.perf_counter() end of the run's time budget
@@ -321,6 +324,8 @@ def _calibrate_into(
             out=out,
             resume=resume,
         )
+    if (fixed := config_with_fixed_walls(cfg, sections)) is not None:  # readers rebuild
+        atomic_write_text(out / "config.yaml", config_yaml(cfg := fixed))  # chain's priors
     _common_draws(cfg, sections)
     ladder = {k: v.rows for k, v in screens.items()}  # model: auto: the screen is the ladder
     if cfg.ladder:
@@ -415,6 +420,7 @@ def _sample_section(
         f"[{s.name}] MAP log-posterior {s.map.log_post:.1f}; "
         f"{s.map.n_agreed}/{s.map.n_starts} starts agreed"
     )
+    fix_section_wall(cfg, prep, s, say)  # a buffer link the MAP leaves idle under a filter
     t0 = time.perf_counter()
     s.identifiability, s.laplace = identifiability_at_map(s.model, s.logpost, s.map, prep.dt)
     s.timings["identifiability_seconds"] = time.perf_counter() - t0

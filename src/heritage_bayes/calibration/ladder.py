@@ -22,7 +22,13 @@ from heritage_bayes.models import initial_state_of
 from heritage_bayes.rc.model import RCModel
 from heritage_bayes.run import section_parameters
 
-__all__ = ["ladder_row", "rung_log_posterior", "section_log_posterior", "structural_at_map"]
+__all__ = [
+    "ladder_row",
+    "rung_log_posterior",
+    "section_log_posterior",
+    "section_temperature",
+    "structural_at_map",
+]
 
 
 def section_log_posterior(
@@ -58,16 +64,24 @@ def section_log_posterior(
             initial_state_sd=getattr(cfg, section).initial_state_sd,
             initial_state_horizon=getattr(cfg, section).horizon_seconds,
             time_constant_cap=getattr(cfg, section).cap_seconds(model.domain),
-            temperature=getattr(cfg, section).temperature(
-                model.domain,
-                model.n_states,
-                getattr(model, "sorption", False),
-                getattr(model, "sink", "none"),
-            ),
+            temperature=section_temperature(getattr(cfg, section), model),
             **extra,
         )
     except ValueError as exc:
         raise InputError(f"{section}: {exc}") from None
+
+
+def section_temperature(sec_cfg, model: RCModel) -> float:
+    """The likelihood temperature of a config section (a
+    :class:`~heritage_bayes.config.models.ModelSection`) for ``model``: its own or the
+    default for the model's domain, nodes, sorption, sink and the section's noise
+    model (:meth:`~heritage_bayes.config.models.ModelSection.temperature`)."""
+    return sec_cfg.temperature(
+        model.domain,
+        model.n_states,
+        getattr(model, "sorption", False),
+        getattr(model, "sink", "none"),
+    )
 
 
 def rung_log_posterior(cfg, prep, section: str, model: RCModel, initial_state) -> LogPosterior:

@@ -443,6 +443,8 @@ def _section_info(o: _Outputs, s, x0, pred_info, saturation, dq_all: dict) -> di
         # identifiability from the Laplace approximation at the MAP
         "map_at_bound": [list(b) for b in getattr(s, "map_at_bound", [])],
         "frozen_node": getattr(s, "frozen_node", None),
+        # a buffer link fixed at its prior's floor at the MAP (calibration.wall)
+        "decoupled_wall": getattr(s, "decoupled_wall", None) and s.decoupled_wall.to_dict(),
         # the share of draws whose slowest mode is frozen (a second posterior branch)
         "frozen_share": _frozen_share(dq_all.get("tau_1_h"), s.logpost),
         "time_constant_cap_h": _hours(s.logpost.time_constant_cap),

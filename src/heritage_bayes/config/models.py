@@ -24,6 +24,9 @@ from heritage_bayes.names import DEFAULT_NOISE, NOISE_MODELS
 
 __all__ = [
     "DEFAULT_LIKELIHOOD_TEMPERATURE",
+    "FILTERED_SINK_LIKELIHOOD_TEMPERATURE",
+    "FILTERED_SINK_MODELS",
+    "FILTERED_SINK_NOISE",
     "SINK_LIKELIHOOD_TEMPERATURE",
     "SORPTION_LIKELIHOOD_TEMPERATURE",
     "TEMPERED_MAX_NODES",
@@ -55,6 +58,23 @@ SORPTION_LIKELIHOOD_TEMPERATURE = 2.0
 #: independent ones, so the slow quantities' intervals are too narrow by a factor that
 #: varies from room to room (docs/science/sbc.md, the coupled hygric models).
 SINK_LIKELIHOOD_TEMPERATURE = 3.0
+#: The noise model of a section that does not choose one, for the catalogue models
+#: whose linear buffer (``isotherm: linear``, the default) exchanges with a vapour sink
+#: at a temperature (``sink: temperature``) and that no humidistat controls: a Kalman
+#: filter over the coupled model's own per-step transitions, whose process noise at the
+#: nodes carries an unmodelled moisture source stored in the buffer and returned over
+#: days (:mod:`heritage_bayes.inference.coupled_kalman`). Its intervals on simulated
+#: cellars meet the coverage target at :data:`FILTERED_SINK_LIKELIHOOD_TEMPERATURE`,
+#: ``ar1_white``'s at 3 do not (docs/science/sbc.md, "The cellars' default"). The GAB
+#: buffer and the controlled rooms, which the filter does not take, keep ``ar1_white``.
+FILTERED_SINK_NOISE = "kalman"
+#: The catalogue models :data:`FILTERED_SINK_NOISE` is the default of (with the sink).
+FILTERED_SINK_MODELS = ("hygric_2c_fixed", "hygric_2c_sorption")
+#: ``likelihood_temperature`` of a hygric model with a vapour sink at a temperature
+#: under :data:`FILTERED_SINK_NOISE`, where the section does not set it: the filter
+#: describes the source's return through the buffer, and what it leaves (the linear
+#: buffer against a GAB one) asks a temperature of 2, not 3 (docs/science/sbc.md).
+FILTERED_SINK_LIKELIHOOD_TEMPERATURE = 2.0
 
 
 def _duration_or_none(v: Any) -> pd.Timedelta | str | None:
@@ -99,7 +119,9 @@ class ModelSection(_Strict):
     noise: Annotated[str, Choices(NOISE_MODELS, described=True)] = key(
         DEFAULT_NOISE,
         unit=None,
-        description="noise model",
+        description="noise model (default: kalman for hygric_2c_fixed and "
+        "hygric_2c_sorption with sink: temperature, a linear isotherm and no humidistat, "
+        "ar1_white otherwise)",
     )
     initial_state: Literal["estimate", "steady"] | dict[str, float] | None = key(
         None,
@@ -129,8 +151,8 @@ class ModelSection(_Strict):
         "sd about √T times wider); 1: none (default: 2 for thermal models of one or two "
         "capacity nodes, chosen by simulation-based calibration on rooms the package did "
         "not generate, and for hygric_2c_sorption; 3 for other hygric models with a vapour "
-        "sink at a temperature (sink: temperature); 1 for other hygric models and richer "
-        "networks such as thermal_4a; docs: "
+        "sink at a temperature (sink: temperature), 2 for those under noise: kalman; 1 for "
+        "other hygric models and richer networks such as thermal_4a; docs: "
         "Simulation-based calibration)",
         ge=1,
         le=10,
@@ -156,6 +178,29 @@ class ModelSection(_Strict):
             )
         return self
 
+    @model_validator(mode="after")
+    def _default_noise(self):
+        if "noise" not in self.model_fields_set and self.filtered_sink:
+            self.noise = FILTERED_SINK_NOISE
+            # still a default, not the user's choice (a run's config.yaml, a full dump,
+            # states it, and reading that back gives the same noise model)
+            self.model_fields_set.discard("noise")
+        return self
+
+    @property
+    def filtered_sink(self) -> bool:
+        """Whether :data:`FILTERED_SINK_NOISE` is this section's default noise model: a
+        catalogue model of :data:`FILTERED_SINK_MODELS` with ``sink: temperature``, a
+        linear isotherm and no humidistat (``model: auto`` and networks given as a
+        mapping keep :data:`~heritage_bayes.names.DEFAULT_NOISE`)."""
+        o = self.options
+        return (
+            self.model in FILTERED_SINK_MODELS
+            and o.sink == "temperature"
+            and o.isotherm in (None, "linear")
+            and o.humidistat is None
+        )
+
     def cap_seconds(self, domain: str) -> float:
         """``time_constant_cap`` in seconds (``inf`` for none); the default by domain:
         a year for thermal models (no building node relaxes slower), none for hygric
@@ -175,11 +220,15 @@ class ModelSection(_Strict):
         except those whose buffer sorbs at a temperature (``sorption``:
         :data:`SORPTION_LIKELIHOOD_TEMPERATURE`) and, otherwise, those with a vapour
         sink at a temperature (``sink == "temperature"``:
-        :data:`SINK_LIKELIHOOD_TEMPERATURE`). ``n_nodes``: the model's capacity nodes
+        :data:`SINK_LIKELIHOOD_TEMPERATURE`, or
+        :data:`FILTERED_SINK_LIKELIHOOD_TEMPERATURE` under
+        :data:`FILTERED_SINK_NOISE`). ``n_nodes``: the model's capacity nodes
         (``RCModel.n_states``)."""
         if self.likelihood_temperature is None:
             if n_nodes > TEMPERED_MAX_NODES:
                 return 1.0
+            if domain == "hygric" and sink == "temperature" and self.noise == FILTERED_SINK_NOISE:
+                return FILTERED_SINK_LIKELIHOOD_TEMPERATURE
             if sorption:
                 return SORPTION_LIKELIHOOD_TEMPERATURE
             if domain == "hygric" and sink == "temperature":

@@ -149,6 +149,14 @@ def _model_notes(m: str, i) -> list[dict]:
             }
         )
     out += _frozen_notes(m, i)
+    if (w := i.decoupled_wall) is not None:
+        out.append(
+            {
+                "level": "info",
+                "title": f"The {m} buffer's link to the outdoors was fixed at its floor",
+                "text": w.text(m).split("] ", 1)[1] + ".",
+            }
+        )
     noise = noise_parameter_names(i.noise, i.output_names, i.state_names)
     flagged = [n for n in i.unidentified if n not in noise]
     if flagged:

@@ -15,6 +15,7 @@ from typing import Any
 __all__ = [
     "STATUSES",
     "Alignment",
+    "DecoupledWall",
     "FrozenNode",
     "Gap",
     "Identifiability",
@@ -111,6 +112,49 @@ class Identifiability:
 
 
 @dataclass(frozen=True)
+class DecoupledWall:
+    """A buffer link ``hbayes calibrate`` fixed at the MAP
+    (:func:`heritage_bayes.calibration.wall.decoupled_wall`): ``parameter`` (the link, e.g. ``Gw``)
+    fixed at ``floor`` [its unit], its MAP value ``map_value``, the buffer's exchange
+    time through it at the MAP ``exchange_h`` [h] and in calibration ``records`` [-],
+    and ``delta_log_posterior`` [nats], the log-posterior at the floor minus the
+    MAP's."""
+
+    parameter: str
+    capacity: str
+    floor: float
+    map_value: float
+    exchange_h: float
+    records: float
+    delta_log_posterior: float
+
+    def to_dict(self) -> dict:
+        """``summary.json``'s ``models.<section>.decoupled_wall``."""
+        return {f: getattr(self, f) for f in self.__dataclass_fields__}
+
+    @classmethod
+    def from_dict(cls, d: dict | None) -> DecoupledWall | None:
+        """The finding from :meth:`to_dict`'s mapping (None: none)."""
+        if not d:
+            return None
+        return cls(**{f: d[f] for f in cls.__dataclass_fields__})
+
+    def text(self, section: str) -> str:
+        """The run's note (the command line, the report)."""
+        p = self.parameter
+        return (
+            f"[{section}] {p} fixed at its prior's floor {self.floor:.3g} for the sampler: "
+            f"at the MAP ({p} {self.map_value:.3g}) the buffer's exchange time through it, "
+            f"{self.capacity}/{p}, is {self.records:.3g} calibration records "
+            f"({self.exchange_h:.3g} h), and the log-posterior with {p} at the floor is "
+            f"{self.delta_log_posterior:+.2g} nats from the MAP's: the buffer does not "
+            "exchange with the outdoors in these data, a flat direction the noise model's "
+            f"filter would leave the chain to wander along. Set {section}.priors.{p} to "
+            "keep it free"
+        )
+
+
+@dataclass(frozen=True)
 class FrozenNode:
     """A node that barely moves over the record at the MAP: its slowest time constant
     ``tau_h`` [h], ``records`` times the calibration record; ``start_free``: its start
@@ -185,6 +229,8 @@ class ModelInfo:
     time_constant_cap_h: float | None = None
     frozen_node: FrozenNode | None = None
     frozen_share: float | None = None
+    #: a buffer link fixed at its prior's floor for the sampler (None: none)
+    decoupled_wall: DecoupledWall | None = None
     #: parameters the data leave almost as uncertain as their priors (Laplace at the MAP)
     unidentified: tuple[str, ...] = ()
     identifiability: Identifiability = field(default_factory=Identifiability)
@@ -258,6 +304,7 @@ class ModelInfo:
                 start_free=bool(fz.get("start_free")),
             ),
             frozen_share=finite_float(info.get("frozen_share")),
+            decoupled_wall=DecoupledWall.from_dict(info.get("decoupled_wall")),
             unidentified=tuple(
                 (info.get("practical_identifiability") or {}).get("unidentified") or ()
             ),

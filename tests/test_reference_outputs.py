@@ -31,18 +31,29 @@ file):
   own would cost a second calibration and ten years of weather).
 
 Floats agree to 12 significant digits: the same arithmetic gives the same bits, and the
-margin only admits a numpy or BLAS that sums in another order (the MAP search and the
-sampler may amplify such a difference: after a dependency upgrade the tiny run's
-numbers can move while every config's hold). Configs that read
-``../shared/data`` skip, saying so, when it is not beside the checkout.
+margin only admits a numpy or BLAS that sums in another order. The configs' numbers
+(one likelihood evaluation each) hold on every machine. The tiny run and the
+projections from it do not: the MAP search and the sampler amplify a last-bit rounding
+difference into other draws, and the last bits depend on the *numerical platform*:
+the processor's vector instructions that numpy dispatches to (its exp and log differ by
+an ulp between AVX2 and AVX-512 code), the BLAS kernel, the processor numba compiles
+for, and the numerical libraries' versions (:func:`platform_fingerprint`). Their
+values are therefore recorded per platform (``platforms`` in the record): on a platform
+with a record they must agree to 12 digits; on one without, the test checks what no
+rounding moves (every key, group, parameter name and list length, the value types) and
+says that the values were not compared. Configs that read ``../shared/data`` skip,
+saying so, when it is not beside the checkout.
 
 Re-recording: ``PYTHONPATH=src python tests/test_reference_outputs.py`` rewrites
-``reference_outputs.json`` from the current tree. That is legitimate only in a commit
+``reference_outputs.json`` from the current tree, keeping the tiny run's values for this
+platform only (the other platforms' would be stale). That is legitimate only in a commit
 that means to change a result (a fix in the physics or the data reading, a new default,
-a shipped config edited, a new dependency version that sums differently) and that says
-in its message which numbers moved and why. A refactoring re-records nothing: if this
-test fails after one, the refactoring changed behaviour. The values were first recorded
-on commit 212f59b.
+a shipped config edited) and that says in its message which numbers moved and why.
+``--add-platform`` records this platform's tiny run beside the others and leaves every
+other entry as it is: for a machine or a dependency version the record has not seen,
+after checking that the configs' numbers hold (they are the platform-free guard). A
+refactoring re-records nothing: if this test fails after one, the refactoring changed
+behaviour. The values were first recorded on commit 212f59b.
 
 Cost: the nine configs' preparations and two likelihood evaluations each, the tiny run
 and three projections: 21 s of CPU for the module alone (imports and numba compilation
@@ -60,6 +71,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+
+from _platform import NUMERICAL_LIBRARIES, platform_fingerprint, platform_info
 
 ROOT = Path(__file__).resolve().parents[1]
 CONFIGS = ROOT / "configs"
@@ -256,6 +269,46 @@ def _differences(got, ref, where: str = "") -> list[str]:
     return [] if got == ref else [f"{where}: {got!r}, recorded {ref!r}"]
 
 
+def _shape_differences(got, ref, where: str = "") -> list[str]:
+    """Where ``got`` differs from ``ref`` in what no rounding moves: the keys at every
+    depth (groups, variables, parameters, summary fields) and the lists' lengths. The
+    values are not compared, strings included: a parameter on a prior bound, or not, is
+    as much the chain's as its median."""
+    if isinstance(ref, dict) and isinstance(got, dict):
+        if sorted(got) != sorted(ref):
+            return [f"{where}: keys {sorted(set(got) ^ set(ref))} differ"]
+        return [d for k in ref for d in _shape_differences(got[k], ref[k], f"{where}/{k}")]
+    if isinstance(ref, list) and isinstance(got, list | tuple):
+        if len(got) != len(ref):
+            return [f"{where}: {len(got)} items, recorded {len(ref)}"]
+        pairs = enumerate(zip(got, ref, strict=True))
+        return [d for i, (g, r) in pairs for d in _shape_differences(g, r, f"{where}[{i}]")]
+    return []
+
+
+def _assert_platform_recorded(got, key: str, capsys) -> None:
+    """``got`` against this platform's record of ``key``; on a platform without one,
+    against the shape of any platform's record (and say so)."""
+    platforms = _recorded().get("platforms", {})
+    info = platform_info()
+    mine = platforms.get(platform_fingerprint(info))
+    if mine is not None:
+        diffs = _differences(got, mine[key], key)
+        assert not diffs, "changed from the recorded values:\n  " + "\n  ".join(diffs[:20])
+        return
+    assert platforms, f"{RECORD.name} holds no platform's tiny run"
+    ref = next(iter(platforms.values()))[key]
+    diffs = _shape_differences(got, ref, key)
+    assert not diffs, "changed from the recorded shape:\n  " + "\n  ".join(diffs[:20])
+    with capsys.disabled():
+        print(
+            f"\n{key}: no record for this numerical platform ({platform_fingerprint(info)}: "
+            f"{info['machine']}, {info['numba_cpu']}, SIMD {'/'.join(info['simd'])}, "
+            f"{'; '.join(info['blas'])}); its shape was checked, not its values "
+            f"(record them: python tests/test_reference_outputs.py --add-platform)"
+        )
+
+
 @cache
 def _recorded() -> dict:
     return json.loads(RECORD.read_text(encoding="utf-8"))
@@ -279,30 +332,61 @@ def tiny_run(tmp_path_factory) -> Path:
     return _tiny_run(tmp_path_factory.mktemp("reference") / "run")
 
 
-def test_tiny_run_gives_the_recorded_outputs(tiny_run):
-    _assert_recorded(run_values(tiny_run), "tiny_run")
+def test_tiny_run_gives_the_recorded_outputs(tiny_run, capsys):
+    _assert_platform_recorded(run_values(tiny_run), "tiny_run", capsys)
 
 
 @pytest.mark.parametrize("name", PROJECTIONS)
-def test_projection_config_gives_the_recorded_outputs(tiny_run, name):
+def test_projection_config_gives_the_recorded_outputs(tiny_run, name, capsys):
     if _needs_shared_data(name) and not SHARED_DATA.is_dir():
         pytest.skip(f"configs/{name}.yaml reads ../shared/data, not found at {SHARED_DATA}")
-    _assert_recorded(projection_values(tiny_run, name), name)
+    _assert_platform_recorded(projection_values(tiny_run, name), name, capsys)
 
 
-def _record() -> None:
-    """Rewrite :data:`RECORD` from the current tree (see the module docstring)."""
+def test_the_shape_check_sees_a_missing_key_and_a_shorter_list():
+    """The check that stands on a platform without a record can fail: it names a key
+    that went missing and a list that changed length, and lets values move."""
+    ref = {"posterior": {"a": 1.0, "b": [1.0, 2.0]}, "summary": {"model": "thermal_1c"}}
+    assert _shape_differences(ref, ref) == []
+    assert _shape_differences({**ref, "posterior": {"a": 3.5, "b": [9.0, 8.0]}}, ref) == []
+    got = {"posterior": {"a": 1.0, "b": [1.0]}, "summary": {}}
+    diffs = _shape_differences(got, ref)
+    assert any("b: 1 items, recorded 2" in d for d in diffs), diffs
+    assert any("keys ['model'] differ" in d for d in diffs), diffs
+
+
+def test_the_platform_fingerprint_names_what_changes_the_last_bits():
+    info = platform_info()
+    assert set(NUMERICAL_LIBRARIES) <= set(info["versions"])
+    assert info["machine"] and info["numba_cpu"]
+    assert platform_fingerprint(info) == platform_fingerprint(dict(info))
+    other = {**info, "versions": {**info["versions"], "numpy": "0.0.0"}}
+    assert platform_fingerprint(other) != platform_fingerprint(info)
+
+
+def _record(add_platform: bool = False) -> None:
+    """Rewrite :data:`RECORD` from the current tree (see the module docstring); with
+    ``add_platform`` only this platform's tiny-run entry is (re)written."""
     import tempfile
 
-    values = {key: calibration_values(key) for key in CALIBRATIONS}
+    values = dict(_recorded()) if add_platform else {}
+    if not add_platform:
+        values.update({key: calibration_values(key) for key in CALIBRATIONS})
+    info = platform_info()
+    entry = {"platform": info}
     with tempfile.TemporaryDirectory() as tmp:
         run_dir = _tiny_run(Path(tmp) / "run")
-        values["tiny_run"] = run_values(run_dir)
-        values.update({name: projection_values(run_dir, name) for name in PROJECTIONS})
+        entry["tiny_run"] = run_values(run_dir)
+        entry.update({name: projection_values(run_dir, name) for name in PROJECTIONS})
+    platforms = dict(values.get("platforms", {})) if add_platform else {}
+    platforms[platform_fingerprint(info)] = entry
+    values["platforms"] = platforms
+    for key in ("tiny_run", *PROJECTIONS):  # the record's layout before platforms
+        values.pop(key, None)
     RECORD.write_text(json.dumps(values, indent=1, ensure_ascii=False) + "\n", encoding="utf-8")
-    print(f"recorded {len(values)} entries in {RECORD}")
+    print(f"recorded {len(values)} entries ({len(platforms)} platforms) in {RECORD}")
 
 
 if __name__ == "__main__":
     sys.path.insert(0, str(Path(__file__).parent))  # test_report's TINY
-    _record()
+    _record(add_platform="--add-platform" in sys.argv[1:])

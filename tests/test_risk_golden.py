@@ -141,9 +141,9 @@ EXPECTED = {
 #: The projection's digests by numerical platform (``tests/_platform.py``): a year of
 #: simulation through numba kernels compiled for the host processor and scipy's matrix
 #: exponential is bit-identical only on one platform. ``unrecorded``: the digests of
-#: the machines of the earlier sessions, whose platform was not fingerprinted. Print
-#: this platform's key with ``python -c "import sys; sys.path.insert(0, 'tests'); import _platform as p;
-#: print(p.platform_fingerprint(p.platform_info()))"``.
+#: the machines of the earlier sessions, whose platform was not fingerprinted. This
+#: platform's key: ``_platform.platform_fingerprint(_platform.platform_info())``, run
+#: from ``tests/``.
 EXPECTED_PROJECTION = {
     "unrecorded": {"projection_0": "f07748c983cabdbbac6b", "projection_1": "f19ec1208de61ae04ab1"},
     "d752d49a426a": {

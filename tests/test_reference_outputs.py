@@ -251,17 +251,21 @@ def _tiny_run(out: Path) -> Path:
 
 
 # ---------------------------------------------------------------------- comparison
-def _differences(got, ref, where: str = "") -> list[str]:
-    """Where ``got`` differs from ``ref`` (floats to :data:`RTOL`, the rest exactly)."""
+def _differences(got, ref, where: str = "", values: bool = True) -> list[str]:
+    """Where ``got`` differs from ``ref``: the keys at every depth and the lists'
+    lengths, and with ``values`` the values too (floats to :data:`RTOL`, the rest
+    exactly)."""
     if isinstance(ref, dict) and isinstance(got, dict):
         if sorted(got) != sorted(ref):
             return [f"{where}: keys {sorted(set(got) ^ set(ref))} differ"]
-        return [d for k in ref for d in _differences(got[k], ref[k], f"{where}/{k}")]
+        return [d for k in ref for d in _differences(got[k], ref[k], f"{where}/{k}", values)]
     if isinstance(ref, list) and isinstance(got, list | tuple):
         if len(got) != len(ref):
             return [f"{where}: {len(got)} items, recorded {len(ref)}"]
         pairs = enumerate(zip(got, ref, strict=True))
-        return [d for i, (g, r) in pairs for d in _differences(g, r, f"{where}[{i}]")]
+        return [d for i, (g, r) in pairs for d in _differences(g, r, f"{where}[{i}]", values)]
+    if not values:
+        return []
     if isinstance(ref, float) and isinstance(got, float | int):
         if got == ref or abs(got - ref) <= RTOL * max(abs(ref), abs(got)):
             return []
@@ -274,16 +278,7 @@ def _shape_differences(got, ref, where: str = "") -> list[str]:
     depth (groups, variables, parameters, summary fields) and the lists' lengths. The
     values are not compared, strings included: a parameter on a prior bound, or not, is
     as much the chain's as its median."""
-    if isinstance(ref, dict) and isinstance(got, dict):
-        if sorted(got) != sorted(ref):
-            return [f"{where}: keys {sorted(set(got) ^ set(ref))} differ"]
-        return [d for k in ref for d in _shape_differences(got[k], ref[k], f"{where}/{k}")]
-    if isinstance(ref, list) and isinstance(got, list | tuple):
-        if len(got) != len(ref):
-            return [f"{where}: {len(got)} items, recorded {len(ref)}"]
-        pairs = enumerate(zip(got, ref, strict=True))
-        return [d for i, (g, r) in pairs for d in _shape_differences(g, r, f"{where}[{i}]")]
-    return []
+    return _differences(got, ref, where, values=False)
 
 
 def _assert_platform_recorded(got, key: str, capsys) -> None:

@@ -47,7 +47,7 @@ import numba
 import numpy as np
 
 from heritage_bayes.inference.coupled_kalman import coupled_kalman
-from heritage_bayes.inference.likelihoods import NoiseModel, register_noise
+from heritage_bayes.inference.likelihoods import NoiseModel, ResidualView, register_noise
 
 __all__ = ["KalmanNoise", "modal_process_noise"]
 
@@ -200,6 +200,24 @@ class KalmanNoise(NoiseModel):
         output's unit."""
         return (
             f"{potential}/√h" if kind == "diffusion" else super().unit(kind, output_unit, potential)
+        )
+
+    def residual_view(self, resid, median, one_step=None):
+        """What the filter leaves white: its one-step-ahead innovations ``one_step``
+        (measured minus the one-step prediction from the measurements before, NaN where
+        missing), not the free-run residuals ``resid``, which carry the process noise
+        accumulated over the slowest time constant. Without ``one_step`` (a run written
+        before it was kept) the residuals themselves, as for a model without an AR part.
+        """
+        if one_step is None:
+            return super().residual_view(resid, median)
+        return ResidualView(
+            None,
+            np.asarray(one_step, dtype=float),
+            1.0,
+            "a state-space model's free-run residuals carry its accumulated process "
+            "noise; its one-step innovations should be white",
+            "the filter's one-step-ahead innovations",
         )
 
     def free_run_reason(self, o, name, noise, params):

@@ -227,7 +227,14 @@ def _residual_entry(s, fit: dict) -> dict | None:
     span = slice(idx[0], idx[-1] + 1)
     resid = np.where(cal[span], fit["resid"][span], np.nan)
     nm = find_noise_model(noise) or NoiseModel()
-    view = nm.residual_view(resid, lambda kind, absent=None: _median(s, f"{m}.{kind}_{o}", absent))
+
+    def median(kind, absent=None):
+        return _median(s, f"{m}.{kind}_{o}", absent)
+
+    if nm.statespace and (one := fit.get("resid_1step")) is not None:
+        view = nm.residual_view(resid, median, np.where(cal[span], one[span], np.nan))
+    else:
+        view = nm.residual_view(resid, median)
     check = _residual_check(resid, view, dt_hours)
     fig = fig_residuals(
         fit["times"][span],

@@ -128,6 +128,8 @@ def fit_context(rd: RunData, outputs: list[dict]) -> list[dict]:
                 )
                 + band_note,
                 "resid": (y - med),
+                # a state-space noise model's check is on its one-step innovations
+                "resid_1step": _one_step_residual(rd, o, pp, y),
                 "measured": y,
                 "codes": codes,
                 "times": times_pp,
@@ -137,6 +139,14 @@ def fit_context(rd: RunData, outputs: list[dict]) -> list[dict]:
         if f"{o['pp']}_1step" in pp:
             items.append(_one_step_item(rd, o, pp, times_pp, y, codes, gaps, what))
     return items
+
+
+def _one_step_residual(rd: RunData, o: dict, pp, y: np.ndarray) -> np.ndarray | None:
+    """Measured minus the median one-step-ahead prediction of a state-space noise model
+    (``noise: kalman``), None for a run without one."""
+    if f"{o['pp']}_1step" not in pp:
+        return None
+    return y - predictive_quantiles(rd.idata, f"{o['pp']}_1step", [0.5])[0]
 
 
 def _one_step_item(rd: RunData, o: dict, pp, times, y, codes, gaps, what: str) -> dict:

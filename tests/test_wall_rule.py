@@ -171,3 +171,16 @@ def test_the_run_config_records_the_fixed_link():
     assert out.hygric.priors["Gw"].fixed == 1e-12 and out.hygric.noise == "kalman"
     assert "Gw" not in cfg.hygric.priors
     assert out.resolved()["hygric"]["priors"]["Gw"] == {"fixed": 1e-12}
+
+
+def test_the_model_page_names_the_cellars_default():
+    """``hbayes models NAME`` says that a sink at a temperature changes the default noise
+    model of the models it does (and only of those)."""
+    from heritage_bayes.models import describe_model
+
+    for name in ("hygric_2c_fixed", "hygric_2c_sorption"):
+        text = describe_model(name)
+        assert f"the default is 'kalman' at likelihood temperature {2:g}" in text
+        assert "the default is 'kalman'" not in describe_model(name, "kalman")
+    assert "the default is 'kalman'" not in describe_model("hygric_2c")
+    assert FILTERED_SINK_LIKELIHOOD_TEMPERATURE == 2.0

@@ -310,6 +310,11 @@ def describe_model(name: str, noise: str = DEFAULT_NOISE) -> str:
     ValueError
         Unknown model or noise name (the message lists the available ones).
     """
+    from heritage_bayes.config.models import (
+        FILTERED_SINK_LIKELIHOOD_TEMPERATURE,
+        FILTERED_SINK_MODELS,
+        FILTERED_SINK_NOISE,
+    )
     from heritage_bayes.inference.likelihoods import get_noise_model
     from heritage_bayes.inference.parameters import parameters_for
 
@@ -349,6 +354,13 @@ def describe_model(name: str, noise: str = DEFAULT_NOISE) -> str:
     nm = get_noise_model(noise)
     ps = parameters_for(m, nm)
     lines += ["", f"Parameters (default priors; noise model {noise!r}):"]
+    if name in FILTERED_SINK_MODELS and noise == DEFAULT_NOISE:
+        lines.append(
+            f"  (with sink: temperature and a linear isotherm the default is "
+            f"{FILTERED_SINK_NOISE!r} at likelihood temperature "
+            f"{FILTERED_SINK_LIKELIHOOD_TEMPERATURE:g}: hbayes models {name} --noise "
+            f"{FILTERED_SINK_NOISE})"
+        )
     for p in ps.parameters:
         lines.append(
             f"  {p.name:<9s} {'[' + p.unit + ']':<13s} {p.kind:<11s} "

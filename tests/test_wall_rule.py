@@ -184,3 +184,15 @@ def test_the_model_page_names_the_cellars_default():
         assert "the default is 'kalman'" not in describe_model(name, "kalman")
     assert "the default is 'kalman'" not in describe_model("hygric_2c")
     assert FILTERED_SINK_LIKELIHOOD_TEMPERATURE == 2.0
+
+
+def test_priors_on_the_ar1_noise_keep_it_for_a_sink():
+    """A config that sets a prior on ``phi_Pi`` or ``sigma_meas_Pi`` (a logger's known
+    resolution, say) has chosen the AR(1) noise, which the filter would refuse: the
+    cellar's default does not override it."""
+    sink = {"sink": "temperature"}
+    for name in ("phi_Pi", "sigma_meas_Pi"):
+        sec = ModelSection(model="hygric_2c_fixed", options=sink, priors={name: {"fixed": 0.5}})
+        assert sec.noise == "ar1_white"
+    sec = ModelSection(model="hygric_2c_fixed", options=sink, priors={"Gw": {"fixed": 1e-12}})
+    assert sec.noise == "kalman"

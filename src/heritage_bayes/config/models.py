@@ -120,8 +120,8 @@ class ModelSection(_Strict):
         DEFAULT_NOISE,
         unit=None,
         description="noise model (default: kalman for hygric_2c_fixed and "
-        "hygric_2c_sorption with sink: temperature, a linear isotherm and no humidistat, "
-        "ar1_white otherwise)",
+        "hygric_2c_sorption with sink: temperature, a linear isotherm, no humidistat and "
+        "no prior on phi_<out> or sigma_meas_<out>, ar1_white otherwise)",
     )
     initial_state: Literal["estimate", "steady"] | dict[str, float] | None = key(
         None,
@@ -180,7 +180,10 @@ class ModelSection(_Strict):
 
     @model_validator(mode="after")
     def _default_noise(self):
-        if "noise" not in self.model_fields_set and self.filtered_sink:
+        # priors on the AR(1) noise's own parameters (phi_<out>, sigma_meas_<out>) are
+        # that noise model chosen: the filter has neither, and would refuse them
+        ar1_priors = any(k.startswith(("phi_", "sigma_meas_")) for k in self.priors)
+        if "noise" not in self.model_fields_set and self.filtered_sink and not ar1_priors:
             self.noise = FILTERED_SINK_NOISE
             # still a default, not the user's choice (a run's config.yaml, a full dump,
             # states it, and reading that back gives the same noise model)

@@ -456,6 +456,51 @@ def idle_link_fixed(lp, mp, priors, fit):
     return lp, mp, wall
 
 
+def truth_ranks(dq: dict, dq_true: dict) -> dict:
+    """Each true quantity against its posterior draws ``dq[name]``: inside the central
+    50 % and 90 % intervals, its rank (the share of draws below it), the draws' median
+    and sd. Quantities without draws, with a non-finite draw or with no spread are left
+    out."""
+    ranks = {}
+    for k, t in dq_true.items():
+        if k not in dq:
+            continue
+        d = np.asarray(dq[k], dtype=float).reshape(-1)
+        if not np.all(np.isfinite(d)) or np.ptp(d) == 0:
+            continue
+        lo90, lo50, hi50, hi90 = np.quantile(d, [0.05, 0.25, 0.75, 0.95])
+        ranks[k] = {
+            "in50": bool(lo50 <= t <= hi50),
+            "in90": bool(lo90 <= t <= hi90),
+            "rank": float(np.mean(d < t)),
+            "median": float(np.median(d)),
+            "sd": float(np.std(d)),
+        }
+    return ranks
+
+
+def posterior_summary(names, theta: np.ndarray, dq: dict) -> dict:
+    """Every parameter's posterior median and sd (the noise's too) from the draws
+    ``theta`` (draws, parameters), as ``posterior``, and the posterior correlation of the
+    solar gain ``gain_Ti_I_S`` with each parameter, ``tau_1_h`` and ``gain_Ti_Te``
+    (where the model has a solar gain), as ``corr_gain_Ti_I_S``."""
+    post = {
+        n: {"median": float(np.median(theta[:, j])), "sd": float(np.std(theta[:, j]))}
+        for j, n in enumerate(names)
+    }
+    corr = {}
+    if "gain_Ti_I_S" in dq:
+        gs = np.asarray(dq["gain_Ti_I_S"], float).reshape(-1)
+        others = {n: theta[:, j] for j, n in enumerate(names)}
+        others.update({k: np.asarray(dq[k], float).reshape(-1) for k in ("tau_1_h", "gain_Ti_Te")})
+        corr = {
+            n: float(np.corrcoef(gs, x)[0, 1])
+            for n, x in others.items()
+            if np.ptp(x) > 0 and np.ptp(gs) > 0
+        }
+    return {"posterior": post, "corr_gain_Ti_I_S": corr}
+
+
 def fit_and_rank(
     model,
     U,
@@ -543,43 +588,9 @@ def fit_and_rank(
         dq = derived_quantities(model, theta[:, : lp.n_model])
         if extra is not None:
             dq = {**dq, **extra(dq, theta)}
-        ranks = {}
-        for k, t in dq_true.items():
-            if k not in dq:
-                continue
-            d = np.asarray(dq[k], dtype=float).reshape(-1)
-            if not np.all(np.isfinite(d)) or np.ptp(d) == 0:
-                continue
-            lo90, lo50, hi50, hi90 = np.quantile(d, [0.05, 0.25, 0.75, 0.95])
-            ranks[k] = {
-                "in50": bool(lo50 <= t <= hi50),
-                "in90": bool(lo90 <= t <= hi90),
-                "rank": float(np.mean(d < t)),
-                "median": float(np.median(d)),
-                "sd": float(np.std(d)),
-            }
-        # every parameter's posterior median and sd (the noise's too), and the posterior
-        # correlation of the solar gain with each parameter (where there is one)
-        post = {
-            n: {"median": float(np.median(theta[:, j])), "sd": float(np.std(theta[:, j]))}
-            for j, n in enumerate(ps.names)
-        }
-        corr = {}
-        if "gain_Ti_I_S" in dq:
-            gs = np.asarray(dq["gain_Ti_I_S"], float).reshape(-1)
-            others = {n: theta[:, j] for j, n in enumerate(ps.names)}
-            others.update(
-                {k: np.asarray(dq[k], float).reshape(-1) for k in ("tau_1_h", "gain_Ti_Te")}
-            )
-            corr = {
-                n: float(np.corrcoef(gs, x)[0, 1])
-                for n, x in others.items()
-                if np.ptp(x) > 0 and np.ptp(gs) > 0
-            }
         out[variant] = {
-            "ranks": ranks,
-            "posterior": post,
-            "corr_gain_Ti_I_S": corr,
+            "ranks": truth_ranks(dq, dq_true),
+            **posterior_summary(ps.names, theta, dq),
             "converged": bool(chain.converged),
             "map": dict(zip(ps.names, map(float, mp.theta), strict=True)),
             "steps": int(chain.steps),

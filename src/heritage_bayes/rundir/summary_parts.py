@@ -8,7 +8,7 @@ key a version lacks reads as absent); see that module for the whole.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from types import MappingProxyType
 from typing import Any
 
@@ -130,7 +130,7 @@ class DecoupledWall:
 
     def to_dict(self) -> dict:
         """``summary.json``'s ``models.<section>.decoupled_wall``."""
-        return {f: getattr(self, f) for f in self.__dataclass_fields__}
+        return asdict(self)
 
     @classmethod
     def from_dict(cls, d: dict | None) -> DecoupledWall | None:

@@ -104,7 +104,7 @@ def test_a_chain_out_of_its_share_continues_with_the_time_left(squeezed_run):
     assert "hygric_continuation_seconds" not in s["timings"]
     # the console says what happened, and warns of no time out
     assert "[thermal] its share of the time budget ran out after 100 steps" in err
-    assert "[thermal] the chain continued from 100 steps with the " in err
+    assert "[thermal] the chain continues from 100 steps with the " in err
     assert "the hygric section left: reached the step cap sampler.max_steps at 400" in err
     assert "ran out after" not in err.replace("share of the time budget ran out after", "")
     # the report says it too

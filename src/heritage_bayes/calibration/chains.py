@@ -108,9 +108,13 @@ def run_chain(s, say, seconds: float | None, *, resume: bool, label: str = ""):
 
 
 def _need(cfg, chain) -> str:
-    """``τmax 315, about 15 750 steps needed`` of a chain's last τ estimate."""
+    """``τmax 315, about 15 750 steps needed`` of a chain's last τ estimate (or, for a
+    chain already that long, that τ or R-hat and ESS had not settled)."""
     tmax = float(np.nanmax(chain.tau))
-    return f"τmax {tmax:.0f}, about {cfg.sampler.tau_factor * tmax:.0f} steps needed"
+    need = cfg.sampler.tau_factor * tmax
+    if chain.steps >= need:
+        return f"τmax {tmax:.0f}: long enough, but τ not yet stable or R-hat/ESS not yet met"
+    return f"τmax {tmax:.0f}, about {need:.0f} steps needed"
 
 
 def say_share_spent(cfg, s, say) -> None:
@@ -159,7 +163,7 @@ def _continue(cfg, sections: list, s, seconds: float, say) -> None:
     s.continued = {"from_steps": int(first.steps), "seconds_given": float(seconds)}
     s.continued["left_by"] = left_by
     words = Continuation.from_dict(s.continued).words
-    say.say(f"[{s.name}] the chain {words}")
+    say.say(f"[{s.name}] the chain {words.replace('continued', 'continues', 1)}")
     steps, resumed_from, wall, cpu = (
         first.steps,
         first.resumed_from,

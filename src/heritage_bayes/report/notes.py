@@ -133,7 +133,8 @@ def _bound_notes(s) -> list[dict]:
 
 def _model_notes(m: str, i) -> list[dict]:
     """The notes on one model: its MAP on a bound, a frozen node, parameters the data
-    leave to their priors, several MAP modes, a chain out of time."""
+    leave to their priors, several MAP modes, a chain out of time or continued with the
+    time the other models left."""
     out = []
     on_bound = [f"{quantity_name(n, domain=m)} ({side})" for n, side in i.map_at_bound]
     if on_bound:

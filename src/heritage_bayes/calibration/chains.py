@@ -13,7 +13,11 @@ budget is spent. The continuation is the same chain: it resumes from the section
 checkpoint (:func:`heritage_bayes.inference.sampler.run_sampler` with ``resume=True``:
 the same random stream and convergence checks at the same step counts), so it gives
 the steps one uninterrupted chain given more time would have given; a run without
-budget pressure never continues anything and is unchanged.
+budget pressure never continues anything and is unchanged. The time a ``model: auto``
+screen took is spent before any section samples (the shares are of what it left); the
+model-order ladder (``ladder: true``) runs after the continuation and gets what it
+leaves. ``--resume`` of a run interrupted during a continuation resumes that chain in
+its section's own turn, from the steps its checkpoint holds.
 
 What the run records of it: ``summary.json``'s ``models.<section>.chain.continued``
 (the steps the chain had, the seconds it was given and the sections that left them;

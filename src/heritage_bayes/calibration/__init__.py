@@ -14,6 +14,9 @@ the run directory's format in :mod:`heritage_bayes.run` and :mod:`heritage_bayes
   model ladder and the one selection rule ``hbayes compare`` shares;
 - :mod:`~heritage_bayes.calibration.ladder` — one rung of the model-order ladder (its
   log-posterior and MAP row);
+- :mod:`~heritage_bayes.calibration.chains` — the sections' chains in one time budget:
+  the sampler's call, a chain out of its share continued with the time later sections
+  left, the draws the sections share;
 - :mod:`~heritage_bayes.calibration.findings` — what the MAP shows before sampling;
 - :mod:`~heritage_bayes.calibration.outputs` and
   :mod:`~heritage_bayes.calibration.runinfo` — the run's InferenceData and the summary

@@ -22,6 +22,13 @@ import numpy as np
 from heritage_bayes._memory import release_memory
 from heritage_bayes._progress import Progress as _Progress
 from heritage_bayes._version import __version__
+from heritage_bayes.calibration.chains import (
+    common_draws,
+    continue_chains,
+    run_chain,
+    sampler_args,
+    say_share_spent,
+)
 from heritage_bayes.calibration.convergence import unconverged_reasons
 from heritage_bayes.calibration.findings import LADDERS, say_findings
 from heritage_bayes.calibration.ladder import (  # structural_at_map: re-exported
@@ -31,7 +38,7 @@ from heritage_bayes.calibration.ladder import (  # structural_at_map: re-exporte
     structural_at_map,
 )
 from heritage_bayes.calibration.wall import config_with_fixed_walls, fix_section_wall
-from heritage_bayes.config import MAX_SEED, CalibrationConfig, chain_tag, config_hash
+from heritage_bayes.config import MAX_SEED, CalibrationConfig, config_hash
 from heritage_bayes.convert import format_timedelta
 from heritage_bayes.errors import InputError
 from heritage_bayes.inference.posterior import LogPosterior
@@ -137,6 +144,8 @@ class _Section:
     lp: np.ndarray | None = None
     timings: dict = field(default_factory=dict)
     deadline: float | None = None  # time.perf_counter() end of the run's time budget
+    sampler_args: dict = field(default_factory=dict)  # calibration.chains.sampler_args
+    continued: dict | None = None  # the chain continued (calibration.chains)
 
 
 def identifiability_at_map(model: RCModel, logpost: LogPosterior, map_result, dt: float):
@@ -324,9 +333,10 @@ def _calibrate_into(
             out=out,
             resume=resume,
         )
+    continue_chains(cfg, sections, end, say)  # a chain out of time: what later ones left
     if (fixed := config_with_fixed_walls(cfg, sections)) is not None:  # readers rebuild
         atomic_write_text(out / "config.yaml", config_yaml(cfg := fixed))  # chain's priors
-    _common_draws(cfg, sections)
+    common_draws(cfg, sections)
     ladder = {k: v.rows for k, v in screens.items()}  # model: auto: the screen is the ladder
     if cfg.ladder:
         for i, s in enumerate(sections):
@@ -397,13 +407,7 @@ def _sample_section(
     sampler's chain (checkpointed in ``out``), all stored on ``s`` with their timings.
     Section ``i`` of ``n_sections`` gets an equal share of the time left before ``end``
     and the seed ``cfg.seed + 101 i``."""
-    from heritage_bayes.calibration.outputs import CONVERGENCE
-    from heritage_bayes.inference.coordinates import sampling_coordinates
-    from heritage_bayes.inference.moves import unidentified_block
     from heritage_bayes.inference.optimize import seconds_left, share_deadline
-    from heritage_bayes.inference.sampler import run_sampler
-    from heritage_bayes.inference.scale import scale_line
-    from heritage_bayes.inference.start import start_hessian
 
     t0, deadline = time.perf_counter(), share_deadline(end, n_sections - i)
     if known is not None and known.x.size == s.logpost.ndim:
@@ -426,76 +430,14 @@ def _sample_section(
     s.timings["identifiability_seconds"] = time.perf_counter() - t0
     say_findings(say, s, getattr(cfg, s.name).priors)
     t0 = time.perf_counter()
-    update = say.sampler(s.name, cfg.sampler.max_steps)
-    coords = sampling_coordinates(s.logpost, cfg.sampler.coordinates)
-    if cfg.sampler.coordinates == "auto":  # the exact scale direction on its own axis
-        coords = scale_line(s.logpost, coords, s.map.x)
-    hessian = start_hessian(s.logpost, s.laplace, cfg.sampler.start)
-    block = unidentified_block(s.logpost, s.laplace)
-    s.block_move = {
-        "parameters": [s.logpost.params.free_names[k] for k in block],
-        "weight": cfg.sampler.block_weight_for(s.model.n_states) if block else 0.0,
-    }
-    try:
-        s.chain = run_sampler(
-            s.logpost,
-            s.map.x,
-            seed=cfg.seed + 101 * i,
-            nwalkers=nwalkers,
-            moves=cfg.sampler.moves,
-            block=block,
-            block_weight=s.block_move["weight"],
-            max_steps=cfg.sampler.max_steps,
-            max_seconds=seconds_left(deadline),
-            bounds=s.logpost.params.bounds,
-            check_every=cfg.sampler.check_every,
-            tau_factor=cfg.sampler.tau_factor,
-            tau_rtol=cfg.sampler.tau_rtol,
-            tau_discard=cfg.sampler.tau_discard,
-            init_ball=cfg.sampler.init_ball,
-            checkpoint=out / f"chain_{s.name}.h5",
-            tag=f"{chain_tag(cfg)}:{s.logpost.data_hash()}:{s.name}",
-            resume=resume,
-            progress=update,
-            notice=say.warn,
-            max_rhat=CONVERGENCE["max_rhat"],
-            min_ess=CONVERGENCE["min_ess_bulk"],
-            max_draws=cfg.sampler.max_draws,
-            coordinates=coords,
-            compact=True,
-            start_hessian=hessian,
-            max_rows=cfg.sampler.max_stored_steps,
-        )
-    finally:
-        say.close()
+    s.sampler_args = sampler_args(cfg, s, i, nwalkers, out)
+    s.chain = run_chain(s, say, seconds_left(deadline), resume=resume)
     s.timings["sampling_seconds"] = time.perf_counter() - t0
     s.timings["sampling_cpu_seconds"] = s.chain.cpu_seconds
     verdict = "converged" if s.chain.converged else "NOT converged"
-    if (budget := cfg.sampler.max_time) is not None and s.chain.stopped_by == "max_seconds":
-        say.warn(
-            f"[{s.name}] the time budget sampler.max_time = {format_timedelta(budget)} "
-            f"ran out after {s.chain.steps} steps (τmax {np.nanmax(s.chain.tau):.0f}, "
-            f"about {cfg.sampler.tau_factor * np.nanmax(s.chain.tau):.0f} steps needed): "
-            "raise it, or run again with --resume to continue the chain"
-        )
+    if s.chain.stopped_by == "max_seconds" and i < n_sections - 1:
+        say_share_spent(cfg, s, say)  # continue_chains: with the time later ones leave
     say.say(f"[{s.name}] {s.chain.steps} steps, τmax {np.nanmax(s.chain.tau):.0f}: {verdict}")
-
-
-def _common_draws(cfg: CalibrationConfig, sections: list[_Section]) -> None:
-    """The draws each sampler checked (R-hat, ESS) give the summaries; the posterior
-    group holds a common number per walker, so draw i of one model pairs with draw i of
-    the other (combined RH). Sets ``X``, ``lp``, ``theta`` (common) and ``X_kept``,
-    ``theta_kept`` (all checked draws) on each section."""
-    for s in sections:
-        s.X, s.lp = s.chain.draws(cfg.sampler.max_draws)
-        s.X_kept = s.X
-        s.theta_kept = s.logpost.params.values(s.X.reshape(-1, s.X.shape[-1])).reshape(
-            *s.X.shape[:2], -1
-        )
-    n_draw = min(s.X.shape[1] for s in sections)
-    for s in sections:
-        s.X, s.lp = s.X[:, -n_draw:], s.lp[:, -n_draw:]
-        s.theta = s.theta_kept[:, -n_draw:]
 
 
 def _section_map(cfg: CalibrationConfig, s: _Section, i: int, deadline, t0, n: int):

@@ -20,6 +20,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from heritage_bayes.format import quantity_name
+from heritage_bayes.rundir.summary_parts import Continuation
 
 __all__ = ["EXIT_UNCONVERGED", "unconverged_reasons"]
 
@@ -70,8 +71,11 @@ def unconverged_reasons(summary: Mapping[str, Any]) -> list[str]:
     -------
     list of str
         E.g. ``"hygric: the time budget `sampler.max_time` ran out after 68 000 steps;
-        τmax 1311 asks for about 65 550 steps (50 τ) with a stable τ"``, ``"max R-hat
-        1.034 (hygric model: moisture capacity of the buffering surfaces Cw) > 1.01"``.
+        τmax 1311 asks for about 65 550 steps (50 τ) with a stable τ"`` (a chain
+        continued with the time later sections left says so: ``"after 15 600 steps
+        (continued from 15 000 steps with the 6 min the hygric section left)"``),
+        ``"max R-hat 1.034 (hygric model: moisture capacity of the buffering surfaces
+        Cw) > 1.01"``.
     """
     if summary.get("converged") is True:
         return []
@@ -91,7 +95,9 @@ def unconverged_reasons(summary: Mapping[str, Any]) -> list[str]:
             if math.isfinite(tau)
             else ""
         )
-        reasons.append(f"{section}: {why} after {_grouped(steps)} steps{need}")
+        more = Continuation.from_dict(chain.get("continued"))
+        more = f" ({more.words})" if more is not None else ""
+        reasons.append(f"{section}: {why} after {_grouped(steps)} steps{more}{need}")
     params = summary.get("parameters") or {}
     max_rhat, min_ess = _num(criteria.get("max_rhat")), _num(criteria.get("min_ess_bulk"))
     rhat = {k: _num(v.get("r_hat")) for k, v in params.items() if "r_hat" in v}

@@ -456,8 +456,10 @@ def _section_info(o: _Outputs, s, x0, pred_info, saturation, dq_all: dict) -> di
 
 
 def _chain_info(o: _Outputs, s) -> dict:
-    """The summary's ``models.<section>.chain``: the sampler's settings and course."""
-    return {
+    """The summary's ``models.<section>.chain``: the sampler's settings and course
+    (``continued``: only for a chain continued with the time later sections left,
+    :mod:`heritage_bayes.calibration.chains`)."""
+    info = {
         "coordinates": getattr(s.chain, "coordinates", "log"),
         # the block move: the flagged parameters and its share of the steps
         # (0: the named moves alone)
@@ -475,6 +477,9 @@ def _chain_info(o: _Outputs, s) -> dict:
         "stopped_by": getattr(s.chain, "stopped_by", ""),
         "cpu_seconds": float(getattr(s.chain, "cpu_seconds", 0.0)),
     }
+    if getattr(s, "continued", None) is not None:
+        info["continued"] = dict(s.continued)
+    return info
 
 
 def _combined_rh(o: _Outputs, prep) -> None:

@@ -44,7 +44,8 @@ class SamplerSettings(_Strict):
     """emcee settings. Run length comes from the chain (τ, R-hat, ESS); ``max_time`` is
     the wall-time budget of the whole calibration — data, MAP search, sampling, ladder;
     each model gets an equal share of what is left (a duration, e.g. ``10min``, or
-    ``none``) and
+    ``none``), and a chain that ran out of its share continues from its checkpoint with
+    the time the later models left (:mod:`heritage_bayes.calibration.chains`); and
     ``max_steps`` a safety cap on memory. A run that stops at either before converging
     exits with code 3 (see :mod:`heritage_bayes.cli`)."""
 
@@ -67,8 +68,9 @@ class SamplerSettings(_Strict):
         "30min",
         unit=DURATION_UNIT,
         description="wall-time budget of the whole calibration, MAP search included, shared "
-        "equally by the models (e.g. 10min, 2h) or none; the chain stops earlier once "
-        "converged",
+        "equally by the models (e.g. 10min, 2h) or none; a chain that runs out of its share "
+        "continues, once every model has been sampled, with the time the others left; the "
+        "chain stops earlier once converged",
         validate_default=True,
     )
     check_every: int = key(500, unit="steps", description="steps between convergence checks", ge=50)

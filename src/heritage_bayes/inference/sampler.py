@@ -316,8 +316,9 @@ def _run_sampler(
     converged = False
     tau = np.full(d, np.nan)
     rule = _Rule(tau_factor, tau_rtol, tau_discard, max_rhat, min_ess, max_draws)
-    if c.done > 0:  # resumed: the saved chain may already be long enough
-        tau, _, converged = rule.decide(c.buf, c.tau_hist, c.done)
+    if c.done > 0:  # resumed: the saved chain may already be long enough, decided as
+        # the chain decided then (τ's stability against the check before this one)
+        tau, _, converged = rule.decide(c.buf, [h for h in c.tau_hist if h[0] < c.done], c.done)
     # SIGINT/SIGTERM only set a flag while sampling: the chain stops after the current
     # step, the steps done are committed, then KeyboardInterrupt (never an exception
     # inside emcee's likelihood call, which would print the parameter matrix)

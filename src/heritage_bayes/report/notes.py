@@ -10,7 +10,7 @@ search, missing chain files, synthetic data. The verdict itself is
 
 from __future__ import annotations
 
-from heritage_bayes.format import prior_text, quantity_name
+from heritage_bayes.format import fmt_int, prior_text, quantity_name
 from heritage_bayes.inference.likelihoods import noise_parameter_names
 from heritage_bayes.rundir.summary import RunSummary, typed_summary
 
@@ -133,7 +133,8 @@ def _bound_notes(s) -> list[dict]:
 
 def _model_notes(m: str, i) -> list[dict]:
     """The notes on one model: its MAP on a bound, a frozen node, parameters the data
-    leave to their priors, several MAP modes, a chain out of time."""
+    leave to their priors, several MAP modes, a chain out of time or continued with the
+    time the other models left."""
     out = []
     on_bound = [f"{quantity_name(n, domain=m)} ({side})" for n, side in i.map_at_bound]
     if on_bound:
@@ -176,12 +177,24 @@ def _model_notes(m: str, i) -> list[dict]:
     if len(i.map_modes) > 1:
         out.append(_modes_note(m, i.map_modes, i.map_restarts))
     if i.stopped_by == "max_seconds":
+        more = "" if i.continued is None else f", even {i.continued.words}"
         out.append(
             {
                 "level": "amber",
                 "title": f"The {m} chain ran out of time",
-                "text": "The wall-time budget `sampler.max_time` ended the chain before "
-                "it converged: raise the budget, or continue it with `--resume`.",
+                "text": f"The wall-time budget `sampler.max_time` ended the chain{more} "
+                "before it converged: raise the budget, or continue it with `--resume`.",
+            }
+        )
+    elif i.continued is not None:
+        end = {"converged": "converged", "max_steps": "reached the step cap"}
+        out.append(
+            {
+                "level": "info",
+                "title": f"The {m} chain was continued with the time left",
+                "text": f"Its share of the wall-time budget `sampler.max_time` ran out; "
+                f"once every model had been sampled it was {i.continued.words}, and "
+                f"{end.get(i.stopped_by, 'stopped')} at {fmt_int(i.steps)} steps.",
             }
         )
     return out

@@ -15,6 +15,7 @@ from typing import Any
 __all__ = [
     "STATUSES",
     "Alignment",
+    "Continuation",
     "DecoupledWall",
     "FrozenNode",
     "Gap",
@@ -39,6 +40,51 @@ def finite_float(v) -> float | None:
     except (TypeError, ValueError):
         return None
     return f if math.isfinite(f) else None
+
+
+def duration_words(seconds: float) -> str:
+    """``6 min 12 s``, ``45 s``, ``1 h 5 min``: a duration [s] in words, to the second
+    (to the minute from an hour)."""
+    n = max(0, round(seconds))
+    if n < 60:
+        return f"{n} s"
+    if n < 3600:
+        m, sec = divmod(n, 60)
+        return f"{m} min" + (f" {sec} s" if sec else "")
+    h, m = divmod(round(n / 60), 60)
+    return f"{h} h" + (f" {m} min" if m else "")
+
+
+@dataclass(frozen=True)
+class Continuation:
+    """A chain the time budget stopped, continued after every section had sampled with
+    the time the later sections left (``models.<section>.chain.continued`` of
+    ``summary.json``, see :mod:`heritage_bayes.calibration.chains`): the steps it had
+    (``from_steps``), the seconds it was given (``seconds_given`` [s]) and the sections
+    that left them (``left_by``)."""
+
+    from_steps: int
+    seconds_given: float
+    left_by: tuple[str, ...] = ()
+
+    @classmethod
+    def from_dict(cls, d) -> Continuation | None:
+        """The continuation of a chain record's ``continued`` (None: not continued)."""
+        if not isinstance(d, dict) or not isinstance(d.get("from_steps"), int):
+            return None
+        return cls(
+            from_steps=int(d["from_steps"]),
+            seconds_given=finite_float(d.get("seconds_given")) or 0.0,
+            left_by=tuple(str(n) for n in d.get("left_by") or ()),
+        )
+
+    @property
+    def words(self) -> str:
+        """``continued from 15 000 steps with the 6 min 12 s the hygric section left``."""
+        steps = f"{self.from_steps:,}".replace(",", " ")
+        by = " and ".join(self.left_by)
+        by = f"the {by} section{'s' if len(self.left_by) > 1 else ''} left" if by else "left"
+        return f"continued from {steps} steps with the {duration_words(self.seconds_given)} {by}"
 
 
 @dataclass(frozen=True)
@@ -206,6 +252,8 @@ class ModelInfo:
     acceptance_mean: float | None = None
     resumed_from: int | None = None
     stopped_by: str = ""
+    #: the chain continued with the time later sections left (None: not continued)
+    continued: Continuation | None = None
     tau_history: tuple[tuple[float, ...], ...] = ()
     output_names: tuple[str, ...] = ()
     input_names: tuple[str, ...] | None = None  # None: not recorded (older runs)
@@ -262,6 +310,7 @@ class ModelInfo:
             acceptance_mean=finite_float(ch.get("acceptance_mean")),
             resumed_from=ch.get("resumed_from"),
             stopped_by=str(ch.get("stopped_by") or ""),
+            continued=Continuation.from_dict(ch.get("continued")),
             tau_history=tuple(
                 tuple(math.nan if v is None else float(v) for v in r)
                 for r in ch.get("tau_history") or []

@@ -164,8 +164,11 @@ def _continue(cfg, sections: list, s, seconds: float, say) -> None:
     k = sections.index(s)
     left_by = [t.name for t in sections[k + 1 :] if t.chain.stopped_by != "max_seconds"]
     first = s.chain
-    s.continued = {"from_steps": int(first.steps), "seconds_given": float(seconds)}
-    s.continued["left_by"] = left_by
+    s.continued = {
+        "from_steps": int(first.steps),
+        "seconds_given": float(seconds),
+        "left_by": left_by,
+    }
     words = Continuation.from_dict(s.continued).words
     say.say(f"[{s.name}] the chain {words.replace('continued', 'continues', 1)}")
     steps, resumed_from, wall, cpu = (

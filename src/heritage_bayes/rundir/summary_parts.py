@@ -12,6 +12,8 @@ from dataclasses import asdict, dataclass, field
 from types import MappingProxyType
 from typing import Any
 
+from heritage_bayes.format import fmt_int
+
 __all__ = [
     "STATUSES",
     "Alignment",
@@ -81,7 +83,7 @@ class Continuation:
     @property
     def words(self) -> str:
         """``continued from 15 000 steps with the 6 min 12 s the hygric section left``."""
-        steps = f"{self.from_steps:,}".replace(",", " ")
+        steps = fmt_int(self.from_steps)
         by = " and ".join(self.left_by)
         by = f"the {by} section{'s' if len(self.left_by) > 1 else ''} left" if by else "left"
         return f"continued from {steps} steps with the {duration_words(self.seconds_given)} {by}"

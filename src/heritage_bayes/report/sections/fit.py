@@ -74,6 +74,7 @@ def fit_context(rd: RunData, outputs: list[dict]) -> list[dict]:
         gaps = measurement_gaps(rd, dt, o["output"])
         med = predictive_quantiles(rd.idata, o["sim"], [0.5])[0]
         q = predictive_quantiles(rd.idata, o["pp"], [0.05, 0.25, 0.75, 0.95])
+        q1 = _one_step_quantiles(rd, o, pp)  # None without a state-space noise model
         y = np.asarray(obs[o["output"]].reindex(time=times_pp).values, dtype=float)
         fig = fig_fit(
             times_pp,
@@ -129,31 +130,31 @@ def fit_context(rd: RunData, outputs: list[dict]) -> list[dict]:
                 + band_note,
                 "resid": (y - med),
                 # a state-space noise model's check is on its one-step innovations
-                "resid_1step": _one_step_residual(rd, o, pp, y),
+                "resid_1step": None if q1 is None else y - q1[2],
                 "measured": y,
                 "codes": codes,
                 "times": times_pp,
                 **o,
             }
         )
-        if f"{o['pp']}_1step" in pp:
-            items.append(_one_step_item(rd, o, pp, times_pp, y, codes, gaps, what))
+        if q1 is not None:
+            items.append(_one_step_item(rd, o, q1, times_pp, y, codes, gaps, what))
     return items
 
 
-def _one_step_residual(rd: RunData, o: dict, pp, y: np.ndarray) -> np.ndarray | None:
-    """Measured minus the median one-step-ahead prediction of a state-space noise model
-    (``noise: kalman``), None for a run without one."""
+def _one_step_quantiles(rd: RunData, o: dict, pp) -> np.ndarray | None:
+    """The 5, 25, 50, 75 and 95 % quantiles of a state-space noise model's one-step-ahead
+    prediction (``noise: kalman``; rows in that order), None for a run without one."""
     if f"{o['pp']}_1step" not in pp:
         return None
-    return y - predictive_quantiles(rd.idata, f"{o['pp']}_1step", [0.5])[0]
+    return predictive_quantiles(rd.idata, f"{o['pp']}_1step", [0.05, 0.25, 0.5, 0.75, 0.95])
 
 
-def _one_step_item(rd: RunData, o: dict, pp, times, y, codes, gaps, what: str) -> dict:
-    """The one-step-ahead band of a state-space noise model (``noise: kalman``)."""
+def _one_step_item(rd: RunData, o: dict, q, times, y, codes, gaps, what: str) -> dict:
+    """The one-step-ahead band of a state-space noise model (``noise: kalman``) from its
+    quantiles ``q`` (:func:`_one_step_quantiles`)."""
     from heritage_bayes.report.figures import fig_fit
 
-    q = predictive_quantiles(rd.idata, f"{o['pp']}_1step", [0.05, 0.25, 0.5, 0.75, 0.95])
     fig = fig_fit(
         times,
         y,
